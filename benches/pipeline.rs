@@ -1,0 +1,158 @@
+//! Criterion benchmarks of the hot path: classification and blob formation, per frame size
+//! (208×160 robot camera, 640×480 overhead), table resolution (6, 7, 8 bits) and connectivity.
+//!
+//! Frames are a port of `../shared/bench/peer_pipeline.py`'s sample scene (field, lines, goals,
+//! beacon, shaded ball, vignetting, noise) and the table is built from the same colour
+//! prototypes, so the figures compare with the peer's and `floors.c`'s on like data.
+
+use std::hint::black_box;
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use eotn::blobs::{BlobSet, Connectivity};
+use eotn::classify::{ClassifiedImage, classify_into};
+use eotn::frame::{Frame, rgb_to_yuv};
+use eotn::lut::{ColourClass, LookupTable};
+
+/// Scene colours (RGB) and their spread (σ in Y, U, V), as the peer's `PROTOS`.
+const PROTOS: [(ColourClass, [u8; 3], [f64; 3]); 6] = [
+    (ColourClass::Orange, [250, 110, 20], [70.0, 16.0, 16.0]),
+    (ColourClass::SkyBlue, [40, 110, 200], [55.0, 14.0, 14.0]),
+    (ColourClass::Yellow, [230, 205, 40], [55.0, 14.0, 14.0]),
+    (ColourClass::Pink, [245, 100, 170], [55.0, 14.0, 14.0]),
+    (ColourClass::Green, [45, 140, 60], [45.0, 12.0, 12.0]),
+    (ColourClass::White, [235, 235, 230], [45.0, 12.0, 12.0]),
+];
+
+fn table(bits: u8) -> LookupTable {
+    let mut t = LookupTable::new(bits).expect("6..=8 bits");
+    let n = t.side();
+    let step = f64::from(1u32 << (8 - bits));
+    let centre = |i: usize| i as f64 * step + (step - 1.0) / 2.0;
+    let protos: Vec<_> = PROTOS
+        .iter()
+        .map(|(c, rgb, s)| {
+            let p = rgb_to_yuv(*rgb);
+            (*c, [f64::from(p.y), f64::from(p.u), f64::from(p.v)], *s)
+        })
+        .collect();
+    for y in 0..n {
+        for u in 0..n {
+            for v in 0..n {
+                let q = [centre(y), centre(u), centre(v)];
+                let best = protos
+                    .iter()
+                    .map(|(c, p, s)| {
+                        (
+                            *c,
+                            (0..3).map(|k| ((q[k] - p[k]) / s[k]).powi(2)).sum::<f64>(),
+                        )
+                    })
+                    .filter(|(_, d)| *d < 1.0)
+                    .min_by(|a, b| a.1.total_cmp(&b.1));
+                if let Some((c, _)) = best {
+                    let i = t.index_of_cell([y, u, v]);
+                    t.set(i, c);
+                }
+            }
+        }
+    }
+    t
+}
+
+fn scene(w: usize, h: usize) -> Frame {
+    let (wf, hf) = (w as f64, h as f64);
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut noise = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed % 1000) as f64 / 1000.0 - 0.5
+    };
+    let rgb_at = |x: f64, y: f64| -> [f64; 3] {
+        let horizon = 0.32 * hf + 0.04 * hf * (x / wf * 2.0).sin();
+        let mut c = if y < 0.12 * hf {
+            [70.0, 70.0, 80.0]
+        } else {
+            [125.0, 112.0, 100.0]
+        };
+        if y >= horizon {
+            c = [45.0, 140.0, 60.0];
+            let lw = (hf / 70.0).max(2.0);
+            let line = (y - (0.62 * hf + 0.1 * (x - wf / 2.0))).abs() < lw
+                || (x - 0.2 * wf - 0.15 * (y - hf)).abs() < lw
+                || ((x - 0.5 * wf).hypot((y - 0.95 * hf) * 2.2) - 0.33 * wf).abs() < lw * 1.2;
+            if line {
+                c = [235.0, 235.0, 230.0];
+            }
+        }
+        if (0.16 * hf..0.36 * hf).contains(&y) {
+            if (0.03 * wf..0.25 * wf).contains(&x) {
+                c = [230.0, 205.0, 40.0];
+            } else if (0.74 * wf..0.95 * wf).contains(&x) {
+                c = [40.0, 110.0, 200.0];
+            }
+        }
+        if (0.46 * wf..0.52 * wf).contains(&x) {
+            if (0.08 * hf..0.17 * hf).contains(&y) {
+                c = [245.0, 100.0, 170.0];
+            } else if (0.17 * hf..0.26 * hf).contains(&y) {
+                c = [230.0, 205.0, 40.0];
+            }
+        }
+        let (cx, cy, r) = (0.55 * wf, 0.72 * hf, 0.065 * wf);
+        if (x - cx).hypot(y - cy) < r {
+            let shade = 1.05 - 0.25 * ((y - cy) / r + 1.0) / 2.0;
+            c = [250.0 * shade, 110.0 * shade, 20.0 * shade];
+        }
+        let vig = 1.0
+            - 0.35
+                * (((x - wf / 2.0) / (wf / 2.0)).powi(2) + ((y - hf / 2.0) / (hf / 2.0)).powi(2))
+                / 2.0;
+        c.map(|v| v * vig)
+    };
+    Frame::uyvy_from_fn(w, h, |x, y| {
+        let c = rgb_at(x as f64, y as f64).map(|v| eotn::frame::round_u8(v + 6.0 * noise()));
+        rgb_to_yuv(c)
+    })
+    .expect("even width")
+}
+
+fn benches(c: &mut Criterion) {
+    let tables: Vec<_> = [6u8, 7, 8].into_iter().map(|b| (b, table(b))).collect();
+    for (w, h) in [(208, 160), (640, 480)] {
+        let frame = scene(w, h);
+        let mut group = c.benchmark_group(format!("{w}x{h}"));
+        group.throughput(Throughput::Elements((w * h) as u64));
+        let mut img = ClassifiedImage::default();
+        for (bits, t) in &tables {
+            group.bench_function(BenchmarkId::new("classify", format!("b{bits}")), |b| {
+                b.iter(|| classify_into(black_box(&frame), t, &mut img));
+            });
+        }
+        classify_into(&frame, &tables[1].1, &mut img);
+        let mut set = BlobSet::default();
+        for conn in [Connectivity::Eight, Connectivity::Four] {
+            group.bench_function(
+                BenchmarkId::new("blobs", format!("conn{}", conn.neighbours())),
+                |b| {
+                    b.iter(|| set.find(black_box(&img), conn));
+                },
+            );
+        }
+        for (bits, t) in &tables {
+            group.bench_function(
+                BenchmarkId::new("classify+blobs", format!("b{bits}_conn8")),
+                |b| {
+                    b.iter(|| {
+                        classify_into(black_box(&frame), t, &mut img);
+                        set.find(&img, Connectivity::Eight);
+                    });
+                },
+            );
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(pipeline, benches);
+criterion_main!(pipeline);

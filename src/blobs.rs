@@ -1,0 +1,548 @@
+//! Blob formation: connected regions of one colour class in a classified image.
+//!
+//! A blob is a maximal connected set of pixels of one class code other than 0 (`FORMATS.md`).
+//! With [`Connectivity::Eight`] (the default, as the original EOTN and CMVision) diagonal
+//! neighbours join; with [`Connectivity::Four`] only left/right/up/down neighbours do.
+//!
+//! The algorithm is CMVision's: run-length encode each row (runs are found a machine word at a
+//! time: a run of one colour is skipped 8 bytes per step), join overlapping runs of equal colour
+//! in adjacent rows with union-find (the root is always the run first in raster order), then one
+//! pass over the runs accumulates each blob's box, pixel count and centroid sums. All buffers
+//! live in a [`BlobSet`] that is reused frame after frame.
+//!
+//! The original tool marked blobs it had merged with `trueblob`/`ignore` flags; here
+//! [`BlobSet::merge`] joins two blobs explicitly and [`BlobSet::active`] lists the survivors.
+
+use serde::{Deserialize, Serialize};
+
+use crate::classify::ClassifiedImage;
+use crate::lut::ColourClass;
+
+/// Which neighbours join a blob.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Connectivity {
+    /// Left, right, up and down neighbours.
+    #[serde(rename = "4")]
+    Four,
+    /// Also the four diagonal neighbours.
+    #[default]
+    #[serde(rename = "8")]
+    Eight,
+}
+
+impl Connectivity {
+    /// 4 or 8.
+    #[must_use]
+    pub const fn neighbours(self) -> u8 {
+        match self {
+            Self::Four => 4,
+            Self::Eight => 8,
+        }
+    }
+
+    /// From 4 or 8.
+    #[must_use]
+    pub const fn from_neighbours(n: u8) -> Option<Self> {
+        match n {
+            4 => Some(Self::Four),
+            8 => Some(Self::Eight),
+            _ => None,
+        }
+    }
+}
+
+/// A horizontal run of one colour: pixels `x0..x1` (end exclusive) of row `y`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Run {
+    /// First column.
+    pub x0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// Row.
+    pub y: u32,
+    /// Class code.
+    pub colour: u8,
+}
+
+/// A connected region of one class.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Blob {
+    /// Class code of its pixels.
+    pub colour: u8,
+    /// Its index in the [`BlobSet`] (raster order of its first pixel).
+    pub number: u32,
+    /// Leftmost column, inclusive.
+    pub minx: u32,
+    /// Top row, inclusive.
+    pub miny: u32,
+    /// Rightmost column, inclusive.
+    pub maxx: u32,
+    /// Bottom row, inclusive.
+    pub maxy: u32,
+    /// Number of its own pixels.
+    pub pixels: u32,
+    /// Sum of its pixels' column indices (for the centroid).
+    pub sum_x: u64,
+    /// Sum of its pixels' row indices (for the centroid).
+    pub sum_y: u64,
+}
+
+impl Blob {
+    /// Box width, pixels.
+    #[must_use]
+    pub const fn width(&self) -> u32 {
+        self.maxx - self.minx + 1
+    }
+
+    /// Box height, pixels.
+    #[must_use]
+    pub const fn height(&self) -> u32 {
+        self.maxy - self.miny + 1
+    }
+
+    /// Box area (width × height), pixels; compare with [`Blob::pixels`] for how full it is.
+    #[must_use]
+    pub const fn area(&self) -> u64 {
+        self.width() as u64 * self.height() as u64
+    }
+
+    /// The class of its pixels.
+    #[must_use]
+    pub fn class(&self) -> ColourClass {
+        ColourClass::from_code(self.colour).unwrap_or(ColourClass::Unclassified)
+    }
+
+    /// Mean pixel centre in image coordinates (pixel (i, j) has its centre at (i + 0.5, j + 0.5)).
+    #[must_use]
+    #[expect(clippy::cast_precision_loss, reason = "pixel sums are far below 2^52")]
+    pub fn centroid(&self) -> (f64, f64) {
+        let n = f64::from(self.pixels.max(1));
+        (self.sum_x as f64 / n + 0.5, self.sum_y as f64 / n + 0.5)
+    }
+
+    /// Box centre in image coordinates.
+    #[must_use]
+    pub fn box_centre(&self) -> (f64, f64) {
+        (
+            f64::from(self.minx + self.maxx + 1) / 2.0,
+            f64::from(self.miny + self.maxy + 1) / 2.0,
+        )
+    }
+
+    /// The blob both together make: the union of boxes, pixels and sums added; keeps this blob's
+    /// colour and number.
+    #[must_use]
+    pub fn merged_with(&self, other: &Self) -> Self {
+        Self {
+            colour: self.colour,
+            number: self.number,
+            minx: self.minx.min(other.minx),
+            miny: self.miny.min(other.miny),
+            maxx: self.maxx.max(other.maxx),
+            maxy: self.maxy.max(other.maxy),
+            pixels: self.pixels + other.pixels,
+            sum_x: self.sum_x + other.sum_x,
+            sum_y: self.sum_y + other.sum_y,
+        }
+    }
+}
+
+/// The blobs of one classified image, with the runs they were built from, and reusable buffers.
+#[derive(Debug, Clone, Default)]
+pub struct BlobSet {
+    width: usize,
+    height: usize,
+    connectivity: Connectivity,
+    blobs: Vec<Blob>,
+    /// For each blob: `None`, or the blob it was merged into.
+    merged_into: Vec<Option<u32>>,
+    runs: Vec<Run>,
+    /// Union-find parent per run (scratch while finding).
+    parent: Vec<u32>,
+    /// The blob number of each run.
+    run_blob: Vec<u32>,
+    /// Index of each row's first run; one extra entry at the end.
+    row_start: Vec<u32>,
+}
+
+impl BlobSet {
+    /// Finds the blobs of `img` and returns them as a new set.
+    #[must_use]
+    pub fn from_image(img: &ClassifiedImage, connectivity: Connectivity) -> Self {
+        let mut set = Self::default();
+        set.find(img, connectivity);
+        set
+    }
+
+    /// Finds the blobs of `img`, replacing what the set held (buffers are reused).
+    pub fn find(&mut self, img: &ClassifiedImage, connectivity: Connectivity) {
+        self.width = img.width();
+        self.height = img.height();
+        self.connectivity = connectivity;
+        self.blobs.clear();
+        self.merged_into.clear();
+        self.runs.clear();
+        self.parent.clear();
+        self.run_blob.clear();
+        self.row_start.clear();
+        let reach = u32::from(connectivity == Connectivity::Eight);
+
+        for y in 0..img.height() {
+            let first = self.runs.len();
+            self.row_start.push(u32_of(first));
+            encode_row(img.row(y), u32_of(y), &mut self.runs);
+            self.parent.extend(u32_of(first)..u32_of(self.runs.len()));
+            if y > 0 {
+                let prev = u32_index(self.row_start[y - 1])..first;
+                self.join_rows(prev, first, reach);
+            }
+        }
+        self.row_start.push(u32_of(self.runs.len()));
+        self.collect_blobs();
+    }
+
+    /// Unites each run of the current row (from `current`) with the runs of the previous row
+    /// (`prev`) it touches.
+    fn join_rows(&mut self, prev: std::ops::Range<usize>, current: usize, reach: u32) {
+        let mut j = prev.start;
+        for i in current..self.runs.len() {
+            let r = self.runs[i];
+            // Skip previous-row runs that end (plus reach) before this run starts.
+            while j < prev.end && self.runs[j].x1 + reach <= r.x0 {
+                j += 1;
+            }
+            let mut k = j;
+            while k < prev.end && self.runs[k].x0 < r.x1 + reach {
+                if self.runs[k].colour == r.colour {
+                    self.unite(k, i);
+                }
+                k += 1;
+            }
+        }
+    }
+
+    fn root(&mut self, mut i: usize) -> usize {
+        while u32_index(self.parent[i]) != i {
+            // Path halving: point to the grandparent while walking up.
+            let grand = self.parent[u32_index(self.parent[i])];
+            self.parent[i] = grand;
+            i = u32_index(grand);
+        }
+        i
+    }
+
+    fn unite(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.root(a), self.root(b));
+        // The smaller index stays root, so a root precedes its members in raster order.
+        if ra < rb {
+            self.parent[rb] = u32_of(ra);
+        } else if rb < ra {
+            self.parent[ra] = u32_of(rb);
+        }
+    }
+
+    /// One pass in raster order: roots open blobs, members add to their root's blob.
+    fn collect_blobs(&mut self) {
+        self.run_blob.resize(self.runs.len(), 0);
+        for i in 0..self.runs.len() {
+            let r = self.runs[i];
+            let len = r.x1 - r.x0;
+            let sum_x = (u64::from(r.x0) + u64::from(r.x1) - 1) * u64::from(len) / 2;
+            let sum_y = u64::from(r.y) * u64::from(len);
+            let root = self.root(i);
+            if root == i {
+                let number = u32_of(self.blobs.len());
+                self.blobs.push(Blob {
+                    colour: r.colour,
+                    number,
+                    minx: r.x0,
+                    miny: r.y,
+                    maxx: r.x1 - 1,
+                    maxy: r.y,
+                    pixels: len,
+                    sum_x,
+                    sum_y,
+                });
+                self.run_blob[i] = number;
+            } else {
+                // The root precedes i, so it already holds its blob number.
+                let number = self.run_blob[root];
+                self.run_blob[i] = number;
+                let b = &mut self.blobs[u32_index(number)];
+                b.minx = b.minx.min(r.x0);
+                b.maxx = b.maxx.max(r.x1 - 1);
+                b.maxy = r.y;
+                b.pixels += len;
+                b.sum_x += sum_x;
+                b.sum_y += sum_y;
+            }
+        }
+        self.merged_into = vec![None; self.blobs.len()];
+    }
+
+    /// Every blob found, merged or not, in raster order of their first pixel.
+    #[must_use]
+    pub fn all(&self) -> &[Blob] {
+        &self.blobs
+    }
+
+    /// The blobs not merged into another, in raster order.
+    pub fn active(&self) -> impl Iterator<Item = &Blob> {
+        self.blobs
+            .iter()
+            .zip(&self.merged_into)
+            .filter(|(_, m)| m.is_none())
+            .map(|(b, _)| b)
+    }
+
+    /// Active blobs of one class.
+    pub fn of_class(&self, class: ColourClass) -> impl Iterator<Item = &Blob> {
+        self.active().filter(move |b| b.colour == class.code())
+    }
+
+    /// A blob by number.
+    #[must_use]
+    pub fn get(&self, number: u32) -> Option<&Blob> {
+        self.blobs.get(u32_index(number))
+    }
+
+    /// Merges blob `absorb` into blob `keep` (the `trueblob`/`ignore` of the original): `keep`
+    /// grows to cover both, `absorb` is no longer active. Returns false (and changes nothing)
+    /// when either number is unknown, they are the same, or either was already merged away.
+    pub fn merge(&mut self, keep: u32, absorb: u32) -> bool {
+        let (k, a) = (u32_index(keep), u32_index(absorb));
+        let ok = k != a
+            && k < self.blobs.len()
+            && a < self.blobs.len()
+            && self.merged_into[k].is_none()
+            && self.merged_into[a].is_none();
+        if ok {
+            self.blobs[k] = self.blobs[k].merged_with(&self.blobs[a]);
+            self.merged_into[a] = Some(keep);
+        }
+        ok
+    }
+
+    /// The blob a merged blob ended up in (itself when never merged).
+    #[must_use]
+    pub fn survivor(&self, number: u32) -> u32 {
+        let mut n = number;
+        // Merges only point to active blobs at merge time, so chains are short and acyclic.
+        for _ in 0..self.blobs.len() {
+            match self.merged_into.get(u32_index(n)).copied().flatten() {
+                Some(next) => n = next,
+                None => break,
+            }
+        }
+        n
+    }
+
+    /// The active blob holding pixel (x, y), or `None` for unclassified pixels and outside.
+    #[must_use]
+    pub fn blob_at(&self, x: usize, y: usize) -> Option<&Blob> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        let (x, start, end) = (
+            u32_of(x),
+            u32_index(*self.row_start.get(y)?),
+            u32_index(*self.row_start.get(y + 1)?),
+        );
+        let runs = self.runs.get(start..end)?;
+        let i = runs.partition_point(|r| r.x1 <= x);
+        runs.get(i).filter(|r| r.x0 <= x)?;
+        let number = *self.run_blob.get(start + i)?;
+        self.get(self.survivor(number))
+    }
+
+    /// All runs, row by row.
+    #[must_use]
+    pub fn runs(&self) -> &[Run] {
+        &self.runs
+    }
+
+    /// The runs of one blob (as found, before any merge).
+    pub fn runs_of(&self, number: u32) -> impl Iterator<Item = &Run> {
+        self.runs
+            .iter()
+            .zip(&self.run_blob)
+            .filter(move |(_, b)| **b == number)
+            .map(|(r, _)| r)
+    }
+
+    /// The connectivity the set was found with.
+    #[must_use]
+    pub const fn connectivity(&self) -> Connectivity {
+        self.connectivity
+    }
+
+    /// Size of the image the set was found in, pixels.
+    #[must_use]
+    pub const fn image_size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+}
+
+/// Appends the runs of one row (unclassified pixels make no runs).
+///
+/// A run of colour `c` is extended 8 bytes at a time while the next word is all `c`; the first
+/// differing byte of a word is found from the trailing zero bits of `word ^ broadcast(c)`.
+fn encode_row(row: &[u8], y: u32, runs: &mut Vec<Run>) {
+    let w = row.len();
+    let mut x = 0;
+    while x < w {
+        let colour = row[x];
+        let x0 = x;
+        x += 1;
+        let broadcast = u64::from_ne_bytes([colour; 8]);
+        loop {
+            match row.get(x..x + 8) {
+                Some(chunk) => {
+                    let mut word = [0u8; 8];
+                    word.copy_from_slice(chunk);
+                    let diff = u64::from_le_bytes(word) ^ broadcast;
+                    if diff == 0 {
+                        x += 8;
+                    } else {
+                        x += (diff.trailing_zeros() / 8) as usize;
+                        break;
+                    }
+                }
+                None => {
+                    while x < w && row[x] == colour {
+                        x += 1;
+                    }
+                    break;
+                }
+            }
+        }
+        if colour != 0 {
+            runs.push(Run {
+                x0: u32_of(x0),
+                x1: u32_of(x),
+                y,
+                colour,
+            });
+        }
+    }
+}
+
+/// Coordinates and counts fit u32: frames are at most 65,535 pixels a side.
+fn u32_of(v: usize) -> u32 {
+    u32::try_from(v).unwrap_or(u32::MAX)
+}
+
+fn u32_index(v: u32) -> usize {
+    v as usize
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An image from rows of digits ('.' = 0).
+    fn img(rows: &[&str]) -> ClassifiedImage {
+        let w = rows[0].len();
+        let codes = rows
+            .iter()
+            .flat_map(|r| r.bytes().map(|b| if b == b'.' { 0 } else { b - b'0' }))
+            .collect();
+        ClassifiedImage::from_codes(w, rows.len(), codes).unwrap()
+    }
+
+    fn boxes(set: &BlobSet) -> Vec<(u8, u32, u32, u32, u32, u32)> {
+        set.active()
+            .map(|b| (b.colour, b.minx, b.miny, b.maxx, b.maxy, b.pixels))
+            .collect()
+    }
+
+    #[test]
+    fn diagonal_neighbours_join_only_with_eight_connectivity() {
+        let i = img(&["1.", ".1"]);
+        assert_eq!(
+            boxes(&BlobSet::from_image(&i, Connectivity::Eight)),
+            [(1, 0, 0, 1, 1, 2)]
+        );
+        assert_eq!(
+            boxes(&BlobSet::from_image(&i, Connectivity::Four)),
+            [(1, 0, 0, 0, 0, 1), (1, 1, 1, 1, 1, 1)]
+        );
+    }
+
+    #[test]
+    fn colours_never_mix_and_unclassified_makes_no_blobs() {
+        let i = img(&["1122..", "1122..", "......"]);
+        let set = BlobSet::from_image(&i, Connectivity::Eight);
+        assert_eq!(boxes(&set), [(1, 0, 0, 1, 1, 4), (2, 2, 0, 3, 1, 4)]);
+    }
+
+    #[test]
+    fn u_shape_joins_late_through_union_find() {
+        let i = img(&["1...1", "1...1", "11111"]);
+        let set = BlobSet::from_image(&i, Connectivity::Four);
+        assert_eq!(boxes(&set), [(1, 0, 0, 4, 2, 9)]);
+        let b = set.all()[0];
+        assert_eq!((b.width(), b.height(), b.area()), (5, 3, 15));
+    }
+
+    #[test]
+    fn blob_numbers_never_mix_with_union_find_parents() {
+        // Regression: the third run's root is not the run with its blob's number; an early
+        // version stored blob numbers in the parent array and merged the 2s into the 1s.
+        let set = BlobSet::from_image(&img(&["1.", "12", "22"]), Connectivity::Four);
+        assert_eq!(boxes(&set), [(1, 0, 0, 0, 1, 2), (2, 0, 1, 1, 2, 3)]);
+    }
+
+    #[test]
+    fn long_runs_cross_word_boundaries() {
+        let row = format!("{}{}{}", "5".repeat(19), "1".repeat(9), "5".repeat(4));
+        let i = img(&[&row, &row]);
+        let set = BlobSet::from_image(&i, Connectivity::Eight);
+        assert_eq!(
+            boxes(&set),
+            [
+                (5, 0, 0, 18, 1, 38),
+                (1, 19, 0, 27, 1, 18),
+                (5, 28, 0, 31, 1, 8)
+            ]
+        );
+        assert_eq!(set.runs().len(), 6);
+    }
+
+    #[test]
+    fn centroid_uses_pixel_centres() {
+        let set = BlobSet::from_image(&img(&["11", "11"]), Connectivity::Eight);
+        assert_eq!(set.all()[0].centroid(), (1.0, 1.0));
+        assert_eq!(set.all()[0].box_centre(), (1.0, 1.0));
+    }
+
+    #[test]
+    fn blob_at_finds_the_blob_under_a_pixel() {
+        let set = BlobSet::from_image(&img(&["1.2", "1.2"]), Connectivity::Eight);
+        assert_eq!(set.blob_at(0, 1).map(|b| b.colour), Some(1));
+        assert_eq!(set.blob_at(1, 1), None);
+        assert_eq!(set.blob_at(2, 0).map(|b| b.number), Some(1));
+        assert_eq!(set.blob_at(9, 0), None);
+    }
+
+    #[test]
+    fn merge_replaces_trueblob_and_ignore_flags() {
+        let mut set = BlobSet::from_image(&img(&["3.3.1"]), Connectivity::Eight);
+        assert_eq!(set.active().count(), 3);
+        assert!(set.merge(0, 1));
+        assert!(!set.merge(1, 2), "a merged-away blob cannot keep");
+        assert!(!set.merge(0, 0));
+        assert_eq!(boxes(&set), [(3, 0, 0, 2, 0, 2), (1, 4, 0, 4, 0, 1)]);
+        assert_eq!(set.survivor(1), 0);
+        assert_eq!(set.blob_at(2, 0).map(|b| b.number), Some(0));
+        assert_eq!(set.runs_of(1).count(), 1);
+    }
+
+    #[test]
+    fn reuse_clears_previous_results() {
+        let mut set = BlobSet::from_image(&img(&["111", "111"]), Connectivity::Eight);
+        set.find(&img(&["..", ".."]), Connectivity::Four);
+        assert_eq!(set.all().len(), 0);
+        assert_eq!(set.connectivity(), Connectivity::Four);
+    }
+}

@@ -1,0 +1,256 @@
+//! Colour classification: every pixel of a frame looked up in the table.
+//!
+//! This is the hottest loop of the pipeline. For UYVY it follows CMVision's shape in safe Rust:
+//! the frame is walked in 4-byte pixel pairs, the shared U/V part of the cell index is built once
+//! per pair, and the table is a fixed-size array per resolution so the compiler can prove every
+//! index in bounds (no checks in the loop). Output goes into a caller-owned
+//! [`ClassifiedImage`] reused frame after frame.
+
+use crate::frame::{Frame, PixelLayout};
+use crate::lut::{ColourClass, LookupTable, code_display_rgb};
+
+/// One class code per pixel, row-major.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct ClassifiedImage {
+    width: usize,
+    height: usize,
+    codes: Vec<u8>,
+}
+
+impl ClassifiedImage {
+    /// An image of unclassified pixels.
+    #[must_use]
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            codes: vec![0; width * height],
+        }
+    }
+
+    /// An image from codes (row-major); `None` when the length is not width × height.
+    #[must_use]
+    pub fn from_codes(width: usize, height: usize, codes: Vec<u8>) -> Option<Self> {
+        (codes.len() == width * height).then_some(Self {
+            width,
+            height,
+            codes,
+        })
+    }
+
+    /// Classifies a frame into a new image.
+    #[must_use]
+    pub fn from_frame(frame: &Frame, lut: &LookupTable) -> Self {
+        let mut out = Self::default();
+        classify_into(frame, lut, &mut out);
+        out
+    }
+
+    /// Width, pixels.
+    #[must_use]
+    pub const fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height, pixels.
+    #[must_use]
+    pub const fn height(&self) -> usize {
+        self.height
+    }
+
+    /// All codes, row-major.
+    #[must_use]
+    pub fn codes(&self) -> &[u8] {
+        &self.codes
+    }
+
+    /// All codes, mutable (for drawing test images).
+    pub fn codes_mut(&mut self) -> &mut [u8] {
+        &mut self.codes
+    }
+
+    /// One row of codes, or an empty slice past the bottom.
+    #[must_use]
+    pub fn row(&self, y: usize) -> &[u8] {
+        self.codes
+            .get(y * self.width..(y + 1) * self.width)
+            .unwrap_or(&[])
+    }
+
+    /// The code at (x, y), or `None` outside the image.
+    #[must_use]
+    pub fn get(&self, x: usize, y: usize) -> Option<u8> {
+        (x < self.width && y < self.height).then(|| self.codes[y * self.width + x])
+    }
+
+    /// The code at signed coordinates, `None` outside: scans that wander past the edge use this.
+    #[must_use]
+    pub fn get_signed(&self, x: i64, y: i64) -> Option<u8> {
+        let (x, y) = (usize::try_from(x).ok()?, usize::try_from(y).ok()?);
+        self.get(x, y)
+    }
+
+    /// The class at (x, y), or `None` outside the image.
+    #[must_use]
+    pub fn class_at(&self, x: usize, y: usize) -> Option<ColourClass> {
+        self.get(x, y).and_then(ColourClass::from_code)
+    }
+
+    /// Resizes for a frame of this size (keeps the allocation when it can).
+    pub fn resize(&mut self, width: usize, height: usize) {
+        self.width = width;
+        self.height = height;
+        self.codes.resize(width * height, 0);
+    }
+
+    /// Pixels per class code (index = code).
+    #[must_use]
+    pub fn histogram(&self) -> [usize; 256] {
+        let mut h = [0usize; 256];
+        for &c in &self.codes {
+            h[usize::from(c)] += 1;
+        }
+        h
+    }
+
+    /// The image in display colours, packed RGB.
+    #[must_use]
+    pub fn to_rgb(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.codes.len() * 3);
+        for &c in &self.codes {
+            out.extend_from_slice(&code_display_rgb(c));
+        }
+        out
+    }
+}
+
+/// Classifies `frame` with `lut` into `out`, resizing it to the frame.
+pub fn classify_into(frame: &Frame, lut: &LookupTable, out: &mut ClassifiedImage) {
+    out.resize(frame.width(), frame.height());
+    let dst = &mut out.codes;
+    match frame.layout() {
+        PixelLayout::Uyvy => classify_uyvy(frame.data(), lut, dst),
+        PixelLayout::Yuv444Packed | PixelLayout::Yuv444Planar => {
+            let w = frame.width();
+            frame.for_each_pixel(|x, y, p| dst[y * w + x] = lut.classify(p));
+        }
+    }
+}
+
+/// Classifies raw UYVY bytes into `dst` (one code per pixel); `dst.len()` must be half of
+/// `src.len()`, extra bytes of either are left alone.
+pub fn classify_uyvy(src: &[u8], lut: &LookupTable, dst: &mut [u8]) {
+    let cells = lut.cells();
+    match lut.bits() {
+        6 => {
+            if let Ok(t) = <&[u8; 1 << 18]>::try_from(cells) {
+                classify_uyvy_b6(src, t, dst);
+            }
+        }
+        7 => {
+            if let Ok(t) = <&[u8; 1 << 21]>::try_from(cells) {
+                classify_uyvy_b7(src, t, dst);
+            }
+        }
+        _ => {
+            if let Ok(t) = <&[u8; 1 << 24]>::try_from(cells) {
+                classify_uyvy_b8(src, t, dst);
+            }
+        }
+    }
+}
+
+/// One monomorphic loop per table resolution; the array type bounds every index.
+macro_rules! classify_uyvy_bits {
+    ($name:ident, $bits:literal) => {
+        #[inline(never)]
+        fn $name(src: &[u8], table: &[u8; 1 << (3 * $bits)], dst: &mut [u8]) {
+            const B: u32 = $bits;
+            const S: u32 = 8 - B;
+            const M: u32 = (1 << B) - 1;
+            for (q, o) in src.chunks_exact(4).zip(dst.chunks_exact_mut(2)) {
+                // Bytes U Y0 V Y1 as one little-endian word.
+                let w = u32::from_le_bytes([q[0], q[1], q[2], q[3]]);
+                let uv = (((w >> S) & M) << B) | ((w >> (16 + S)) & M);
+                let y0 = (w >> (8 + S)) & M;
+                let y1 = w >> (24 + S);
+                o[0] = table[((y0 << (2 * B)) | uv) as usize];
+                o[1] = table[((y1 << (2 * B)) | uv) as usize];
+            }
+        }
+    };
+}
+
+classify_uyvy_bits!(classify_uyvy_b6, 6);
+classify_uyvy_bits!(classify_uyvy_b7, 7);
+classify_uyvy_bits!(classify_uyvy_b8, 8);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Yuv;
+    use crate::lut::{EditRecord, Region, Sensitivity};
+
+    fn table_with(bits: u8, p: Yuv, class: ColourClass) -> LookupTable {
+        let mut t = LookupTable::new(bits).unwrap();
+        t.apply(EditRecord::now(
+            class,
+            Region::AroundSample {
+                sample: p,
+                sensitivity: Sensitivity::default(),
+            },
+        ));
+        t
+    }
+
+    #[test]
+    fn fast_path_agrees_with_per_pixel_lookup_for_all_resolutions() {
+        let frame = Frame::uyvy_from_fn(16, 8, |x, y| {
+            Yuv::new((x * 16 + y) as u8, (y * 31) as u8, (x * 13 + 7) as u8)
+        })
+        .unwrap();
+        for bits in [6, 7, 8] {
+            let mut t = LookupTable::new(bits).unwrap();
+            for i in 0..t.cells().len() {
+                t.set(i, ColourClass::from_code((i % 15) as u8).unwrap());
+            }
+            let img = ClassifiedImage::from_frame(&frame, &t);
+            for y in 0..8 {
+                for x in 0..16 {
+                    assert_eq!(img.get(x, y), Some(t.classify(frame.pixel(x, y).unwrap())));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn both_pixels_of_a_pair_use_their_own_luma() {
+        let frame = Frame::from_uyvy(2, 1, vec![80, 120, 190, 30]).unwrap();
+        let t = table_with(7, Yuv::new(120, 80, 190), ColourClass::Orange);
+        let img = ClassifiedImage::from_frame(&frame, &t);
+        assert_eq!(img.codes(), [1, 0]);
+    }
+
+    #[test]
+    fn yuv444_frames_classify_too() {
+        let frame = Frame::yuv444_from_fn(3, 1, |x, _| {
+            if x == 1 {
+                Yuv::new(120, 80, 190)
+            } else {
+                Yuv::new(0, 0, 0)
+            }
+        })
+        .unwrap();
+        let t = table_with(6, Yuv::new(120, 80, 190), ColourClass::Orange);
+        assert_eq!(ClassifiedImage::from_frame(&frame, &t).codes(), [0, 1, 0]);
+    }
+
+    #[test]
+    fn signed_access_is_none_outside() {
+        let img = ClassifiedImage::new(4, 3);
+        assert_eq!(img.get_signed(-1, 0), None);
+        assert_eq!(img.get_signed(3, 2), Some(0));
+        assert_eq!(img.get_signed(4, 2), None);
+        assert!(img.row(3).is_empty());
+    }
+}

@@ -1,0 +1,58 @@
+//! The headless command line: the same pipeline as the app, for scripts, CI and benchmarks.
+//!
+//! One file per subcommand, each with its clap `Args` and a `run` function. Errors carry
+//! `anyhow` context naming the file; `main` prints them as one line and exits non-zero.
+
+mod bench;
+mod blobs;
+mod classify;
+mod info;
+pub mod inputs;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// eotn — Eye Of The NUbot: see what your robots see.
+///
+/// With no command, opens the desktop app (when built with the `gui` feature).
+#[derive(Debug, Parser)]
+#[command(name = "eotn", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do; none opens the app.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Describe frames, lookup tables and streams: sizes, layouts, class counts.
+    Info(info::Args),
+    /// Classify frames with a lookup table and write the classified images as PNG.
+    Classify(classify::Args),
+    /// Find the blobs of classified frames; `--json` prints the peer-compatible JSON Lines.
+    Blobs(blobs::Args),
+    /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
+    Bench(bench::Args),
+}
+
+/// Runs a headless subcommand.
+///
+/// # Errors
+/// Whatever the subcommand reports, with context naming the file.
+pub fn run(command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Info(a) => info::run(&a),
+        Command::Classify(a) => classify::run(&a),
+        Command::Blobs(a) => blobs::run(&a),
+        Command::Bench(a) => bench::run(&a),
+    }
+}
+
+/// Prints an error as one line, `eotn: …`, and gives the failure exit code.
+#[must_use]
+pub fn report(err: &anyhow::Error) -> ExitCode {
+    eprintln!("eotn: {err:#}");
+    ExitCode::FAILURE
+}

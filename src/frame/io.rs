@@ -1,0 +1,214 @@
+//! Reading frames from files (raw `.uyvy`, PNG, JPEG) and writing RGB views as PNG.
+
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use super::{AIBO_SIZE, Frame, FrameError, OVERHEAD_SIZE, PixelLayout, rgb_to_yuv};
+
+/// Why a frame file could not be read or written; always names the file.
+#[derive(Debug, Error)]
+pub enum FrameFileError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the OS said.
+        source: std::io::Error,
+    },
+    /// A raw file's length matches no known size and none was given.
+    #[error(
+        "{path}: {len} bytes is not a known UYVY frame size (208×160 or 640×480); give the size with --size WxH"
+    )]
+    UnknownSize {
+        /// The file.
+        path: PathBuf,
+        /// Its length, bytes.
+        len: usize,
+    },
+    /// The bytes do not make a frame of the given size.
+    #[error("{path}: {source}")]
+    Frame {
+        /// The file.
+        path: PathBuf,
+        /// The frame error.
+        source: FrameError,
+    },
+    /// The image decoder or encoder failed.
+    #[error("{path}: {source}")]
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// The decoder's error.
+        source: image::ImageError,
+    },
+}
+
+/// Where a frame came from; used in messages and JSON output.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrameSource {
+    /// The file the frame was read from.
+    pub path: PathBuf,
+}
+
+impl FrameSource {
+    /// The file name without folders, for messages and the JSON `frame` field.
+    #[must_use]
+    pub fn name(&self) -> String {
+        self.path.file_name().map_or_else(
+            || self.path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        )
+    }
+}
+
+/// The frame size a raw UYVY file of `len` bytes has when none is given: 208×160 or 640×480.
+#[must_use]
+pub fn infer_uyvy_size(len: usize) -> Option<(usize, usize)> {
+    [AIBO_SIZE, OVERHEAD_SIZE]
+        .into_iter()
+        .find(|&(w, h)| PixelLayout::Uyvy.frame_len(w, h) == len)
+}
+
+/// Reads a raw UYVY file; `size` (width, height) is inferred from the length when `None`.
+///
+/// # Errors
+/// [`FrameFileError`] naming the file: unreadable, unknown size, or wrong length.
+pub fn load_raw_uyvy(path: &Path, size: Option<(usize, usize)>) -> Result<Frame, FrameFileError> {
+    let data = std::fs::read(path).map_err(|source| FrameFileError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let (width, height) = match size.or_else(|| infer_uyvy_size(data.len())) {
+        Some(s) => s,
+        None => {
+            return Err(FrameFileError::UnknownSize {
+                path: path.to_owned(),
+                len: data.len(),
+            });
+        }
+    };
+    Frame::from_uyvy(width, height, data).map_err(|source| FrameFileError::Frame {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// True when the path names an image format the `image` crate reads for us (PNG, JPEG).
+#[must_use]
+pub fn is_image_file(path: &Path) -> bool {
+    matches!(
+        path.extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .as_deref(),
+        Some("png" | "jpg" | "jpeg")
+    )
+}
+
+/// Reads a frame: PNG and JPEG through the `image` crate (converted with
+/// [`rgb_to_yuv`] into a 4:4:4 frame), anything else as raw UYVY.
+///
+/// # Errors
+/// [`FrameFileError`] naming the file.
+pub fn load_frame(path: &Path, size: Option<(usize, usize)>) -> Result<Frame, FrameFileError> {
+    if !is_image_file(path) {
+        return load_raw_uyvy(path, size);
+    }
+    let img = image::open(path)
+        .map_err(|source| FrameFileError::Image {
+            path: path.to_owned(),
+            source,
+        })?
+        .into_rgb8();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    Frame::yuv444_from_fn(w, h, |x, y| {
+        // x < w and y < h, so get_pixel_checked always answers.
+        let p = img
+            .get_pixel_checked(u32::try_from(x).unwrap_or(0), u32::try_from(y).unwrap_or(0))
+            .map_or([0, 0, 0], |p| p.0);
+        rgb_to_yuv(p)
+    })
+    .map_err(|source| FrameFileError::Frame {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// Writes packed RGB (3 bytes a pixel) as a PNG.
+///
+/// # Errors
+/// [`FrameFileError`] naming the file when the buffer is the wrong length or writing fails.
+pub fn save_rgb_png(
+    path: &Path,
+    width: usize,
+    height: usize,
+    rgb: &[u8],
+) -> Result<(), FrameFileError> {
+    let bad = || FrameFileError::Frame {
+        path: path.to_owned(),
+        source: FrameError::WrongLength {
+            len: rgb.len(),
+            expected: width * height * 3,
+            width,
+            height,
+            layout: PixelLayout::Yuv444Packed,
+        },
+    };
+    let (w, h) = (
+        u32::try_from(width).map_err(|_| bad())?,
+        u32::try_from(height).map_err(|_| bad())?,
+    );
+    let img = image::RgbImage::from_raw(w, h, rgb.to_vec()).ok_or_else(bad)?;
+    img.save_with_format(path, image::ImageFormat::Png)
+        .map_err(|source| FrameFileError::Image {
+            path: path.to_owned(),
+            source,
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{Yuv, yuv_to_rgb};
+
+    #[test]
+    fn raw_sizes_are_inferred_for_the_two_cameras() {
+        assert_eq!(infer_uyvy_size(208 * 160 * 2), Some((208, 160)));
+        assert_eq!(infer_uyvy_size(640 * 480 * 2), Some((640, 480)));
+        assert_eq!(infer_uyvy_size(1000), None);
+    }
+
+    #[test]
+    fn wrong_sized_raw_file_names_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("odd.uyvy");
+        std::fs::write(&p, [0u8; 1000]).unwrap();
+        let e = load_raw_uyvy(&p, None).unwrap_err().to_string();
+        assert!(e.contains("odd.uyvy") && e.contains("1000 bytes"), "{e}");
+        let e = load_raw_uyvy(&p, Some((20, 20))).unwrap_err().to_string();
+        assert!(e.contains("odd.uyvy") && e.contains("800 bytes"), "{e}");
+    }
+
+    #[test]
+    fn png_round_trip_keeps_colours() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.png");
+        let f = Frame::uyvy_from_fn(8, 4, |x, _| {
+            if x < 4 {
+                Yuv::new(120, 80, 190)
+            } else {
+                Yuv::new(100, 100, 100)
+            }
+        })
+        .unwrap();
+        save_rgb_png(&p, 8, 4, &f.to_rgb()).unwrap();
+        let back = load_frame(&p, None).unwrap();
+        assert_eq!((back.width(), back.height()), (8, 4));
+        let a = yuv_to_rgb(back.pixel(1, 1).unwrap());
+        let b = yuv_to_rgb(f.pixel(1, 1).unwrap());
+        for (x, y) in a.iter().zip(b) {
+            assert!(x.abs_diff(y) <= 2);
+        }
+    }
+}

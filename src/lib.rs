@@ -1,0 +1,22 @@
+//! eotn — Eye Of The NUbot: the colour-vision pipeline of a robot-soccer team, and the tools to
+//! see every stage of it.
+//!
+//! Modules read in data-flow order; each uses only those above it:
+//!
+//! | module | role |
+//! |---|---|
+//! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
+//! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model |
+//! | [`classify`] | frame + table → classified image |
+//! | [`blobs`] | classified image → connected blobs |
+//!
+//! See `ARCHITECTURE.md` for the map.
+
+pub mod atomic_file;
+pub mod blobs;
+pub mod classify;
+pub mod frame;
+pub mod lut;
+pub mod pipeline;
+
+pub mod cli;

@@ -1,0 +1,163 @@
+//! The whole pipeline, one frame at a time: classification, blobs, and (as they land) the
+//! recognition stages, with per-stage timings.
+//!
+//! [`Pipeline`] owns the lookup table and every reusable buffer; the CLI, the benchmarks and the
+//! app all call [`Pipeline::process_frame`], so what the app shows is exactly what the headless
+//! tools compute.
+
+use std::time::{Duration, Instant};
+
+use serde::{Deserialize, Serialize};
+
+use crate::blobs::{BlobSet, Connectivity};
+use crate::classify::{ClassifiedImage, classify_into};
+use crate::frame::Frame;
+use crate::lut::LookupTable;
+
+/// Settings of the pipeline's stages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct PipelineParams {
+    /// Which neighbours join a blob.
+    pub connectivity: Connectivity,
+}
+
+/// How long each stage took on the last frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct StageTimings {
+    /// Table lookup of every pixel.
+    pub classify: Duration,
+    /// Run-length encoding and union-find.
+    pub blobs: Duration,
+}
+
+impl StageTimings {
+    /// All stages together.
+    #[must_use]
+    pub fn total(&self) -> Duration {
+        self.classify + self.blobs
+    }
+}
+
+/// The pipeline: a table, parameters and the buffers of the last frame's results.
+#[derive(Debug, Clone)]
+pub struct Pipeline {
+    lut: LookupTable,
+    params: PipelineParams,
+    classified: ClassifiedImage,
+    blobs: BlobSet,
+    timings: StageTimings,
+}
+
+impl Pipeline {
+    /// A pipeline classifying with `lut`.
+    #[must_use]
+    pub fn new(lut: LookupTable, params: PipelineParams) -> Self {
+        Self {
+            lut,
+            params,
+            classified: ClassifiedImage::default(),
+            blobs: BlobSet::default(),
+            timings: StageTimings::default(),
+        }
+    }
+
+    /// Runs every stage on `frame`; results stay in the pipeline until the next frame.
+    pub fn process_frame(&mut self, frame: &Frame) -> FrameResult<'_> {
+        let t0 = Instant::now();
+        classify_into(frame, &self.lut, &mut self.classified);
+        let t1 = Instant::now();
+        self.blobs.find(&self.classified, self.params.connectivity);
+        let t2 = Instant::now();
+        self.timings = StageTimings {
+            classify: t1 - t0,
+            blobs: t2 - t1,
+        };
+        self.result()
+    }
+
+    /// The results of the last processed frame.
+    #[must_use]
+    pub fn result(&self) -> FrameResult<'_> {
+        FrameResult {
+            classified: &self.classified,
+            blobs: &self.blobs,
+            timings: self.timings,
+        }
+    }
+
+    /// The table in use.
+    #[must_use]
+    pub fn lut(&self) -> &LookupTable {
+        &self.lut
+    }
+
+    /// The table, for editing; re-run [`Pipeline::process_frame`] to see the effect.
+    pub fn lut_mut(&mut self) -> &mut LookupTable {
+        &mut self.lut
+    }
+
+    /// Replaces the table.
+    pub fn set_lut(&mut self, lut: LookupTable) {
+        self.lut = lut;
+    }
+
+    /// The stage settings.
+    #[must_use]
+    pub const fn params(&self) -> &PipelineParams {
+        &self.params
+    }
+
+    /// Changes the stage settings.
+    pub fn set_params(&mut self, params: PipelineParams) {
+        self.params = params;
+    }
+}
+
+/// What the pipeline made of one frame (borrowed from the pipeline's buffers).
+#[derive(Debug, Clone, Copy)]
+pub struct FrameResult<'a> {
+    /// One class code per pixel.
+    pub classified: &'a ClassifiedImage,
+    /// Blobs of every class.
+    pub blobs: &'a BlobSet,
+    /// How long each stage took.
+    pub timings: StageTimings,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Yuv;
+    use crate::lut::{ColourClass, EditRecord, Region, Sensitivity};
+
+    #[test]
+    fn process_frame_classifies_and_finds_blobs() {
+        let orange = Yuv::new(120, 80, 190);
+        let frame = Frame::uyvy_from_fn(32, 16, |x, y| {
+            if (8..16).contains(&x) && (4..10).contains(&y) {
+                orange
+            } else {
+                Yuv::new(60, 128, 128)
+            }
+        })
+        .unwrap();
+        let mut lut = LookupTable::new(7).unwrap();
+        lut.apply(EditRecord::now(
+            ColourClass::Orange,
+            Region::AroundSample {
+                sample: orange,
+                sensitivity: Sensitivity::uniform(1),
+            },
+        ));
+        let mut p = Pipeline::new(lut, PipelineParams::default());
+        let r = p.process_frame(&frame);
+        let balls: Vec<_> = r.blobs.of_class(ColourClass::Orange).collect();
+        assert_eq!(balls.len(), 1);
+        assert_eq!(
+            (balls[0].minx, balls[0].miny, balls[0].maxx, balls[0].maxy),
+            (8, 4, 15, 9)
+        );
+        assert_eq!(balls[0].pixels, 48);
+    }
+}

@@ -1,0 +1,167 @@
+//! The command line as a user runs it: outputs, exit codes, one-line errors.
+
+use std::ffi::OsStr;
+
+use eotn::frame::{Frame, Yuv};
+use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
+
+use crate::common::eotn;
+
+fn orange_table(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut t = LookupTable::new(7).unwrap();
+    t.apply(EditRecord::now(
+        ColourClass::Orange,
+        Region::AroundSample {
+            sample: Yuv::new(120, 80, 190),
+            sensitivity: Sensitivity::uniform(1),
+        },
+    ));
+    let p = dir.join("t.lut");
+    t.save(&p).unwrap();
+    p
+}
+
+fn ball_frame(dir: &std::path::Path) -> std::path::PathBuf {
+    // An orange patch on even column boundaries, so no UYVY pair mixes its chroma.
+    let f = Frame::uyvy_from_fn(208, 160, |x, y| {
+        if (92..110).contains(&x) && (70..90).contains(&y) {
+            Yuv::new(120, 80, 190)
+        } else {
+            Yuv::new(90, 110, 110)
+        }
+    })
+    .unwrap();
+    let p = dir.join("ball.uyvy");
+    std::fs::write(&p, f.data()).unwrap();
+    p
+}
+
+#[test]
+fn blobs_json_has_the_fixed_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let (lut, frame) = (orange_table(dir.path()), ball_frame(dir.path()));
+    let out = eotn(&[
+        OsStr::new("blobs"),
+        frame.as_os_str(),
+        OsStr::new("--lut"),
+        lut.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["frame"], "ball.uyvy");
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(208), Some(160))
+    );
+    assert_eq!(
+        (v["lut_bits"].as_u64(), v["connectivity"].as_u64()),
+        (Some(7), Some(8))
+    );
+    let blobs = v["blobs"].as_array().unwrap();
+    assert_eq!(blobs.len(), 1);
+    let b = &blobs[0];
+    assert_eq!(b["colour"], 1);
+    assert_eq!(
+        (b["minx"].as_u64(), b["maxx"].as_u64()),
+        (Some(92), Some(109))
+    );
+    assert_eq!(
+        (b["miny"].as_u64(), b["maxy"].as_u64()),
+        (Some(70), Some(89))
+    );
+    assert_eq!(b["pixels"].as_u64(), Some(18 * 20));
+}
+
+#[test]
+fn bench_json_ends_with_medians() {
+    let dir = tempfile::tempdir().unwrap();
+    let (lut, frame) = (orange_table(dir.path()), ball_frame(dir.path()));
+    let out = eotn(&[
+        OsStr::new("bench"),
+        frame.as_os_str(),
+        OsStr::new("--lut"),
+        lut.as_os_str(),
+        OsStr::new("--json"),
+        OsStr::new("--reps"),
+        OsStr::new("5"),
+        OsStr::new("--warmup"),
+        OsStr::new("1"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let last: serde_json::Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
+    for key in ["classify_ns_per_px", "blobs_ns_per_px", "total_ns_per_px"] {
+        assert!(
+            last[key].as_f64().is_some_and(|v| v > 0.0),
+            "{key} in {last}"
+        );
+    }
+}
+
+#[test]
+fn bad_input_exits_non_zero_with_one_line_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let lut = orange_table(dir.path());
+    let bad = dir.path().join("short.uyvy");
+    std::fs::write(&bad, [0u8; 999]).unwrap();
+    let garbage = dir.path().join("garbage.lut");
+    std::fs::write(&garbage, [0u8; 12]).unwrap();
+    for args in [
+        vec![
+            OsStr::new("blobs"),
+            bad.as_os_str(),
+            OsStr::new("--lut"),
+            lut.as_os_str(),
+        ],
+        vec![
+            OsStr::new("classify"),
+            bad.as_os_str(),
+            OsStr::new("--lut"),
+            garbage.as_os_str(),
+        ],
+        vec![OsStr::new("info"), garbage.as_os_str()],
+    ] {
+        let out = eotn(&args);
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert!(
+            err.contains("short.uyvy") || err.contains("garbage.lut"),
+            "{err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn classify_writes_png_and_raw_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (lut, frame) = (orange_table(dir.path()), ball_frame(dir.path()));
+    let outdir = dir.path().join("out");
+    let out = eotn(&[
+        OsStr::new("classify"),
+        frame.as_os_str(),
+        OsStr::new("--lut"),
+        lut.as_os_str(),
+        OsStr::new("-o"),
+        outdir.as_os_str(),
+        OsStr::new("--raw"),
+        OsStr::new("--json"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let codes = std::fs::read(outdir.join("ball.uyvy.cls")).unwrap();
+    assert_eq!(codes.len(), 208 * 160);
+    let orange = codes.iter().filter(|&&c| c == 1).count();
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["pixels"]["orange"].as_u64(), Some(orange as u64));
+    assert!(outdir.join("ball.uyvy.classified.png").exists());
+}

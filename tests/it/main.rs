@@ -1,0 +1,7 @@
+//! Integration tests, one binary with a module per area (as ripgrep does).
+
+#![allow(clippy::unwrap_used, reason = "test helpers: a panic is a failed test")]
+
+mod cli;
+mod common;
+mod peer;
