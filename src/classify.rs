@@ -168,14 +168,18 @@ macro_rules! classify_uyvy_bits {
             const B: u32 = $bits;
             const S: u32 = 8 - B;
             const M: u32 = (1 << B) - 1;
-            for (q, o) in src.chunks_exact(4).zip(dst.chunks_exact_mut(2)) {
-                // Bytes U Y0 V Y1 as one little-endian word.
-                let w = u32::from_le_bytes([q[0], q[1], q[2], q[3]]);
+            let (pairs, _) = src.as_chunks::<4>();
+            let (outs, _) = dst.as_chunks_mut::<2>();
+            for (q, o) in pairs.iter().zip(outs) {
+                // Bytes U Y0 V Y1 as one little-endian word: one load per pixel pair.
+                let w = u32::from_le_bytes(*q);
                 let uv = (((w >> S) & M) << B) | ((w >> (16 + S)) & M);
                 let y0 = (w >> (8 + S)) & M;
                 let y1 = w >> (24 + S);
-                o[0] = table[((y0 << (2 * B)) | uv) as usize];
-                o[1] = table[((y1 << (2 * B)) | uv) as usize];
+                *o = [
+                    table[((y0 << (2 * B)) | uv) as usize],
+                    table[((y1 << (2 * B)) | uv) as usize],
+                ];
             }
         }
     };

@@ -257,7 +257,11 @@ impl Frame {
         Some(match self.layout {
             PixelLayout::Uyvy => {
                 let pair = (y * w + (x & !1)) * 2;
-                let luma = if x.is_multiple_of(2) { pair + 1 } else { pair + 3 };
+                let luma = if x.is_multiple_of(2) {
+                    pair + 1
+                } else {
+                    pair + 3
+                };
                 Yuv::new(d[luma], d[pair], d[pair + 2])
             }
             PixelLayout::Yuv444Packed => {
