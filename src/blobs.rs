@@ -204,40 +204,23 @@ impl BlobSet {
     /// Unites each run of the current row (from `current`) with the runs of the previous row
     /// (`prev`) it touches.
     fn join_rows(&mut self, prev: std::ops::Range<usize>, current: usize, reach: u32) {
-        let mut j = prev.start;
-        for i in current..self.runs.len() {
-            let r = self.runs[i];
+        let (before, now) = self.runs.split_at(current);
+        let above = before.get(prev.clone()).unwrap_or(&[]);
+        let parent = &mut self.parent;
+        let mut j = 0;
+        for (offset, r) in now.iter().enumerate() {
             // Skip previous-row runs that end (plus reach) before this run starts.
-            while j < prev.end && self.runs[j].x1 + reach <= r.x0 {
+            while above.get(j).is_some_and(|a| a.x1 + reach <= r.x0) {
                 j += 1;
             }
-            let mut k = j;
-            while k < prev.end && self.runs[k].x0 < r.x1 + reach {
-                if self.runs[k].colour == r.colour {
-                    self.unite(k, i);
+            for (k, a) in above.iter().enumerate().skip(j) {
+                if a.x0 >= r.x1 + reach {
+                    break;
                 }
-                k += 1;
+                if a.colour == r.colour {
+                    unite(parent, prev.start + k, current + offset);
+                }
             }
-        }
-    }
-
-    fn root(&mut self, mut i: usize) -> usize {
-        while u32_index(self.parent[i]) != i {
-            // Path halving: point to the grandparent while walking up.
-            let grand = self.parent[u32_index(self.parent[i])];
-            self.parent[i] = grand;
-            i = u32_index(grand);
-        }
-        i
-    }
-
-    fn unite(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.root(a), self.root(b));
-        // The smaller index stays root, so a root precedes its members in raster order.
-        if ra < rb {
-            self.parent[rb] = u32_of(ra);
-        } else if rb < ra {
-            self.parent[ra] = u32_of(rb);
         }
     }
 
@@ -388,12 +371,12 @@ impl BlobSet {
 
 /// Appends the runs of one row (unclassified pixels make no runs).
 ///
-/// Run boundaries are found a block at a time: the row is compared with itself shifted by one
-/// byte, [`BLOCK`] bytes per step, giving a bit mask of the places where the colour changes;
-/// each set bit ends one run. Long runs of one colour cost one compare per block.
+/// Run boundaries are found a machine word at a time (SWAR): each 8-byte word of the row is
+/// compared with itself shifted by one byte (the byte before the word shifted in), and every
+/// non-zero byte of the difference is a place where the colour changes. Inside a long run a word
+/// costs one load, a shift and a compare.
 fn encode_row(row: &[u8], y: u32, runs: &mut Vec<Run>) {
     let Some(&first) = row.first() else { return };
-    let w = row.len();
     let mut emit = |x0: usize, x1: usize, colour: u8| {
         if colour != 0 {
             runs.push(Run {
@@ -405,47 +388,75 @@ fn encode_row(row: &[u8], y: u32, runs: &mut Vec<Run>) {
         }
     };
     let (mut start, mut colour) = (0, first);
-    let mut x = 1;
-    while let Some(window) = row.get(x - 1..x + BLOCK) {
-        let mut changed = changes(window);
+    let (words, tail) = row.as_chunks::<8>();
+    // The byte before the current word, in the low byte; the first pixel is its own predecessor.
+    let mut before = u64::from(first);
+    for (k, bytes) in words.iter().enumerate() {
+        let word = u64::from_le_bytes(*bytes);
+        let shifted = (word << 8) | before;
+        before = word >> 56;
+        let diff = word ^ shifted;
+        if diff == 0 {
+            continue;
+        }
+        let mut changed = nonzero_bytes(diff);
         while changed != 0 {
-            let p = x + (changed.trailing_zeros() / 8) as usize;
+            let byte = (changed.trailing_zeros() / 8) as usize;
             changed &= changed - 1;
+            let p = k * 8 + byte;
             emit(start, p, colour);
             start = p;
-            colour = window[p - x + 1];
+            colour = bytes[byte];
         }
-        x += BLOCK;
     }
-    while x < w {
-        if row[x] != colour {
-            emit(start, x, colour);
-            start = x;
-            colour = row[x];
+    let tail_start = row.len() - tail.len();
+    for (i, &c) in tail.iter().enumerate() {
+        if c != colour {
+            emit(start, tail_start + i, colour);
+            start = tail_start + i;
+            colour = c;
         }
-        x += 1;
     }
-    emit(start, w, colour);
+    emit(start, row.len(), colour);
 }
 
-/// Bytes compared per step when finding run boundaries: one machine word.
-const BLOCK: usize = 8;
-
-/// Bit 7 of byte `i` set where `window[i + 1] != window[i]`, for `i` in `0..8`, all other bits
-/// clear; `window` holds 9 bytes. A change at byte `i` is found as `trailing_zeros / 8`.
-///
-/// Word-at-a-time (SWAR) in safe, portable Rust. An SSE2 version (16 bytes a step with a
-/// move-mask) measured no faster here: the run search is not the blob stage's bottleneck.
-fn changes(window: &[u8]) -> u64 {
+/// Bit 7 of every non-zero byte of `t`, all other bits clear.
+const fn nonzero_bytes(t: u64) -> u64 {
     const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
-    let mut previous = [0u8; 8];
-    let mut current = [0u8; 8];
-    previous.copy_from_slice(&window[..8]);
-    current.copy_from_slice(&window[1..9]);
-    let t = u64::from_le_bytes(current) ^ u64::from_le_bytes(previous);
     // (b & 0x7f) + 0x7f sets bit 7 for any non-zero low part without carrying into the next
     // byte; or-ing b itself catches 0x80.
     (((t & LOW7) + LOW7) | t) & !LOW7
+}
+
+/// The root of run `i`'s set, halving the path on the way (each run then points to its
+/// grandparent).
+fn root(parent: &mut [u32], mut i: usize) -> usize {
+    while u32_index(parent[i]) != i {
+        let grand = parent[u32_index(parent[i])];
+        parent[i] = grand;
+        i = u32_index(grand);
+    }
+    i
+}
+
+/// Joins the sets of run `above` (previous row) and run `below` (current row, `above < below`).
+///
+/// The smaller root index stays root, so every parent pointer points to a smaller index and a
+/// root precedes its members in raster order. Current-row runs are never anyone's parent (they
+/// only join earlier runs), so a current-row run that is still its own parent is a singleton and
+/// simply takes the other root.
+fn unite(parent: &mut [u32], above: usize, below: usize) {
+    let ra = root(parent, above);
+    if u32_index(parent[below]) == below {
+        parent[below] = u32_of(ra);
+        return;
+    }
+    let rb = root(parent, below);
+    if ra < rb {
+        parent[rb] = u32_of(ra);
+    } else if rb < ra {
+        parent[ra] = u32_of(rb);
+    }
 }
 
 /// Coordinates and counts fit u32: frames are at most 65,535 pixels a side.
