@@ -9,6 +9,7 @@
 //! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model |
 //! | [`classify`] | frame + table → classified image |
 //! | [`blobs`] | classified image → connected blobs |
+//! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -18,5 +19,6 @@ pub mod classify;
 pub mod frame;
 pub mod lut;
 pub mod pipeline;
+pub mod sensors;
 
 pub mod cli;
