@@ -181,12 +181,16 @@ fn ns_to_seconds(ns: u64) -> f64 {
 /// Seconds → nanoseconds, `None` for negative, non-finite or absurd (> 500 years) times.
 fn seconds_to_ns(s: f64) -> Option<u64> {
     let ns = (s * 1e9).round();
+    if !(s.is_finite() && (0.0..1.6e19).contains(&ns)) {
+        return None;
+    }
     #[expect(
         clippy::cast_possible_truncation,
         clippy::cast_sign_loss,
         reason = "checked: finite, non-negative and below 1.6e19"
     )]
-    (s.is_finite() && (0.0..1.6e19).contains(&ns)).then(|| ns as u64)
+    let n = ns as u64;
+    Some(n)
 }
 
 #[cfg(test)]

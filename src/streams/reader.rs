@@ -289,11 +289,14 @@ impl StreamReader {
     /// # Errors
     /// [`StreamError::NoSuchFrame`] past the end; I/O or corruption errors naming the file.
     pub fn read(&mut self, index: usize) -> Result<FrameRecord, StreamError> {
-        let loc = *self.frames.get(index).ok_or(StreamError::NoSuchFrame {
-            path: self.path.clone(),
-            index,
-            len: self.frames.len(),
-        })?;
+        let loc = *self
+            .frames
+            .get(index)
+            .ok_or_else(|| StreamError::NoSuchFrame {
+                path: self.path.clone(),
+                index,
+                len: self.frames.len(),
+            })?;
         if self.cache.as_ref().is_none_or(|(c, _)| *c != loc.chunk) {
             self.cache = None;
             let messages = self.load_chunk(loc.chunk)?;
@@ -379,16 +382,14 @@ impl StreamReader {
     fn warn(&mut self, text: String) {
         if self.warnings.len() < MAX_WARNINGS {
             self.warnings.push(text);
-        } else {
-            self.warnings_dropped += 1;
-            let note = format!("… and {} more warnings", self.warnings_dropped);
-            if let Some(last) = self.warnings.last_mut() {
-                if self.warnings_dropped == 1 {
-                    self.warnings.push(note);
-                } else {
-                    *last = note;
-                }
-            }
+            return;
+        }
+        self.warnings_dropped += 1;
+        let note = format!("… and {} more warnings", self.warnings_dropped);
+        if self.warnings_dropped == 1 {
+            self.warnings.push(note);
+        } else if let Some(last) = self.warnings.last_mut() {
+            *last = note;
         }
     }
 
@@ -434,8 +435,7 @@ impl StreamReader {
         let got = self.read_up_to(offset, &mut buf)?;
         if got < n {
             return Err(self.corrupt(format!(
-                "the file ends {} bytes into a {n}-byte record at offset {offset}",
-                got
+                "the file ends {got} bytes into a {n}-byte record at offset {offset}"
             )));
         }
         Ok(buf)
@@ -720,7 +720,7 @@ impl StreamReader {
             .chunks
             .get(chunk as usize)
             .ok_or_else(|| self.corrupt(format!("no chunk {chunk}")))?;
-        let (opcode, body) = self.read_record_at(loc.offset, MAX_CHUNK_BYTES)?;
+        let (opcode, body) = self.read_record_at(loc.offset, loc.length.saturating_sub(9))?;
         if opcode != op::CHUNK {
             return Err(self.corrupt(format!(
                 "the chunk index points at offset {} which holds no chunk",
@@ -797,4 +797,73 @@ fn for_each_chunk_record(
         each(record?);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{Frame, Yuv};
+    use crate::streams::schema::{encode_image, raw_image_schema};
+
+    /// A file from another writer: frames on another topic, times out of order, default
+    /// chunking, no eotn metadata.
+    fn foreign_file(path: &Path, times: &[u64]) {
+        let file = std::io::BufWriter::new(File::create(path).unwrap());
+        let mut w = mcap::Writer::new(file).unwrap();
+        let s = raw_image_schema().unwrap();
+        let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+        let ch = w
+            .add_channel(sid, "/cam/front", "protobuf", &Default::default())
+            .unwrap();
+        let tf = w
+            .add_channel(0, "/tf", "ros1msg", &Default::default())
+            .unwrap();
+        let mut buf = Vec::new();
+        for (i, &t) in times.iter().enumerate() {
+            let f = Frame::filled_uyvy(4, 2, Yuv::new(u8::try_from(i).unwrap(), 128, 128)).unwrap();
+            encode_image(t, &f, &mut buf).unwrap();
+            let header = |channel_id| mcap::records::MessageHeader {
+                channel_id,
+                sequence: 0,
+                log_time: t,
+                publish_time: t,
+            };
+            w.write_to_known_channel(&header(ch), &buf).unwrap();
+            w.write_to_known_channel(&header(tf), b"\x01\x02").unwrap();
+        }
+        w.finish().unwrap();
+    }
+
+    #[test]
+    fn frames_of_another_writer_and_unsorted_times() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.mcap");
+        foreign_file(&p, &[100, 300, 200, 400]);
+        let mut r = StreamReader::open(&p).unwrap();
+        assert_eq!(r.len(), 4);
+        assert_eq!(r.info().source, "unknown");
+        let joined = r.warnings().join("\n");
+        assert!(joined.contains("/cam/front") && joined.contains("/tf"), "{joined}");
+        assert_eq!(r.index_at_time(250), 2, "latest frame at or before 250 ns");
+        assert_eq!(r.index_at_time(350), 1);
+        assert_eq!(r.index_at_time(50), 0);
+        for i in 0..4 {
+            let rec = r.read(i).unwrap();
+            assert_eq!(rec.frame.pixel(0, 0).unwrap().y, u8::try_from(i).unwrap());
+            assert!(rec.sensors.is_none() && rec.extra.is_empty());
+        }
+    }
+
+    #[test]
+    fn warnings_are_bounded() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.mcap");
+        foreign_file(&p, &[1]);
+        let mut r = StreamReader::open(&p).unwrap();
+        for i in 0..1000 {
+            r.warn(format!("w{i}"));
+        }
+        assert_eq!(r.warnings().len(), MAX_WARNINGS + 1);
+        assert!(r.warnings().last().unwrap().contains("more warnings"));
+    }
 }

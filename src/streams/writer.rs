@@ -235,8 +235,9 @@ impl StreamWriter {
     /// [`StreamError::BadRecord`] for an image that cannot be UYVY (odd width) or a reserved
     /// extra topic; I/O errors naming the file.
     pub fn write(&mut self, record: &FrameRecord) -> Result<(), StreamError> {
+        let path = self.path.clone();
         let bad = |detail: String| StreamError::BadRecord {
-            path: self.path.clone(),
+            path: path.clone(),
             time_ns: record.time_ns,
             detail,
         };
