@@ -9,9 +9,7 @@ use std::time::Duration;
 
 use serde::Serialize;
 
-use super::inputs::{
-    FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress,
-};
+use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
 use crate::blobs::Connectivity;
 use crate::pipeline::{Pipeline, PipelineParams};
 

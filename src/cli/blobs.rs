@@ -6,10 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use serde::Serialize;
 
-use super::inputs::{
-    FrameInputs, load_lut_arg, parse_connectivity, parse_size,
-    progress,
-};
+use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
 use crate::blobs::{Blob, BlobSet, Connectivity};
 use crate::classify::ClassifiedImage;
 

@@ -6,9 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::inputs::{
-    FrameInputs, load_lut_arg, parse_size, progress,
-};
+use super::inputs::{FrameInputs, load_lut_arg, parse_size, progress};
 use crate::classify::ClassifiedImage;
 use crate::frame::save_rgb_png;
 use crate::lut::ColourClass;

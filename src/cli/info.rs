@@ -62,7 +62,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
     let mut reader = StreamReader::open(path)?;
     let n = reader.len();
-    let (first, last) = (reader.time_ns(0), n.checked_sub(1).and_then(|i| reader.time_ns(i)));
+    let (first, last) = (
+        reader.time_ns(0),
+        n.checked_sub(1).and_then(|i| reader.time_ns(i)),
+    );
     let mut value = serde_json::json!({
         "file": path.display().to_string(), "kind": "stream",
         "source": reader.info().source, "description": reader.info().description,

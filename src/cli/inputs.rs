@@ -140,10 +140,9 @@ impl FrameInput {
         match self {
             Self::File(p) => frame_name(p),
             Self::Stream { path, index } => {
-                let stem = path.file_stem().map_or_else(
-                    || "stream".to_owned(),
-                    |s| s.to_string_lossy().into_owned(),
-                );
+                let stem = path
+                    .file_stem()
+                    .map_or_else(|| "stream".to_owned(), |s| s.to_string_lossy().into_owned());
                 format!("{stem}_{index:06}")
             }
         }
@@ -177,9 +176,9 @@ impl FrameInputs {
                     bail!("{}: the stream holds no frames", p.display());
                 }
                 let all = 0..reader.len();
-                let take = range.clone().map_or(all.clone(), |r| {
-                    r.start.min(all.end)..r.end.min(all.end)
-                });
+                let take = range
+                    .clone()
+                    .map_or(all.clone(), |r| r.start.min(all.end)..r.end.min(all.end));
                 if take.is_empty() {
                     bail!(
                         "{}: --frames selects none of its {} frames",

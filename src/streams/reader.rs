@@ -498,7 +498,9 @@ impl StreamReader {
             if index.name != METADATA_NAME {
                 continue;
             }
-            if index.length > MAX_INDEX_BYTES || index.offset.saturating_add(index.length) > self.file_len {
+            if index.length > MAX_INDEX_BYTES
+                || index.offset.saturating_add(index.length) > self.file_len
+            {
                 self.warn("the stream metadata index points outside the file".to_owned());
                 continue;
             }
@@ -513,7 +515,12 @@ impl StreamReader {
         let mut ids: Vec<u16> = summary.channels.keys().copied().collect();
         ids.sort_unstable();
         // Prefer the canonical image topic over any other RawImage channel.
-        ids.sort_by_key(|id| summary.channels.get(id).is_none_or(|c| c.topic != IMAGE_TOPIC));
+        ids.sort_by_key(|id| {
+            summary
+                .channels
+                .get(id)
+                .is_none_or(|c| c.topic != IMAGE_TOPIC)
+        });
         for id in ids {
             if let Some(c) = summary.channels.get(&id) {
                 let schema = c.schema.as_ref().map(|s| s.name.as_str());
@@ -548,12 +555,16 @@ impl StreamReader {
                 {
                     Ok(Record::MessageIndex(mi)) if mi.channel_id == image => mi.records,
                     _ => {
-                        self.warn(format!("message index at offset {at} is malformed; scanning instead"));
+                        self.warn(format!(
+                            "message index at offset {at} is malformed; scanning instead"
+                        ));
                         return Ok(false);
                     }
                 },
                 Ok(_) | Err(_) => {
-                    self.warn(format!("message index at offset {at} is unreadable; scanning instead"));
+                    self.warn(format!(
+                        "message index at offset {at} is unreadable; scanning instead"
+                    ));
                     return Ok(false);
                 }
             };
@@ -636,7 +647,9 @@ impl StreamReader {
             match opcode {
                 op::CHUNK => {
                     if len > MAX_CHUNK_BYTES {
-                        self.warn(format!("chunk at offset {offset} is implausibly large ({len} bytes); stopping"));
+                        self.warn(format!(
+                            "chunk at offset {offset} is implausibly large ({len} bytes); stopping"
+                        ));
                         break;
                     }
                     let body = self.read_exact_at(body_at, len)?;
@@ -675,7 +688,9 @@ impl StreamReader {
                 }
                 op::SCHEMA | op::CHANNEL | op::METADATA => {
                     if len > MAX_INDEX_BYTES {
-                        self.warn(format!("record at offset {offset} is implausibly large; stopping"));
+                        self.warn(format!(
+                            "record at offset {offset} is implausibly large; stopping"
+                        ));
                         break;
                     }
                     let body = self.read_exact_at(body_at, len)?;
@@ -728,10 +743,8 @@ impl StreamReader {
             )));
         }
         let mut messages = Vec::new();
-        decode_chunk_messages(&body, &mut messages).map_err(self.mcap_err(format!(
-            "reading the chunk at offset {}",
-            loc.offset
-        )))?;
+        decode_chunk_messages(&body, &mut messages)
+            .map_err(self.mcap_err(format!("reading the chunk at offset {}", loc.offset)))?;
         Ok(messages)
     }
 }
@@ -843,7 +856,10 @@ mod tests {
         assert_eq!(r.len(), 4);
         assert_eq!(r.info().source, "unknown");
         let joined = r.warnings().join("\n");
-        assert!(joined.contains("/cam/front") && joined.contains("/tf"), "{joined}");
+        assert!(
+            joined.contains("/cam/front") && joined.contains("/tf"),
+            "{joined}"
+        );
         assert_eq!(r.index_at_time(250), 2, "latest frame at or before 250 ns");
         assert_eq!(r.index_at_time(350), 1);
         assert_eq!(r.index_at_time(50), 0);

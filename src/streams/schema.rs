@@ -270,7 +270,10 @@ mod tests {
         assert_eq!(v["s"], "NaN in text");
         assert_eq!(v["c"], 1);
         assert!(parse_json_lenient(b"{not json").is_err());
-        assert_eq!(parse_json_lenient(b"[1]").unwrap(), (serde_json::json!([1]), false));
+        assert_eq!(
+            parse_json_lenient(b"[1]").unwrap(),
+            (serde_json::json!([1]), false)
+        );
     }
 
     #[test]

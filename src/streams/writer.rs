@@ -12,8 +12,8 @@ use super::schema::{
     any_json_schema, encode_image, object_json_schema, raw_image_schema, sensors_json_schema,
 };
 use super::{
-    FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME,
-    RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
+    FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME, RECOGNITION_TOPIC,
+    SENSORS_TOPIC, StreamError, StreamInfo,
 };
 
 /// How chunks are compressed.
@@ -138,7 +138,11 @@ impl StreamWriter {
             detail: "the foxglove.RawImage schema is not available".to_owned(),
         })?;
         let image_schema = mcap
-            .add_schema(&image_schema.name, &image_schema.encoding, &image_schema.data)
+            .add_schema(
+                &image_schema.name,
+                &image_schema.encoding,
+                &image_schema.data,
+            )
             .map_err(mcap_err("cannot add the image schema"))?;
         let image_channel = mcap
             .add_channel(image_schema, IMAGE_TOPIC, "protobuf", &BTreeMap::new())
@@ -242,8 +246,13 @@ impl StreamWriter {
             detail,
         };
         for (topic, _) in &record.extra {
-            if [IMAGE_TOPIC, SENSORS_TOPIC, GROUND_TRUTH_TOPIC, RECOGNITION_TOPIC]
-                .contains(&topic.as_str())
+            if [
+                IMAGE_TOPIC,
+                SENSORS_TOPIC,
+                GROUND_TRUTH_TOPIC,
+                RECOGNITION_TOPIC,
+            ]
+            .contains(&topic.as_str())
                 || !topic.starts_with('/')
             {
                 return Err(bad(format!(
