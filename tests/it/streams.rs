@@ -34,7 +34,7 @@ fn record(i: usize) -> FrameRecord {
             ..SensorReadings::default()
         });
     }
-    if i % 2 == 0 {
+    if i.is_multiple_of(2) {
         r.ground_truth = Some(serde_json::json!({ "ball": [i, 2 * i] }));
     }
     if i % 4 == 1 {
@@ -151,8 +151,8 @@ fn truncated_files_stay_readable_up_to_their_last_complete_chunk() {
                         "metadata sits before the chunks"
                     );
                 }
-                for i in 0..r.len() {
-                    assert_eq!(r.read(i).unwrap(), records[i], "cut at {cut}, frame {i}");
+                for (i, want) in records.iter().enumerate().take(r.len()) {
+                    assert_eq!(&r.read(i).unwrap(), want, "cut at {cut}, frame {i}");
                 }
                 last_len = r.len();
             }
