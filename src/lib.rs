@@ -10,6 +10,7 @@
 //! | [`classify`] | frame + table → classified image |
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
+//! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -17,6 +18,7 @@ pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
 pub mod frame;
+pub mod geometry;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;
