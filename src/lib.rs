@@ -11,6 +11,7 @@
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
+//! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -22,5 +23,6 @@ pub mod geometry;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;
+pub mod sim;
 
 pub mod cli;

@@ -8,6 +8,7 @@ mod blobs;
 mod classify;
 mod info;
 pub mod inputs;
+mod lut_from_labels;
 
 use std::process::ExitCode;
 
@@ -35,6 +36,8 @@ pub enum Command {
     Blobs(blobs::Args),
     /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
     Bench(bench::Args),
+    /// Build a first lookup table from labelled frames and score it on held-back frames.
+    LutFromLabels(lut_from_labels::Args),
 }
 
 /// Runs a headless subcommand.
@@ -47,6 +50,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Classify(a) => classify::run(&a),
         Command::Blobs(a) => blobs::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::LutFromLabels(a) => lut_from_labels::run(&a),
     }
 }
 
