@@ -86,7 +86,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut index = 0_u64;
     let mut take = |name: String, frame: Frame, labels: Vec<u8>| -> anyhow::Result<()> {
         index += 1;
-        if index % args.holdout_every == 0 {
+        if index.is_multiple_of(args.holdout_every) {
             held_back.push((name, frame, labels));
         } else {
             builder

@@ -368,16 +368,16 @@ impl World {
         }
         let (hl, hw, lw) = (f.length_cm / 2.0, f.width_cm / 2.0, f.line_width_cm);
         let half_lw = lw / 2.0;
-        let on_line = (ay <= hw && ay >= hw - lw && ax <= hl)
-            || (ax <= hl && ax >= hl - lw && ay <= hw)
-            || (ax <= half_lw && ay <= hw)
-            || ((x.hypot(y) - f.centre_circle_radius_cm).abs() <= half_lw)
-            || {
-                let front = hl - f.penalty_area_depth_cm;
-                let pw = f.penalty_area_width_cm / 2.0;
-                ((ax - front).abs() <= half_lw && ay <= pw + half_lw)
-                    || ((ay - pw).abs() <= half_lw && ax >= front && ax <= hl)
-            };
+        let inside = ax <= hl && ay <= hw;
+        let side_line = ay >= hw - lw;
+        let goal_line = ax >= hl - lw;
+        let centre_line = ax <= half_lw;
+        let circle = (x.hypot(y) - f.centre_circle_radius_cm).abs() <= half_lw;
+        let front = hl - f.penalty_area_depth_cm;
+        let pw = f.penalty_area_width_cm / 2.0;
+        let penalty = ((ax - front).abs() <= half_lw && ay <= pw + half_lw)
+            || ((ay - pw).abs() <= half_lw && ax >= front && ax <= hl);
+        let on_line = (inside && (side_line || goal_line || centre_line)) || circle || penalty;
         if on_line {
             Material::Line
         } else {

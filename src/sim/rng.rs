@@ -71,8 +71,7 @@ impl SimRng {
         if n == 0 {
             return 0;
         }
-        let i = ((u128::from(self.next_u64()) * n as u128) >> 64) as usize;
-        i
+        ((u128::from(self.next_u64()) * n as u128) >> 64) as usize
     }
 }
 
