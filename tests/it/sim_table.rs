@@ -20,6 +20,9 @@ fn shipped_sim_table_classifies_unseen_frames() {
     assert!(accuracy.colour_accuracy() > 0.97, "{accuracy:?}");
     assert!(accuracy.false_colour_rate() < 0.05, "{accuracy:?}");
     for class in [ColourClass::Orange, ColourClass::Green, ColourClass::White] {
-        assert!(accuracy.recall(class).unwrap() > 0.8, "{class:?}: {accuracy:?}");
+        assert!(
+            accuracy.recall(class).unwrap() > 0.8,
+            "{class:?}: {accuracy:?}"
+        );
     }
 }
