@@ -11,6 +11,8 @@
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
 //! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
+//! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
+//! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -18,9 +20,11 @@ pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
 pub mod frame;
+pub mod geometry;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;
 pub mod streams;
+pub mod sim;
 
 pub mod cli;

@@ -10,6 +10,7 @@ mod export;
 mod import;
 mod info;
 pub mod inputs;
+mod lut_from_labels;
 
 use std::process::ExitCode;
 
@@ -41,6 +42,8 @@ pub enum Command {
     Import(import::Args),
     /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
     Export(export::Args),
+    /// Build a first lookup table from labelled frames and score it on held-back frames.
+    LutFromLabels(lut_from_labels::Args),
 }
 
 /// Runs a headless subcommand.
@@ -55,6 +58,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(&a),
         Command::Import(a) => import::run(&a),
         Command::Export(a) => export::run(&a),
+        Command::LutFromLabels(a) => lut_from_labels::run(&a),
     }
 }
 

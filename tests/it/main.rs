@@ -6,3 +6,4 @@ mod cli;
 mod common;
 mod peer;
 mod streams;
+mod sim_table;
