@@ -10,6 +10,7 @@
 //! | [`classify`] | frame + table → classified image |
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
+//! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -17,6 +18,7 @@ pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
 pub mod frame;
+pub mod import;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;
