@@ -11,10 +11,13 @@
 //!
 //! **Images.** The JPEGImage payload is `i32 width` (320), `i32 height` (240), `u32 timeStamp`
 //! (ms), `u32 length` and a JPEG with 4 components (Adobe APP14, no colour transform). Each
-//! decoded "pixel" is one YUYV macropixel of the camera — Y0, Cb, Y1, Cr — stored inverted
-//! (255 − v, as Adobe CMYK is). The `image` crate converts 4-component JPEGs to RGB and cannot
-//! hand back the four raw channels, so this uses `zune-jpeg` (the decoder `image` itself uses)
-//! with CMYK output, which copies the components untouched.
+//! decoded "pixel" is one YUYV macropixel of the camera — Y0, Cb, Y1, Cr. The `image` crate
+//! converts 4-component JPEGs to RGB and cannot hand back the four raw channels, so this uses
+//! `zune-jpeg` (the decoder `image` itself uses) with CMYK output. Decoders in libjpeg's style
+//! return Adobe CMYK channels inverted (255 − v); zune-jpeg's CMYK output is already the values
+//! B-Human wrote, checked against their table: as decoded, frame 80 classifies (with one luma
+//! per macropixel, as B-Human did) into 49,623 green, 12,339 white and 3,880 orange pixels — their
+//! published ~49,600 / 12,300 / 3,900 — while the inverted values give 5,769 green and no orange.
 //!
 //! **Frames: 320×240 UYVY.** B-Human's camera gave 640×480 YUV 4:2:2; their software kept every
 //! second row and treated each macropixel (two camera pixels side by side) as one pixel of a
@@ -301,7 +304,7 @@ fn parse_sensors(p: &[u8]) -> Option<SensorRecord> {
 }
 
 /// Decodes a JPEGImage payload's JPEG to B-Human's macropixels: `width × height` entries of
-/// `[Y0, Cb, Y1, Cr]`, already un-inverted.
+/// `[Y0, Cb, Y1, Cr]` (zune-jpeg's CMYK output as it comes; see the module docs).
 ///
 /// # Errors
 /// A message when the JPEG does not decode or is not 4-component at the given size.
@@ -336,7 +339,7 @@ pub fn decode_macropixels(
         .map_err(|e| format!("JPEG data: {e:?}"))?;
     Ok(out
         .chunks_exact(4)
-        .map(|c| [255 - c[0], 255 - c[1], 255 - c[2], 255 - c[3]])
+        .map(|c| [c[0], c[1], c[2], c[3]])
         .collect())
 }
 
