@@ -349,14 +349,14 @@ pub fn decode_macropixels(
 /// # Errors
 /// A message when the width is odd or the count does not match.
 pub fn macropixels_to_uyvy(mp: &[[u8; 4]], width: usize, height: usize) -> Result<Frame, String> {
-    if width % 2 != 0 || mp.len() != width * height {
+    if !width.is_multiple_of(2) || mp.len() != width * height {
         return Err(format!(
             "{} macropixels for {width}×{height} (the width must be even)",
             mp.len()
         ));
     }
     let mean =
-        |a: u8, b: u8| u8::try_from((u16::from(a) + u16::from(b) + 1) / 2).unwrap_or(u8::MAX);
+        |a: u8, b: u8| u8::try_from((u16::from(a) + u16::from(b)).div_ceil(2)).unwrap_or(u8::MAX);
     let mut data = Vec::with_capacity(width * height * 2);
     for pair in mp.chunks_exact(2) {
         let (a, b) = (pair[0], pair[1]);
