@@ -319,9 +319,9 @@ fn bhuman_log_frames_sensors_and_frame_80() {
         f64::from(ball.pixels) > 0.5 * ball.area() as f64,
         "{ball:?}"
     );
-    // The carpet at the bottom centre is green (the decoding is not inverted or swapped).
-    let carpet = log.frames[80].frame.pixel(160, 230).unwrap();
-    assert_eq!(table.class_of(carpet), ColourClass::Green, "{carpet:?}");
+    // Green is the most common class: the field (the decoding is neither inverted nor swapped).
+    let top = (1..15).max_by_key(|&c| h[c]).unwrap();
+    assert_eq!(top, usize::from(ColourClass::Green.code()));
 }
 
 #[test]
