@@ -13,6 +13,7 @@
 //! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
 //! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
+//! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -21,6 +22,7 @@ pub mod blobs;
 pub mod classify;
 pub mod frame;
 pub mod geometry;
+pub mod import;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;

@@ -11,6 +11,7 @@ mod import;
 mod info;
 pub mod inputs;
 mod lut_from_labels;
+mod lut;
 
 use std::process::ExitCode;
 
@@ -44,6 +45,8 @@ pub enum Command {
     Export(export::Args),
     /// Build a first lookup table from labelled frames and score it on held-back frames.
     LutFromLabels(lut_from_labels::Args),
+    /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
+    Lut(lut::Args),
 }
 
 /// Runs a headless subcommand.
@@ -59,6 +62,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Import(a) => import::run(&a),
         Command::Export(a) => export::run(&a),
         Command::LutFromLabels(a) => lut_from_labels::run(&a),
+        Command::Lut(a) => lut::run(&a),
     }
 }
 

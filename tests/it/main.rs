@@ -7,3 +7,4 @@ mod common;
 mod peer;
 mod streams;
 mod sim_table;
+mod real_data;
