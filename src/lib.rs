@@ -19,6 +19,7 @@ pub mod classify;
 pub mod frame;
 pub mod lut;
 pub mod pipeline;
+pub mod recognition;
 pub mod sensors;
 
 pub mod cli;

@@ -1,0 +1,8 @@
+//! Object recognition on a classified frame and its blobs: the ball, goals with posts and the
+//! open gap, beacons, coloured patterns and the horizon. Every candidate carries a
+//! [`confidence::Confidence`] breakdown, and every scan is kept as drawing data, so the app and
+//! the JSON show why an object was or was not recognised.
+
+pub mod confidence;
+pub mod fit;
+pub mod scan;
