@@ -3,6 +3,9 @@
 //! [`confidence::Confidence`] breakdown, and every scan is kept as drawing data, so the app and
 //! the JSON show why an object was or was not recognised.
 
+pub mod ball;
 pub mod confidence;
+pub mod context;
+pub mod draw;
 pub mod fit;
 pub mod scan;
