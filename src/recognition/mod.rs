@@ -8,4 +8,5 @@ pub mod confidence;
 pub mod context;
 pub mod draw;
 pub mod fit;
+pub mod goals;
 pub mod scan;
