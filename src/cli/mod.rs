@@ -6,6 +6,7 @@
 mod bench;
 mod blobs;
 mod classify;
+pub mod detect;
 mod info;
 pub mod inputs;
 
@@ -35,6 +36,8 @@ pub enum Command {
     Blobs(blobs::Args),
     /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
     Bench(bench::Args),
+    /// Recognise ball, goals (posts, gap) and beacons; `--json` prints one line per frame.
+    Detect(detect::Args),
 }
 
 /// Runs a headless subcommand.
@@ -47,6 +50,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Classify(a) => classify::run(&a),
         Command::Blobs(a) => blobs::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Detect(a) => detect::run(&a),
     }
 }
 
