@@ -9,6 +9,7 @@ mod classify;
 pub mod detect;
 mod info;
 pub mod inputs;
+mod render;
 
 use std::process::ExitCode;
 
@@ -38,6 +39,8 @@ pub enum Command {
     Bench(bench::Args),
     /// Recognise ball, goals (posts, gap) and beacons; `--json` prints one line per frame.
     Detect(detect::Args),
+    /// Draw frames with recognition overlays (circles, posts, gaps, horizon, scans) as PNG.
+    Render(render::Args),
 }
 
 /// Runs a headless subcommand.
@@ -51,6 +54,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Blobs(a) => blobs::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Detect(a) => detect::run(&a),
+        Command::Render(a) => render::run(&a),
     }
 }
 
