@@ -10,6 +10,7 @@
 //! | [`fit`] | circle and line fits, rotation about a centre |
 //! | [`scan`] | horizon-parallel scan areas, the six edge-scan patterns, skew removal |
 //! | [`ball`], [`goals`], [`beacons`] | the recognisers |
+//! | [`patterns`] | the "almost SLAM" coloured-pattern recogniser (learn, then identify) |
 //! | [`draw`] | drawing primitives as data |
 
 pub mod ball;
@@ -19,6 +20,7 @@ pub mod context;
 pub mod draw;
 pub mod fit;
 pub mod goals;
+pub mod patterns;
 pub mod scan;
 
 use serde::{Deserialize, Serialize};
