@@ -13,6 +13,7 @@ use crate::blobs::{BlobSet, Connectivity};
 use crate::classify::{ClassifiedImage, classify_into};
 use crate::frame::Frame;
 use crate::lut::LookupTable;
+use crate::recognition::patterns::PatternMemory;
 use crate::recognition::{Recognition, RecognitionParams, recognise};
 use crate::sensors::SensorReadings;
 
@@ -71,6 +72,7 @@ pub struct Pipeline {
     classified: ClassifiedImage,
     blobs: BlobSet,
     recognition: Recognition,
+    pattern_memory: Option<PatternMemory>,
     timings: StageTimings,
 }
 
@@ -84,6 +86,7 @@ impl Pipeline {
             classified: ClassifiedImage::default(),
             blobs: BlobSet::default(),
             recognition: Recognition::default(),
+            pattern_memory: None,
             timings: StageTimings::default(),
         }
     }
@@ -104,7 +107,13 @@ impl Pipeline {
         if self.params.recognise {
             let p = &self.params.recognition;
             let ctx = p.context_for(frame.width(), frame.height(), sensors);
-            self.recognition = recognise(&self.classified, &self.blobs, &ctx, p);
+            self.recognition = recognise(
+                &self.classified,
+                &self.blobs,
+                &ctx,
+                p,
+                self.pattern_memory.as_ref(),
+            );
         } else {
             self.recognition = Recognition::default();
         }
@@ -142,6 +151,11 @@ impl Pipeline {
     /// Replaces the table.
     pub fn set_lut(&mut self, lut: LookupTable) {
         self.lut = lut;
+    }
+
+    /// Learnt coloured patterns used to identify pink markers (none: signatures only).
+    pub fn set_pattern_memory(&mut self, memory: Option<PatternMemory>) {
+        self.pattern_memory = memory;
     }
 
     /// The stage settings.

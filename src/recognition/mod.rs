@@ -45,6 +45,8 @@ pub struct RecognitionParams {
     pub goals: GoalParams,
     /// Beacon recognition.
     pub beacons: BeaconParams,
+    /// Coloured-pattern signatures.
+    pub patterns: patterns::PatternParams,
     /// Horizontal field of view (degrees) for frames other than 208×160 (which are the ERS-7's
     /// 56.9°). 46.4° is the Nao's camera.
     pub other_camera_fov_deg: f64,
@@ -58,6 +60,7 @@ impl Default for RecognitionParams {
             ball: BallParams::default(),
             goals: GoalParams::default(),
             beacons: BeaconParams::default(),
+            patterns: patterns::PatternParams::default(),
             other_camera_fov_deg: 46.4,
             body: Ers7Dimensions::ERS7,
         }
@@ -105,22 +108,35 @@ pub struct Recognition {
     pub goals: GoalResult,
     /// Beacon candidates; accepted ones are beacons.
     pub beacons: Vec<Beacon>,
+    /// Signatures around pink markers, with their identification when a pattern memory was
+    /// given.
+    pub patterns: Vec<(patterns::PatternObservation, Option<patterns::PatternMatch>)>,
     /// The horizon, when the camera pose was known.
     pub horizon: Option<Horizon>,
 }
 
-/// Runs every recogniser on a classified frame.
+/// Runs every recogniser on a classified frame; `memory` (learnt coloured patterns), when
+/// given, identifies the pink markers' signatures.
 #[must_use]
 pub fn recognise(
     img: &ClassifiedImage,
     blobs: &BlobSet,
     ctx: &ViewContext,
     params: &RecognitionParams,
+    memory: Option<&patterns::PatternMemory>,
 ) -> Recognition {
+    let observations = patterns::observe(img, blobs, ctx.camera.focal_px, &params.patterns);
     Recognition {
         ball: ball::recognise_ball(img, blobs, ctx, &params.ball),
         goals: goals::recognise_goals(img, blobs, ctx, &params.goals),
         beacons: beacons::recognise_beacons(blobs, ctx, &params.beacons),
+        patterns: observations
+            .into_iter()
+            .map(|o| {
+                let m = memory.and_then(|m| m.identify(&o, &params.patterns));
+                (o, m)
+            })
+            .collect(),
         horizon: ctx.horizon,
     }
 }
