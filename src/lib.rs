@@ -10,16 +10,22 @@
 //! | [`classify`] | frame + table → classified image |
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
+//! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
+//! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
 pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
+pub mod eval;
 pub mod frame;
+pub mod geometry;
 pub mod lut;
+pub mod overlay;
 pub mod pipeline;
 pub mod recognition;
 pub mod sensors;
+pub mod sim;
 
 pub mod cli;

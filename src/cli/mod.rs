@@ -9,6 +9,7 @@ mod classify;
 pub mod detect;
 mod info;
 pub mod inputs;
+mod lut_from_labels;
 mod render;
 
 use std::process::ExitCode;
@@ -41,6 +42,8 @@ pub enum Command {
     Detect(detect::Args),
     /// Draw frames with recognition overlays (circles, posts, gaps, horizon, scans) as PNG.
     Render(render::Args),
+    /// Build a first lookup table from labelled frames and score it on held-back frames.
+    LutFromLabels(lut_from_labels::Args),
 }
 
 /// Runs a headless subcommand.
@@ -55,6 +58,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(&a),
         Command::Detect(a) => detect::run(&a),
         Command::Render(a) => render::run(&a),
+        Command::LutFromLabels(a) => lut_from_labels::run(&a),
     }
 }
 

@@ -54,6 +54,9 @@ pub struct FrameEval {
     pub ball_reported: bool,
     /// The reported ball matches the true one.
     pub ball_correct: bool,
+    /// The reported ball is at least near the true one (within two radii): not a false ball,
+    /// though perhaps badly placed.
+    pub ball_near: bool,
     /// A ball was reported where there is none (or far from it).
     pub ball_false: bool,
     /// The true ball is cut off by the image edge.
@@ -110,9 +113,17 @@ pub fn evaluate_frame(
             && 2.0 * radius >= p.ball_min_diameter_px;
         e.ball_cut = tb.cut_off.left || tb.cut_off.right || tb.cut_off.top || tb.cut_off.bottom;
         if let (Some(b), Some(img)) = (reported, tb.relative.image) {
-            let tol = (p.ball_match_radius_fraction * radius).max(p.ball_match_min_px);
+            // A ball cut by the image edge is matched within its radius, an uncut one within
+            // half of it; anything within two radii is at least the ball (not a false one).
+            let fraction = if e.ball_cut {
+                1.0
+            } else {
+                p.ball_match_radius_fraction
+            };
+            let tol = (fraction * radius).max(p.ball_match_min_px);
             let off = (b.center_x - img.x_px).hypot(b.center_y - img.y_px);
             e.ball_correct = off <= tol;
+            e.ball_near = off <= 2.0 * radius + p.ball_match_min_px;
             if e.ball_correct {
                 let d = tb.relative.camera_distance_cm;
                 e.ball_distance_error = Some((b.camera.distance_cm - d).abs() / d);
@@ -122,7 +133,7 @@ pub fn evaluate_frame(
             }
         }
     }
-    e.ball_false = e.ball_reported && !e.ball_correct;
+    e.ball_false = e.ball_reported && !e.ball_near;
 
     for tg in &t.goals {
         let class = goal_class(tg.colour);
@@ -130,7 +141,11 @@ pub fn evaluate_frame(
             (Some(a), Some(b)) => {
                 let (l, rr) = (a.x_px.min(b.x_px), a.x_px.max(b.x_px));
                 let inside = (rr.min(width) - l.max(0.0)).max(0.0);
-                if rr - l > 1e-9 { inside / (rr - l) } else { 0.0 }
+                if rr - l > 1e-9 {
+                    inside / (rr - l)
+                } else {
+                    0.0
+                }
             }
             _ => 0.0,
         };
@@ -145,7 +160,8 @@ pub fn evaluate_frame(
         }
         if !g.cut_off.top && !g.cut_off.bottom && !g.distance_from_ir {
             let d = tg.relative.camera_distance_cm;
-            e.goal_distance_errors.push((g.camera.distance_cm - d).abs() / d);
+            e.goal_distance_errors
+                .push((g.camera.distance_cm - d).abs() / d);
         }
         for post in &g.posts {
             // The true post nearest this one at the foot row.
@@ -154,11 +170,21 @@ pub fn evaluate_frame(
                 .iter()
                 .filter_map(|tp| Some((tp.image_base?, tp.image_top?)))
                 .filter(|(b, top)| {
-                    [b, top].iter().all(|q| q.x_px >= 0.0 && q.x_px <= width && q.y_px >= 0.0 && q.y_px <= height)
+                    [b, top].iter().all(|q| {
+                        q.x_px >= 0.0 && q.x_px <= width && q.y_px >= 0.0 && q.y_px <= height
+                    })
                 })
                 .map(|(base, top)| {
-                    let at = |y: f64| if post.fit.steep { post.fit.at(y).0 } else { post.top.0 };
-                    (at(base.y_px) - base.x_px).abs().max((at(top.y_px) - top.x_px).abs())
+                    let at = |y: f64| {
+                        if post.fit.steep {
+                            post.fit.at(y).0
+                        } else {
+                            post.top.0
+                        }
+                    };
+                    (at(base.y_px) - base.x_px)
+                        .abs()
+                        .max((at(top.y_px) - top.x_px).abs())
                 })
                 .fold(f64::INFINITY, f64::min);
             if best.is_finite() {
@@ -177,7 +203,11 @@ pub fn evaluate_frame(
         .filter(|g| g.visible_pixels > 0)
         .map(|g| goal_class(g.colour))
         .collect();
-    e.goals_false = r.goals.goals().filter(|g| !in_view.contains(&g.colour)).count();
+    e.goals_false = r
+        .goals
+        .goals()
+        .filter(|g| !in_view.contains(&g.colour))
+        .count();
     e
 }
 
@@ -333,7 +363,9 @@ pub fn fit_inverse_size(samples: &[(f64, f64)]) -> Option<(f64, f64)> {
     if pts.len() < 2 {
         return None;
     }
-    let (mx, my) = pts.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
     let (sxx, sxy) = pts.iter().fold((0.0, 0.0), |(a, b), p| {
         (a + (p.0 - mx).powi(2), b + (p.0 - mx) * (p.1 - my))
     });
@@ -358,7 +390,10 @@ mod tests {
 
     #[test]
     fn inverse_size_fit_recovers_the_relation() {
-        let samples: Vec<(f64, f64)> = [10.0, 20.0, 40.0].iter().map(|h| (*h, 5757.0 / h + 12.0)).collect();
+        let samples: Vec<(f64, f64)> = [10.0, 20.0, 40.0]
+            .iter()
+            .map(|h| (*h, 5757.0 / h + 12.0))
+            .collect();
         let (m, o) = fit_inverse_size(&samples).expect("fit");
         assert!((m - 5757.0).abs() < 1e-6 && (o - 12.0).abs() < 1e-6);
         assert!(fit_inverse_size(&[(10.0, 5.0)]).is_none());
@@ -367,9 +402,25 @@ mod tests {
     #[test]
     fn report_counts_misses_and_false_balls() {
         let frames = vec![
-            FrameEval { frame: 0, ball_eligible: true, ball_reported: true, ball_correct: true, ball_distance_error: Some(0.02), ..FrameEval::default() },
-            FrameEval { frame: 1, ball_eligible: true, ..FrameEval::default() },
-            FrameEval { frame: 2, ball_reported: true, ball_false: true, ..FrameEval::default() },
+            FrameEval {
+                frame: 0,
+                ball_eligible: true,
+                ball_reported: true,
+                ball_correct: true,
+                ball_distance_error: Some(0.02),
+                ..FrameEval::default()
+            },
+            FrameEval {
+                frame: 1,
+                ball_eligible: true,
+                ..FrameEval::default()
+            },
+            FrameEval {
+                frame: 2,
+                ball_reported: true,
+                ball_false: true,
+                ..FrameEval::default()
+            },
         ];
         let r = EvalReport::from_frames(&frames);
         assert_eq!((r.ball_eligible, r.ball_found, r.ball_false), (2, 1, 1));

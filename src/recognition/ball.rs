@@ -59,6 +59,13 @@ pub struct BallParams {
     /// A fitted circle is rejected when its residual spread exceeds this fraction of its radius
     /// plus 0.75 px.
     pub max_fit_residual_ratio: f64,
+    /// Largest visible extent along a cut-off axis relative to the uncut extent (a ball cut at
+    /// the top cannot be taller than wide).
+    pub max_cut_extent_ratio: f64,
+    /// Weight of the cut-extent test.
+    pub cut_extent_weight: TestWeight,
+    /// Penalty when the outline was scanned but does not fit a circle.
+    pub bad_circle_penalty: f64,
     /// Remove the horizontal rolling-shutter shear (pan velocity) before fitting.
     pub skew_correction: bool,
     /// Remove the vertical counterpart (tilt velocity) before fitting; off by default.
@@ -85,6 +92,9 @@ impl Default for BallParams {
             edge_margin_px: 3,
             min_fit_diameter_ratio: 0.75,
             max_fit_residual_ratio: 0.15,
+            max_cut_extent_ratio: 1.25,
+            cut_extent_weight: TestWeight::new(0.0, 3.0),
+            bad_circle_penalty: 1.5,
             skew_correction: true,
             vertical_skew_correction: false,
         }
@@ -277,11 +287,15 @@ pub fn recognise_ball(
         let pattern = EdgeScanPattern::for_cut_off(cut);
         let mut points = edge_points(img, bounds, pattern, params.edge_margin_px, is_ball_colour);
         let (box_centre, box_radius) = box_estimate(&group, cut);
+        // Move every outline point to the read-out time of the reference row, the instant the
+        // sensor readings describe: this removes the shear and puts the ball where the camera
+        // pose says it is.
+        let reference = ctx.reference_row();
         if params.skew_correction {
-            unskew_points(&mut points, ctx.skew_x_per_line, box_centre.1);
+            unskew_points(&mut points, ctx.skew_x_per_line, reference);
         }
         if params.vertical_skew_correction {
-            unskew_points_vertical(&mut points, ctx.skew_y_per_line, box_centre.1);
+            unskew_points_vertical(&mut points, ctx.skew_y_per_line, reference);
         }
         let w = f64::from(group.maxx - group.minx + 1);
         let h = f64::from(group.maxy - group.miny + 1);
@@ -313,6 +327,10 @@ pub fn recognise_ball(
         let use_fit = fit.is_some() && fit_rejected.is_none();
         let (center, radius) = match (&fit, use_fit) {
             (Some(f), true) => ((f.center_x, f.center_y), f.radius),
+            _ if params.skew_correction => (
+                ctx.unskew(box_centre, params.vertical_skew_correction),
+                box_radius,
+            ),
             _ => (box_centre, box_radius),
         };
         let distance = d * params.diameter_cm / (2.0 * radius).max(0.5);
@@ -326,6 +344,27 @@ pub fn recognise_ball(
             params.orange_fraction,
             params.orange_fraction_weight,
         );
+        let horizontal_cut = cut.left || cut.right;
+        let vertical_cut = cut.top || cut.bottom;
+        if horizontal_cut != vertical_cut {
+            let ratio = if horizontal_cut { w / h } else { h / w };
+            confidence.range_test(
+                "cut_extent",
+                ratio,
+                [0.0, params.max_cut_extent_ratio],
+                params.cut_extent_weight,
+            );
+        }
+        if let (Some(f), Some(why)) = (&fit, &fit_rejected)
+            && why.starts_with("residual")
+        {
+            confidence.range_test(
+                "circle_residual_px",
+                f.residual_sd,
+                [0.0, params.max_fit_residual_ratio * f.radius + 0.75],
+                TestWeight::new(0.0, params.bad_circle_penalty),
+            );
+        }
         if cut.any() {
             confidence.skipped("pixel_ratio", params.pixel_ratio);
             confidence.skipped("roundness", params.aspect);

@@ -111,6 +111,27 @@ impl ViewContext {
         ctx
     }
 
+    /// The row whose read-out time the sensor readings describe (the middle of the read-out),
+    /// pixels.
+    #[must_use]
+    pub fn reference_row(&self) -> f64 {
+        self.camera.height_px as f64 / 2.0
+    }
+
+    /// Moves an image point to where it would have been seen at the reference row's read-out
+    /// time, removing the rolling shutter's horizontal shear (and, with `vertical`, the tilt's
+    /// stretch). Rows above the reference were read earlier, rows below later.
+    #[must_use]
+    pub fn unskew(&self, p: Point, vertical: bool) -> Point {
+        let lines = p.1 - self.reference_row();
+        let y = if vertical {
+            p.1 - self.skew_y_per_line * lines
+        } else {
+            p.1
+        };
+        (p.0 - self.skew_x_per_line * lines, y)
+    }
+
     /// The horizon's angle on screen (radians, counter-clockwise positive), 0 without a pose.
     /// Scans "parallel to the ground" rotate by minus this angle.
     #[must_use]

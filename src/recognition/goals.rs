@@ -55,8 +55,15 @@ pub struct GoalParams {
     pub pixel_ratio_weight: TestWeight,
     /// Green fraction below the goal that earns a bonus.
     pub green_below: [f64; 2],
-    /// Bonus for green below.
+    /// Bonus for green (or white lines) below.
     pub green_below_bonus: f64,
+    /// Penalty when there is too little green below (a yellow thing off the field).
+    pub green_below_penalty: f64,
+    /// Accepted ratio of the size-based distance to the distance of the bottom's foot on the
+    /// ground (through the camera pose); a thing of another height than a goal fails.
+    pub distance_agreement: [f64; 2],
+    /// Weight of the distance-agreement test.
+    pub distance_agreement_weight: TestWeight,
     /// Accepted height of the goal's bottom above the ground, centimetres.
     pub bottom_height_cm: [f64; 2],
     /// Weight of the bottom-height test.
@@ -77,6 +84,10 @@ pub struct GoalParams {
     pub gap_scan_height_cm: f64,
     /// Holes up to this many pixels inside a goal-coloured run do not end it.
     pub gap_hole_px: u32,
+    /// Move posts, gap and centre to the reference row's read-out time (rolling shutter).
+    pub skew_correction: bool,
+    /// Penalty for a candidate overlapping an accepted beacon (its yellow or sky-blue band).
+    pub beacon_overlap_penalty: f64,
 }
 
 impl Default for GoalParams {
@@ -99,6 +110,9 @@ impl Default for GoalParams {
             pixel_ratio_weight: TestWeight::new(0.5, 1.5),
             green_below: [0.2, 1.0],
             green_below_bonus: 1.0,
+            green_below_penalty: 1.5,
+            distance_agreement: [0.6, 1.6],
+            distance_agreement_weight: TestWeight::new(1.0, 3.0),
             bottom_height_cm: [-20.0, 20.0],
             bottom_height_weight: TestWeight::new(1.0, 3.0),
             elevation_rad: [-0.8, 0.5],
@@ -109,6 +123,8 @@ impl Default for GoalParams {
             post_max_residual_variance: 2.0,
             gap_scan_height_cm: 15.0,
             gap_hole_px: 1,
+            skew_correction: true,
+            beacon_overlap_penalty: 10.0,
         }
     }
 }
@@ -323,6 +339,14 @@ fn build_groups(
     groups
 }
 
+/// Share of box `a` covered by box `b` (inclusive pixel boxes).
+fn overlap_fraction(a: [u32; 4], b: [u32; 4]) -> f64 {
+    let w = (a[2].min(b[2]) + 1).saturating_sub(a[0].max(b[0]));
+    let h = (a[3].min(b[3]) + 1).saturating_sub(a[1].max(b[1]));
+    let area = f64::from(a[2] - a[0] + 1) * f64::from(a[3] - a[1] + 1);
+    f64::from(w) * f64::from(h) / area
+}
+
 /// Cut-off detection: the level box's 8 points (corners and side midpoints), rotated back into
 /// the image; a side is cut off when two or more of its three points are near or outside the edge.
 fn detect_cut_off(e: [f64; 4], centre: Point, angle: f64, w: f64, h: f64, margin: f64) -> CutOff {
@@ -350,12 +374,26 @@ pub fn recognise_goals(
     blobs: &BlobSet,
     ctx: &ViewContext,
     p: &GoalParams,
+    beacons: &[[u32; 4]],
 ) -> GoalResult {
     let mut result = GoalResult::default();
     for colour in [ColourClass::Yellow, ColourClass::SkyBlue] {
         let mut accepted_one = false;
         for g in build_groups(blobs, colour, ctx, p) {
             let mut cand = examine(img, &g, colour, ctx, p);
+            // A beacon's yellow or sky-blue band is not a goal.
+            let overlap = beacons
+                .iter()
+                .map(|b| overlap_fraction(cand.bounds, *b))
+                .fold(0.0, f64::max);
+            if overlap > 0.0 {
+                cand.confidence.range_test(
+                    "beacon_overlap",
+                    overlap,
+                    [0.0, 0.2],
+                    TestWeight::new(0.0, p.beacon_overlap_penalty),
+                );
+            }
             if !accepted_one && cand.confidence.accepted() {
                 cand.accepted = true;
                 accepted_one = true;
@@ -397,11 +435,14 @@ fn examine(
         distance = ir;
         from_ir = true;
     }
-    let mid = rotate_about(
+    let mut mid = rotate_about(
         ((e_all[0] + e_all[2]) / 2.0, (e_all[1] + e_all[3]) / 2.0),
         centre,
         -angle,
     );
+    if p.skew_correction {
+        mid = ctx.unskew(mid, false);
+    }
     let camera = ctx.camera_relative(mid, distance);
     let body = ctx.body_relative(mid, distance);
     let mut confidence = Confidence::default();
@@ -435,7 +476,12 @@ fn examine(
             (band / 4.0).max(1.0),
         );
         match below.ratio(|c| c == ColourClass::Green.code() || c == ColourClass::White.code()) {
-            Some(r) => confidence.bonus_test("green_below", r, p.green_below, p.green_below_bonus),
+            Some(r) => confidence.range_test(
+                "green_below",
+                r,
+                p.green_below,
+                TestWeight::new(p.green_below_bonus, p.green_below_penalty),
+            ),
             None => confidence.skipped("green_below", p.green_below),
         }
         if cut.bottom {
@@ -450,6 +496,16 @@ fn examine(
                 ),
                 None => confidence.skipped("bottom_height_cm", p.bottom_height_cm),
             }
+        }
+        let foot = ctx.distance_to_plane(bottom_mid, 0.0);
+        match foot {
+            Some(f) if !cut.bottom && !cut.top && f > 0.0 => confidence.range_test(
+                "distance_agreement",
+                distance / f,
+                p.distance_agreement,
+                p.distance_agreement_weight,
+            ),
+            _ => confidence.skipped("distance_agreement", p.distance_agreement),
         }
         match &body {
             Some(b) => confidence.range_test(
@@ -631,8 +687,12 @@ fn find_posts_and_gap(
         rotate_about((e[2], y), centre, -angle),
     ));
     if let Some((a, b)) = best {
-        let left = rotate_about((a, y), centre, -angle);
-        let right = rotate_about((b, y), centre, -angle);
+        let mut left = rotate_about((a, y), centre, -angle);
+        let mut right = rotate_about((b, y), centre, -angle);
+        if p.skew_correction {
+            left = ctx.unskew(left, false);
+            right = ctx.unskew(right, false);
+        }
         let mid = ((left.0 + right.0) / 2.0, (left.1 + right.1) / 2.0);
         cand.gap = Some(Gap {
             left,
@@ -764,7 +824,7 @@ mod tests {
         let bottom = foot.y_px.round() as usize;
         let img = scene(40, 150, bottom - 25, bottom, Some((70, 90, bottom - 35)));
         let blobs = BlobSet::from_image(&img, Connectivity::Eight);
-        let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default());
+        let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default(), &[]);
         let goals: Vec<_> = res.goals().collect();
         assert_eq!(goals.len(), 1, "{:#?}", res.candidates);
         let g = goals[0];
@@ -804,7 +864,7 @@ mod tests {
         let ctx = ctx();
         let img = scene(0, 60, 0, 90, None);
         let blobs = BlobSet::from_image(&img, Connectivity::Eight);
-        let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default());
+        let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default(), &[]);
         let g = res.goals().next().expect("goal");
         assert!(g.cut_off.left && g.cut_off.top && !g.cut_off.right && !g.cut_off.bottom);
         assert!(g.distance_is_max);
@@ -838,7 +898,7 @@ mod tests {
     fn no_goal_colour_no_candidates() {
         let img = scene(0, 0, 0, 90, None);
         let blobs = BlobSet::from_image(&img, Connectivity::Eight);
-        let res = recognise_goals(&img, &blobs, &ctx(), &GoalParams::default());
+        let res = recognise_goals(&img, &blobs, &ctx(), &GoalParams::default(), &[]);
         assert!(res.candidates.is_empty());
     }
 }

@@ -126,10 +126,16 @@ pub fn recognise(
     memory: Option<&patterns::PatternMemory>,
 ) -> Recognition {
     let observations = patterns::observe(img, blobs, ctx.camera.focal_px, &params.patterns);
+    let beacons = beacons::recognise_beacons(blobs, ctx, &params.beacons);
+    let beacon_boxes: Vec<[u32; 4]> = beacons
+        .iter()
+        .filter(|b| b.accepted)
+        .map(|b| b.bounds)
+        .collect();
     Recognition {
         ball: ball::recognise_ball(img, blobs, ctx, &params.ball),
-        goals: goals::recognise_goals(img, blobs, ctx, &params.goals),
-        beacons: beacons::recognise_beacons(blobs, ctx, &params.beacons),
+        goals: goals::recognise_goals(img, blobs, ctx, &params.goals, &beacon_boxes),
+        beacons,
         patterns: observations
             .into_iter()
             .map(|o| {

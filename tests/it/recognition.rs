@@ -1,0 +1,174 @@
+//! Recognition on the renderer's scenarios, measured against their ground truth with the same
+//! evaluation `eotn eval` prints. The table is learnt from labelled frames of other seeds (as
+//! `eotn lut-from-labels` does), so the test frames are held back.
+
+use eotn::eval::{EvalParams, EvalReport, FrameEval, evaluate_frame};
+use eotn::lut::LookupTable;
+use eotn::lut::learn::{LearnParams, TableBuilder};
+use eotn::pipeline::{Pipeline, PipelineParams};
+use eotn::sim::truth::GroundTruth;
+use eotn::sim::{Scenario, ScenarioKind, Simulator};
+
+const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
+    ScenarioKind::WalkAndPan,
+    ScenarioKind::BallEdge,
+    ScenarioKind::Goalkeeper,
+    ScenarioKind::FastPans,
+    ScenarioKind::OrangeClutter,
+    ScenarioKind::BeaconTour,
+];
+
+/// A table learnt from every 10th frame of each robot scenario with seed 100.
+fn learnt_table() -> LookupTable {
+    let mut builder = TableBuilder::new(7).expect("7 bits");
+    for kind in ROBOT_SCENARIOS {
+        let sim = Simulator::new(Scenario::new(kind, 100));
+        for i in (0..90).step_by(10) {
+            let f = sim.frame(i).expect("frame");
+            builder.add_frame(&f.frame, &f.labels).expect("labels fit");
+        }
+    }
+    builder.build(&LearnParams::default())
+}
+
+fn evaluate(
+    kind: ScenarioKind,
+    seed: u64,
+    frames: u64,
+    lut: &LookupTable,
+    params: PipelineParams,
+) -> EvalReport {
+    let sim = Simulator::new(Scenario::new(kind, seed));
+    let mut pipeline = Pipeline::new(lut.clone(), params);
+    let mut evals: Vec<FrameEval> = Vec::new();
+    for i in 0..frames {
+        let f = sim.frame(i).expect("frame");
+        let GroundTruth::Robot(truth) = &f.ground_truth else {
+            panic!("robot scenario gave an overhead frame");
+        };
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        let (w, h) = (f.frame.width() as f64, f.frame.height() as f64);
+        evals.push(evaluate_frame(
+            i as usize,
+            r.recognition,
+            truth,
+            w,
+            h,
+            &EvalParams::default(),
+        ));
+    }
+    let report = EvalReport::from_frames(&evals);
+    eprintln!(
+        "{}: {}",
+        kind.name(),
+        serde_json::to_string(&report).expect("json")
+    );
+    report
+}
+
+#[test]
+fn recognition_meets_its_targets_on_synthetic_scenarios() {
+    let lut = learnt_table();
+    let params = PipelineParams::default();
+    let mut all = Vec::new();
+    for kind in ROBOT_SCENARIOS {
+        all.push((kind, evaluate(kind, 7, 90, &lut, params)));
+    }
+    let sum = |f: &dyn Fn(&EvalReport) -> usize| all.iter().map(|(_, r)| f(r)).sum::<usize>();
+    let eligible = sum(&|r| r.ball_eligible);
+    let found = sum(&|r| r.ball_found);
+    eprintln!("ball found {found}/{eligible}");
+    assert!(eligible > 50, "scenarios must show the ball");
+    assert!(
+        found as f64 >= 0.98 * eligible as f64,
+        "ball found {found}/{eligible}"
+    );
+    let clutter = &all
+        .iter()
+        .find(|(k, _)| *k == ScenarioKind::OrangeClutter)
+        .expect("clutter")
+        .1;
+    assert!(
+        clutter.ball_false as f64 <= 0.005 * clutter.frames as f64,
+        "false balls in clutter frames {:?}",
+        clutter.ball_false_frames
+    );
+    let goals_eligible = sum(&|r| r.goals_eligible);
+    let goals_found = sum(&|r| r.goals_found);
+    eprintln!("goals found {goals_found}/{goals_eligible}");
+    assert!(goals_found as f64 >= 0.97 * goals_eligible as f64);
+}
+
+/// Prints what happened per frame: `EOTN_DEBUG_SCENARIO=fast-pans cargo test --test it
+/// debug_scenario -- --ignored --nocapture`.
+#[test]
+#[ignore = "a debugging aid, not a check"]
+fn debug_scenario() {
+    let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "walk-and-pan".into());
+    let kind = ScenarioKind::from_name(&name).expect("scenario name");
+    let lut = learnt_table();
+    let sim = Simulator::new(Scenario::new(kind, 7));
+    let mut pipeline = Pipeline::new(lut, PipelineParams::default());
+    for i in 0..90 {
+        let f = sim.frame(i).expect("frame");
+        let GroundTruth::Robot(truth) = &f.ground_truth else {
+            continue;
+        };
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        let tb = truth.ball.as_ref().filter(|b| b.visible_pixels > 0);
+        let db = r.recognition.ball.ball.as_ref();
+        eprintln!(
+            "#{i} pan {:?} prev {:?} | truth ball {:?} | found {:?} | cands {:?}",
+            f.sensors
+                .and_then(|s| s.head_pan_rad)
+                .map(|v| (v * 1000.0).round() / 1000.0),
+            f.sensors
+                .and_then(|s| s.previous_head_pan_rad)
+                .map(|v| (v * 1000.0).round() / 1000.0),
+            tb.map(|b| (
+                b.relative.image.map(|p| (p.x_px.round(), p.y_px.round())),
+                b.image_radius_px.map(|r| (r * 10.0).round() / 10.0),
+                b.relative.camera_distance_cm.round(),
+                b.visible_fraction
+            )),
+            db.map(|b| (
+                (b.center_x.round(), b.center_y.round()),
+                (b.radius_px * 10.0).round() / 10.0,
+                b.camera.distance_cm.round()
+            )),
+            r.recognition
+                .ball
+                .candidates
+                .iter()
+                .map(|c| (
+                    c.bounds,
+                    c.pixels,
+                    (c.confidence.total * 10.0).round() / 10.0,
+                    c.fit_rejected.clone()
+                ))
+                .collect::<Vec<_>>(),
+        );
+        for g in r.recognition.goals.candidates.iter().filter(|g| g.accepted) {
+            let t = truth
+                .goals
+                .iter()
+                .find(|t| eotn::eval::goal_class(t.colour) == g.colour);
+            eprintln!(
+                "    goal {:?} {:?} d {:.0} (truth {:?}) posts {:?} truth posts {:?}",
+                g.colour,
+                g.bounds,
+                g.camera.distance_cm,
+                t.map(|t| (t.relative.camera_distance_cm.round(), t.visible_pixels)),
+                g.posts
+                    .iter()
+                    .map(|p| (p.top, p.bottom))
+                    .collect::<Vec<_>>(),
+                t.map(|t| t
+                    .posts
+                    .iter()
+                    .map(|p| (p.image_top, p.image_base))
+                    .collect::<Vec<_>>())
+            );
+        }
+    }
+}
