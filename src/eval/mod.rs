@@ -65,7 +65,7 @@ pub struct FrameEval {
     pub ball_distance_error: Option<f64>,
     /// Bearing error of a correct ball, radians.
     pub ball_bearing_error_rad: Option<f64>,
-    /// Radius error of a correct ball, pixels.
+    /// Radius error of a reported ball near the true one, pixels.
     pub ball_radius_error_px: Option<f64>,
     /// Goals that had to be found.
     pub goals_eligible: usize,
@@ -129,6 +129,8 @@ pub fn evaluate_frame(
                 e.ball_distance_error = Some((b.camera.distance_cm - d).abs() / d);
                 e.ball_bearing_error_rad =
                     Some((b.camera.bearing_rad - tb.relative.camera_bearing_rad).abs());
+            }
+            if e.ball_near {
                 e.ball_radius_error_px = Some((b.radius_px - radius).abs());
             }
         }

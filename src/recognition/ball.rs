@@ -66,6 +66,18 @@ pub struct BallParams {
     pub cut_extent_weight: TestWeight,
     /// Penalty when the outline was scanned but does not fit a circle.
     pub bad_circle_penalty: f64,
+    /// Combine the size-based distance with where the ray through the centre meets the plane of
+    /// ball centres (through the camera pose), weighting each by its expected error. Beyond the
+    /// original: far balls are a few pixels wide, and half a pixel of radius is 10% of distance.
+    pub ground_plane_fusion: bool,
+    /// Added to every measured radius, pixels: the classified outline of a real ball is a little
+    /// larger than its geometric disc (edge pixels mixing ball and carpet classify as ball);
+    /// `eotn eval` measures it.
+    pub radius_bias_px: f64,
+    /// Expected error of the fitted radius, pixels.
+    pub radius_sigma_px: f64,
+    /// Expected error of the camera's pitch from the joints and body model, radians.
+    pub pose_sigma_rad: f64,
     /// Remove the horizontal rolling-shutter shear (pan velocity) before fitting.
     pub skew_correction: bool,
     /// Remove the vertical counterpart (tilt velocity) before fitting; off by default.
@@ -95,10 +107,45 @@ impl Default for BallParams {
             max_cut_extent_ratio: 1.25,
             cut_extent_weight: TestWeight::new(0.0, 3.0),
             bad_circle_penalty: 1.5,
+            ground_plane_fusion: true,
+            radius_bias_px: 0.0,
+            radius_sigma_px: 0.5,
+            pose_sigma_rad: 0.01,
             skew_correction: true,
             vertical_skew_correction: false,
         }
     }
+}
+
+/// Inverse-variance combination of the size-based distance with the ground-plane one. The
+/// plane distance D = h / sin φ (h: camera height above ball centres, φ: depression of the ray)
+/// has an error of about D² / h · σ_φ; the size distance one of D · σ_r / r. When the two
+/// disagree by more than a factor of two (a ball in the air or held), the size distance stands.
+fn fuse_with_ground_plane(
+    ctx: &ViewContext,
+    center: Point,
+    radius: f64,
+    size_distance: f64,
+    params: &BallParams,
+) -> f64 {
+    let Some(pose) = ctx.pose else {
+        return size_distance;
+    };
+    let ip = crate::geometry::ImagePoint::new(center.0, center.1);
+    let Some(hit) = pose.point_on_plane(ip, params.diameter_cm / 2.0) else {
+        return size_distance;
+    };
+    let plane = hit.distance_to(&pose.position());
+    if !(plane.is_finite() && plane > 0.5 * size_distance && plane < 2.0 * size_distance) {
+        return size_distance;
+    }
+    let h = (pose.position().z() - params.diameter_cm / 2.0)
+        .abs()
+        .max(1.0);
+    let sigma_phi = params.pose_sigma_rad + params.radius_sigma_px / ctx.camera.focal_px;
+    let var_plane = (plane * plane / h * sigma_phi).powi(2);
+    let var_size = (size_distance * params.radius_sigma_px / radius.max(0.5)).powi(2);
+    (plane / var_plane + size_distance / var_size) / (1.0 / var_plane + 1.0 / var_size)
 }
 
 /// The recognised ball.
@@ -333,7 +380,13 @@ pub fn recognise_ball(
             ),
             _ => (box_centre, box_radius),
         };
-        let distance = d * params.diameter_cm / (2.0 * radius).max(0.5);
+        let radius = (radius + params.radius_bias_px).max(0.5);
+        let size_distance = d * params.diameter_cm / (2.0 * radius);
+        let distance = if params.ground_plane_fusion {
+            fuse_with_ground_plane(ctx, center, radius, size_distance, params)
+        } else {
+            size_distance
+        };
         let camera = ctx.camera_relative(center, distance);
 
         let mut confidence = Confidence::default();
