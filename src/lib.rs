@@ -12,6 +12,7 @@
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
 //! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
+//! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -27,5 +28,6 @@ pub mod pipeline;
 pub mod recognition;
 pub mod sensors;
 pub mod sim;
+pub mod streams;
 
 pub mod cli;

@@ -7,10 +7,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use serde::Serialize;
 
-use super::inputs::{
-    expand_frame_paths, frame_name, load_frame_arg, load_lut_arg, parse_connectivity, parse_size,
-    progress,
-};
+use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
 use crate::blobs::Connectivity;
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::{GoalCandidate, Recognition, Relative};
@@ -19,7 +16,8 @@ use crate::sensors::SensorReadings;
 /// Arguments of `eotn detect`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them.
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (which carry their own
+    /// sensor readings).
     #[arg(required = true)]
     pub frames: Vec<PathBuf>,
     /// Lookup table (`.lut`).
@@ -310,7 +308,7 @@ pub fn load_params(
 /// Unreadable or malformed inputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let lut = load_lut_arg(&args.lut)?;
-    let paths = expand_frame_paths(&args.frames)?;
+    let mut inputs = FrameInputs::open(&args.frames, None)?;
     let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
     let params = PipelineParams {
         connectivity: args.connectivity,
@@ -320,15 +318,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut pipeline = Pipeline::new(lut, params);
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    let bar = progress(paths.len(), "detect");
-    for (i, path) in paths.iter().enumerate() {
-        let frame = load_frame_arg(path, args.size)?;
-        let readings = sensors
+    let bar = progress(inputs.len(), "detect");
+    for i in 0..inputs.len() {
+        let (frame, recorded) = inputs.load_with_sensors(i, args.size)?;
+        let from_file = sensors
             .as_ref()
             .and_then(|s| if s.len() == 1 { s.first() } else { s.get(i) });
+        let readings = recorded.as_ref().or(from_file);
         let result = pipeline.process(&frame, readings);
         let us = result.timings.recognition.as_secs_f64() * 1e6;
-        let line = detect_json(frame_name(path), result.recognition, us, args.evidence);
+        let line = detect_json(inputs.name(i), result.recognition, us, args.evidence);
         if args.json {
             serde_json::to_writer(&mut out, &line)?;
             writeln!(out)?;

@@ -7,6 +7,9 @@ mod bench;
 mod blobs;
 mod classify;
 pub mod detect;
+mod eval;
+mod export;
+mod import;
 mod info;
 pub mod inputs;
 mod lut_from_labels;
@@ -42,8 +45,15 @@ pub enum Command {
     Detect(detect::Args),
     /// Draw frames with recognition overlays (circles, posts, gaps, horizon, scans) as PNG.
     Render(render::Args),
+    /// Compare recognition with the ground truth of synthetic streams: rates, errors, misses;
+    /// two tables or parameter sets side by side; goal-distance calibration.
+    Eval(eval::Args),
     /// Build a first lookup table from labelled frames and score it on held-back frames.
     LutFromLabels(lut_from_labels::Args),
+    /// Build an MCAP stream from frame files and a CSV/JSON table of sensor readings.
+    Import(import::Args),
+    /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
+    Export(export::Args),
 }
 
 /// Runs a headless subcommand.
@@ -58,7 +68,10 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(&a),
         Command::Detect(a) => detect::run(&a),
         Command::Render(a) => render::run(&a),
+        Command::Eval(a) => eval::run(&a),
         Command::LutFromLabels(a) => lut_from_labels::run(&a),
+        Command::Import(a) => import::run(&a),
+        Command::Export(a) => export::run(&a),
     }
 }
 

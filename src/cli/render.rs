@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 
 use super::detect::{load_params, load_sensor_file};
-use super::inputs::{expand_frame_paths, frame_name, load_frame_arg, load_lut_arg, parse_size};
+use super::inputs::{FrameInputs, load_lut_arg, parse_size};
 use crate::frame::save_rgb_png;
 use crate::overlay::Canvas;
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -47,7 +47,8 @@ pub enum Overlay {
 /// Arguments of `eotn render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them.
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (which carry their own
+    /// sensor readings).
     #[arg(required = true)]
     pub frames: Vec<PathBuf>,
     /// Lookup table (`.lut`).
@@ -101,7 +102,7 @@ fn wanted(overlays: &[Overlay], p: &Primitive) -> bool {
 /// Unreadable inputs or an unwritable output, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let lut = load_lut_arg(&args.lut)?;
-    let paths = expand_frame_paths(&args.frames)?;
+    let mut inputs = FrameInputs::open(&args.frames, None)?;
     let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
     let params = PipelineParams {
         recognition: load_params(args.params.as_deref())?,
@@ -110,11 +111,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
     let mut pipeline = Pipeline::new(lut, params);
-    for (i, path) in paths.iter().enumerate() {
-        let frame = load_frame_arg(path, args.size)?;
-        let readings = sensors
+    for i in 0..inputs.len() {
+        let (frame, recorded) = inputs.load_with_sensors(i, args.size)?;
+        let from_file = sensors
             .as_ref()
             .and_then(|s| if s.len() == 1 { s.first() } else { s.get(i) });
+        let readings = recorded.as_ref().or(from_file);
         let result = pipeline.process(&frame, readings);
         let (w, h) = (frame.width(), frame.height());
         let base = match args.view {
@@ -145,7 +147,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 .filter(|p| wanted(&args.overlays, p)),
         );
         canvas.draw(&prims);
-        let name = frame_name(path);
+        let name = inputs.name(i);
         let stem = name.rsplit_once('.').map_or(name.as_str(), |(s, _)| s);
         let out = args.output.join(format!("{stem}.png"));
         save_rgb_png(&out, canvas.width, canvas.height, &canvas.rgb)?;

@@ -6,3 +6,4 @@ mod cli;
 mod common;
 mod peer;
 mod recognition;
+mod streams;
