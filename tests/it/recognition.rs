@@ -224,3 +224,131 @@ fn debug_scenario() {
         }
     }
 }
+
+/// Writes `frames` frames of a scenario to a stream with sensors and ground truth, as `eotn sim`
+/// does, and the learnt table beside it.
+fn write_scenario(
+    dir: &std::path::Path,
+    kind: ScenarioKind,
+    frames: u64,
+) -> (std::path::PathBuf, std::path::PathBuf) {
+    use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
+    let stream = dir.join(format!("{}.mcap", kind.name()));
+    let info = StreamInfo {
+        source: format!("sim:{}", kind.name()),
+        description: "test".into(),
+    };
+    let mut w = StreamWriter::create(&stream, &info).unwrap();
+    let sim = Simulator::new(Scenario::new(kind, 7));
+    for i in 0..frames {
+        let f = sim.frame(i).unwrap();
+        let mut rec = FrameRecord::new(f.time_ns, f.frame);
+        rec.sensors = f.sensors;
+        rec.ground_truth = Some(serde_json::to_value(&f.ground_truth).unwrap());
+        w.write(&rec).unwrap();
+    }
+    w.finish().unwrap();
+    let lut = dir.join("learnt.lut");
+    learnt_table().save(&lut).unwrap();
+    (stream, lut)
+}
+
+#[test]
+fn detect_render_and_eval_commands_on_a_rendered_stream() {
+    let dir = tempfile::tempdir().unwrap();
+    let (stream, lut) = write_scenario(dir.path(), ScenarioKind::Goalkeeper, 12);
+    let out = super::common::eotn(&[
+        "detect".as_ref(),
+        stream.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+        "--json".as_ref(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 12);
+    let goals = lines[0]["goals"].as_array().unwrap();
+    assert_eq!(goals.len(), 1, "{}", lines[0]);
+    assert_eq!(goals[0]["colour"], "yellow");
+    assert!(goals[0]["posts"].as_array().is_some_and(|p| !p.is_empty()));
+    assert!(goals[0]["gap"].is_object());
+    assert!(
+        goals[0]["body_distance_cm"].is_number(),
+        "streams carry joint readings"
+    );
+    assert!(lines[0]["ball"].is_null());
+
+    let render_dir = dir.path().join("render");
+    let out = super::common::eotn(&[
+        "render".as_ref(),
+        stream.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+        "-o".as_ref(),
+        render_dir.as_os_str(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let png = image::open(render_dir.join("goalkeeper_000000.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (208 * 3, 160 * 3));
+
+    // Evaluation and calibration on a robot walking towards the goal (distances vary).
+    let (walk, _) = write_scenario(dir.path(), ScenarioKind::WalkAndPan, 60);
+    let calibrated = dir.path().join("calibrated.json");
+    let out = super::common::eotn(&[
+        "eval".as_ref(),
+        walk.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+        "--json".as_ref(),
+        "--calibrate-goals".as_ref(),
+        calibrated.as_os_str(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["report"]["frames"], 60);
+    assert!(
+        report["report"]["ball_found"]
+            .as_u64()
+            .is_some_and(|n| n >= 5),
+        "{report}"
+    );
+    let fitted = report["goal_calibration"].as_array().unwrap();
+    assert!(
+        fitted
+            .iter()
+            .all(|v| v.as_f64().is_some_and(f64::is_finite))
+    );
+    let params: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&calibrated).unwrap()).unwrap();
+    assert_eq!(
+        params["goals"]["distance_multiplier"], fitted[0],
+        "the written parameters hold the fit"
+    );
+
+    // A frame without truth is refused clearly, not a panic.
+    let bad = dir.path().join("garbage.mcap");
+    std::fs::write(&bad, b"not an mcap file").unwrap();
+    let out = super::common::eotn(&[
+        "eval".as_ref(),
+        bad.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("garbage.mcap"));
+}
