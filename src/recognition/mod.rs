@@ -83,7 +83,10 @@ impl RecognitionParams {
         }
     }
 
-    /// The view context of a frame of this size with these readings (none: no pose).
+    /// The view context of a frame of this size with these readings (none: no pose). The body
+    /// model is the ERS-7's, so only 208×160 frames get a camera pose from the joints; frames of
+    /// other robots (the Nao's 320×240) get camera-relative recognition without heights or
+    /// horizon, but keep their infra-red and shutter-skew readings.
     #[must_use]
     pub fn context_for(
         &self,
@@ -92,10 +95,19 @@ impl RecognitionParams {
         sensors: Option<&SensorReadings>,
     ) -> ViewContext {
         let camera = self.camera_for(width, height);
-        sensors.map_or_else(
-            || ViewContext::without_pose(camera),
-            |s| ViewContext::from_sensors(camera, s, &self.body),
-        )
+        match sensors {
+            Some(s) if (width, height) == (208, 160) => {
+                ViewContext::from_sensors(camera, s, &self.body)
+            }
+            Some(s) => {
+                let mut ctx = ViewContext::from_sensors(camera, s, &self.body);
+                ctx.pose = None;
+                ctx.body_from_camera = None;
+                ctx.horizon = None;
+                ctx
+            }
+            None => ViewContext::without_pose(camera),
+        }
     }
 }
 
