@@ -20,13 +20,16 @@
 pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
+pub mod eval;
 pub mod frame;
 pub mod geometry;
 pub mod import;
 pub mod lut;
+pub mod overlay;
 pub mod pipeline;
+pub mod recognition;
 pub mod sensors;
-pub mod streams;
 pub mod sim;
+pub mod streams;
 
 pub mod cli;
