@@ -259,7 +259,7 @@ fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blob, u32)> {
         }
     }
     groups.retain(|(b, _)| b.pixels >= params.min_pixels);
-    groups.sort_by(|a, b| b.0.pixels.cmp(&a.0.pixels));
+    groups.sort_by_key(|g| std::cmp::Reverse(g.0.pixels));
     groups.truncate(params.max_candidates);
     groups
 }

@@ -335,7 +335,7 @@ fn build_groups(
         }
     }
     groups.retain(|g| g.all.pixels >= p.min_candidate_pixels);
-    groups.sort_by(|a, b| b.all.pixels.cmp(&a.all.pixels));
+    groups.sort_by_key(|g| std::cmp::Reverse(g.all.pixels));
     groups
 }
 
