@@ -10,8 +10,8 @@ mod export;
 mod import;
 mod info;
 pub mod inputs;
-mod lut_from_labels;
 mod lut;
+mod lut_from_labels;
 
 use std::process::ExitCode;
 
