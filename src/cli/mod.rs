@@ -6,12 +6,15 @@
 mod bench;
 mod blobs;
 mod classify;
+pub mod detect;
+mod eval;
 mod export;
 mod import;
 mod info;
 pub mod inputs;
 mod lut;
 mod lut_from_labels;
+mod render;
 
 use std::process::ExitCode;
 
@@ -39,6 +42,13 @@ pub enum Command {
     Blobs(blobs::Args),
     /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
     Bench(bench::Args),
+    /// Recognise ball, goals (posts, gap) and beacons; `--json` prints one line per frame.
+    Detect(detect::Args),
+    /// Draw frames with recognition overlays (circles, posts, gaps, horizon, scans) as PNG.
+    Render(render::Args),
+    /// Compare recognition with the ground truth of synthetic streams: rates, errors, misses;
+    /// two tables or parameter sets side by side; goal-distance calibration.
+    Eval(eval::Args),
     /// Build an MCAP stream from frame files and a CSV/JSON table of sensor readings.
     Import(import::Args),
     /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
@@ -63,6 +73,9 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Export(a) => export::run(&a),
         Command::LutFromLabels(a) => lut_from_labels::run(&a),
         Command::Lut(a) => lut::run(&a),
+        Command::Detect(a) => detect::run(&a),
+        Command::Render(a) => render::run(&a),
+        Command::Eval(a) => eval::run(&a),
     }
 }
 
