@@ -6,9 +6,13 @@
 mod bench;
 mod blobs;
 mod classify;
+mod export;
+mod import;
+mod import_bhuman;
 mod info;
 pub mod inputs;
 mod lut;
+mod lut_from_labels;
 
 use std::process::ExitCode;
 
@@ -38,6 +42,12 @@ pub enum Command {
     Bench(bench::Args),
     /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
     Lut(lut::Args),
+    /// Build an MCAP stream from frame files and a CSV/JSON table of sensor readings.
+    Import(import::Args),
+    /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
+    Export(export::Args),
+    /// Build a first lookup table from labelled frames and score it on held-back frames.
+    LutFromLabels(lut_from_labels::Args),
 }
 
 /// Runs a headless subcommand.
@@ -51,6 +61,9 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Blobs(a) => blobs::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Lut(a) => lut::run(&a),
+        Command::Import(a) => import::run(&a),
+        Command::Export(a) => export::run(&a),
+        Command::LutFromLabels(a) => lut_from_labels::run(&a),
     }
 }
 

@@ -11,6 +11,7 @@
 pub mod classes;
 pub mod convert;
 pub mod edit;
+pub mod learn;
 
 pub use classes::{CLASS_COUNT, ClassKind, ColourClass, code_display_rgb};
 pub use edit::{AppliedEdit, CellBox, EditHistory, EditRecord, Region, Sensitivity};

@@ -6,3 +6,5 @@ mod cli;
 mod common;
 mod peer;
 mod real_data;
+mod sim_table;
+mod streams;
