@@ -11,8 +11,8 @@ mod import;
 mod import_bhuman;
 mod info;
 pub mod inputs;
-mod lut_from_labels;
 mod lut;
+mod lut_from_labels;
 
 use std::process::ExitCode;
 

@@ -5,6 +5,6 @@
 mod cli;
 mod common;
 mod peer;
-mod streams;
-mod sim_table;
 mod real_data;
+mod sim_table;
+mod streams;
