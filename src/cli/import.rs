@@ -27,8 +27,12 @@ pub enum CompressionArg {
 pub struct Args {
     /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them; a folder's frames are taken in name
     /// order. PNG/JPEG frames are stored as UYVY.
-    #[arg(required = true)]
+    #[arg(required_unless_present = "bhuman")]
     pub frames: Vec<PathBuf>,
+    /// Import a B-Human 2009 Nao log (`logfile.log`) instead of frame files: its camera images
+    /// as 320×240 UYVY, joint and sensor data as readings, raw records on `/bhuman2009`.
+    #[arg(long, conflicts_with_all = ["frames", "sensors", "size"])]
+    pub bhuman: Option<PathBuf>,
     /// Sensor readings: a CSV file with a header row of sensor field names (plus optional `frame`
     /// and `time_s` columns), or a `.json` array of objects with the same keys. Frames without a
     /// row get no readings.
@@ -62,6 +66,11 @@ pub struct Args {
 /// # Errors
 /// Unreadable frames or sensor table, bad times, an unwritable output, each naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if let Some(log) = &args.bhuman {
+        let n = super::import_bhuman::run(log, &args.output, writer_options(args))?;
+        eprintln!("eotn: wrote {n} frames to {}", args.output.display());
+        return Ok(());
+    }
     if !(args.fps.is_finite() && args.fps > 0.0) {
         bail!("--fps must be a positive number, not {}", args.fps);
     }
@@ -95,14 +104,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let options = WriterOptions {
-        compression: match args.compression {
-            CompressionArg::Zstd => Compression::Zstd,
-            CompressionArg::Lz4 => Compression::Lz4,
-            CompressionArg::None => Compression::None,
-        },
-        frames_per_chunk: args.frames_per_chunk,
-    };
+    let options = writer_options(args);
     let info = StreamInfo {
         source: args.source.clone(),
         description: args.description.clone(),
@@ -143,6 +145,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// The writer options of the command line.
+fn writer_options(args: &Args) -> WriterOptions {
+    WriterOptions {
+        compression: match args.compression {
+            CompressionArg::Zstd => Compression::Zstd,
+            CompressionArg::Lz4 => Compression::Lz4,
+            CompressionArg::None => Compression::None,
+        },
+        frames_per_chunk: args.frames_per_chunk,
+    }
 }
 
 /// Fills the readings derived from the previous frame when the table left them out: previous pan

@@ -10,6 +10,7 @@ pub mod detect;
 mod eval;
 mod export;
 mod import;
+mod import_bhuman;
 mod info;
 pub mod inputs;
 mod lut;

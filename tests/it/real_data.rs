@@ -361,3 +361,37 @@ fn lut_convert_cli_writes_a_loadable_table() {
     assert!(e.contains("coltable.c64") && e.contains("ssl-xml"), "{e}");
     assert!(!Path::new(&dir.path().join("x.lut")).exists());
 }
+
+#[test]
+fn import_bhuman_cli_writes_a_readable_stream() {
+    let Some(log) = shared_file("data/bhuman2009/logfile.log") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b.mcap");
+    let o = crate::common::eotn(&[
+        "import".as_ref(),
+        "--bhuman".as_ref(),
+        log.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut r = eotn::streams::StreamReader::open(&out).unwrap();
+    assert_eq!(r.len(), 160);
+    assert_eq!(r.info().source, "bhuman2009");
+    assert!(r.info().description.contains("http://www.b-human.de"));
+    assert!(r.warnings().is_empty(), "{:?}", r.warnings());
+    assert_eq!(r.time_ns(0), Some(0));
+    assert!((0..159).all(|i| r.time_ns(i) < r.time_ns(i + 1)));
+    let rec = r.read(80).unwrap();
+    assert_eq!((rec.frame.width(), rec.frame.height()), (320, 240));
+    assert!(rec.sensors.unwrap().head_pan_rad.is_some());
+    let raw = rec.extra.iter().find(|(t, _)| t == "/bhuman2009").unwrap();
+    assert!(raw.1["image_time_ms"].as_u64().unwrap() > 0);
+    // The shipped sample is this stream.
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("streams/bhuman2009.mcap");
+    let mut s = eotn::streams::StreamReader::open(&shipped).unwrap();
+    assert_eq!(s.len(), 160);
+    assert_eq!(s.read(80).unwrap().frame, rec.frame);
+}
