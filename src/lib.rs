@@ -22,3 +22,7 @@ pub mod pipeline;
 pub mod sensors;
 
 pub mod cli;
+
+/// The desktop app (egui/eframe on wgpu); only this module names the UI crates.
+#[cfg(feature = "gui")]
+pub mod app;

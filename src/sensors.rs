@@ -180,7 +180,11 @@ mod tests {
     fn fields_lists_every_reading_with_units() {
         let fields = SensorReadings::default().fields();
         assert_eq!(fields.len(), 18);
-        assert!(fields.iter().any(|f| f.name == "pan_pwm" && f.unit == "duty"));
+        assert!(
+            fields
+                .iter()
+                .any(|f| f.name == "pan_pwm" && f.unit == "duty")
+        );
         assert!(fields.iter().all(|f| f.value.is_none()));
     }
 }

@@ -8,6 +8,7 @@ mod blobs;
 mod classify;
 mod info;
 pub mod inputs;
+pub mod open;
 
 use std::process::ExitCode;
 
@@ -35,6 +36,8 @@ pub enum Command {
     Blobs(blobs::Args),
     /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
     Bench(bench::Args),
+    /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
+    Open(open::Args),
 }
 
 /// Runs a headless subcommand.
@@ -47,6 +50,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Classify(a) => classify::run(&a),
         Command::Blobs(a) => blobs::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Open(a) => open::run(&a),
     }
 }
 
