@@ -54,7 +54,7 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Comma
         ("V", &mut s.v, "V / Shift+V"),
     ] {
         ui.add(egui::Slider::new(value, 0..=max).text(name))
-            .on_hover_text(format!("keys {keys}; + and − change all three"));
+            .on_hover_text(format!("keys {keys}; + and - change all three"));
     }
     if s != before {
         commands.push(Command::SetSensitivity(s));
@@ -175,7 +175,7 @@ fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Comm
                     ui.label(format!("{}", r.changed_pixels));
                     let delta = r.blobs_after as i64 - r.blobs_before as i64;
                     ui.label(format!(
-                        "{} → {} ({delta:+})",
+                        "{} -> {} ({delta:+})",
                         r.blobs_before, r.blobs_after
                     ));
                     ui.end_row();

@@ -315,8 +315,8 @@ fn view_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
 fn stream_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
     let open = state.source().is_some();
     for (label, cmd, key) in [
-        ("Previous frame", Command::Step(-1), "←"),
-        ("Next frame", Command::Step(1), "→"),
+        ("Previous frame", Command::Step(-1), "Left"),
+        ("Next frame", Command::Step(1), "Right"),
         ("Back 10 frames", Command::Step(-10), "PgUp"),
         ("Forward 10 frames", Command::Step(10), "PgDn"),
         ("First frame", Command::Seek(0), "Home"),

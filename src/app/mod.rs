@@ -314,7 +314,7 @@ impl EotnApp {
                 commands.push(Command::Step(1));
             }
             let mut speed = self.state.settings.speed;
-            egui::ComboBox::from_id_salt("speed")
+            egui::ComboBox::from_label("speed")
                 .selected_text(menus::speed_name(speed))
                 .width(90.0)
                 .show_ui(ui, |ui| {
@@ -340,12 +340,12 @@ impl EotnApp {
                 "/ {}  {t:8.3} s / {end:.3} s",
                 len.saturating_sub(1)
             ));
-            ui.spacing_mut().slider_width = (ui.available_width() - 20.0).max(100.0);
+            ui.spacing_mut().slider_width = (ui.available_width() - 70.0).max(100.0);
             let mut j = index;
             let slider = ui.add(
                 egui::Slider::new(&mut j, 0..=len.saturating_sub(1))
                     .show_value(false)
-                    .text(""),
+                    .text("timeline"),
             );
             if slider.changed() {
                 commands.push(Command::Seek(j));

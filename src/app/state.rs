@@ -1155,7 +1155,7 @@ impl AppState {
                     self.status = format!("opened table {}; journal: {n} edits can be undone", path.display());
                 }
                 Ok(r) => self.warn(format!(
-                    "{}: the table differs from its journal's replay ({} edits; unsaved edits before a crash?): Classification ▸ Rebuild from journal recovers them",
+                    "{}: the table differs from its journal's replay ({} edits; unsaved edits before a crash?): Classification > Rebuild from journal recovers them",
                     path.display(),
                     r.commits
                 )),

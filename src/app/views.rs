@@ -38,7 +38,7 @@ pub fn main_view_ui(
             &painter,
             rect,
             Align2::CENTER_CENTER,
-            "File ▸ Open… a stream (.mcap), frames (.uyvy, .png) or a table (.lut)".to_owned(),
+            "File > Open… a stream (.mcap), frames (.uyvy, .png) or a table (.lut)".to_owned(),
         );
         return MainViewOutput::default();
     };
