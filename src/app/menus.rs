@@ -167,7 +167,10 @@ fn file_menu_ui(
         }
     });
     ui.separator();
-    if ui.button("Quit").clicked() {
+    if ui
+        .add(egui::Button::new("Quit").shortcut_text("Ctrl+Q"))
+        .clicked()
+    {
         out.quit = true;
         ui.close();
     }
@@ -299,6 +302,10 @@ fn view_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
     ui.checkbox(&mut o.preview, "Selection preview");
     if o != before {
         commands.push(Command::SetOverlays(o));
+    }
+    let mut timings = state.settings.show_timings;
+    if ui.checkbox(&mut timings, "Frame-time readout").changed() {
+        commands.push(Command::ShowTimings(timings));
     }
     ui.separator();
     let c = state.settings.connectivity;

@@ -36,6 +36,9 @@ pub use state::{AppState, Command, Settings, ViewKind};
 use overlays::{FrameTextures, ImageTransform};
 use state::PixelInfo;
 
+/// How much the pixels outside a pending selection are darkened (alpha of black over them).
+const PREVIEW_DIM_ALPHA: u8 = 110;
+
 /// Key of the persisted [`Settings`] in eframe's storage.
 pub const SETTINGS_KEY: &str = "eotn-settings";
 
@@ -223,17 +226,19 @@ impl EotnApp {
         if mask.len() != size[0] * size[1] {
             return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
         }
+        // Unselected pixels are dimmed, so the highlight shows even where the class colour is
+        // the colour of the pixels themselves (orange on an orange ball).
+        let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
         ColorImage::new(
             size,
-            mask.iter()
-                .map(|&m| if m { colour } else { Color32::TRANSPARENT })
-                .collect(),
+            mask.iter().map(|&m| if m { colour } else { dim }).collect(),
         )
     }
 
-    fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) {
+    fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
+        let mut quit = false;
         if ctx.egui_wants_keyboard_input() {
-            return;
+            return quit;
         }
         ctx.input_mut(|i| {
             let cmd = |k| KeyboardShortcut::new(Modifiers::COMMAND, k);
@@ -249,6 +254,9 @@ impl EotnApp {
             }
             if i.consume_shortcut(&cmd(Key::S)) {
                 commands.push(Command::SaveTable);
+            }
+            if i.consume_shortcut(&cmd(Key::Q)) {
+                quit = true;
             }
             for (key, channel) in [(Key::Y, 0), (Key::U, 1), (Key::V, 2)] {
                 if i.consume_key(Modifiers::SHIFT, key) {
@@ -290,6 +298,7 @@ impl EotnApp {
                 commands.push(Command::ClearSelection);
             }
         });
+        quit
     }
 
     fn timeline_ui(&self, ui: &mut egui::Ui, commands: &mut Vec<Command>) {
@@ -367,6 +376,7 @@ impl EotnApp {
             }
             let s = self.state.timings.last_step;
             let ms = |d: Duration| d.as_secs_f64() * 1e3;
+            if self.state.settings.show_timings {
             ui.monospace(format!(
                 "step {:.1} ms (read {:.1} classify {:.1} blobs {:.1} prep {:.1} upload {:.1}) | frame {:.1} ms",
                 ms(s.total()),
@@ -383,6 +393,7 @@ impl EotnApp {
                 state::median(&self.state.timings.frames_ms),
                 state::median(&self.state.timings.playing_frames_ms),
             ));
+            }
             ui.separator();
             ui.label(&self.state.status);
         });
@@ -507,14 +518,13 @@ impl eframe::App for EotnApp {
         self.state.tick(dt.min(Duration::from_millis(250)));
 
         let mut commands = Vec::new();
-        self.keyboard(&ctx, &mut commands);
+        let mut quit = self.keyboard(&ctx, &mut commands);
         self.update_textures(&ctx);
         let tex = self.textures.as_ref().map(Textures::ids);
 
-        let mut quit = false;
         egui::Panel::top("menu").show(ui, |ui| {
             let out = menus::menu_bar_ui(ui, &self.state, &mut self.menu_input, &mut commands);
-            quit = out.quit;
+            quit |= out.quit;
         });
         egui::Panel::bottom("status").show(ui, |ui| self.status_ui(ui));
         if self.state.source().is_some() {

@@ -8,6 +8,9 @@ use egui::{
 use super::state::{AppState, ViewKind, box_colour};
 use crate::blobs::Blob;
 
+/// Blobs get a label outside the objects view when at least this many times the minimum size.
+const LABEL_SIZE_FACTOR: u32 = 20;
+
 /// Maps image pixels to screen points for one view: `screen = view_centre + (image − centre) · zoom`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImageTransform {
@@ -147,13 +150,14 @@ pub fn paint_view(
         _ => Vec::new(),
     };
     let labels = with_overlays && (o.labels || kind == ViewKind::Objects);
+    // Outside the objects view only sizeable blobs get a label, or the field drowns in text.
+    let label_min = state
+        .settings
+        .min_blob_pixels
+        .saturating_mul(LABEL_SIZE_FACTOR);
     for b in &boxes {
-        blob_box(
-            &painter,
-            xf,
-            b,
-            labels && (kind == ViewKind::Objects || boxes.len() <= 40),
-        );
+        let label = labels && (kind == ViewKind::Objects || b.pixels >= label_min);
+        blob_box(&painter, xf, b, label);
     }
     if with_overlays {
         if let Some((x, y)) = state.selection().and_then(|s| s.pixel) {

@@ -154,6 +154,8 @@ pub struct Settings {
     pub uv_plane_y: u8,
     /// "Try edit on the stream" window open.
     pub show_try_edit: bool,
+    /// The step and frame-time readout in the status bar.
+    pub show_timings: bool,
 }
 
 impl Default for Settings {
@@ -176,6 +178,7 @@ impl Default for Settings {
             show_uv_plane: false,
             uv_plane_y: 128,
             show_try_edit: false,
+            show_timings: true,
         }
     }
 }
@@ -260,6 +263,8 @@ pub enum Command {
     SetUvPlaneY(u8),
     /// Open or close a window.
     ShowWindow(Window, bool),
+    /// Show or hide the frame-time readout.
+    ShowTimings(bool),
 }
 
 /// The app's extra windows.
@@ -725,6 +730,7 @@ impl AppState {
             }
             Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
             Command::ShowWindow(w, open) => *self.window_flag(w) = open,
+            Command::ShowTimings(on) => self.settings.show_timings = on,
         }
         Ok(())
     }
@@ -749,7 +755,8 @@ impl AppState {
             let at = self.source.as_ref().map_or(0, |s| s.index_at_time(clock));
             at.max(self.index)
         };
-        if target >= len {
+        let target = target.min(len.saturating_sub(1));
+        if target == self.index && target + 1 >= len {
             self.playing = false;
             return;
         }
@@ -1035,6 +1042,9 @@ impl AppState {
                 for (px, &m) in out.chunks_exact_mut(3).zip(&self.preview_mask) {
                     if m {
                         px.copy_from_slice(&k);
+                    } else {
+                        // As on screen: the rest is dimmed so the highlight always shows.
+                        px.iter_mut().for_each(|v| *v = mix(*v, 0, 110.0 / 255.0));
                     }
                 }
             }
@@ -1251,7 +1261,12 @@ impl AppState {
     fn reprocess(&mut self) {
         if let Some(c) = &self.current {
             let frame = c.frame.clone();
-            self.pipeline.process_frame(&frame);
+            let t = self.pipeline.process_frame(&frame).timings;
+            self.timings.last_step = StepTiming {
+                classify: t.classify,
+                blobs: t.blobs,
+                ..StepTiming::default()
+            };
             self.frame_generation += 1;
         }
         self.refresh_preview();
