@@ -80,7 +80,7 @@ impl ImageTransform {
     pub fn pixel_at(&self, s: Pos2) -> Option<(usize, usize)> {
         let p = self.to_image(s);
         let inside = p.x >= 0.0 && p.y >= 0.0 && p.x < self.size[0] && p.y < self.size[1];
-        inside.then(|| (p.x as usize, p.y as usize))
+        inside.then_some((p.x as usize, p.y as usize))
     }
 
     /// The screen centre of pixel (x, y).
@@ -159,10 +159,8 @@ pub fn paint_view(
         let label = labels && (kind == ViewKind::Objects || b.pixels >= label_min);
         blob_box(&painter, xf, b, label);
     }
-    if with_overlays {
-        if let Some((x, y)) = state.selection().and_then(|s| s.pixel) {
-            sample_marker(&painter, xf, x, y);
-        }
+    if with_overlays && let Some((x, y)) = state.selection().and_then(|s| s.pixel) {
+        sample_marker(&painter, xf, x, y);
     }
 }
 

@@ -593,7 +593,7 @@ impl AppState {
                     2 => &mut s.v,
                     _ => anyhow::bail!("channel {channel} is not 0 (Y), 1 (U) or 2 (V)"),
                 };
-                let max = i32::try_from(self.max_sensitivity()).unwrap_or(255);
+                let max = i32::from(self.max_sensitivity());
                 *slot = u8::try_from((i32::from(*slot) + delta).clamp(0, max)).unwrap_or(0);
                 self.set_sensitivity(s);
             }
@@ -1037,15 +1037,15 @@ impl AppState {
                 rgb
             }
         };
-        if o.preview {
-            if let Some(k) = self.preview_colour() {
-                for (px, &m) in out.chunks_exact_mut(3).zip(&self.preview_mask) {
-                    if m {
-                        px.copy_from_slice(&k);
-                    } else {
-                        // As on screen: the rest is dimmed so the highlight always shows.
-                        px.iter_mut().for_each(|v| *v = mix(*v, 0, 110.0 / 255.0));
-                    }
+        if o.preview
+            && let Some(k) = self.preview_colour()
+        {
+            for (px, &m) in out.chunks_exact_mut(3).zip(&self.preview_mask) {
+                if m {
+                    px.copy_from_slice(&k);
+                } else {
+                    // As on screen: the rest is dimmed so the highlight always shows.
+                    px.iter_mut().for_each(|v| *v = mix(*v, 0, 110.0 / 255.0));
                 }
             }
         }
@@ -1217,12 +1217,11 @@ impl AppState {
             .context("nothing selected: left-click a pixel first")?;
         let record = EditRecord::now(self.settings.class, sel.region);
         // The journal must start from the table before its first edit.
-        if let Some(path) = self.table_path.clone() {
-            if !journal::journal_path(&path).exists() {
-                if let Err(e) = journal::append(&path, self.pipeline.lut(), &[]) {
-                    self.warn(format!("{e:#}"));
-                }
-            }
+        if let Some(path) = self.table_path.clone()
+            && !journal::journal_path(&path).exists()
+            && let Err(e) = journal::append(&path, self.pipeline.lut(), &[])
+        {
+            self.warn(format!("{e:#}"));
         }
         let changed = self.history.commit(self.pipeline.lut_mut(), record.clone());
         self.journal(&JournalEntry::Commit { record });

@@ -74,19 +74,19 @@ impl UvPlane {
         }
         let cell = side / n as f32;
         // Selected cells on this layer: outline their bounding box.
-        if let Some(Selection::Box(b)) = state.resolved_selection() {
-            if (b.min[0]..=b.max[0]).contains(&layer) {
-                let r = Rect::from_min_max(
-                    rect.min + vec2(b.min[2] as f32 * cell, b.min[1] as f32 * cell),
-                    rect.min + vec2((b.max[2] + 1) as f32 * cell, (b.max[1] + 1) as f32 * cell),
-                );
-                ui.painter().rect_stroke(
-                    r,
-                    0.0,
-                    Stroke::new(2.0, Color32::from_rgb(255, 0, 255)),
-                    StrokeKind::Outside,
-                );
-            }
+        if let Some(Selection::Box(b)) = state.resolved_selection()
+            && (b.min[0]..=b.max[0]).contains(&layer)
+        {
+            let r = Rect::from_min_max(
+                rect.min + vec2(b.min[2] as f32 * cell, b.min[1] as f32 * cell),
+                rect.min + vec2((b.max[2] + 1) as f32 * cell, (b.max[1] + 1) as f32 * cell),
+            );
+            ui.painter().rect_stroke(
+                r,
+                0.0,
+                Stroke::new(2.0, Color32::from_rgb(255, 0, 255)),
+                StrokeKind::Outside,
+            );
         }
         let to_cell = |p: egui::Pos2| {
             let u = ((p.y - rect.min.y) / cell) as usize;
@@ -100,10 +100,10 @@ impl UvPlane {
         } else {
             ui.weak("U down, V across; bright dots: this frame's pixels");
         }
-        if response.clicked() {
-            if let Some((u, v)) = response.interact_pointer_pos().and_then(to_cell) {
-                commands.push(Command::SampleCell([layer, u, v]));
-            }
+        if response.clicked()
+            && let Some((u, v)) = response.interact_pointer_pos().and_then(to_cell)
+        {
+            commands.push(Command::SampleCell([layer, u, v]));
         }
     }
 

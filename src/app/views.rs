@@ -74,10 +74,10 @@ pub fn main_view_ui(
     }
     if response.double_clicked_by(PointerButton::Primary) {
         commands.push(Command::ResetView);
-    } else if response.clicked_by(PointerButton::Primary) {
-        if let Some((x, y)) = response.interact_pointer_pos().and_then(|p| xf.pixel_at(p)) {
-            commands.push(Command::Sample { x, y });
-        }
+    } else if response.clicked_by(PointerButton::Primary)
+        && let Some((x, y)) = response.interact_pointer_pos().and_then(|p| xf.pixel_at(p))
+    {
+        commands.push(Command::Sample { x, y });
     }
     if response.clicked_by(PointerButton::Secondary) && state.selection().is_some() {
         commands.push(Command::Commit);
