@@ -132,6 +132,7 @@ pub fn try_edit_window(ctx: &Context, state: &mut AppState, commands: &mut Vec<C
     egui::Window::new("Try edit on stream")
         .open(&mut open)
         .default_width(360.0)
+        .default_pos([900.0, 420.0])
         .show(ctx, |ui| try_edit_ui(ui, &t, state.index(), commands));
     state.settings.show_try_edit = open;
 }

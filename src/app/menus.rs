@@ -19,8 +19,37 @@ pub struct MenuOutput {
 /// Path typed into File ▸ Open path (dialogs are not always available, e.g. under Xvfb).
 #[derive(Debug, Default)]
 pub struct MenuInput {
+    /// The "Open path" window is shown.
+    pub open: bool,
     /// The text of the path field.
     pub path: String,
+}
+
+/// The "Open path" window: a text field, because native dialogs are not always available.
+pub fn open_path_window(ctx: &egui::Context, input: &mut MenuInput, commands: &mut Vec<Command>) {
+    if !input.open {
+        return;
+    }
+    let mut open = true;
+    let mut done = false;
+    egui::Window::new("Open path")
+        .open(&mut open)
+        .collapsible(false)
+        .default_pos([300.0, 120.0])
+        .show(ctx, |ui| {
+            let edit = ui.add(
+                egui::TextEdit::singleline(&mut input.path)
+                    .hint_text("/path/to/stream.mcap, table.lut or frames")
+                    .desired_width(420.0),
+            );
+            edit.request_focus();
+            let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
+            if (ui.button("Open").clicked() || enter) && !input.path.trim().is_empty() {
+                commands.push(Command::Open(vec![PathBuf::from(input.path.trim())]));
+                done = true;
+            }
+        });
+    input.open = open && !done;
 }
 
 fn pick_open(title: &str, filters: &[(&str, &[&str])]) -> Option<Vec<PathBuf>> {
@@ -81,18 +110,14 @@ fn file_menu_ui(
         }
         ui.close();
     }
-    ui.horizontal(|ui| {
-        let edit = ui.add(
-            egui::TextEdit::singleline(&mut input.path)
-                .hint_text("path to open")
-                .desired_width(220.0),
-        );
-        let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-        if (ui.button("Open path").clicked() || enter) && !input.path.trim().is_empty() {
-            commands.push(Command::Open(vec![PathBuf::from(input.path.trim())]));
-            ui.close();
-        }
-    });
+    if ui
+        .button("Open path…")
+        .on_hover_text("type a path: a stream, frames, a folder of frames or a table")
+        .clicked()
+    {
+        input.open = true;
+        ui.close();
+    }
     ui.menu_button("New table", |ui| {
         for bits in [6u8, 7, 8] {
             if ui

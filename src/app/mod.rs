@@ -557,6 +557,7 @@ impl eframe::App for EotnApp {
         self.uv_plane.window(&ctx, &mut self.state, &mut commands);
         classify_panel::try_edit_window(&ctx, &mut self.state, &mut commands);
         self.warnings_window(&ctx);
+        menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
         if quit {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }

@@ -25,6 +25,7 @@ impl UvPlane {
         egui::Window::new("U–V plane")
             .open(&mut open)
             .default_width(300.0)
+            .default_pos([960.0, 60.0])
             .show(ctx, |ui| self.ui(ui, state, commands));
         state.settings.show_uv_plane = open;
     }
