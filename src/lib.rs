@@ -10,6 +10,7 @@
 //! | [`classify`] | frame + table → classified image |
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
+//! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -20,6 +21,7 @@ pub mod frame;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;
+pub mod streams;
 
 pub mod cli;
 

@@ -22,7 +22,6 @@ pub mod overlays;
 pub mod sensors_dialog;
 pub mod source;
 pub mod state;
-mod streams_api;
 pub mod uv_plane;
 pub mod views;
 

@@ -7,9 +7,9 @@ use std::sync::Arc;
 
 use anyhow::Context as _;
 
-use super::streams_api;
 use crate::frame::{Frame, load_frame};
 use crate::sensors::SensorReadings;
+use crate::streams as streams_api;
 
 /// Nominal interval between frames that carry no time (frame files), nanoseconds: 25 fps.
 pub const NOMINAL_FRAME_INTERVAL_NS: u64 = 40_000_000;

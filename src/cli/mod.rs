@@ -6,6 +6,8 @@
 mod bench;
 mod blobs;
 mod classify;
+mod export;
+mod import;
 mod info;
 pub mod inputs;
 pub mod open;
@@ -36,6 +38,10 @@ pub enum Command {
     Blobs(blobs::Args),
     /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
     Bench(bench::Args),
+    /// Build an MCAP stream from frame files and a CSV/JSON table of sensor readings.
+    Import(import::Args),
+    /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
+    Export(export::Args),
     /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
     Open(open::Args),
 }
@@ -50,6 +56,8 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Classify(a) => classify::run(&a),
         Command::Blobs(a) => blobs::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Import(a) => import::run(&a),
+        Command::Export(a) => export::run(&a),
         Command::Open(a) => open::run(&a),
     }
 }

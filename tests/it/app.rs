@@ -419,3 +419,82 @@ fn snapshot_with_overlays() {
     h.run();
     h.snapshot("app_overlays");
 }
+
+/// A short recorded stream: the scenes above at 25 fps with head-pan readings.
+fn stream_fixture(dir: &Path, frames: usize) -> PathBuf {
+    use eotn::sensors::SensorReadings;
+    use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
+    let path = dir.join("s.mcap");
+    let info = StreamInfo {
+        source: "robot".to_owned(),
+        description: "app test".to_owned(),
+    };
+    let mut w = StreamWriter::create(&path, &info).unwrap();
+    for i in 0..frames {
+        let mut r = FrameRecord::new(i as u64 * 40_000_000, scene(i % 3));
+        r.sensors = Some(SensorReadings {
+            head_pan_rad: Some(0.1 * i as f64),
+            previous_head_pan_rad: Some(0.1 * i.saturating_sub(1) as f64),
+            frame_interval_s: Some(0.04),
+            pan_pwm: if i == 2 { Some(f64::NAN) } else { Some(0.5) },
+            ..SensorReadings::default()
+        });
+        w.write(&r).unwrap();
+    }
+    w.finish().unwrap();
+    path
+}
+
+#[test]
+fn stream_steps_plays_and_plots_sensors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, table) = fixture(dir.path());
+    let stream = stream_fixture(dir.path(), 20);
+    let mut h = harness(vec![stream, table]);
+    h.run();
+    let s = state(&h);
+    assert_eq!(s.source().unwrap().len(), 20);
+    assert!(s.source().unwrap().is_stream());
+    h.key_press(Key::ArrowRight);
+    h.key_press(Key::ArrowRight);
+    h.run();
+    let s = state(&h);
+    assert_eq!(s.index(), 2);
+    let c = s.current().unwrap();
+    assert_eq!(c.time_ns, 80_000_000);
+    let sensors = c.sensors.unwrap();
+    assert!((sensors.head_pan_rad.unwrap() - 0.2).abs() < 1e-9);
+    assert_eq!(sensors.pan_pwm, None, "NaN dropped");
+    assert!(
+        s.warnings().iter().any(|w| w.contains("pan_pwm")),
+        "{:?}",
+        s.warnings()
+    );
+    // Jump, and the cache stays small.
+    h.state_mut().state.run(Command::Seek(15));
+    for i in 0..15 {
+        h.state_mut().state.run(Command::Seek(i));
+    }
+    assert!(state(&h).source().unwrap().cached() <= eotn::app::source::CACHE_FRAMES);
+    // The sensor dialog reads the whole series in the background.
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Sensors, true));
+    h.run();
+    let st = &mut h.state_mut().state;
+    for _ in 0..100 {
+        st.tick(std::time::Duration::from_millis(16));
+    }
+    assert_eq!(st.sensor_series.points.len(), 20);
+    // Play at the recorded rate: 0.2 s of wall time moves 5 frames.
+    st.run(Command::Seek(0));
+    st.run(Command::SetSpeed(1.0));
+    st.run(Command::SetPlaying(true));
+    st.tick(std::time::Duration::from_millis(200));
+    assert_eq!(st.index(), 5);
+    st.run(Command::SetSpeed(4.0));
+    st.tick(std::time::Duration::from_millis(200));
+    assert_eq!(st.index(), 19);
+    assert!(!st.playing(), "stops at the end");
+    h.run();
+}

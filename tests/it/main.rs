@@ -7,3 +7,4 @@ mod app;
 mod cli;
 mod common;
 mod peer;
+mod streams;
