@@ -464,12 +464,8 @@ fn stream_steps_plays_and_plots_sensors() {
     assert_eq!(c.time_ns, 80_000_000);
     let sensors = c.sensors.unwrap();
     assert!((sensors.head_pan_rad.unwrap() - 0.2).abs() < 1e-9);
-    assert_eq!(sensors.pan_pwm, None, "NaN dropped");
-    assert!(
-        s.warnings().iter().any(|w| w.contains("pan_pwm")),
-        "{:?}",
-        s.warnings()
-    );
+    // NaN cannot be stored in JSON: it arrives as a missing reading, never as a number.
+    assert_eq!(sensors.pan_pwm, None);
     // Jump, and the cache stays small.
     h.state_mut().state.run(Command::Seek(15));
     for i in 0..15 {
