@@ -258,11 +258,13 @@ impl EotnApp {
                 quit = true;
             }
             for (key, channel) in [(Key::Y, 0), (Key::U, 1), (Key::V, 2)] {
-                if i.consume_key(Modifiers::SHIFT, key) {
-                    commands.push(Command::AdjustSensitivity { channel, delta: -1 });
-                }
-                if i.consume_key(Modifiers::NONE, key) {
-                    commands.push(Command::AdjustSensitivity { channel, delta: 1 });
+                let down = i.count_and_consume_key(Modifiers::SHIFT, key) as i32;
+                let up = i.count_and_consume_key(Modifiers::NONE, key) as i32;
+                if up != down {
+                    commands.push(Command::AdjustSensitivity {
+                        channel,
+                        delta: up - down,
+                    });
                 }
             }
             for (key, delta) in [(Key::Plus, 1), (Key::Equals, 1), (Key::Minus, -1)] {
@@ -279,8 +281,10 @@ impl EotnApp {
                     (Key::PageDown, 10),
                     (Key::PageUp, -10),
                 ] {
-                    if i.consume_key(Modifiers::NONE, key) {
-                        commands.push(Command::Step(delta));
+                    // Every press counts, even several within one slow frame.
+                    let n = i.count_and_consume_key(Modifiers::NONE, key);
+                    if n > 0 {
+                        commands.push(Command::Step(delta * n as i64));
                     }
                 }
                 if i.consume_key(Modifiers::NONE, Key::Home) {

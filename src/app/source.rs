@@ -57,7 +57,7 @@ impl std::fmt::Debug for StreamSource {
 #[derive(Debug)]
 enum Kind {
     Files(FileSequence),
-    Stream(StreamSource),
+    Stream(Box<StreamSource>),
 }
 
 /// An open frame source with its cache.
@@ -87,15 +87,15 @@ impl Source {
     pub fn stream(path: &Path) -> anyhow::Result<Self> {
         let reader = streams_api::StreamReader::open(path)?;
         anyhow::ensure!(
-            reader.len() > 0,
+            !reader.is_empty(),
             "{}: the stream holds no camera frames",
             path.display()
         );
         Ok(Self {
-            kind: Kind::Stream(StreamSource {
+            kind: Kind::Stream(Box::new(StreamSource {
                 path: path.to_owned(),
                 reader,
-            }),
+            })),
             cache: VecDeque::new(),
         })
     }
