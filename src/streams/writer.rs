@@ -34,7 +34,7 @@ pub struct WriterOptions {
     /// Chunk compression.
     pub compression: Compression,
     /// Frames per chunk; `None` chooses about 1 MiB of image data per chunk (16 robot-camera
-    /// frames, 2 overhead frames). Fewer frames per chunk: faster random access, larger files,
+    /// frames, 1 overhead frame). Fewer frames per chunk: faster random access, larger files,
     /// less lost in a crash.
     pub frames_per_chunk: Option<usize>,
 }
