@@ -22,8 +22,8 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Comma
             .weak(),
     );
     ui.separator();
-    let counts = state.lut().class_counts();
-    let frame_counts = state.classified().histogram();
+    let counts = state.table_counts();
+    let frame_counts = state.frame_counts();
     egui::Grid::new("classes").num_columns(3).show(ui, |ui| {
         for class in ColourClass::ALL {
             ui.horizontal(|ui| {

@@ -449,6 +449,8 @@ pub struct AppState {
     /// The sensor series of the open stream.
     pub sensor_series: SensorSeries,
     try_edit: Option<TryEdit>,
+    table_counts: crate::lut::ClassCounts,
+    frame_counts: [usize; 256],
 }
 
 impl Default for AppState {
@@ -470,6 +472,7 @@ impl AppState {
         let params = PipelineParams {
             connectivity: settings.connectivity,
         };
+        let table_counts = lut.class_counts();
         Self {
             settings,
             pipeline: Pipeline::new(lut, params),
@@ -492,6 +495,8 @@ impl AppState {
             timings: Timings::default(),
             sensor_series: SensorSeries::default(),
             try_edit: None,
+            table_counts,
+            frame_counts: [0; 256],
         }
     }
 
@@ -878,6 +883,19 @@ impl AppState {
         best
     }
 
+    /// Table cells per class code, kept up to date on every table change (counting 2M cells
+    /// every UI frame would cost milliseconds).
+    #[must_use]
+    pub const fn table_counts(&self) -> &crate::lut::ClassCounts {
+        &self.table_counts
+    }
+
+    /// Pixels of the shown frame per class code.
+    #[must_use]
+    pub const fn frame_counts(&self) -> &[usize; 256] {
+        &self.frame_counts
+    }
+
     /// The pending selection.
     #[must_use]
     pub const fn selection(&self) -> Option<&PendingSelection> {
@@ -1252,6 +1270,7 @@ impl AppState {
 
     fn table_changed(&mut self) {
         self.table_generation += 1;
+        self.table_counts = self.pipeline.lut().class_counts();
         self.try_edit = None;
         self.reprocess();
     }
@@ -1267,6 +1286,7 @@ impl AppState {
                 ..StepTiming::default()
             };
             self.frame_generation += 1;
+            self.frame_counts = self.pipeline.result().classified.histogram();
         }
         self.refresh_preview();
     }
@@ -1291,6 +1311,7 @@ impl AppState {
         let r = self.pipeline.process_frame(&loaded.frame);
         let (classify, blobs) = (r.timings.classify, r.timings.blobs);
         let t2 = Instant::now();
+        self.frame_counts = self.pipeline.result().classified.histogram();
         loaded.frame.to_rgb_into(&mut self.rgb);
         for w in &loaded.warnings {
             if !self.warnings.contains(w) {
