@@ -10,6 +10,8 @@ mod export;
 mod import;
 mod info;
 pub mod inputs;
+mod lut;
+mod lut_from_labels;
 pub mod open;
 
 use std::process::ExitCode;
@@ -42,6 +44,10 @@ pub enum Command {
     Import(import::Args),
     /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
     Export(export::Args),
+    /// Build a first lookup table from labelled frames and score it on held-back frames.
+    LutFromLabels(lut_from_labels::Args),
+    /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
+    Lut(lut::Args),
     /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
     Open(open::Args),
 }
@@ -58,6 +64,8 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(&a),
         Command::Import(a) => import::run(&a),
         Command::Export(a) => export::run(&a),
+        Command::LutFromLabels(a) => lut_from_labels::run(&a),
+        Command::Lut(a) => lut::run(&a),
         Command::Open(a) => open::run(&a),
     }
 }

@@ -7,4 +7,6 @@ mod app;
 mod cli;
 mod common;
 mod peer;
+mod real_data;
+mod sim_table;
 mod streams;

@@ -1,0 +1,182 @@
+//! `eotn lut-from-labels`: a first lookup table from labelled frames, scored on held-back ones.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+
+use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
+use crate::frame::Frame;
+use crate::lut::ColourClass;
+use crate::lut::learn::{Accuracy, LearnParams, TableBuilder};
+use crate::sim::{Scenario, ScenarioKind, Simulator};
+
+/// Arguments of `eotn lut-from-labels`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Labelled frames: each `NAME.uyvy`/`.png` needs a mask `NAME.cls` beside it (one class
+    /// code per pixel, row-major, as `eotn classify --raw` writes). Folders are searched.
+    pub frames: Vec<PathBuf>,
+    /// Also (or instead) render labelled frames of these scenarios (repeatable).
+    #[arg(long = "sim")]
+    pub scenarios: Vec<String>,
+    /// Frames rendered per scenario.
+    #[arg(long, default_value_t = 60)]
+    pub frames_per_scenario: u64,
+    /// Seed for rendered frames.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Hold back every Kth frame (from building) to score the table on.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u64).range(2..))]
+    pub holdout_every: u64,
+    /// Table resolution, bits per channel (6, 7 or 8).
+    #[arg(long, default_value_t = 7)]
+    pub bits: u8,
+    /// Cells each class grows into unseen neighbouring colours.
+    #[arg(long, default_value_t = 2)]
+    pub margin: usize,
+    /// Fewest labelled pixels of the winning class for a cell to take it.
+    #[arg(long, default_value_t = 2)]
+    pub min_pixels: u32,
+    /// Smallest share of a cell's pixels the winning class needs (0..1).
+    #[arg(long, default_value_t = 0.6)]
+    pub min_purity: f64,
+    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+    /// Where to write the table (`.lut`).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Print the accuracy as one JSON line.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn load_mask(frame_path: &Path, frame: &Frame) -> anyhow::Result<Vec<u8>> {
+    let mask = frame_path.with_extension("cls");
+    let bytes = std::fs::read(&mask)
+        .with_context(|| format!("{}: cannot read label mask", mask.display()))?;
+    let pixels = frame.width() * frame.height();
+    anyhow::ensure!(
+        bytes.len() == pixels,
+        "{}: {} bytes, but {} has {pixels} pixels",
+        mask.display(),
+        bytes.len(),
+        frame_path.display()
+    );
+    Ok(bytes)
+}
+
+/// Runs `eotn lut-from-labels`.
+///
+/// # Errors
+/// Unreadable frames or masks, unknown scenarios, an unwritable table, or no labelled frames.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.min_purity.is_finite() && (0.0..=1.0).contains(&args.min_purity),
+        "--min-purity must be between 0 and 1"
+    );
+    let params = LearnParams {
+        bits: args.bits,
+        margin_cells: args.margin,
+        min_pixels: args.min_pixels,
+        min_purity: args.min_purity,
+    };
+    let mut builder = TableBuilder::new(args.bits)?;
+    let mut held_back: Vec<(String, Frame, Vec<u8>)> = Vec::new();
+    let mut index = 0_u64;
+    let mut take = |name: String, frame: Frame, labels: Vec<u8>| -> anyhow::Result<()> {
+        index += 1;
+        if index.is_multiple_of(args.holdout_every) {
+            held_back.push((name, frame, labels));
+        } else {
+            builder
+                .add_frame(&frame, &labels)
+                .with_context(|| format!("{name}: labels"))?;
+        }
+        Ok(())
+    };
+    let paths = if args.frames.is_empty() {
+        Vec::new()
+    } else {
+        expand_frame_paths(&args.frames)?
+    };
+    for path in &paths {
+        let frame = load_frame_arg(path, args.size)?;
+        let labels = load_mask(path, &frame)?;
+        take(path.display().to_string(), frame, labels)?;
+    }
+    for name in &args.scenarios {
+        let kind =
+            ScenarioKind::from_name(name).with_context(|| format!("unknown scenario {name:?}"))?;
+        let sim = Simulator::new(Scenario::new(kind, args.seed));
+        let bar = progress(
+            usize::try_from(args.frames_per_scenario).unwrap_or(usize::MAX),
+            name,
+        );
+        for k in 0..args.frames_per_scenario {
+            let f = sim.frame(k)?;
+            take(format!("{name}#{k}"), f.frame, f.labels)?;
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
+    }
+    anyhow::ensure!(
+        builder.pixel_count() > 0,
+        "no labelled frames to build from (give frames with .cls masks, or --sim SCENARIO)"
+    );
+    let table = builder.build(&params);
+    table
+        .save(&args.output)
+        .with_context(|| format!("{}: cannot save the table", args.output.display()))?;
+    let mut accuracy = Accuracy::default();
+    for (name, frame, labels) in &held_back {
+        accuracy
+            .add_frame(frame, labels, &table)
+            .with_context(|| format!("{name}: labels"))?;
+    }
+    let recalls: Vec<(String, f64)> = ColourClass::ALL
+        .iter()
+        .filter_map(|&c| {
+            (c != ColourClass::Unclassified)
+                .then(|| accuracy.recall(c).map(|r| (c.name().to_owned(), r)))
+                .flatten()
+        })
+        .collect();
+    if args.json {
+        let per_class: serde_json::Map<String, serde_json::Value> = recalls
+            .iter()
+            .map(|(n, r)| (n.clone(), serde_json::json!(r)))
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({
+                "table": args.output.display().to_string(),
+                "bits": args.bits,
+                "training_pixels": builder.pixel_count(),
+                "cells_seen": builder.cells_seen(),
+                "held_back_frames": held_back.len(),
+                "colour_accuracy": accuracy.colour_accuracy(),
+                "false_colour_rate": accuracy.false_colour_rate(),
+                "recall": per_class,
+            })
+        );
+    } else {
+        println!(
+            "{}: {}-bit table from {} labelled pixels ({} cells seen)",
+            args.output.display(),
+            args.bits,
+            builder.pixel_count(),
+            builder.cells_seen()
+        );
+        println!(
+            "held back {} frames: colour accuracy {:.2}%, false colour on unlabelled pixels {:.2}%",
+            held_back.len(),
+            100.0 * accuracy.colour_accuracy(),
+            100.0 * accuracy.false_colour_rate()
+        );
+        for (name, r) in &recalls {
+            println!("  {name:<12} {:.2}%", 100.0 * r);
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,231 @@
+//! Synthetic test data: a renderer of the 2005 Four-Legged League field with ground truth.
+//!
+//! There is no public archive of 2005 AIBO camera frames, so the project makes its own frames
+//! whose answers are known, from the same camera models recognition uses ([`crate::geometry`]).
+//! [`scene`] describes the world, [`render`] ray-casts it into UYVY frames with the camera's
+//! faults (noise, vignetting, shared chroma, rolling shutter), [`truth`] says what a perfect
+//! recognition would find, and [`scenario`] moves the world over time. [`Simulator::frame`]
+//! puts them together: frame `k` of a scenario and seed is always the same, whatever order
+//! frames are made in.
+
+pub mod render;
+pub mod rng;
+pub mod scenario;
+pub mod scene;
+pub mod truth;
+
+use thiserror::Error;
+
+pub use render::{Rendered, Renderer, World};
+pub use rng::SimRng;
+pub use scenario::{Scenario, ScenarioKind, View};
+pub use scene::{CameraEffects, Scene};
+pub use truth::GroundTruth;
+
+use crate::frame::{Frame, FrameError};
+use crate::geometry::{
+    CameraPose, Ers7Dimensions, OverheadCamera, PinholeCamera, Transform, Vector,
+};
+use crate::sensors::SensorReadings;
+
+/// Time between frames, seconds: both cameras deliver 30 frames a second.
+pub const FRAME_INTERVAL_S: f64 = 1.0 / 30.0;
+
+/// Why a frame could not be simulated.
+#[derive(Debug, Error)]
+pub enum SimError {
+    /// The scenario's observing robot is missing from its scene (a scenario bug).
+    #[error("scenario {scenario}: observing robot {id} is not in the scene at {time_s:.3} s")]
+    MissingObserver {
+        /// Scenario name.
+        scenario: &'static str,
+        /// Robot id.
+        id: u32,
+        /// Time, seconds.
+        time_s: f64,
+    },
+    /// The frame could not be assembled.
+    #[error("scenario {scenario}: {source}")]
+    Frame {
+        /// Scenario name.
+        scenario: &'static str,
+        /// What went wrong.
+        source: FrameError,
+    },
+}
+
+/// One simulated frame with everything that travels with it in a stream.
+#[derive(Debug, Clone)]
+pub struct SimFrame {
+    /// Capture time (middle of readout), nanoseconds since the scenario start.
+    pub time_ns: u64,
+    /// The camera frame.
+    pub frame: Frame,
+    /// The true colour class of each pixel (row-major class codes), for building and scoring
+    /// lookup tables.
+    pub labels: Vec<u8>,
+    /// The robot's sensor readings (robot views only).
+    pub sensors: Option<SensorReadings>,
+    /// What a perfect recognition would report.
+    pub ground_truth: GroundTruth,
+    /// Other JSON channels: each robot's world model in the overhead game.
+    pub extra: Vec<(String, serde_json::Value)>,
+}
+
+/// Renders the frames of one scenario.
+#[derive(Debug, Clone)]
+pub struct Simulator {
+    scenario: Scenario,
+    renderer: Renderer,
+    head_camera: PinholeCamera,
+    overhead_camera: OverheadCamera,
+    effects: CameraEffects,
+}
+
+impl Simulator {
+    /// A simulator for a scenario, with the camera's usual effects.
+    #[must_use]
+    pub fn new(scenario: Scenario) -> Self {
+        let head_camera = PinholeCamera::ers7();
+        let overhead_camera = OverheadCamera::above_field_2005();
+        let (renderer, effects) = match scenario.view() {
+            View::Robot { .. } => (Renderer::pinhole(&head_camera), CameraEffects::ERS7),
+            View::Overhead => (
+                Renderer::overhead(&overhead_camera),
+                CameraEffects::OVERHEAD,
+            ),
+        };
+        Self {
+            scenario,
+            renderer,
+            head_camera,
+            overhead_camera,
+            effects,
+        }
+    }
+
+    /// The same, with other camera effects (e.g. [`CameraEffects::NONE`] for ideal frames).
+    #[must_use]
+    pub fn with_effects(mut self, effects: CameraEffects) -> Self {
+        self.effects = effects;
+        self
+    }
+
+    /// The scenario.
+    #[must_use]
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// Renders frame `index` (time `index / 30` s).
+    ///
+    /// # Errors
+    /// [`SimError`] if the scenario is inconsistent; never for valid scenarios.
+    pub fn frame(&self, index: u64) -> Result<SimFrame, SimError> {
+        #[expect(
+            clippy::cast_precision_loss,
+            reason = "frame counts are far below 2^52"
+        )]
+        let t = index as f64 * FRAME_INTERVAL_S;
+        #[expect(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            reason = "t ≥ 0, small"
+        )]
+        let time_ns = (t * 1e9).round() as u64;
+        let scene = self.scenario.scene_at(t);
+        let world = World::compile(&scene);
+        let mut rng = SimRng::derived(self.scenario.seed, index);
+        let name = self.scenario.kind.name();
+        let frame_err = |source| SimError::Frame {
+            scenario: name,
+            source,
+        };
+        match self.scenario.view() {
+            View::Overhead => {
+                let pose = self.overhead_camera.field_from_camera().isometry;
+                let out = self
+                    .renderer
+                    .render(&world, &|_| pose, &self.effects, u16::MAX, &mut rng)
+                    .map_err(frame_err)?;
+                let truth = truth::overhead_truth(&scene, t, &self.overhead_camera, &out.objects);
+                Ok(SimFrame {
+                    time_ns,
+                    frame: out.frame,
+                    labels: out.labels,
+                    sensors: None,
+                    ground_truth: GroundTruth::Overhead(truth),
+                    extra: self.scenario.world_models(&scene, t, index),
+                })
+            }
+            View::Robot { observer_id } => {
+                let missing = |time_s| SimError::MissingObserver {
+                    scenario: name,
+                    id: observer_id,
+                    time_s,
+                };
+                let (robot, body, joints) =
+                    self.scenario.observer_at(t).ok_or_else(|| missing(t))?;
+                let dims = Ers7Dimensions::ERS7;
+                let mid: Transform<_, _> =
+                    body.field_from_body(&robot) * dims.body_from_camera(&joints);
+                let height = self.head_camera.height_px;
+                let readout = self.effects.readout_s;
+                #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+                let row_pose = |row: usize| {
+                    let tr = t + ((row as f64 + 0.5) / height as f64 - 0.5) * readout;
+                    match self.scenario.observer_at(tr) {
+                        Some((r, b, j)) if readout > 0.0 => {
+                            (b.field_from_body(&r) * dims.body_from_camera(&j)).isometry
+                        }
+                        _ => mid.isometry,
+                    }
+                };
+                let skip =
+                    render::object_id::ROBOT + u16::try_from(observer_id).unwrap_or(0).min(899);
+                let out = self
+                    .renderer
+                    .render(&world, &row_pose, &self.effects, skip, &mut rng)
+                    .map_err(frame_err)?;
+                let pose = CameraPose {
+                    camera: self.head_camera,
+                    field_from_camera: mid,
+                };
+                let mut sensors = SensorReadings::default();
+                joints.write_to(&mut sensors);
+                body.write_to(&mut sensors);
+                let before = self.scenario.observer_at(t - FRAME_INTERVAL_S).map(|o| o.2);
+                sensors.previous_head_pan_rad = before.map(|j| j.pan_rad);
+                sensors.previous_head_tilt_rad = before.map(|j| j.tilt1_rad);
+                sensors.frame_interval_s = Some(FRAME_INTERVAL_S);
+                if let Some(v) = sensors.pan_velocity_rad_per_s() {
+                    // Duty grows with speed; the ERS-7's pan saturates around 8 rad/s.
+                    sensors.pan_pwm = Some((v / 8.0).clamp(-1.0, 1.0));
+                }
+                // The head's far infra-red sensor looks along the optical axis (10–150 cm).
+                let axis = mid * Vector::<crate::geometry::Camera>::new(1.0, 0.0, 0.0);
+                let d = world.distance_along(&mid.origin(), &axis, skip);
+                sensors.ir_far_cm = (10.0..=150.0).contains(&d).then_some(d);
+                let truth = truth::robot_view_truth(
+                    &scene,
+                    t,
+                    observer_id,
+                    robot,
+                    body,
+                    joints,
+                    &pose,
+                    sensors,
+                    &out.objects,
+                );
+                Ok(SimFrame {
+                    time_ns,
+                    frame: out.frame,
+                    labels: out.labels,
+                    sensors: Some(sensors),
+                    ground_truth: GroundTruth::Robot(Box::new(truth)),
+                    extra: Vec::new(),
+                })
+            }
+        }
+    }
+}

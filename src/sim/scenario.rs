@@ -1,0 +1,545 @@
+//! Scenarios: scenes that move over time, each exercising one part of the pipeline.
+//!
+//! A [`Scenario`] is a pure function of time (seconds) and its seed: [`Scenario::scene_at`]
+//! gives the whole world at any instant, so the renderer can ask for the observing robot's pose
+//! at each row's exposure time (rolling shutter) and frames can be made in any order. The seed
+//! moves the ball and robots a little and sets the world-model noise, so different seeds give
+//! different but equally valid streams.
+
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::rng::SimRng;
+use super::scene::{Ball, Clutter, Material, Robot, Scene, Shape, Team};
+use crate::geometry::{
+    BodyPose, Camera, Ers7Dimensions, Field, HeadJoints, PinholeCamera, Point, RobotPose, Transform,
+};
+
+/// Which camera a scenario films with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum View {
+    /// The head camera of the robot with this id.
+    Robot {
+        /// The observing robot's id.
+        observer_id: u32,
+    },
+    /// The overhead camera.
+    Overhead,
+}
+
+/// The scenarios, by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ScenarioKind {
+    /// A robot walks towards the ball, scanning with its head, then tracks the ball.
+    WalkAndPan,
+    /// A standing robot watches the ball roll across its view, out of the image edges and
+    /// behind two robots.
+    BallEdge,
+    /// A robot looks at the yellow goal while a goalkeeper moves across it, splitting the open
+    /// goal into gaps.
+    Goalkeeper,
+    /// Fast sinusoidal head pans past the ball: the rolling shutter skews it.
+    FastPans,
+    /// A robot at the side line looks off the field at orange and yellow clutter.
+    OrangeClutter,
+    /// A robot circles the centre with its head panning: every beacon and goal in turn.
+    BeaconTour,
+    /// The overhead camera over a game of 4–8 robots and a moving ball, with each robot's noisy
+    /// world-model estimate.
+    OverheadGame,
+}
+
+impl ScenarioKind {
+    /// Every scenario in documentation order.
+    pub const ALL: [Self; 7] = [
+        Self::WalkAndPan,
+        Self::BallEdge,
+        Self::Goalkeeper,
+        Self::FastPans,
+        Self::OrangeClutter,
+        Self::BeaconTour,
+        Self::OverheadGame,
+    ];
+
+    /// The command-line name (`walk-and-pan`, …).
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::WalkAndPan => "walk-and-pan",
+            Self::BallEdge => "ball-edge",
+            Self::Goalkeeper => "goalkeeper",
+            Self::FastPans => "fast-pans",
+            Self::OrangeClutter => "orange-clutter",
+            Self::BeaconTour => "beacon-tour",
+            Self::OverheadGame => "overhead-game",
+        }
+    }
+
+    /// The scenario with this command-line name.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// One line on what it exercises.
+    #[must_use]
+    pub const fn description(self) -> &'static str {
+        match self {
+            Self::WalkAndPan => "a robot walks towards the ball, scanning, then tracks it",
+            Self::BallEdge => "the ball rolls out of the image edges and behind two robots",
+            Self::Goalkeeper => "a goalkeeper moves across the yellow goal, splitting it",
+            Self::FastPans => "fast head pans past the ball: rolling-shutter skew",
+            Self::OrangeClutter => "orange and yellow things off the field, and the real ball",
+            Self::BeaconTour => "a robot circles the centre, panning past every beacon",
+            Self::OverheadGame => "overhead view of 4-8 robots and the ball, with world models",
+        }
+    }
+}
+
+/// A scenario with its seed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scenario {
+    /// Which one.
+    pub kind: ScenarioKind,
+    /// The seed.
+    pub seed: u64,
+    /// Seed-dependent offsets, −1..1.
+    jitter: [f64; 4],
+    /// Robots in the overhead game.
+    robot_count: u32,
+}
+
+/// The observing robot's id in every robot-camera scenario.
+pub const OBSERVER_ID: u32 = 1;
+
+impl Scenario {
+    /// A scenario for a seed.
+    #[must_use]
+    pub fn new(kind: ScenarioKind, seed: u64) -> Self {
+        let mut rng = SimRng::derived(seed, 0x5CE7_A210);
+        let jitter = [0; 4].map(|_| rng.range(-1.0, 1.0));
+        let robot_count = 4 + u32::try_from(rng.below(5)).unwrap_or(0);
+        Self {
+            kind,
+            seed,
+            jitter,
+            robot_count,
+        }
+    }
+
+    /// Which camera films it.
+    #[must_use]
+    pub fn view(&self) -> View {
+        match self.kind {
+            ScenarioKind::OverheadGame => View::Overhead,
+            _ => View::Robot {
+                observer_id: OBSERVER_ID,
+            },
+        }
+    }
+
+    /// The world at time `t_s` (seconds from the start).
+    #[must_use]
+    pub fn scene_at(&self, t_s: f64) -> Scene {
+        let mut scene = Scene::four_legged_2005();
+        let j = self.jitter;
+        match self.kind {
+            ScenarioKind::WalkAndPan => {
+                let ball = Ball::at(80.0 + 30.0 * j[0], 50.0 + 30.0 * j[1]);
+                scene.ball = Some(ball);
+                let start = (-180.0, -90.0);
+                let (dx, dy) = (ball.x_cm - start.0, ball.y_cm - start.1);
+                let total = dx.hypot(dy);
+                let walked = (20.0 * t_s).min(total - 35.0).max(0.0);
+                let heading = dy.atan2(dx);
+                let pose = RobotPose::new(
+                    start.0 + heading.cos() * walked,
+                    start.1 + heading.sin() * walked,
+                    heading,
+                );
+                let body = walking_body(t_s, walked < total - 35.0);
+                let scan = HeadJoints {
+                    tilt1_rad: -0.3,
+                    pan_rad: 0.9 * (TAU * t_s / 2.0).sin(),
+                    tilt2_rad: 0.0,
+                };
+                let track = look_at(&pose, &body, &Point::new(ball.x_cm, ball.y_cm, 4.25));
+                let wgt = (t_s - 1.5).clamp(0.0, 1.0);
+                let joints = blend(&scan, &track, wgt);
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+                scene.robots.push(standing(5, Team::Blue, 150.0, -60.0, PI));
+            }
+            ScenarioKind::BallEdge => {
+                // Triangle wave: the ball rolls from y = +110 to −110 and back every 12 s.
+                let phase = (t_s / 12.0 + 0.1 * j[0]).rem_euclid(1.0);
+                let y = 110.0 - 440.0 * if phase < 0.5 { phase } else { 1.0 - phase };
+                scene.ball = Some(Ball::at(110.0, y));
+                let pose = RobotPose::new(-40.0, 5.0 * j[1], 0.0);
+                let body = BodyPose::ERS7_STANCE;
+                let joints = HeadJoints {
+                    tilt1_rad: -0.28,
+                    pan_rad: 0.05 * j[2],
+                    tilt2_rad: 0.0,
+                };
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+                scene.robots.push(standing(2, Team::Blue, 70.0, 18.0, PI));
+                scene
+                    .robots
+                    .push(standing(3, Team::Blue, 75.0, -32.0, PI - 0.4));
+            }
+            ScenarioKind::Goalkeeper => {
+                scene.ball = Some(Ball::at(190.0 + 10.0 * j[0], -45.0));
+                let pose = RobotPose::new(100.0, 30.0 + 10.0 * j[1], 0.0);
+                let body = BodyPose::ERS7_STANCE;
+                let pose = RobotPose {
+                    heading_rad: (0.0 - pose.y_cm).atan2(270.0 - pose.x_cm),
+                    ..pose
+                };
+                let joints = look_at(&pose, &body, &Point::new(270.0, 0.0, 12.0));
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+                let keeper_y = 28.0 * (TAU * t_s / 4.0 + j[2]).sin();
+                scene
+                    .robots
+                    .push(standing(2, Team::Blue, 245.0, keeper_y, PI));
+                scene
+                    .robots
+                    .push(standing(3, Team::Blue, 200.0, 70.0, PI + 0.5));
+            }
+            ScenarioKind::FastPans => {
+                scene.ball = Some(Ball::at(70.0 + 15.0 * j[0], -10.0 + 15.0 * j[1]));
+                let pose = RobotPose::new(-60.0, 20.0, 0.0);
+                let body = BodyPose::ERS7_STANCE;
+                let joints = HeadJoints {
+                    tilt1_rad: -0.32,
+                    pan_rad: 1.1 * (TAU * t_s / 1.2).sin(),
+                    tilt2_rad: 0.0,
+                };
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+            }
+            ScenarioKind::OrangeClutter => {
+                scene.ball = Some(Ball::at(115.0 + 10.0 * j[0], 150.0));
+                let pose = RobotPose::new(130.0, 120.0, FRAC_PI_2 + 0.2 * j[1]);
+                let body = BodyPose::ERS7_STANCE;
+                let joints = HeadJoints {
+                    tilt1_rad: -0.12,
+                    pan_rad: 1.0 * (TAU * t_s / 4.0).sin(),
+                    tilt2_rad: 0.05,
+                };
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+                scene.clutter.extend(orange_clutter());
+            }
+            ScenarioKind::BeaconTour => {
+                let angle = TAU * t_s / 16.0 + j[0];
+                let pose = RobotPose::new(90.0 * angle.cos(), 90.0 * angle.sin(), angle);
+                let body = walking_body(t_s, true);
+                let joints = HeadJoints {
+                    tilt1_rad: -0.05,
+                    pan_rad: 1.2 * (TAU * t_s / 3.0).sin(),
+                    tilt2_rad: 0.1,
+                };
+                scene.ball = Some(Ball::at(-30.0 + 20.0 * j[1], 40.0));
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+                scene
+                    .robots
+                    .push(standing(4, Team::Blue, 160.0, -100.0, 2.5));
+            }
+            ScenarioKind::OverheadGame => {
+                for k in 0..self.robot_count {
+                    let team = if k % 2 == 0 { Team::Red } else { Team::Blue };
+                    let (x, y, heading) = self.game_path(k, t_s);
+                    scene.robots.push(robot(
+                        k + 1,
+                        team,
+                        RobotPose::new(x, y, heading),
+                        walking_body(t_s + f64::from(k), true),
+                        HeadJoints {
+                            tilt1_rad: -0.4,
+                            pan_rad: 0.8 * (TAU * t_s / 2.5 + f64::from(k)).sin(),
+                            tilt2_rad: 0.0,
+                        },
+                    ));
+                }
+                let w = 0.35;
+                scene.ball = Some(Ball::at(
+                    200.0 * (w * t_s + j[0]).sin(),
+                    120.0 * (1.7 * w * t_s + j[1]).sin(),
+                ));
+            }
+        }
+        scene
+    }
+
+    /// Robot `k`'s smooth path in the overhead game: position (cm) and heading along the
+    /// direction of travel.
+    fn game_path(&self, k: u32, t_s: f64) -> (f64, f64, f64) {
+        let mut rng = SimRng::derived(self.seed, 100 + u64::from(k));
+        let (cx, cy) = (rng.range(-150.0, 150.0), rng.range(-100.0, 100.0));
+        let (ax, ay) = (rng.range(40.0, 90.0), rng.range(30.0, 70.0));
+        let (wx, wy) = (rng.range(0.2, 0.5), rng.range(0.2, 0.5));
+        let (px, py) = (rng.range(0.0, TAU), rng.range(0.0, TAU));
+        let x = cx + ax * (wx * t_s + px).sin();
+        let y = cy + ay * (wy * t_s + py).sin();
+        let vx = ax * wx * (wx * t_s + px).cos();
+        let vy = ay * wy * (wy * t_s + py).cos();
+        (x, y, vy.atan2(vx))
+    }
+
+    /// What the observing robot does at time `t_s`: pose, body and head joints (`None` for the
+    /// overhead view).
+    #[must_use]
+    pub fn observer_at(&self, t_s: f64) -> Option<(RobotPose, BodyPose, HeadJoints)> {
+        match self.view() {
+            View::Overhead => None,
+            View::Robot { observer_id } => self
+                .scene_at(t_s)
+                .robot(observer_id)
+                .map(|r| (r.pose, r.body, r.joints)),
+        }
+    }
+
+    /// Each robot's own estimate of where it and the ball are, as its world model would
+    /// report it: the truth plus a slowly drifting bias and per-frame noise (σ 8 cm, 0.05 rad;
+    /// ball σ 12 cm). One JSON value per robot, keyed by channel name `/world_model/robotN`.
+    #[must_use]
+    pub fn world_models(
+        &self,
+        scene: &Scene,
+        t_s: f64,
+        frame: u64,
+    ) -> Vec<(String, serde_json::Value)> {
+        let mut rng = SimRng::derived(self.seed ^ 0x3D_0D31, frame);
+        scene
+            .robots
+            .iter()
+            .map(|r| {
+                let id = f64::from(r.id);
+                let bias = |k: f64, amp: f64| amp * (0.3 * t_s + id * 1.7 + k).sin();
+                let x = r.pose.x_cm + bias(0.0, 15.0) + 8.0 * rng.normal();
+                let y = r.pose.y_cm + bias(1.0, 15.0) + 8.0 * rng.normal();
+                let heading = r.pose.heading_rad + bias(2.0, 0.1) + 0.05 * rng.normal();
+                let ball = scene.ball.map(|b| {
+                    serde_json::json!({
+                        "x_cm": b.x_cm + bias(3.0, 20.0) + 12.0 * rng.normal(),
+                        "y_cm": b.y_cm + bias(4.0, 20.0) + 12.0 * rng.normal(),
+                        "sd_cm": 25.0,
+                    })
+                });
+                (
+                    format!("/world_model/robot{}", r.id),
+                    serde_json::json!({
+                        "robot_id": r.id,
+                        "team": r.team,
+                        "time_s": t_s,
+                        "self": {
+                            "x_cm": x,
+                            "y_cm": y,
+                            "heading_rad": heading,
+                            "sd_cm": 17.0,
+                            "sd_heading_rad": 0.11,
+                        },
+                        "ball": ball,
+                    }),
+                )
+            })
+            .collect()
+    }
+}
+
+fn robot(id: u32, team: Team, pose: RobotPose, body: BodyPose, joints: HeadJoints) -> Robot {
+    Robot {
+        id,
+        team,
+        pose,
+        body,
+        joints,
+    }
+}
+
+fn standing(id: u32, team: Team, x_cm: f64, y_cm: f64, heading_rad: f64) -> Robot {
+    robot(
+        id,
+        team,
+        RobotPose::new(x_cm, y_cm, heading_rad),
+        BodyPose::ERS7_STANCE,
+        HeadJoints {
+            tilt1_rad: -0.3,
+            ..HeadJoints::default()
+        },
+    )
+}
+
+/// The body bobbing with a 2 Hz trot while walking, still otherwise.
+fn walking_body(t_s: f64, walking: bool) -> BodyPose {
+    let s = if walking { 1.0 } else { 0.0 };
+    let step = TAU * 2.0 * t_s;
+    BodyPose {
+        height_cm: 12.0 + s * 0.4 * step.sin(),
+        pitch_rad: 0.10 + s * 0.02 * (step + 0.5).sin(),
+        roll_rad: s * 0.025 * (step / 2.0).sin(),
+    }
+}
+
+fn blend(a: &HeadJoints, b: &HeadJoints, w: f64) -> HeadJoints {
+    HeadJoints {
+        tilt1_rad: a.tilt1_rad + (b.tilt1_rad - a.tilt1_rad) * w,
+        pan_rad: a.pan_rad + (b.pan_rad - a.pan_rad) * w,
+        tilt2_rad: a.tilt2_rad + (b.tilt2_rad - a.tilt2_rad) * w,
+    }
+}
+
+/// Head joints (lower tilt and pan; upper tilt 0) that put `target` at the image centre, within
+/// the ERS-7's joint ranges (tilt1 −75°..0°, pan ±91°).
+#[must_use]
+pub fn look_at(robot: &RobotPose, body: &BodyPose, target: &Point<Field>) -> HeadJoints {
+    let camera = PinholeCamera::ers7();
+    let field_from_body = body.field_from_body(robot);
+    let mut joints = HeadJoints::default();
+    for _ in 0..8 {
+        let field_from_camera: Transform<Field, Camera> =
+            field_from_body * Ers7Dimensions::ERS7.body_from_camera(&joints);
+        let local = field_from_camera.inverse() * *target;
+        let Some(p) = camera.project(&local) else {
+            // Behind: turn towards it first.
+            let b = field_from_body.inverse() * *target;
+            joints.pan_rad = b.y().atan2(b.x());
+            continue;
+        };
+        let err_pan = camera.bearing_rad(p);
+        let err_tilt = camera.elevation_rad(p);
+        joints.pan_rad = (joints.pan_rad + err_pan).clamp(-1.59, 1.59);
+        joints.tilt1_rad = (joints.tilt1_rad + err_tilt).clamp(-1.31, 0.0);
+        if err_pan.abs() + err_tilt.abs() < 1e-6 {
+            break;
+        }
+    }
+    joints
+}
+
+/// Off-field things in ball and goal colours: an orange chair, an orange ball-sized sphere on
+/// the table, a yellow box, an orange bag.
+fn orange_clutter() -> Vec<Clutter> {
+    vec![
+        Clutter {
+            name: "orange chair".to_owned(),
+            shape: Shape::Box {
+                length_cm: 45.0,
+                width_cm: 45.0,
+                height_cm: 45.0,
+            },
+            position_cm: [150.0, 265.0, 0.0],
+            yaw_rad: 0.3,
+            material: Material::ClutterOrange,
+        },
+        Clutter {
+            name: "orange toy ball".to_owned(),
+            shape: Shape::Sphere { radius_cm: 6.0 },
+            position_cm: [80.0, 320.0, 75.0],
+            yaw_rad: 0.0,
+            material: Material::ClutterOrange,
+        },
+        Clutter {
+            name: "yellow box".to_owned(),
+            shape: Shape::Box {
+                length_cm: 40.0,
+                width_cm: 30.0,
+                height_cm: 30.0,
+            },
+            position_cm: [40.0, 250.0, 0.0],
+            yaw_rad: -0.2,
+            material: Material::ClutterYellow,
+        },
+        Clutter {
+            name: "orange bag".to_owned(),
+            shape: Shape::Cylinder {
+                radius_cm: 12.0,
+                height_cm: 25.0,
+            },
+            position_cm: [230.0, 240.0, 0.0],
+            yaw_rad: 0.0,
+            material: Material::ClutterOrange,
+        },
+    ]
+}
+
+/// The vector from a robot's camera to a point, field axes (cm); handy in tests.
+#[must_use]
+pub fn camera_to(
+    robot: &RobotPose,
+    body: &BodyPose,
+    joints: &HeadJoints,
+    p: &Point<Field>,
+) -> Vector3<f64> {
+    let c = (body.field_from_body(robot) * Ers7Dimensions::ERS7.body_from_camera(joints)).origin();
+    p.coords - c.coords
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for k in ScenarioKind::ALL {
+            assert_eq!(ScenarioKind::from_name(k.name()), Some(k));
+        }
+        assert_eq!(ScenarioKind::from_name("nope"), None);
+    }
+
+    #[test]
+    fn look_at_centres_the_target() {
+        let robot = RobotPose::new(10.0, -20.0, 0.4);
+        let body = BodyPose::ERS7_STANCE;
+        let target = Point::new(80.0, 30.0, 4.25);
+        let joints = look_at(&robot, &body, &target);
+        let t = body.field_from_body(&robot) * Ers7Dimensions::ERS7.body_from_camera(&joints);
+        let p = PinholeCamera::ers7()
+            .project(&(t.inverse() * target))
+            .expect("in front");
+        assert!(
+            (p.x_px - 104.0).abs() < 0.01 && (p.y_px - 80.0).abs() < 0.01,
+            "{p:?}"
+        );
+        assert!(camera_to(&robot, &body, &joints, &target).norm() > 50.0);
+    }
+
+    #[test]
+    fn scenes_are_pure_functions_of_time_and_seed() {
+        for k in ScenarioKind::ALL {
+            let a = Scenario::new(k, 3);
+            let b = Scenario::new(k, 3);
+            assert_eq!(a.scene_at(1.25), b.scene_at(1.25), "{}", k.name());
+            if let View::Robot { observer_id } = a.view() {
+                assert!(a.scene_at(0.0).robot(observer_id).is_some());
+            }
+        }
+        let game = Scenario::new(ScenarioKind::OverheadGame, 9).scene_at(2.0);
+        assert!((4..=8).contains(&game.robots.len()));
+    }
+
+    #[test]
+    fn world_models_have_one_channel_per_robot() {
+        let s = Scenario::new(ScenarioKind::OverheadGame, 1);
+        let scene = s.scene_at(0.5);
+        let models = s.world_models(&scene, 0.5, 15);
+        assert_eq!(models.len(), scene.robots.len());
+        assert_eq!(models[0].0, "/world_model/robot1");
+        let x = models[0].1["self"]["x_cm"].as_f64().expect("x");
+        assert!((x - scene.robots[0].pose.x_cm).abs() < 80.0);
+    }
+}

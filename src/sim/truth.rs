@@ -1,0 +1,568 @@
+//! Per-frame ground truth: what a perfect recognition would report for a rendered frame.
+//!
+//! Stored as JSON on a stream's `/ground_truth` channel. Image positions are projections with
+//! the camera pose at the middle of the frame's readout, the instant the sensor readings
+//! describe (so they are what a perfect skew correction would give); pixel counts, boxes and
+//! gaps come from the rendered object buffer, so they include occlusion, the image border and
+//! the rolling shutter's skew. Distances in centimetres, angles in radians (`FORMATS.md` signs:
+//! bearing positive left, elevation positive up), image coordinates in pixels.
+
+use serde::{Deserialize, Serialize};
+
+use super::render::object_id;
+use super::scene::{GoalColour, Scene, Team};
+use crate::geometry::{
+    BodyPose, CameraPose, Field, HeadJoints, Horizon, ImagePoint, OverheadCamera, Point,
+    PoseRecord, RobotPose,
+};
+use crate::sensors::SensorReadings;
+
+/// Ground truth of one frame: a robot's camera view or the overhead view.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "view", rename_all = "snake_case")]
+pub enum GroundTruth {
+    /// A frame from a robot's head camera.
+    Robot(Box<RobotViewTruth>),
+    /// A frame from the overhead camera.
+    Overhead(OverheadTruth),
+}
+
+/// An inclusive pixel box, `FORMATS.md` convention.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PixelBox {
+    /// Leftmost column.
+    pub min_x: usize,
+    /// Topmost row.
+    pub min_y: usize,
+    /// Rightmost column.
+    pub max_x: usize,
+    /// Bottom row.
+    pub max_y: usize,
+}
+
+/// Which image borders cut an object's outline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct CutOff {
+    /// Cut by the left border.
+    pub left: bool,
+    /// Cut by the right border.
+    pub right: bool,
+    /// Cut by the top border.
+    pub top: bool,
+    /// Cut by the bottom border.
+    pub bottom: bool,
+}
+
+/// Truth of a robot-camera frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RobotViewTruth {
+    /// Time of the frame (middle of readout), seconds since the scenario start.
+    pub time_s: f64,
+    /// Identity of the robot whose camera this is.
+    pub observer_id: u32,
+    /// Where it stands.
+    pub robot_pose: RobotPose,
+    /// Its body height and tilt.
+    pub body: BodyPose,
+    /// Its head joints at the middle of readout.
+    pub joints: HeadJoints,
+    /// The camera pose in the field at the middle of readout.
+    pub camera_pose: PoseRecord,
+    /// The sensor readings sent with the frame (also on `/sensors`).
+    pub sensors: SensorReadings,
+    /// The horizon at the middle of readout, if the camera is not looking straight down.
+    pub horizon: Option<Horizon>,
+    /// The ball, if in the scene.
+    pub ball: Option<BallTruth>,
+    /// Both goals.
+    pub goals: Vec<GoalTruth>,
+    /// Every beacon.
+    pub beacons: Vec<BeaconTruth>,
+    /// Every other robot.
+    pub robots: Vec<RobotTruth>,
+}
+
+/// Where something is relative to the observing robot.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Relative {
+    /// Field position (x, y), centimetres.
+    pub field_cm: [f64; 2],
+    /// Straight-line distance from the camera to the object's reference point, centimetres.
+    pub camera_distance_cm: f64,
+    /// Distance on the ground from the body centre, centimetres.
+    pub body_distance_cm: f64,
+    /// Bearing on the ground from the body's heading, radians, positive left.
+    pub body_bearing_rad: f64,
+    /// Bearing from the camera's optical axis (as the image point gives it), radians.
+    pub camera_bearing_rad: f64,
+    /// Elevation above the camera's x–y plane, radians.
+    pub camera_elevation_rad: f64,
+    /// Projection of the reference point into the image, if in front of the camera (may lie
+    /// outside the image).
+    pub image: Option<ImagePoint>,
+}
+
+/// The ball in a robot's view.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BallTruth {
+    /// Position relative to the observer (reference point: the ball's centre).
+    pub relative: Relative,
+    /// Image radius, pixels (for a ball in front of the camera).
+    pub image_radius_px: Option<f64>,
+    /// Pixels that show the ball.
+    pub visible_pixels: usize,
+    /// Visible pixels over the area of the whole projected disc (0..1): less than 1 when cut
+    /// by the image border or hidden behind something.
+    pub visible_fraction: f64,
+    /// Part of the projected disc inside the image (0..1), ignoring occlusion.
+    pub in_image_fraction: f64,
+    /// Image borders that cut the disc.
+    pub cut_off: CutOff,
+    /// Box of the visible ball pixels.
+    pub image_box: Option<PixelBox>,
+}
+
+/// A goal post: the front end of a side wall.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PostTruth {
+    /// Field position of the post's centre on the ground (x, y), centimetres.
+    pub field_cm: [f64; 2],
+    /// Image position of the post's foot.
+    pub image_base: Option<ImagePoint>,
+    /// Image position of the post's top.
+    pub image_top: Option<ImagePoint>,
+}
+
+/// The widest stretch of a goal not hidden by robots.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GoalGap {
+    /// Leftmost open column.
+    pub from_x_px: usize,
+    /// Rightmost open column.
+    pub to_x_px: usize,
+    /// Camera bearing of the gap's centre, radians.
+    pub centre_bearing_rad: f64,
+    /// Angular width of the gap, radians.
+    pub width_rad: f64,
+}
+
+/// A goal in a robot's view.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GoalTruth {
+    /// Which goal.
+    pub colour: GoalColour,
+    /// Position relative to the observer (reference point: the goal mouth's centre on the
+    /// ground).
+    pub relative: Relative,
+    /// Pixels that show the goal.
+    pub visible_pixels: usize,
+    /// Box of those pixels.
+    pub image_box: Option<PixelBox>,
+    /// Left and right post as seen from the field (left = +y side for the yellow goal seen
+    /// from the centre).
+    pub posts: [PostTruth; 2],
+    /// The largest stretch of goal columns with no robot in front, if any of the goal shows.
+    pub largest_gap: Option<GoalGap>,
+}
+
+/// A beacon in a robot's view.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BeaconTruth {
+    /// Its name in the scene (top colour first).
+    pub name: String,
+    /// Relative position (reference point: the boundary between the two colour bands).
+    pub relative: Relative,
+    /// Pixels that show the beacon.
+    pub visible_pixels: usize,
+    /// Box of those pixels.
+    pub image_box: Option<PixelBox>,
+}
+
+/// Another robot in a robot's view.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RobotTruth {
+    /// Identity.
+    pub id: u32,
+    /// Team.
+    pub team: Team,
+    /// Heading, radians.
+    pub heading_rad: f64,
+    /// Relative position (reference point: the body centre).
+    pub relative: Relative,
+    /// Pixels that show the robot.
+    pub visible_pixels: usize,
+    /// Box of those pixels.
+    pub image_box: Option<PixelBox>,
+}
+
+/// Truth of an overhead frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OverheadTruth {
+    /// Time of the frame, seconds since the scenario start.
+    pub time_s: f64,
+    /// The camera model that made the frame.
+    pub camera: OverheadCamera,
+    /// The ball, if in the scene.
+    pub ball: Option<OverheadObject>,
+    /// Every robot.
+    pub robots: Vec<OverheadRobot>,
+}
+
+/// The ball seen from above.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct OverheadObject {
+    /// Field position (x, y), centimetres.
+    pub field_cm: [f64; 2],
+    /// Image position of its centre.
+    pub image: Option<ImagePoint>,
+    /// Pixels that show it.
+    pub visible_pixels: usize,
+}
+
+/// A robot seen from above.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct OverheadRobot {
+    /// Identity.
+    pub id: u32,
+    /// Team.
+    pub team: Team,
+    /// Field position of the body centre (x, y), centimetres.
+    pub field_cm: [f64; 2],
+    /// Heading, radians counter-clockwise from +x.
+    pub heading_rad: f64,
+    /// Image position of the body centre.
+    pub image: Option<ImagePoint>,
+    /// Pixels that show it.
+    pub visible_pixels: usize,
+}
+
+/// Pixel statistics of one object in an object buffer.
+#[derive(Debug, Clone, Copy, Default)]
+struct Coverage {
+    pixels: usize,
+    bbox: Option<PixelBox>,
+}
+
+fn coverage(objects: &[u16], width: usize, id: u16) -> Coverage {
+    let mut c = Coverage::default();
+    for (k, _) in objects.iter().enumerate().filter(|(_, o)| **o == id) {
+        let (x, y) = (k % width, k / width);
+        c.pixels += 1;
+        c.bbox = Some(match c.bbox {
+            None => PixelBox {
+                min_x: x,
+                min_y: y,
+                max_x: x,
+                max_y: y,
+            },
+            Some(b) => PixelBox {
+                min_x: b.min_x.min(x),
+                min_y: b.min_y.min(y),
+                max_x: b.max_x.max(x),
+                max_y: b.max_y.max(y),
+            },
+        });
+    }
+    c
+}
+
+fn relative(pose: &CameraPose, robot: &RobotPose, p: &Point<Field>) -> Relative {
+    let camera_local = pose.field_from_camera.inverse() * *p;
+    let (dx, dy) = (p.x() - robot.x_cm, p.y() - robot.y_cm);
+    let (s, c) = robot.heading_rad.sin_cos();
+    let (fx, fy) = (c * dx + s * dy, -s * dx + c * dy);
+    let v = camera_local.coords;
+    Relative {
+        field_cm: [p.x(), p.y()],
+        camera_distance_cm: v.coords.norm(),
+        body_distance_cm: dx.hypot(dy),
+        body_bearing_rad: fy.atan2(fx),
+        camera_bearing_rad: v.y.atan2(v.x),
+        camera_elevation_rad: v.z.atan2(v.x.hypot(v.y)),
+        image: pose.camera.project(&camera_local),
+    }
+}
+
+/// Builds the truth of a robot-camera frame from the scene, the camera pose at mid-readout and
+/// the rendered object buffer.
+#[must_use]
+#[expect(
+    clippy::too_many_arguments,
+    reason = "one call site; every input is distinct"
+)]
+pub fn robot_view_truth(
+    scene: &Scene,
+    time_s: f64,
+    observer_id: u32,
+    robot_pose: RobotPose,
+    body: BodyPose,
+    joints: HeadJoints,
+    pose: &CameraPose,
+    sensors: SensorReadings,
+    objects: &[u16],
+) -> RobotViewTruth {
+    let (w, h) = (pose.camera.width_px, pose.camera.height_px);
+    let ball = scene.ball.map(|b| {
+        let centre = Point::<Field>::new(b.x_cm, b.y_cm, b.radius_cm);
+        let rel = relative(pose, &robot_pose, &centre);
+        let cov = coverage(objects, w, object_id::BALL);
+        let radius = rel.image.and_then(|_| {
+            pose.camera
+                .sphere_radius_px(b.radius_cm, rel.camera_distance_cm)
+        });
+        let (in_image, cut_off, area) = match (rel.image, radius) {
+            (Some(c), Some(r)) => disc_in_image(c, r, w, h),
+            _ => (0.0, CutOff::default(), 0.0),
+        };
+        #[expect(clippy::cast_precision_loss, reason = "pixel counts are small")]
+        let visible_fraction = if area > 0.0 {
+            (cov.pixels as f64 / area).min(1.0)
+        } else {
+            0.0
+        };
+        BallTruth {
+            relative: rel,
+            image_radius_px: radius,
+            visible_pixels: cov.pixels,
+            visible_fraction,
+            in_image_fraction: in_image,
+            cut_off,
+            image_box: cov.bbox,
+        }
+    });
+    let f = &scene.field;
+    let goals = [GoalColour::Yellow, GoalColour::SkyBlue]
+        .into_iter()
+        .map(|colour| {
+            let (s, id) = match colour {
+                GoalColour::Yellow => (1.0, object_id::YELLOW_GOAL),
+                GoalColour::SkyBlue => (-1.0, object_id::SKY_BLUE_GOAL),
+            };
+            let x = s * f.length_cm / 2.0;
+            let post_y = f.goal_width_cm / 2.0 + f.goal_wall_cm / 2.0;
+            let post = |y: f64| PostTruth {
+                field_cm: [x, y],
+                image_base: pose.image_from_field(&Point::new(x, y, 0.0)),
+                image_top: pose.image_from_field(&Point::new(x, y, f.goal_height_cm)),
+            };
+            let cov = coverage(objects, w, id);
+            GoalTruth {
+                colour,
+                relative: relative(pose, &robot_pose, &Point::new(x, 0.0, 0.0)),
+                visible_pixels: cov.pixels,
+                image_box: cov.bbox,
+                posts: [post(s * post_y), post(-s * post_y)],
+                largest_gap: cov.bbox.and_then(|b| largest_gap(objects, w, id, &b, pose)),
+            }
+        })
+        .collect();
+    let beacons = scene
+        .beacons
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let id = object_id::BEACON + u16::try_from(i).unwrap_or(0).min(89);
+            let cov = coverage(objects, w, id);
+            let boundary = Point::new(b.x_cm, b.y_cm, b.base_height_cm + b.band_height_cm);
+            BeaconTruth {
+                name: b.name.clone(),
+                relative: relative(pose, &robot_pose, &boundary),
+                visible_pixels: cov.pixels,
+                image_box: cov.bbox,
+            }
+        })
+        .collect();
+    let robots = scene
+        .robots
+        .iter()
+        .filter(|r| r.id != observer_id)
+        .map(|r| {
+            let id = object_id::ROBOT + u16::try_from(r.id).unwrap_or(0).min(899);
+            let cov = coverage(objects, w, id);
+            let centre = Point::new(r.pose.x_cm, r.pose.y_cm, r.body.height_cm);
+            RobotTruth {
+                id: r.id,
+                team: r.team,
+                heading_rad: r.pose.heading_rad,
+                relative: relative(pose, &robot_pose, &centre),
+                visible_pixels: cov.pixels,
+                image_box: cov.bbox,
+            }
+        })
+        .collect();
+    RobotViewTruth {
+        time_s,
+        observer_id,
+        robot_pose,
+        body,
+        joints,
+        camera_pose: PoseRecord::from_transform(&pose.field_from_camera),
+        sensors,
+        horizon: pose.horizon(),
+        ball,
+        goals,
+        beacons,
+        robots,
+    }
+}
+
+/// Fraction of a disc inside the image (sampled on a 41×41 grid), the borders it crosses, and
+/// its area in pixels.
+fn disc_in_image(c: ImagePoint, r: f64, w: usize, h: usize) -> (f64, CutOff, f64) {
+    #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+    let (wf, hf) = (w as f64, h as f64);
+    let mut inside = 0_u32;
+    let mut total = 0_u32;
+    for a in -20..=20 {
+        for b in -20..=20 {
+            let (dx, dy) = (f64::from(a) / 20.0, f64::from(b) / 20.0);
+            if dx * dx + dy * dy > 1.0 {
+                continue;
+            }
+            total += 1;
+            let (x, y) = (c.x_px + dx * r, c.y_px + dy * r);
+            if x >= 0.0 && y >= 0.0 && x < wf && y < hf {
+                inside += 1;
+            }
+        }
+    }
+    let overlaps = inside > 0;
+    let cut_off = CutOff {
+        left: overlaps && c.x_px - r < 0.0,
+        right: overlaps && c.x_px + r > wf,
+        top: overlaps && c.y_px - r < 0.0,
+        bottom: overlaps && c.y_px + r > hf,
+    };
+    (
+        f64::from(inside) / f64::from(total.max(1)),
+        cut_off,
+        std::f64::consts::PI * r * r,
+    )
+}
+
+/// The longest run of columns in the goal's box that show the goal and no robot within the
+/// box's rows.
+fn largest_gap(
+    objects: &[u16],
+    w: usize,
+    goal: u16,
+    b: &PixelBox,
+    pose: &CameraPose,
+) -> Option<GoalGap> {
+    let open = |x: usize| {
+        let mut goal_seen = false;
+        for y in b.min_y..=b.max_y {
+            match objects.get(y * w + x) {
+                Some(&o) if o == goal => goal_seen = true,
+                Some(&o) if (object_id::ROBOT..object_id::CLUTTER).contains(&o) => return false,
+                _ => {}
+            }
+        }
+        goal_seen
+    };
+    let (mut best, mut run_start): (Option<(usize, usize)>, Option<usize>) = (None, None);
+    for x in b.min_x..=b.max_x + 1 {
+        if x <= b.max_x && open(x) {
+            run_start.get_or_insert(x);
+        } else if let Some(s) = run_start.take() {
+            let e = x - 1;
+            if best.is_none_or(|(bs, be)| e - s > be - bs) {
+                best = Some((s, e));
+            }
+        }
+    }
+    best.map(|(s, e)| {
+        #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+        let mid_y = (b.min_y + b.max_y) as f64 / 2.0 + 0.5;
+        #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+        let (left, right) = (
+            pose.camera.bearing_rad(ImagePoint::new(s as f64, mid_y)),
+            pose.camera
+                .bearing_rad(ImagePoint::new((e + 1) as f64, mid_y)),
+        );
+        GoalGap {
+            from_x_px: s,
+            to_x_px: e,
+            centre_bearing_rad: (left + right) / 2.0,
+            width_rad: left - right,
+        }
+    })
+}
+
+/// Builds the truth of an overhead frame.
+#[must_use]
+pub fn overhead_truth(
+    scene: &Scene,
+    time_s: f64,
+    camera: &OverheadCamera,
+    objects: &[u16],
+) -> OverheadTruth {
+    let w = camera.width_px;
+    OverheadTruth {
+        time_s,
+        camera: *camera,
+        ball: scene.ball.map(|b| OverheadObject {
+            field_cm: [b.x_cm, b.y_cm],
+            image: camera.image_from_field(&Point::new(b.x_cm, b.y_cm, b.radius_cm)),
+            visible_pixels: coverage(objects, w, object_id::BALL).pixels,
+        }),
+        robots: scene
+            .robots
+            .iter()
+            .map(|r| OverheadRobot {
+                id: r.id,
+                team: r.team,
+                field_cm: [r.pose.x_cm, r.pose.y_cm],
+                heading_rad: r.pose.heading_rad,
+                image: camera.image_from_field(&Point::new(
+                    r.pose.x_cm,
+                    r.pose.y_cm,
+                    r.body.height_cm,
+                )),
+                visible_pixels: coverage(
+                    objects,
+                    w,
+                    object_id::ROBOT + u16::try_from(r.id).unwrap_or(0).min(899),
+                )
+                .pixels,
+            })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disc_fully_inside_and_half_cut() {
+        let (f, cut, area) = disc_in_image(ImagePoint::new(100.0, 80.0), 10.0, 208, 160);
+        assert!((f - 1.0).abs() < 1e-12);
+        assert_eq!(cut, CutOff::default());
+        assert!((area - std::f64::consts::PI * 100.0).abs() < 1e-9);
+        let (f, cut, _) = disc_in_image(ImagePoint::new(0.0, 80.0), 10.0, 208, 160);
+        assert!((f - 0.5).abs() < 0.05, "{f}");
+        assert!(cut.left && !cut.right && !cut.top && !cut.bottom);
+        let (f, cut, _) = disc_in_image(ImagePoint::new(-50.0, 80.0), 10.0, 208, 160);
+        assert_eq!(f, 0.0);
+        assert_eq!(cut, CutOff::default());
+    }
+
+    #[test]
+    fn coverage_counts_pixels_and_boxes() {
+        let mut objects = vec![0_u16; 10 * 4];
+        objects[12] = 1;
+        objects[27] = 1;
+        let c = coverage(&objects, 10, 1);
+        assert_eq!(c.pixels, 2);
+        assert_eq!(
+            c.bbox,
+            Some(PixelBox {
+                min_x: 2,
+                min_y: 1,
+                max_x: 7,
+                max_y: 2
+            })
+        );
+    }
+}
