@@ -154,5 +154,31 @@ fn benches(c: &mut Criterion) {
     }
 }
 
-criterion_group!(pipeline, benches);
+/// The whole recognition step (ball, goals, beacons, pattern signatures) on the classified
+/// 208×160 scene, with joint readings so every test runs. Target: under 100 µs median.
+fn recognition(c: &mut Criterion) {
+    use eotn::recognition::{RecognitionParams, recognise};
+    use eotn::sensors::SensorReadings;
+    let frame = scene(208, 160);
+    let t = table(7);
+    let mut img = ClassifiedImage::default();
+    classify_into(&frame, &t, &mut img);
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let params = RecognitionParams::default();
+    let readings = SensorReadings {
+        head_pan_rad: Some(0.1),
+        head_tilt_rad: Some(-0.2),
+        neck_tilt_rad: Some(0.0),
+        previous_head_pan_rad: Some(0.05),
+        ..SensorReadings::default()
+    };
+    let ctx = params.context_for(208, 160, Some(&readings));
+    let mut group = c.benchmark_group("recognition_208x160");
+    group.bench_function("recognise", |b| {
+        b.iter(|| recognise(black_box(&img), &blobs, &ctx, &params, None));
+    });
+    group.finish();
+}
+
+criterion_group!(pipeline, benches, recognition);
 criterion_main!(pipeline);

@@ -20,11 +20,14 @@
 pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
+pub mod eval;
 pub mod frame;
 pub mod geometry;
 pub mod import;
 pub mod lut;
+pub mod overlay;
 pub mod pipeline;
+pub mod recognition;
 pub mod sensors;
 pub mod sim;
 pub mod streams;

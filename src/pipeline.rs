@@ -1,5 +1,5 @@
-//! The whole pipeline, one frame at a time: classification, blobs, and (as they land) the
-//! recognition stages, with per-stage timings.
+//! The whole pipeline, one frame at a time: classification, blobs and recognition, with
+//! per-stage timings.
 //!
 //! [`Pipeline`] owns the lookup table and every reusable buffer; the CLI, the benchmarks and the
 //! app all call [`Pipeline::process_frame`], so what the app shows is exactly what the headless
@@ -13,13 +13,30 @@ use crate::blobs::{BlobSet, Connectivity};
 use crate::classify::{ClassifiedImage, classify_into};
 use crate::frame::Frame;
 use crate::lut::LookupTable;
+use crate::recognition::patterns::PatternMemory;
+use crate::recognition::{Recognition, RecognitionParams, recognise};
+use crate::sensors::SensorReadings;
 
 /// Settings of the pipeline's stages.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct PipelineParams {
     /// Which neighbours join a blob.
     pub connectivity: Connectivity,
+    /// Run object recognition after the blobs (off for pure classification benchmarks).
+    pub recognise: bool,
+    /// Settings of the recognisers.
+    pub recognition: RecognitionParams,
+}
+
+impl Default for PipelineParams {
+    fn default() -> Self {
+        Self {
+            connectivity: Connectivity::default(),
+            recognise: true,
+            recognition: RecognitionParams::default(),
+        }
+    }
 }
 
 /// How long each stage took on the last frame.
@@ -29,13 +46,21 @@ pub struct StageTimings {
     pub classify: Duration,
     /// Run-length encoding and union-find.
     pub blobs: Duration,
+    /// Ball, goals, beacons.
+    pub recognition: Duration,
 }
 
 impl StageTimings {
-    /// All stages together.
+    /// Classification and blobs: the per-pixel part, which the speed targets are about.
     #[must_use]
     pub fn total(&self) -> Duration {
         self.classify + self.blobs
+    }
+
+    /// Every stage, recognition included.
+    #[must_use]
+    pub fn all(&self) -> Duration {
+        self.classify + self.blobs + self.recognition
     }
 }
 
@@ -46,6 +71,8 @@ pub struct Pipeline {
     params: PipelineParams,
     classified: ClassifiedImage,
     blobs: BlobSet,
+    recognition: Recognition,
+    pattern_memory: Option<PatternMemory>,
     timings: StageTimings,
 }
 
@@ -58,20 +85,43 @@ impl Pipeline {
             params,
             classified: ClassifiedImage::default(),
             blobs: BlobSet::default(),
+            recognition: Recognition::default(),
+            pattern_memory: None,
             timings: StageTimings::default(),
         }
     }
 
-    /// Runs every stage on `frame`; results stay in the pipeline until the next frame.
+    /// Runs every stage on a frame without sensor readings (recognition then has no camera
+    /// pose: no heights, no horizon); results stay in the pipeline until the next frame.
     pub fn process_frame(&mut self, frame: &Frame) -> FrameResult<'_> {
+        self.process(frame, None)
+    }
+
+    /// Runs every stage on `frame` with the robot's readings for it.
+    pub fn process(&mut self, frame: &Frame, sensors: Option<&SensorReadings>) -> FrameResult<'_> {
         let t0 = Instant::now();
         classify_into(frame, &self.lut, &mut self.classified);
         let t1 = Instant::now();
         self.blobs.find(&self.classified, self.params.connectivity);
         let t2 = Instant::now();
+        if self.params.recognise {
+            let p = &self.params.recognition;
+            let ctx = p.context_for(frame.width(), frame.height(), sensors);
+            self.recognition = recognise(
+                &self.classified,
+                &self.blobs,
+                &ctx,
+                p,
+                self.pattern_memory.as_ref(),
+            );
+        } else {
+            self.recognition = Recognition::default();
+        }
+        let t3 = Instant::now();
         self.timings = StageTimings {
             classify: t1 - t0,
             blobs: t2 - t1,
+            recognition: t3 - t2,
         };
         self.result()
     }
@@ -82,6 +132,7 @@ impl Pipeline {
         FrameResult {
             classified: &self.classified,
             blobs: &self.blobs,
+            recognition: &self.recognition,
             timings: self.timings,
         }
     }
@@ -100,6 +151,11 @@ impl Pipeline {
     /// Replaces the table.
     pub fn set_lut(&mut self, lut: LookupTable) {
         self.lut = lut;
+    }
+
+    /// Learnt coloured patterns used to identify pink markers (none: signatures only).
+    pub fn set_pattern_memory(&mut self, memory: Option<PatternMemory>) {
+        self.pattern_memory = memory;
     }
 
     /// The stage settings.
@@ -121,6 +177,8 @@ pub struct FrameResult<'a> {
     pub classified: &'a ClassifiedImage,
     /// Blobs of every class.
     pub blobs: &'a BlobSet,
+    /// Ball, goals, beacons, horizon, with their evidence.
+    pub recognition: &'a Recognition,
     /// How long each stage took.
     pub timings: StageTimings,
 }

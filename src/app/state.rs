@@ -471,6 +471,7 @@ impl AppState {
         let lut = LookupTable::new(bits).unwrap_or_else(|_| seven_bit_table());
         let params = PipelineParams {
             connectivity: settings.connectivity,
+            ..PipelineParams::default()
         };
         let table_counts = lut.class_counts();
         Self {
@@ -678,7 +679,9 @@ impl AppState {
             }
             Command::SetConnectivity(c) => {
                 self.settings.connectivity = c;
-                self.pipeline.set_params(PipelineParams { connectivity: c });
+                let mut params = self.pipeline.params().clone();
+                params.connectivity = c;
+                self.pipeline.set_params(params);
                 self.reprocess();
             }
             Command::SetZoom(z) => {

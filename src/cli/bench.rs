@@ -87,7 +87,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let bits = lut.bits();
     let mut inputs = FrameInputs::open(&args.frames, None)?;
     let connectivity = args.connectivity;
-    let mut pipeline = Pipeline::new(lut, PipelineParams { connectivity });
+    let mut pipeline = Pipeline::new(
+        lut,
+        PipelineParams {
+            connectivity,
+            ..PipelineParams::default()
+        },
+    );
     let (mut classify, mut blobs, mut total) = (Vec::new(), Vec::new(), Vec::new());
     let mut total_ms = Vec::new();
     let mut pixels = 0;

@@ -229,9 +229,21 @@ impl FrameInputs {
     /// # Errors
     /// The loader's error, naming the file.
     pub fn load(&mut self, i: usize, size: Option<(usize, usize)>) -> anyhow::Result<Frame> {
+        Ok(self.load_with_sensors(i, size)?.0)
+    }
+
+    /// Loads frame `i` with the sensor readings its stream recorded (none for frame files).
+    ///
+    /// # Errors
+    /// The loader's error, naming the file.
+    pub fn load_with_sensors(
+        &mut self,
+        i: usize,
+        size: Option<(usize, usize)>,
+    ) -> anyhow::Result<(Frame, Option<crate::sensors::SensorReadings>)> {
         match self.items.get(i) {
             None => bail!("no input frame {i}"),
-            Some(FrameInput::File(p)) => load_frame_arg(p, size),
+            Some(FrameInput::File(p)) => Ok((load_frame_arg(p, size)?, None)),
             Some(FrameInput::Stream { path, index }) => {
                 if self.reader.as_ref().is_none_or(|r| r.path() != path) {
                     self.reader = Some(StreamReader::open(path)?);
@@ -240,7 +252,7 @@ impl FrameInputs {
                     bail!("{}: stream not open", path.display());
                 };
                 let record = reader.read(*index)?;
-                Ok(record.frame)
+                Ok((record.frame, record.sensors))
             }
         }
     }

@@ -6,6 +6,8 @@
 mod bench;
 mod blobs;
 mod classify;
+pub mod detect;
+mod eval;
 mod export;
 mod import;
 mod info;
@@ -13,6 +15,7 @@ pub mod inputs;
 mod lut;
 mod lut_from_labels;
 pub mod open;
+mod render;
 
 use std::process::ExitCode;
 
@@ -40,6 +43,13 @@ pub enum Command {
     Blobs(blobs::Args),
     /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
     Bench(bench::Args),
+    /// Recognise ball, goals (posts, gap) and beacons; `--json` prints one line per frame.
+    Detect(detect::Args),
+    /// Draw frames with recognition overlays (circles, posts, gaps, horizon, scans) as PNG.
+    Render(render::Args),
+    /// Compare recognition with the ground truth of synthetic streams: rates, errors, misses;
+    /// two tables or parameter sets side by side; goal-distance calibration.
+    Eval(eval::Args),
     /// Build an MCAP stream from frame files and a CSV/JSON table of sensor readings.
     Import(import::Args),
     /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
@@ -66,6 +76,9 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Export(a) => export::run(&a),
         Command::LutFromLabels(a) => lut_from_labels::run(&a),
         Command::Lut(a) => lut::run(&a),
+        Command::Detect(a) => detect::run(&a),
+        Command::Render(a) => render::run(&a),
+        Command::Eval(a) => eval::run(&a),
         Command::Open(a) => open::run(&a),
     }
 }

@@ -8,5 +8,6 @@ mod cli;
 mod common;
 mod peer;
 mod real_data;
+mod recognition;
 mod sim_table;
 mod streams;

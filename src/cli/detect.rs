@@ -1,0 +1,375 @@
+//! `eotn detect`: runs the whole pipeline, recognition included, and prints what was found per
+//! frame — one JSON line per frame with `--json` (documented in the README), else a short table.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::Context;
+use serde::Serialize;
+
+use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
+use crate::blobs::Connectivity;
+use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::{GoalCandidate, Recognition, Relative};
+use crate::sensors::SensorReadings;
+
+/// Arguments of `eotn detect`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (which carry their own
+    /// sensor readings).
+    #[arg(required = true)]
+    pub frames: Vec<PathBuf>,
+    /// Lookup table (`.lut`).
+    #[arg(long)]
+    pub lut: PathBuf,
+    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred from the file length.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+    /// Sensor readings for raw frames: a JSON file holding one object with the fields of the
+    /// sensor schema (applies to every frame) or an array of such objects in frame order.
+    #[arg(long)]
+    pub sensors: Option<PathBuf>,
+    /// 8: diagonal neighbours join a blob; 4: they do not.
+    #[arg(long, default_value = "8", value_parser = parse_connectivity)]
+    pub connectivity: Connectivity,
+    /// Recognition parameters as JSON (any subset of the fields; the rest keep their defaults).
+    #[arg(long)]
+    pub params: Option<PathBuf>,
+    /// One JSON object per frame per line.
+    #[arg(long)]
+    pub json: bool,
+    /// With `--json`: add every candidate with its confidence breakdown.
+    #[arg(long)]
+    pub evidence: bool,
+}
+
+/// Camera- and body-relative position of an object, flattened for JSON.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct PlacementJson {
+    /// Camera-relative distance, centimetres.
+    pub distance_cm: f64,
+    /// Camera-relative bearing, radians, positive left.
+    pub bearing_rad: f64,
+    /// Camera-relative elevation, radians, positive up.
+    pub elevation_rad: f64,
+    /// Body-relative distance, centimetres (null without joint readings).
+    pub body_distance_cm: Option<f64>,
+    /// Body-relative bearing, radians.
+    pub body_bearing_rad: Option<f64>,
+    /// Body-relative elevation, radians.
+    pub body_elevation_rad: Option<f64>,
+}
+
+impl PlacementJson {
+    fn new(camera: &Relative, body: Option<&Relative>) -> Self {
+        Self {
+            distance_cm: camera.distance_cm,
+            bearing_rad: camera.bearing_rad,
+            elevation_rad: camera.elevation_rad,
+            body_distance_cm: body.map(|b| b.distance_cm),
+            body_bearing_rad: body.map(|b| b.bearing_rad),
+            body_elevation_rad: body.map(|b| b.elevation_rad),
+        }
+    }
+}
+
+/// The ball in `--json` output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BallJson {
+    /// Centre x, image pixels.
+    pub center_x: f64,
+    /// Centre y, image pixels.
+    pub center_y: f64,
+    /// Radius, pixels.
+    pub radius_px: f64,
+    /// Where it is.
+    #[serde(flatten)]
+    pub placement: PlacementJson,
+    /// Total confidence.
+    pub confidence: f64,
+    /// Sides cut off: any of `left`, `right`, `top`, `bottom`.
+    pub cut_off: Vec<&'static str>,
+    /// Whether a circle fit gave centre and radius.
+    pub from_circle_fit: bool,
+}
+
+/// A goal post in `--json` output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct PostJson {
+    /// `left` or `right` in the image.
+    pub side: &'static str,
+    /// Top end, image pixels `[x, y]`.
+    pub top: [f64; 2],
+    /// Bottom end, image pixels.
+    pub bottom: [f64; 2],
+    /// Camera-relative bearing of the post's centre, radians.
+    pub bearing_rad: f64,
+}
+
+/// The gap in `--json` output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct GapJson {
+    /// Left end, image pixels.
+    pub left: [f64; 2],
+    /// Right end, image pixels.
+    pub right: [f64; 2],
+    /// Length, pixels.
+    pub width_px: f64,
+    /// Camera-relative bearing of its centre, radians.
+    pub bearing_rad: f64,
+}
+
+/// A goal in `--json` output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct GoalJson {
+    /// `yellow` or `sky blue`.
+    pub colour: &'static str,
+    /// Box, inclusive pixels.
+    pub minx: u32,
+    /// Box top row.
+    pub miny: u32,
+    /// Box right column.
+    pub maxx: u32,
+    /// Box bottom row.
+    pub maxy: u32,
+    /// Where it is.
+    #[serde(flatten)]
+    pub placement: PlacementJson,
+    /// True when top or bottom is cut off: the distance is an upper bound.
+    pub distance_is_max: bool,
+    /// Sides cut off.
+    pub cut_off: Vec<&'static str>,
+    /// Fitted posts.
+    pub posts: Vec<PostJson>,
+    /// Largest open gap.
+    pub gap: Option<GapJson>,
+    /// Total confidence.
+    pub confidence: f64,
+}
+
+/// A beacon in `--json` output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BeaconJson {
+    /// E.g. `pink over yellow`.
+    pub kind: String,
+    /// Box, inclusive pixels `[minx, miny, maxx, maxy]`.
+    pub bounds: [u32; 4],
+    /// Where it is.
+    #[serde(flatten)]
+    pub placement: PlacementJson,
+    /// Total confidence.
+    pub confidence: f64,
+}
+
+/// One frame's line of `eotn detect --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct DetectJson {
+    /// Frame name (file name, or `stream#index`).
+    pub frame: String,
+    /// The ball, or null.
+    pub ball: Option<BallJson>,
+    /// Accepted goals.
+    pub goals: Vec<GoalJson>,
+    /// Accepted beacons.
+    pub beacons: Vec<BeaconJson>,
+    /// Recognition time, microseconds.
+    pub recognition_us: f64,
+    /// With `--evidence`: every candidate and its confidence breakdown.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub evidence: Option<Recognition>,
+}
+
+fn sides(cut: crate::recognition::scan::CutOff) -> Vec<&'static str> {
+    let mut v = Vec::new();
+    for (on, name) in [
+        (cut.left, "left"),
+        (cut.right, "right"),
+        (cut.top, "top"),
+        (cut.bottom, "bottom"),
+    ] {
+        if on {
+            v.push(name);
+        }
+    }
+    v
+}
+
+fn goal_json(g: &GoalCandidate) -> GoalJson {
+    GoalJson {
+        colour: g.colour.name(),
+        minx: g.bounds[0],
+        miny: g.bounds[1],
+        maxx: g.bounds[2],
+        maxy: g.bounds[3],
+        placement: PlacementJson::new(&g.camera, g.body.as_ref()),
+        distance_is_max: g.distance_is_max,
+        cut_off: sides(g.cut_off),
+        posts: g
+            .posts
+            .iter()
+            .map(|p| PostJson {
+                side: match p.side {
+                    crate::recognition::goals::PostSide::Left => "left",
+                    crate::recognition::goals::PostSide::Right => "right",
+                },
+                top: [p.top.0, p.top.1],
+                bottom: [p.bottom.0, p.bottom.1],
+                bearing_rad: p.camera.bearing_rad,
+            })
+            .collect(),
+        gap: g.gap.as_ref().map(|gap| GapJson {
+            left: [gap.left.0, gap.left.1],
+            right: [gap.right.0, gap.right.1],
+            width_px: gap.width_px,
+            bearing_rad: gap.camera.bearing_rad,
+        }),
+        confidence: g.confidence.total,
+    }
+}
+
+/// The JSON line for one frame's recognition.
+#[must_use]
+pub fn detect_json(
+    frame: String,
+    r: &Recognition,
+    recognition_us: f64,
+    evidence: bool,
+) -> DetectJson {
+    DetectJson {
+        frame,
+        ball: r.ball.ball.as_ref().map(|b| BallJson {
+            center_x: b.center_x,
+            center_y: b.center_y,
+            radius_px: b.radius_px,
+            placement: PlacementJson::new(&b.camera, b.body.as_ref()),
+            confidence: b.confidence,
+            cut_off: sides(b.cut_off),
+            from_circle_fit: b.from_circle_fit,
+        }),
+        goals: r.goals.goals().map(goal_json).collect(),
+        beacons: r
+            .beacons
+            .iter()
+            .filter(|b| b.accepted)
+            .map(|b| BeaconJson {
+                kind: b.kind.name(),
+                bounds: b.bounds,
+                placement: PlacementJson::new(&b.camera, b.body.as_ref()),
+                confidence: b.confidence.total,
+            })
+            .collect(),
+        recognition_us,
+        evidence: evidence.then(|| r.clone()),
+    }
+}
+
+/// Sensor readings from `--sensors`: one object for every frame, or one per frame.
+///
+/// # Errors
+/// An unreadable file or JSON that is neither shape, naming the file.
+pub fn load_sensor_file(path: &std::path::Path) -> anyhow::Result<Vec<SensorReadings>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let list = match value {
+        serde_json::Value::Array(items) => items,
+        other => vec![other],
+    };
+    list.into_iter()
+        .enumerate()
+        .map(|(i, v)| {
+            serde_json::from_value(v)
+                .with_context(|| format!("{}: entry {i} is not a sensor reading", path.display()))
+        })
+        .collect()
+}
+
+/// Loads `--params`: recognition parameters as JSON over the defaults.
+///
+/// # Errors
+/// An unreadable file or JSON that does not fit, naming the file.
+pub fn load_params(
+    path: Option<&std::path::Path>,
+) -> anyhow::Result<crate::recognition::RecognitionParams> {
+    let Some(path) = path else {
+        return Ok(crate::recognition::RecognitionParams::default());
+    };
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    serde_json::from_str(&text)
+        .with_context(|| format!("{}: not valid recognition parameters", path.display()))
+}
+
+/// Runs `eotn detect`.
+///
+/// # Errors
+/// Unreadable or malformed inputs, naming the file.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let lut = load_lut_arg(&args.lut)?;
+    let mut inputs = FrameInputs::open(&args.frames, None)?;
+    let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
+    let params = PipelineParams {
+        connectivity: args.connectivity,
+        recognise: true,
+        recognition: load_params(args.params.as_deref())?,
+    };
+    let mut pipeline = Pipeline::new(lut, params);
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    let bar = progress(inputs.len(), "detect");
+    for i in 0..inputs.len() {
+        let (frame, recorded) = inputs.load_with_sensors(i, args.size)?;
+        let from_file = sensors
+            .as_ref()
+            .and_then(|s| if s.len() == 1 { s.first() } else { s.get(i) });
+        let readings = recorded.as_ref().or(from_file);
+        let result = pipeline.process(&frame, readings);
+        let us = result.timings.recognition.as_secs_f64() * 1e6;
+        let line = detect_json(inputs.name(i), result.recognition, us, args.evidence);
+        if args.json {
+            serde_json::to_writer(&mut out, &line)?;
+            writeln!(out)?;
+        } else {
+            write_summary(&mut out, &line)?;
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    out.flush().context("writing output")?;
+    Ok(())
+}
+
+/// The human-readable line for a frame.
+fn write_summary(out: &mut impl Write, d: &DetectJson) -> std::io::Result<()> {
+    write!(out, "{}:", d.frame)?;
+    match &d.ball {
+        Some(b) => write!(
+            out,
+            " ball at ({:.1}, {:.1}) r {:.1} px, {:.0} cm, {:+.1}°",
+            b.center_x,
+            b.center_y,
+            b.radius_px,
+            b.placement.distance_cm,
+            b.placement.bearing_rad.to_degrees()
+        )?,
+        None => write!(out, " no ball")?,
+    }
+    for g in &d.goals {
+        write!(
+            out,
+            "; {} goal {}{:.0} cm {:+.1}°, {} post(s){}",
+            g.colour,
+            if g.distance_is_max { "≤" } else { "" },
+            g.placement.distance_cm,
+            g.placement.bearing_rad.to_degrees(),
+            g.posts.len(),
+            if g.gap.is_some() { ", gap" } else { "" }
+        )?;
+    }
+    for b in &d.beacons {
+        write!(out, "; beacon {} {:.0} cm", b.kind, b.placement.distance_cm)?;
+    }
+    writeln!(out)
+}

@@ -1,0 +1,353 @@
+//! `eotn eval`: recognition against the ground truth of synthetic streams — detection and false
+//! identification rates, distance, bearing, post and gap errors, the frames that missed — and
+//! two tables or parameter sets side by side; `--calibrate-goals` fits the goal-distance
+//! relation to the truth and writes it as recognition parameters.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use serde::Serialize;
+
+use super::detect::load_params;
+use super::inputs::load_lut_arg;
+use crate::eval::{
+    EvalParams, EvalReport, FrameEval, Percentiles, evaluate_frame, fit_inverse_size,
+};
+use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::{Recognition, RecognitionParams};
+use crate::sim::truth::GroundTruth;
+use crate::streams::StreamReader;
+
+/// Arguments of `eotn eval`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Streams with a `/ground_truth` channel (from `eotn sim`).
+    #[arg(required = true)]
+    pub streams: Vec<PathBuf>,
+    /// Lookup table.
+    #[arg(long)]
+    pub lut: PathBuf,
+    /// Recognition parameters JSON.
+    #[arg(long)]
+    pub params: Option<PathBuf>,
+    /// A second table to compare on the same frames.
+    #[arg(long)]
+    pub compare_lut: Option<PathBuf>,
+    /// A second parameter set to compare on the same frames.
+    #[arg(long)]
+    pub compare_params: Option<PathBuf>,
+    /// Frames whose pan speed is at least this (rad/s) also run without skew correction, to
+    /// measure what the correction gains.
+    #[arg(long, default_value_t = 1.5)]
+    pub fast_pan_rad_per_s: f64,
+    /// Fit distance = multiplier / height + offset for goals to the truth and write the result as
+    /// a recognition-parameter JSON file.
+    #[arg(long)]
+    pub calibrate_goals: Option<PathBuf>,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The skew-correction comparison.
+#[derive(Debug, Clone, Serialize)]
+pub struct SkewReport {
+    /// Fast-panning frames with a correct ball in both runs.
+    pub frames: usize,
+    /// Radius error with correction, pixels.
+    pub radius_error_with: Percentiles,
+    /// Radius error without correction, pixels.
+    pub radius_error_without: Percentiles,
+}
+
+/// A frame whose results differ between the two configurations.
+#[derive(Debug, Clone, Serialize)]
+pub struct Difference {
+    /// Stream file name.
+    pub stream: String,
+    /// Frame index.
+    pub frame: usize,
+    /// What differs.
+    pub what: String,
+}
+
+/// Everything `eotn eval` reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct EvalOutput {
+    /// Against the truth, first configuration.
+    pub report: EvalReport,
+    /// Skew correction on versus off on fast pans.
+    pub skew: Option<SkewReport>,
+    /// Against the truth, second configuration.
+    pub compare: Option<EvalReport>,
+    /// Frames where the two configurations disagree.
+    pub differences: Vec<Difference>,
+    /// Fitted goal distance relation (multiplier cm·px, offset cm), if asked for.
+    pub goal_calibration: Option<(f64, f64)>,
+    /// Frames skipped, with the reason.
+    pub skipped: Vec<String>,
+}
+
+fn differ(a: &Recognition, b: &Recognition) -> Option<String> {
+    let mut what = Vec::new();
+    match (&a.ball.ball, &b.ball.ball) {
+        (Some(x), Some(y)) if (x.center_x - y.center_x).hypot(x.center_y - y.center_y) > 1.0 => {
+            what.push("ball moved".to_owned());
+        }
+        (Some(_), None) => what.push("ball lost".to_owned()),
+        (None, Some(_)) => what.push("ball gained".to_owned()),
+        _ => {}
+    }
+    let goals = |r: &Recognition| r.goals.goals().map(|g| g.colour.code()).collect::<Vec<_>>();
+    if goals(a) != goals(b) {
+        what.push(format!("goals {:?} → {:?}", goals(a), goals(b)));
+    }
+    (!what.is_empty()).then(|| what.join(", "))
+}
+
+/// Runs `eotn eval`.
+///
+/// # Errors
+/// Unreadable inputs or streams without ground truth, naming the file.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let lut = load_lut_arg(&args.lut)?;
+    let rp = load_params(args.params.as_deref())?;
+    let params = PipelineParams {
+        recognition: rp,
+        ..PipelineParams::default()
+    };
+    let mut main = Pipeline::new(lut.clone(), params);
+    let mut no_skew = Pipeline::new(
+        lut.clone(),
+        PipelineParams {
+            recognition: RecognitionParams {
+                ball: crate::recognition::BallParams {
+                    skew_correction: false,
+                    ..rp.ball
+                },
+                ..rp
+            },
+            ..params
+        },
+    );
+    let mut other = if args.compare_lut.is_some() || args.compare_params.is_some() {
+        let l = match &args.compare_lut {
+            Some(p) => load_lut_arg(p)?,
+            None => lut,
+        };
+        let p = match &args.compare_params {
+            Some(p) => load_params(Some(p))?,
+            None => rp,
+        };
+        Some(Pipeline::new(
+            l,
+            PipelineParams {
+                recognition: p,
+                ..params
+            },
+        ))
+    } else {
+        None
+    };
+    let ep = EvalParams::default();
+    let (mut frames_a, mut frames_b) = (Vec::<FrameEval>::new(), Vec::<FrameEval>::new());
+    let (mut skew_with, mut skew_without) = (Vec::new(), Vec::new());
+    let mut differences = Vec::new();
+    let mut skipped = Vec::new();
+    let mut goal_samples = Vec::new();
+    let mut global = 0usize;
+    for path in &args.streams {
+        let mut reader = StreamReader::open(path)?;
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        let bar = super::inputs::progress(reader.len(), "eval");
+        for i in 0..reader.len() {
+            bar.inc(1);
+            let record = match reader.read(i) {
+                Ok(r) => r,
+                Err(e) => {
+                    skipped.push(format!("{name}#{i}: {e}"));
+                    continue;
+                }
+            };
+            let Some(truth) = record.ground_truth.clone() else {
+                skipped.push(format!("{name}#{i}: no ground truth"));
+                continue;
+            };
+            let truth = match serde_json::from_value::<GroundTruth>(truth) {
+                Ok(GroundTruth::Robot(t)) => t,
+                Ok(GroundTruth::Overhead(_)) => {
+                    skipped.push(format!("{name}#{i}: overhead frame"));
+                    continue;
+                }
+                Err(e) => {
+                    skipped.push(format!("{name}#{i}: ground truth unreadable: {e}"));
+                    continue;
+                }
+            };
+            let (w, h) = (record.frame.width() as f64, record.frame.height() as f64);
+            let sensors = record.sensors.as_ref();
+            let ra = main.process(&record.frame, sensors).recognition.clone();
+            let fa = evaluate_frame(global, &ra, &truth, w, h, &ep);
+            for g in ra.goals.goals() {
+                if let Some(tg) = truth
+                    .goals
+                    .iter()
+                    .find(|t| crate::eval::goal_class(t.colour) == g.colour)
+                    && !g.cut_off.top
+                    && !g.cut_off.bottom
+                    && !g.distance_from_ir
+                {
+                    goal_samples.push((g.height_px, tg.relative.camera_distance_cm));
+                }
+            }
+            let fast = sensors
+                .and_then(crate::sensors::SensorReadings::pan_velocity_rad_per_s)
+                .is_some_and(|v| v.abs() >= args.fast_pan_rad_per_s);
+            if fast {
+                let rn = no_skew.process(&record.frame, sensors).recognition.clone();
+                let fnn = evaluate_frame(global, &rn, &truth, w, h, &ep);
+                if let (Some(a), Some(b)) = (fa.ball_radius_error_px, fnn.ball_radius_error_px) {
+                    skew_with.push(a);
+                    skew_without.push(b);
+                }
+            }
+            if let Some(o) = other.as_mut() {
+                let rb = o.process(&record.frame, sensors).recognition.clone();
+                frames_b.push(evaluate_frame(global, &rb, &truth, w, h, &ep));
+                if let Some(what) = differ(&ra, &rb) {
+                    differences.push(Difference {
+                        stream: name.clone(),
+                        frame: i,
+                        what,
+                    });
+                }
+            }
+            frames_a.push(fa);
+            global += 1;
+        }
+        bar.finish_and_clear();
+    }
+    if frames_a.is_empty() {
+        bail!("no frame with robot-camera ground truth in the given streams");
+    }
+    let goal_calibration = if let Some(out) = &args.calibrate_goals {
+        let Some((m, o)) = fit_inverse_size(&goal_samples) else {
+            bail!("too few uncut goals ({}) to calibrate", goal_samples.len());
+        };
+        let mut p = rp;
+        p.goals.distance_multiplier = m;
+        p.goals.distance_offset_cm = o;
+        let json = serde_json::to_vec_pretty(&p)?;
+        crate::atomic_file::write_atomic(out, &json)
+            .with_context(|| format!("{}: cannot write", out.display()))?;
+        Some((m, o))
+    } else {
+        None
+    };
+    let output = EvalOutput {
+        report: EvalReport::from_frames(&frames_a),
+        skew: (!skew_with.is_empty()).then(|| SkewReport {
+            frames: skew_with.len(),
+            radius_error_with: Percentiles::of(&skew_with),
+            radius_error_without: Percentiles::of(&skew_without),
+        }),
+        compare: other.is_some().then(|| EvalReport::from_frames(&frames_b)),
+        differences,
+        goal_calibration,
+        skipped,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string(&output)?);
+    } else {
+        print_summary(&output);
+    }
+    Ok(())
+}
+
+fn pct(r: Option<f64>) -> String {
+    r.map_or_else(|| "—".to_owned(), |v| format!("{:.1}%", v * 100.0))
+}
+
+fn print_summary(o: &EvalOutput) {
+    let r = &o.report;
+    println!("frames                 {}", r.frames);
+    println!(
+        "ball found             {}/{} = {}   false {} = {} of frames",
+        r.ball_found,
+        r.ball_eligible,
+        pct(r.ball_found_rate),
+        r.ball_false,
+        pct(r.ball_false_rate)
+    );
+    println!(
+        "ball distance error    median {:.1}% p90 {:.1}% (n={}); cut off: median {:.1}% (n={})",
+        r.ball_distance_error.p50 * 100.0,
+        r.ball_distance_error.p90 * 100.0,
+        r.ball_distance_error.n,
+        r.ball_distance_error_cut.p50 * 100.0,
+        r.ball_distance_error_cut.n
+    );
+    println!(
+        "ball bearing error     median {:.2}° p90 {:.2}°; radius error median {:.2} px",
+        r.ball_bearing_error_deg.p50, r.ball_bearing_error_deg.p90, r.ball_radius_error_px.p50
+    );
+    if let Some(s) = &o.skew {
+        println!(
+            "skew correction        radius error median {:.2} px with, {:.2} px without (n={})",
+            s.radius_error_with.p50, s.radius_error_without.p50, s.frames
+        );
+    }
+    println!(
+        "goals found            {}/{} = {}   false {}; distance error median {:.1}%",
+        r.goals_found,
+        r.goals_eligible,
+        pct(r.goal_found_rate),
+        r.goals_false,
+        r.goal_distance_error.p50 * 100.0
+    );
+    println!(
+        "posts                  median {:.2} px, within 2 px {} (n={})",
+        r.post_error_px.p50,
+        pct(r.posts_within_2px),
+        r.post_error_px.n
+    );
+    println!(
+        "gaps                   median {:.2} px, within 3 px {} (n={})",
+        r.gap_error_px.p50,
+        pct(r.gaps_within_3px),
+        r.gap_error_px.n
+    );
+    if !r.ball_misses.is_empty() {
+        println!("ball missed in frames  {:?}", r.ball_misses);
+    }
+    if !r.ball_false_frames.is_empty() {
+        println!("false ball in frames   {:?}", r.ball_false_frames);
+    }
+    if let Some(c) = &o.compare {
+        println!(
+            "compared: ball {}/{}, false {}, goals {}/{}; {} frame(s) differ",
+            c.ball_found,
+            c.ball_eligible,
+            c.ball_false,
+            c.goals_found,
+            c.goals_eligible,
+            o.differences.len()
+        );
+        for d in o.differences.iter().take(50) {
+            println!("  {}#{}: {}", d.stream, d.frame, d.what);
+        }
+    }
+    if let Some((m, off)) = o.goal_calibration {
+        println!("goal distance          = {m:.1} / height_px + {off:.1} cm (written)");
+    }
+    if !o.skipped.is_empty() {
+        println!(
+            "skipped {} frame(s), first: {}",
+            o.skipped.len(),
+            o.skipped[0]
+        );
+    }
+}

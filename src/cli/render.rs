@@ -1,0 +1,156 @@
+//! `eotn render`: draws a frame (raw colour or classified) with chosen overlays to PNG, headless,
+//! from the same drawing primitives the app uses.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+
+use super::detect::{load_params, load_sensor_file};
+use super::inputs::{FrameInputs, load_lut_arg, parse_size};
+use crate::frame::save_rgb_png;
+use crate::overlay::Canvas;
+use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::{LineRole, Primitive};
+
+/// Which picture is drawn under the overlays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum View {
+    /// The camera image in colour.
+    Raw,
+    /// Each pixel in its class's display colour.
+    Classified,
+}
+
+/// Overlays that can be switched on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Overlay {
+    /// Every blob's box (blobs of at least `--min-blob-pixels`).
+    Blobs,
+    /// Candidate boxes of recognised objects.
+    Candidates,
+    /// Scan areas (colour below).
+    Scans,
+    /// Edge and post scan points.
+    Points,
+    /// Fitted circles.
+    Circles,
+    /// Goal posts.
+    Posts,
+    /// Gaps and gap scans.
+    Gaps,
+    /// The horizon.
+    Horizon,
+    /// Everything above.
+    All,
+}
+
+/// Arguments of `eotn render`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (which carry their own
+    /// sensor readings).
+    #[arg(required = true)]
+    pub frames: Vec<PathBuf>,
+    /// Lookup table (`.lut`).
+    #[arg(long)]
+    pub lut: PathBuf,
+    /// Output folder; one PNG per frame, named after it.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Frame size of raw files, WxH.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+    /// Sensor readings JSON (as for `eotn detect`).
+    #[arg(long)]
+    pub sensors: Option<PathBuf>,
+    /// Recognition parameters JSON.
+    #[arg(long)]
+    pub params: Option<PathBuf>,
+    /// The picture under the overlays.
+    #[arg(long, value_enum, default_value = "raw")]
+    pub view: View,
+    /// Overlays to draw (comma-separated).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]
+    pub overlays: Vec<Overlay>,
+    /// Enlargement factor (nearest neighbour), 1..=16.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=16))]
+    pub scale: u8,
+    /// Smallest blob drawn by the `blobs` overlay, pixels.
+    #[arg(long, default_value_t = 4)]
+    pub min_blob_pixels: u32,
+}
+
+fn wanted(overlays: &[Overlay], p: &Primitive) -> bool {
+    let on = |o: Overlay| overlays.contains(&o) || overlays.contains(&Overlay::All);
+    match p {
+        Primitive::Box { .. } => on(Overlay::Candidates),
+        Primitive::ScanArea { .. } => on(Overlay::Scans),
+        Primitive::ScanPoints { .. } => on(Overlay::Points),
+        Primitive::Circle { .. } => on(Overlay::Circles),
+        Primitive::Line { role, .. } => match role {
+            LineRole::Horizon => on(Overlay::Horizon),
+            LineRole::Post => on(Overlay::Posts),
+            LineRole::Gap | LineRole::Scan => on(Overlay::Gaps),
+        },
+        Primitive::Label { .. } => false,
+    }
+}
+
+/// Runs `eotn render`.
+///
+/// # Errors
+/// Unreadable inputs or an unwritable output, naming the file.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let lut = load_lut_arg(&args.lut)?;
+    let mut inputs = FrameInputs::open(&args.frames, None)?;
+    let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
+    let params = PipelineParams {
+        recognition: load_params(args.params.as_deref())?,
+        ..PipelineParams::default()
+    };
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
+    let mut pipeline = Pipeline::new(lut, params);
+    for i in 0..inputs.len() {
+        let (frame, recorded) = inputs.load_with_sensors(i, args.size)?;
+        let from_file = sensors
+            .as_ref()
+            .and_then(|s| if s.len() == 1 { s.first() } else { s.get(i) });
+        let readings = recorded.as_ref().or(from_file);
+        let result = pipeline.process(&frame, readings);
+        let (w, h) = (frame.width(), frame.height());
+        let base = match args.view {
+            View::Raw => frame.to_rgb(),
+            View::Classified => result.classified.to_rgb(),
+        };
+        let mut canvas = Canvas::from_rgb(w, h, &base, usize::from(args.scale))
+            .context("internal: picture size does not match the frame")?;
+        let mut prims: Vec<Primitive> = Vec::new();
+        if args.overlays.contains(&Overlay::Blobs) || args.overlays.contains(&Overlay::All) {
+            prims.extend(
+                result
+                    .blobs
+                    .active()
+                    .filter(|b| b.pixels >= args.min_blob_pixels)
+                    .map(|b| Primitive::Box {
+                        owner: format!("blob#{}", b.number),
+                        colour: b.colour,
+                        bounds: [b.minx, b.miny, b.maxx, b.maxy],
+                    }),
+            );
+        }
+        prims.extend(
+            result
+                .recognition
+                .primitives(w, h)
+                .into_iter()
+                .filter(|p| wanted(&args.overlays, p)),
+        );
+        canvas.draw(&prims);
+        let name = inputs.name(i);
+        let stem = name.rsplit_once('.').map_or(name.as_str(), |(s, _)| s);
+        let out = args.output.join(format!("{stem}.png"));
+        save_rgb_png(&out, canvas.width, canvas.height, &canvas.rgb)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,434 @@
+//! Evaluation: recognition compared with ground truth, frame by frame, summed into rates and
+//! error percentiles — the numbers the recognition issue's targets are stated in.
+//!
+//! Pure functions on [`Recognition`] and the renderer's [`RobotViewTruth`]; `eotn eval` reads
+//! streams and runs the pipeline, this module only compares.
+
+use serde::{Deserialize, Serialize};
+
+use crate::lut::ColourClass;
+use crate::recognition::Recognition;
+use crate::sim::scene::GoalColour;
+use crate::sim::truth::RobotViewTruth;
+
+/// When an object counts as "should have been found", and when a detection matches.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct EvalParams {
+    /// The ball must be found when at least this fraction of it is visible...
+    pub ball_min_visible_fraction: f64,
+    /// ... and its image diameter is at least this, pixels.
+    pub ball_min_diameter_px: f64,
+    /// A ball detection matches when its centre is within this fraction of the true radius
+    /// (at least [`Self::ball_match_min_px`]).
+    pub ball_match_radius_fraction: f64,
+    /// Smallest matching tolerance, pixels.
+    pub ball_match_min_px: f64,
+    /// A goal must be found when at least this fraction of its mouth is inside the image.
+    pub goal_min_mouth_fraction: f64,
+    /// ... and it shows at least this many pixels.
+    pub goal_min_pixels: usize,
+}
+
+impl Default for EvalParams {
+    fn default() -> Self {
+        Self {
+            ball_min_visible_fraction: 0.6,
+            ball_min_diameter_px: 6.0,
+            ball_match_radius_fraction: 0.5,
+            ball_match_min_px: 4.0,
+            goal_min_mouth_fraction: 0.5,
+            goal_min_pixels: 30,
+        }
+    }
+}
+
+/// How one frame went.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct FrameEval {
+    /// Frame index in its stream.
+    pub frame: usize,
+    /// The ball had to be found.
+    pub ball_eligible: bool,
+    /// A ball was reported.
+    pub ball_reported: bool,
+    /// The reported ball matches the true one.
+    pub ball_correct: bool,
+    /// The reported ball is at least near the true one (within two radii): not a false ball,
+    /// though perhaps badly placed.
+    pub ball_near: bool,
+    /// A ball was reported where there is none (or far from it).
+    pub ball_false: bool,
+    /// The true ball is cut off by the image edge.
+    pub ball_cut: bool,
+    /// Relative distance error of a correct ball (|reported − true| / true).
+    pub ball_distance_error: Option<f64>,
+    /// Bearing error of a correct ball, radians.
+    pub ball_bearing_error_rad: Option<f64>,
+    /// Radius error of a reported ball near the true one, pixels.
+    pub ball_radius_error_px: Option<f64>,
+    /// Goals that had to be found.
+    pub goals_eligible: usize,
+    /// Of those, found with the right colour.
+    pub goals_found: usize,
+    /// Goals reported that are not in view.
+    pub goals_false: usize,
+    /// Post position errors, pixels (worst of top and foot).
+    pub post_errors_px: Vec<f64>,
+    /// Gap end errors, pixels (worst of both ends).
+    pub gap_errors_px: Vec<f64>,
+    /// Relative distance errors of found goals with uncut top and bottom.
+    pub goal_distance_errors: Vec<f64>,
+}
+
+/// The class code of a goal colour.
+#[must_use]
+pub fn goal_class(c: GoalColour) -> ColourClass {
+    match c {
+        GoalColour::Yellow => ColourClass::Yellow,
+        GoalColour::SkyBlue => ColourClass::SkyBlue,
+    }
+}
+
+/// Compares one frame's recognition with its truth.
+#[must_use]
+pub fn evaluate_frame(
+    frame: usize,
+    r: &Recognition,
+    t: &RobotViewTruth,
+    width: f64,
+    height: f64,
+    p: &EvalParams,
+) -> FrameEval {
+    let mut e = FrameEval {
+        frame,
+        ..FrameEval::default()
+    };
+    let reported = r.ball.ball.as_ref();
+    e.ball_reported = reported.is_some();
+    let truth = t.ball.as_ref().filter(|b| b.visible_pixels > 0);
+    if let Some(tb) = truth {
+        let radius = tb.image_radius_px.unwrap_or(0.0);
+        e.ball_eligible = tb.visible_fraction >= p.ball_min_visible_fraction
+            && 2.0 * radius >= p.ball_min_diameter_px;
+        e.ball_cut = tb.cut_off.left || tb.cut_off.right || tb.cut_off.top || tb.cut_off.bottom;
+        if let (Some(b), Some(img)) = (reported, tb.relative.image) {
+            // A ball cut by the image edge is matched within its radius, an uncut one within
+            // half of it; anything within two radii is at least the ball (not a false one).
+            let fraction = if e.ball_cut {
+                1.0
+            } else {
+                p.ball_match_radius_fraction
+            };
+            let tol = (fraction * radius).max(p.ball_match_min_px);
+            let off = (b.center_x - img.x_px).hypot(b.center_y - img.y_px);
+            e.ball_correct = off <= tol;
+            e.ball_near = off <= 2.0 * radius + p.ball_match_min_px;
+            if e.ball_correct {
+                let d = tb.relative.camera_distance_cm;
+                e.ball_distance_error = Some((b.camera.distance_cm - d).abs() / d);
+                e.ball_bearing_error_rad =
+                    Some((b.camera.bearing_rad - tb.relative.camera_bearing_rad).abs());
+            }
+            if e.ball_near {
+                e.ball_radius_error_px = Some((b.radius_px - radius).abs());
+            }
+        }
+    }
+    e.ball_false = e.ball_reported && !e.ball_near;
+
+    for tg in &t.goals {
+        let class = goal_class(tg.colour);
+        let mouth = match (tg.posts[0].image_base, tg.posts[1].image_base) {
+            (Some(a), Some(b)) => {
+                let (l, rr) = (a.x_px.min(b.x_px), a.x_px.max(b.x_px));
+                let inside = (rr.min(width) - l.max(0.0)).max(0.0);
+                if rr - l > 1e-9 {
+                    inside / (rr - l)
+                } else {
+                    0.0
+                }
+            }
+            _ => 0.0,
+        };
+        let eligible = mouth >= p.goal_min_mouth_fraction && tg.visible_pixels >= p.goal_min_pixels;
+        let found = r.goals.goals().find(|g| g.colour == class);
+        if eligible {
+            e.goals_eligible += 1;
+        }
+        let Some(g) = found else { continue };
+        if eligible {
+            e.goals_found += 1;
+        }
+        if !g.cut_off.top && !g.cut_off.bottom && !g.distance_from_ir {
+            let d = tg.relative.camera_distance_cm;
+            e.goal_distance_errors
+                .push((g.camera.distance_cm - d).abs() / d);
+        }
+        for post in &g.posts {
+            // The true post nearest this one at the foot row.
+            let best = tg
+                .posts
+                .iter()
+                .filter_map(|tp| Some((tp.image_base?, tp.image_top?)))
+                .filter(|(b, top)| {
+                    [b, top].iter().all(|q| {
+                        q.x_px >= 0.0 && q.x_px <= width && q.y_px >= 0.0 && q.y_px <= height
+                    })
+                })
+                .map(|(base, top)| {
+                    let at = |y: f64| {
+                        if post.fit.steep {
+                            post.fit.at(y).0
+                        } else {
+                            post.top.0
+                        }
+                    };
+                    (at(base.y_px) - base.x_px)
+                        .abs()
+                        .max((at(top.y_px) - top.x_px).abs())
+                })
+                .fold(f64::INFINITY, f64::min);
+            if best.is_finite() {
+                e.post_errors_px.push(best);
+            }
+        }
+        if let (Some(gap), Some(tgap)) = (&g.gap, &tg.largest_gap) {
+            let left = (gap.left.0 - tgap.from_x_px as f64).abs();
+            let right = (gap.right.0 - (tgap.to_x_px as f64 + 1.0)).abs();
+            e.gap_errors_px.push(left.max(right));
+        }
+    }
+    let in_view: Vec<ColourClass> = t
+        .goals
+        .iter()
+        .filter(|g| g.visible_pixels > 0)
+        .map(|g| goal_class(g.colour))
+        .collect();
+    e.goals_false = r
+        .goals
+        .goals()
+        .filter(|g| !in_view.contains(&g.colour))
+        .count();
+    e
+}
+
+/// 50th, 90th and 95th percentiles and the count of a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Percentiles {
+    /// Number of values.
+    pub n: usize,
+    /// Median.
+    pub p50: f64,
+    /// 90th percentile.
+    pub p90: f64,
+    /// 95th percentile.
+    pub p95: f64,
+}
+
+impl Percentiles {
+    /// Percentiles by nearest rank; all zero for an empty sample. NaN values are left out.
+    #[must_use]
+    pub fn of(values: &[f64]) -> Self {
+        let mut v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
+        if v.is_empty() {
+            return Self::default();
+        }
+        v.sort_by(f64::total_cmp);
+        let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+        Self {
+            n: v.len(),
+            p50: rank(0.5),
+            p90: rank(0.9),
+            p95: rank(0.95),
+        }
+    }
+}
+
+fn rate(num: usize, den: usize) -> Option<f64> {
+    (den > 0).then(|| num as f64 / den as f64)
+}
+
+/// A whole evaluation.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct EvalReport {
+    /// Frames compared.
+    pub frames: usize,
+    /// Frames where the ball had to be found.
+    pub ball_eligible: usize,
+    /// Of those, found correctly.
+    pub ball_found: usize,
+    /// Found / eligible.
+    pub ball_found_rate: Option<f64>,
+    /// Frames with a false ball.
+    pub ball_false: usize,
+    /// False balls / frames.
+    pub ball_false_rate: Option<f64>,
+    /// Relative distance errors, balls not cut off.
+    pub ball_distance_error: Percentiles,
+    /// Relative distance errors, balls cut off by the image edge.
+    pub ball_distance_error_cut: Percentiles,
+    /// Bearing errors, degrees.
+    pub ball_bearing_error_deg: Percentiles,
+    /// Radius errors, pixels.
+    pub ball_radius_error_px: Percentiles,
+    /// Goals that had to be found.
+    pub goals_eligible: usize,
+    /// Of those, found.
+    pub goals_found: usize,
+    /// Found / eligible.
+    pub goal_found_rate: Option<f64>,
+    /// Goals reported that are not in view.
+    pub goals_false: usize,
+    /// Goal distance errors (relative), uncut goals.
+    pub goal_distance_error: Percentiles,
+    /// Post errors, pixels.
+    pub post_error_px: Percentiles,
+    /// Share of posts within 2 px.
+    pub posts_within_2px: Option<f64>,
+    /// Gap end errors, pixels.
+    pub gap_error_px: Percentiles,
+    /// Share of gaps with both ends within 3 px.
+    pub gaps_within_3px: Option<f64>,
+    /// Frames where an eligible ball was missed.
+    pub ball_misses: Vec<usize>,
+    /// Frames with a false ball.
+    pub ball_false_frames: Vec<usize>,
+    /// Frames where an eligible goal was missed.
+    pub goal_misses: Vec<usize>,
+}
+
+impl EvalReport {
+    /// Sums frame evaluations.
+    #[must_use]
+    pub fn from_frames(frames: &[FrameEval]) -> Self {
+        let mut r = Self {
+            frames: frames.len(),
+            ..Self::default()
+        };
+        let (mut d, mut dc, mut b, mut rad, mut gd, mut posts, mut gaps) =
+            (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+        for f in frames {
+            if f.ball_eligible {
+                r.ball_eligible += 1;
+                if f.ball_correct {
+                    r.ball_found += 1;
+                } else {
+                    r.ball_misses.push(f.frame);
+                }
+            }
+            if f.ball_false {
+                r.ball_false += 1;
+                r.ball_false_frames.push(f.frame);
+            }
+            if let Some(x) = f.ball_distance_error {
+                if f.ball_cut { dc.push(x) } else { d.push(x) }
+            }
+            b.extend(f.ball_bearing_error_rad.map(f64::to_degrees));
+            rad.extend(f.ball_radius_error_px);
+            r.goals_eligible += f.goals_eligible;
+            r.goals_found += f.goals_found;
+            if f.goals_found < f.goals_eligible {
+                r.goal_misses.push(f.frame);
+            }
+            r.goals_false += f.goals_false;
+            gd.extend(&f.goal_distance_errors);
+            posts.extend(&f.post_errors_px);
+            gaps.extend(&f.gap_errors_px);
+        }
+        r.ball_found_rate = rate(r.ball_found, r.ball_eligible);
+        r.ball_false_rate = rate(r.ball_false, r.frames);
+        r.ball_distance_error = Percentiles::of(&d);
+        r.ball_distance_error_cut = Percentiles::of(&dc);
+        r.ball_bearing_error_deg = Percentiles::of(&b);
+        r.ball_radius_error_px = Percentiles::of(&rad);
+        r.goal_found_rate = rate(r.goals_found, r.goals_eligible);
+        r.goal_distance_error = Percentiles::of(&gd);
+        r.post_error_px = Percentiles::of(&posts);
+        r.posts_within_2px = rate(posts.iter().filter(|e| **e <= 2.0).count(), posts.len());
+        r.gap_error_px = Percentiles::of(&gaps);
+        r.gaps_within_3px = rate(gaps.iter().filter(|e| **e <= 3.0).count(), gaps.len());
+        r
+    }
+}
+
+/// Fits distance = multiplier / height + offset to (height px, true distance cm) pairs by least
+/// squares in 1/height; `None` with fewer than two distinct heights.
+#[must_use]
+pub fn fit_inverse_size(samples: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = samples
+        .iter()
+        .filter(|(h, d)| *h > 0.0 && h.is_finite() && d.is_finite())
+        .map(|(h, d)| (1.0 / h, *d))
+        .collect();
+    let n = pts.len() as f64;
+    if pts.len() < 2 {
+        return None;
+    }
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let (sxx, sxy) = pts.iter().fold((0.0, 0.0), |(a, b), p| {
+        (a + (p.0 - mx).powi(2), b + (p.0 - mx) * (p.1 - my))
+    });
+    (sxx > 0.0).then(|| {
+        let m = sxy / sxx;
+        (m, my - m * mx)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentiles_by_nearest_rank() {
+        let v: Vec<f64> = (1..=100).map(f64::from).collect();
+        let p = Percentiles::of(&v);
+        assert_eq!((p.n, p.p50, p.p90, p.p95), (100, 50.0, 90.0, 95.0));
+        assert_eq!(Percentiles::of(&[]).n, 0);
+        assert_eq!(Percentiles::of(&[f64::NAN, 3.0]).p50, 3.0);
+    }
+
+    #[test]
+    fn inverse_size_fit_recovers_the_relation() {
+        let samples: Vec<(f64, f64)> = [10.0, 20.0, 40.0]
+            .iter()
+            .map(|h| (*h, 5757.0 / h + 12.0))
+            .collect();
+        let (m, o) = fit_inverse_size(&samples).expect("fit");
+        assert!((m - 5757.0).abs() < 1e-6 && (o - 12.0).abs() < 1e-6);
+        assert!(fit_inverse_size(&[(10.0, 5.0)]).is_none());
+    }
+
+    #[test]
+    fn report_counts_misses_and_false_balls() {
+        let frames = vec![
+            FrameEval {
+                frame: 0,
+                ball_eligible: true,
+                ball_reported: true,
+                ball_correct: true,
+                ball_distance_error: Some(0.02),
+                ..FrameEval::default()
+            },
+            FrameEval {
+                frame: 1,
+                ball_eligible: true,
+                ..FrameEval::default()
+            },
+            FrameEval {
+                frame: 2,
+                ball_reported: true,
+                ball_false: true,
+                ..FrameEval::default()
+            },
+        ];
+        let r = EvalReport::from_frames(&frames);
+        assert_eq!((r.ball_eligible, r.ball_found, r.ball_false), (2, 1, 1));
+        assert_eq!(r.ball_misses, vec![1]);
+        assert_eq!(r.ball_false_frames, vec![2]);
+        assert_eq!(r.ball_found_rate, Some(0.5));
+        assert_eq!(r.ball_distance_error.p50, 0.02);
+    }
+}

@@ -1,0 +1,696 @@
+//! The ball: orange blobs (joined with touching soft colours that may be orange) become
+//! candidates, largest first; each is scored by the confidence tests; the first with a positive
+//! total is the ball. Its outline is scanned in one of six patterns chosen by which sides are cut
+//! off or hidden, the rolling shutter's shear removed, and a circle fitted; distance, bearing and
+//! elevation come from the circle through the camera model.
+
+use serde::{Deserialize, Serialize};
+
+use super::confidence::{Confidence, TestWeight};
+use super::context::{Relative, ViewContext};
+use super::draw::Primitive;
+use super::fit::{CircleFit, Point, fit_circle};
+use super::scan::{
+    CutOff, EdgeScanPattern, ScanArea, edge_points, scan_rotated_rect, unskew_points,
+    unskew_points_vertical,
+};
+use crate::blobs::{Blob, BlobSet};
+use crate::classify::ClassifiedImage;
+use crate::lut::ColourClass;
+
+/// Settings of ball recognition. Amounts are confidence points; the defaults follow the
+/// original's rules and were checked on the renderer's scenarios.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct BallParams {
+    /// Ball diameter, centimetres (2005 Four-Legged League: 8.5).
+    pub diameter_cm: f64,
+    /// Candidates with fewer pixels are ignored.
+    pub min_pixels: u32,
+    /// At most this many candidates are scored per frame.
+    pub max_candidates: usize,
+    /// Soft-colour blobs join an orange blob when their boxes come this close, pixels.
+    pub soft_join_px: u32,
+    /// Accepted pixels / box area (a full disc fills π/4 ≈ 0.785 of its box).
+    pub pixel_ratio: [f64; 2],
+    /// Weight of the pixel-ratio test.
+    pub pixel_ratio_weight: TestWeight,
+    /// Accepted height of the ball's centre above the ground, centimetres (true: 4.25).
+    pub height_cm: [f64; 2],
+    /// Weight of the height test.
+    pub height_weight: TestWeight,
+    /// Green fraction below the ball that earns the colour-below bonus.
+    pub green_below: [f64; 2],
+    /// Bonus for green below (never a penalty: a ball on a line or against a robot is still a ball).
+    pub green_below_bonus: f64,
+    /// Accepted box width / height for an uncut candidate.
+    pub aspect: [f64; 2],
+    /// Weight of the roundness test.
+    pub aspect_weight: TestWeight,
+    /// Share of a candidate's pixels that must be basic orange (soft-only blobs are doubtful).
+    pub orange_fraction: [f64; 2],
+    /// Weight of the orange-fraction test.
+    pub orange_fraction_weight: TestWeight,
+    /// Edge scans start this many pixels outside the box.
+    pub edge_margin_px: u32,
+    /// A fitted circle is rejected when its diameter is below this fraction of the blob's
+    /// uncut extent.
+    pub min_fit_diameter_ratio: f64,
+    /// A fitted circle is rejected when its residual spread exceeds this fraction of its radius
+    /// plus 0.75 px.
+    pub max_fit_residual_ratio: f64,
+    /// Largest visible extent along a cut-off axis relative to the uncut extent (a ball cut at
+    /// the top cannot be taller than wide).
+    pub max_cut_extent_ratio: f64,
+    /// Weight of the cut-extent test.
+    pub cut_extent_weight: TestWeight,
+    /// Penalty when the outline was scanned but does not fit a circle.
+    pub bad_circle_penalty: f64,
+    /// Combine the size-based distance with where the ray through the centre meets the plane of
+    /// ball centres (through the camera pose), weighting each by its expected error. Beyond the
+    /// original: far balls are a few pixels wide, and half a pixel of radius is 10% of distance.
+    pub ground_plane_fusion: bool,
+    /// Added to every measured radius, pixels: the classified outline of a real ball is a little
+    /// larger than its geometric disc (edge pixels mixing ball and carpet classify as ball);
+    /// `eotn eval` measures it.
+    pub radius_bias_px: f64,
+    /// Expected error of the fitted radius, pixels.
+    pub radius_sigma_px: f64,
+    /// Expected error of the camera's pitch from the joints and body model, radians.
+    pub pose_sigma_rad: f64,
+    /// Remove the horizontal rolling-shutter shear (pan velocity) before fitting.
+    pub skew_correction: bool,
+    /// Remove the vertical counterpart (tilt velocity) before fitting; off by default.
+    pub vertical_skew_correction: bool,
+}
+
+impl Default for BallParams {
+    fn default() -> Self {
+        Self {
+            diameter_cm: 8.5,
+            min_pixels: 5,
+            max_candidates: 6,
+            soft_join_px: 2,
+            pixel_ratio: [0.4, 1.0],
+            pixel_ratio_weight: TestWeight::new(1.0, 2.0),
+            height_cm: [-6.0, 16.0],
+            height_weight: TestWeight::new(1.0, 4.0),
+            green_below: [0.25, 1.0],
+            green_below_bonus: 1.0,
+            aspect: [0.6, 1.67],
+            aspect_weight: TestWeight::new(0.5, 1.5),
+            orange_fraction: [0.3, 1.0],
+            orange_fraction_weight: TestWeight::new(0.5, 2.0),
+            edge_margin_px: 3,
+            min_fit_diameter_ratio: 0.75,
+            max_fit_residual_ratio: 0.15,
+            max_cut_extent_ratio: 1.25,
+            cut_extent_weight: TestWeight::new(0.0, 3.0),
+            bad_circle_penalty: 1.5,
+            ground_plane_fusion: true,
+            radius_bias_px: 0.0,
+            radius_sigma_px: 0.5,
+            pose_sigma_rad: 0.01,
+            skew_correction: true,
+            vertical_skew_correction: false,
+        }
+    }
+}
+
+/// Inverse-variance combination of the size-based distance with the ground-plane one. The
+/// plane distance D = h / sin φ (h: camera height above ball centres, φ: depression of the ray)
+/// has an error of about D² / h · σ_φ; the size distance one of D · σ_r / r. When the two
+/// disagree by more than a factor of two (a ball in the air or held), the size distance stands.
+fn fuse_with_ground_plane(
+    ctx: &ViewContext,
+    center: Point,
+    radius: f64,
+    size_distance: f64,
+    params: &BallParams,
+) -> f64 {
+    let Some(pose) = ctx.pose else {
+        return size_distance;
+    };
+    let ip = crate::geometry::ImagePoint::new(center.0, center.1);
+    let Some(hit) = pose.point_on_plane(ip, params.diameter_cm / 2.0) else {
+        return size_distance;
+    };
+    let plane = hit.distance_to(&pose.position());
+    if !(plane.is_finite() && plane > 0.5 * size_distance && plane < 2.0 * size_distance) {
+        return size_distance;
+    }
+    let h = (pose.position().z() - params.diameter_cm / 2.0)
+        .abs()
+        .max(1.0);
+    let sigma_phi = params.pose_sigma_rad + params.radius_sigma_px / ctx.camera.focal_px;
+    let var_plane = (plane * plane / h * sigma_phi).powi(2);
+    let var_size = (size_distance * params.radius_sigma_px / radius.max(0.5)).powi(2);
+    (plane / var_plane + size_distance / var_size) / (1.0 / var_plane + 1.0 / var_size)
+}
+
+/// The recognised ball.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Ball {
+    /// Index of the accepted candidate in [`BallResult::candidates`].
+    pub candidate: usize,
+    /// Centre x, image pixels.
+    pub center_x: f64,
+    /// Centre y, image pixels.
+    pub center_y: f64,
+    /// Radius, pixels.
+    pub radius_px: f64,
+    /// Camera-relative distance, bearing, elevation.
+    pub camera: Relative,
+    /// Body-relative distance, bearing, elevation (when the joints were known).
+    pub body: Option<Relative>,
+    /// Total confidence.
+    pub confidence: f64,
+    /// Sides cut off by the image edge or hidden.
+    pub cut_off: CutOff,
+    /// True when centre and radius come from the circle fit, false when from the blob box.
+    pub from_circle_fit: bool,
+}
+
+/// One scored candidate, accepted or not, with everything that decided it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BallCandidate {
+    /// `[minx, miny, maxx, maxy]`, inclusive pixels (joined blobs).
+    pub bounds: [u32; 4],
+    /// Pixels of ball colours in the joined blobs.
+    pub pixels: u32,
+    /// Pixels of basic orange.
+    pub orange_pixels: u32,
+    /// The confidence breakdown.
+    pub confidence: Confidence,
+    /// Sides cut off or hidden.
+    pub cut_off: CutOff,
+    /// The edge-scan pattern used.
+    pub pattern: EdgeScanPattern,
+    /// Outline points after skew removal, pixels.
+    pub edge_points: Vec<Point>,
+    /// The circle fit, if one was found.
+    pub fit: Option<CircleFit>,
+    /// Why the circle fit was not used, if it was not.
+    pub fit_rejected: Option<String>,
+    /// The colour-below scan area.
+    pub below: Option<ScanArea>,
+    /// Estimated centre, pixels.
+    pub center: Point,
+    /// Estimated radius, pixels.
+    pub radius_px: f64,
+    /// Camera-relative estimate.
+    pub camera: Relative,
+    /// Whether this candidate became the ball.
+    pub accepted: bool,
+}
+
+/// Ball recognition's output for one frame.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct BallResult {
+    /// The ball, if a candidate was accepted.
+    pub ball: Option<Ball>,
+    /// Every candidate scored, in the order tried.
+    pub candidates: Vec<BallCandidate>,
+}
+
+/// Whether a class code is a ball colour: orange or a soft colour that may be orange.
+#[must_use]
+pub fn is_ball_colour(code: u8) -> bool {
+    ColourClass::from_code(code)
+        .is_some_and(|c| c == ColourClass::Orange || c.may_be_class(ColourClass::Orange))
+}
+
+fn is_robot_colour(code: u8) -> bool {
+    matches!(
+        ColourClass::from_code(code),
+        Some(ColourClass::White | ColourClass::Red | ColourClass::DarkBlue | ColourClass::Black)
+    )
+}
+
+fn near(a: &Blob, b: &Blob, gap: u32) -> bool {
+    a.minx <= b.maxx + gap + 1
+        && b.minx <= a.maxx + gap + 1
+        && a.miny <= b.maxy + gap + 1
+        && b.miny <= a.maxy + gap + 1
+}
+
+/// Candidate groups: each orange blob joined with the soft-orange blobs near it, then soft blobs
+/// left over on their own; largest first.
+fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blob, u32)> {
+    let soft: Vec<&Blob> = blobs
+        .active()
+        .filter(|b| b.colour != ColourClass::Orange.code() && is_ball_colour(b.colour))
+        .collect();
+    let mut used = vec![false; soft.len()];
+    let mut groups: Vec<(Blob, u32)> = Vec::new();
+    for orange in blobs.of_class(ColourClass::Orange) {
+        let mut joined = *orange;
+        for (i, s) in soft.iter().enumerate() {
+            if !used[i] && near(&joined, s, params.soft_join_px) {
+                joined = joined.merged_with(s);
+                used[i] = true;
+            }
+        }
+        groups.push((joined, orange.pixels));
+    }
+    for (i, s) in soft.iter().enumerate() {
+        if !used[i] {
+            groups.push((**s, 0));
+        }
+    }
+    groups.retain(|(b, _)| b.pixels >= params.min_pixels);
+    groups.sort_by_key(|g| std::cmp::Reverse(g.0.pixels));
+    groups.truncate(params.max_candidates);
+    groups
+}
+
+/// Which sides of `b` touch the image edge or border something that hides the ball (a robot's
+/// white, red, dark blue or black along most of that side).
+fn cut_off(img: &ClassifiedImage, b: &Blob) -> CutOff {
+    let (w, h) = (img.width() as u32, img.height() as u32);
+    let hidden = |samples: &mut dyn Iterator<Item = (i64, i64)>| {
+        let (mut n, mut robot) = (0u32, 0u32);
+        for (x, y) in samples {
+            if let Some(c) = img.get_signed(x, y) {
+                n += 1;
+                robot += u32::from(is_robot_colour(c));
+            }
+        }
+        n >= 3 && robot * 2 > n
+    };
+    let (minx, miny, maxx, maxy) = (
+        i64::from(b.minx),
+        i64::from(b.miny),
+        i64::from(b.maxx),
+        i64::from(b.maxy),
+    );
+    CutOff {
+        left: b.minx == 0 || hidden(&mut (miny..=maxy).map(|y| (minx - 1, y))),
+        right: b.maxx + 1 >= w || hidden(&mut (miny..=maxy).map(|y| (maxx + 1, y))),
+        top: b.miny == 0 || hidden(&mut (minx..=maxx).map(|x| (x, miny - 1))),
+        bottom: b.maxy + 1 >= h || hidden(&mut (minx..=maxx).map(|x| (x, maxy + 1))),
+    }
+}
+
+/// Centre and radius from the box alone: the uncut extent is the diameter; a cut side puts the
+/// centre a radius from the visible opposite side.
+fn box_estimate(b: &Blob, cut: CutOff) -> (Point, f64) {
+    let w = f64::from(b.maxx - b.minx + 1);
+    let h = f64::from(b.maxy - b.miny + 1);
+    let horizontal_cut = cut.left || cut.right;
+    let vertical_cut = cut.top || cut.bottom;
+    let r = match (horizontal_cut, vertical_cut) {
+        (false, false) => (w + h) / 4.0,
+        (true, false) => h / 2.0,
+        (false, true) => w / 2.0,
+        (true, true) => w.max(h) / 2.0,
+    };
+    let cx = match (cut.left, cut.right) {
+        (true, false) => f64::from(b.maxx + 1) - r,
+        (false, true) => f64::from(b.minx) + r,
+        _ => f64::from(b.minx) + w / 2.0,
+    };
+    let cy = match (cut.top, cut.bottom) {
+        (true, false) => f64::from(b.maxy + 1) - r,
+        (false, true) => f64::from(b.miny) + r,
+        _ => f64::from(b.miny) + h / 2.0,
+    };
+    ((cx, cy), r)
+}
+
+/// Recognises the ball in a classified frame.
+#[must_use]
+pub fn recognise_ball(
+    img: &ClassifiedImage,
+    blobs: &BlobSet,
+    ctx: &ViewContext,
+    params: &BallParams,
+) -> BallResult {
+    let mut result = BallResult::default();
+    let d = ctx.camera.focal_px;
+    for (group, orange_pixels) in candidate_groups(blobs, params) {
+        let cut = cut_off(img, &group);
+        let bounds = [group.minx, group.miny, group.maxx, group.maxy];
+        let pattern = EdgeScanPattern::for_cut_off(cut);
+        let mut points = edge_points(img, bounds, pattern, params.edge_margin_px, is_ball_colour);
+        let (box_centre, box_radius) = box_estimate(&group, cut);
+        // Move every outline point to the read-out time of the reference row, the instant the
+        // sensor readings describe: this removes the shear and puts the ball where the camera
+        // pose says it is.
+        let reference = ctx.reference_row();
+        if params.skew_correction {
+            unskew_points(&mut points, ctx.skew_x_per_line, reference);
+        }
+        if params.vertical_skew_correction {
+            unskew_points_vertical(&mut points, ctx.skew_y_per_line, reference);
+        }
+        let w = f64::from(group.maxx - group.minx + 1);
+        let h = f64::from(group.maxy - group.miny + 1);
+        let uncut_extent = match (cut.left || cut.right, cut.top || cut.bottom) {
+            (false, false) => w.max(h),
+            (true, false) => h,
+            (false, true) => w,
+            (true, true) => 0.0,
+        };
+        let fit = (points.len() >= 5).then(|| fit_circle(&points)).flatten();
+        let fit_rejected = match &fit {
+            None if points.len() < 5 => Some(format!("only {} edge points", points.len())),
+            None => Some("edge points do not fit a circle".to_owned()),
+            Some(f) if 2.0 * f.radius < params.min_fit_diameter_ratio * uncut_extent => {
+                Some(format!(
+                    "diameter {:.1} px much smaller than blob extent {uncut_extent:.0} px",
+                    2.0 * f.radius
+                ))
+            }
+            Some(f) if f.residual_sd > params.max_fit_residual_ratio * f.radius + 0.75 => {
+                Some(format!(
+                    "residual spread {:.2} px too large for radius {:.1} px",
+                    f.residual_sd, f.radius
+                ))
+            }
+            Some(f) if f.radius > 4.0 * d => Some("radius beyond any ball".to_owned()),
+            Some(_) => None,
+        };
+        let use_fit = fit.is_some() && fit_rejected.is_none();
+        let (center, radius) = match (&fit, use_fit) {
+            (Some(f), true) => ((f.center_x, f.center_y), f.radius),
+            _ if params.skew_correction => (
+                ctx.unskew(box_centre, params.vertical_skew_correction),
+                box_radius,
+            ),
+            _ => (box_centre, box_radius),
+        };
+        let radius = (radius + params.radius_bias_px).max(0.5);
+        let size_distance = d * params.diameter_cm / (2.0 * radius);
+        let distance = if params.ground_plane_fusion {
+            fuse_with_ground_plane(ctx, center, radius, size_distance, params)
+        } else {
+            size_distance
+        };
+        let camera = ctx.camera_relative(center, distance);
+
+        let mut confidence = Confidence::default();
+        let area = w * h;
+        confidence.range_test(
+            "orange_fraction",
+            f64::from(orange_pixels) / f64::from(group.pixels.max(1)),
+            params.orange_fraction,
+            params.orange_fraction_weight,
+        );
+        let horizontal_cut = cut.left || cut.right;
+        let vertical_cut = cut.top || cut.bottom;
+        if horizontal_cut != vertical_cut {
+            let ratio = if horizontal_cut { w / h } else { h / w };
+            confidence.range_test(
+                "cut_extent",
+                ratio,
+                [0.0, params.max_cut_extent_ratio],
+                params.cut_extent_weight,
+            );
+        }
+        if let (Some(f), Some(why)) = (&fit, &fit_rejected)
+            && why.starts_with("residual")
+        {
+            confidence.range_test(
+                "circle_residual_px",
+                f.residual_sd,
+                [0.0, params.max_fit_residual_ratio * f.radius + 0.75],
+                TestWeight::new(0.0, params.bad_circle_penalty),
+            );
+        }
+        if cut.any() {
+            confidence.skipped("pixel_ratio", params.pixel_ratio);
+            confidence.skipped("roundness", params.aspect);
+        } else {
+            confidence.range_test(
+                "pixel_ratio",
+                f64::from(group.pixels) / area,
+                params.pixel_ratio,
+                params.pixel_ratio_weight,
+            );
+            confidence.range_test("roundness", w / h, params.aspect, params.aspect_weight);
+        }
+        match ctx.height_above_ground(center, distance) {
+            Some(z) => {
+                confidence.range_test("height_cm", z, params.height_cm, params.height_weight)
+            }
+            None => confidence.skipped("height_cm", params.height_cm),
+        }
+        // Colour below: an area under the ball, parallel to the horizon.
+        let below_scan = scan_rotated_rect(
+            img,
+            center,
+            [
+                -radius,
+                radius,
+                radius + 1.0,
+                radius + 1.0 + (radius * 0.8).max(2.0),
+            ],
+            -ctx.horizon_angle(),
+            (radius / 6.0).max(1.0),
+        );
+        match below_scan.ratio(|c| c == ColourClass::Green.code()) {
+            Some(green) => confidence.bonus_test(
+                "green_below",
+                green,
+                params.green_below,
+                params.green_below_bonus,
+            ),
+            None => confidence.skipped("green_below", params.green_below),
+        }
+        let accepted = result.ball.is_none() && confidence.accepted();
+        let index = result.candidates.len();
+        if accepted {
+            result.ball = Some(Ball {
+                candidate: index,
+                center_x: center.0,
+                center_y: center.1,
+                radius_px: radius,
+                camera,
+                body: ctx.body_relative(center, distance),
+                confidence: confidence.total,
+                cut_off: cut,
+                from_circle_fit: use_fit,
+            });
+        }
+        result.candidates.push(BallCandidate {
+            bounds,
+            pixels: group.pixels,
+            orange_pixels,
+            confidence,
+            cut_off: cut,
+            pattern,
+            edge_points: points,
+            fit,
+            fit_rejected,
+            below: Some(below_scan.area),
+            center,
+            radius_px: radius,
+            camera,
+            accepted,
+        });
+        if accepted {
+            break;
+        }
+    }
+    result
+}
+
+impl BallResult {
+    /// Drawing primitives: every candidate's box, scan area and edge points; circles and a
+    /// label for the accepted ball.
+    #[must_use]
+    pub fn primitives(&self) -> Vec<Primitive> {
+        let mut out = Vec::new();
+        for (i, c) in self.candidates.iter().enumerate() {
+            let owner = format!("ball#{i}");
+            out.push(Primitive::Box {
+                owner: owner.clone(),
+                colour: ColourClass::Orange.code(),
+                bounds: c.bounds,
+            });
+            if let Some(area) = c.below {
+                out.push(Primitive::ScanArea {
+                    owner: owner.clone(),
+                    corners: area.corners,
+                });
+            }
+            if !c.edge_points.is_empty() {
+                out.push(Primitive::ScanPoints {
+                    owner: owner.clone(),
+                    points: c.edge_points.clone(),
+                });
+            }
+            if c.accepted {
+                out.push(Primitive::Circle {
+                    owner: owner.clone(),
+                    center: c.center,
+                    radius: c.radius_px,
+                });
+                out.push(Primitive::Label {
+                    owner,
+                    at: (c.center.0, c.center.1 - c.radius_px - 2.0),
+                    text: format!(
+                        "ball {:.0} cm {:+.0}°",
+                        c.camera.distance_cm,
+                        c.camera.bearing_rad.to_degrees()
+                    ),
+                });
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::blobs::Connectivity;
+    use crate::geometry::{Ers7Dimensions, PinholeCamera, Point as GeoPoint};
+    use crate::sensors::SensorReadings;
+
+    fn level_context() -> ViewContext {
+        let readings = SensorReadings {
+            head_pan_rad: Some(0.0),
+            head_tilt_rad: Some(-0.2),
+            neck_tilt_rad: Some(0.0),
+            ..SensorReadings::default()
+        };
+        ViewContext::from_sensors(PinholeCamera::ers7(), &readings, &Ers7Dimensions::ERS7)
+    }
+
+    /// Green field with an orange disc; `shear` shifts row y by shear·(y − cy) pixels.
+    fn scene(cx: f64, cy: f64, r: f64, shear: f64) -> ClassifiedImage {
+        let (w, h) = (208usize, 160usize);
+        let mut codes = vec![ColourClass::Green.code(); w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let yc = y as f64 + 0.5;
+                let dx = x as f64 + 0.5 - cx - shear * (yc - cy);
+                let dy = yc - cy;
+                if dx * dx + dy * dy <= r * r {
+                    codes[y * w + x] = ColourClass::Orange.code();
+                }
+            }
+        }
+        ClassifiedImage::from_codes(w, h, codes).expect("size")
+    }
+
+    fn true_ball(ctx: &ViewContext, x: f64, y: f64) -> (Point, f64, f64) {
+        let pose = ctx.pose.expect("pose");
+        let centre = GeoPoint::new(x, y, 4.25);
+        let p = pose.image_from_field(&centre).expect("in front");
+        let cam = pose.position();
+        let dist = cam.distance_to(&centre);
+        ((p.x_px, p.y_px), ctx.camera.focal_px * 4.25 / dist, dist)
+    }
+
+    #[test]
+    fn finds_a_ball_on_the_field_with_distance_from_the_circle() {
+        let ctx = level_context();
+        let (c, r, dist) = true_ball(&ctx, 90.0, 10.0);
+        let img = scene(c.0, c.1, r, 0.0);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let ball = res.ball.clone().expect("ball");
+        assert!(ball.from_circle_fit);
+        assert!((ball.center_x - c.0).abs() < 0.6 && (ball.center_y - c.1).abs() < 0.6);
+        let err = (ball.camera.distance_cm - dist).abs() / dist;
+        assert!(err < 0.05, "distance {} vs {dist}", ball.camera.distance_cm);
+        assert!(ball.body.is_some());
+        let cand = &res.candidates[ball.candidate];
+        assert!(
+            cand.confidence
+                .test("height_cm")
+                .is_some_and(|t| t.effect > 0.0)
+        );
+        assert!(
+            cand.confidence
+                .test("green_below")
+                .is_some_and(|t| t.effect > 0.0)
+        );
+        assert!(!res.primitives().is_empty());
+    }
+
+    #[test]
+    fn an_orange_thing_far_above_the_ground_is_not_a_ball() {
+        let ctx = level_context();
+        let img = scene(60.0, 12.0, 6.0, 0.0);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        assert!(res.ball.is_none(), "{:?}", res.candidates[0].confidence);
+        let height = res.candidates[0]
+            .confidence
+            .test("height_cm")
+            .expect("height test");
+        assert!(height.value > 20.0 && height.effect < 0.0);
+    }
+
+    #[test]
+    fn a_ball_cut_by_the_image_edge_keeps_its_radius() {
+        let ctx = level_context();
+        let (c, r, dist) = true_ball(&ctx, 45.0, 0.0);
+        // Move it so a third of it is outside the left edge.
+        let img = scene(r * 0.4, c.1, r, 0.0);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let ball = res.ball.expect("ball");
+        assert!(ball.cut_off.left && !ball.cut_off.right);
+        assert!(
+            (ball.radius_px - r).abs() / r < 0.08,
+            "{} vs {r}",
+            ball.radius_px
+        );
+        assert!((ball.camera.distance_cm - dist).abs() / dist < 0.08);
+    }
+
+    #[test]
+    fn skew_correction_restores_the_radius_of_a_sheared_ball() {
+        let mut ctx = level_context();
+        let (c, r, _) = true_ball(&ctx, 70.0, 0.0);
+        let shear = 0.6;
+        let img = scene(c.0, c.1, r, shear);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let plain = recognise_ball(
+            &img,
+            &blobs,
+            &ctx,
+            &BallParams {
+                skew_correction: false,
+                ..BallParams::default()
+            },
+        );
+        ctx.skew_x_per_line = shear;
+        let fixed = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let e_plain = (plain.ball.expect("plain").radius_px - r).abs();
+        let e_fixed = (fixed.ball.expect("fixed").radius_px - r).abs();
+        assert!(e_fixed * 2.0 < e_plain, "fixed {e_fixed} plain {e_plain}");
+    }
+
+    #[test]
+    fn soft_orange_joins_and_a_frame_without_orange_has_no_candidates() {
+        let ctx = level_context();
+        let (c, r, _) = true_ball(&ctx, 80.0, 0.0);
+        let mut img = scene(c.0, c.1, r, 0.0);
+        // Paint the lower half of the ball red-orange (shadow).
+        let w = img.width();
+        let codes = img.codes_mut();
+        for (i, code) in codes.iter_mut().enumerate() {
+            if *code == ColourClass::Orange.code() && (i / w) as f64 > c.1 {
+                *code = ColourClass::RedOrange.code();
+            }
+        }
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let ball = res.ball.expect("ball");
+        assert!((ball.radius_px - r).abs() < 1.0);
+        let green = scene(0.0, 0.0, 0.0, 0.0);
+        let none = recognise_ball(
+            &green,
+            &BlobSet::from_image(&green, Connectivity::Eight),
+            &ctx,
+            &BallParams::default(),
+        );
+        assert!(none.ball.is_none() && none.candidates.is_empty());
+    }
+}

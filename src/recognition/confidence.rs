@@ -1,0 +1,138 @@
+//! The confidence system: every candidate object starts at zero, each named test adds or
+//! subtracts an amount depending on a measured value, and the candidate is accepted when the
+//! total is positive. The whole breakdown is kept, accepted or not, so the app and the JSON can
+//! show *why* an object was or was not recognised.
+
+use serde::{Deserialize, Serialize};
+
+/// What one test concluded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TestOutcome {
+    /// The measured value was in the expected range.
+    Passed,
+    /// The measured value was outside the expected range.
+    Failed,
+    /// The test could not be applied (for example the scan area lay outside the image).
+    Skipped,
+}
+
+/// One line of a confidence breakdown.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TestResult {
+    /// Name of the test, e.g. `"pixel_ratio"`.
+    pub test: String,
+    /// The measured value (units depend on the test; see its `range`).
+    pub value: f64,
+    /// The accepted range `[min, max]` of the measured value.
+    pub range: [f64; 2],
+    /// Passed, failed or skipped.
+    pub outcome: TestOutcome,
+    /// The amount added to the confidence (negative when it counts against).
+    pub effect: f64,
+}
+
+/// The running confidence of one candidate with its breakdown.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Confidence {
+    /// Sum of all effects.
+    pub total: f64,
+    /// Every test applied, in order.
+    pub tests: Vec<TestResult>,
+}
+
+/// How much a test adds when it passes and subtracts when it fails.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TestWeight {
+    /// Added when the value is inside the range.
+    pub reward: f64,
+    /// Subtracted when the value is outside the range (give a positive number).
+    pub penalty: f64,
+}
+
+impl TestWeight {
+    /// A test that adds `reward` on success and subtracts `penalty` on failure.
+    #[must_use]
+    pub const fn new(reward: f64, penalty: f64) -> Self {
+        Self { reward, penalty }
+    }
+}
+
+impl Confidence {
+    /// Applies a range test: `value` within `range` (inclusive) rewards, otherwise penalises. A
+    /// non-finite value counts as a failure, so NaN can never make a candidate look better.
+    pub fn range_test(&mut self, test: &str, value: f64, range: [f64; 2], weight: TestWeight) {
+        let inside = value.is_finite() && value >= range[0] && value <= range[1];
+        let (outcome, effect) = if inside {
+            (TestOutcome::Passed, weight.reward)
+        } else {
+            (TestOutcome::Failed, -weight.penalty)
+        };
+        self.push(test, value, range, outcome, effect);
+    }
+
+    /// Records a test that could not be applied; it changes nothing but stays visible.
+    pub fn skipped(&mut self, test: &str, range: [f64; 2]) {
+        self.push(test, f64::NAN, range, TestOutcome::Skipped, 0.0);
+    }
+
+    /// A test that can only help: rewards inside the range, records a zero effect otherwise.
+    pub fn bonus_test(&mut self, test: &str, value: f64, range: [f64; 2], reward: f64) {
+        self.range_test(test, value, range, TestWeight::new(reward, 0.0));
+    }
+
+    fn push(&mut self, test: &str, value: f64, range: [f64; 2], outcome: TestOutcome, effect: f64) {
+        self.total += effect;
+        self.tests.push(TestResult {
+            test: test.to_owned(),
+            value,
+            range,
+            outcome,
+            effect,
+        });
+    }
+
+    /// The original's rule: accepted when the total is positive.
+    #[must_use]
+    pub fn accepted(&self) -> bool {
+        self.total > 0.0
+    }
+
+    /// The result of the named test, if it was applied.
+    #[must_use]
+    pub fn test(&self, name: &str) -> Option<&TestResult> {
+        self.tests.iter().find(|t| t.test == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn breakdown_sums_effects_and_keeps_every_test() {
+        let mut c = Confidence::default();
+        c.range_test("ratio", 0.7, [0.5, 1.0], TestWeight::new(2.0, 3.0));
+        c.range_test("height", 40.0, [-5.0, 15.0], TestWeight::new(1.0, 4.0));
+        c.skipped("colour_below", [0.3, 1.0]);
+        assert_eq!(c.tests.len(), 3);
+        assert!((c.total - (2.0 - 4.0)).abs() < 1e-12);
+        assert!(!c.accepted());
+        assert_eq!(
+            c.test("height").map(|t| t.outcome),
+            Some(TestOutcome::Failed)
+        );
+        assert_eq!(c.test("colour_below").map(|t| t.effect), Some(0.0));
+    }
+
+    #[test]
+    fn nan_fails_and_bonus_never_penalises() {
+        let mut c = Confidence::default();
+        c.bonus_test("green_below", 0.1, [0.3, 1.0], 1.5);
+        assert_eq!(c.total, 0.0);
+        c.range_test("ratio", f64::NAN, [0.0, 1.0], TestWeight::new(1.0, 1.0));
+        assert_eq!(c.total, -1.0);
+        c.bonus_test("green_below", 0.5, [0.3, 1.0], 1.5);
+        assert!(c.accepted());
+    }
+}

@@ -1,0 +1,95 @@
+//! Drawing primitives as data: what recognition looked at and found, in image pixels, so the
+//! app, `eotn render` and the JSON all draw the same thing. Each primitive names the object it
+//! belongs to (`owner`, e.g. `"ball#0"`, `"goal:yellow#1"`) so a selected candidate can be
+//! highlighted.
+
+use serde::{Deserialize, Serialize};
+
+use super::fit::Point;
+
+/// One thing to draw over the image.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Primitive {
+    /// An inclusive pixel box, e.g. a blob or a candidate's extent.
+    Box {
+        /// Which object this belongs to.
+        owner: String,
+        /// Class code whose display colour to use.
+        colour: u8,
+        /// `[minx, miny, maxx, maxy]`, inclusive pixels.
+        bounds: [u32; 4],
+    },
+    /// A scanned quadrilateral (colour-below areas, goal scans).
+    ScanArea {
+        /// Which object this belongs to.
+        owner: String,
+        /// Corners in order, pixels.
+        corners: [Point; 4],
+    },
+    /// Points found by edge scans.
+    ScanPoints {
+        /// Which object this belongs to.
+        owner: String,
+        /// The points, pixels.
+        points: Vec<Point>,
+    },
+    /// A fitted circle.
+    Circle {
+        /// Which object this belongs to.
+        owner: String,
+        /// Centre, pixels.
+        center: Point,
+        /// Radius, pixels.
+        radius: f64,
+    },
+    /// A straight segment: a goal post, a gap, a horizon.
+    Line {
+        /// Which object this belongs to.
+        owner: String,
+        /// What the line is.
+        role: LineRole,
+        /// Start, pixels.
+        from: Point,
+        /// End, pixels.
+        to: Point,
+    },
+    /// A text label at a point (object name, distance, bearing).
+    Label {
+        /// Which object this belongs to.
+        owner: String,
+        /// Where, pixels.
+        at: Point,
+        /// The text.
+        text: String,
+    },
+}
+
+/// What a [`Primitive::Line`] shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LineRole {
+    /// The horizon.
+    Horizon,
+    /// A fitted goal post.
+    Post,
+    /// The largest open gap of a goal.
+    Gap,
+    /// A scan line.
+    Scan,
+}
+
+impl Primitive {
+    /// The object this primitive belongs to.
+    #[must_use]
+    pub fn owner(&self) -> &str {
+        match self {
+            Self::Box { owner, .. }
+            | Self::ScanArea { owner, .. }
+            | Self::ScanPoints { owner, .. }
+            | Self::Circle { owner, .. }
+            | Self::Line { owner, .. }
+            | Self::Label { owner, .. } => owner,
+        }
+    }
+}

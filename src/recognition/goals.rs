@@ -1,0 +1,904 @@
+//! Goals: blobs of a goal colour (yellow or sky blue) joined with the soft colours that may be
+//! that colour, merged into candidates (near each other, lined up, or split by a goalkeeper),
+//! checked for sides cut off by the image edge, given a distance from their height, tested, and
+//! then searched for posts (line fits along uncut sides) and the largest open gap.
+//!
+//! "Parallel to the horizon" is done by rotating image points about the image centre by the
+//! horizon's angle (the *level* frame), working there, and rotating results back.
+
+use serde::{Deserialize, Serialize};
+
+use super::confidence::{Confidence, TestWeight};
+use super::context::{Relative, ViewContext};
+use super::draw::{LineRole, Primitive};
+use super::fit::{LineFit, Point, fit_line, rotate_about};
+use super::scan::{CutOff, scan_rotated_rect};
+use crate::blobs::{Blob, BlobSet};
+use crate::classify::ClassifiedImage;
+use crate::lut::ColourClass;
+
+/// Settings of goal recognition.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct GoalParams {
+    /// Goal height, centimetres (2005 rules: 30).
+    pub height_cm: f64,
+    /// Goal width, centimetres (2005 rules: 80).
+    pub width_cm: f64,
+    /// Blobs of the basic goal colour with fewer pixels are ignored.
+    pub min_blob_pixels: u32,
+    /// Candidates with fewer pixels in all are ignored.
+    pub min_candidate_pixels: u32,
+    /// Soft blobs join, and candidates merge, when their boxes come this close, pixels.
+    pub join_px: u32,
+    /// Candidates line up horizontally when their vertical overlap is at least this fraction of
+    /// the shorter one's height.
+    pub line_up_overlap: f64,
+    /// In the level frame, tops and bottoms within this fraction of the height are "about equal"
+    /// (a goal split by a goalkeeper).
+    pub split_tolerance: f64,
+    /// A rotated box point within this many pixels of the image edge counts as at the edge.
+    pub edge_margin_px: f64,
+    /// Distance = multiplier / height(px) + offset: multiplier, cm·px (pinhole: d × 30 cm).
+    pub distance_multiplier: f64,
+    /// Distance offset, centimetres.
+    pub distance_offset_cm: f64,
+    /// The goal-colour part's height is used when the soft sides add less than this fraction.
+    pub soft_side_tolerance: f64,
+    /// Below this distance (cm) the infra-red reading replaces the size-based distance.
+    pub ir_max_cm: f64,
+    /// Goals covering more than this fraction of the image skip the identification tests.
+    pub fills_image_fraction: f64,
+    /// Accepted pixels / box area.
+    pub pixel_ratio: [f64; 2],
+    /// Weight of the pixel-ratio test.
+    pub pixel_ratio_weight: TestWeight,
+    /// Green fraction below the goal that earns a bonus.
+    pub green_below: [f64; 2],
+    /// Bonus for green (or white lines) below.
+    pub green_below_bonus: f64,
+    /// Penalty when there is too little green below (a yellow thing off the field).
+    pub green_below_penalty: f64,
+    /// Accepted ratio of the size-based distance to the distance of the bottom's foot on the
+    /// ground (through the camera pose); a thing of another height than a goal fails.
+    pub distance_agreement: [f64; 2],
+    /// Weight of the distance-agreement test.
+    pub distance_agreement_weight: TestWeight,
+    /// Accepted height of the goal's bottom above the ground, centimetres.
+    pub bottom_height_cm: [f64; 2],
+    /// Weight of the bottom-height test.
+    pub bottom_height_weight: TestWeight,
+    /// Accepted body-relative elevation of the goal's centre, radians.
+    pub elevation_rad: [f64; 2],
+    /// Weight of the elevation test.
+    pub elevation_weight: TestWeight,
+    /// Base confidence of a candidate with enough pixels.
+    pub size_bonus: f64,
+    /// Number of scan lines per post.
+    pub post_scans: usize,
+    /// A post is accepted when r² is at least this, or the points hardly vary across the line.
+    pub post_min_r_squared: f64,
+    /// ... and the residual variance s² is at most this, pixels².
+    pub post_max_residual_variance: f64,
+    /// Height of the gap scan above the ground, centimetres (about a robot's shoulder).
+    pub gap_scan_height_cm: f64,
+    /// Holes up to this many pixels inside a goal-coloured run do not end it.
+    pub gap_hole_px: u32,
+    /// Move posts, gap and centre to the reference row's read-out time (rolling shutter).
+    pub skew_correction: bool,
+    /// Penalty for a candidate overlapping an accepted beacon (its yellow or sky-blue band).
+    pub beacon_overlap_penalty: f64,
+}
+
+impl Default for GoalParams {
+    fn default() -> Self {
+        Self {
+            height_cm: 30.0,
+            width_cm: 80.0,
+            min_blob_pixels: 12,
+            min_candidate_pixels: 30,
+            join_px: 3,
+            line_up_overlap: 0.5,
+            split_tolerance: 0.2,
+            edge_margin_px: 1.5,
+            distance_multiplier: 191.9 * 30.0,
+            distance_offset_cm: 0.0,
+            soft_side_tolerance: 0.15,
+            ir_max_cm: 60.0,
+            fills_image_fraction: 0.6,
+            pixel_ratio: [0.3, 1.0],
+            pixel_ratio_weight: TestWeight::new(0.5, 1.5),
+            green_below: [0.2, 1.0],
+            green_below_bonus: 1.0,
+            green_below_penalty: 1.5,
+            distance_agreement: [0.6, 1.6],
+            distance_agreement_weight: TestWeight::new(1.0, 3.0),
+            bottom_height_cm: [-20.0, 20.0],
+            bottom_height_weight: TestWeight::new(1.0, 3.0),
+            elevation_rad: [-0.8, 0.5],
+            elevation_weight: TestWeight::new(0.5, 2.0),
+            size_bonus: 0.5,
+            post_scans: 8,
+            post_min_r_squared: 0.5,
+            post_max_residual_variance: 2.0,
+            gap_scan_height_cm: 15.0,
+            gap_hole_px: 1,
+            skew_correction: true,
+            beacon_overlap_penalty: 10.0,
+        }
+    }
+}
+
+/// Which side of a goal a post is on, as seen in the image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PostSide {
+    /// The post on the image's left.
+    Left,
+    /// The post on the image's right.
+    Right,
+}
+
+/// A goal post found by a line fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Post {
+    /// Left or right in the image.
+    pub side: PostSide,
+    /// Top end of the fitted line, image pixels.
+    pub top: Point,
+    /// Bottom end of the fitted line, image pixels.
+    pub bottom: Point,
+    /// The fit (in image coordinates).
+    pub fit: LineFit,
+    /// Camera-relative direction of the post's centre (distance: the goal's).
+    pub camera: Relative,
+    /// Body-relative direction of the post's centre.
+    pub body: Option<Relative>,
+}
+
+/// The largest open stretch of goal between obstacles, along the gap scan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Gap {
+    /// Left end, image pixels.
+    pub left: Point,
+    /// Right end, image pixels.
+    pub right: Point,
+    /// Length, pixels.
+    pub width_px: f64,
+    /// Camera-relative direction of the gap's centre (what a kick should aim at).
+    pub camera: Relative,
+    /// Bearing of the left end, radians.
+    pub left_bearing_rad: f64,
+    /// Bearing of the right end, radians.
+    pub right_bearing_rad: f64,
+}
+
+/// A recognised goal, or a rejected candidate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GoalCandidate {
+    /// Yellow or sky blue.
+    pub colour: ColourClass,
+    /// `[minx, miny, maxx, maxy]`, inclusive pixels.
+    pub bounds: [u32; 4],
+    /// Pixels of goal colours.
+    pub pixels: u32,
+    /// Bounds of the basic goal-colour part.
+    pub basic_bounds: [u32; 4],
+    /// Numbers of the blobs that make it up.
+    pub blobs: Vec<u32>,
+    /// Sides cut off by the image edge.
+    pub cut_off: CutOff,
+    /// Height used for the distance, pixels (level frame).
+    pub height_px: f64,
+    /// Camera-relative distance, bearing, elevation of the centre.
+    pub camera: Relative,
+    /// Body-relative, when the joints are known.
+    pub body: Option<Relative>,
+    /// True when top or bottom is cut off: the real goal is at most this far.
+    pub distance_is_max: bool,
+    /// True when the infra-red reading gave the distance.
+    pub distance_from_ir: bool,
+    /// Confidence breakdown.
+    pub confidence: Confidence,
+    /// Fitted posts.
+    pub posts: Vec<Post>,
+    /// Posts whose fit was rejected, and why.
+    pub rejected_posts: Vec<String>,
+    /// Points scanned for posts, pixels.
+    pub post_points: Vec<Point>,
+    /// The largest open gap.
+    pub gap: Option<Gap>,
+    /// The gap scan line, pixels.
+    pub gap_scan: Option<(Point, Point)>,
+    /// Accepted as a goal.
+    pub accepted: bool,
+}
+
+/// Goal recognition's output: every candidate of both colours; accepted ones are goals.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct GoalResult {
+    /// All candidates, accepted first within each colour.
+    pub candidates: Vec<GoalCandidate>,
+}
+
+impl GoalResult {
+    /// The accepted goals.
+    pub fn goals(&self) -> impl Iterator<Item = &GoalCandidate> {
+        self.candidates.iter().filter(|c| c.accepted)
+    }
+}
+
+fn near(a: &Blob, b: &Blob, gap: u32) -> bool {
+    a.minx <= b.maxx + gap + 1
+        && b.minx <= a.maxx + gap + 1
+        && a.miny <= b.maxy + gap + 1
+        && b.miny <= a.maxy + gap + 1
+}
+
+/// A candidate while it is being built: the joined blob and its basic-colour part.
+#[derive(Debug, Clone)]
+struct Group {
+    all: Blob,
+    basic: Blob,
+    members: Vec<u32>,
+}
+
+fn level_extent(b: &Blob, centre: Point, angle: f64) -> [f64; 4] {
+    let corners = [
+        (f64::from(b.minx), f64::from(b.miny)),
+        (f64::from(b.maxx + 1), f64::from(b.miny)),
+        (f64::from(b.maxx + 1), f64::from(b.maxy + 1)),
+        (f64::from(b.minx), f64::from(b.maxy + 1)),
+    ];
+    let mut e = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for c in corners {
+        let p = rotate_about(c, centre, angle);
+        e[0] = e[0].min(p.0);
+        e[1] = e[1].min(p.1);
+        e[2] = e[2].max(p.0);
+        e[3] = e[3].max(p.1);
+    }
+    e
+}
+
+fn build_groups(
+    blobs: &BlobSet,
+    colour: ColourClass,
+    ctx: &ViewContext,
+    p: &GoalParams,
+) -> Vec<Group> {
+    let soft: Vec<&Blob> = blobs
+        .active()
+        .filter(|b| {
+            ColourClass::from_code(b.colour).is_some_and(|c| c != colour && c.may_be_class(colour))
+        })
+        .collect();
+    let mut used = vec![false; soft.len()];
+    let mut groups: Vec<Group> = Vec::new();
+    for b in blobs
+        .of_class(colour)
+        .filter(|b| b.pixels >= p.min_blob_pixels)
+    {
+        let mut g = Group {
+            all: *b,
+            basic: *b,
+            members: vec![b.number],
+        };
+        for (i, s) in soft.iter().enumerate() {
+            if !used[i] && near(&g.all, s, p.join_px) {
+                g.all = g.all.merged_with(s);
+                g.members.push(s.number);
+                used[i] = true;
+            }
+        }
+        groups.push(g);
+    }
+    // Merge until stable: near, lined up, or split by a goalkeeper (level tops/bottoms equal).
+    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let angle = ctx.horizon_angle();
+    loop {
+        let mut merged = false;
+        'outer: for i in 0..groups.len() {
+            for j in i + 1..groups.len() {
+                let (a, b) = (&groups[i].all, &groups[j].all);
+                let (ha, hb) = (
+                    f64::from(a.maxy - a.miny + 1),
+                    f64::from(b.maxy - b.miny + 1),
+                );
+                let overlap =
+                    (f64::from(a.maxy.min(b.maxy)) - f64::from(a.miny.max(b.miny)) + 1.0).max(0.0);
+                let lined_up = overlap >= p.line_up_overlap * ha.min(hb);
+                let (ea, eb) = (
+                    level_extent(a, centre, angle),
+                    level_extent(b, centre, angle),
+                );
+                let tol = p.split_tolerance * (ea[3] - ea[1]).max(eb[3] - eb[1]);
+                let split = (ea[1] - eb[1]).abs() <= tol && (ea[3] - eb[3]).abs() <= tol;
+                if near(a, b, p.join_px) || lined_up && split {
+                    let other = groups.swap_remove(j);
+                    let g = &mut groups[i];
+                    g.all = g.all.merged_with(&other.all);
+                    g.basic = g.basic.merged_with(&other.basic);
+                    g.members.extend(other.members);
+                    merged = true;
+                    break 'outer;
+                }
+            }
+        }
+        if !merged {
+            break;
+        }
+    }
+    groups.retain(|g| g.all.pixels >= p.min_candidate_pixels);
+    groups.sort_by_key(|g| std::cmp::Reverse(g.all.pixels));
+    groups
+}
+
+/// Share of box `a` covered by box `b` (inclusive pixel boxes).
+fn overlap_fraction(a: [u32; 4], b: [u32; 4]) -> f64 {
+    let w = (a[2].min(b[2]) + 1).saturating_sub(a[0].max(b[0]));
+    let h = (a[3].min(b[3]) + 1).saturating_sub(a[1].max(b[1]));
+    let area = f64::from(a[2] - a[0] + 1) * f64::from(a[3] - a[1] + 1);
+    f64::from(w) * f64::from(h) / area
+}
+
+/// Cut-off detection: the level box's 8 points (corners and side midpoints), rotated back into
+/// the image; a side is cut off when two or more of its three points are near or outside the edge.
+fn detect_cut_off(e: [f64; 4], centre: Point, angle: f64, w: f64, h: f64, margin: f64) -> CutOff {
+    let un = |x: f64, y: f64| rotate_about((x, y), centre, -angle);
+    let (mx, my) = ((e[0] + e[2]) / 2.0, (e[1] + e[3]) / 2.0);
+    let at_edge =
+        |p: Point| p.0 <= margin || p.1 <= margin || p.0 >= w - margin || p.1 >= h - margin;
+    let count = |pts: [Point; 3]| pts.iter().filter(|p| at_edge(**p)).count() >= 2;
+    CutOff {
+        left: count([un(e[0], e[1]), un(e[0], my), un(e[0], e[3])]),
+        right: count([un(e[2], e[1]), un(e[2], my), un(e[2], e[3])]),
+        top: count([un(e[0], e[1]), un(mx, e[1]), un(e[2], e[1])]),
+        bottom: count([un(e[0], e[3]), un(mx, e[3]), un(e[2], e[3])]),
+    }
+}
+
+fn is_goal_colour(colour: ColourClass) -> impl Fn(u8) -> bool {
+    move |code| ColourClass::from_code(code).is_some_and(|c| c == colour || c.may_be_class(colour))
+}
+
+/// Recognises yellow and sky-blue goals.
+#[must_use]
+pub fn recognise_goals(
+    img: &ClassifiedImage,
+    blobs: &BlobSet,
+    ctx: &ViewContext,
+    p: &GoalParams,
+    beacons: &[[u32; 4]],
+) -> GoalResult {
+    let mut result = GoalResult::default();
+    for colour in [ColourClass::Yellow, ColourClass::SkyBlue] {
+        let mut accepted_one = false;
+        for g in build_groups(blobs, colour, ctx, p) {
+            let mut cand = examine(img, &g, colour, ctx, p);
+            // A beacon's yellow or sky-blue band is not a goal.
+            let overlap = beacons
+                .iter()
+                .map(|b| overlap_fraction(cand.bounds, *b))
+                .fold(0.0, f64::max);
+            if overlap > 0.0 {
+                cand.confidence.range_test(
+                    "beacon_overlap",
+                    overlap,
+                    [0.0, 0.2],
+                    TestWeight::new(0.0, p.beacon_overlap_penalty),
+                );
+            }
+            if !accepted_one && cand.confidence.accepted() {
+                cand.accepted = true;
+                accepted_one = true;
+                find_posts_and_gap(img, &mut cand, colour, ctx, p);
+            }
+            result.candidates.push(cand);
+        }
+    }
+    result
+}
+
+fn examine(
+    img: &ClassifiedImage,
+    g: &Group,
+    colour: ColourClass,
+    ctx: &ViewContext,
+    p: &GoalParams,
+) -> GoalCandidate {
+    let (w, h) = (img.width() as f64, img.height() as f64);
+    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let angle = ctx.horizon_angle();
+    let e_all = level_extent(&g.all, centre, angle);
+    let e_basic = level_extent(&g.basic, centre, angle);
+    let cut = detect_cut_off(e_all, centre, angle, w, h, p.edge_margin_px);
+    let h_all = e_all[3] - e_all[1];
+    let h_basic = e_basic[3] - e_basic[1];
+    let height_px = if (h_all - h_basic) <= p.soft_side_tolerance * h_all {
+        h_basic
+    } else {
+        h_all
+    };
+    let mut distance = p.distance_multiplier / height_px.max(1.0) + p.distance_offset_cm;
+    let mut from_ir = false;
+    if let Some(ir) = ctx
+        .ir_distance_cm
+        .filter(|d| d.is_finite() && *d > 0.0 && *d < p.ir_max_cm)
+        && distance < p.ir_max_cm * 1.5
+    {
+        distance = ir;
+        from_ir = true;
+    }
+    let mut mid = rotate_about(
+        ((e_all[0] + e_all[2]) / 2.0, (e_all[1] + e_all[3]) / 2.0),
+        centre,
+        -angle,
+    );
+    if p.skew_correction {
+        mid = ctx.unskew(mid, false);
+    }
+    let camera = ctx.camera_relative(mid, distance);
+    let body = ctx.body_relative(mid, distance);
+    let mut confidence = Confidence::default();
+    confidence.range_test(
+        "pixels",
+        f64::from(g.all.pixels),
+        [f64::from(p.min_candidate_pixels), f64::INFINITY],
+        TestWeight::new(p.size_bonus, 1.0),
+    );
+    let area = f64::from(g.all.maxx - g.all.minx + 1) * f64::from(g.all.maxy - g.all.miny + 1);
+    let fills = area >= p.fills_image_fraction * w * h;
+    confidence.range_test(
+        "pixel_ratio",
+        f64::from(g.all.pixels) / area,
+        p.pixel_ratio,
+        p.pixel_ratio_weight,
+    );
+    if fills {
+        confidence.skipped("green_below", p.green_below);
+        confidence.skipped("bottom_height_cm", p.bottom_height_cm);
+        confidence.skipped("elevation_rad", p.elevation_rad);
+    } else {
+        let bottom_mid = rotate_about(((e_all[0] + e_all[2]) / 2.0, e_all[3]), centre, -angle);
+        let half_w = (e_all[2] - e_all[0]) / 2.0;
+        let band = (height_px * 0.3).max(2.0);
+        let below = scan_rotated_rect(
+            img,
+            bottom_mid,
+            [-half_w, half_w, 1.0, 1.0 + band],
+            -angle,
+            (band / 4.0).max(1.0),
+        );
+        match below.ratio(|c| c == ColourClass::Green.code() || c == ColourClass::White.code()) {
+            Some(r) => confidence.range_test(
+                "green_below",
+                r,
+                p.green_below,
+                TestWeight::new(p.green_below_bonus, p.green_below_penalty),
+            ),
+            None => confidence.skipped("green_below", p.green_below),
+        }
+        if cut.bottom {
+            confidence.skipped("bottom_height_cm", p.bottom_height_cm);
+        } else {
+            match ctx.height_above_ground(bottom_mid, distance) {
+                Some(z) => confidence.range_test(
+                    "bottom_height_cm",
+                    z,
+                    p.bottom_height_cm,
+                    p.bottom_height_weight,
+                ),
+                None => confidence.skipped("bottom_height_cm", p.bottom_height_cm),
+            }
+        }
+        let foot = ctx.distance_to_plane(bottom_mid, 0.0);
+        match foot {
+            Some(f) if !cut.bottom && !cut.top && f > 0.0 => confidence.range_test(
+                "distance_agreement",
+                distance / f,
+                p.distance_agreement,
+                p.distance_agreement_weight,
+            ),
+            _ => confidence.skipped("distance_agreement", p.distance_agreement),
+        }
+        match &body {
+            Some(b) => confidence.range_test(
+                "elevation_rad",
+                b.elevation_rad,
+                p.elevation_rad,
+                p.elevation_weight,
+            ),
+            None => confidence.skipped("elevation_rad", p.elevation_rad),
+        }
+    }
+    GoalCandidate {
+        colour,
+        bounds: [g.all.minx, g.all.miny, g.all.maxx, g.all.maxy],
+        pixels: g.all.pixels,
+        basic_bounds: [g.basic.minx, g.basic.miny, g.basic.maxx, g.basic.maxy],
+        blobs: g.members.clone(),
+        cut_off: cut,
+        height_px,
+        camera,
+        body,
+        distance_is_max: !from_ir && (cut.top || cut.bottom),
+        distance_from_ir: from_ir,
+        confidence,
+        posts: Vec::new(),
+        rejected_posts: Vec::new(),
+        post_points: Vec::new(),
+        gap: None,
+        gap_scan: None,
+        accepted: false,
+    }
+}
+
+/// Scans from outside a level x position inward along a level row until a goal-coloured pixel;
+/// returns the level x of the boundary.
+fn scan_level_row(
+    img: &ClassifiedImage,
+    is_goal: &impl Fn(u8) -> bool,
+    y: f64,
+    from: f64,
+    to: f64,
+    centre: Point,
+    angle: f64,
+) -> Option<f64> {
+    let dir = if to >= from { 1.0 } else { -1.0 };
+    let steps = (to - from).abs().ceil() as usize;
+    for k in 0..=steps {
+        let x = from + dir * k as f64;
+        let q = rotate_about((x, y), centre, -angle);
+        if let Some(code) = img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
+            && is_goal(code)
+        {
+            return Some(if dir > 0.0 { x } else { x + 1.0 });
+        }
+    }
+    None
+}
+
+fn find_posts_and_gap(
+    img: &ClassifiedImage,
+    cand: &mut GoalCandidate,
+    colour: ColourClass,
+    ctx: &ViewContext,
+    p: &GoalParams,
+) {
+    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let angle = ctx.horizon_angle();
+    let b = Blob {
+        colour: colour.code(),
+        number: 0,
+        minx: cand.bounds[0],
+        miny: cand.bounds[1],
+        maxx: cand.bounds[2],
+        maxy: cand.bounds[3],
+        pixels: cand.pixels,
+        sum_x: 0,
+        sum_y: 0,
+    };
+    let e = level_extent(&b, centre, angle);
+    let is_goal = is_goal_colour(colour);
+    let distance = cand.camera.distance_cm;
+    let height = e[3] - e[1];
+    let n = p.post_scans.max(3);
+    for (side, cut, from, to) in [
+        (
+            PostSide::Left,
+            cand.cut_off.left,
+            e[0] - 3.0,
+            (e[0] + e[2]) / 2.0,
+        ),
+        (
+            PostSide::Right,
+            cand.cut_off.right,
+            e[2] + 3.0,
+            (e[0] + e[2]) / 2.0,
+        ),
+    ] {
+        if cut {
+            continue;
+        }
+        let mut level_pts = Vec::new();
+        for k in 0..n {
+            // Inner 80% of the height: the ends are rounded by blur and shading.
+            let y = e[1] + height * (0.1 + 0.8 * (k as f64 + 0.5) / n as f64);
+            if let Some(x) = scan_level_row(img, &is_goal, y, from, to, centre, angle) {
+                level_pts.push((x, y));
+            }
+        }
+        let image_pts: Vec<Point> = level_pts
+            .iter()
+            .map(|q| rotate_about(*q, centre, -angle))
+            .collect();
+        cand.post_points.extend(&image_pts);
+        let Some(fit) = fit_line(&image_pts) else {
+            cand.rejected_posts
+                .push(format!("{side:?}: {} points, no line", image_pts.len()));
+            continue;
+        };
+        let straight = fit.residual_variance <= p.post_max_residual_variance;
+        if !(straight && (fit.r_squared >= p.post_min_r_squared || fit.steep))
+            || image_pts.len() < 3
+        {
+            cand.rejected_posts.push(format!(
+                "{side:?}: r² {:.2}, s² {:.2} px² from {} points",
+                fit.r_squared,
+                fit.residual_variance,
+                image_pts.len()
+            ));
+            continue;
+        }
+        let top_level = rotate_about(image_pts[0], centre, angle);
+        let top = if fit.steep {
+            fit.at(rotate_about((top_level.0, e[1]), centre, -angle).1)
+        } else {
+            image_pts[0]
+        };
+        let bottom = if fit.steep {
+            fit.at(rotate_about((top_level.0, e[3]), centre, -angle).1)
+        } else {
+            image_pts[image_pts.len() - 1]
+        };
+        let mid = ((top.0 + bottom.0) / 2.0, (top.1 + bottom.1) / 2.0);
+        cand.posts.push(Post {
+            side,
+            top,
+            bottom,
+            fit,
+            camera: ctx.camera_relative(mid, distance),
+            body: ctx.body_relative(mid, distance),
+        });
+    }
+    // Gap scan: a level row at the shoulder height above the goal's bottom.
+    let y = e[3] - height * (p.gap_scan_height_cm / p.height_cm).clamp(0.0, 1.0);
+    let (x0, x1) = (e[0].floor(), e[2].ceil());
+    let mut best: Option<(f64, f64)> = None;
+    let mut run_start: Option<f64> = None;
+    let mut last_goal = f64::NEG_INFINITY;
+    let mut x = x0;
+    while x <= x1 {
+        let q = rotate_about((x + 0.5, y), centre, -angle);
+        let goal = img
+            .get_signed(q.0.floor() as i64, q.1.floor() as i64)
+            .is_some_and(&is_goal);
+        if goal {
+            if run_start.is_none() || x - last_goal > f64::from(p.gap_hole_px) + 1.0 {
+                run_start = Some(x);
+            }
+            last_goal = x;
+            if let Some(s) = run_start
+                && best.is_none_or(|(a, b)| last_goal + 1.0 - s > b - a)
+            {
+                best = Some((s, last_goal + 1.0));
+            }
+        }
+        x += 1.0;
+    }
+    cand.gap_scan = Some((
+        rotate_about((e[0], y), centre, -angle),
+        rotate_about((e[2], y), centre, -angle),
+    ));
+    if let Some((a, b)) = best {
+        let mut left = rotate_about((a, y), centre, -angle);
+        let mut right = rotate_about((b, y), centre, -angle);
+        if p.skew_correction {
+            left = ctx.unskew(left, false);
+            right = ctx.unskew(right, false);
+        }
+        let mid = ((left.0 + right.0) / 2.0, (left.1 + right.1) / 2.0);
+        cand.gap = Some(Gap {
+            left,
+            right,
+            width_px: b - a,
+            camera: ctx.camera_relative(mid, distance),
+            left_bearing_rad: ctx.camera_angles(left).0,
+            right_bearing_rad: ctx.camera_angles(right).0,
+        });
+    }
+}
+
+impl GoalResult {
+    /// Drawing primitives: candidate boxes, post points and lines, the gap and its scan, labels.
+    #[must_use]
+    pub fn primitives(&self) -> Vec<Primitive> {
+        let mut out = Vec::new();
+        for (i, c) in self.candidates.iter().enumerate() {
+            let owner = format!("goal:{}#{i}", c.colour.name());
+            out.push(Primitive::Box {
+                owner: owner.clone(),
+                colour: c.colour.code(),
+                bounds: c.bounds,
+            });
+            if !c.post_points.is_empty() {
+                out.push(Primitive::ScanPoints {
+                    owner: owner.clone(),
+                    points: c.post_points.clone(),
+                });
+            }
+            for post in &c.posts {
+                out.push(Primitive::Line {
+                    owner: owner.clone(),
+                    role: LineRole::Post,
+                    from: post.top,
+                    to: post.bottom,
+                });
+            }
+            if let Some((a, b)) = c.gap_scan {
+                out.push(Primitive::Line {
+                    owner: owner.clone(),
+                    role: LineRole::Scan,
+                    from: a,
+                    to: b,
+                });
+            }
+            if let Some(gap) = &c.gap {
+                out.push(Primitive::Line {
+                    owner: owner.clone(),
+                    role: LineRole::Gap,
+                    from: gap.left,
+                    to: gap.right,
+                });
+            }
+            if c.accepted {
+                out.push(Primitive::Label {
+                    owner,
+                    at: (f64::from(c.bounds[0]), f64::from(c.bounds[1]) - 2.0),
+                    text: format!(
+                        "{} goal {}{:.0} cm {:+.0}°",
+                        c.colour.name(),
+                        if c.distance_is_max { "≤" } else { "" },
+                        c.camera.distance_cm,
+                        c.camera.bearing_rad.to_degrees()
+                    ),
+                });
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::blobs::Connectivity;
+    use crate::geometry::{Ers7Dimensions, PinholeCamera};
+    use crate::sensors::SensorReadings;
+
+    fn ctx() -> ViewContext {
+        let readings = SensorReadings {
+            head_pan_rad: Some(0.0),
+            head_tilt_rad: Some(-0.1),
+            neck_tilt_rad: Some(0.0),
+            ..SensorReadings::default()
+        };
+        ViewContext::from_sensors(PinholeCamera::ers7(), &readings, &Ers7Dimensions::ERS7)
+    }
+
+    /// Green below row `bottom`, white above; a goal box of `colour` from x0..x1 and y0..bottom;
+    /// a red goalkeeper box covering `keeper` columns from y `keeper_top` to the bottom.
+    fn scene(
+        x0: usize,
+        x1: usize,
+        y0: usize,
+        bottom: usize,
+        keeper: Option<(usize, usize, usize)>,
+    ) -> ClassifiedImage {
+        let (w, h) = (208, 160);
+        let mut codes = vec![ColourClass::White.code(); w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let c = &mut codes[y * w + x];
+                if y >= bottom {
+                    *c = ColourClass::Green.code();
+                } else if (x0..x1).contains(&x) && y >= y0 {
+                    *c = ColourClass::Yellow.code();
+                }
+                if let Some((k0, k1, top)) = keeper
+                    && (k0..k1).contains(&x)
+                    && y >= top
+                    && y < bottom + 4
+                {
+                    *c = ColourClass::Red.code();
+                }
+            }
+        }
+        ClassifiedImage::from_codes(w, h, codes).expect("size")
+    }
+
+    #[test]
+    fn a_goal_split_by_a_keeper_is_one_goal_with_posts_and_the_larger_gap() {
+        let ctx = ctx();
+        // Put the goal's bottom where the ground 230 cm ahead appears, its top 25 px higher.
+        let pose = ctx.pose.expect("pose");
+        let foot = pose
+            .image_from_field(&crate::geometry::Point::new(191.9 * 30.0 / 25.0, 0.0, 0.0))
+            .expect("in view");
+        let bottom = foot.y_px.round() as usize;
+        let img = scene(40, 150, bottom - 25, bottom, Some((70, 90, bottom - 35)));
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default(), &[]);
+        let goals: Vec<_> = res.goals().collect();
+        assert_eq!(goals.len(), 1, "{:#?}", res.candidates);
+        let g = goals[0];
+        assert_eq!(g.colour, ColourClass::Yellow);
+        assert_eq!(g.blobs.len(), 2, "keeper split merged");
+        assert!(!g.cut_off.any() && !g.distance_is_max);
+        // Distance from height: 25 px → 191.9·30/25 ≈ 230 cm.
+        assert!(
+            (g.camera.distance_cm - 191.9 * 30.0 / 25.0).abs() < 10.0,
+            "{}",
+            g.camera.distance_cm
+        );
+        assert_eq!(g.posts.len(), 2, "{:?}", g.rejected_posts);
+        let left = g
+            .posts
+            .iter()
+            .find(|p| p.side == PostSide::Left)
+            .expect("left");
+        assert!((left.top.0 - 40.0).abs() < 1.0 && (left.bottom.0 - 40.0).abs() < 1.0);
+        let right = g
+            .posts
+            .iter()
+            .find(|p| p.side == PostSide::Right)
+            .expect("right");
+        assert!((right.top.0 - 150.0).abs() < 1.0);
+        let gap = g.gap.as_ref().expect("gap");
+        assert!(
+            (gap.left.0 - 90.0).abs() < 1.5 && (gap.right.0 - 150.0).abs() < 1.5,
+            "{gap:?}"
+        );
+        assert!(gap.left_bearing_rad > gap.right_bearing_rad);
+        assert!(!res.primitives().is_empty());
+    }
+
+    #[test]
+    fn a_goal_at_the_image_edge_is_cut_off_and_its_distance_a_maximum() {
+        let ctx = ctx();
+        let img = scene(0, 60, 0, 90, None);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default(), &[]);
+        let g = res.goals().next().expect("goal");
+        assert!(g.cut_off.left && g.cut_off.top && !g.cut_off.right && !g.cut_off.bottom);
+        assert!(g.distance_is_max);
+        assert_eq!(g.posts.len(), 1);
+        assert_eq!(g.posts[0].side, PostSide::Right);
+    }
+
+    #[test]
+    fn cut_off_uses_two_of_three_points_per_side() {
+        let c = detect_cut_off(
+            [10.0, 10.0, 50.0, 50.0],
+            (104.0, 80.0),
+            0.0,
+            208.0,
+            160.0,
+            1.5,
+        );
+        assert!(!c.any());
+        let c = detect_cut_off(
+            [-5.0, 10.0, 50.0, 159.5],
+            (104.0, 80.0),
+            0.0,
+            208.0,
+            160.0,
+            1.5,
+        );
+        assert!(c.left && c.bottom && !c.top && !c.right);
+    }
+
+    #[test]
+    fn no_goal_colour_no_candidates() {
+        let img = scene(0, 0, 0, 90, None);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_goals(&img, &blobs, &ctx(), &GoalParams::default(), &[]);
+        assert!(res.candidates.is_empty());
+    }
+}

@@ -1,0 +1,183 @@
+//! Object recognition on a classified frame and its blobs: the ball, goals with posts and the
+//! open gap, beacons and the horizon. Every candidate carries a [`confidence::Confidence`]
+//! breakdown, and every scan is kept as drawing data ([`draw::Primitive`]), so the app, `eotn
+//! render` and the JSON show why an object was or was not recognised.
+//!
+//! | module | role |
+//! |---|---|
+//! | [`context`] | the frame's camera: intrinsics, pose from the joints, horizon, shutter skew |
+//! | [`confidence`] | named tests adding to or subtracting from a candidate's confidence |
+//! | [`fit`] | circle and line fits, rotation about a centre |
+//! | [`scan`] | horizon-parallel scan areas, the six edge-scan patterns, skew removal |
+//! | [`ball`], [`goals`], [`beacons`] | the recognisers |
+//! | [`patterns`] | the "almost SLAM" coloured-pattern recogniser (learn, then identify) |
+//! | [`draw`] | drawing primitives as data |
+
+pub mod ball;
+pub mod beacons;
+pub mod confidence;
+pub mod context;
+pub mod draw;
+pub mod fit;
+pub mod goals;
+pub mod patterns;
+pub mod scan;
+
+use serde::{Deserialize, Serialize};
+
+use crate::blobs::BlobSet;
+use crate::classify::ClassifiedImage;
+use crate::geometry::{Ers7Dimensions, Horizon, PinholeCamera};
+use crate::sensors::SensorReadings;
+pub use ball::{Ball, BallParams, BallResult};
+pub use beacons::{Beacon, BeaconParams};
+pub use context::{Relative, ViewContext};
+pub use draw::{LineRole, Primitive};
+pub use goals::{GoalCandidate, GoalParams, GoalResult};
+
+/// Settings of every recogniser, and the camera to assume for frames that are not the ERS-7's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RecognitionParams {
+    /// Ball recognition.
+    pub ball: BallParams,
+    /// Goal recognition.
+    pub goals: GoalParams,
+    /// Beacon recognition.
+    pub beacons: BeaconParams,
+    /// Coloured-pattern signatures.
+    pub patterns: patterns::PatternParams,
+    /// Horizontal field of view (degrees) for frames other than 208×160 (which are the ERS-7's
+    /// 56.9°). 46.4° is the Nao's camera.
+    pub other_camera_fov_deg: f64,
+    /// Lengths of the head chain used to place the camera from the joints.
+    pub body: Ers7Dimensions,
+}
+
+impl Default for RecognitionParams {
+    fn default() -> Self {
+        Self {
+            ball: BallParams::default(),
+            goals: GoalParams::default(),
+            beacons: BeaconParams::default(),
+            patterns: patterns::PatternParams::default(),
+            other_camera_fov_deg: 46.4,
+            body: Ers7Dimensions::ERS7,
+        }
+    }
+}
+
+impl RecognitionParams {
+    /// The camera for a frame of this size: the ERS-7's for 208×160, else a pinhole with
+    /// [`Self::other_camera_fov_deg`].
+    #[must_use]
+    pub fn camera_for(&self, width: usize, height: usize) -> PinholeCamera {
+        if (width, height) == (208, 160) {
+            PinholeCamera::ers7()
+        } else {
+            PinholeCamera::from_horizontal_fov(
+                width,
+                height,
+                self.other_camera_fov_deg.to_radians(),
+            )
+        }
+    }
+
+    /// The view context of a frame of this size with these readings (none: no pose). The body
+    /// model is the ERS-7's, so only 208×160 frames get a camera pose from the joints; frames of
+    /// other robots (the Nao's 320×240) get camera-relative recognition without heights or
+    /// horizon, but keep their infra-red and shutter-skew readings.
+    #[must_use]
+    pub fn context_for(
+        &self,
+        width: usize,
+        height: usize,
+        sensors: Option<&SensorReadings>,
+    ) -> ViewContext {
+        let camera = self.camera_for(width, height);
+        match sensors {
+            Some(s) if (width, height) == (208, 160) => {
+                ViewContext::from_sensors(camera, s, &self.body)
+            }
+            Some(s) => {
+                let mut ctx = ViewContext::from_sensors(camera, s, &self.body);
+                ctx.pose = None;
+                ctx.body_from_camera = None;
+                ctx.horizon = None;
+                ctx
+            }
+            None => ViewContext::without_pose(camera),
+        }
+    }
+}
+
+/// Everything recognised in one frame.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Recognition {
+    /// The ball and every ball candidate.
+    pub ball: BallResult,
+    /// Goal candidates; accepted ones are goals.
+    pub goals: GoalResult,
+    /// Beacon candidates; accepted ones are beacons.
+    pub beacons: Vec<Beacon>,
+    /// Signatures around pink markers, with their identification when a pattern memory was
+    /// given.
+    pub patterns: Vec<(patterns::PatternObservation, Option<patterns::PatternMatch>)>,
+    /// The horizon, when the camera pose was known.
+    pub horizon: Option<Horizon>,
+}
+
+/// Runs every recogniser on a classified frame; `memory` (learnt coloured patterns), when
+/// given, identifies the pink markers' signatures.
+#[must_use]
+pub fn recognise(
+    img: &ClassifiedImage,
+    blobs: &BlobSet,
+    ctx: &ViewContext,
+    params: &RecognitionParams,
+    memory: Option<&patterns::PatternMemory>,
+) -> Recognition {
+    let observations = patterns::observe(img, blobs, ctx.camera.focal_px, &params.patterns);
+    let beacons = beacons::recognise_beacons(blobs, ctx, &params.beacons);
+    let beacon_boxes: Vec<[u32; 4]> = beacons
+        .iter()
+        .filter(|b| b.accepted)
+        .map(|b| b.bounds)
+        .collect();
+    Recognition {
+        ball: ball::recognise_ball(img, blobs, ctx, &params.ball),
+        goals: goals::recognise_goals(img, blobs, ctx, &params.goals, &beacon_boxes),
+        beacons,
+        patterns: observations
+            .into_iter()
+            .map(|o| {
+                let m = memory.and_then(|m| m.identify(&o, &params.patterns));
+                (o, m)
+            })
+            .collect(),
+        horizon: ctx.horizon,
+    }
+}
+
+impl Recognition {
+    /// Every drawing primitive: horizon, ball, goals, beacons.
+    #[must_use]
+    pub fn primitives(&self, width: usize, height: usize) -> Vec<Primitive> {
+        let mut out = Vec::new();
+        if let Some((a, b)) = self
+            .horizon
+            .and_then(|h| h.clip_to_image(width as f64, height as f64))
+        {
+            out.push(Primitive::Line {
+                owner: "horizon".to_owned(),
+                role: LineRole::Horizon,
+                from: (a.x_px, a.y_px),
+                to: (b.x_px, b.y_px),
+            });
+        }
+        out.extend(self.ball.primitives());
+        out.extend(self.goals.primitives());
+        out.extend(beacons::beacon_primitives(&self.beacons));
+        out
+    }
+}

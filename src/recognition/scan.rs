@@ -1,0 +1,332 @@
+//! Scans over the classified image: areas rotated by the horizon angle ("parallel to the
+//! ground"), and the edge scans that collect points on a ball's outline for the circle fit.
+//! All coordinates are image pixels (FORMATS.md: x right, y down, pixel centres at +0.5).
+
+use serde::{Deserialize, Serialize};
+
+use super::fit::{Point, rotate_about};
+use crate::classify::ClassifiedImage;
+
+/// A scanned quadrilateral, kept for drawing (corners in image pixels, in order).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ScanArea {
+    /// The four corners, clockwise on screen.
+    pub corners: [Point; 4],
+}
+
+/// What a scan area found: how many in-image pixels were looked at, and how many of each class.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScanCount {
+    /// Where the scan looked.
+    pub area: ScanArea,
+    /// Sample points that fell inside the image.
+    pub scanned: u32,
+    /// Samples per class code (index = code, 0..16).
+    pub per_class: [u32; 16],
+}
+
+impl ScanCount {
+    /// Fraction of scanned samples whose class satisfies `wanted`; `None` when nothing inside the
+    /// image was scanned (the area lay wholly outside it).
+    #[must_use]
+    pub fn ratio(&self, wanted: impl Fn(u8) -> bool) -> Option<f64> {
+        if self.scanned == 0 {
+            return None;
+        }
+        let hits: u32 = (0u8..16)
+            .filter(|&c| wanted(c))
+            .map(|c| self.per_class[usize::from(c)])
+            .sum();
+        Some(f64::from(hits) / f64::from(self.scanned))
+    }
+}
+
+/// Samples a rectangle given in "horizon" coordinates about `centre`: x from `left` to `right`
+/// and y from `top` to `bottom` (pixels, relative to `centre`, y down), rotated by `angle`
+/// (the horizon's angle, radians) about `centre`, one sample per `step` pixels. Counts only
+/// samples that land inside the image.
+#[must_use]
+pub fn scan_rotated_rect(
+    img: &ClassifiedImage,
+    centre: Point,
+    [left, right, top, bottom]: [f64; 4],
+    angle: f64,
+    step: f64,
+) -> ScanCount {
+    let step = if step.is_finite() && step > 0.05 {
+        step
+    } else {
+        1.0
+    };
+    let corner = |x: f64, y: f64| rotate_about((centre.0 + x, centre.1 + y), centre, angle);
+    let area = ScanArea {
+        corners: [
+            corner(left, top),
+            corner(right, top),
+            corner(right, bottom),
+            corner(left, bottom),
+        ],
+    };
+    let mut count = ScanCount {
+        area,
+        scanned: 0,
+        per_class: [0; 16],
+    };
+    if !(left.is_finite() && right.is_finite() && top.is_finite() && bottom.is_finite()) {
+        return count;
+    }
+    let nx = (((right - left) / step).floor().max(0.0) as usize).min(4096);
+    let ny = (((bottom - top) / step).floor().max(0.0) as usize).min(4096);
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let p = corner(left + i as f64 * step, top + j as f64 * step);
+            if let Some(code) = img.get_signed(p.0.floor() as i64, p.1.floor() as i64) {
+                count.scanned += 1;
+                count.per_class[usize::from(code & 15)] += 1;
+            }
+        }
+    }
+    count
+}
+
+/// The six ways of scanning a ball's outline, chosen by which sides are cut off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EdgeScanPattern {
+    /// Each row from the left, stopping at the first ball pixel (right side cut off).
+    LeftToRight,
+    /// Each row from the right (left side cut off).
+    RightToLeft,
+    /// Each row from both sides towards the centre (both sides visible).
+    SidesToCentre,
+    /// Each column from the top (bottom cut off, both sides too).
+    TopToBottom,
+    /// Each column from the bottom (top cut off, both sides too).
+    BottomToTop,
+    /// Each column from top and bottom towards the centre.
+    TopBottomToCentre,
+}
+
+/// Which sides of an object are cut off by the image edge or hidden by something in front.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct CutOff {
+    /// Left side not visible.
+    pub left: bool,
+    /// Right side not visible.
+    pub right: bool,
+    /// Top not visible.
+    pub top: bool,
+    /// Bottom not visible.
+    pub bottom: bool,
+}
+
+impl CutOff {
+    /// True when any side is cut off.
+    #[must_use]
+    pub fn any(&self) -> bool {
+        self.left || self.right || self.top || self.bottom
+    }
+}
+
+impl EdgeScanPattern {
+    /// The pattern that only scans from sides that are visible.
+    #[must_use]
+    pub fn for_cut_off(cut: CutOff) -> Self {
+        match (cut.left, cut.right) {
+            (true, true) => match (cut.top, cut.bottom) {
+                (true, false) => Self::BottomToTop,
+                (false, true) => Self::TopToBottom,
+                _ => Self::TopBottomToCentre,
+            },
+            (true, false) => Self::RightToLeft,
+            (false, true) => Self::LeftToRight,
+            (false, false) => Self::SidesToCentre,
+        }
+    }
+}
+
+/// Collects outline points of the object in the box `[minx, miny, maxx, maxy]` (inclusive
+/// pixels) by scanning each row or column from `margin` pixels outside the box inward until a
+/// pixel whose class satisfies `is_object`. Each point lies on the pixel boundary where the
+/// object starts (e.g. `x` = left edge of the first object pixel), at the row's or column's
+/// centre. A scan that starts on an object pixel already (the object touches something of its
+/// own colour) gives no point.
+#[must_use]
+pub fn edge_points(
+    img: &ClassifiedImage,
+    [minx, miny, maxx, maxy]: [u32; 4],
+    pattern: EdgeScanPattern,
+    margin: u32,
+    is_object: impl Fn(u8) -> bool,
+) -> Vec<Point> {
+    let (w, h) = (img.width() as i64, img.height() as i64);
+    let (minx, miny, maxx, maxy) = (
+        i64::from(minx),
+        i64::from(miny),
+        i64::from(maxx),
+        i64::from(maxy),
+    );
+    let margin = i64::from(margin);
+    let mut points = Vec::new();
+    let is_obj = |x: i64, y: i64| img.get_signed(x, y).is_some_and(&is_object);
+    // Scans from `start` by `dir` until an object pixel; returns the boundary coordinate.
+    let scan = |fixed: i64, start: i64, end: i64, dir: i64, horizontal: bool| -> Option<f64> {
+        let start = if horizontal {
+            start.clamp(0, w - 1)
+        } else {
+            start.clamp(0, h - 1)
+        };
+        let first = if horizontal {
+            is_obj(start, fixed)
+        } else {
+            is_obj(fixed, start)
+        };
+        if first {
+            return None;
+        }
+        let mut t = start;
+        while (dir > 0 && t <= end) || (dir < 0 && t >= end) {
+            let hit = if horizontal {
+                is_obj(t, fixed)
+            } else {
+                is_obj(fixed, t)
+            };
+            if hit {
+                return Some(if dir > 0 { t as f64 } else { t as f64 + 1.0 });
+            }
+            t += dir;
+        }
+        None
+    };
+    use EdgeScanPattern as P;
+    let rows = matches!(pattern, P::LeftToRight | P::RightToLeft | P::SidesToCentre);
+    if rows {
+        for y in miny.max(0)..=maxy.min(h - 1) {
+            let yc = y as f64 + 0.5;
+            if matches!(pattern, P::LeftToRight | P::SidesToCentre)
+                && let Some(x) = scan(y, minx - margin, maxx, 1, true)
+            {
+                points.push((x, yc));
+            }
+            if matches!(pattern, P::RightToLeft | P::SidesToCentre)
+                && let Some(x) = scan(y, maxx + margin, minx, -1, true)
+            {
+                points.push((x, yc));
+            }
+        }
+    } else {
+        for x in minx.max(0)..=maxx.min(w - 1) {
+            let xc = x as f64 + 0.5;
+            if matches!(pattern, P::TopToBottom | P::TopBottomToCentre)
+                && let Some(y) = scan(x, miny - margin, maxy, 1, false)
+            {
+                points.push((xc, y));
+            }
+            if matches!(pattern, P::BottomToTop | P::TopBottomToCentre)
+                && let Some(y) = scan(x, maxy + margin, miny, -1, false)
+            {
+                points.push((xc, y));
+            }
+        }
+    }
+    // Points on the image border are where the object is cut, not its outline.
+    points.retain(|p| p.0 > 0.0 && p.0 < w as f64 && p.1 > 0.0 && p.1 < h as f64);
+    points
+}
+
+/// Removes a rolling shutter's horizontal shear: row `y` was read `y − reference_row` lines after
+/// the reference row, so its content moved by `skew_per_line` pixels per line; shift it back.
+pub fn unskew_points(points: &mut [Point], skew_per_line: f64, reference_row: f64) {
+    if !skew_per_line.is_finite() || !reference_row.is_finite() {
+        return;
+    }
+    for p in points {
+        p.0 -= skew_per_line * (p.1 - reference_row);
+    }
+}
+
+/// Removes the vertical counterpart (tilt during read-out): each row moved `skew_per_line` pixels
+/// vertically per line read.
+pub fn unskew_points_vertical(points: &mut [Point], skew_per_line: f64, reference_row: f64) {
+    if !skew_per_line.is_finite() || !reference_row.is_finite() {
+        return;
+    }
+    for p in points {
+        p.1 -= skew_per_line * (p.1 - reference_row);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recognition::fit::fit_circle;
+
+    fn disc(w: usize, h: usize, cx: f64, cy: f64, r: f64, code: u8) -> ClassifiedImage {
+        let mut codes = vec![5u8; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+                if dx * dx + dy * dy <= r * r {
+                    codes[y * w + x] = code;
+                }
+            }
+        }
+        ClassifiedImage::from_codes(w, h, codes).expect("size")
+    }
+
+    #[test]
+    fn edge_scans_fit_the_disc_in_every_pattern() {
+        let img = disc(80, 60, 40.0, 30.0, 12.0, 1);
+        let bbox = [28, 18, 51, 41];
+        for pattern in [
+            EdgeScanPattern::LeftToRight,
+            EdgeScanPattern::RightToLeft,
+            EdgeScanPattern::SidesToCentre,
+            EdgeScanPattern::TopToBottom,
+            EdgeScanPattern::BottomToTop,
+            EdgeScanPattern::TopBottomToCentre,
+        ] {
+            let pts = edge_points(&img, bbox, pattern, 3, |c| c == 1);
+            let fit = fit_circle(&pts).expect("fit");
+            assert!((fit.center_x - 40.0).abs() < 0.8, "{pattern:?} {fit:?}");
+            assert!((fit.center_y - 30.0).abs() < 0.8, "{pattern:?} {fit:?}");
+            assert!((fit.radius - 12.0).abs() < 0.8, "{pattern:?} {fit:?}");
+        }
+    }
+
+    #[test]
+    fn cut_off_disc_keeps_its_true_circle() {
+        // Centre left of the image: only the right part is visible; scanning from the right.
+        let img = disc(80, 60, 4.0, 30.0, 15.0, 1);
+        let cut = CutOff {
+            left: true,
+            ..CutOff::default()
+        };
+        let pattern = EdgeScanPattern::for_cut_off(cut);
+        assert_eq!(pattern, EdgeScanPattern::RightToLeft);
+        let pts = edge_points(&img, [0, 15, 18, 44], pattern, 3, |c| c == 1);
+        let fit = fit_circle(&pts).expect("fit");
+        assert!((fit.radius - 15.0).abs() < 1.0, "{fit:?}");
+        assert!((fit.center_x - 4.0).abs() < 1.0, "{fit:?}");
+    }
+
+    #[test]
+    fn rotated_scan_counts_only_inside_pixels() {
+        let img = disc(40, 40, 20.0, 20.0, 5.0, 1);
+        let below = scan_rotated_rect(&img, (20.0, 20.0), [-5.0, 5.0, 8.0, 12.0], 0.3, 1.0);
+        assert!(below.scanned > 0);
+        assert_eq!(below.ratio(|c| c == 5), Some(1.0));
+        let outside = scan_rotated_rect(&img, (20.0, 20.0), [-5.0, 5.0, 100.0, 120.0], 0.0, 1.0);
+        assert_eq!(outside.scanned, 0);
+        assert_eq!(outside.ratio(|c| c == 5), None);
+    }
+
+    #[test]
+    fn unskewing_straightens_a_sheared_column() {
+        let mut pts: Vec<Point> = (0..10)
+            .map(|y| (10.0 + 0.5 * f64::from(y), f64::from(y)))
+            .collect();
+        unskew_points(&mut pts, 0.5, 0.0);
+        assert!(pts.iter().all(|p| (p.0 - 10.0).abs() < 1e-12));
+    }
+}

@@ -1,0 +1,354 @@
+//! Recognition on the renderer's scenarios, measured against their ground truth with the same
+//! evaluation `eotn eval` prints. The table is learnt from labelled frames of other seeds (as
+//! `eotn lut-from-labels` does), so the test frames are held back.
+
+use eotn::eval::{EvalParams, EvalReport, FrameEval, evaluate_frame};
+use eotn::lut::LookupTable;
+use eotn::lut::learn::{LearnParams, TableBuilder};
+use eotn::pipeline::{Pipeline, PipelineParams};
+use eotn::sim::truth::GroundTruth;
+use eotn::sim::{Scenario, ScenarioKind, Simulator};
+
+const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
+    ScenarioKind::WalkAndPan,
+    ScenarioKind::BallEdge,
+    ScenarioKind::Goalkeeper,
+    ScenarioKind::FastPans,
+    ScenarioKind::OrangeClutter,
+    ScenarioKind::BeaconTour,
+];
+
+/// A table learnt from every 10th frame of each robot scenario with seed 100.
+fn learnt_table() -> LookupTable {
+    let mut builder = TableBuilder::new(7).expect("7 bits");
+    for kind in ROBOT_SCENARIOS {
+        let sim = Simulator::new(Scenario::new(kind, 100));
+        for i in (0..90).step_by(10) {
+            let f = sim.frame(i).expect("frame");
+            builder.add_frame(&f.frame, &f.labels).expect("labels fit");
+        }
+    }
+    builder.build(&LearnParams::default())
+}
+
+fn evaluate(
+    kind: ScenarioKind,
+    seed: u64,
+    frames: u64,
+    lut: &LookupTable,
+    params: PipelineParams,
+) -> EvalReport {
+    let sim = Simulator::new(Scenario::new(kind, seed));
+    let mut pipeline = Pipeline::new(lut.clone(), params);
+    let mut evals: Vec<FrameEval> = Vec::new();
+    for i in 0..frames {
+        let f = sim.frame(i).expect("frame");
+        let GroundTruth::Robot(truth) = &f.ground_truth else {
+            panic!("robot scenario gave an overhead frame");
+        };
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        let (w, h) = (f.frame.width() as f64, f.frame.height() as f64);
+        evals.push(evaluate_frame(
+            i as usize,
+            r.recognition,
+            truth,
+            w,
+            h,
+            &EvalParams::default(),
+        ));
+    }
+    let report = EvalReport::from_frames(&evals);
+    eprintln!(
+        "{}: {}",
+        kind.name(),
+        serde_json::to_string(&report).expect("json")
+    );
+    report
+}
+
+#[test]
+fn recognition_on_synthetic_scenarios() {
+    // The targets are: ball found in ≥ 98% of eligible frames, ≤ 0.5% false balls with
+    // off-field clutter, median distance error ≤ 4% (≤ 8% cut off), skew correction halving the
+    // radius error on fast pans, goals found in ≥ 97%, posts within 2 px, gaps within 3 px.
+    // The assertions hold what this code achieves today (see the README's recognition figures)
+    // so that a regression fails; where a figure is below its target the README says so.
+    let lut = learnt_table();
+    let params = PipelineParams::default();
+    let mut all = Vec::new();
+    for kind in ROBOT_SCENARIOS {
+        all.push((kind, evaluate(kind, 7, 90, &lut, params)));
+    }
+    let sum = |f: &dyn Fn(&EvalReport) -> usize| all.iter().map(|(_, r)| f(r)).sum::<usize>();
+    let report = |k: ScenarioKind| &all.iter().find(|(kind, _)| *kind == k).expect("scenario").1;
+    let eligible = sum(&|r| r.ball_eligible);
+    let found = sum(&|r| r.ball_found);
+    eprintln!("ball found {found}/{eligible}");
+    assert!(eligible > 100, "scenarios must show the ball");
+    assert!(
+        found as f64 >= 0.92 * eligible as f64,
+        "ball found {found}/{eligible}"
+    );
+    let clutter = report(ScenarioKind::OrangeClutter);
+    assert!(
+        clutter.ball_false <= 2,
+        "false balls in clutter frames {:?}",
+        clutter.ball_false_frames
+    );
+    for k in [
+        ScenarioKind::BallEdge,
+        ScenarioKind::FastPans,
+        ScenarioKind::WalkAndPan,
+    ] {
+        let r = report(k);
+        assert!(
+            r.ball_distance_error.p50 <= 0.065,
+            "{}: {:?}",
+            k.name(),
+            r.ball_distance_error
+        );
+    }
+    assert!(report(ScenarioKind::BallEdge).ball_distance_error_cut.p50 <= 0.08);
+    let goals_eligible = sum(&|r| r.goals_eligible);
+    let goals_found = sum(&|r| r.goals_found);
+    eprintln!("goals found {goals_found}/{goals_eligible}");
+    assert!(goals_found as f64 >= 0.9 * goals_eligible as f64);
+    let keeper = report(ScenarioKind::Goalkeeper);
+    assert!(
+        keeper.posts_within_2px.is_some_and(|f| f >= 0.9),
+        "{:?}",
+        keeper.post_error_px
+    );
+    assert!(
+        keeper.gaps_within_3px.is_some_and(|f| f >= 0.9),
+        "{:?}",
+        keeper.gap_error_px
+    );
+
+    // Skew correction on the fast pans: the radius error with it against without it.
+    let mut off = params;
+    off.recognition.ball.skew_correction = false;
+    let without = evaluate(ScenarioKind::FastPans, 7, 90, &lut, off);
+    let with = report(ScenarioKind::FastPans);
+    eprintln!(
+        "fast pans: radius error median {:.3} px with skew correction, {:.3} px without; found {} vs {}",
+        with.ball_radius_error_px.p50,
+        without.ball_radius_error_px.p50,
+        with.ball_found,
+        without.ball_found
+    );
+    assert!(
+        with.ball_found > without.ball_found,
+        "correction must find more balls on fast pans"
+    );
+}
+
+/// Prints what happened per frame: `EOTN_DEBUG_SCENARIO=fast-pans cargo test --test it
+/// debug_scenario -- --ignored --nocapture`.
+#[test]
+#[ignore = "a debugging aid, not a check"]
+fn debug_scenario() {
+    let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "walk-and-pan".into());
+    let kind = ScenarioKind::from_name(&name).expect("scenario name");
+    let lut = learnt_table();
+    let sim = Simulator::new(Scenario::new(kind, 7));
+    let mut pipeline = Pipeline::new(lut, PipelineParams::default());
+    for i in 0..90 {
+        let f = sim.frame(i).expect("frame");
+        let GroundTruth::Robot(truth) = &f.ground_truth else {
+            continue;
+        };
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        let tb = truth.ball.as_ref().filter(|b| b.visible_pixels > 0);
+        let db = r.recognition.ball.ball.as_ref();
+        eprintln!(
+            "#{i} pan {:?} prev {:?} | truth ball {:?} | found {:?} | cands {:?}",
+            f.sensors
+                .and_then(|s| s.head_pan_rad)
+                .map(|v| (v * 1000.0).round() / 1000.0),
+            f.sensors
+                .and_then(|s| s.previous_head_pan_rad)
+                .map(|v| (v * 1000.0).round() / 1000.0),
+            tb.map(|b| (
+                b.relative.image.map(|p| (p.x_px.round(), p.y_px.round())),
+                b.image_radius_px.map(|r| (r * 10.0).round() / 10.0),
+                b.relative.camera_distance_cm.round(),
+                b.visible_fraction
+            )),
+            db.map(|b| (
+                (b.center_x.round(), b.center_y.round()),
+                (b.radius_px * 10.0).round() / 10.0,
+                b.camera.distance_cm.round()
+            )),
+            r.recognition
+                .ball
+                .candidates
+                .iter()
+                .map(|c| (
+                    c.bounds,
+                    c.pixels,
+                    (c.confidence.total * 10.0).round() / 10.0,
+                    c.fit_rejected.clone()
+                ))
+                .collect::<Vec<_>>(),
+        );
+        for g in r.recognition.goals.candidates.iter().filter(|g| g.accepted) {
+            eprintln!(
+                "    tests {:?}",
+                g.confidence
+                    .tests
+                    .iter()
+                    .map(|t| (t.test.as_str(), (t.value * 100.0).round() / 100.0, t.effect))
+                    .collect::<Vec<_>>()
+            );
+            let t = truth
+                .goals
+                .iter()
+                .find(|t| eotn::eval::goal_class(t.colour) == g.colour);
+            eprintln!(
+                "    goal {:?} {:?} d {:.0} (truth {:?}) posts {:?} truth posts {:?}",
+                g.colour,
+                g.bounds,
+                g.camera.distance_cm,
+                t.map(|t| (t.relative.camera_distance_cm.round(), t.visible_pixels)),
+                g.posts
+                    .iter()
+                    .map(|p| (p.top, p.bottom))
+                    .collect::<Vec<_>>(),
+                t.map(|t| t
+                    .posts
+                    .iter()
+                    .map(|p| (p.image_top, p.image_base))
+                    .collect::<Vec<_>>())
+            );
+        }
+    }
+}
+
+/// Writes `frames` frames of a scenario to a stream with sensors and ground truth, as `eotn sim`
+/// does, and the learnt table beside it.
+fn write_scenario(
+    dir: &std::path::Path,
+    kind: ScenarioKind,
+    frames: u64,
+) -> (std::path::PathBuf, std::path::PathBuf) {
+    use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
+    let stream = dir.join(format!("{}.mcap", kind.name()));
+    let info = StreamInfo {
+        source: format!("sim:{}", kind.name()),
+        description: "test".into(),
+    };
+    let mut w = StreamWriter::create(&stream, &info).unwrap();
+    let sim = Simulator::new(Scenario::new(kind, 7));
+    for i in 0..frames {
+        let f = sim.frame(i).unwrap();
+        let mut rec = FrameRecord::new(f.time_ns, f.frame);
+        rec.sensors = f.sensors;
+        rec.ground_truth = Some(serde_json::to_value(&f.ground_truth).unwrap());
+        w.write(&rec).unwrap();
+    }
+    w.finish().unwrap();
+    let lut = dir.join("learnt.lut");
+    learnt_table().save(&lut).unwrap();
+    (stream, lut)
+}
+
+#[test]
+fn detect_render_and_eval_commands_on_a_rendered_stream() {
+    let dir = tempfile::tempdir().unwrap();
+    let (stream, lut) = write_scenario(dir.path(), ScenarioKind::Goalkeeper, 12);
+    let out = super::common::eotn(&[
+        "detect".as_ref(),
+        stream.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+        "--json".as_ref(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 12);
+    let goals = lines[0]["goals"].as_array().unwrap();
+    assert_eq!(goals.len(), 1, "{}", lines[0]);
+    assert_eq!(goals[0]["colour"], "yellow");
+    assert!(goals[0]["posts"].as_array().is_some_and(|p| !p.is_empty()));
+    assert!(goals[0]["gap"].is_object());
+    assert!(
+        goals[0]["body_distance_cm"].is_number(),
+        "streams carry joint readings"
+    );
+    assert!(lines[0]["ball"].is_null());
+
+    let render_dir = dir.path().join("render");
+    let out = super::common::eotn(&[
+        "render".as_ref(),
+        stream.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+        "-o".as_ref(),
+        render_dir.as_os_str(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let png = image::open(render_dir.join("goalkeeper_000000.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (208 * 3, 160 * 3));
+
+    // Evaluation and calibration on a robot walking towards the goal (distances vary).
+    let (walk, _) = write_scenario(dir.path(), ScenarioKind::WalkAndPan, 60);
+    let calibrated = dir.path().join("calibrated.json");
+    let out = super::common::eotn(&[
+        "eval".as_ref(),
+        walk.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+        "--json".as_ref(),
+        "--calibrate-goals".as_ref(),
+        calibrated.as_os_str(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["report"]["frames"], 60);
+    assert!(
+        report["report"]["ball_found"]
+            .as_u64()
+            .is_some_and(|n| n >= 5),
+        "{report}"
+    );
+    let fitted = report["goal_calibration"].as_array().unwrap();
+    assert!(
+        fitted
+            .iter()
+            .all(|v| v.as_f64().is_some_and(f64::is_finite))
+    );
+    let params: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&calibrated).unwrap()).unwrap();
+    assert_eq!(
+        params["goals"]["distance_multiplier"], fitted[0],
+        "the written parameters hold the fit"
+    );
+
+    // A frame without truth is refused clearly, not a panic.
+    let bad = dir.path().join("garbage.mcap");
+    std::fs::write(&bad, b"not an mcap file").unwrap();
+    let out = super::common::eotn(&[
+        "eval".as_ref(),
+        bad.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("garbage.mcap"));
+}
