@@ -679,7 +679,7 @@ impl AppState {
             }
             Command::SetConnectivity(c) => {
                 self.settings.connectivity = c;
-                let mut params = self.pipeline.params().clone();
+                let mut params = *self.pipeline.params();
                 params.connectivity = c;
                 self.pipeline.set_params(params);
                 self.reprocess();
