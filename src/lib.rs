@@ -33,3 +33,7 @@ pub mod sim;
 pub mod streams;
 
 pub mod cli;
+
+/// The desktop app (egui/eframe on wgpu); only this module names the UI crates.
+#[cfg(feature = "gui")]
+pub mod app;

@@ -8,16 +8,19 @@ use eotn::cli::{Cli, report};
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
-    match cli.command {
-        Some(command) => match eotn::cli::run(command) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => report(&e),
-        },
-        None => {
-            eprintln!(
-                "eotn: the desktop app is not built yet; see `eotn --help` for the headless commands"
-            );
-            ExitCode::FAILURE
-        }
+    let result = match cli.command {
+        #[cfg(feature = "gui")]
+        Some(eotn::cli::Command::Open(args)) => eotn::app::run(args.files),
+        Some(command) => eotn::cli::run(command),
+        #[cfg(feature = "gui")]
+        None => eotn::app::run(Vec::new()),
+        #[cfg(not(feature = "gui"))]
+        None => Err(anyhow::anyhow!(
+            "this eotn was built without the desktop app (cargo feature `gui`); see `eotn --help` for the headless commands"
+        )),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => report(&e),
     }
 }

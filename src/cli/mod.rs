@@ -15,6 +15,7 @@ mod info;
 pub mod inputs;
 mod lut;
 mod lut_from_labels;
+pub mod open;
 mod render;
 
 use std::process::ExitCode;
@@ -58,6 +59,8 @@ pub enum Command {
     LutFromLabels(lut_from_labels::Args),
     /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
     Lut(lut::Args),
+    /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
+    Open(open::Args),
 }
 
 /// Runs a headless subcommand.
@@ -77,6 +80,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Detect(a) => detect::run(&a),
         Command::Render(a) => render::run(&a),
         Command::Eval(a) => eval::run(&a),
+        Command::Open(a) => open::run(&a),
     }
 }
 

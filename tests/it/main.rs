@@ -2,6 +2,8 @@
 
 #![allow(clippy::unwrap_used, reason = "test helpers: a panic is a failed test")]
 
+#[cfg(feature = "gui")]
+mod app;
 mod cli;
 mod common;
 mod peer;

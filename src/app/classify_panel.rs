@@ -1,0 +1,186 @@
+//! Hand classification: the class picker, the sensitivity sliders, the pending selection with
+//! commit, undo and redo, and the whole-stream check of a pending edit.
+
+use egui::{Color32, Context, RichText, Sense, Ui, vec2};
+
+use super::state::{AppState, Command, TryEdit};
+use crate::lut::{ColourClass, Sensitivity};
+
+/// A colour swatch the size of a line of text.
+pub fn swatch(ui: &mut Ui, rgb: [u8; 3]) {
+    let (rect, _) = ui.allocate_exact_size(vec2(12.0, 12.0), Sense::hover());
+    ui.painter()
+        .rect_filled(rect, 2.0, Color32::from_rgb(rgb[0], rgb[1], rgb[2]));
+}
+
+/// The side panel's contents.
+pub fn classify_panel_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+    ui.heading("Classify");
+    ui.label(
+        RichText::new("left-click: sample · right-click: commit")
+            .small()
+            .weak(),
+    );
+    ui.separator();
+    let counts = state.table_counts();
+    let frame_counts = state.frame_counts();
+    egui::Grid::new("classes").num_columns(3).show(ui, |ui| {
+        for class in ColourClass::ALL {
+            ui.horizontal(|ui| {
+                swatch(ui, class.display_rgb());
+                if ui
+                    .selectable_label(state.settings.class == class, class.name())
+                    .clicked()
+                {
+                    commands.push(Command::SetClass(class));
+                }
+            });
+            let code = usize::from(class.code());
+            ui.label(RichText::new(format!("{}", counts[code])).small())
+                .on_hover_text("table cells of this class");
+            ui.label(RichText::new(format!("{}", frame_counts[code])).small())
+                .on_hover_text("pixels of this class in the frame");
+            ui.end_row();
+        }
+    });
+    ui.separator();
+    ui.label("Sensitivity (± cells)");
+    let max = state.max_sensitivity();
+    let mut s = state.settings.sensitivity;
+    let before = s;
+    for (name, value, keys) in [
+        ("Y", &mut s.y, "Y / Shift+Y"),
+        ("U", &mut s.u, "U / Shift+U"),
+        ("V", &mut s.v, "V / Shift+V"),
+    ] {
+        ui.add(egui::Slider::new(value, 0..=max).text(name))
+            .on_hover_text(format!("keys {keys}; + and - change all three"));
+    }
+    if s != before {
+        commands.push(Command::SetSensitivity(s));
+    }
+    ui.horizontal(|ui| {
+        for n in [0u8, 1, 2, 4] {
+            if ui.small_button(format!("{n}")).clicked() {
+                commands.push(Command::SetSensitivity(Sensitivity::uniform(n)));
+            }
+        }
+    });
+    ui.separator();
+    match (state.selection(), state.resolved_selection()) {
+        (Some(sel), Some(resolved)) => {
+            let cells = resolved.indices(state.lut()).count();
+            let pixels = state.preview_mask().iter().filter(|&&m| m).count();
+            if let Some((x, y)) = sel.pixel {
+                ui.label(format!("sample ({x}, {y})"));
+            } else {
+                ui.label("sample from the U–V plane");
+            }
+            ui.label(format!("{cells} cells, {pixels} pixels in this frame"));
+            ui.horizontal(|ui| {
+                if ui
+                    .button("Commit")
+                    .on_hover_text("right-click in the image")
+                    .clicked()
+                {
+                    commands.push(Command::Commit);
+                }
+                if ui.button("Clear").on_hover_text("Esc").clicked() {
+                    commands.push(Command::ClearSelection);
+                }
+            });
+            if state.source().is_some_and(|s| s.len() > 1)
+                && ui
+                    .button("Try on whole stream")
+                    .on_hover_text("list the frames this edit would change")
+                    .clicked()
+            {
+                commands.push(Command::TryEditOnStream);
+            }
+        }
+        _ => {
+            ui.weak("no pending selection");
+        }
+    }
+    ui.separator();
+    let h = state.history();
+    ui.horizontal(|ui| {
+        if ui
+            .add_enabled(h.undo_len() > 0, egui::Button::new("Undo"))
+            .on_hover_text("Ctrl+Z")
+            .clicked()
+        {
+            commands.push(Command::Undo);
+        }
+        if ui
+            .add_enabled(h.redo_len() > 0, egui::Button::new("Redo"))
+            .on_hover_text("Ctrl+Y")
+            .clicked()
+        {
+            commands.push(Command::Redo);
+        }
+        ui.label(format!("{} / {}", h.undo_len(), h.redo_len()));
+    });
+}
+
+/// The results of "Try on whole stream"; clicking a row shows that frame.
+pub fn try_edit_window(ctx: &Context, state: &mut AppState, commands: &mut Vec<Command>) {
+    let Some(t) = state.try_edit().cloned() else {
+        return;
+    };
+    let mut open = state.settings.show_try_edit;
+    egui::Window::new("Try edit on stream")
+        .open(&mut open)
+        .default_width(360.0)
+        .default_pos([900.0, 420.0])
+        .show(ctx, |ui| try_edit_ui(ui, &t, state.index(), commands));
+    state.settings.show_try_edit = open;
+}
+
+fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        super::classify_panel::swatch(ui, t.class.display_rgb());
+        ui.label(format!("{} over {} frames", t.class.name(), t.total));
+    });
+    if !t.done() {
+        ui.add(
+            egui::ProgressBar::new(t.next as f32 / t.total.max(1) as f32)
+                .text(format!("{} / {}", t.next, t.total)),
+        );
+    }
+    let changed: usize = t.rows.iter().map(|r| r.changed_pixels).sum();
+    ui.label(format!(
+        "{} frames change, {changed} pixels in all{}",
+        t.rows.len(),
+        if t.errors > 0 {
+            format!("; {} frames unreadable", t.errors)
+        } else {
+            String::new()
+        }
+    ));
+    egui::ScrollArea::vertical()
+        .max_height(300.0)
+        .show(ui, |ui| {
+            egui::Grid::new("try_rows").striped(true).show(ui, |ui| {
+                ui.strong("frame");
+                ui.strong("pixels");
+                ui.strong("blobs");
+                ui.end_row();
+                for r in &t.rows {
+                    if ui
+                        .selectable_label(r.index == current, format!("{}", r.index))
+                        .clicked()
+                    {
+                        commands.push(Command::Seek(r.index));
+                    }
+                    ui.label(format!("{}", r.changed_pixels));
+                    let delta = r.blobs_after as i64 - r.blobs_before as i64;
+                    ui.label(format!(
+                        "{} -> {} ({delta:+})",
+                        r.blobs_before, r.blobs_after
+                    ));
+                    ui.end_row();
+                }
+            });
+        });
+}

@@ -1,0 +1,591 @@
+//! The desktop app (feature `gui`): eframe on the wgpu renderer, embedding the same pipeline as
+//! the CLI. Laid out like egui's demo app and rerun's viewer:
+//!
+//! | file | role |
+//! |---|---|
+//! | `state.rs` | [`AppState`]: all non-UI state; [`Command`]s applied in one place |
+//! | `source.rs` | frames on demand from a stream or frame files, with a small cache |
+//! | `journal.rs` | the edit journal beside a table: append, replay |
+//! | `views.rs` | the enlarged view (zoom, pan, hover, clicks) and the thumbnails |
+//! | `overlays.rs` | drawing in image pixels through one transform: boxes, labels, markers |
+//! | `classify_panel.rs` | class picker, sensitivity, commit/undo/redo, try-on-stream |
+//! | `sensors_dialog.rs` | every sensor reading with units, plots over the stream |
+//! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
+//! | `menus.rs` | File, Classification, View, Stream, Windows |
+//!
+//! Only this folder names egui/eframe (`scripts/check.sh` checks it).
+
+pub mod classify_panel;
+pub mod journal;
+pub mod menus;
+pub mod overlays;
+pub mod sensors_dialog;
+pub mod source;
+pub mod state;
+pub mod uv_plane;
+pub mod views;
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use egui::{Color32, ColorImage, Key, KeyboardShortcut, Modifiers, TextureHandle, TextureOptions};
+
+pub use state::{AppState, Command, Settings, ViewKind};
+
+use overlays::{FrameTextures, ImageTransform};
+use state::PixelInfo;
+
+/// How much the pixels outside a pending selection are darkened (alpha of black over them).
+const PREVIEW_DIM_ALPHA: u8 = 110;
+
+/// Key of the persisted [`Settings`] in eframe's storage.
+pub const SETTINGS_KEY: &str = "eotn-settings";
+
+/// Opens the app window on `paths` (streams, frames, tables; none reopens the last session).
+///
+/// # Errors
+/// The window or renderer could not be created (no display, no Vulkan/GL driver).
+pub fn run(paths: Vec<PathBuf>) -> anyhow::Result<()> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("eotn")
+            .with_app_id("eotn")
+            .with_inner_size([1280.0, 800.0])
+            .with_min_inner_size([640.0, 400.0]),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "eotn",
+        options,
+        Box::new(move |cc| Ok(Box::new(EotnApp::new(cc, paths)))),
+    )
+    .map_err(|e| anyhow::anyhow!("cannot open the app window: {e}"))
+}
+
+/// The textures of the shown frame and what they were built from.
+struct Textures {
+    raw: TextureHandle,
+    classified: TextureHandle,
+    preview: TextureHandle,
+    frame_generation: u64,
+    preview_generation: u64,
+}
+
+impl Textures {
+    fn ids(&self) -> FrameTextures {
+        FrameTextures {
+            raw: self.raw.id(),
+            classified: self.classified.id(),
+            preview: self.preview.id(),
+        }
+    }
+}
+
+/// Display colours of every class code, transparent for unclassified.
+fn palette() -> [Color32; 256] {
+    let mut p = [Color32::TRANSPARENT; 256];
+    for (code, c) in p.iter_mut().enumerate().skip(1) {
+        let [r, g, b] = crate::lut::code_display_rgb(u8::try_from(code).unwrap_or(0));
+        *c = Color32::from_rgb(r, g, b);
+    }
+    p
+}
+
+/// The eframe application: the state plus the runtime resources of the window.
+pub struct EotnApp {
+    /// Everything that is not a widget.
+    pub state: AppState,
+    textures: Option<Textures>,
+    menu_input: menus::MenuInput,
+    uv_plane: uv_plane::UvPlane,
+    hovered: Option<PixelInfo>,
+    /// Where the enlarged view was last drawn (tests click pixels through it).
+    pub last_view: Option<ImageTransform>,
+    confirm_close: bool,
+    allow_close: bool,
+    show_warnings: bool,
+    title: String,
+    last_frame: Option<Instant>,
+    palette: [Color32; 256],
+}
+
+impl EotnApp {
+    /// The app with persisted settings from `cc`, opening `paths` (or the last session's files
+    /// when there are none).
+    #[must_use]
+    pub fn new(cc: &eframe::CreationContext<'_>, paths: Vec<PathBuf>) -> Self {
+        let settings = cc
+            .storage
+            .and_then(|s| eframe::get_value::<Settings>(s, SETTINGS_KEY))
+            .unwrap_or_default();
+        let mut app = Self::with_state(AppState::new(settings));
+        if paths.is_empty() {
+            app.state.reopen_last();
+        } else {
+            app.state.run(Command::Open(paths));
+        }
+        app
+    }
+
+    /// The app around an existing state (tests build the state first).
+    #[must_use]
+    pub fn with_state(state: AppState) -> Self {
+        Self {
+            state,
+            textures: None,
+            menu_input: menus::MenuInput::default(),
+            uv_plane: uv_plane::UvPlane::default(),
+            hovered: None,
+            last_view: None,
+            confirm_close: false,
+            allow_close: false,
+            show_warnings: false,
+            title: String::new(),
+            last_frame: None,
+            palette: palette(),
+        }
+    }
+
+    /// The pixel the pointer was over in the last frame.
+    #[must_use]
+    pub const fn hovered(&self) -> Option<&PixelInfo> {
+        self.hovered.as_ref()
+    }
+
+    /// True while the "unsaved changes" question is shown.
+    #[must_use]
+    pub const fn confirming_close(&self) -> bool {
+        self.confirm_close
+    }
+
+    fn update_textures(&mut self, ctx: &egui::Context) {
+        let Some(frame) = self.state.frame() else {
+            return;
+        };
+        let size = [frame.width(), frame.height()];
+        let opts = TextureOptions::NEAREST;
+        let fg = self.state.frame_generation();
+        let pg = self.state.preview_generation();
+        if self
+            .textures
+            .as_ref()
+            .is_some_and(|t| t.frame_generation == fg && t.preview_generation == pg)
+        {
+            return;
+        }
+        let t0 = Instant::now();
+        let frame_changed = self
+            .textures
+            .as_ref()
+            .is_none_or(|t| t.frame_generation != fg);
+        let preview = self.preview_image(size);
+        if frame_changed {
+            let raw = ColorImage::from_rgb(size, self.state.rgb());
+            let classified = ColorImage::new(
+                size,
+                self.state
+                    .classified()
+                    .codes()
+                    .iter()
+                    .map(|&c| self.palette[usize::from(c)])
+                    .collect(),
+            );
+            match &mut self.textures {
+                Some(t) => {
+                    t.raw.set(raw, opts);
+                    t.classified.set(classified, opts);
+                    t.preview.set(preview, opts);
+                }
+                None => {
+                    self.textures = Some(Textures {
+                        raw: ctx.load_texture("raw", raw, opts),
+                        classified: ctx.load_texture("classified", classified, opts),
+                        preview: ctx.load_texture("preview", preview, opts),
+                        frame_generation: fg,
+                        preview_generation: pg,
+                    });
+                }
+            }
+            self.state.record_upload(t0.elapsed());
+        } else if let Some(t) = &mut self.textures {
+            t.preview.set(preview, opts);
+        }
+        if let Some(t) = &mut self.textures {
+            t.frame_generation = fg;
+            t.preview_generation = pg;
+        }
+    }
+
+    fn preview_image(&self, size: [usize; 2]) -> ColorImage {
+        let mask = self.state.preview_mask();
+        let colour = self
+            .state
+            .preview_colour()
+            .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
+        if mask.len() != size[0] * size[1] {
+            return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
+        }
+        // Unselected pixels are dimmed, so the highlight shows even where the class colour is
+        // the colour of the pixels themselves (orange on an orange ball).
+        let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
+        ColorImage::new(
+            size,
+            mask.iter().map(|&m| if m { colour } else { dim }).collect(),
+        )
+    }
+
+    fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
+        let mut quit = false;
+        if ctx.egui_wants_keyboard_input() {
+            return quit;
+        }
+        ctx.input_mut(|i| {
+            let cmd = |k| KeyboardShortcut::new(Modifiers::COMMAND, k);
+            if i.consume_shortcut(&KeyboardShortcut::new(
+                Modifiers::COMMAND | Modifiers::SHIFT,
+                Key::Z,
+            )) || i.consume_shortcut(&cmd(Key::Y))
+            {
+                commands.push(Command::Redo);
+            }
+            if i.consume_shortcut(&cmd(Key::Z)) {
+                commands.push(Command::Undo);
+            }
+            if i.consume_shortcut(&cmd(Key::S)) {
+                commands.push(Command::SaveTable);
+            }
+            if i.consume_shortcut(&cmd(Key::Q)) {
+                quit = true;
+            }
+            for (key, channel) in [(Key::Y, 0), (Key::U, 1), (Key::V, 2)] {
+                let down = i.count_and_consume_key(Modifiers::SHIFT, key) as i32;
+                let up = i.count_and_consume_key(Modifiers::NONE, key) as i32;
+                if up != down {
+                    commands.push(Command::AdjustSensitivity {
+                        channel,
+                        delta: up - down,
+                    });
+                }
+            }
+            for (key, delta) in [(Key::Plus, 1), (Key::Equals, 1), (Key::Minus, -1)] {
+                if i.consume_key(Modifiers::NONE, key) {
+                    for channel in 0..3 {
+                        commands.push(Command::AdjustSensitivity { channel, delta });
+                    }
+                }
+            }
+            if self.state.source().is_some() {
+                for (key, delta) in [
+                    (Key::ArrowRight, 1),
+                    (Key::ArrowLeft, -1),
+                    (Key::PageDown, 10),
+                    (Key::PageUp, -10),
+                ] {
+                    // Every press counts, even several within one slow frame.
+                    let n = i.count_and_consume_key(Modifiers::NONE, key);
+                    if n > 0 {
+                        commands.push(Command::Step(delta * n as i64));
+                    }
+                }
+                if i.consume_key(Modifiers::NONE, Key::Home) {
+                    commands.push(Command::Seek(0));
+                }
+                if i.consume_key(Modifiers::NONE, Key::End) {
+                    commands.push(Command::Seek(usize::MAX));
+                }
+                if i.consume_key(Modifiers::NONE, Key::Space) {
+                    commands.push(Command::SetPlaying(!self.state.playing()));
+                }
+            }
+            if i.consume_key(Modifiers::NONE, Key::Escape) {
+                commands.push(Command::ClearSelection);
+            }
+        });
+        quit
+    }
+
+    fn timeline_ui(&self, ui: &mut egui::Ui, commands: &mut Vec<Command>) {
+        let Some(src) = self.state.source() else {
+            return;
+        };
+        let len = src.len();
+        let index = self.state.index();
+        ui.horizontal(|ui| {
+            if ui.button("Previous").on_hover_text("Left arrow").clicked() {
+                commands.push(Command::Step(-1));
+            }
+            let play = if self.state.playing() {
+                "Pause"
+            } else {
+                "Play"
+            };
+            if ui.button(play).on_hover_text("Space").clicked() {
+                commands.push(Command::SetPlaying(!self.state.playing()));
+            }
+            if ui.button("Next").on_hover_text("Right arrow").clicked() {
+                commands.push(Command::Step(1));
+            }
+            let mut speed = self.state.settings.speed;
+            egui::ComboBox::from_label("speed")
+                .selected_text(menus::speed_name(speed))
+                .width(90.0)
+                .show_ui(ui, |ui| {
+                    for s in state::SPEEDS {
+                        ui.selectable_value(&mut speed, s, menus::speed_name(s));
+                    }
+                });
+            if (speed - self.state.settings.speed).abs() > f32::EPSILON {
+                commands.push(Command::SetSpeed(speed));
+            }
+            let mut i = index;
+            ui.label("frame");
+            if ui
+                .add(egui::DragValue::new(&mut i).range(0..=len.saturating_sub(1)))
+                .on_hover_text("type a frame number to jump")
+                .changed()
+            {
+                commands.push(Command::Seek(i));
+            }
+            let t = src.time_ns(index) as f64 / 1e9;
+            let end = src.time_ns(len.saturating_sub(1)) as f64 / 1e9;
+            ui.monospace(format!(
+                "/ {}  {t:8.3} s / {end:.3} s",
+                len.saturating_sub(1)
+            ));
+            ui.spacing_mut().slider_width = (ui.available_width() - 70.0).max(100.0);
+            let mut j = index;
+            let slider = ui.add(
+                egui::Slider::new(&mut j, 0..=len.saturating_sub(1))
+                    .show_value(false)
+                    .text("timeline"),
+            );
+            if slider.changed() {
+                commands.push(Command::Seek(j));
+            }
+        });
+    }
+
+    fn status_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let n = self.state.warnings().len();
+            let label = if n == 0 {
+                "no warnings".to_owned()
+            } else {
+                format!("{n} warnings")
+            };
+            let button = egui::Button::new(label).selected(self.show_warnings);
+            if ui.add_enabled(n > 0, button).clicked() {
+                self.show_warnings = !self.show_warnings;
+            }
+            let s = self.state.timings.last_step;
+            let ms = |d: Duration| d.as_secs_f64() * 1e3;
+            if self.state.settings.show_timings {
+            ui.monospace(format!(
+                "step {:.1} ms (read {:.1} classify {:.1} blobs {:.1} prep {:.1} upload {:.1}) | frame {:.1} ms",
+                ms(s.total()),
+                ms(s.read),
+                ms(s.classify),
+                ms(s.blobs),
+                ms(s.prepare),
+                ms(s.upload),
+                self.state.timings.frames_ms.last().copied().unwrap_or(0.0),
+            ))
+            .on_hover_text(format!(
+                "medians: step {:.2} ms, frame {:.2} ms, playing {:.2} ms",
+                state::median(&self.state.timings.steps_ms),
+                state::median(&self.state.timings.frames_ms),
+                state::median(&self.state.timings.playing_frames_ms),
+            ));
+            }
+            ui.separator();
+            ui.label(&self.state.status);
+        });
+        ui.horizontal(|ui| views::pixel_readout_ui(ui, self.hovered.as_ref()));
+    }
+
+    fn warnings_window(&mut self, ctx: &egui::Context) {
+        if !self.show_warnings {
+            return;
+        }
+        let mut open = true;
+        let mut clear = false;
+        egui::Window::new("Warnings")
+            .open(&mut open)
+            .default_width(520.0)
+            .show(ctx, |ui| {
+                if ui.button("Clear").clicked() {
+                    clear = true;
+                }
+                egui::ScrollArea::vertical()
+                    .max_height(300.0)
+                    .show(ui, |ui| {
+                        for w in self.state.warnings().iter().rev() {
+                            ui.label(w);
+                        }
+                    });
+            });
+        if clear {
+            self.state.clear_warnings();
+            open = false;
+        }
+        self.show_warnings = open;
+    }
+
+    fn close_dialog(&mut self, ctx: &egui::Context, commands: &mut Vec<Command>) {
+        if ctx.input(|i| i.viewport().close_requested()) && self.state.dirty() && !self.allow_close
+        {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.confirm_close = true;
+        }
+        if !self.confirm_close {
+            return;
+        }
+        let mut choice = None;
+        egui::Modal::new(egui::Id::unique("confirm_close")).show(ctx, |ui| {
+            ui.heading("Unsaved changes");
+            ui.label(format!(
+                "{} has edits that are not saved.",
+                self.state.title()
+            ));
+            ui.horizontal(|ui| {
+                if self.state.table_path().is_some() && ui.button("Save and quit").clicked() {
+                    choice = Some(1);
+                }
+                if ui.button("Quit without saving").clicked() {
+                    choice = Some(2);
+                }
+                if ui.button("Cancel").clicked() {
+                    choice = Some(0);
+                }
+            });
+        });
+        match choice {
+            Some(1) => {
+                commands.push(Command::SaveTable);
+                self.allow_close = true;
+                self.confirm_close = false;
+            }
+            Some(2) => {
+                self.allow_close = true;
+                self.confirm_close = false;
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+            Some(_) => self.confirm_close = false,
+            None => {}
+        }
+    }
+
+    /// Applies queued commands; after "Save and quit", closes once the save succeeded.
+    fn apply_all(&mut self, ctx: &egui::Context, commands: Vec<Command>) {
+        for c in commands {
+            let saving_to_quit = c == Command::SaveTable && self.allow_close;
+            self.state.run(c);
+            if saving_to_quit {
+                if self.state.dirty() {
+                    // The save failed: stay open, the error is in the status area.
+                    self.allow_close = false;
+                } else {
+                    ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                }
+            }
+        }
+    }
+
+    /// Prints the measured medians (`EOTN_STATS=1`), for the figures in the notes.
+    fn report_stats(&self) {
+        if std::env::var_os("EOTN_STATS").is_some() {
+            let t = &self.state.timings;
+            eprintln!(
+                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms",
+                t.steps_ms.len(),
+                state::median(&t.steps_ms),
+                t.frames_ms.len(),
+                state::median(&t.frames_ms),
+                t.playing_frames_ms.len(),
+                state::median(&t.playing_frames_ms),
+            );
+        }
+    }
+}
+
+impl eframe::App for EotnApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        let now = Instant::now();
+        let dt = self.last_frame.map_or(Duration::ZERO, |t| now - t);
+        self.last_frame = Some(now);
+        if dt > Duration::ZERO {
+            self.state.record_frame_time(dt);
+        }
+        // Playback and scans use wall time, capped so a stall does not skip half the stream.
+        self.state.tick(dt.min(Duration::from_millis(250)));
+
+        let mut commands = Vec::new();
+        let mut quit = self.keyboard(&ctx, &mut commands);
+        self.update_textures(&ctx);
+        let tex = self.textures.as_ref().map(Textures::ids);
+
+        egui::Panel::top("menu").show(ui, |ui| {
+            let out = menus::menu_bar_ui(ui, &self.state, &mut self.menu_input, &mut commands);
+            quit |= out.quit;
+        });
+        egui::Panel::bottom("status").show(ui, |ui| self.status_ui(ui));
+        if self.state.source().is_some() {
+            egui::Panel::bottom("timeline").show(ui, |ui| self.timeline_ui(ui, &mut commands));
+        }
+        egui::Panel::bottom("thumbnails")
+            .resizable(true)
+            .default_size(120.0)
+            .size_range(60.0..=300.0)
+            .show(ui, |ui| {
+                views::thumbnails_ui(ui, &self.state, tex.as_ref(), &mut commands)
+            });
+        egui::Panel::left("classify")
+            .resizable(true)
+            .default_size(230.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    classify_panel::classify_panel_ui(ui, &self.state, &mut commands);
+                });
+            });
+        egui::CentralPanel::default()
+            .frame(egui::Frame::NONE)
+            .show(ui, |ui| {
+                let out = views::main_view_ui(ui, &self.state, tex.as_ref(), &mut commands);
+                self.hovered = out.hovered;
+                self.last_view = out.transform;
+            });
+
+        sensors_dialog::sensors_window(&ctx, &mut self.state);
+        self.uv_plane.window(&ctx, &mut self.state, &mut commands);
+        classify_panel::try_edit_window(&ctx, &mut self.state, &mut commands);
+        self.warnings_window(&ctx);
+        menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
+        if quit {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+        self.close_dialog(&ctx, &mut commands);
+        self.apply_all(&ctx, commands);
+
+        let title = self.state.title();
+        if title != self.title {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
+            self.title = title;
+        }
+        let busy = self.state.playing()
+            || self.state.try_edit().is_some_and(|t| !t.done())
+            || (self.state.settings.show_sensors
+                && self.state.sensor_series.points.len() < self.state.sensor_series.total);
+        if busy {
+            ctx.request_repaint();
+        }
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        eframe::set_value(storage, SETTINGS_KEY, &self.state.settings);
+    }
+
+    fn on_exit(&mut self) {
+        self.report_stats();
+    }
+}

@@ -1,0 +1,206 @@
+//! Drawing in image-pixel coordinates: one [`ImagePainter`] owns zoom and pan, so no overlay
+//! does screen maths. Blob boxes, object labels, the sampled pixel and the preview highlight.
+
+use egui::{
+    Align2, Color32, FontId, Painter, Pos2, Rect, Stroke, StrokeKind, TextureId, pos2, vec2,
+};
+
+use super::state::{AppState, ViewKind, box_colour};
+use crate::blobs::Blob;
+
+/// Blobs get a label outside the objects view when at least this many times the minimum size.
+const LABEL_SIZE_FACTOR: u32 = 20;
+
+/// Maps image pixels to screen points for one view: `screen = view_centre + (image − centre) · zoom`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageTransform {
+    /// The view's rectangle on screen.
+    pub view: Rect,
+    /// Screen points per image pixel.
+    pub zoom: f32,
+    /// The image point (pixels) at the centre of the view.
+    pub centre: Pos2,
+    /// Image size, pixels.
+    pub size: [f32; 2],
+}
+
+impl ImageTransform {
+    /// The zoom that fits an image of `size` pixels into `view`.
+    #[must_use]
+    pub fn fit_zoom(view: Rect, size: [f32; 2]) -> f32 {
+        if size[0] <= 0.0 || size[1] <= 0.0 {
+            return 1.0;
+        }
+        (view.width() / size[0])
+            .min(view.height() / size[1])
+            .max(0.01)
+    }
+
+    /// The transform of the enlarged view with the state's zoom and pan.
+    #[must_use]
+    pub fn for_state(view: Rect, state: &AppState) -> Self {
+        let (w, h) = state.image_size();
+        let size = [w as f32, h as f32];
+        let t = state.settings.transform;
+        let zoom = t.effective_zoom(Self::fit_zoom(view, size));
+        let c = t.effective_centre(size);
+        Self {
+            view,
+            zoom,
+            centre: pos2(c[0], c[1]),
+            size,
+        }
+    }
+
+    /// A fitted, centred transform (thumbnails).
+    #[must_use]
+    pub fn fitted(view: Rect, size: [f32; 2]) -> Self {
+        Self {
+            view,
+            zoom: Self::fit_zoom(view, size),
+            centre: pos2(size[0] / 2.0, size[1] / 2.0),
+            size,
+        }
+    }
+
+    /// Image point (pixels, 0,0 = top-left corner of the first pixel) → screen point.
+    #[must_use]
+    pub fn to_screen(&self, p: Pos2) -> Pos2 {
+        self.view.center() + (p - self.centre) * self.zoom
+    }
+
+    /// Screen point → image point (pixels).
+    #[must_use]
+    pub fn to_image(&self, s: Pos2) -> Pos2 {
+        self.centre + (s - self.view.center()) / self.zoom
+    }
+
+    /// The pixel under a screen point, if inside the image.
+    #[must_use]
+    pub fn pixel_at(&self, s: Pos2) -> Option<(usize, usize)> {
+        let p = self.to_image(s);
+        let inside = p.x >= 0.0 && p.y >= 0.0 && p.x < self.size[0] && p.y < self.size[1];
+        inside.then_some((p.x as usize, p.y as usize))
+    }
+
+    /// The screen centre of pixel (x, y).
+    #[must_use]
+    pub fn pixel_centre(&self, x: usize, y: usize) -> Pos2 {
+        self.to_screen(pos2(x as f32 + 0.5, y as f32 + 0.5))
+    }
+
+    /// The whole image on screen.
+    #[must_use]
+    pub fn image_rect(&self) -> Rect {
+        Rect::from_min_max(
+            self.to_screen(Pos2::ZERO),
+            self.to_screen(pos2(self.size[0], self.size[1])),
+        )
+    }
+}
+
+/// The textures of the shown frame.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameTextures {
+    /// The colour image.
+    pub raw: TextureId,
+    /// Class colours, transparent where unclassified.
+    pub classified: TextureId,
+    /// The preview highlight, transparent elsewhere.
+    pub preview: TextureId,
+}
+
+/// Paints one view of the shown frame, clipped to the transform's view.
+pub fn paint_view(
+    painter: &Painter,
+    xf: &ImageTransform,
+    kind: ViewKind,
+    state: &AppState,
+    tex: &FrameTextures,
+    with_overlays: bool,
+) {
+    let painter = painter.with_clip_rect(xf.view);
+    let img = xf.image_rect();
+    let uv = Rect::from_min_max(Pos2::ZERO, pos2(1.0, 1.0));
+    let o = state.settings.overlays;
+    match kind {
+        ViewKind::Raw | ViewKind::Objects => {
+            painter.image(tex.raw, img, uv, Color32::WHITE);
+            if o.classified && with_overlays {
+                let a = (o.opacity.clamp(0.0, 1.0) * 255.0) as u8;
+                painter.image(tex.classified, img, uv, Color32::from_white_alpha(a));
+            }
+        }
+        ViewKind::Classified => {
+            painter.rect_filled(img, 0.0, Color32::BLACK);
+            painter.image(tex.classified, img, uv, Color32::WHITE);
+        }
+        ViewKind::Blobs => {
+            painter.rect_filled(img, 0.0, Color32::BLACK);
+            painter.image(tex.classified, img, uv, Color32::from_gray(110));
+        }
+    }
+    if with_overlays && o.preview && state.selection().is_some() {
+        painter.image(tex.preview, img, uv, Color32::WHITE);
+    }
+    let boxes = match kind {
+        ViewKind::Objects => state.largest_blobs(),
+        ViewKind::Blobs => state.drawn_blobs(),
+        _ if with_overlays && o.blob_boxes => state.drawn_blobs(),
+        _ => Vec::new(),
+    };
+    let labels = with_overlays && (o.labels || kind == ViewKind::Objects);
+    // Outside the objects view only sizeable blobs get a label, or the field drowns in text.
+    let label_min = state
+        .settings
+        .min_blob_pixels
+        .saturating_mul(LABEL_SIZE_FACTOR);
+    for b in &boxes {
+        let label = labels && (kind == ViewKind::Objects || b.pixels >= label_min);
+        blob_box(&painter, xf, b, label);
+    }
+    if with_overlays && let Some((x, y)) = state.selection().and_then(|s| s.pixel) {
+        sample_marker(&painter, xf, x, y);
+    }
+}
+
+/// One blob's box (pixel edges inclusive), optionally labelled with its class and size.
+pub fn blob_box(painter: &Painter, xf: &ImageTransform, b: &Blob, label: bool) {
+    let [r, g, bl] = box_colour(b.colour);
+    let colour = Color32::from_rgb(r, g, bl);
+    let rect = Rect::from_min_max(
+        xf.to_screen(pos2(b.minx as f32, b.miny as f32)),
+        xf.to_screen(pos2(b.maxx as f32 + 1.0, b.maxy as f32 + 1.0)),
+    );
+    painter.rect_stroke(rect, 0.0, Stroke::new(1.5, colour), StrokeKind::Outside);
+    if label {
+        let text = format!("{} {}×{}", b.class().name(), b.width(), b.height());
+        let pos = rect.left_top() - vec2(0.0, 2.0);
+        let galley = painter.layout_no_wrap(text, FontId::proportional(11.0), colour);
+        let bg = Rect::from_min_size(pos - vec2(0.0, galley.size().y), galley.size()).expand(1.0);
+        painter.rect_filled(bg, 2.0, Color32::from_black_alpha(160));
+        painter.galley(bg.min + vec2(1.0, 1.0), galley, colour);
+    }
+}
+
+/// A cross on the sampled pixel.
+pub fn sample_marker(painter: &Painter, xf: &ImageTransform, x: usize, y: usize) {
+    let c = xf.pixel_centre(x, y);
+    let r = (xf.zoom * 0.5).max(4.0) + 3.0;
+    for stroke in [
+        Stroke::new(3.0, Color32::BLACK),
+        Stroke::new(1.0, Color32::WHITE),
+    ] {
+        painter.line_segment([c - vec2(r, 0.0), c + vec2(r, 0.0)], stroke);
+        painter.line_segment([c - vec2(0.0, r), c + vec2(0.0, r)], stroke);
+    }
+}
+
+/// A short text with a dark background at a corner of the view (zoom level, frame time).
+pub fn corner_text(painter: &Painter, view: Rect, align: Align2, text: String) {
+    let galley = painter.layout_no_wrap(text, FontId::monospace(11.0), Color32::WHITE);
+    let size = galley.size() + vec2(6.0, 4.0);
+    let rect = align.align_size_within_rect(size, view.shrink(4.0));
+    painter.rect_filled(rect, 3.0, Color32::from_black_alpha(170));
+    painter.galley(rect.min + vec2(3.0, 2.0), galley, Color32::WHITE);
+}

@@ -1,0 +1,121 @@
+//! The sensor dialog: every reading of the current frame with its unit, live during playback,
+//! and plots of head pan, pan velocity and the pan motor's PWM over the stream with a cursor at
+//! the current frame.
+
+use egui::{Color32, Context, Id};
+use egui_plot::{Legend, Line, Plot, VLine};
+
+use super::state::AppState;
+use crate::sensors::SensorReadings;
+
+/// Shows the dialog while `state.settings.show_sensors` is set.
+pub fn sensors_window(ctx: &Context, state: &mut AppState) {
+    let mut open = state.settings.show_sensors;
+    egui::Window::new("Sensors")
+        .open(&mut open)
+        .default_width(420.0)
+        .default_pos([700.0, 80.0])
+        .show(ctx, |ui| sensors_ui(ui, state));
+    state.settings.show_sensors = open;
+}
+
+fn sensors_ui(ui: &mut egui::Ui, state: &AppState) {
+    let Some(current) = state.current() else {
+        ui.label("No frame open.");
+        return;
+    };
+    ui.label(format!(
+        "frame {} at {:.3} s",
+        state.index(),
+        current.time_ns as f64 / 1e9
+    ));
+    match &current.sensors {
+        None => {
+            ui.weak("This frame carries no sensor readings.");
+        }
+        Some(r) => readings_grid_ui(ui, r),
+    }
+    if !current.extra.is_empty() {
+        egui::CollapsingHeader::new("Other channels")
+            .default_open(false)
+            .show(ui, |ui| {
+                for (channel, value) in &current.extra {
+                    ui.monospace(format!("{channel}: {value}"));
+                }
+            });
+    }
+    ui.separator();
+    series_plots_ui(ui, state, current.time_ns as f64 / 1e9);
+}
+
+fn readings_grid_ui(ui: &mut egui::Ui, r: &SensorReadings) {
+    egui::Grid::new("sensor_readings")
+        .striped(true)
+        .num_columns(3)
+        .show(ui, |ui| {
+            for f in r.fields() {
+                ui.label(f.name);
+                match f.value {
+                    Some(v) => ui.monospace(format!("{v:>10.4}")),
+                    None => ui.weak("—"),
+                };
+                ui.label(f.unit);
+                ui.end_row();
+            }
+            ui.label("pan velocity");
+            match r.pan_velocity_rad_per_s() {
+                Some(v) => ui.monospace(format!("{v:>10.4}")),
+                None => ui.weak("—"),
+            };
+            ui.label("rad/s");
+            ui.end_row();
+        });
+}
+
+fn series_plots_ui(ui: &mut egui::Ui, state: &AppState, now_s: f64) {
+    let series = &state.sensor_series;
+    if series.total == 0 {
+        ui.weak("Plots need a recorded stream.");
+        return;
+    }
+    if series.points.len() < series.total {
+        ui.add(
+            egui::ProgressBar::new(series.points.len() as f32 / series.total as f32)
+                .text("reading the stream's sensors…"),
+        );
+    }
+    type Get = fn(&SensorReadings) -> Option<f64>;
+    let plots: [(&str, &str, Get, Color32); 3] = [
+        ("head pan", "rad", |r| r.head_pan_rad, Color32::LIGHT_BLUE),
+        (
+            "pan velocity",
+            "rad/s",
+            SensorReadings::pan_velocity_rad_per_s,
+            Color32::LIGHT_GREEN,
+        ),
+        (
+            "pan PWM",
+            "duty",
+            |r| r.pan_pwm,
+            Color32::from_rgb(255, 160, 60),
+        ),
+    ];
+    let link = Id::unique("sensor_plots");
+    for (name, unit, get, colour) in plots {
+        let points: Vec<[f64; 2]> = series
+            .points
+            .iter()
+            .filter_map(|(t, r)| r.as_ref().and_then(get).map(|v| [*t, v]))
+            .collect();
+        Plot::new(name)
+            .height(110.0)
+            .legend(Legend::default())
+            .link_axis(link, [true, false])
+            .link_cursor(link, [true, false])
+            .y_axis_label(unit)
+            .show(ui, |p| {
+                p.line(Line::new(format!("{name} ({unit})"), points).color(colour));
+                p.vline(VLine::new("current frame", now_s).color(Color32::WHITE));
+            });
+    }
+}

@@ -1,0 +1,278 @@
+//! Where the app's frames come from: a list of frame files or a recorded stream, read on demand
+//! by index with a small cache, so stepping stays instant however long the recording is.
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use anyhow::Context as _;
+
+use crate::frame::{Frame, load_frame};
+use crate::sensors::SensorReadings;
+use crate::streams as streams_api;
+
+/// Nominal interval between frames that carry no time (frame files), nanoseconds: 25 fps.
+pub const NOMINAL_FRAME_INTERVAL_NS: u64 = 40_000_000;
+
+/// How many decoded frames the cache keeps.
+pub const CACHE_FRAMES: usize = 8;
+
+/// One frame as the app uses it, wherever it came from.
+#[derive(Debug, Clone)]
+pub struct LoadedFrame {
+    /// The image.
+    pub frame: Arc<Frame>,
+    /// Capture time, nanoseconds since the start of the stream (frame files: index × 40 ms).
+    pub time_ns: u64,
+    /// The robot's sensor readings, when the source has them (NaN values already removed).
+    pub sensors: Option<SensorReadings>,
+    /// Other per-frame data of the source as (channel, JSON), shown as text.
+    pub extra: Vec<(String, serde_json::Value)>,
+    /// Problems found while reading this frame (NaN readings dropped, …).
+    pub warnings: Vec<String>,
+}
+
+/// A sequence of frame files opened together (`eotn open a.uyvy b.png …`), stepped like a stream.
+#[derive(Debug)]
+pub struct FileSequence {
+    paths: Vec<PathBuf>,
+}
+
+/// A recorded MCAP stream read through [`streams_api::StreamReader`].
+pub struct StreamSource {
+    path: PathBuf,
+    reader: streams_api::StreamReader,
+}
+
+impl std::fmt::Debug for StreamSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StreamSource")
+            .field("path", &self.path)
+            .field("frames", &self.reader.len())
+            .finish()
+    }
+}
+
+/// What is open.
+#[derive(Debug)]
+enum Kind {
+    Files(FileSequence),
+    Stream(Box<StreamSource>),
+}
+
+/// An open frame source with its cache.
+#[derive(Debug)]
+pub struct Source {
+    kind: Kind,
+    cache: VecDeque<(usize, LoadedFrame)>,
+}
+
+impl Source {
+    /// Frame files, in the given order.
+    ///
+    /// # Errors
+    /// When the list is empty.
+    pub fn files(paths: Vec<PathBuf>) -> anyhow::Result<Self> {
+        anyhow::ensure!(!paths.is_empty(), "no frame files given");
+        Ok(Self {
+            kind: Kind::Files(FileSequence { paths }),
+            cache: VecDeque::new(),
+        })
+    }
+
+    /// A recorded stream (reads only its index now; frames on demand).
+    ///
+    /// # Errors
+    /// The reader's error, naming the file; a stream without frames.
+    pub fn stream(path: &Path) -> anyhow::Result<Self> {
+        let reader = streams_api::StreamReader::open(path)?;
+        anyhow::ensure!(
+            !reader.is_empty(),
+            "{}: the stream holds no camera frames",
+            path.display()
+        );
+        Ok(Self {
+            kind: Kind::Stream(Box::new(StreamSource {
+                path: path.to_owned(),
+                reader,
+            })),
+            cache: VecDeque::new(),
+        })
+    }
+
+    /// The files this source was opened from (for "reopen at start" and recent files).
+    #[must_use]
+    pub fn paths(&self) -> Vec<PathBuf> {
+        match &self.kind {
+            Kind::Files(f) => f.paths.clone(),
+            Kind::Stream(s) => vec![s.path.clone()],
+        }
+    }
+
+    /// True for a recorded stream (sensor readings, recorded times).
+    #[must_use]
+    pub const fn is_stream(&self) -> bool {
+        matches!(self.kind, Kind::Stream(_))
+    }
+
+    /// A short description for the title and status line.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match &self.kind {
+            Kind::Files(f) if f.paths.len() == 1 => file_name(&f.paths[0]),
+            Kind::Files(f) => format!("{} frame files", f.paths.len()),
+            Kind::Stream(s) => {
+                let info = s.reader.info();
+                format!("{} ({})", file_name(&s.path), info.source)
+            }
+        }
+    }
+
+    /// Number of frames.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match &self.kind {
+            Kind::Files(f) => f.paths.len(),
+            Kind::Stream(s) => s.reader.len(),
+        }
+    }
+
+    /// Never true: an empty source is refused when opening.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Time of frame `index`, nanoseconds since the stream's first frame.
+    #[must_use]
+    pub fn time_ns(&self, index: usize) -> u64 {
+        match &self.kind {
+            Kind::Files(_) => index as u64 * NOMINAL_FRAME_INTERVAL_NS,
+            Kind::Stream(s) => {
+                let first = s.reader.time_ns(0).unwrap_or(0);
+                s.reader
+                    .time_ns(index)
+                    .map_or(0, |t| t.saturating_sub(first))
+            }
+        }
+    }
+
+    /// The last frame at or before `time_ns` (relative to the first frame).
+    #[must_use]
+    pub fn index_at_time(&self, time_ns: u64) -> usize {
+        match &self.kind {
+            Kind::Files(f) => usize::try_from(time_ns / NOMINAL_FRAME_INTERVAL_NS)
+                .unwrap_or(usize::MAX)
+                .min(f.paths.len().saturating_sub(1)),
+            Kind::Stream(s) => {
+                let first = s.reader.time_ns(0).unwrap_or(0);
+                s.reader
+                    .index_at_time(first.saturating_add(time_ns))
+                    .min(s.reader.len().saturating_sub(1))
+            }
+        }
+    }
+
+    /// Problems the reader collected (skipped messages, unknown channels, truncation).
+    #[must_use]
+    pub fn warnings(&self) -> Vec<String> {
+        match &self.kind {
+            Kind::Files(_) => Vec::new(),
+            Kind::Stream(s) => s.reader.warnings().to_vec(),
+        }
+    }
+
+    /// Frame `index`, from the cache or read now (and cached).
+    ///
+    /// # Errors
+    /// Index out of range; the file's read error, naming it.
+    pub fn read(&mut self, index: usize) -> anyhow::Result<LoadedFrame> {
+        if let Some(pos) = self.cache.iter().position(|(i, _)| *i == index) {
+            // Most recently used at the back.
+            if let Some(entry) = self.cache.remove(pos) {
+                let frame = entry.1.clone();
+                self.cache.push_back(entry);
+                return Ok(frame);
+            }
+        }
+        let frame = self.read_uncached(index)?;
+        self.cache.push_back((index, frame.clone()));
+        while self.cache.len() > CACHE_FRAMES {
+            self.cache.pop_front();
+        }
+        Ok(frame)
+    }
+
+    /// Number of frames in the cache (for tests and the status line).
+    #[must_use]
+    pub fn cached(&self) -> usize {
+        self.cache.len()
+    }
+
+    /// Frame `index` read now, bypassing the cache (whole-stream scans must not evict the frames
+    /// the user is stepping through).
+    ///
+    /// # Errors
+    /// Index out of range; the file's read error, naming it.
+    pub fn read_uncached(&mut self, index: usize) -> anyhow::Result<LoadedFrame> {
+        anyhow::ensure!(
+            index < self.len(),
+            "frame {index} is past the end ({} frames)",
+            self.len()
+        );
+        let time_ns = self.time_ns(index);
+        match &mut self.kind {
+            Kind::Files(f) => {
+                let path = &f.paths[index];
+                let frame = load_frame(path, None)?;
+                Ok(LoadedFrame {
+                    frame: Arc::new(frame),
+                    time_ns,
+                    sensors: None,
+                    extra: Vec::new(),
+                    warnings: Vec::new(),
+                })
+            }
+            Kind::Stream(s) => {
+                let record = s
+                    .reader
+                    .read(index)
+                    .with_context(|| format!("frame {index}"))?;
+                let mut warnings = Vec::new();
+                let sensors = record.sensors.map(|r| {
+                    let (clean, dropped) = r.sanitised();
+                    if !dropped.is_empty() {
+                        warnings.push(format!(
+                            "frame {index}: non-finite sensor readings dropped: {}",
+                            dropped.join(", ")
+                        ));
+                    }
+                    clean
+                });
+                let mut extra = record.extra;
+                if let Some(g) = record.ground_truth {
+                    extra.insert(0, ("/ground_truth".to_owned(), g));
+                }
+                if let Some(r) = record.recognition {
+                    extra.insert(0, ("/recognition".to_owned(), r));
+                }
+                Ok(LoadedFrame {
+                    frame: Arc::new(record.frame),
+                    time_ns,
+                    sensors,
+                    extra,
+                    warnings,
+                })
+            }
+        }
+    }
+}
+
+/// The file name of a path, for labels.
+#[must_use]
+pub fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}

@@ -1,0 +1,496 @@
+//! The desktop app driven headlessly with egui_kittest: the real `EotnApp` and `AppState`, real
+//! clicks and keys, assertions on state, on the saved table's bytes and on the journal.
+
+use std::path::{Path, PathBuf};
+
+use egui::{Event, Key, Modifiers, PointerButton, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable as _;
+use eotn::app::journal;
+use eotn::app::state::{Command, ViewKind, Window};
+use eotn::app::{AppState, EotnApp};
+use eotn::frame::{Frame, Yuv};
+use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
+
+const GREEN: Yuv = Yuv::new(100, 110, 100);
+const ORANGE: Yuv = Yuv::new(120, 80, 190);
+const YELLOW: Yuv = Yuv::new(190, 40, 150);
+
+/// A 208×160 field: green everywhere, an orange 20×20 ball whose place depends on `n`, a
+/// yellow goal bar on the left.
+fn scene(n: usize) -> Frame {
+    Frame::uyvy_from_fn(208, 160, |x, y| {
+        let bx = 60 + 10 * n;
+        if (bx..bx + 20).contains(&x) && (40..60).contains(&y) {
+            ORANGE
+        } else if x < 12 && (20..100).contains(&y) {
+            YELLOW
+        } else {
+            GREEN
+        }
+    })
+    .unwrap()
+}
+
+/// Three frame files and a 7-bit table with green and yellow classified, orange not.
+fn fixture(dir: &Path) -> (Vec<PathBuf>, PathBuf) {
+    let mut frames = Vec::new();
+    for n in 0..3 {
+        let p = dir.join(format!("f{n}.uyvy"));
+        std::fs::write(&p, scene(n).data()).unwrap();
+        frames.push(p);
+    }
+    let mut lut = LookupTable::new(7).unwrap();
+    for (class, sample) in [(ColourClass::Green, GREEN), (ColourClass::Yellow, YELLOW)] {
+        lut.apply(EditRecord::now(
+            class,
+            Region::AroundSample {
+                sample,
+                sensitivity: Sensitivity::uniform(2),
+            },
+        ));
+    }
+    let table = dir.join("field.lut");
+    lut.save(&table).unwrap();
+    (frames, table)
+}
+
+fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
+    Harness::builder()
+        .with_size(Vec2::new(1200.0, 800.0))
+        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
+}
+
+/// Where pixel (x, y) of the enlarged view is on screen.
+fn pixel_pos(h: &Harness<'_, EotnApp>, x: usize, y: usize) -> Pos2 {
+    h.state()
+        .last_view
+        .expect("the view was drawn")
+        .pixel_centre(x, y)
+}
+
+fn click_at(h: &Harness<'_, EotnApp>, pos: Pos2, button: PointerButton) {
+    h.event(Event::PointerMoved(pos));
+    for pressed in [true, false] {
+        h.event(Event::PointerButton {
+            pos,
+            button,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+    }
+}
+
+fn state<'h>(h: &'h Harness<'_, EotnApp>) -> &'h AppState {
+    &h.state().state
+}
+
+#[test]
+fn step_switch_views_zoom_pan_classify_undo_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut paths = frames;
+    paths.push(table.clone());
+    let mut h = harness(paths);
+    h.run();
+    assert!(
+        state(&h).warnings().is_empty(),
+        "{:?}",
+        state(&h).warnings()
+    );
+    assert_eq!(state(&h).source().unwrap().len(), 3);
+    assert_eq!(state(&h).table_path(), Some(table.as_path()));
+
+    // Step with the arrow keys and the timeline button.
+    h.key_press(Key::ArrowRight);
+    h.run();
+    assert_eq!(state(&h).index(), 1);
+    h.get_by_label("Next").click();
+    h.run();
+    assert_eq!(state(&h).index(), 2);
+    h.key_press(Key::ArrowRight);
+    h.run();
+    assert_eq!(state(&h).index(), 2, "stepping stops at the last frame");
+    h.key_press(Key::Home);
+    h.run();
+    assert_eq!(state(&h).index(), 0);
+
+    // Thumbnails swap with the enlarged view.
+    h.get_by_label("Classified").click();
+    h.run();
+    assert_eq!(state(&h).settings.main_view, ViewKind::Classified);
+    h.get_by_label("Raw").click();
+    h.run();
+    assert_eq!(state(&h).settings.main_view, ViewKind::Raw);
+
+    // Overlays switch.
+    let mut o = state(&h).settings.overlays;
+    o.classified = true;
+    o.opacity = 0.7;
+    h.state_mut().state.run(Command::SetOverlays(o));
+    h.run();
+    assert!(state(&h).settings.overlays.classified);
+
+    // Hover readout.
+    let ball = pixel_pos(&h, 65, 45);
+    h.event(Event::PointerMoved(ball));
+    h.run();
+    let info = h.state().hovered().copied().expect("hovering a pixel");
+    assert_eq!((info.x, info.y, info.yuv), (65, 45, ORANGE));
+    assert_eq!(info.class, ColourClass::Unclassified);
+
+    // Zoom about the cursor: the pixel under it stays under it.
+    h.event(Event::Zoom(2.0));
+    h.run();
+    let z = state(&h).settings.transform.zoom.expect("zoom set");
+    let xf = h.state().last_view.unwrap();
+    assert!((xf.zoom - z).abs() < 1e-4);
+    assert_eq!(xf.pixel_at(ball), Some((65, 45)));
+    // Middle-drag pans by screen points / zoom.
+    let before = xf.centre;
+    h.event(Event::PointerButton {
+        pos: ball,
+        button: PointerButton::Middle,
+        pressed: true,
+        modifiers: Modifiers::NONE,
+    });
+    h.run();
+    for k in 1..=4 {
+        h.event(Event::PointerMoved(ball + Vec2::new(10.0 * k as f32, 0.0)));
+        h.run();
+    }
+    h.event(Event::PointerButton {
+        pos: ball + Vec2::new(40.0, 0.0),
+        button: PointerButton::Middle,
+        pressed: false,
+        modifiers: Modifiers::NONE,
+    });
+    h.run();
+    let after = h.state().last_view.unwrap().centre;
+    assert!(
+        after.x < before.x,
+        "panning right moves the centre left: {before:?} → {after:?}"
+    );
+    assert!((after.y - before.y).abs() < 1e-3);
+    h.state_mut().state.run(Command::ResetView);
+    h.run();
+    assert_eq!(state(&h).settings.transform.zoom, None);
+
+    // Left-click samples with a sensitivity: the preview marks the ball, nothing is written.
+    h.state_mut()
+        .state
+        .run(Command::SetClass(ColourClass::Orange));
+    h.state_mut()
+        .state
+        .run(Command::SetSensitivity(Sensitivity::uniform(1)));
+    let original = std::fs::read(&table).unwrap();
+    click_at(&h, pixel_pos(&h, 65, 45), PointerButton::Primary);
+    h.run();
+    let s = state(&h);
+    assert_eq!(s.selection().and_then(|s| s.pixel), Some((65, 45)));
+    assert_eq!(s.preview_mask().iter().filter(|&&m| m).count(), 400);
+    assert_eq!(s.lut().cells(), &original[..], "preview writes nothing");
+    // Keys widen the sensitivity.
+    h.key_press(Key::Y);
+    h.run();
+    assert_eq!(state(&h).settings.sensitivity.y, 2);
+    h.key_press_modifiers(Modifiers::SHIFT, Key::Y);
+    h.run();
+    assert_eq!(state(&h).settings.sensitivity.y, 1);
+
+    // Right-click commits; the pipeline re-runs at once.
+    click_at(&h, pixel_pos(&h, 65, 45), PointerButton::Secondary);
+    h.run();
+    let s = state(&h);
+    assert!(s.dirty());
+    assert!(s.title().contains('*'), "{}", s.title());
+    assert_eq!(s.lut().class_counts()[1], 27);
+    let balls: Vec<_> = s.blobs().of_class(ColourClass::Orange).collect();
+    assert_eq!(balls.len(), 1);
+    assert_eq!(
+        (balls[0].minx, balls[0].miny, balls[0].pixels),
+        (60, 40, 400)
+    );
+    let committed = s.lut().clone();
+
+    // Undo and redo with the keys.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(state(&h).lut().cells(), &original[..]);
+    assert_eq!(state(&h).blobs().of_class(ColourClass::Orange).count(), 0);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Y);
+    h.run();
+    assert_eq!(state(&h).lut(), &committed);
+
+    // Save: the file holds exactly the table, atomically replaced; the journal replays to it.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run();
+    assert!(!state(&h).dirty(), "{}", state(&h).status);
+    assert_eq!(std::fs::read(&table).unwrap(), committed.cells());
+    let r = journal::replay(&table).unwrap();
+    assert_eq!(r.table, committed);
+    assert_eq!(r.commits, 1);
+    assert!(r.warnings.is_empty());
+    let lines = std::fs::read_to_string(journal::journal_path(&table)).unwrap();
+    assert_eq!(
+        lines.lines().count(),
+        4,
+        "start, commit, undo, redo:\n{lines}"
+    );
+    assert!(lines.contains(r#""event":"commit""#) && lines.contains(r#""class":"Orange""#));
+
+    // Export the view with overlays.
+    let png = dir.path().join("view.png");
+    h.state_mut().state.run(Command::ExportView(png.clone()));
+    let img = image::open(&png).unwrap().into_rgb8();
+    assert_eq!(img.dimensions(), (208, 160));
+}
+
+#[test]
+fn reopening_a_table_restores_undo_from_the_journal() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut s = AppState::default();
+    s.apply(Command::Open(vec![table.clone(), frames[0].clone()]))
+        .unwrap();
+    let original = s.lut().clone();
+    s.apply(Command::SetClass(ColourClass::Orange)).unwrap();
+    s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
+    s.apply(Command::Commit).unwrap();
+    s.apply(Command::SetClass(ColourClass::White)).unwrap();
+    s.apply(Command::Sample { x: 100, y: 100 }).unwrap();
+    s.apply(Command::Commit).unwrap();
+    s.apply(Command::SaveTable).unwrap();
+    let saved = s.lut().clone();
+
+    // A new session: the journal gives back both undo steps.
+    let mut s2 = AppState::default();
+    s2.apply(Command::OpenTable(table.clone())).unwrap();
+    assert_eq!(s2.lut(), &saved);
+    assert_eq!(s2.history().undo_len(), 2);
+    s2.apply(Command::Undo).unwrap();
+    s2.apply(Command::Undo).unwrap();
+    assert_eq!(s2.lut(), &original);
+    assert!(s2.dirty());
+
+    // A crash before saving: the table on disk lags the journal, which recovers it.
+    s2.apply(Command::Redo).unwrap();
+    let unsaved = s2.lut().clone();
+    let mut s3 = AppState::default();
+    s3.apply(Command::OpenTable(table.clone())).unwrap();
+    assert_eq!(s3.warnings().len(), 1, "{:?}", s3.warnings());
+    s3.apply(Command::RebuildFromJournal).unwrap();
+    assert_eq!(s3.lut(), &unsaved);
+
+    // A torn last line is skipped with a warning, not an error.
+    let jp = journal::journal_path(&table);
+    let mut text = std::fs::read_to_string(&jp).unwrap();
+    text.push_str("{\"event\":\"commit\",\"rec");
+    std::fs::write(&jp, text).unwrap();
+    let r = journal::replay(&table).unwrap();
+    assert_eq!(r.warnings.len(), 1);
+    assert_eq!(r.table, unsaved);
+}
+
+#[test]
+fn bad_files_are_reported_not_fatal() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("short.lut");
+    std::fs::write(&bad, [0u8; 1000]).unwrap();
+    let mut s = AppState::default();
+    let err = s.apply(Command::Open(vec![bad.clone()])).unwrap_err();
+    assert!(format!("{err:#}").contains("short.lut"), "{err:#}");
+    let frame = dir.path().join("odd.uyvy");
+    std::fs::write(&frame, [0u8; 333]).unwrap();
+    s.run(Command::Open(vec![frame]));
+    assert_eq!(s.warnings().len(), 1);
+    assert!(s.warnings()[0].contains("odd.uyvy"), "{:?}", s.warnings());
+    assert!(s.source().is_none());
+}
+
+#[test]
+fn try_edit_lists_the_frames_that_would_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut s = AppState::default();
+    let mut paths = frames;
+    paths.push(table);
+    s.apply(Command::Open(paths)).unwrap();
+    // Selecting green as white would change every frame's field.
+    s.apply(Command::SetClass(ColourClass::White)).unwrap();
+    s.apply(Command::Sample { x: 150, y: 120 }).unwrap();
+    s.apply(Command::TryEditOnStream).unwrap();
+    while !s.try_edit().unwrap().done() {
+        s.tick(std::time::Duration::from_millis(16));
+    }
+    let t = s.try_edit().unwrap();
+    assert_eq!(t.rows.len(), 3);
+    let field = 208 * 160 - 400 - 12 * 80;
+    assert!(
+        t.rows.iter().all(|r| r.changed_pixels == field),
+        "{:?}",
+        t.rows
+    );
+    // Nothing was written.
+    assert_eq!(s.lut().class_counts()[6], 0);
+}
+
+#[test]
+fn every_window_and_menu_opens() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut paths = frames;
+    paths.push(table);
+    let mut h = harness(paths);
+    h.run();
+    for w in Window::ALL {
+        h.state_mut().state.run(Command::ShowWindow(w, true));
+    }
+    h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
+    h.state_mut().state.run(Command::TryEditOnStream);
+    h.run();
+    assert!(
+        h.query_all_by_label_contains("plane").count() >= 1,
+        "{:#?}",
+        h.root()
+    );
+    for menu in ["File", "Classification", "View", "Stream", "Windows"] {
+        h.get_by_label(menu).click();
+        h.run();
+    }
+    // Clicking the U–V plane selects around a cell and previews matching pixels.
+    h.state_mut().state.run(Command::ClearSelection);
+    h.state_mut().state.run(Command::SetUvPlaneY(100));
+    h.run();
+    let s = state(&h);
+    assert!(s.selection().is_none());
+    h.state_mut().state.run(Command::SampleCell([50, 55, 50]));
+    assert_eq!(
+        state(&h).preview_mask().iter().filter(|&&m| m).count(),
+        208 * 160 - 400 - 12 * 80,
+        "the green cell marks the field"
+    );
+}
+
+#[test]
+fn closing_with_unsaved_changes_asks_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut h = harness(vec![frames[0].clone(), table]);
+    h.run();
+    h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
+    h.state_mut().state.run(Command::Commit);
+    h.run();
+    assert!(state(&h).dirty());
+    h.input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    h.run();
+    assert!(h.state().confirming_close());
+    assert!(h.query_by_label("Quit without saving").is_some());
+    h.get_by_label("Cancel").click();
+    h.run();
+    assert!(!h.state().confirming_close());
+}
+
+#[test]
+fn snapshot_with_overlays() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut s = AppState::default();
+    let mut paths = frames;
+    paths.push(table);
+    s.apply(Command::Open(paths)).unwrap();
+    let mut o = s.settings.overlays;
+    o.classified = true;
+    o.opacity = 0.6;
+    s.apply(Command::SetOverlays(o)).unwrap();
+    s.apply(Command::SetClass(ColourClass::Orange)).unwrap();
+    s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
+    // Timings differ from run to run; everything else on screen is deterministic.
+    s.apply(Command::ShowTimings(false)).unwrap();
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(1000.0, 700.0))
+        .wgpu()
+        .build_eframe(move |_| EotnApp::with_state(s));
+    h.run();
+    h.snapshot("app_overlays");
+}
+
+/// A short recorded stream: the scenes above at 25 fps with head-pan readings.
+fn stream_fixture(dir: &Path, frames: usize) -> PathBuf {
+    use eotn::sensors::SensorReadings;
+    use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
+    let path = dir.join("s.mcap");
+    let info = StreamInfo {
+        source: "robot".to_owned(),
+        description: "app test".to_owned(),
+    };
+    let mut w = StreamWriter::create(&path, &info).unwrap();
+    for i in 0..frames {
+        let mut r = FrameRecord::new(i as u64 * 40_000_000, scene(i % 3));
+        r.sensors = Some(SensorReadings {
+            head_pan_rad: Some(0.1 * i as f64),
+            previous_head_pan_rad: Some(0.1 * i.saturating_sub(1) as f64),
+            frame_interval_s: Some(0.04),
+            pan_pwm: if i == 2 { Some(f64::NAN) } else { Some(0.5) },
+            ..SensorReadings::default()
+        });
+        w.write(&r).unwrap();
+    }
+    w.finish().unwrap();
+    path
+}
+
+#[test]
+fn stream_steps_plays_and_plots_sensors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, table) = fixture(dir.path());
+    let stream = stream_fixture(dir.path(), 20);
+    let mut h = harness(vec![stream, table]);
+    h.run();
+    let s = state(&h);
+    assert_eq!(s.source().unwrap().len(), 20);
+    assert!(s.source().unwrap().is_stream());
+    h.key_press(Key::ArrowRight);
+    h.key_press(Key::ArrowRight);
+    h.run();
+    let s = state(&h);
+    assert_eq!(s.index(), 2);
+    let c = s.current().unwrap();
+    assert_eq!(c.time_ns, 80_000_000);
+    let sensors = c.sensors.unwrap();
+    assert!((sensors.head_pan_rad.unwrap() - 0.2).abs() < 1e-9);
+    // NaN cannot be stored in JSON: it arrives as a missing reading, never as a number.
+    assert_eq!(sensors.pan_pwm, None);
+    // Jump, and the cache stays small.
+    h.state_mut().state.run(Command::Seek(15));
+    for i in 0..15 {
+        h.state_mut().state.run(Command::Seek(i));
+    }
+    assert!(state(&h).source().unwrap().cached() <= eotn::app::source::CACHE_FRAMES);
+    // The sensor dialog reads the whole series in the background.
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Sensors, true));
+    h.run();
+    let st = &mut h.state_mut().state;
+    for _ in 0..100 {
+        st.tick(std::time::Duration::from_millis(16));
+    }
+    assert_eq!(st.sensor_series.points.len(), 20);
+    // Play at the recorded rate: 0.2 s of wall time moves 5 frames.
+    st.run(Command::Seek(0));
+    st.run(Command::SetSpeed(1.0));
+    st.run(Command::SetPlaying(true));
+    st.tick(std::time::Duration::from_millis(200));
+    assert_eq!(st.index(), 5);
+    st.run(Command::SetSpeed(4.0));
+    st.tick(std::time::Duration::from_millis(200));
+    assert_eq!(st.index(), 19);
+    assert!(!st.playing(), "stops at the end");
+    h.run();
+}
