@@ -838,7 +838,7 @@ mod tests {
             .collect();
         let p = ball[ball.len() / 2];
         let yuv = out.frame.pixel(p % 208, p / 208).expect("in image");
-        assert!(yuv.v > 170 && yuv.u < 110, "{yuv:?}");
+        assert!(yuv.v > 150 && yuv.u < 110 && yuv.v > yuv.u + 40, "{yuv:?}");
     }
 
     #[test]
