@@ -10,8 +10,10 @@
 //! | [`classify`] | frame + table → classified image |
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
+//! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
 //! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
+//! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -20,9 +22,11 @@ pub mod blobs;
 pub mod classify;
 pub mod frame;
 pub mod geometry;
+pub mod import;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;
+pub mod streams;
 pub mod sim;
 
 pub mod cli;

@@ -9,16 +9,14 @@ use std::time::Duration;
 
 use serde::Serialize;
 
-use super::inputs::{
-    expand_frame_paths, load_frame_arg, load_lut_arg, parse_connectivity, parse_size, progress,
-};
+use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
 use crate::blobs::Connectivity;
 use crate::pipeline::{Pipeline, PipelineParams};
 
 /// Arguments of `eotn bench`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them.
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`).
     #[arg(required = true)]
     pub frames: Vec<PathBuf>,
     /// Lookup table (`.lut`).
@@ -87,15 +85,15 @@ fn ns_per_px(d: Duration, pixels: usize) -> f64 {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let lut = load_lut_arg(&args.lut)?;
     let bits = lut.bits();
-    let paths = expand_frame_paths(&args.frames)?;
+    let mut inputs = FrameInputs::open(&args.frames, None)?;
     let connectivity = args.connectivity;
     let mut pipeline = Pipeline::new(lut, PipelineParams { connectivity });
     let (mut classify, mut blobs, mut total) = (Vec::new(), Vec::new(), Vec::new());
     let mut total_ms = Vec::new();
     let mut pixels = 0;
-    let bar = progress(paths.len(), "bench");
-    for path in &paths {
-        let frame = load_frame_arg(path, args.size)?;
+    let bar = progress(inputs.len(), "bench");
+    for i in 0..inputs.len() {
+        let frame = inputs.load(i, args.size)?;
         pixels = frame.pixel_count();
         for _ in 0..args.warmup {
             pipeline.process_frame(&frame);
@@ -111,7 +109,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
     let result = BenchJson {
-        frames: paths.len(),
+        frames: inputs.len(),
         pixels_per_frame: pixels,
         lut_bits: bits,
         connectivity: connectivity.neighbours(),

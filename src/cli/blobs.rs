@@ -6,17 +6,14 @@ use std::path::PathBuf;
 use anyhow::Context;
 use serde::Serialize;
 
-use super::inputs::{
-    expand_frame_paths, frame_name, load_frame_arg, load_lut_arg, parse_connectivity, parse_size,
-    progress,
-};
+use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
 use crate::blobs::{Blob, BlobSet, Connectivity};
 use crate::classify::ClassifiedImage;
 
 /// Arguments of `eotn blobs`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them.
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`).
     #[arg(required = true)]
     pub frames: Vec<PathBuf>,
     /// Lookup table (`.lut`, 6, 7 or 8 bits per channel).
@@ -94,21 +91,21 @@ pub fn peer_sorted(blobs: impl Iterator<Item = Blob>, min_pixels: u32) -> Vec<Bl
 /// Unreadable or malformed inputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let lut = load_lut_arg(&args.lut)?;
-    let paths = expand_frame_paths(&args.frames)?;
+    let mut inputs = FrameInputs::open(&args.frames, None)?;
     let connectivity = args.connectivity;
     let mut classified = ClassifiedImage::default();
     let mut set = BlobSet::default();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    let bar = progress(paths.len(), "blobs");
-    for path in &paths {
-        let frame = load_frame_arg(path, args.size)?;
+    let bar = progress(inputs.len(), "blobs");
+    for i in 0..inputs.len() {
+        let frame = inputs.load(i, args.size)?;
         crate::classify::classify_into(&frame, &lut, &mut classified);
         set.find(&classified, connectivity);
         let blobs = peer_sorted(set.active().copied(), args.min_pixels);
         if args.json {
             let line = FrameBlobsJson {
-                frame: frame_name(path),
+                frame: inputs.name(i),
                 width: frame.width(),
                 height: frame.height(),
                 lut_bits: lut.bits(),
@@ -121,7 +118,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             writeln!(
                 out,
                 "{} ({}×{}): {} blobs",
-                frame_name(path),
+                inputs.name(i),
                 frame.width(),
                 frame.height(),
                 blobs.len()

@@ -6,9 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::inputs::{
-    expand_frame_paths, frame_name, load_frame_arg, load_lut_arg, parse_size, progress,
-};
+use super::inputs::{FrameInputs, load_lut_arg, parse_size, progress};
 use crate::classify::ClassifiedImage;
 use crate::frame::save_rgb_png;
 use crate::lut::ColourClass;
@@ -16,7 +14,7 @@ use crate::lut::ColourClass;
 /// Arguments of `eotn classify`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them.
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`).
     #[arg(required = true)]
     pub frames: Vec<PathBuf>,
     /// Lookup table (`.lut`).
@@ -43,7 +41,7 @@ pub struct Args {
 /// Unreadable inputs or unwritable outputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let lut = load_lut_arg(&args.lut)?;
-    let paths = expand_frame_paths(&args.frames)?;
+    let mut inputs = FrameInputs::open(&args.frames, None)?;
     if let Some(dir) = &args.output {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create folder", dir.display()))?;
@@ -51,11 +49,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut img = ClassifiedImage::default();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    let bar = progress(paths.len(), "classify");
-    for path in &paths {
-        let frame = load_frame_arg(path, args.size)?;
+    let bar = progress(inputs.len(), "classify");
+    for i in 0..inputs.len() {
+        let frame = inputs.load(i, args.size)?;
         crate::classify::classify_into(&frame, &lut, &mut img);
-        let name = frame_name(path);
+        let name = inputs.name(i);
         if let Some(dir) = &args.output {
             let png = dir.join(format!("{name}.classified.png"));
             save_rgb_png(&png, img.width(), img.height(), &img.to_rgb())?;

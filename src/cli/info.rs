@@ -1,14 +1,15 @@
-//! `eotn info`: what a file is — lookup table, frame (and, as streams land, MCAP stream).
+//! `eotn info`: what a file is — lookup table, frame, or MCAP stream.
 
 use std::path::PathBuf;
 
 use super::inputs::{is_frame_file, load_frame_arg, parse_size};
 use crate::lut::{ColourClass, LookupTable};
+use crate::streams::{StreamReader, is_stream_file};
 
 /// Arguments of `eotn info`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Lookup tables (`.lut`) and frames (`.uyvy`, `.png`, `.jpg`).
+    /// Lookup tables (`.lut`), frames (`.uyvy`, `.png`, `.jpg`) and streams (`.mcap`).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred.
@@ -25,7 +26,9 @@ pub struct Args {
 /// An unreadable or malformed file, naming it.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     for path in &args.files {
-        let value = if is_frame_file(path) {
+        let value = if is_stream_file(path) {
+            stream_info(path)?
+        } else if is_frame_file(path) {
             let f = load_frame_arg(path, args.size)?;
             serde_json::json!({
                 "file": path.display().to_string(), "kind": "frame",
@@ -52,6 +55,60 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// A stream's description: source, frames, times, frame size, which channels frame 0 has,
+/// and the reader's warnings.
+fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
+    let mut reader = StreamReader::open(path)?;
+    let n = reader.len();
+    let (first, last) = (
+        reader.time_ns(0),
+        n.checked_sub(1).and_then(|i| reader.time_ns(i)),
+    );
+    let mut value = serde_json::json!({
+        "file": path.display().to_string(), "kind": "stream",
+        "source": reader.info().source, "description": reader.info().description,
+        "frames": n, "chunks": reader.chunk_count(),
+        "first_time_ns": first, "last_time_ns": last,
+    });
+    if let (Some(a), Some(b)) = (first, last)
+        && n > 1
+        && b > a
+    {
+        let (secs, fps) = duration_and_rate(b - a, n);
+        value["duration_s"] = secs.into();
+        value["fps"] = fps.into();
+    }
+    if n > 0 {
+        let r = reader.read(0)?;
+        value["width"] = r.frame.width().into();
+        value["height"] = r.frame.height().into();
+        let mut channels = vec!["/camera/image".to_owned()];
+        if r.sensors.is_some() {
+            channels.push("/sensors".to_owned());
+        }
+        if r.ground_truth.is_some() {
+            channels.push("/ground_truth".to_owned());
+        }
+        if r.recognition.is_some() {
+            channels.push("/recognition".to_owned());
+        }
+        channels.extend(r.extra.iter().map(|(t, _)| t.clone()));
+        value["frame0_channels"] = channels.into();
+    }
+    value["warnings"] = reader.warnings().to_vec().into();
+    Ok(value)
+}
+
+/// Seconds spanned by `span_ns` and frames per second for `n` frames over it.
+#[expect(
+    clippy::cast_precision_loss,
+    reason = "a duration in ns and a frame count are far below 2^52"
+)]
+fn duration_and_rate(span_ns: u64, n: usize) -> (f64, f64) {
+    let secs = span_ns as f64 / 1e9;
+    (secs, n.saturating_sub(1) as f64 / secs)
 }
 
 fn print_human(v: &serde_json::Value) {

@@ -1,5 +1,7 @@
-//! Shared command-line inputs: frame lists, `--size`, `--lut`, progress bars.
+//! Shared command-line inputs: frame lists (files, folders, MCAP streams), `--size`, `--lut`,
+//! `--frames`, progress bars.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -8,6 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::blobs::Connectivity;
 use crate::frame::{Frame, is_image_file, load_frame};
 use crate::lut::LookupTable;
+use crate::streams::{StreamReader, is_stream_file};
 
 /// File extensions read as raw UYVY frames.
 pub const RAW_EXTENSIONS: [&str; 3] = ["uyvy", "yuv", "raw"];
@@ -55,7 +58,8 @@ pub fn is_frame_file(path: &Path) -> bool {
             .is_some_and(|e| RAW_EXTENSIONS.iter().any(|r| e.eq_ignore_ascii_case(r)))
 }
 
-/// Expands the arguments: files stay, folders give their frame files sorted by name.
+/// Expands the arguments: files (frames and `.mcap` streams) stay, folders give their frame files
+/// sorted by name.
 ///
 /// # Errors
 /// A path that does not exist, or a folder without frames.
@@ -87,6 +91,159 @@ pub fn expand_frame_paths(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
         bail!("no input frames given");
     }
     Ok(out)
+}
+
+/// Parses a frame range: `A..B` (B excluded), `A..=B`, `A..`, `..B`, or a single index `A`.
+///
+/// # Errors
+/// A message for anything else.
+pub fn parse_frame_range(text: &str) -> Result<Range<usize>, String> {
+    let bad = || format!("'{text}' is not a frame range (A..B, A..=B, A.., ..B or A)");
+    let num = |s: &str| s.trim().parse::<usize>().map_err(|_| bad());
+    let Some((a, b)) = text.split_once("..") else {
+        let a = num(text)?;
+        return Ok(a..a.saturating_add(1));
+    };
+    let start = if a.trim().is_empty() { 0 } else { num(a)? };
+    let end = if let Some(b) = b.strip_prefix('=') {
+        num(b)?.saturating_add(1)
+    } else if b.trim().is_empty() {
+        usize::MAX
+    } else {
+        num(b)?
+    };
+    if end < start {
+        return Err(bad());
+    }
+    Ok(start..end)
+}
+
+/// One frame to process: a frame file, or one frame of a stream.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FrameInput {
+    /// A `.uyvy`/PNG/JPEG file.
+    File(PathBuf),
+    /// Frame `index` of the MCAP stream at `path`.
+    Stream {
+        /// The stream file.
+        path: PathBuf,
+        /// Frame index within the stream.
+        index: usize,
+    },
+}
+
+impl FrameInput {
+    /// The name used in JSON output and output file names: the file name, or for a stream
+    /// frame `STEM_NNNNNN` (stem of the stream file, 6-digit frame index).
+    #[must_use]
+    pub fn name(&self) -> String {
+        match self {
+            Self::File(p) => frame_name(p),
+            Self::Stream { path, index } => {
+                let stem = path
+                    .file_stem()
+                    .map_or_else(|| "stream".to_owned(), |s| s.to_string_lossy().into_owned());
+                format!("{stem}_{index:06}")
+            }
+        }
+    }
+}
+
+/// The frames named on a command line, in order: frame files, folders of them, and MCAP streams
+/// (every frame of each, or those in `--frames`). Streams are read one frame at a time, so a long
+/// stream costs no more memory than a short one.
+#[derive(Debug)]
+pub struct FrameInputs {
+    items: Vec<FrameInput>,
+    reader: Option<StreamReader>,
+}
+
+impl FrameInputs {
+    /// Expands the arguments; `range` limits the frames taken from each stream.
+    ///
+    /// # Errors
+    /// A path that does not exist, a folder without frames, an unreadable stream, or a stream
+    /// without frames (each naming the file).
+    pub fn open(paths: &[PathBuf], range: Option<Range<usize>>) -> anyhow::Result<Self> {
+        let mut items = Vec::new();
+        for p in expand_frame_paths(paths)? {
+            if is_stream_file(&p) {
+                let reader = StreamReader::open(&p)?;
+                for w in reader.warnings() {
+                    log::warn!("{}: {w}", p.display());
+                }
+                if reader.is_empty() {
+                    bail!("{}: the stream holds no frames", p.display());
+                }
+                let all = 0..reader.len();
+                let take = range
+                    .clone()
+                    .map_or(all.clone(), |r| r.start.min(all.end)..r.end.min(all.end));
+                if take.is_empty() {
+                    bail!(
+                        "{}: --frames selects none of its {} frames",
+                        p.display(),
+                        reader.len()
+                    );
+                }
+                items.extend(take.map(|index| FrameInput::Stream {
+                    path: p.clone(),
+                    index,
+                }));
+            } else {
+                items.push(FrameInput::File(p));
+            }
+        }
+        Ok(Self {
+            items,
+            reader: None,
+        })
+    }
+
+    /// Number of frames.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// True when there are no frames.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// The inputs in order.
+    #[must_use]
+    pub fn items(&self) -> &[FrameInput] {
+        &self.items
+    }
+
+    /// The name of frame `i` (see [`FrameInput::name`]).
+    #[must_use]
+    pub fn name(&self, i: usize) -> String {
+        self.items.get(i).map(FrameInput::name).unwrap_or_default()
+    }
+
+    /// Loads frame `i` (raw files with `size`, inferred when `None`).
+    ///
+    /// # Errors
+    /// The loader's error, naming the file.
+    pub fn load(&mut self, i: usize, size: Option<(usize, usize)>) -> anyhow::Result<Frame> {
+        match self.items.get(i) {
+            None => bail!("no input frame {i}"),
+            Some(FrameInput::File(p)) => load_frame_arg(p, size),
+            Some(FrameInput::Stream { path, index }) => {
+                if self.reader.as_ref().is_none_or(|r| r.path() != path) {
+                    self.reader = Some(StreamReader::open(path)?);
+                }
+                let Some(reader) = self.reader.as_mut() else {
+                    bail!("{}: stream not open", path.display());
+                };
+                let record = reader.read(*index)?;
+                Ok(record.frame)
+            }
+        }
+    }
 }
 
 /// Loads one frame with the error naming the file.
@@ -150,5 +307,16 @@ mod tests {
         let names: Vec<_> = got.iter().map(|p| frame_name(p)).collect();
         assert_eq!(names, ["a.uyvy", "b.uyvy", "c.png"]);
         assert!(expand_frame_paths(&[dir.path().join("nope")]).is_err());
+    }
+
+    #[test]
+    fn frame_ranges_parse() {
+        assert_eq!(parse_frame_range("2..5"), Ok(2..5));
+        assert_eq!(parse_frame_range("2..=5"), Ok(2..6));
+        assert_eq!(parse_frame_range("..3"), Ok(0..3));
+        assert_eq!(parse_frame_range("7.."), Ok(7..usize::MAX));
+        assert_eq!(parse_frame_range("4"), Ok(4..5));
+        assert!(parse_frame_range("5..2").is_err());
+        assert!(parse_frame_range("a..b").is_err());
     }
 }

@@ -6,9 +6,12 @@
 mod bench;
 mod blobs;
 mod classify;
+mod export;
+mod import;
 mod info;
 pub mod inputs;
 mod lut_from_labels;
+mod lut;
 
 use std::process::ExitCode;
 
@@ -36,8 +39,14 @@ pub enum Command {
     Blobs(blobs::Args),
     /// Time classification and blob formation; `--json` ends with the medians in ns/pixel.
     Bench(bench::Args),
+    /// Build an MCAP stream from frame files and a CSV/JSON table of sensor readings.
+    Import(import::Args),
+    /// Write frames of streams or frame files as PNG: raw, classified, or with blob boxes.
+    Export(export::Args),
     /// Build a first lookup table from labelled frames and score it on held-back frames.
     LutFromLabels(lut_from_labels::Args),
+    /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
+    Lut(lut::Args),
 }
 
 /// Runs a headless subcommand.
@@ -50,7 +59,10 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Classify(a) => classify::run(&a),
         Command::Blobs(a) => blobs::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Import(a) => import::run(&a),
+        Command::Export(a) => export::run(&a),
         Command::LutFromLabels(a) => lut_from_labels::run(&a),
+        Command::Lut(a) => lut::run(&a),
     }
 }
 

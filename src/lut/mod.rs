@@ -6,9 +6,10 @@
 //! (`FORMATS.md`), so tables move freely between tools; loading infers `bits` from the size.
 //!
 //! Editing (selecting cells around a sample pixel, committing, undo/redo) is in [`edit`];
-//! other teams' formats convert in [`convert`] when that lands.
+//! other teams' formats convert in [`convert`].
 
 pub mod classes;
+pub mod convert;
 pub mod edit;
 pub mod learn;
 

@@ -61,3 +61,24 @@ pub fn python_with_opencv() -> Option<PathBuf> {
     eprintln!("SKIPPED: python3 with numpy + OpenCV not found; the peer cross-check did not run");
     None
 }
+
+/// A python3 with the `mcap` and `mcap_protobuf` readers (an independent MCAP implementation),
+/// or `None` (with a "skipped" line) outside CI. Under `CI=true` their absence fails the test.
+pub fn python_with_mcap() -> Option<PathBuf> {
+    let python = PathBuf::from(std::env::var_os("PYTHON").unwrap_or_else(|| "python3".into()));
+    let ok = Command::new(&python)
+        .args(["-c", "import mcap, mcap_protobuf"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if ok {
+        return Some(python);
+    }
+    assert!(
+        !in_ci(),
+        "python3 with mcap and mcap-protobuf-support is required under CI=true (pip install mcap mcap-protobuf-support)"
+    );
+    eprintln!(
+        "SKIPPED: python3 with the mcap + mcap_protobuf readers not found; the independent-reader cross-check did not run"
+    );
+    None
+}

@@ -5,4 +5,6 @@
 mod cli;
 mod common;
 mod peer;
+mod streams;
 mod sim_table;
+mod real_data;

@@ -1,0 +1,223 @@
+//! `eotn import`: a folder of frames plus a table of sensor readings → one MCAP stream.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+
+use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
+use crate::sensors::SensorReadings;
+use crate::streams::sensor_table::SensorTable;
+use crate::streams::{
+    Compression, FrameRecord, StreamInfo, StreamWriter, WriterOptions, is_stream_file,
+};
+
+/// Chunk compression on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CompressionArg {
+    /// Zstandard: smallest files.
+    Zstd,
+    /// LZ4: fastest.
+    Lz4,
+    /// No compression.
+    None,
+}
+
+/// Arguments of `eotn import`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them; a folder's frames are taken in name
+    /// order. PNG/JPEG frames are stored as UYVY.
+    #[arg(required = true)]
+    pub frames: Vec<PathBuf>,
+    /// Sensor readings: a CSV file with a header row of sensor field names (plus optional `frame`
+    /// and `time_s` columns), or a `.json` array of objects with the same keys. Frames without a
+    /// row get no readings.
+    #[arg(long)]
+    pub sensors: Option<PathBuf>,
+    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+    /// Frames per second, for frame times when the sensor table has no `time_s` column.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    /// Kind of source stored in the stream's metadata (`robot`, `overhead`, `sim:NAME`, …).
+    #[arg(long, default_value = "import")]
+    pub source: String,
+    /// Free description stored in the stream's metadata.
+    #[arg(long, default_value = "")]
+    pub description: String,
+    /// Chunk compression.
+    #[arg(long, value_enum, default_value = "zstd")]
+    pub compression: CompressionArg,
+    /// Frames per chunk (default: about 1 MiB of images per chunk).
+    #[arg(long)]
+    pub frames_per_chunk: Option<usize>,
+    /// The stream to write (`.mcap`); written as `OUT.partial` and renamed when complete.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// Runs `eotn import`.
+///
+/// # Errors
+/// Unreadable frames or sensor table, bad times, an unwritable output, each naming the file.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        bail!("--fps must be a positive number, not {}", args.fps);
+    }
+    let paths = expand_frame_paths(&args.frames)?;
+    if let Some(stream) = paths.iter().find(|p| is_stream_file(p)) {
+        bail!(
+            "{}: import reads frame files; this is already a stream",
+            stream.display()
+        );
+    }
+    let table = match &args.sensors {
+        Some(p) => {
+            let t = SensorTable::load(p)?;
+            for w in t.warnings() {
+                log::warn!("{}: {w}", p.display());
+            }
+            let unmatched = t
+                .rows()
+                .iter()
+                .enumerate()
+                .filter(|(i, r)| r.frame.unwrap_or(*i) >= paths.len())
+                .count();
+            if unmatched > 0 {
+                log::warn!(
+                    "{}: {unmatched} rows name frames beyond the {} given; ignored",
+                    p.display(),
+                    paths.len()
+                );
+            }
+            Some(t)
+        }
+        None => None,
+    };
+    let options = WriterOptions {
+        compression: match args.compression {
+            CompressionArg::Zstd => Compression::Zstd,
+            CompressionArg::Lz4 => Compression::Lz4,
+            CompressionArg::None => Compression::None,
+        },
+        frames_per_chunk: args.frames_per_chunk,
+    };
+    let info = StreamInfo {
+        source: args.source.clone(),
+        description: args.description.clone(),
+    };
+    let mut writer = StreamWriter::create_with(&args.output, &info, options)?;
+    let bar = progress(paths.len(), "import");
+    let mut previous: Option<(u64, Option<SensorReadings>)> = None;
+    for (i, path) in paths.iter().enumerate() {
+        let frame = load_frame_arg(path, args.size)?;
+        let row = table.as_ref().and_then(|t| t.for_frame(i));
+        let time_ns = match row.and_then(|r| r.time_s) {
+            Some(t) => seconds_to_ns(t).with_context(|| {
+                format!(
+                    "{}: time_s {t} of frame {i} is not a time",
+                    args.sensors.as_deref().unwrap_or(path).display()
+                )
+            })?,
+            None => seconds_to_ns(frame_seconds(i, args.fps))
+                .with_context(|| format!("frame {i} at {} fps is too late", args.fps))?,
+        };
+        let mut sensors = row.map(|r| r.readings);
+        if let (Some(s), Some((t0, before))) = (sensors.as_mut(), previous.as_ref()) {
+            fill_from_previous(s, *t0, time_ns, before.as_ref());
+        }
+        let mut record = FrameRecord::new(time_ns, frame);
+        record.sensors = sensors;
+        writer
+            .write(&record)
+            .with_context(|| format!("frame {}", path.display()))?;
+        previous = Some((time_ns, sensors));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    writer.finish()?;
+    eprintln!(
+        "eotn: wrote {} frames to {}",
+        paths.len(),
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Fills the readings derived from the previous frame when the table left them out: previous pan
+/// and tilt, and the frame interval (used for the pan velocity).
+fn fill_from_previous(
+    s: &mut SensorReadings,
+    t0_ns: u64,
+    t_ns: u64,
+    before: Option<&SensorReadings>,
+) {
+    if s.frame_interval_s.is_none() && t_ns > t0_ns {
+        s.frame_interval_s = Some(ns_to_seconds(t_ns - t0_ns));
+    }
+    if let Some(b) = before {
+        s.previous_head_pan_rad = s.previous_head_pan_rad.or(b.head_pan_rad);
+        s.previous_head_tilt_rad = s.previous_head_tilt_rad.or(b.head_tilt_rad);
+    }
+}
+
+#[expect(
+    clippy::cast_precision_loss,
+    reason = "frame counts are far below 2^52"
+)]
+fn frame_seconds(i: usize, fps: f64) -> f64 {
+    i as f64 / fps
+}
+
+#[expect(
+    clippy::cast_precision_loss,
+    reason = "intervals between frames are far below 2^52 ns"
+)]
+fn ns_to_seconds(ns: u64) -> f64 {
+    ns as f64 / 1e9
+}
+
+/// Seconds → nanoseconds, `None` for negative, non-finite or absurd (> 500 years) times.
+fn seconds_to_ns(s: f64) -> Option<u64> {
+    let ns = (s * 1e9).round();
+    if !(s.is_finite() && (0.0..1.6e19).contains(&ns)) {
+        return None;
+    }
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        reason = "checked: finite, non-negative and below 1.6e19"
+    )]
+    let n = ns as u64;
+    Some(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn times_convert_and_reject_nonsense() {
+        assert_eq!(seconds_to_ns(1.5), Some(1_500_000_000));
+        assert_eq!(seconds_to_ns(-0.1), None);
+        assert_eq!(seconds_to_ns(f64::NAN), None);
+        assert_eq!(seconds_to_ns(1e30), None);
+    }
+
+    #[test]
+    fn previous_pan_and_interval_are_derived() {
+        let before = SensorReadings {
+            head_pan_rad: Some(0.1),
+            ..SensorReadings::default()
+        };
+        let mut now = SensorReadings {
+            head_pan_rad: Some(0.3),
+            ..SensorReadings::default()
+        };
+        fill_from_previous(&mut now, 0, 40_000_000, Some(&before));
+        assert_eq!(now.previous_head_pan_rad, Some(0.1));
+        let v = now.pan_velocity_rad_per_s().unwrap();
+        assert!((v - 5.0).abs() < 1e-9, "{v}");
+    }
+}

@@ -1,0 +1,150 @@
+//! Recorded streams: camera frames with the robot's sensor readings, ground truth and recognition
+//! results, in one MCAP file that Foxglove and other MCAP tools open.
+//!
+//! One frame is one message on [`IMAGE_TOPIC`] (`foxglove.RawImage`, protobuf, encoding `uyvy`,
+//! `step` = 2 × width bytes). The frame's other data are JSON messages with the image's log time,
+//! written right after it in the same chunk: [`SENSORS_TOPIC`] (a [`SensorReadings`]),
+//! [`GROUND_TRUTH_TOPIC`], [`RECOGNITION_TOPIC`] and any extra JSON channels (for example
+//! `/world_model/robot3`). Every JSON channel has a `jsonschema` schema. The stream's
+//! [`StreamInfo`] is an MCAP metadata record named [`METADATA_NAME`].
+//!
+//! [`StreamWriter`] writes chunks of a few frames (zstd by default) with message and chunk
+//! indexes; each finished chunk is flushed to the file, so a recording cut off by a crash stays
+//! readable up to its last complete chunk. [`StreamReader`] finds frames through the summary's
+//! chunk indexes and the image channel's message indexes, and reads only the one chunk a frame is
+//! in (the last chunk stays cached), so memory stays flat however long the file is; when the
+//! summary is missing it recovers by scanning the complete chunks, and says so in
+//! [`StreamReader::warnings`].
+
+mod reader;
+pub mod schema;
+pub mod sensor_table;
+mod writer;
+
+use std::path::PathBuf;
+
+pub use reader::StreamReader;
+pub use writer::{Compression, StreamWriter, WriterOptions};
+
+use crate::frame::Frame;
+use crate::sensors::SensorReadings;
+
+/// Topic of the camera image channel (`foxglove.RawImage`, protobuf).
+pub const IMAGE_TOPIC: &str = "/camera/image";
+/// Topic of the sensor readings channel (JSON, schema `eotn.SensorReadings`).
+pub const SENSORS_TOPIC: &str = "/sensors";
+/// Topic of the ground-truth channel (JSON object, free form; written by renderers/simulators).
+pub const GROUND_TRUTH_TOPIC: &str = "/ground_truth";
+/// Topic of the recognition-results channel (JSON object, free form; written by the pipeline).
+pub const RECOGNITION_TOPIC: &str = "/recognition";
+/// Name of the MCAP metadata record that holds the [`StreamInfo`].
+pub const METADATA_NAME: &str = "eotn.stream";
+/// Version of the stream layout written by this crate (metadata key `format_version`).
+pub const FORMAT_VERSION: &str = "1";
+
+/// What a stream is: where its frames came from and a free description.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct StreamInfo {
+    /// Kind of source: `"robot"`, `"overhead"`, `"sim:SCENARIO"`, `"bhuman2009"`, `"import"`, …
+    pub source: String,
+    /// Free text for people (what was recorded, where, when).
+    pub description: String,
+}
+
+/// One frame of a stream with everything recorded for it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameRecord {
+    /// Capture time, nanoseconds since the stream's start (or since the Unix epoch).
+    pub time_ns: u64,
+    /// The camera image (stored as UYVY; 4:4:4 frames are converted when written).
+    pub frame: Frame,
+    /// The robot's sensor readings, channel [`SENSORS_TOPIC`].
+    pub sensors: Option<SensorReadings>,
+    /// Ground truth, channel [`GROUND_TRUTH_TOPIC`].
+    pub ground_truth: Option<serde_json::Value>,
+    /// Recognition results, channel [`RECOGNITION_TOPIC`].
+    pub recognition: Option<serde_json::Value>,
+    /// Other JSON channels as (topic, value), e.g. `("/world_model/robot3", …)`.
+    pub extra: Vec<(String, serde_json::Value)>,
+}
+
+impl FrameRecord {
+    /// A record with only the image.
+    #[must_use]
+    pub fn new(time_ns: u64, frame: Frame) -> Self {
+        Self {
+            time_ns,
+            frame,
+            sensors: None,
+            ground_truth: None,
+            recognition: None,
+            extra: Vec::new(),
+        }
+    }
+}
+
+/// Why a stream could not be written or read; the message always names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    /// The operating system refused to open, read, write or rename the file.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the OS said.
+        source: std::io::Error,
+    },
+    /// The file does not start with the MCAP magic bytes.
+    #[error("{path}: not an MCAP stream ({detail})")]
+    NotMcap {
+        /// The file.
+        path: PathBuf,
+        /// What was found instead.
+        detail: String,
+    },
+    /// The MCAP library reported a malformed record, bad CRC or failed decompression.
+    #[error("{path}: {context}: {source}")]
+    Mcap {
+        /// The file.
+        path: PathBuf,
+        /// What we were doing.
+        context: String,
+        /// The MCAP library's error.
+        source: mcap::McapError,
+    },
+    /// The file is MCAP but its contents do not make sense (bad index, broken message).
+    #[error("{path}: {detail}")]
+    Corrupt {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        detail: String,
+    },
+    /// A frame index past the end of the stream.
+    #[error("{path}: no frame {index} (the stream has {len} frames)")]
+    NoSuchFrame {
+        /// The file.
+        path: PathBuf,
+        /// Index asked for.
+        index: usize,
+        /// Number of frames.
+        len: usize,
+    },
+    /// A record the writer cannot store (odd width, unserialisable JSON, bad topic).
+    #[error("{path}: cannot write frame at {time_ns} ns: {detail}")]
+    BadRecord {
+        /// The file.
+        path: PathBuf,
+        /// The record's time, nanoseconds.
+        time_ns: u64,
+        /// What is wrong.
+        detail: String,
+    },
+}
+
+/// True when the path looks like an MCAP stream (extension `.mcap`, any case).
+#[must_use]
+pub fn is_stream_file(path: &std::path::Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+}

@@ -1,0 +1,885 @@
+//! [`StreamReader`]: random access to the frames of an MCAP stream, by index and by time.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+
+use mcap::records::{Record, op};
+use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
+
+use super::schema::{decode_image, parse_json_lenient};
+use super::{
+    FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME, RECOGNITION_TOPIC, SENSORS_TOPIC,
+    StreamError, StreamInfo,
+};
+use crate::sensors::SensorReadings;
+
+/// The MCAP magic bytes at both ends of a file.
+const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
+/// Largest chunk record read into memory, bytes (compressed or not); larger ones are corrupt.
+const MAX_CHUNK_BYTES: u64 = 1 << 30;
+/// Largest summary-side record (message index, metadata) read, bytes.
+const MAX_INDEX_BYTES: u64 = 64 << 20;
+/// Warnings kept; later ones are only counted, so memory stays bounded on a bad file.
+const MAX_WARNINGS: usize = 100;
+/// Name of the schema of frame images from other writers.
+const RAW_IMAGE_SCHEMA: &str = "foxglove.RawImage";
+
+/// What a channel's messages are to a frame.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Role {
+    Image,
+    Sensors,
+    GroundTruth,
+    Recognition,
+    Extra(String),
+    Ignored,
+}
+
+/// Where a chunk record lies in the file (opcode and length prefix included), bytes.
+#[derive(Debug, Clone, Copy)]
+struct ChunkLoc {
+    offset: u64,
+    length: u64,
+}
+
+/// Where a frame is: its time, its chunk, and which image message of that chunk it is.
+#[derive(Debug, Clone, Copy)]
+struct FrameLoc {
+    time_ns: u64,
+    chunk: u32,
+    nth: u32,
+}
+
+/// One message of a decoded chunk.
+#[derive(Debug)]
+struct Msg {
+    channel: u16,
+    data: Vec<u8>,
+}
+
+/// Reads a stream written by [`super::StreamWriter`] (or any MCAP file with `foxglove.RawImage`
+/// frames on [`IMAGE_TOPIC`]).
+///
+/// Opening reads the summary and the image channel's message indexes (a few bytes per chunk);
+/// [`StreamReader::read`] then reads and decompresses only the chunk holding the frame and keeps
+/// that one chunk cached. Memory is this index (16 bytes a frame) plus one chunk, whatever the
+/// file's length.
+pub struct StreamReader {
+    path: PathBuf,
+    file: BufReader<File>,
+    file_len: u64,
+    info: StreamInfo,
+    roles: HashMap<u16, Role>,
+    chunks: Vec<ChunkLoc>,
+    frames: Vec<FrameLoc>,
+    times_sorted: bool,
+    cache: Option<(u32, Vec<Msg>)>,
+    warnings: Vec<String>,
+    warnings_dropped: usize,
+}
+
+impl std::fmt::Debug for StreamReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StreamReader")
+            .field("path", &self.path)
+            .field("frames", &self.frames.len())
+            .field("chunks", &self.chunks.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// Schemas and channels seen so far, to give each channel its [`Role`].
+#[derive(Default)]
+struct ChannelTable {
+    schema_names: HashMap<u16, String>,
+    image: Option<u16>,
+    roles: HashMap<u16, Role>,
+    notes: Vec<String>,
+}
+
+impl ChannelTable {
+    fn add(&mut self, id: u16, topic: &str, encoding: &str, schema_name: Option<&str>) {
+        if self.roles.contains_key(&id) {
+            return;
+        }
+        let is_raw_image = schema_name == Some(RAW_IMAGE_SCHEMA) && encoding == "protobuf";
+        let role = if (topic == IMAGE_TOPIC || is_raw_image) && self.image.is_none() {
+            if !is_raw_image {
+                self.notes.push(format!(
+                    "channel {topic} is not a protobuf foxglove.RawImage (schema {}, encoding {encoding}); its frames will not decode",
+                    schema_name.unwrap_or("none")
+                ));
+            } else if topic != IMAGE_TOPIC {
+                self.notes.push(format!(
+                    "no {IMAGE_TOPIC} channel yet; frames are read from {topic}"
+                ));
+            }
+            self.image = Some(id);
+            Role::Image
+        } else if encoding != "json" {
+            self.notes.push(format!(
+                "channel {topic} ({encoding}) is not read: only {IMAGE_TOPIC} and JSON channels are"
+            ));
+            Role::Ignored
+        } else {
+            match topic {
+                SENSORS_TOPIC => Role::Sensors,
+                GROUND_TRUTH_TOPIC => Role::GroundTruth,
+                RECOGNITION_TOPIC => Role::Recognition,
+                _ => Role::Extra(topic.to_owned()),
+            }
+        };
+        self.roles.insert(id, role);
+    }
+}
+
+impl StreamReader {
+    /// Opens a stream. Files without a summary (a recording cut off by a crash) are recovered by
+    /// scanning their complete chunks; files without frames open with zero frames. Both say so
+    /// in [`StreamReader::warnings`].
+    ///
+    /// # Errors
+    /// [`StreamError`] naming the file when it cannot be read or is not MCAP at all.
+    pub fn open(path: &Path) -> Result<Self, StreamError> {
+        let io = |source| StreamError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let file = File::open(path).map_err(io)?;
+        let file_len = file.metadata().map_err(io)?.len();
+        let mut reader = Self {
+            path: path.to_owned(),
+            file: BufReader::with_capacity(64 << 10, file),
+            file_len,
+            info: StreamInfo::default(),
+            roles: HashMap::new(),
+            chunks: Vec::new(),
+            frames: Vec::new(),
+            times_sorted: true,
+            cache: None,
+            warnings: Vec::new(),
+            warnings_dropped: 0,
+        };
+        let mut magic = [0u8; 8];
+        let got = reader.read_up_to(0, &mut magic)?;
+        if got < magic.len() || &magic != MAGIC {
+            let detail = if file_len == 0 {
+                "the file is empty".to_owned()
+            } else if got < magic.len() {
+                format!("only {file_len} bytes, no MCAP header")
+            } else {
+                "it does not start with the MCAP magic bytes".to_owned()
+            };
+            return Err(StreamError::NotMcap {
+                path: path.to_owned(),
+                detail,
+            });
+        }
+        let mut table = ChannelTable::default();
+        let indexed = match reader.read_summary() {
+            Ok(Some(summary)) => reader.index_from_summary(&summary, &mut table)?,
+            Ok(None) => {
+                reader.warn("the file has no summary section; scanning its chunks".to_owned());
+                false
+            }
+            Err(e) => {
+                reader.warn(format!(
+                    "no usable summary ({e}): the recording was probably cut off; scanning its complete chunks"
+                ));
+                false
+            }
+        };
+        if !indexed {
+            table = ChannelTable::default();
+            reader.chunks.clear();
+            reader.frames.clear();
+            reader.scan(&mut table)?;
+        }
+        for note in std::mem::take(&mut table.notes) {
+            reader.warn(note);
+        }
+        if table.image.is_none() {
+            reader.warn(format!(
+                "no {IMAGE_TOPIC} (foxglove.RawImage) channel: the file holds no frames"
+            ));
+        }
+        reader.roles = table.roles;
+        reader.times_sorted = reader
+            .frames
+            .windows(2)
+            .all(|w| w[0].time_ns <= w[1].time_ns);
+        Ok(reader)
+    }
+
+    /// What the stream is (from its `eotn.stream` metadata; source `"unknown"` without it).
+    #[must_use]
+    pub fn info(&self) -> &StreamInfo {
+        &self.info
+    }
+
+    /// The file this reader reads.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Number of frames.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// True when the stream holds no frames.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+
+    /// Number of chunks holding frames (or, after a recovery scan, the complete chunks found).
+    #[must_use]
+    pub fn chunk_count(&self) -> usize {
+        self.chunks.len()
+    }
+
+    /// Capture time of frame `index`, nanoseconds, or `None` past the end.
+    #[must_use]
+    pub fn time_ns(&self, index: usize) -> Option<u64> {
+        self.frames.get(index).map(|f| f.time_ns)
+    }
+
+    /// The frame at or before `time_ns` (the latest such; the first frame when all are later,
+    /// and 0 for an empty stream).
+    #[must_use]
+    pub fn index_at_time(&self, time_ns: u64) -> usize {
+        if self.times_sorted {
+            return self
+                .frames
+                .partition_point(|f| f.time_ns <= time_ns)
+                .saturating_sub(1);
+        }
+        let mut best: Option<(u64, usize)> = None;
+        for (i, f) in self.frames.iter().enumerate() {
+            if f.time_ns <= time_ns && best.is_none_or(|(t, _)| f.time_ns >= t) {
+                best = Some((f.time_ns, i));
+            }
+        }
+        best.map_or_else(
+            || {
+                self.frames
+                    .iter()
+                    .enumerate()
+                    .min_by_key(|(_, f)| f.time_ns)
+                    .map_or(0, |(i, _)| i)
+            },
+            |(_, i)| i,
+        )
+    }
+
+    /// Things the reader skipped or repaired: truncation, unknown channels, bad JSON, NaN
+    /// sensor values. Bounded: after 100 only a count is kept.
+    #[must_use]
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Reads frame `index` with all its data.
+    ///
+    /// # Errors
+    /// [`StreamError::NoSuchFrame`] past the end; I/O or corruption errors naming the file.
+    pub fn read(&mut self, index: usize) -> Result<FrameRecord, StreamError> {
+        let loc = *self
+            .frames
+            .get(index)
+            .ok_or_else(|| StreamError::NoSuchFrame {
+                path: self.path.clone(),
+                index,
+                len: self.frames.len(),
+            })?;
+        if self.cache.as_ref().is_none_or(|(c, _)| *c != loc.chunk) {
+            self.cache = None;
+            let messages = self.load_chunk(loc.chunk)?;
+            self.cache = Some((loc.chunk, messages));
+        }
+        let Some((_, messages)) = self.cache.take() else {
+            return Err(self.corrupt(format!("frame {index}: its chunk could not be loaded")));
+        };
+        let result = self.assemble(index, loc, &messages);
+        self.cache = Some((loc.chunk, messages));
+        result
+    }
+
+    fn assemble(
+        &mut self,
+        index: usize,
+        loc: FrameLoc,
+        messages: &[Msg],
+    ) -> Result<FrameRecord, StreamError> {
+        let mut images = messages
+            .iter()
+            .enumerate()
+            .filter(|(_, m)| self.roles.get(&m.channel) == Some(&Role::Image));
+        let Some((at, image)) = images.nth(loc.nth as usize) else {
+            return Err(self.corrupt(format!(
+                "frame {index}: its chunk does not hold the indexed image"
+            )));
+        };
+        let frame = decode_image(&image.data)
+            .map_err(|detail| self.corrupt(format!("frame {index}: {detail}")))?;
+        let mut record = FrameRecord::new(loc.time_ns, frame);
+        for m in messages.iter().skip(at + 1) {
+            let role = self.roles.get(&m.channel).cloned().unwrap_or(Role::Ignored);
+            if role == Role::Image {
+                break;
+            }
+            if role == Role::Ignored {
+                continue;
+            }
+            let value = match parse_json_lenient(&m.data) {
+                Ok((v, replaced)) => {
+                    if replaced {
+                        self.warn(format!(
+                            "frame {index}: {} has NaN/Infinity values; read as missing",
+                            topic_of(&role)
+                        ));
+                    }
+                    v
+                }
+                Err(e) => {
+                    self.warn(format!(
+                        "frame {index}: {} is not valid JSON ({e}); skipped",
+                        topic_of(&role)
+                    ));
+                    continue;
+                }
+            };
+            match role {
+                Role::Sensors => match serde_json::from_value::<SensorReadings>(value) {
+                    Ok(s) => {
+                        let (clean, dropped) = s.sanitised();
+                        if !dropped.is_empty() {
+                            self.warn(format!(
+                                "frame {index}: non-finite sensor values dropped: {}",
+                                dropped.join(", ")
+                            ));
+                        }
+                        record.sensors = Some(clean);
+                    }
+                    Err(e) => self.warn(format!(
+                        "frame {index}: {SENSORS_TOPIC} does not match the sensor schema ({e}); skipped"
+                    )),
+                },
+                Role::GroundTruth => record.ground_truth = Some(value),
+                Role::Recognition => record.recognition = Some(value),
+                Role::Extra(topic) => record.extra.push((topic, value)),
+                Role::Image | Role::Ignored => {}
+            }
+        }
+        Ok(record)
+    }
+
+    fn warn(&mut self, text: String) {
+        if self.warnings.len() < MAX_WARNINGS {
+            self.warnings.push(text);
+            return;
+        }
+        self.warnings_dropped += 1;
+        let note = format!("… and {} more warnings", self.warnings_dropped);
+        if self.warnings_dropped == 1 {
+            self.warnings.push(note);
+        } else if let Some(last) = self.warnings.last_mut() {
+            *last = note;
+        }
+    }
+
+    fn corrupt(&self, detail: String) -> StreamError {
+        StreamError::Corrupt {
+            path: self.path.clone(),
+            detail,
+        }
+    }
+
+    fn mcap_err(&self, context: String) -> impl FnOnce(mcap::McapError) -> StreamError {
+        let path = self.path.clone();
+        move |source| StreamError::Mcap {
+            path,
+            context,
+            source,
+        }
+    }
+
+    /// Reads as many bytes as the file has at `offset`, up to `buf.len()`.
+    fn read_up_to(&mut self, offset: u64, buf: &mut [u8]) -> Result<usize, StreamError> {
+        let io = |source| StreamError::Io {
+            path: self.path.clone(),
+            source,
+        };
+        self.file.seek(SeekFrom::Start(offset)).map_err(io)?;
+        let mut got = 0;
+        while got < buf.len() {
+            match self.file.read(&mut buf[got..]) {
+                Ok(0) => break,
+                Ok(n) => got += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(io(e)),
+            }
+        }
+        Ok(got)
+    }
+
+    /// Reads `len` bytes at `offset`, which the caller has checked lie inside the file.
+    fn read_exact_at(&mut self, offset: u64, len: u64) -> Result<Vec<u8>, StreamError> {
+        let n = usize::try_from(len).map_err(|_| self.corrupt(format!("{len} bytes too large")))?;
+        let mut buf = vec![0u8; n];
+        let got = self.read_up_to(offset, &mut buf)?;
+        if got < n {
+            return Err(self.corrupt(format!(
+                "the file ends {got} bytes into a {n}-byte record at offset {offset}"
+            )));
+        }
+        Ok(buf)
+    }
+
+    /// Reads one record (opcode, length, body) at `offset` whose total length must not exceed
+    /// `limit` bytes.
+    fn read_record_at(&mut self, offset: u64, limit: u64) -> Result<(u8, Vec<u8>), StreamError> {
+        let head = self.read_exact_at(offset, 9)?;
+        let opcode = head[0];
+        let len = u64::from_le_bytes(head[1..9].try_into().unwrap_or([0xff; 8]));
+        let end = offset.saturating_add(9).saturating_add(len);
+        if len > limit || end > self.file_len {
+            return Err(self.corrupt(format!(
+                "record at offset {offset} claims {len} bytes, beyond the file or any sane size"
+            )));
+        }
+        Ok((opcode, self.read_exact_at(offset + 9, len)?))
+    }
+
+    fn read_summary(&mut self) -> Result<Option<mcap::Summary>, StreamError> {
+        let path = self.path.clone();
+        let io = |source| StreamError::Io {
+            path: path.clone(),
+            source,
+        };
+        let mut summary = SummaryReader::new_with_options(
+            SummaryReaderOptions::default()
+                .with_file_size(self.file_len)
+                .with_record_length_limit(256 << 20),
+        );
+        let mut steps = 0u64;
+        while let Some(event) = summary.next_event() {
+            steps += 1;
+            if steps > 100_000_000 {
+                return Err(self.corrupt("the summary section never ends".to_owned()));
+            }
+            match event.map_err(self.mcap_err("reading the summary".to_owned()))? {
+                SummaryReadEvent::ReadRequest(n) => {
+                    let got = self.file.read(summary.insert(n)).map_err(io)?;
+                    summary.notify_read(got);
+                }
+                SummaryReadEvent::SeekRequest(to) => {
+                    let pos = self.file.seek(to).map_err(io)?;
+                    summary.notify_seeked(pos);
+                }
+            }
+        }
+        Ok(summary.finish())
+    }
+
+    /// Builds the frame index from the summary; `false` when the summary cannot locate the
+    /// frames (no chunk indexes), so the caller scans instead.
+    fn index_from_summary(
+        &mut self,
+        summary: &mcap::Summary,
+        table: &mut ChannelTable,
+    ) -> Result<bool, StreamError> {
+        for index in &summary.metadata_indexes {
+            if index.name != METADATA_NAME {
+                continue;
+            }
+            if index.length > MAX_INDEX_BYTES
+                || index.offset.saturating_add(index.length) > self.file_len
+            {
+                self.warn("the stream metadata index points outside the file".to_owned());
+                continue;
+            }
+            match self.read_record_at(index.offset, MAX_INDEX_BYTES) {
+                Ok((opcode, body)) => self.take_metadata(opcode, &body),
+                Err(e) => self.warn(format!("stream metadata unreadable: {e}")),
+            }
+        }
+        if self.info == StreamInfo::default() {
+            self.no_metadata();
+        }
+        let mut ids: Vec<u16> = summary.channels.keys().copied().collect();
+        ids.sort_unstable();
+        // Prefer the canonical image topic over any other RawImage channel.
+        ids.sort_by_key(|id| {
+            summary
+                .channels
+                .get(id)
+                .is_none_or(|c| c.topic != IMAGE_TOPIC)
+        });
+        for id in ids {
+            if let Some(c) = summary.channels.get(&id) {
+                let schema = c.schema.as_ref().map(|s| s.name.as_str());
+                table.add(id, &c.topic, &c.message_encoding, schema);
+            }
+        }
+        let messages = summary.stats.as_ref().map_or(1, |s| s.message_count);
+        if summary.chunk_indexes.is_empty() {
+            return Ok(messages == 0);
+        }
+        let Some(image) = table.image else {
+            return Ok(true);
+        };
+        let mut chunk_indexes: Vec<&mcap::records::ChunkIndex> =
+            summary.chunk_indexes.iter().collect();
+        chunk_indexes.sort_by_key(|c| c.chunk_start_offset);
+        for ci in chunk_indexes {
+            if ci.chunk_length > MAX_CHUNK_BYTES
+                || ci.chunk_start_offset.saturating_add(ci.chunk_length) > self.file_len
+            {
+                self.warn(format!(
+                    "chunk index points outside the file (offset {}, {} bytes); the summary is not trusted",
+                    ci.chunk_start_offset, ci.chunk_length
+                ));
+                return Ok(false);
+            }
+            let Some(&at) = ci.message_index_offsets.get(&image) else {
+                continue;
+            };
+            let entries = match self.read_record_at(at, MAX_INDEX_BYTES) {
+                Ok((op::MESSAGE_INDEX, body)) => match mcap::parse_record(op::MESSAGE_INDEX, &body)
+                {
+                    Ok(Record::MessageIndex(mi)) if mi.channel_id == image => mi.records,
+                    _ => {
+                        self.warn(format!(
+                            "message index at offset {at} is malformed; scanning instead"
+                        ));
+                        return Ok(false);
+                    }
+                },
+                Ok(_) | Err(_) => {
+                    self.warn(format!(
+                        "message index at offset {at} is unreadable; scanning instead"
+                    ));
+                    return Ok(false);
+                }
+            };
+            let chunk = u32::try_from(self.chunks.len())
+                .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
+            self.chunks.push(ChunkLoc {
+                offset: ci.chunk_start_offset,
+                length: ci.chunk_length,
+            });
+            let mut entries = entries;
+            entries.sort_by_key(|e| e.offset);
+            for (nth, e) in entries.iter().enumerate() {
+                self.frames.push(FrameLoc {
+                    time_ns: e.log_time,
+                    chunk,
+                    nth: u32::try_from(nth).unwrap_or(u32::MAX),
+                });
+            }
+        }
+        Ok(true)
+    }
+
+    fn no_metadata(&mut self) {
+        self.info = StreamInfo {
+            source: "unknown".to_owned(),
+            description: String::new(),
+        };
+        self.warn(format!(
+            "no {METADATA_NAME} metadata: not written by eotn, source unknown"
+        ));
+    }
+
+    fn take_metadata(&mut self, opcode: u8, body: &[u8]) {
+        match mcap::parse_record(opcode, body) {
+            Ok(Record::Metadata(m)) if m.name == METADATA_NAME => {
+                let get = |k: &str| m.metadata.get(k).cloned().unwrap_or_default();
+                self.info = StreamInfo {
+                    source: get("source"),
+                    description: get("description"),
+                };
+            }
+            Ok(Record::Metadata(_)) => {}
+            _ => self.warn("a metadata record is malformed; ignored".to_owned()),
+        }
+    }
+
+    /// Recovery: walks the data section record by record, decompressing each chunk once, and
+    /// stops at the first record that is cut off or damaged.
+    fn scan(&mut self, table: &mut ChannelTable) -> Result<(), StreamError> {
+        let mut offset = 8u64;
+        let mut loose_messages = 0u64;
+        let mut complete = false;
+        loop {
+            let remaining = self.file_len.saturating_sub(offset);
+            if remaining == 0 {
+                break;
+            }
+            if remaining < 9 {
+                self.warn(format!(
+                    "the file ends inside a record header at offset {offset}"
+                ));
+                break;
+            }
+            let head = self.read_exact_at(offset, 9)?;
+            let opcode = head[0];
+            let len = u64::from_le_bytes(head[1..9].try_into().unwrap_or([0xff; 8]));
+            if opcode == op::DATA_END || opcode == op::FOOTER {
+                complete = true;
+                break;
+            }
+            if len > remaining - 9 {
+                self.warn(format!(
+                    "record at offset {offset} (opcode {opcode:#04x}) needs {len} bytes but the file ends after {}: it was cut off; frames up to the last complete chunk are kept",
+                    remaining - 9
+                ));
+                break;
+            }
+            let body_at = offset + 9;
+            let next = body_at + len;
+            match opcode {
+                op::CHUNK => {
+                    if len > MAX_CHUNK_BYTES {
+                        self.warn(format!(
+                            "chunk at offset {offset} is implausibly large ({len} bytes); stopping"
+                        ));
+                        break;
+                    }
+                    let body = self.read_exact_at(body_at, len)?;
+                    let mut records = Vec::new();
+                    if let Err(e) = decode_chunk(&body, |r| records.push(r)) {
+                        self.warn(format!(
+                            "chunk at offset {offset} is damaged ({e}); frames up to the previous chunk are kept"
+                        ));
+                        break;
+                    }
+                    let chunk = u32::try_from(self.chunks.len())
+                        .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
+                    let mut nth = 0u32;
+                    for r in records {
+                        match r {
+                            ChunkItem::Schema(id, name) => {
+                                table.schema_names.insert(id, name);
+                            }
+                            ChunkItem::Channel(c) => add_channel(table, &c),
+                            ChunkItem::Message(channel, log_time) => {
+                                if Some(channel) == table.image {
+                                    self.frames.push(FrameLoc {
+                                        time_ns: log_time,
+                                        chunk,
+                                        nth,
+                                    });
+                                    nth = nth.saturating_add(1);
+                                }
+                            }
+                        }
+                    }
+                    self.chunks.push(ChunkLoc {
+                        offset,
+                        length: len + 9,
+                    });
+                }
+                op::SCHEMA | op::CHANNEL | op::METADATA => {
+                    if len > MAX_INDEX_BYTES {
+                        self.warn(format!(
+                            "record at offset {offset} is implausibly large; stopping"
+                        ));
+                        break;
+                    }
+                    let body = self.read_exact_at(body_at, len)?;
+                    match mcap::parse_record(opcode, &body) {
+                        Ok(Record::Schema { header, .. }) => {
+                            table.schema_names.insert(header.id, header.name);
+                        }
+                        Ok(Record::Channel(c)) => add_channel(table, &c),
+                        Ok(Record::Metadata(_)) => self.take_metadata(opcode, &body),
+                        _ => {
+                            self.warn(format!("record at offset {offset} is malformed; stopping"));
+                            break;
+                        }
+                    }
+                }
+                op::MESSAGE => loose_messages += 1,
+                _ => {}
+            }
+            offset = next;
+        }
+        if self.info == StreamInfo::default() {
+            self.no_metadata();
+        }
+        if loose_messages > 0 {
+            self.warn(format!(
+                "{loose_messages} messages outside chunks were skipped (only chunked streams are read)"
+            ));
+        }
+        if !complete {
+            self.warn(format!(
+                "recovered {} frames from {} complete chunks",
+                self.frames.len(),
+                self.chunks.len()
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reads and decompresses chunk `chunk` into its messages.
+    fn load_chunk(&mut self, chunk: u32) -> Result<Vec<Msg>, StreamError> {
+        let loc = *self
+            .chunks
+            .get(chunk as usize)
+            .ok_or_else(|| self.corrupt(format!("no chunk {chunk}")))?;
+        let (opcode, body) = self.read_record_at(loc.offset, loc.length.saturating_sub(9))?;
+        if opcode != op::CHUNK {
+            return Err(self.corrupt(format!(
+                "the chunk index points at offset {} which holds no chunk",
+                loc.offset
+            )));
+        }
+        let mut messages = Vec::new();
+        decode_chunk_messages(&body, &mut messages)
+            .map_err(self.mcap_err(format!("reading the chunk at offset {}", loc.offset)))?;
+        Ok(messages)
+    }
+}
+
+fn topic_of(role: &Role) -> &str {
+    match role {
+        Role::Image => IMAGE_TOPIC,
+        Role::Sensors => SENSORS_TOPIC,
+        Role::GroundTruth => GROUND_TRUTH_TOPIC,
+        Role::Recognition => RECOGNITION_TOPIC,
+        Role::Extra(t) => t,
+        Role::Ignored => "an ignored channel",
+    }
+}
+
+fn add_channel(table: &mut ChannelTable, c: &mcap::records::Channel) {
+    let schema = table.schema_names.get(&c.schema_id).cloned();
+    table.add(c.id, &c.topic, &c.message_encoding, schema.as_deref());
+}
+
+/// What the recovery scan needs from a chunk's records.
+enum ChunkItem {
+    Schema(u16, String),
+    Channel(mcap::records::Channel),
+    Message(u16, u64),
+}
+
+/// Parses a chunk record's body and calls `each` for its schemas, channels and messages.
+fn decode_chunk(body: &[u8], mut each: impl FnMut(ChunkItem)) -> Result<(), mcap::McapError> {
+    for_each_chunk_record(body, |r| match r {
+        Record::Schema { header, .. } => each(ChunkItem::Schema(header.id, header.name)),
+        Record::Channel(c) => each(ChunkItem::Channel(c)),
+        Record::Message { header, .. } => {
+            each(ChunkItem::Message(header.channel_id, header.log_time));
+        }
+        _ => {}
+    })
+}
+
+/// Parses a chunk record's body into its messages.
+fn decode_chunk_messages(body: &[u8], out: &mut Vec<Msg>) -> Result<(), mcap::McapError> {
+    for_each_chunk_record(body, |r| {
+        if let Record::Message { header, data } = r {
+            out.push(Msg {
+                channel: header.channel_id,
+                data: data.into_owned(),
+            });
+        }
+    })
+}
+
+fn for_each_chunk_record(
+    body: &[u8],
+    mut each: impl FnMut(Record<'_>),
+) -> Result<(), mcap::McapError> {
+    let Record::Chunk { header, data } = mcap::parse_record(op::CHUNK, body)? else {
+        return Err(mcap::McapError::BadIndex);
+    };
+    if header.uncompressed_size > MAX_CHUNK_BYTES {
+        return Err(mcap::McapError::ChunkTooLarge(header.uncompressed_size));
+    }
+    for record in mcap::read::ChunkReader::new(header, &data)? {
+        each(record?);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{Frame, Yuv};
+    use crate::streams::schema::{encode_image, raw_image_schema};
+
+    /// A file from another writer: frames on another topic, times out of order, default
+    /// chunking, no eotn metadata.
+    fn foreign_file(path: &Path, times: &[u64]) {
+        let file = std::io::BufWriter::new(File::create(path).unwrap());
+        let mut w = mcap::Writer::new(file).unwrap();
+        let s = raw_image_schema().unwrap();
+        let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+        let ch = w
+            .add_channel(sid, "/cam/front", "protobuf", &Default::default())
+            .unwrap();
+        let tf = w
+            .add_channel(0, "/tf", "ros1msg", &Default::default())
+            .unwrap();
+        let mut buf = Vec::new();
+        for (i, &t) in times.iter().enumerate() {
+            let f = Frame::filled_uyvy(4, 2, Yuv::new(u8::try_from(i).unwrap(), 128, 128)).unwrap();
+            encode_image(t, &f, &mut buf).unwrap();
+            let header = |channel_id| mcap::records::MessageHeader {
+                channel_id,
+                sequence: 0,
+                log_time: t,
+                publish_time: t,
+            };
+            w.write_to_known_channel(&header(ch), &buf).unwrap();
+            w.write_to_known_channel(&header(tf), b"\x01\x02").unwrap();
+        }
+        w.finish().unwrap();
+    }
+
+    #[test]
+    fn frames_of_another_writer_and_unsorted_times() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.mcap");
+        foreign_file(&p, &[100, 300, 200, 400]);
+        let mut r = StreamReader::open(&p).unwrap();
+        assert_eq!(r.len(), 4);
+        assert_eq!(r.info().source, "unknown");
+        let joined = r.warnings().join("\n");
+        assert!(
+            joined.contains("/cam/front") && joined.contains("/tf"),
+            "{joined}"
+        );
+        assert_eq!(r.index_at_time(250), 2, "latest frame at or before 250 ns");
+        assert_eq!(r.index_at_time(350), 1);
+        assert_eq!(r.index_at_time(50), 0);
+        for i in 0..4 {
+            let rec = r.read(i).unwrap();
+            assert_eq!(rec.frame.pixel(0, 0).unwrap().y, u8::try_from(i).unwrap());
+            assert!(rec.sensors.is_none() && rec.extra.is_empty());
+        }
+    }
+
+    #[test]
+    fn warnings_are_bounded() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.mcap");
+        foreign_file(&p, &[1]);
+        let mut r = StreamReader::open(&p).unwrap();
+        for i in 0..1000 {
+            r.warn(format!("w{i}"));
+        }
+        assert_eq!(r.warnings().len(), MAX_WARNINGS + 1);
+        assert!(r.warnings().last().unwrap().contains("more warnings"));
+    }
+}

@@ -1,0 +1,286 @@
+//! Schemas and encodings of the stream's channels: the camera image as `foxglove.RawImage`
+//! (protobuf) and JSON channels described by `jsonschema` documents.
+
+use foxglove::{Decode, Encode};
+
+use crate::frame::{Frame, PixelLayout};
+use crate::sensors::SensorReadings;
+
+/// Name of the sensor readings' JSON schema.
+pub const SENSORS_SCHEMA_NAME: &str = "eotn.SensorReadings";
+/// Name of the ground-truth JSON schema (a free-form object).
+pub const GROUND_TRUTH_SCHEMA_NAME: &str = "eotn.GroundTruth";
+/// Name of the recognition JSON schema (a free-form object).
+pub const RECOGNITION_SCHEMA_NAME: &str = "eotn.Recognition";
+/// Name of the schema of extra JSON channels (any JSON value).
+pub const EXTRA_SCHEMA_NAME: &str = "eotn.Json";
+/// Foxglove frame id written into every image (the camera's optical frame).
+pub const CAMERA_FRAME_ID: &str = "camera";
+
+/// The `jsonschema` document of [`SensorReadings`]: every field a number (or null when the source
+/// did not provide it), with its unit in the description.
+#[must_use]
+pub fn sensors_json_schema() -> serde_json::Value {
+    let mut props = serde_json::Map::new();
+    for f in SensorReadings::default().fields() {
+        props.insert(
+            f.name.to_owned(),
+            serde_json::json!({ "type": ["number", "null"], "description": format!("unit: {}", f.unit) }),
+        );
+    }
+    serde_json::json!({
+        "title": SENSORS_SCHEMA_NAME,
+        "description": "The robot's sensor readings for one frame. Angles in radians (pan positive \
+                        to the left, tilt positive up), lengths in centimetres, accelerations in \
+                        m/s². A missing or null field was not provided by the source.",
+        "type": "object",
+        "properties": props,
+    })
+}
+
+/// The `jsonschema` document of a free-form JSON object channel.
+#[must_use]
+pub fn object_json_schema(title: &str, description: &str) -> serde_json::Value {
+    serde_json::json!({ "title": title, "description": description, "type": "object" })
+}
+
+/// The `jsonschema` document of extra channels: any JSON value.
+#[must_use]
+pub fn any_json_schema() -> serde_json::Value {
+    serde_json::json!({ "title": EXTRA_SCHEMA_NAME, "description": "Any JSON value." })
+}
+
+/// The protobuf schema (a serialised `FileDescriptorSet`) of `foxglove.RawImage`, and its name.
+#[must_use]
+pub fn raw_image_schema() -> Option<foxglove::Schema> {
+    foxglove::messages::RawImage::get_schema()
+}
+
+/// Encodes a frame as a `foxglove.RawImage` with encoding `uyvy` and `step` = 2 × width bytes;
+/// 4:4:4 frames are converted to UYVY first.
+///
+/// # Errors
+/// A message when the frame cannot become UYVY (odd width) or is too large for the message's
+/// 32-bit fields.
+pub fn encode_image(time_ns: u64, frame: &Frame, out: &mut Vec<u8>) -> Result<(), String> {
+    let converted;
+    let uyvy = if frame.layout() == PixelLayout::Uyvy {
+        frame
+    } else {
+        converted = frame.to_uyvy().map_err(|e| e.to_string())?;
+        &converted
+    };
+    let too_big = |_| format!("{}×{} is too large", uyvy.width(), uyvy.height());
+    let width = u32::try_from(uyvy.width()).map_err(too_big)?;
+    let height = u32::try_from(uyvy.height()).map_err(too_big)?;
+    let step = width
+        .checked_mul(2)
+        .ok_or_else(|| format!("{width}×{height} is too large"))?;
+    let sec = u32::try_from(time_ns / 1_000_000_000).unwrap_or(u32::MAX);
+    let nsec = u32::try_from(time_ns % 1_000_000_000).unwrap_or(0);
+    let msg = foxglove::messages::RawImage {
+        timestamp: Some(foxglove::messages::Timestamp::new(sec, nsec)),
+        frame_id: CAMERA_FRAME_ID.to_owned(),
+        width,
+        height,
+        encoding: "uyvy".to_owned(),
+        step,
+        data: uyvy.data().to_vec().into(),
+    };
+    out.clear();
+    out.reserve(msg.encoded_len().unwrap_or(0));
+    msg.encode(out).map_err(|e| e.to_string())
+}
+
+/// Decodes a `foxglove.RawImage` into a UYVY frame. Encodings `uyvy`/`yuv422` are taken as they
+/// are, `yuyv`/`yuv422_yuy2` are reordered; row padding (`step` > 2 × width) is dropped.
+///
+/// # Errors
+/// A message for undecodable protobuf, other encodings, or sizes that do not match the data.
+pub fn decode_image(bytes: &[u8]) -> Result<Frame, String> {
+    let msg = foxglove::messages::RawImage::decode(bytes)
+        .map_err(|e| format!("image message is not a foxglove.RawImage: {e}"))?;
+    let (w, h) = (msg.width as usize, msg.height as usize);
+    let swap = match msg.encoding.as_str() {
+        "uyvy" | "yuv422" => false,
+        "yuyv" | "yuv422_yuy2" => true,
+        other => {
+            return Err(format!(
+                "image encoding '{other}' is not supported (uyvy, yuv422, yuyv)"
+            ));
+        }
+    };
+    let row = w
+        .checked_mul(2)
+        .ok_or_else(|| format!("image size {w}×{h} is not usable"))?;
+    let step = msg.step as usize;
+    if step < row {
+        return Err(format!(
+            "image step {step} is shorter than a {w}-pixel UYVY row ({row} bytes)"
+        ));
+    }
+    let needed = step
+        .checked_mul(h.saturating_sub(1))
+        .and_then(|n| n.checked_add(row))
+        .ok_or_else(|| format!("image size {w}×{h} is not usable"))?;
+    if h == 0 || msg.data.len() < needed {
+        return Err(format!(
+            "image data has {} bytes, a {w}×{h} frame with step {step} needs {needed}",
+            msg.data.len()
+        ));
+    }
+    let mut data = Vec::with_capacity(row * h);
+    for r in msg.data.chunks(step).take(h) {
+        data.extend_from_slice(r.get(..row).unwrap_or(r));
+    }
+    if swap {
+        for q in data.chunks_exact_mut(4) {
+            // Y0 U Y1 V → U Y0 V Y1
+            let (y0, u, y1, v) = (q[0], q[1], q[2], q[3]);
+            q.copy_from_slice(&[u, y0, v, y1]);
+        }
+    }
+    Frame::from_uyvy(w, h, data).map_err(|e| e.to_string())
+}
+
+/// Parses a JSON message leniently: Python's `NaN`, `Infinity` and `-Infinity` (not JSON, but
+/// what `json.dumps` writes) become `null`. Returns the value and whether any were replaced.
+///
+/// # Errors
+/// The JSON parser's message.
+pub fn parse_json_lenient(bytes: &[u8]) -> Result<(serde_json::Value, bool), String> {
+    match serde_json::from_slice(bytes) {
+        Ok(v) => Ok((v, false)),
+        Err(first) => {
+            let text = std::str::from_utf8(bytes).map_err(|_| first.to_string())?;
+            let (fixed, replaced) = replace_non_finite_tokens(text);
+            if !replaced {
+                return Err(first.to_string());
+            }
+            serde_json::from_str(&fixed)
+                .map(|v| (v, true))
+                .map_err(|_| first.to_string())
+        }
+    }
+}
+
+/// Replaces `NaN`, `Infinity`, `-Infinity` outside strings with `null`.
+fn replace_non_finite_tokens(text: &str) -> (String, bool) {
+    let mut out = String::with_capacity(text.len());
+    let mut replaced = false;
+    let mut in_string = false;
+    let mut escaped = false;
+    let mut rest = text;
+    while let Some(c) = rest.chars().next() {
+        if in_string {
+            out.push(c);
+            if escaped {
+                escaped = false;
+            } else if c == '\\' {
+                escaped = true;
+            } else if c == '"' {
+                in_string = false;
+            }
+            rest = &rest[c.len_utf8()..];
+            continue;
+        }
+        let token = ["-Infinity", "Infinity", "NaN"]
+            .into_iter()
+            .find(|t| rest.starts_with(t));
+        if let Some(t) = token {
+            out.push_str("null");
+            replaced = true;
+            rest = &rest[t.len()..];
+            continue;
+        }
+        if c == '"' {
+            in_string = true;
+        }
+        out.push(c);
+        rest = &rest[c.len_utf8()..];
+    }
+    (out, replaced)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Yuv;
+
+    #[test]
+    fn image_round_trip_keeps_bytes_and_times() {
+        let f = Frame::uyvy_from_fn(6, 4, |x, y| Yuv::new((x * 10 + y) as u8, 90, 200)).unwrap();
+        let mut buf = Vec::new();
+        encode_image(3_000_000_123, &f, &mut buf).unwrap();
+        let msg = foxglove::messages::RawImage::decode(buf.as_slice()).unwrap();
+        assert_eq!((msg.width, msg.height, msg.step), (6, 4, 12));
+        assert_eq!(msg.encoding, "uyvy");
+        let ts = msg.timestamp.unwrap();
+        assert_eq!((ts.sec(), ts.nsec()), (3, 123));
+        assert_eq!(decode_image(&buf).unwrap(), f);
+    }
+
+    #[test]
+    fn padded_rows_and_yuyv_are_understood() {
+        let msg = foxglove::messages::RawImage {
+            width: 2,
+            height: 2,
+            step: 6,
+            encoding: "yuyv".into(),
+            data: vec![10, 20, 30, 40, 0, 0, 11, 21, 31, 41, 0, 0].into(),
+            ..Default::default()
+        };
+        let mut buf = Vec::new();
+        msg.encode(&mut buf).unwrap();
+        let f = decode_image(&buf).unwrap();
+        assert_eq!(f.data(), &[20, 10, 40, 30, 21, 11, 41, 31]);
+    }
+
+    #[test]
+    fn bad_images_are_errors_not_panics() {
+        assert!(decode_image(b"\xff\xff\xff garbage").is_err());
+        for (enc, w, h, step, len) in [
+            ("rgb8", 2, 2, 6, 12),
+            ("uyvy", 4, 2, 4, 16),
+            ("uyvy", 4, 2, 8, 15),
+            ("uyvy", u32::MAX, u32::MAX, u32::MAX, 4),
+            ("uyvy", 3, 1, 6, 6),
+        ] {
+            let msg = foxglove::messages::RawImage {
+                width: w,
+                height: h,
+                step,
+                encoding: enc.into(),
+                data: vec![0; len].into(),
+                ..Default::default()
+            };
+            let mut buf = Vec::new();
+            msg.encode(&mut buf).unwrap();
+            assert!(decode_image(&buf).is_err(), "{enc} {w}x{h}");
+        }
+    }
+
+    #[test]
+    fn lenient_json_turns_python_nan_into_null() {
+        let (v, replaced) =
+            parse_json_lenient(br#"{"a": NaN, "b": -Infinity, "s": "NaN in text", "c": 1}"#)
+                .unwrap();
+        assert!(replaced);
+        assert!(v["a"].is_null() && v["b"].is_null());
+        assert_eq!(v["s"], "NaN in text");
+        assert_eq!(v["c"], 1);
+        assert!(parse_json_lenient(b"{not json").is_err());
+        assert_eq!(
+            parse_json_lenient(b"[1]").unwrap(),
+            (serde_json::json!([1]), false)
+        );
+    }
+
+    #[test]
+    fn sensor_schema_lists_every_field() {
+        let s = sensors_json_schema();
+        let props = s["properties"].as_object().unwrap();
+        assert_eq!(props.len(), SensorReadings::default().fields().len());
+        assert_eq!(props["ir_far_cm"]["description"], "unit: cm");
+    }
+}

@@ -1,0 +1,325 @@
+//! [`StreamWriter`]: frames and their data into a chunked, indexed MCAP file.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use mcap::records::MessageHeader;
+
+use super::schema::{
+    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, RECOGNITION_SCHEMA_NAME, SENSORS_SCHEMA_NAME,
+    any_json_schema, encode_image, object_json_schema, raw_image_schema, sensors_json_schema,
+};
+use super::{
+    FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME, RECOGNITION_TOPIC,
+    SENSORS_TOPIC, StreamError, StreamInfo,
+};
+
+/// How chunks are compressed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Compression {
+    /// Zstandard: smaller files (the default).
+    #[default]
+    Zstd,
+    /// LZ4: faster to write and read, larger.
+    Lz4,
+    /// No compression.
+    None,
+}
+
+/// Tuning of a [`StreamWriter`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct WriterOptions {
+    /// Chunk compression.
+    pub compression: Compression,
+    /// Frames per chunk; `None` chooses about 1 MiB of image data per chunk (16 robot-camera
+    /// frames, 1 overhead frame). Fewer frames per chunk: faster random access, larger files,
+    /// less lost in a crash.
+    pub frames_per_chunk: Option<usize>,
+}
+
+/// Uncompressed image bytes aimed at per chunk when [`WriterOptions::frames_per_chunk`] is `None`.
+const TARGET_CHUNK_BYTES: usize = 1 << 20;
+/// Most frames in one chunk when the writer chooses.
+const MAX_FRAMES_PER_CHUNK: usize = 16;
+
+/// Writes a stream: one [`FrameRecord`] at a time, each frame's messages in one chunk.
+///
+/// The file is written as `PATH.partial` and renamed to `PATH` by [`StreamWriter::finish`], so an
+/// existing stream is never replaced by a half-written one. Each finished chunk is flushed to the
+/// `.partial` file: after a crash it is readable (by [`super::StreamReader`]) up to its last
+/// complete chunk.
+pub struct StreamWriter {
+    path: PathBuf,
+    partial: PathBuf,
+    mcap: mcap::Writer<BufWriter<File>>,
+    image_channel: u16,
+    sensors_channel: u16,
+    lazy_channels: HashMap<String, u16>,
+    frames_per_chunk: Option<usize>,
+    frames_in_chunk: usize,
+    frames: u32,
+    buf: Vec<u8>,
+}
+
+impl std::fmt::Debug for StreamWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StreamWriter")
+            .field("path", &self.path)
+            .field("frames", &self.frames)
+            .finish_non_exhaustive()
+    }
+}
+
+impl StreamWriter {
+    /// Starts a stream at `path` with the default options (zstd, about 1 MiB per chunk).
+    ///
+    /// # Errors
+    /// [`StreamError`] naming the file when it cannot be created.
+    pub fn create(path: &Path, info: &StreamInfo) -> Result<Self, StreamError> {
+        Self::create_with(path, info, WriterOptions::default())
+    }
+
+    /// Starts a stream at `path` with the given options.
+    ///
+    /// # Errors
+    /// [`StreamError`] naming the file when it cannot be created.
+    pub fn create_with(
+        path: &Path,
+        info: &StreamInfo,
+        options: WriterOptions,
+    ) -> Result<Self, StreamError> {
+        let mut partial = path.as_os_str().to_owned();
+        partial.push(".partial");
+        let partial = PathBuf::from(partial);
+        let file = File::create(&partial).map_err(|source| StreamError::Io {
+            path: partial.clone(),
+            source,
+        })?;
+        let mcap_err = |context: &str| {
+            let path = partial.clone();
+            let context = context.to_owned();
+            move |source| StreamError::Mcap {
+                path,
+                context,
+                source,
+            }
+        };
+        let compression = match options.compression {
+            Compression::Zstd => Some(mcap::Compression::Zstd),
+            Compression::Lz4 => Some(mcap::Compression::Lz4),
+            Compression::None => None,
+        };
+        let mut mcap = mcap::WriteOptions::new()
+            .compression(compression)
+            .chunk_size(None)
+            .compression_threads(1)
+            .profile("")
+            .library(concat!("eotn ", env!("CARGO_PKG_VERSION")))
+            .create(BufWriter::with_capacity(1 << 20, file))
+            .map_err(mcap_err("cannot start the MCAP file"))?;
+        let metadata = mcap::records::Metadata {
+            name: METADATA_NAME.to_owned(),
+            metadata: BTreeMap::from([
+                ("source".to_owned(), info.source.clone()),
+                ("description".to_owned(), info.description.clone()),
+                ("format_version".to_owned(), FORMAT_VERSION.to_owned()),
+                (
+                    "writer".to_owned(),
+                    concat!("eotn ", env!("CARGO_PKG_VERSION")).to_owned(),
+                ),
+            ]),
+        };
+        mcap.write_metadata(&metadata)
+            .map_err(mcap_err("cannot write the stream metadata"))?;
+        let image_schema = raw_image_schema().ok_or_else(|| StreamError::Corrupt {
+            path: partial.clone(),
+            detail: "the foxglove.RawImage schema is not available".to_owned(),
+        })?;
+        let image_schema = mcap
+            .add_schema(
+                &image_schema.name,
+                &image_schema.encoding,
+                &image_schema.data,
+            )
+            .map_err(mcap_err("cannot add the image schema"))?;
+        let image_channel = mcap
+            .add_channel(image_schema, IMAGE_TOPIC, "protobuf", &BTreeMap::new())
+            .map_err(mcap_err("cannot add the image channel"))?;
+        let sensors_schema = mcap
+            .add_schema(
+                SENSORS_SCHEMA_NAME,
+                "jsonschema",
+                sensors_json_schema().to_string().as_bytes(),
+            )
+            .map_err(mcap_err("cannot add the sensors schema"))?;
+        let sensors_channel = mcap
+            .add_channel(sensors_schema, SENSORS_TOPIC, "json", &BTreeMap::new())
+            .map_err(mcap_err("cannot add the sensors channel"))?;
+        Ok(Self {
+            path: path.to_owned(),
+            partial,
+            mcap,
+            image_channel,
+            sensors_channel,
+            lazy_channels: HashMap::new(),
+            frames_per_chunk: options.frames_per_chunk.map(|n| n.max(1)),
+            frames_in_chunk: 0,
+            frames: 0,
+            buf: Vec::new(),
+        })
+    }
+
+    /// Number of frames written so far.
+    #[must_use]
+    pub fn frames(&self) -> usize {
+        self.frames as usize
+    }
+
+    fn mcap_err(&self, context: &str) -> impl FnOnce(mcap::McapError) -> StreamError {
+        let path = self.partial.clone();
+        let context = context.to_owned();
+        move |source| StreamError::Mcap {
+            path,
+            context,
+            source,
+        }
+    }
+
+    /// The channel for a JSON topic other than the sensors, added on first use.
+    fn json_channel(&mut self, topic: &str) -> Result<u16, StreamError> {
+        if let Some(&id) = self.lazy_channels.get(topic) {
+            return Ok(id);
+        }
+        let (name, schema) = match topic {
+            GROUND_TRUTH_TOPIC => (
+                GROUND_TRUTH_SCHEMA_NAME,
+                object_json_schema(
+                    GROUND_TRUTH_SCHEMA_NAME,
+                    "What was really in the frame (from a renderer or simulator).",
+                ),
+            ),
+            RECOGNITION_TOPIC => (
+                RECOGNITION_SCHEMA_NAME,
+                object_json_schema(
+                    RECOGNITION_SCHEMA_NAME,
+                    "What the vision pipeline recognised in the frame.",
+                ),
+            ),
+            _ => (EXTRA_SCHEMA_NAME, any_json_schema()),
+        };
+        let schema_id = self
+            .mcap
+            .add_schema(name, "jsonschema", schema.to_string().as_bytes())
+            .map_err(self.mcap_err("cannot add a schema"))?;
+        let id = self
+            .mcap
+            .add_channel(schema_id, topic, "json", &BTreeMap::new())
+            .map_err(self.mcap_err("cannot add a channel"))?;
+        self.lazy_channels.insert(topic.to_owned(), id);
+        Ok(id)
+    }
+
+    fn put(&mut self, channel_id: u16, time_ns: u64, data: &[u8]) -> Result<(), StreamError> {
+        let header = MessageHeader {
+            channel_id,
+            sequence: self.frames,
+            log_time: time_ns,
+            publish_time: time_ns,
+        };
+        self.mcap
+            .write_to_known_channel(&header, data)
+            .map_err(self.mcap_err("cannot write a message"))
+    }
+
+    /// Appends one frame with its data. Non-finite sensor values are written as `null`.
+    ///
+    /// # Errors
+    /// [`StreamError::BadRecord`] for an image that cannot be UYVY (odd width) or a reserved
+    /// extra topic; I/O errors naming the file.
+    pub fn write(&mut self, record: &FrameRecord) -> Result<(), StreamError> {
+        let path = self.path.clone();
+        let bad = |detail: String| StreamError::BadRecord {
+            path: path.clone(),
+            time_ns: record.time_ns,
+            detail,
+        };
+        for (topic, _) in &record.extra {
+            if [
+                IMAGE_TOPIC,
+                SENSORS_TOPIC,
+                GROUND_TRUTH_TOPIC,
+                RECOGNITION_TOPIC,
+            ]
+            .contains(&topic.as_str())
+                || !topic.starts_with('/')
+            {
+                return Err(bad(format!(
+                    "extra channel '{topic}' must start with '/' and not be a fixed channel"
+                )));
+            }
+        }
+        let mut image = std::mem::take(&mut self.buf);
+        encode_image(record.time_ns, &record.frame, &mut image).map_err(bad)?;
+        let written = self.put(self.image_channel, record.time_ns, &image);
+        self.buf = image;
+        written?;
+        if let Some(s) = &record.sensors {
+            let (clean, _) = s.sanitised();
+            let json = serde_json::to_vec(&clean).map_err(|e| bad(e.to_string()))?;
+            self.put(self.sensors_channel, record.time_ns, &json)?;
+        }
+        let fixed = [
+            (GROUND_TRUTH_TOPIC, record.ground_truth.as_ref()),
+            (RECOGNITION_TOPIC, record.recognition.as_ref()),
+        ];
+        let extra = record.extra.iter().map(|(t, v)| (t.as_str(), Some(v)));
+        for (topic, value) in fixed.into_iter().chain(extra) {
+            if let Some(v) = value {
+                let id = self.json_channel(topic)?;
+                let json = serde_json::to_vec(v).map_err(|e| bad(e.to_string()))?;
+                self.put(id, record.time_ns, &json)?;
+            }
+        }
+        self.frames = self.frames.saturating_add(1);
+        self.frames_in_chunk += 1;
+        let per_chunk = self.frames_per_chunk.unwrap_or_else(|| {
+            (TARGET_CHUNK_BYTES / self.buf.len().max(1)).clamp(1, MAX_FRAMES_PER_CHUNK)
+        });
+        if self.frames_in_chunk >= per_chunk {
+            self.frames_in_chunk = 0;
+            // Ends the chunk and flushes it to the file: it survives a crash from here on.
+            self.mcap
+                .flush()
+                .map_err(self.mcap_err("cannot finish a chunk"))?;
+        }
+        Ok(())
+    }
+
+    /// Writes the summary (indexes, statistics), syncs the file and renames it into place.
+    ///
+    /// # Errors
+    /// I/O errors naming the file.
+    pub fn finish(mut self) -> Result<(), StreamError> {
+        self.mcap
+            .finish()
+            .map_err(self.mcap_err("cannot write the summary"))?;
+        let io = |path: &Path| {
+            let path = path.to_owned();
+            move |source| StreamError::Io { path, source }
+        };
+        let file = self
+            .mcap
+            .into_inner()
+            .into_inner()
+            .map_err(|e| StreamError::Io {
+                path: self.partial.clone(),
+                source: e.into_error(),
+            })?;
+        file.sync_all().map_err(io(&self.partial))?;
+        drop(file);
+        std::fs::rename(&self.partial, &self.path).map_err(io(&self.path))?;
+        Ok(())
+    }
+}
