@@ -26,7 +26,7 @@ pub mod import;
 pub mod lut;
 pub mod pipeline;
 pub mod sensors;
-pub mod streams;
 pub mod sim;
+pub mod streams;
 
 pub mod cli;

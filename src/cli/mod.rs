@@ -10,8 +10,9 @@ mod export;
 mod import;
 mod info;
 pub mod inputs;
-mod lut_from_labels;
 mod lut;
+mod lut_from_labels;
+mod sim;
 
 use std::process::ExitCode;
 
@@ -45,6 +46,8 @@ pub enum Command {
     Export(export::Args),
     /// Build a first lookup table from labelled frames and score it on held-back frames.
     LutFromLabels(lut_from_labels::Args),
+    /// Render a synthetic scenario into a stream with sensor readings and ground truth.
+    Sim(sim::Args),
     /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
     Lut(lut::Args),
 }
@@ -62,6 +65,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Import(a) => import::run(&a),
         Command::Export(a) => export::run(&a),
         Command::LutFromLabels(a) => lut_from_labels::run(&a),
+        Command::Sim(a) => sim::run(&a),
         Command::Lut(a) => lut::run(&a),
     }
 }

@@ -5,6 +5,7 @@
 mod cli;
 mod common;
 mod peer;
-mod streams;
-mod sim_table;
 mod real_data;
+mod sim;
+mod sim_table;
+mod streams;
