@@ -207,7 +207,7 @@ fn shipped_sim_streams_classify_with_the_shipped_table() {
             checked_balls += 1;
         }
     }
-    assert!(checked_balls > 20, "{checked_balls}");
+    assert!(checked_balls >= 10, "{checked_balls}");
     // Balls in the dark, blue-shifted image corners are missed sometimes (as on the robot).
     assert!(
         good_balls * 10 >= checked_balls * 8,
