@@ -17,6 +17,7 @@ mod lut;
 mod lut_from_labels;
 pub mod open;
 mod render;
+mod sim;
 
 use std::process::ExitCode;
 
@@ -57,6 +58,8 @@ pub enum Command {
     Export(export::Args),
     /// Build a first lookup table from labelled frames and score it on held-back frames.
     LutFromLabels(lut_from_labels::Args),
+    /// Render a synthetic scenario into a stream with sensor readings and ground truth.
+    Sim(sim::Args),
     /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
     Lut(lut::Args),
     /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
@@ -76,6 +79,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Import(a) => import::run(&a),
         Command::Export(a) => export::run(&a),
         Command::LutFromLabels(a) => lut_from_labels::run(&a),
+        Command::Sim(a) => sim::run(&a),
         Command::Lut(a) => lut::run(&a),
         Command::Detect(a) => detect::run(&a),
         Command::Render(a) => render::run(&a),

@@ -9,5 +9,6 @@ mod common;
 mod peer;
 mod real_data;
 mod recognition;
+mod sim;
 mod sim_table;
 mod streams;
