@@ -9,6 +9,30 @@
 use crate::lut::classes::code_display_rgb;
 use crate::recognition::{LineRole, Primitive};
 
+/// Outlines the inclusive pixel box `[minx, miny, maxx, maxy]` on a packed RGB image of
+/// `width` × `height` at its own resolution (one-pixel lines), clamped to the image: blob boxes in
+/// exports and the app's blob view.
+pub fn outline_box(rgb: &mut [u8], width: usize, height: usize, bounds: [u32; 4], colour: [u8; 3]) {
+    if width == 0 || height == 0 || rgb.len() < width * height * 3 {
+        return;
+    }
+    let clamp = |v: u32, max: usize| (v as usize).min(max - 1);
+    let (x0, y0) = (clamp(bounds[0], width), clamp(bounds[1], height));
+    let (x1, y1) = (clamp(bounds[2], width), clamp(bounds[3], height));
+    let mut put = |x: usize, y: usize| {
+        let i = (y * width + x) * 3;
+        rgb[i..i + 3].copy_from_slice(&colour);
+    };
+    for x in x0..=x1 {
+        put(x, y0);
+        put(x, y1);
+    }
+    for y in y0..=y1 {
+        put(x0, y);
+        put(x1, y);
+    }
+}
+
 /// An RGB picture being drawn on.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Canvas {

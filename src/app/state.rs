@@ -1077,7 +1077,13 @@ impl AppState {
             _ => Vec::new(),
         };
         for b in boxes {
-            draw_box(&mut out, w, h, &b, box_colour(b.colour));
+            crate::overlay::outline_box(
+                &mut out,
+                w,
+                h,
+                [b.minx, b.miny, b.maxx, b.maxy],
+                box_colour(b.colour),
+            );
         }
         Ok((w, h, out))
     }
@@ -1418,27 +1424,6 @@ pub fn box_colour(code: u8) -> [u8; 3] {
     match code {
         9 => [255, 255, 255],
         c => crate::lut::code_display_rgb(c),
-    }
-}
-
-fn draw_box(rgb: &mut [u8], w: usize, h: usize, b: &Blob, colour: [u8; 3]) {
-    let (x0, y0) = (b.minx as usize, b.miny as usize);
-    let (x1, y1) = (
-        (b.maxx as usize).min(w.saturating_sub(1)),
-        (b.maxy as usize).min(h.saturating_sub(1)),
-    );
-    let mut put = |x: usize, y: usize| {
-        if let Some(px) = rgb.get_mut((y * w + x) * 3..(y * w + x) * 3 + 3) {
-            px.copy_from_slice(&colour);
-        }
-    };
-    for x in x0..=x1 {
-        put(x, y0);
-        put(x, y1);
-    }
-    for y in y0..=y1 {
-        put(x0, y);
-        put(x1, y);
     }
 }
 

@@ -96,7 +96,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 blobs.find(&classified, args.connectivity);
                 frame.to_rgb_into(&mut rgb);
                 for b in blobs.active().filter(|b| b.pixels >= args.min_pixels) {
-                    draw_box(&mut rgb, w, b, code_display_rgb(b.colour));
+                    crate::overlay::outline_box(
+                        &mut rgb,
+                        w,
+                        frame.height(),
+                        [b.minx, b.miny, b.maxx, b.maxy],
+                        code_display_rgb(b.colour),
+                    );
                 }
             }
             _ => frame.to_rgb_into(&mut rgb),
@@ -112,25 +118,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 /// Draws a blob's inclusive bounding box, one pixel wide, into packed RGB of width `w`.
-fn draw_box(rgb: &mut [u8], w: usize, b: &crate::blobs::Blob, colour: [u8; 3]) {
-    let (x0, x1) = (b.minx as usize, b.maxx as usize);
-    let (y0, y1) = (b.miny as usize, b.maxy as usize);
-    let mut put = |x: usize, y: usize| {
-        let i = (y * w + x) * 3;
-        if let Some(px) = rgb.get_mut(i..i + 3) {
-            px.copy_from_slice(&colour);
-        }
-    };
-    for x in x0..=x1 {
-        put(x, y0);
-        put(x, y1);
-    }
-    for y in y0..=y1 {
-        put(x0, y);
-        put(x1, y);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -149,7 +136,7 @@ mod tests {
         let set = BlobSet::from_image(&img, Connectivity::Eight);
         let b = set.active().next().unwrap();
         let mut rgb = vec![0u8; 8 * 6 * 3];
-        draw_box(&mut rgb, 8, b, [9, 9, 9]);
+        crate::overlay::outline_box(&mut rgb, 8, 6, [b.minx, b.miny, b.maxx, b.maxy], [9, 9, 9]);
         let lit = |x: usize, y: usize| rgb[(y * 8 + x) * 3] == 9;
         assert!(lit(2, 1) && lit(5, 3) && lit(2, 3) && lit(5, 1));
         assert!(!lit(3, 2), "inside stays");
