@@ -9,11 +9,8 @@ use serde::{Deserialize, Serialize};
 use super::confidence::{Confidence, TestWeight};
 use super::context::{Relative, ViewContext};
 use super::draw::Primitive;
-use super::fit::{CircleFit, Point, fit_circle};
-use super::scan::{
-    CutOff, EdgeScanPattern, ScanArea, edge_points, scan_rotated_rect, unskew_points,
-    unskew_points_vertical,
-};
+use super::fit::{CircleFit, Point, fit_circle_trimmed};
+use super::scan::{CutOff, EdgeScanPattern, ScanArea, edge_points, scan_rotated_rect};
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
 use crate::lut::ColourClass;
@@ -53,6 +50,20 @@ pub struct BallParams {
     pub orange_fraction_weight: TestWeight,
     /// Edge scans start this many pixels outside the box.
     pub edge_margin_px: u32,
+    /// An edge scan stops at the first run of this many ball-coloured pixels, so single noisy
+    /// pixels outside the ball are not taken for its outline.
+    pub edge_run_px: u32,
+    /// A side touching the image border counts as cut off only when at least this share of the
+    /// border pixels along the candidate's box are ball-coloured (a cut ball has a long chord on
+    /// the border; a stray pixel reaching it does not make the ball cut).
+    pub border_cut_min_share: f64,
+    /// Outline points farther than this many residual SDs from the first circle are dropped
+    /// and the circle refitted (see [`super::fit::fit_circle_trimmed`]).
+    pub fit_trim_sd: f64,
+    /// ... but never closer than this, pixels.
+    pub fit_trim_min_px: f64,
+    /// ... and only when at most this share of the points would go.
+    pub fit_trim_max_share: f64,
     /// A fitted circle is rejected when its diameter is below this fraction of the blob's
     /// uncut extent.
     pub min_fit_diameter_ratio: f64,
@@ -64,7 +75,11 @@ pub struct BallParams {
     pub max_cut_extent_ratio: f64,
     /// Weight of the cut-extent test.
     pub cut_extent_weight: TestWeight,
-    /// Penalty when the outline was scanned but does not fit a circle.
+    /// Pixels added to the uncut extent in the cut-extent ratio: both extents of a small ball
+    /// are whole pixels and either may be one too many.
+    pub extent_slack_px: f64,
+    /// Penalty when the outline was scanned but does not fit a circle (residuals too large, or
+    /// the points lie on a line: a straight edge is not a ball's).
     pub bad_circle_penalty: f64,
     /// Combine the size-based distance with where the ray through the centre meets the plane of
     /// ball centres (through the camera pose), weighting each by its expected error. Beyond the
@@ -80,6 +95,10 @@ pub struct BallParams {
     pub pose_sigma_rad: f64,
     /// Remove the horizontal rolling-shutter shear (pan velocity) before fitting.
     pub skew_correction: bool,
+    /// Remove the skew through the body model (the camera pose at each row's read-out time,
+    /// [`ViewContext::unskew_at`]) when the pose and the head's motion are known; otherwise, or
+    /// when false, the linear shear Δx = d·tan θ − d·tan θ_prev per frame.
+    pub pose_skew_model: bool,
     /// Remove the vertical counterpart (tilt velocity) before fitting; off by default.
     pub vertical_skew_correction: bool,
 }
@@ -102,16 +121,23 @@ impl Default for BallParams {
             orange_fraction: [0.3, 1.0],
             orange_fraction_weight: TestWeight::new(0.5, 2.0),
             edge_margin_px: 3,
+            edge_run_px: 2,
+            border_cut_min_share: 0.25,
+            fit_trim_sd: 2.5,
+            fit_trim_min_px: 1.0,
+            fit_trim_max_share: 0.2,
             min_fit_diameter_ratio: 0.75,
             max_fit_residual_ratio: 0.15,
             max_cut_extent_ratio: 1.25,
             cut_extent_weight: TestWeight::new(0.0, 3.0),
+            extent_slack_px: 1.0,
             bad_circle_penalty: 1.5,
             ground_plane_fusion: true,
             radius_bias_px: 0.0,
             radius_sigma_px: 0.5,
             pose_sigma_rad: 0.01,
             skew_correction: true,
+            pose_skew_model: true,
             vertical_skew_correction: false,
         }
     }
@@ -264,10 +290,21 @@ fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blob, u32)> {
     groups
 }
 
-/// Which sides of `b` touch the image edge or border something that hides the ball (a robot's
-/// white, red, dark blue or black along most of that side).
-fn cut_off(img: &ClassifiedImage, b: &Blob) -> CutOff {
+/// Which sides of `b` are cut by the image border (with at least `border_share` of the border
+/// pixels along the box ball-coloured) or border something that hides the ball (a robot's white,
+/// red, dark blue or black along most of that side).
+fn cut_off(img: &ClassifiedImage, b: &Blob, border_share: f64) -> CutOff {
     let (w, h) = (img.width() as u32, img.height() as u32);
+    let on_border = |samples: &mut dyn Iterator<Item = (i64, i64)>| {
+        let (mut n, mut ball) = (0u32, 0u32);
+        for (x, y) in samples {
+            if let Some(c) = img.get_signed(x, y) {
+                n += 1;
+                ball += u32::from(is_ball_colour(c));
+            }
+        }
+        ball >= 1 && f64::from(ball) >= border_share * f64::from(n)
+    };
     let hidden = |samples: &mut dyn Iterator<Item = (i64, i64)>| {
         let (mut n, mut robot) = (0u32, 0u32);
         for (x, y) in samples {
@@ -284,11 +321,36 @@ fn cut_off(img: &ClassifiedImage, b: &Blob) -> CutOff {
         i64::from(b.maxx),
         i64::from(b.maxy),
     );
+    let side = |at_border: bool, line: &mut dyn Iterator<Item = (i64, i64)>| {
+        let samples: Vec<(i64, i64)> = line.collect();
+        if at_border {
+            // The border line itself is inside the image: the box's own first or last line.
+            on_border(&mut samples.into_iter())
+        } else {
+            hidden(&mut samples.into_iter())
+        }
+    };
     CutOff {
-        left: b.minx == 0 || hidden(&mut (miny..=maxy).map(|y| (minx - 1, y))),
-        right: b.maxx + 1 >= w || hidden(&mut (miny..=maxy).map(|y| (maxx + 1, y))),
-        top: b.miny == 0 || hidden(&mut (minx..=maxx).map(|x| (x, miny - 1))),
-        bottom: b.maxy + 1 >= h || hidden(&mut (minx..=maxx).map(|x| (x, maxy + 1))),
+        left: if b.minx == 0 {
+            side(true, &mut (miny..=maxy).map(|y| (minx, y)))
+        } else {
+            side(false, &mut (miny..=maxy).map(|y| (minx - 1, y)))
+        },
+        right: if b.maxx + 1 >= w {
+            side(true, &mut (miny..=maxy).map(|y| (maxx, y)))
+        } else {
+            side(false, &mut (miny..=maxy).map(|y| (maxx + 1, y)))
+        },
+        top: if b.miny == 0 {
+            side(true, &mut (minx..=maxx).map(|x| (x, miny)))
+        } else {
+            side(false, &mut (minx..=maxx).map(|x| (x, miny - 1)))
+        },
+        bottom: if b.maxy + 1 >= h {
+            side(true, &mut (minx..=maxx).map(|x| (x, maxy)))
+        } else {
+            side(false, &mut (minx..=maxx).map(|x| (x, maxy + 1)))
+        },
     }
 }
 
@@ -318,6 +380,16 @@ fn box_estimate(b: &Blob, cut: CutOff) -> (Point, f64) {
     ((cx, cy), r)
 }
 
+/// One outline point moved to the reference row's read-out time: through the body model when
+/// asked and possible, else by the linear shear; `depth_cm` is the point's distance estimate.
+fn unskew_point(ctx: &ViewContext, params: &BallParams, p: Point, depth_cm: f64) -> Point {
+    if params.pose_skew_model && ctx.motion.is_some() && ctx.pose.is_some() {
+        ctx.unskew_at(p, depth_cm, params.vertical_skew_correction)
+    } else {
+        ctx.unskew(p, params.vertical_skew_correction)
+    }
+}
+
 /// Recognises the ball in a classified frame.
 #[must_use]
 pub fn recognise_ball(
@@ -329,20 +401,27 @@ pub fn recognise_ball(
     let mut result = BallResult::default();
     let d = ctx.camera.focal_px;
     for (group, orange_pixels) in candidate_groups(blobs, params) {
-        let cut = cut_off(img, &group);
+        let cut = cut_off(img, &group, params.border_cut_min_share);
         let bounds = [group.minx, group.miny, group.maxx, group.maxy];
         let pattern = EdgeScanPattern::for_cut_off(cut);
-        let mut points = edge_points(img, bounds, pattern, params.edge_margin_px, is_ball_colour);
+        let mut points = edge_points(
+            img,
+            bounds,
+            pattern,
+            params.edge_margin_px,
+            params.edge_run_px,
+            is_ball_colour,
+        );
         let (box_centre, box_radius) = box_estimate(&group, cut);
         // Move every outline point to the read-out time of the reference row, the instant the
         // sensor readings describe: this removes the shear and puts the ball where the camera
-        // pose says it is.
-        let reference = ctx.reference_row();
+        // pose says it is. The body model needs a depth: the distance the box's size implies.
+        let depth = d * params.diameter_cm / (2.0 * box_radius.max(0.5));
+        let unskew = |p: Point| unskew_point(ctx, params, p, depth);
         if params.skew_correction {
-            unskew_points(&mut points, ctx.skew_x_per_line, reference);
-        }
-        if params.vertical_skew_correction {
-            unskew_points_vertical(&mut points, ctx.skew_y_per_line, reference);
+            for p in &mut points {
+                *p = unskew(*p);
+            }
         }
         let w = f64::from(group.maxx - group.minx + 1);
         let h = f64::from(group.maxy - group.miny + 1);
@@ -352,7 +431,16 @@ pub fn recognise_ball(
             (false, true) => w,
             (true, true) => 0.0,
         };
-        let fit = (points.len() >= 5).then(|| fit_circle(&points)).flatten();
+        let fit = (points.len() >= 5)
+            .then(|| {
+                fit_circle_trimmed(
+                    &points,
+                    params.fit_trim_sd,
+                    params.fit_trim_min_px,
+                    params.fit_trim_max_share,
+                )
+            })
+            .flatten();
         let fit_rejected = match &fit {
             None if points.len() < 5 => Some(format!("only {} edge points", points.len())),
             None => Some("edge points do not fit a circle".to_owned()),
@@ -374,10 +462,7 @@ pub fn recognise_ball(
         let use_fit = fit.is_some() && fit_rejected.is_none();
         let (center, radius) = match (&fit, use_fit) {
             (Some(f), true) => ((f.center_x, f.center_y), f.radius),
-            _ if params.skew_correction => (
-                ctx.unskew(box_centre, params.vertical_skew_correction),
-                box_radius,
-            ),
+            _ if params.skew_correction => (unskew(box_centre), box_radius),
             _ => (box_centre, box_radius),
         };
         let radius = (radius + params.radius_bias_px).max(0.5);
@@ -400,7 +485,12 @@ pub fn recognise_ball(
         let horizontal_cut = cut.left || cut.right;
         let vertical_cut = cut.top || cut.bottom;
         if horizontal_cut != vertical_cut {
-            let ratio = if horizontal_cut { w / h } else { h / w };
+            let slack = params.extent_slack_px;
+            let ratio = if horizontal_cut {
+                w / (h + slack)
+            } else {
+                h / (w + slack)
+            };
             confidence.range_test(
                 "cut_extent",
                 ratio,
@@ -415,6 +505,15 @@ pub fn recognise_ball(
                 "circle_residual_px",
                 f.residual_sd,
                 [0.0, params.max_fit_residual_ratio * f.radius + 0.75],
+                TestWeight::new(0.0, params.bad_circle_penalty),
+            );
+        }
+        if fit.is_none() && points.len() >= 5 {
+            // Enough outline points, but on a line: a straight edge.
+            confidence.range_test(
+                "circle_fit",
+                0.0,
+                [1.0, 1.0],
                 TestWeight::new(0.0, params.bad_circle_penalty),
             );
         }

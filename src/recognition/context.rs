@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::fit::Point;
 use crate::geometry::{
-    Body, BodyPose, Camera, CameraPose, Ers7Dimensions, HeadJoints, Horizon, ImagePoint,
+    Body, BodyPose, Camera, CameraPose, Ers7Dimensions, Field, HeadJoints, Horizon, ImagePoint,
     PinholeCamera, Point as GeoPoint, RobotPose, Transform,
 };
 use crate::sensors::SensorReadings;
@@ -33,6 +33,42 @@ impl Relative {
     }
 }
 
+/// How the head moved while the frame was read out: the joints at the reference row and their
+/// change over one frame interval (from the previous frame's readings), with the body they sit
+/// on. It gives the camera pose at any row's read-out time, so the rolling shutter's skew can be
+/// removed through the body model rather than by a linear shear.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadMotion {
+    /// Joint angles at the reference row's read-out time, radians.
+    pub joints: HeadJoints,
+    /// Pan change over one frame interval (now − previous), radians.
+    pub pan_per_frame_rad: f64,
+    /// Lower-tilt change over one frame interval (now − previous), radians.
+    pub tilt_per_frame_rad: f64,
+    /// The body in the robot's ground frame (taken as still during the frame).
+    pub field_from_body: Transform<Field, Body>,
+    /// The head chain.
+    pub dims: Ers7Dimensions,
+}
+
+impl HeadMotion {
+    /// The camera pose `frames` frame intervals after the reference row's read-out time
+    /// (negative: before), the joints moving at their last measured rate; `with_tilt` false
+    /// keeps the tilt at its reference value (pan only).
+    #[must_use]
+    pub fn pose_at(&self, camera: PinholeCamera, frames: f64, with_tilt: bool) -> CameraPose {
+        let mut joints = self.joints;
+        joints.pan_rad += frames * self.pan_per_frame_rad;
+        if with_tilt {
+            joints.tilt1_rad += frames * self.tilt_per_frame_rad;
+        }
+        CameraPose {
+            camera,
+            field_from_camera: self.field_from_body * self.dims.body_from_camera(&joints),
+        }
+    }
+}
+
 /// The camera of one frame, as recognition needs it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewContext {
@@ -51,6 +87,9 @@ pub struct ViewContext {
     pub skew_y_per_line: f64,
     /// Near infra-red distance, centimetres.
     pub ir_distance_cm: Option<f64>,
+    /// The head's motion during read-out, when the joints now and one frame earlier were known
+    /// (and the pose is known).
+    pub motion: Option<HeadMotion>,
 }
 
 impl ViewContext {
@@ -65,6 +104,7 @@ impl ViewContext {
             skew_x_per_line: 0.0,
             skew_y_per_line: 0.0,
             ir_distance_cm: None,
+            motion: None,
         }
     }
 
@@ -82,7 +122,23 @@ impl ViewContext {
         if let Some(joints) = HeadJoints::from_sensors(&readings) {
             let body_from_camera = dims.body_from_camera(&joints);
             let body = BodyPose::from_sensors(&readings, &BodyPose::ERS7_STANCE);
-            let field_from_camera = body.field_from_body(&RobotPose::default()) * body_from_camera;
+            let field_from_body = body.field_from_body(&RobotPose::default());
+            let field_from_camera = field_from_body * body_from_camera;
+            let change = |now: Option<f64>, before: Option<f64>| match (now, before) {
+                (Some(a), Some(b)) if (a - b).is_finite() => Some(a - b),
+                _ => None,
+            };
+            let pan = change(readings.head_pan_rad, readings.previous_head_pan_rad);
+            let tilt = change(readings.head_tilt_rad, readings.previous_head_tilt_rad);
+            if pan.is_some() || tilt.is_some() {
+                ctx.motion = Some(HeadMotion {
+                    joints,
+                    pan_per_frame_rad: pan.unwrap_or(0.0),
+                    tilt_per_frame_rad: tilt.unwrap_or(0.0),
+                    field_from_body,
+                    dims: *dims,
+                });
+            }
             let pose = CameraPose {
                 camera,
                 field_from_camera,
@@ -130,6 +186,32 @@ impl ViewContext {
             p.1
         };
         (p.0 - self.skew_x_per_line * lines, y)
+    }
+
+    /// Moves an image point to where it would have been seen at the reference row's read-out
+    /// time, through the body model when the head's motion is known: the point, taken to lie
+    /// `distance_cm` from the camera, is placed in the ground frame with the camera pose of its
+    /// row's read-out time and projected with the reference pose. This follows panning with a
+    /// tilted head (which also moves things vertically) and the tangent's growth towards the
+    /// image sides, which the linear shear of [`Self::unskew`] does not. `with_tilt` includes the
+    /// tilt's motion. Without the motion (or when the point does not project back), falls back
+    /// to [`Self::unskew`].
+    #[must_use]
+    pub fn unskew_at(&self, p: Point, distance_cm: f64, with_tilt: bool) -> Point {
+        let (Some(motion), Some(pose)) = (self.motion, self.pose) else {
+            return self.unskew(p, with_tilt);
+        };
+        let lines = self.camera.height_px.max(1) as f64;
+        let frames = p.1 / lines - 0.5;
+        if !(frames.is_finite() && distance_cm.is_finite() && distance_cm > 0.0) {
+            return self.unskew(p, with_tilt);
+        }
+        let then = motion.pose_at(self.camera, frames, with_tilt);
+        let field = then.field_from_camera * self.camera_point(p, distance_cm);
+        match pose.image_from_field(&field) {
+            Some(q) if q.x_px.is_finite() && q.y_px.is_finite() => (q.x_px, q.y_px),
+            _ => self.unskew(p, with_tilt),
+        }
     }
 
     /// The horizon's angle on screen (radians, counter-clockwise positive), 0 without a pose.

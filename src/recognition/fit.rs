@@ -113,6 +113,37 @@ pub fn fit_circle(points: &[Point]) -> Option<CircleFit> {
     })
 }
 
+/// [`fit_circle`], then once more without the points farther from the circle than
+/// `max(k_sd · residual SD, min_px)` pixels, when those are at most `max_share` of the points
+/// (a classified outline has single noisy pixels; a shape that is not a circle has many points
+/// off it and keeps its large residual). Returns the first fit when nothing is dropped or the
+/// refit fails.
+#[must_use]
+pub fn fit_circle_trimmed(
+    points: &[Point],
+    k_sd: f64,
+    min_px: f64,
+    max_share: f64,
+) -> Option<CircleFit> {
+    let first = fit_circle(points)?;
+    let limit = (k_sd * first.residual_sd).max(min_px);
+    let keep: Vec<Point> = points
+        .iter()
+        .copied()
+        .filter(|p| {
+            (((p.0 - first.center_x).powi(2) + (p.1 - first.center_y).powi(2)).sqrt()
+                - first.radius)
+                .abs()
+                <= limit
+        })
+        .collect();
+    let dropped = points.len() - keep.len();
+    if dropped == 0 || dropped as f64 > max_share * points.len() as f64 || keep.len() < 5 {
+        return Some(first);
+    }
+    fit_circle(&keep).or(Some(first))
+}
+
 /// Solves a 3×3 system by Cramer's rule; `None` when singular.
 fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
     let det3 = |m: &[[f64; 3]; 3]| {
@@ -243,6 +274,30 @@ mod tests {
         let part = fit_circle(&pts).expect("fit");
         assert!((part.radius - 30.0).abs() < 1.0, "radius {}", part.radius);
         assert!(part.residual_sd > 0.0);
+    }
+
+    #[test]
+    fn trimming_drops_a_stray_point_but_not_a_shape() {
+        let mut pts = arc(20.0, 20.0, 8.0, 0.0, 6.0, 24);
+        pts[5].0 += 4.0;
+        let plain = fit_circle(&pts).expect("fit");
+        let trimmed = fit_circle_trimmed(&pts, 2.5, 1.0, 0.2).expect("fit");
+        assert!((trimmed.radius - 8.0).abs() < 1e-6 && trimmed.points == 23);
+        assert!((plain.radius - 8.0).abs() > (trimmed.radius - 8.0).abs());
+        // A square's outline is not a circle: too many points would go, so nothing does.
+        let square: Vec<Point> = (0..40)
+            .map(|i| {
+                let t = f64::from(i % 10);
+                match i / 10 {
+                    0 => (t, 0.0),
+                    1 => (10.0, t),
+                    2 => (10.0 - t, 10.0),
+                    _ => (0.0, 10.0 - t),
+                }
+            })
+            .collect();
+        let s = fit_circle_trimmed(&square, 1.0, 0.1, 0.2).expect("fit");
+        assert_eq!(s.points, 40);
     }
 
     #[test]

@@ -104,6 +104,7 @@ impl RecognitionParams {
                 ctx.pose = None;
                 ctx.body_from_camera = None;
                 ctx.horizon = None;
+                ctx.motion = None;
                 ctx
             }
             None => ViewContext::without_pose(camera),

@@ -146,19 +146,22 @@ impl EdgeScanPattern {
 }
 
 /// Collects outline points of the object in the box `[minx, miny, maxx, maxy]` (inclusive
-/// pixels) by scanning each row or column from `margin` pixels outside the box inward until a
-/// pixel whose class satisfies `is_object`. Each point lies on the pixel boundary where the
-/// object starts (e.g. `x` = left edge of the first object pixel), at the row's or column's
-/// centre. A scan that starts on an object pixel already (the object touches something of its
-/// own colour) gives no point.
+/// pixels) by scanning each row or column from `margin` pixels outside the box inward until
+/// `run` consecutive pixels whose class satisfies `is_object` (a run of 2 steps over single
+/// noisy pixels outside a ball; 1 stops at the first object pixel). Each point lies on the pixel
+/// boundary where the run starts (e.g. `x` = left edge of its first pixel), at the row's or
+/// column's centre. A scan that starts on an object pixel already (the object touches something
+/// of its own colour) gives no point.
 #[must_use]
 pub fn edge_points(
     img: &ClassifiedImage,
     [minx, miny, maxx, maxy]: [u32; 4],
     pattern: EdgeScanPattern,
     margin: u32,
+    run: u32,
     is_object: impl Fn(u8) -> bool,
 ) -> Vec<Point> {
+    let run = i64::from(run.max(1));
     let (w, h) = (img.width() as i64, img.height() as i64);
     let (minx, miny, maxx, maxy) = (
         i64::from(minx),
@@ -176,22 +179,19 @@ pub fn edge_points(
         } else {
             start.clamp(0, h - 1)
         };
-        let first = if horizontal {
-            is_obj(start, fixed)
-        } else {
-            is_obj(fixed, start)
+        let at = |t: i64| {
+            if horizontal {
+                is_obj(t, fixed)
+            } else {
+                is_obj(fixed, t)
+            }
         };
-        if first {
+        if (0..run).all(|k| at(start + k * dir)) {
             return None;
         }
         let mut t = start;
         while (dir > 0 && t <= end) || (dir < 0 && t >= end) {
-            let hit = if horizontal {
-                is_obj(t, fixed)
-            } else {
-                is_obj(fixed, t)
-            };
-            if hit {
+            if (0..run).all(|k| at(t + k * dir)) {
                 return Some(if dir > 0 { t as f64 } else { t as f64 + 1.0 });
             }
             t += dir;
@@ -286,7 +286,7 @@ mod tests {
             EdgeScanPattern::BottomToTop,
             EdgeScanPattern::TopBottomToCentre,
         ] {
-            let pts = edge_points(&img, bbox, pattern, 3, |c| c == 1);
+            let pts = edge_points(&img, bbox, pattern, 3, 2, |c| c == 1);
             let fit = fit_circle(&pts).expect("fit");
             assert!((fit.center_x - 40.0).abs() < 0.8, "{pattern:?} {fit:?}");
             assert!((fit.center_y - 30.0).abs() < 0.8, "{pattern:?} {fit:?}");
@@ -304,7 +304,7 @@ mod tests {
         };
         let pattern = EdgeScanPattern::for_cut_off(cut);
         assert_eq!(pattern, EdgeScanPattern::RightToLeft);
-        let pts = edge_points(&img, [0, 15, 18, 44], pattern, 3, |c| c == 1);
+        let pts = edge_points(&img, [0, 15, 18, 44], pattern, 3, 2, |c| c == 1);
         let fit = fit_circle(&pts).expect("fit");
         assert!((fit.radius - 15.0).abs() < 1.0, "{fit:?}");
         assert!((fit.center_x - 4.0).abs() < 1.0, "{fit:?}");

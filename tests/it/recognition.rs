@@ -153,6 +153,12 @@ fn debug_scenario() {
     let lut = learnt_table();
     let sim = Simulator::new(Scenario::new(kind, 7));
     let mut pipeline = Pipeline::new(lut, PipelineParams::default());
+    // EOTN_DEBUG_FRAMES=19,53 also prints those frames' ball candidates in full.
+    let detail: Vec<u64> = std::env::var("EOTN_DEBUG_FRAMES")
+        .unwrap_or_default()
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
     for i in 0..90 {
         let f = sim.frame(i).expect("frame");
         let GroundTruth::Robot(truth) = &f.ground_truth else {
@@ -192,6 +198,9 @@ fn debug_scenario() {
                 ))
                 .collect::<Vec<_>>(),
         );
+        if detail.contains(&i) {
+            print_ball_detail(&r);
+        }
         for g in r.recognition.goals.candidates.iter().filter(|g| g.accepted) {
             eprintln!(
                 "    tests {:?}",
@@ -221,6 +230,58 @@ fn debug_scenario() {
                     .map(|p| (p.image_top, p.image_base))
                     .collect::<Vec<_>>())
             );
+        }
+    }
+}
+
+/// Prints every ball candidate's tests, fit and the class codes around it (one character per
+/// pixel: `O` orange, `o` soft orange, `g` green, `w` white, `r` red, `.` other).
+fn print_ball_detail(r: &eotn::pipeline::FrameResult<'_>) {
+    use eotn::lut::ColourClass;
+    let img = r.classified;
+    for c in &r.recognition.ball.candidates {
+        eprintln!(
+            "    cand {:?} px {} orange {} cut {:?} pattern {:?} centre ({:.1},{:.1}) r {:.2} fit {:?} rejected {:?}",
+            c.bounds,
+            c.pixels,
+            c.orange_pixels,
+            c.cut_off,
+            c.pattern,
+            c.center.0,
+            c.center.1,
+            c.radius_px,
+            c.fit,
+            c.fit_rejected
+        );
+        for t in &c.confidence.tests {
+            eprintln!(
+                "      {:<20} {:>8.3} in {:?} -> {:+.1}",
+                t.test, t.value, t.range, t.effect
+            );
+        }
+        eprintln!(
+            "      edge points {:?}",
+            c.edge_points
+                .iter()
+                .map(|p| ((p.0 * 10.0).round() / 10.0, (p.1 * 10.0).round() / 10.0))
+                .collect::<Vec<_>>()
+        );
+        let [x0, y0, x1, y1] = c.bounds;
+        for y in y0.saturating_sub(3)..=(y1 + 3).min(img.height() as u32 - 1) {
+            let row: String = (x0.saturating_sub(4)..=(x1 + 4).min(img.width() as u32 - 1))
+                .map(|x| {
+                    let code = img.get(x as usize, y as usize).unwrap_or(0);
+                    match ColourClass::from_code(code) {
+                        Some(ColourClass::Orange) => 'O',
+                        Some(ColourClass::Green) => 'g',
+                        Some(ColourClass::White) => 'w',
+                        Some(ColourClass::Red) => 'r',
+                        Some(k) if k.may_be_class(ColourClass::Orange) => 'o',
+                        _ => '.',
+                    }
+                })
+                .collect();
+            eprintln!("      {y:>3} {row}");
         }
     }
 }
