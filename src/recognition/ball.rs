@@ -99,7 +99,9 @@ pub struct BallParams {
     /// [`ViewContext::unskew_at`]) when the pose and the head's motion are known; otherwise, or
     /// when false, the linear shear Δx = d·tan θ − d·tan θ_prev per frame.
     pub pose_skew_model: bool,
-    /// Remove the vertical counterpart (tilt velocity) before fitting; off by default.
+    /// Remove the vertical counterpart (tilt velocity) too. On by default: on the walk-and-pan
+    /// scenario (the head tilts while tracking) it lowers the median distance error from 5.5%
+    /// to 4.8% and changes nothing where the tilt is still.
     pub vertical_skew_correction: bool,
 }
 
@@ -138,7 +140,7 @@ impl Default for BallParams {
             pose_sigma_rad: 0.01,
             skew_correction: true,
             pose_skew_model: true,
-            vertical_skew_correction: false,
+            vertical_skew_correction: true,
         }
     }
 }
@@ -380,6 +382,26 @@ fn box_estimate(b: &Blob, cut: CutOff) -> (Point, f64) {
     ((cx, cy), r)
 }
 
+/// Whether a fitted circle can be the blob's ball: the box's centre lies inside it, and it
+/// reaches every side the blob is cut at (a short arc of a few outline points can bend the fit
+/// the wrong way, putting the circle beside the blob). `shift` moves the box as the skew removal
+/// moved its centre (the circle is fitted to unskewed points).
+fn circle_holds_blob(f: &CircleFit, b: &Blob, cut: CutOff, shift: Point) -> bool {
+    let (minx, miny) = (f64::from(b.minx) + shift.0, f64::from(b.miny) + shift.1);
+    let (maxx, maxy) = (
+        f64::from(b.maxx + 1) + shift.0,
+        f64::from(b.maxy + 1) + shift.1,
+    );
+    let (bx, by) = ((minx + maxx) / 2.0, (miny + maxy) / 2.0);
+    let inside = (bx - f.center_x).hypot(by - f.center_y) <= f.radius;
+    let reach = 1.0;
+    inside
+        && (!cut.left || f.center_x - f.radius <= minx + reach)
+        && (!cut.right || f.center_x + f.radius >= maxx - reach)
+        && (!cut.top || f.center_y - f.radius <= miny + reach)
+        && (!cut.bottom || f.center_y + f.radius >= maxy - reach)
+}
+
 /// One outline point moved to the reference row's read-out time: through the body model when
 /// asked and possible, else by the linear shear; `depth_cm` is the point's distance estimate.
 fn unskew_point(ctx: &ViewContext, params: &BallParams, p: Point, depth_cm: f64) -> Point {
@@ -418,10 +440,13 @@ pub fn recognise_ball(
         // pose says it is. The body model needs a depth: the distance the box's size implies.
         let depth = d * params.diameter_cm / (2.0 * box_radius.max(0.5));
         let unskew = |p: Point| unskew_point(ctx, params, p, depth);
+        let mut box_shift = (0.0, 0.0);
         if params.skew_correction {
             for p in &mut points {
                 *p = unskew(*p);
             }
+            let c = unskew(box_centre);
+            box_shift = (c.0 - box_centre.0, c.1 - box_centre.1);
         }
         let w = f64::from(group.maxx - group.minx + 1);
         let h = f64::from(group.maxy - group.miny + 1);
@@ -457,6 +482,9 @@ pub fn recognise_ball(
                 ))
             }
             Some(f) if f.radius > 4.0 * d => Some("radius beyond any ball".to_owned()),
+            Some(f) if !circle_holds_blob(f, &group, cut, box_shift) => {
+                Some("circle does not hold the blob".to_owned())
+            }
             Some(_) => None,
         };
         let use_fit = fit.is_some() && fit_rejected.is_none();
