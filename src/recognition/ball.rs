@@ -48,6 +48,12 @@ pub struct BallParams {
     pub orange_fraction: [f64; 2],
     /// Weight of the orange-fraction test.
     pub orange_fraction_weight: TestWeight,
+    /// Accepted share of unclassified pixels on the ring just outside the candidate's box: a
+    /// ball lies against field, lines, robots or goals, all classified; orange specks inside an
+    /// unclassified region (a robot's shaded red shoulder on the B-Human recording) are not balls.
+    pub unclassified_around: [f64; 2],
+    /// Weight of the unclassified-surroundings test.
+    pub unclassified_around_weight: TestWeight,
     /// Edge scans start this many pixels outside the box.
     pub edge_margin_px: u32,
     /// An edge scan stops at the first run of this many ball-coloured pixels, so single noisy
@@ -122,6 +128,8 @@ impl Default for BallParams {
             aspect_weight: TestWeight::new(0.5, 1.5),
             orange_fraction: [0.3, 1.0],
             orange_fraction_weight: TestWeight::new(0.5, 2.0),
+            unclassified_around: [0.0, 0.6],
+            unclassified_around_weight: TestWeight::new(0.0, 2.0),
             edge_margin_px: 3,
             edge_run_px: 2,
             border_cut_min_share: 0.25,
@@ -402,6 +410,24 @@ fn circle_holds_blob(f: &CircleFit, b: &Blob, cut: CutOff, shift: Point) -> bool
         && (!cut.bottom || f.center_y + f.radius >= maxy - reach)
 }
 
+/// Share of unclassified pixels on the ring one pixel outside the box (pixels inside the image
+/// only); `None` when the ring lies wholly outside.
+fn unclassified_around(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
+    let (minx, miny) = (i64::from(b.minx) - 1, i64::from(b.miny) - 1);
+    let (maxx, maxy) = (i64::from(b.maxx) + 1, i64::from(b.maxy) + 1);
+    let ring = (minx..=maxx)
+        .flat_map(|x| [(x, miny), (x, maxy)])
+        .chain((miny + 1..maxy).flat_map(|y| [(minx, y), (maxx, y)]));
+    let (mut n, mut none) = (0u32, 0u32);
+    for (x, y) in ring {
+        if let Some(c) = img.get_signed(x, y) {
+            n += 1;
+            none += u32::from(c == ColourClass::Unclassified.code());
+        }
+    }
+    (n > 0).then(|| f64::from(none) / f64::from(n))
+}
+
 /// One outline point moved to the reference row's read-out time: through the body model when
 /// asked and possible, else by the linear shear; `depth_cm` is the point's distance estimate.
 fn unskew_point(ctx: &ViewContext, params: &BallParams, p: Point, depth_cm: f64) -> Point {
@@ -510,6 +536,14 @@ pub fn recognise_ball(
             params.orange_fraction,
             params.orange_fraction_weight,
         );
+        if let Some(share) = unclassified_around(img, &group) {
+            confidence.range_test(
+                "unclassified_around",
+                share,
+                params.unclassified_around,
+                params.unclassified_around_weight,
+            );
+        }
         let horizontal_cut = cut.left || cut.right;
         let vertical_cut = cut.top || cut.bottom;
         if horizontal_cut != vertical_cut {
@@ -563,10 +597,11 @@ pub fn recognise_ball(
             }
             None => confidence.skipped("height_cm", params.height_cm),
         }
-        // Colour below: an area under the ball, parallel to the horizon.
+        // Colour below: an area under the ball, parallel to the horizon, where the ball is in
+        // the image (the centre before skew removal).
         let below_scan = scan_rotated_rect(
             img,
-            center,
+            (center.0 - box_shift.0, center.1 - box_shift.1),
             [
                 -radius,
                 radius,
