@@ -84,6 +84,18 @@ pub struct BallParams {
     /// Pixels added to the uncut extent in the cut-extent ratio: both extents of a small ball
     /// are whole pixels and either may be one too many.
     pub extent_slack_px: f64,
+    /// Bonus when the outline fits a circle with at least [`Self::circle_fit_min_points`]
+    /// points (a well-fitted outline says "round" better than the fill of the box, which holes
+    /// in a real ball's classification lower).
+    pub circle_fit_bonus: f64,
+    /// Outline points needed for the circle-fit bonus.
+    pub circle_fit_min_points: usize,
+    /// Smallest fitted radius that earns the circle-fit bonus, pixels (a circle through the
+    /// outline of a speck proves little).
+    pub circle_fit_min_radius_px: f64,
+    /// A fitted circle is rejected when its diameter exceeds this multiple of the blob's
+    /// uncut extent (an uncut ball's circle is as wide as its blob).
+    pub max_fit_diameter_ratio: f64,
     /// Penalty when the outline was scanned but does not fit a circle (residuals too large, or
     /// the points lie on a line: a straight edge is not a ball's).
     pub bad_circle_penalty: f64,
@@ -142,6 +154,10 @@ impl Default for BallParams {
             cut_extent_weight: TestWeight::new(0.0, 3.0),
             extent_slack_px: 1.0,
             bad_circle_penalty: 1.5,
+            circle_fit_bonus: 1.0,
+            circle_fit_min_points: 12,
+            circle_fit_min_radius_px: 8.0,
+            max_fit_diameter_ratio: 1.5,
             ground_plane_fusion: true,
             radius_bias_px: 0.0,
             radius_sigma_px: 0.5,
@@ -508,6 +524,15 @@ pub fn recognise_ball(
                 ))
             }
             Some(f) if f.radius > 4.0 * d => Some("radius beyond any ball".to_owned()),
+            Some(f)
+                if uncut_extent > 0.0
+                    && 2.0 * f.radius > params.max_fit_diameter_ratio * uncut_extent =>
+            {
+                Some(format!(
+                    "diameter {:.1} px much larger than blob extent {uncut_extent:.0} px",
+                    2.0 * f.radius
+                ))
+            }
             Some(f) if !circle_holds_blob(f, &group, cut, box_shift) => {
                 Some("circle does not hold the blob".to_owned())
             }
@@ -568,6 +593,16 @@ pub fn recognise_ball(
                 f.residual_sd,
                 [0.0, params.max_fit_residual_ratio * f.radius + 0.75],
                 TestWeight::new(0.0, params.bad_circle_penalty),
+            );
+        }
+        if let (Some(f), true) = (&fit, use_fit)
+            && f.radius >= params.circle_fit_min_radius_px
+        {
+            confidence.bonus_test(
+                "circle_fit_points",
+                f.points as f64,
+                [params.circle_fit_min_points as f64, f64::INFINITY],
+                params.circle_fit_bonus,
             );
         }
         if fit.is_none() && points.len() >= 5 {

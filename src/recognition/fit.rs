@@ -296,7 +296,7 @@ mod tests {
                 }
             })
             .collect();
-        let s = fit_circle_trimmed(&square, 1.0, 0.1, 0.2).expect("fit");
+        let s = fit_circle_trimmed(&square, 1.0, 0.1, 0.15).expect("fit");
         assert_eq!(s.points, 40);
     }
 
