@@ -52,7 +52,12 @@ fn classify_uyvy_avx2(src: &[u8], table: &[u8], bits: u32, dst: &mut [u8]) -> us
     let low_byte = _mm256_set1_epi32(0xff);
     let word_start = _mm256_set1_epi32(!3);
     let byte_in_word = _mm256_set1_epi32(3);
-    let (s_u, s_y0, s_v, s_y1) = (count(shift), count(8 + shift), count(16 + shift), count(24 + shift));
+    let (s_u, s_y0, s_v, s_y1) = (
+        count(shift),
+        count(8 + shift),
+        count(16 + shift),
+        count(24 + shift),
+    );
     let (to_u, to_y) = (count(b), count(2 * b));
     let (times_8, by_a_byte) = (count(3), count(8));
 
@@ -82,7 +87,12 @@ fn classify_uyvy_avx2(src: &[u8], table: &[u8], bits: u32, dst: &mut [u8]) -> us
         // Dwords to words within each 128-bit half, then the two halves' low quads together.
         let packed = _mm256_permute4x64_epi64::<0b00_00_10_00>(_mm256_packus_epi32(pairs, pairs));
         // SAFETY: `out` is 16 bytes; the store is unaligned.
-        unsafe { _mm_storeu_si128(out.as_mut_ptr().cast::<__m128i>(), _mm256_castsi256_si128(packed)) };
+        unsafe {
+            _mm_storeu_si128(
+                out.as_mut_ptr().cast::<__m128i>(),
+                _mm256_castsi256_si128(packed),
+            )
+        };
         done += 16;
     }
     done
