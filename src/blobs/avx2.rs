@@ -9,7 +9,7 @@
 
 #![allow(unsafe_code)]
 
-use super::{Run, u16_of};
+use super::{RowRuns, Run};
 
 /// Appends the runs of `row` with the AVX2 scan; `false` (and nothing appended) when the CPU
 /// has no AVX2, so the caller falls back to the portable scan.
@@ -36,20 +36,16 @@ fn encode_row_avx2(row: &[u8], y: u16, runs: &mut Vec<Run>) {
     use std::arch::x86_64::{__m256i, _mm256_cmpeq_epi8, _mm256_loadu_si256, _mm256_movemask_epi8};
 
     let Some(&first) = row.first() else { return };
-    let mut emit = |x0: usize, x1: usize, colour: u8| {
-        if colour != 0 {
-            runs.push(Run {
-                x0: u16_of(x0),
-                x1: u16_of(x1),
-                y,
-                colour,
-            });
-        }
-    };
-    let (mut start, mut colour) = (0, first);
-    // Block k compares pixels x..x+32 with their left neighbours x-1..x+31; it starts at 1.
+    let mut out = RowRuns::new(runs, y, first);
+    // A block compares pixels x..x+32 with their left neighbours x-1..x+31, from x = 1. The
+    // last block is moved back to end at the row's end; its boundaries before `x` were already
+    // emitted and are masked off.
     let mut x = 1;
-    while let (Some(now), Some(left)) = (row.get(x..x + 32), row.get(x - 1..x + 31)) {
+    while x < row.len() {
+        let at = x.min(row.len().saturating_sub(32)).max(1);
+        let (Some(now), Some(left)) = (row.get(at..at + 32), row.get(at - 1..at + 31)) else {
+            break;
+        };
         // SAFETY: both slices are 32 bytes long (`get` checked it); the loads are unaligned.
         let (a, b) = unsafe {
             (
@@ -59,21 +55,15 @@ fn encode_row_avx2(row: &[u8], y: u16, runs: &mut Vec<Run>) {
         };
         // One bit per pixel that differs from its left neighbour: a run boundary.
         let mut changed = !(_mm256_movemask_epi8(_mm256_cmpeq_epi8(a, b)).cast_unsigned());
+        changed &= u32::MAX.checked_shl((x - at) as u32).unwrap_or(0);
         while changed != 0 {
-            let p = x + changed.trailing_zeros() as usize;
+            let p = at + changed.trailing_zeros() as usize;
             changed &= changed - 1;
-            emit(start, p, colour);
-            start = p;
-            colour = now[p - x];
+            out.boundary(p, now[p - at]);
         }
-        x += 32;
+        x = at + 32;
     }
-    for (p, &c) in row.iter().enumerate().skip(x) {
-        if c != colour {
-            emit(start, p, colour);
-            start = p;
-            colour = c;
-        }
-    }
-    emit(start, row.len(), colour);
+    // Rows shorter than 33 pixels.
+    out.scan_tail(row, x);
+    out.finish(row.len());
 }

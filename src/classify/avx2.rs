@@ -28,6 +28,18 @@ pub(super) fn classify_uyvy(src: &[u8], table: &[u8], bits: u32, dst: &mut [u8])
     unsafe { classify_uyvy_avx2(src, table, bits, dst) }
 }
 
+/// Whether the CPU has AVX2 (detected once, then cached by the standard library).
+pub(super) fn available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Non-x86 targets always take the portable loop.
 #[cfg(not(target_arch = "x86_64"))]
 pub(super) fn classify_uyvy(_src: &[u8], _table: &[u8], _bits: u32, _dst: &mut [u8]) -> usize {

@@ -154,6 +154,17 @@ pub fn classify_uyvy(src: &[u8], lut: &LookupTable, dst: &mut [u8]) {
     classify_uyvy_portable(src_rest, lut, dst_rest);
 }
 
+/// The kernels [`classify_uyvy`] and blob formation use on this CPU: `"avx2"` or `"portable"`
+/// (`eotn bench` reports it, so figures from different machines can be told apart).
+#[must_use]
+pub fn active_kernels() -> &'static str {
+    if avx2::available() {
+        "avx2"
+    } else {
+        "portable"
+    }
+}
+
 /// [`classify_uyvy`] in safe portable Rust on every CPU (for comparison in benchmarks).
 pub fn classify_uyvy_portable(src: &[u8], lut: &LookupTable, dst: &mut [u8]) {
     let cells = lut.cells();
