@@ -44,6 +44,10 @@ pub struct Args {
     /// a recognition-parameter JSON file.
     #[arg(long)]
     pub calibrate_goals: Option<PathBuf>,
+    /// Draw the evaluation as PNG charts into this folder (measured against true distance,
+    /// error histograms, found rates per distance band, post errors).
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -84,6 +88,8 @@ pub struct EvalOutput {
     pub differences: Vec<Difference>,
     /// Fitted goal distance relation (multiplier cm·px, offset cm), if asked for.
     pub goal_calibration: Option<(f64, f64)>,
+    /// Charts written by `--plots` (and the calibration plot is beside the calibration file).
+    pub plots: Vec<PathBuf>,
     /// Frames skipped, with the reason.
     pub skipped: Vec<String>,
 }
@@ -243,9 +249,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let json = serde_json::to_vec_pretty(&p)?;
         crate::atomic_file::write_atomic(out, &json)
             .with_context(|| format!("{}: cannot write", out.display()))?;
+        let plot = out.with_extension("png");
+        crate::eval::plots::write_calibration_plot(
+            &plot,
+            &goal_samples,
+            (m, o),
+            (rp.goals.distance_multiplier, rp.goals.distance_offset_cm),
+        )
+        .context("calibration plot")?;
         Some((m, o))
     } else {
         None
+    };
+    let plots = match &args.plots {
+        Some(dir) => crate::eval::plots::write_eval_plots(dir, &frames_a).context("plots")?,
+        None => Vec::new(),
     };
     let output = EvalOutput {
         report: EvalReport::from_frames(&frames_a),
@@ -257,6 +275,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         compare: other.is_some().then(|| EvalReport::from_frames(&frames_b)),
         differences,
         goal_calibration,
+        plots,
         skipped,
     };
     if args.json {
@@ -326,6 +345,12 @@ fn print_summary(o: &EvalOutput) {
     if !r.ball_false_frames.is_empty() {
         println!("false ball in frames   {:?}", r.ball_false_frames);
     }
+    if !r.goal_misses.is_empty() {
+        println!("goal missed in frames  {:?}", r.goal_misses);
+    }
+    if !r.goal_false_frames.is_empty() {
+        println!("false goal in frames   {:?}", r.goal_false_frames);
+    }
     if let Some(c) = &o.compare {
         println!(
             "compared: ball {}/{}, false {}, goals {}/{}; {} frame(s) differ",
@@ -342,6 +367,9 @@ fn print_summary(o: &EvalOutput) {
     }
     if let Some((m, off)) = o.goal_calibration {
         println!("goal distance          = {m:.1} / height_px + {off:.1} cm (written)");
+    }
+    if !o.plots.is_empty() {
+        println!("plots                  {} written", o.plots.len());
     }
     if !o.skipped.is_empty() {
         println!(

@@ -59,6 +59,13 @@ pub struct GoalParams {
     pub green_below_bonus: f64,
     /// Penalty when there is too little green below (a yellow thing off the field).
     pub green_below_penalty: f64,
+    /// Green or white fraction in a thin band right under the bottom edge (the carpet or the
+    /// goal line a goal stands on; a yellow thing off the field stands on the floor).
+    pub ground_at_foot: [f64; 2],
+    /// Height of that band as a fraction of the goal's height (at least 2 pixels).
+    pub ground_at_foot_band: f64,
+    /// Weight of the ground-at-foot test.
+    pub ground_at_foot_weight: TestWeight,
     /// Accepted ratio of the size-based distance to the distance of the bottom's foot on the
     /// ground (through the camera pose); a thing of another height than a goal fails.
     pub distance_agreement: [f64; 2],
@@ -72,6 +79,13 @@ pub struct GoalParams {
     pub elevation_rad: [f64; 2],
     /// Weight of the elevation test.
     pub elevation_weight: TestWeight,
+    /// Accepted real width of a candidate, centimetres: its level width in pixels times the
+    /// size-based distance over the focal length. A goal shows its 84-cm front (less when seen
+    /// from the side, but its 30-cm-deep side wall then shows too); a yellow box or jacket of
+    /// a goal's height is narrower. Skipped when the left or right side is cut off.
+    pub apparent_width_cm: [f64; 2],
+    /// Weight of the width test.
+    pub apparent_width_weight: TestWeight,
     /// Base confidence of a candidate with enough pixels.
     pub size_bonus: f64,
     /// Number of scan lines per post.
@@ -111,12 +125,17 @@ impl Default for GoalParams {
             green_below: [0.2, 1.0],
             green_below_bonus: 1.0,
             green_below_penalty: 1.5,
+            ground_at_foot: [0.4, 1.0],
+            ground_at_foot_band: 0.1,
+            ground_at_foot_weight: TestWeight::new(0.5, 6.0),
             distance_agreement: [0.6, 1.6],
             distance_agreement_weight: TestWeight::new(1.0, 3.0),
             bottom_height_cm: [-20.0, 20.0],
             bottom_height_weight: TestWeight::new(1.0, 3.0),
             elevation_rad: [-0.8, 0.5],
             elevation_weight: TestWeight::new(0.5, 2.0),
+            apparent_width_cm: [55.0, 160.0],
+            apparent_width_weight: TestWeight::new(0.5, 6.0),
             size_bonus: 0.5,
             post_scans: 8,
             post_min_r_squared: 0.5,
@@ -150,6 +169,13 @@ pub struct Post {
     pub bottom: Point,
     /// The fit (in image coordinates).
     pub fit: LineFit,
+    /// Top end moved to the reference row's read-out time (rolling shutter), pixels: where the
+    /// post is in the instant the camera pose describes. Equals `top` without skew correction.
+    #[serde(default)]
+    pub reference_top: Point,
+    /// Bottom end moved to the reference row's read-out time, pixels.
+    #[serde(default)]
+    pub reference_bottom: Point,
     /// Camera-relative direction of the post's centre (distance: the goal's).
     pub camera: Relative,
     /// Body-relative direction of the post's centre.
@@ -159,9 +185,9 @@ pub struct Post {
 /// The largest open stretch of goal between obstacles, along the gap scan.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Gap {
-    /// Left end, image pixels.
+    /// Left end, image pixels (as scanned; the bearings below are skew-corrected).
     pub left: Point,
-    /// Right end, image pixels.
+    /// Right end, image pixels (as scanned).
     pub right: Point,
     /// Length, pixels.
     pub width_px: f64,
@@ -198,6 +224,14 @@ pub struct GoalCandidate {
     pub distance_is_max: bool,
     /// True when the infra-red reading gave the distance.
     pub distance_from_ir: bool,
+    /// True when the distance is that of the goal's foot on the ground (through the camera
+    /// pose), used when the top is cut off.
+    #[serde(default)]
+    pub distance_from_ground: bool,
+    /// Extent of the candidate's pixels in the level frame (rotated about the image centre by
+    /// the horizon angle): `[min x, min y, max x, max y]`, pixels.
+    #[serde(default)]
+    pub level_extent: [f64; 4],
     /// Confidence breakdown.
     pub confidence: Confidence,
     /// Fitted posts.
@@ -264,6 +298,35 @@ fn level_extent(b: &Blob, centre: Point, angle: f64) -> [f64; 4] {
         e[3] = e[3].max(p.1);
     }
     e
+}
+
+/// Level-frame extent of the pixels of some blobs (their runs' ends, rotated), tighter than
+/// the rotated box when the horizon is tilted: a tilted box's corners add w·sin θ to its height.
+fn pixel_level_extent(
+    blobs: &BlobSet,
+    members: impl Iterator<Item = u32>,
+    centre: Point,
+    angle: f64,
+) -> Option<[f64; 4]> {
+    let mut e = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for m in members {
+        for r in blobs.runs_of(m) {
+            let (x0, x1, y) = (f64::from(r.x0), f64::from(r.x1), f64::from(r.y));
+            for c in [(x0, y), (x1, y), (x0, y + 1.0), (x1, y + 1.0)] {
+                let q = rotate_about(c, centre, angle);
+                e[0] = e[0].min(q.0);
+                e[1] = e[1].min(q.1);
+                e[2] = e[2].max(q.0);
+                e[3] = e[3].max(q.1);
+            }
+        }
+    }
+    (e[0] < e[2] && e[1] < e[3]).then_some(e)
 }
 
 fn build_groups(
@@ -380,7 +443,7 @@ pub fn recognise_goals(
     for colour in [ColourClass::Yellow, ColourClass::SkyBlue] {
         let mut accepted_one = false;
         for g in build_groups(blobs, colour, ctx, p) {
-            let mut cand = examine(img, &g, colour, ctx, p);
+            let mut cand = examine(img, blobs, &g, colour, ctx, p);
             // A beacon's yellow or sky-blue band is not a goal.
             let overlap = beacons
                 .iter()
@@ -407,6 +470,7 @@ pub fn recognise_goals(
 
 fn examine(
     img: &ClassifiedImage,
+    blobs: &BlobSet,
     g: &Group,
     colour: ColourClass,
     ctx: &ViewContext,
@@ -415,9 +479,25 @@ fn examine(
     let (w, h) = (img.width() as f64, img.height() as f64);
     let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
     let angle = ctx.horizon_angle();
-    let e_all = level_extent(&g.all, centre, angle);
-    let e_basic = level_extent(&g.basic, centre, angle);
-    let cut = detect_cut_off(e_all, centre, angle, w, h, p.edge_margin_px);
+    // Cut-off from the rotated box (its corners reach the edge when the goal does); sizes and
+    // positions from the pixels themselves.
+    let cut = detect_cut_off(
+        level_extent(&g.all, centre, angle),
+        centre,
+        angle,
+        w,
+        h,
+        p.edge_margin_px,
+    );
+    let e_all = pixel_level_extent(blobs, g.members.iter().copied(), centre, angle)
+        .unwrap_or_else(|| level_extent(&g.all, centre, angle));
+    let basic_members = g
+        .members
+        .iter()
+        .copied()
+        .filter(|m| blobs.get(*m).is_some_and(|b| b.colour == colour.code()));
+    let e_basic = pixel_level_extent(blobs, basic_members, centre, angle)
+        .unwrap_or_else(|| level_extent(&g.basic, centre, angle));
     let h_all = e_all[3] - e_all[1];
     let h_basic = e_basic[3] - e_basic[1];
     let height_px = if (h_all - h_basic) <= p.soft_side_tolerance * h_all {
@@ -426,6 +506,19 @@ fn examine(
         h_all
     };
     let mut distance = p.distance_multiplier / height_px.max(1.0) + p.distance_offset_cm;
+    // Top cut off, bottom in view: the foot on the ground (through the camera pose) gives the
+    // distance; the height would only give a maximum.
+    let bottom_mid = rotate_about(((e_all[0] + e_all[2]) / 2.0, e_all[3]), centre, -angle);
+    let mut from_ground = false;
+    if cut.top
+        && !cut.bottom
+        && let Some(f) = ctx
+            .distance_to_plane(bottom_mid, 0.0)
+            .filter(|f| f.is_finite() && *f > 0.0)
+    {
+        distance = f;
+        from_ground = true;
+    }
     let mut from_ir = false;
     if let Some(ir) = ctx
         .ir_distance_cm
@@ -465,7 +558,6 @@ fn examine(
         confidence.skipped("bottom_height_cm", p.bottom_height_cm);
         confidence.skipped("elevation_rad", p.elevation_rad);
     } else {
-        let bottom_mid = rotate_about(((e_all[0] + e_all[2]) / 2.0, e_all[3]), centre, -angle);
         let half_w = (e_all[2] - e_all[0]) / 2.0;
         let band = (height_px * 0.3).max(2.0);
         let below = scan_rotated_rect(
@@ -484,6 +576,23 @@ fn examine(
             ),
             None => confidence.skipped("green_below", p.green_below),
         }
+        let foot_band = (height_px * p.ground_at_foot_band).max(2.0);
+        let at_foot = scan_rotated_rect(
+            img,
+            bottom_mid,
+            [-half_w, half_w, 1.0, 1.0 + foot_band],
+            -angle,
+            1.0,
+        );
+        match at_foot.ratio(|c| c == ColourClass::Green.code() || c == ColourClass::White.code()) {
+            Some(r) if !cut.bottom => confidence.range_test(
+                "ground_at_foot",
+                r,
+                p.ground_at_foot,
+                p.ground_at_foot_weight,
+            ),
+            _ => confidence.skipped("ground_at_foot", p.ground_at_foot),
+        }
         if cut.bottom {
             confidence.skipped("bottom_height_cm", p.bottom_height_cm);
         } else {
@@ -496,6 +605,16 @@ fn examine(
                 ),
                 None => confidence.skipped("bottom_height_cm", p.bottom_height_cm),
             }
+        }
+        if cut.left || cut.right {
+            confidence.skipped("apparent_width_cm", p.apparent_width_cm);
+        } else {
+            confidence.range_test(
+                "apparent_width_cm",
+                (e_all[2] - e_all[0]) * distance / ctx.camera.focal_px,
+                p.apparent_width_cm,
+                p.apparent_width_weight,
+            );
         }
         let foot = ctx.distance_to_plane(bottom_mid, 0.0);
         match foot {
@@ -527,8 +646,10 @@ fn examine(
         height_px,
         camera,
         body,
-        distance_is_max: !from_ir && (cut.top || cut.bottom),
+        distance_is_max: !from_ir && !from_ground && (cut.top || cut.bottom),
         distance_from_ir: from_ir,
+        distance_from_ground: from_ground && !from_ir,
+        level_extent: e_all,
         confidence,
         posts: Vec::new(),
         rejected_posts: Vec::new(),
@@ -573,18 +694,7 @@ fn find_posts_and_gap(
 ) {
     let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
     let angle = ctx.horizon_angle();
-    let b = Blob {
-        colour: colour.code(),
-        number: 0,
-        minx: cand.bounds[0],
-        miny: cand.bounds[1],
-        maxx: cand.bounds[2],
-        maxy: cand.bounds[3],
-        pixels: cand.pixels,
-        sum_x: 0,
-        sum_y: 0,
-    };
-    let e = level_extent(&b, centre, angle);
+    let e = cand.level_extent;
     let is_goal = is_goal_colour(colour);
     let distance = cand.camera.distance_cm;
     let height = e[3] - e[1];
@@ -647,12 +757,22 @@ fn find_posts_and_gap(
         } else {
             image_pts[image_pts.len() - 1]
         };
-        let mid = ((top.0 + bottom.0) / 2.0, (top.1 + bottom.1) / 2.0);
+        let (reference_top, reference_bottom) = if p.skew_correction {
+            (ctx.unskew(top, false), ctx.unskew(bottom, false))
+        } else {
+            (top, bottom)
+        };
+        let mid = (
+            (reference_top.0 + reference_bottom.0) / 2.0,
+            (reference_top.1 + reference_bottom.1) / 2.0,
+        );
         cand.posts.push(Post {
             side,
             top,
             bottom,
             fit,
+            reference_top,
+            reference_bottom,
             camera: ctx.camera_relative(mid, distance),
             body: ctx.body_relative(mid, distance),
         });
@@ -687,20 +807,24 @@ fn find_posts_and_gap(
         rotate_about((e[2], y), centre, -angle),
     ));
     if let Some((a, b)) = best {
-        let mut left = rotate_about((a, y), centre, -angle);
-        let mut right = rotate_about((b, y), centre, -angle);
-        if p.skew_correction {
-            left = ctx.unskew(left, false);
-            right = ctx.unskew(right, false);
-        }
-        let mid = ((left.0 + right.0) / 2.0, (left.1 + right.1) / 2.0);
+        let left = rotate_about((a, y), centre, -angle);
+        let right = rotate_about((b, y), centre, -angle);
+        let (ref_left, ref_right) = if p.skew_correction {
+            (ctx.unskew(left, false), ctx.unskew(right, false))
+        } else {
+            (left, right)
+        };
+        let mid = (
+            (ref_left.0 + ref_right.0) / 2.0,
+            (ref_left.1 + ref_right.1) / 2.0,
+        );
         cand.gap = Some(Gap {
             left,
             right,
             width_px: b - a,
             camera: ctx.camera_relative(mid, distance),
-            left_bearing_rad: ctx.camera_angles(left).0,
-            right_bearing_rad: ctx.camera_angles(right).0,
+            left_bearing_rad: ctx.camera_angles(ref_left).0,
+            right_bearing_rad: ctx.camera_angles(ref_right).0,
         });
     }
 }

@@ -192,9 +192,12 @@ fn debug_scenario() {
                 ))
                 .collect::<Vec<_>>(),
         );
-        for g in r.recognition.goals.candidates.iter().filter(|g| g.accepted) {
+        for g in &r.recognition.goals.candidates {
             eprintln!(
-                "    tests {:?}",
+                "    {} cut {:?} h {:.1} tests {:?}",
+                if g.accepted { "ACCEPTED" } else { "rejected" },
+                g.cut_off,
+                g.height_px,
                 g.confidence
                     .tests
                     .iter()
@@ -305,6 +308,7 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     // Evaluation and calibration on a robot walking towards the goal (distances vary).
     let (walk, _) = write_scenario(dir.path(), ScenarioKind::WalkAndPan, 60);
     let calibrated = dir.path().join("calibrated.json");
+    let plots = dir.path().join("plots");
     let out = super::common::eotn(&[
         "eval".as_ref(),
         walk.as_os_str(),
@@ -313,6 +317,8 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
         "--json".as_ref(),
         "--calibrate-goals".as_ref(),
         calibrated.as_os_str(),
+        "--plots".as_ref(),
+        plots.as_os_str(),
     ]);
     assert!(
         out.status.success(),
@@ -338,6 +344,48 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     assert_eq!(
         params["goals"]["distance_multiplier"], fitted[0],
         "the written parameters hold the fit"
+    );
+
+    // The charts: every one a 720×480 PNG; the distance charts show their data points in the
+    // series colours, the calibration plot its samples and the fitted curve.
+    let count = |img: &image::RgbImage, c: [u8; 3]| img.pixels().filter(|p| p.0 == c).count();
+    for name in [
+        "ball_distance.png",
+        "goal_distance.png",
+        "ball_distance_error.png",
+        "goal_distance_error.png",
+        "ball_detection.png",
+        "goal_detection.png",
+        "post_error.png",
+    ] {
+        let img = image::open(plots.join(name)).unwrap().to_rgb8();
+        assert_eq!((img.width(), img.height()), (720, 480), "{name}");
+        let dark = img.pixels().filter(|p| p.0.iter().all(|v| *v < 60)).count();
+        assert!(
+            dark > 500,
+            "{name}: axes and text drawn ({dark} dark pixels)"
+        );
+    }
+    let ball = image::open(plots.join("ball_distance.png"))
+        .unwrap()
+        .to_rgb8();
+    assert!(
+        count(&ball, [235, 120, 20]) >= 25 * 5,
+        "ball points and legend"
+    );
+    let goal = image::open(plots.join("goal_distance.png"))
+        .unwrap()
+        .to_rgb8();
+    assert!(count(&goal, [210, 170, 0]) >= 25 * 3, "yellow goal points");
+    let calibration = image::open(calibrated.with_extension("png"))
+        .unwrap()
+        .to_rgb8();
+    assert!(count(&calibration, [30, 140, 220]) >= 25 * 3, "samples");
+    assert!(count(&calibration, [200, 30, 30]) >= 100, "fitted curve");
+    assert_eq!(
+        report["plots"].as_array().map(Vec::len),
+        Some(7),
+        "{report}"
     );
 
     // A frame without truth is refused clearly, not a panic.
