@@ -243,6 +243,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let Some((m, o)) = fit_inverse_size(&goal_samples) else {
             bail!("too few uncut goals ({}) to calibrate", goal_samples.len());
         };
+        if !(m > 0.0 && m.is_finite() && o.is_finite()) {
+            let (lo, hi) = goal_samples
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
+                    (a.min(s.1), b.max(s.1))
+                });
+            bail!(
+                "goal calibration gives distance = {m:.1} / height + {o:.1} cm from {} goals \
+                 {lo:.0}–{hi:.0} cm away: not a size → distance relation; give streams with \
+                 goals over a wider range of distances",
+                goal_samples.len()
+            );
+        }
         let mut p = rp;
         p.goals.distance_multiplier = m;
         p.goals.distance_offset_cm = o;

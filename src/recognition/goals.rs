@@ -45,10 +45,20 @@ pub struct GoalParams {
     pub distance_offset_cm: f64,
     /// The goal-colour part's height is used when the soft sides add less than this fraction.
     pub soft_side_tolerance: f64,
+    /// Each post's height is the tallest level column within this fraction of the goal's
+    /// width from its side (at least 3 pixels).
+    pub post_height_band: f64,
+    /// The two posts' heights are used only when the shorter is at least this fraction of the
+    /// goal's height (a robot in front of a post shortens it).
+    pub post_height_agreement: f64,
     /// Below this distance (cm) the infra-red reading replaces the size-based distance.
     pub ir_max_cm: f64,
     /// Goals covering more than this fraction of the image skip the identification tests.
     pub fills_image_fraction: f64,
+    /// Candidates cut off on more sides than this (and not filling the image) are penalised.
+    pub max_cut_sides: f64,
+    /// Penalty for too many cut sides.
+    pub cut_sides_penalty: f64,
     /// Accepted pixels / box area.
     pub pixel_ratio: [f64; 2],
     /// Weight of the pixel-ratio test.
@@ -118,14 +128,18 @@ impl Default for GoalParams {
             distance_multiplier: 191.9 * 30.0,
             distance_offset_cm: 0.0,
             soft_side_tolerance: 0.15,
+            post_height_band: 0.15,
+            post_height_agreement: 0.75,
             ir_max_cm: 60.0,
             fills_image_fraction: 0.6,
+            max_cut_sides: 2.0,
+            cut_sides_penalty: 3.0,
             pixel_ratio: [0.3, 1.0],
             pixel_ratio_weight: TestWeight::new(0.5, 1.5),
             green_below: [0.2, 1.0],
             green_below_bonus: 1.0,
             green_below_penalty: 1.5,
-            ground_at_foot: [0.4, 1.0],
+            ground_at_foot: [0.5, 1.0],
             ground_at_foot_band: 0.1,
             ground_at_foot_weight: TestWeight::new(0.5, 6.0),
             distance_agreement: [0.6, 1.6],
@@ -500,11 +514,25 @@ fn examine(
         .unwrap_or_else(|| level_extent(&g.basic, centre, angle));
     let h_all = e_all[3] - e_all[1];
     let h_basic = e_basic[3] - e_basic[1];
-    let height_px = if (h_all - h_basic) <= p.soft_side_tolerance * h_all {
-        h_basic
-    } else {
-        h_all
-    };
+    let use_basic = (h_all - h_basic) <= p.soft_side_tolerance * h_all;
+    let mut height_px = if use_basic { h_basic } else { h_all };
+    // Whole goal in view: the distance is that of the mouth's centre, between the two posts'
+    // distances (the tallest level column near each side; the box's height is the nearer
+    // post's). The equivalent height is their harmonic mean.
+    if !cut.any() {
+        let basic = |c: u8| c == colour.code();
+        let any = is_goal_colour(colour);
+        let pred: &dyn Fn(u8) -> bool = if use_basic { &basic } else { &any };
+        let e = if use_basic { e_basic } else { e_all };
+        let band = ((e[2] - e[0]) * p.post_height_band).max(3.0);
+        if let (Some(hl), Some(hr)) = (
+            side_height(img, pred, e, true, band, centre, angle),
+            side_height(img, pred, e, false, band, centre, angle),
+        ) && hl.min(hr) >= p.post_height_agreement * height_px
+        {
+            height_px = 2.0 / (1.0 / hl + 1.0 / hr);
+        }
+    }
     let mut distance = p.distance_multiplier / height_px.max(1.0) + p.distance_offset_cm;
     // Top cut off, bottom in view: the foot on the ground (through the camera pose) gives the
     // distance; the height would only give a maximum.
@@ -554,10 +582,23 @@ fn examine(
         p.pixel_ratio_weight,
     );
     if fills {
+        confidence.skipped("cut_sides", [0.0, p.max_cut_sides]);
         confidence.skipped("green_below", p.green_below);
         confidence.skipped("bottom_height_cm", p.bottom_height_cm);
         confidence.skipped("elevation_rad", p.elevation_rad);
     } else {
+        // A sliver cut off on three or four sides that does not fill the image shows too
+        // little of itself to be identified.
+        let cut_sides = [cut.left, cut.right, cut.top, cut.bottom]
+            .iter()
+            .filter(|c| **c)
+            .count();
+        confidence.range_test(
+            "cut_sides",
+            cut_sides as f64,
+            [0.0, p.max_cut_sides],
+            TestWeight::new(0.0, p.cut_sides_penalty),
+        );
         let half_w = (e_all[2] - e_all[0]) / 2.0;
         let band = (height_px * 0.3).max(2.0);
         let below = scan_rotated_rect(
@@ -658,6 +699,46 @@ fn examine(
         gap_scan: None,
         accepted: false,
     }
+}
+
+/// The tallest run of goal colour along level columns within `band` pixels inside one side of
+/// the level extent `e`: the height of the post on that side, pixels.
+fn side_height(
+    img: &ClassifiedImage,
+    is_goal: &dyn Fn(u8) -> bool,
+    e: [f64; 4],
+    left: bool,
+    band: f64,
+    centre: Point,
+    angle: f64,
+) -> Option<f64> {
+    let columns = band.ceil() as usize;
+    let rows = (e[3] - e[1]).ceil() as usize + 2;
+    let mut best: Option<f64> = None;
+    for k in 0..columns {
+        let x = if left {
+            e[0] + 0.5 + k as f64
+        } else {
+            e[2] - 0.5 - k as f64
+        };
+        let (mut top, mut bottom) = (None, None);
+        for i in 0..rows {
+            let y = e[1] - 1.0 + i as f64 + 0.5;
+            let q = rotate_about((x, y), centre, -angle);
+            if img
+                .get_signed(q.0.floor() as i64, q.1.floor() as i64)
+                .is_some_and(is_goal)
+            {
+                top.get_or_insert(y);
+                bottom = Some(y);
+            }
+        }
+        if let (Some(t), Some(b)) = (top, bottom) {
+            let h: f64 = b - t + 1.0;
+            best = Some(best.map_or(h, |v| v.max(h)));
+        }
+    }
+    best
 }
 
 /// Scans from outside a level x position inward along a level row until a goal-coloured pixel;
@@ -777,8 +858,13 @@ fn find_posts_and_gap(
             body: ctx.body_relative(mid, distance),
         });
     }
-    // Gap scan: a level row at the shoulder height above the goal's bottom.
-    let y = e[3] - height * (p.gap_scan_height_cm / p.height_cm).clamp(0.0, 1.0);
+    // Gap scan: a level row at the shoulder height above the goal's bottom (from the foot's
+    // distance when the top is cut off, since then the visible height is not the goal's).
+    let y = if cand.distance_from_ground && distance > 0.0 {
+        (e[3] - p.gap_scan_height_cm * ctx.camera.focal_px / distance).max(e[1] + 0.5)
+    } else {
+        e[3] - height * (p.gap_scan_height_cm / p.height_cm).clamp(0.0, 1.0)
+    };
     let (x0, x1) = (e[0].floor(), e[2].ceil());
     let mut best: Option<(f64, f64)> = None;
     let mut run_start: Option<f64> = None;

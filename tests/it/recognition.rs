@@ -192,6 +192,32 @@ fn debug_scenario() {
                 ))
                 .collect::<Vec<_>>(),
         );
+        let fe = evaluate_frame(
+            i as usize,
+            r.recognition,
+            truth,
+            208.0,
+            160.0,
+            &EvalParams::default(),
+        );
+        eprintln!(
+            "    eval goals {}/{} false {} posts {:?} gaps {:?} dist {:?}",
+            fe.goals_found,
+            fe.goals_eligible,
+            fe.goals_false,
+            fe.post_errors_px
+                .iter()
+                .map(|e| (e * 10.0).round() / 10.0)
+                .collect::<Vec<_>>(),
+            fe.gap_errors_px
+                .iter()
+                .map(|e| (e * 10.0).round() / 10.0)
+                .collect::<Vec<_>>(),
+            fe.goal_distances_cm
+                .iter()
+                .map(|g| (g.true_cm.round(), g.measured_cm.round(), g.height_px))
+                .collect::<Vec<_>>(),
+        );
         for g in &r.recognition.goals.candidates {
             eprintln!(
                 "    {} cut {:?} h {:.1} tests {:?}",
@@ -209,20 +235,25 @@ fn debug_scenario() {
                 .iter()
                 .find(|t| eotn::eval::goal_class(t.colour) == g.colour);
             eprintln!(
-                "    goal {:?} {:?} d {:.0} (truth {:?}) posts {:?} truth posts {:?}",
+                "    goal {:?} {:?} gap {:?} d {:.0} (truth {:?}) posts {:?} truth posts {:?}",
                 g.colour,
                 g.bounds,
+                g.gap
+                    .as_ref()
+                    .map(|g| (g.left.0.round(), g.right.0.round())),
                 g.camera.distance_cm,
                 t.map(|t| (t.relative.camera_distance_cm.round(), t.visible_pixels)),
                 g.posts
                     .iter()
-                    .map(|p| (p.top, p.bottom))
+                    .map(|p| (p.side, p.reference_top, p.reference_bottom))
                     .collect::<Vec<_>>(),
-                t.map(|t| t
-                    .posts
-                    .iter()
-                    .map(|p| (p.image_top, p.image_base))
-                    .collect::<Vec<_>>())
+                t.map(|t| (
+                    t.largest_gap.map(|g| (g.from_x_px, g.to_x_px + 1)),
+                    t.posts
+                        .iter()
+                        .map(|p| (p.image_top, p.image_base))
+                        .collect::<Vec<_>>()
+                ))
             );
         }
     }
@@ -305,13 +336,15 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     let png = image::open(render_dir.join("goalkeeper_000000.png")).unwrap();
     assert_eq!((png.width(), png.height()), (208 * 3, 160 * 3));
 
-    // Evaluation and calibration on a robot walking towards the goal (distances vary).
+    // Evaluation and calibration on a robot walking towards the goal (about 4 m away) and the
+    // goalkeeper frames (1.6 m): a size → distance fit needs a spread of distances.
     let (walk, _) = write_scenario(dir.path(), ScenarioKind::WalkAndPan, 60);
     let calibrated = dir.path().join("calibrated.json");
     let plots = dir.path().join("plots");
     let out = super::common::eotn(&[
         "eval".as_ref(),
         walk.as_os_str(),
+        stream.as_os_str(),
         "--lut".as_ref(),
         lut.as_os_str(),
         "--json".as_ref(),
@@ -326,7 +359,7 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
         String::from_utf8_lossy(&out.stderr)
     );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(report["report"]["frames"], 60);
+    assert_eq!(report["report"]["frames"], 72);
     assert!(
         report["report"]["ball_found"]
             .as_u64()
