@@ -12,6 +12,7 @@ use super::detect::load_params;
 use super::inputs::load_lut_arg;
 use crate::eval::{
     EvalParams, EvalReport, FrameEval, Percentiles, evaluate_frame, fit_inverse_size,
+    fit_inverse_size_multiplier,
 };
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::{Recognition, RecognitionParams};
@@ -44,6 +45,10 @@ pub struct Args {
     /// a recognition-parameter JSON file.
     #[arg(long)]
     pub calibrate_goals: Option<PathBuf>,
+    /// Multiplier and offset are both fitted only when the tallest goal is at least this many
+    /// times the shortest (else the multiplier alone).
+    #[arg(long, default_value_t = 1.3)]
+    pub calibration_min_spread: f64,
     /// Draw the evaluation as PNG charts into this folder (measured against true distance,
     /// error histograms, found rates per distance band, post errors).
     #[arg(long)]
@@ -240,8 +245,28 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         bail!("no frame with robot-camera ground truth in the given streams");
     }
     let goal_calibration = if let Some(out) = &args.calibrate_goals {
-        let Some((m, o)) = fit_inverse_size(&goal_samples) else {
-            bail!("too few uncut goals ({}) to calibrate", goal_samples.len());
+        let (lo_h, hi_h) = goal_samples
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
+                (a.min(s.0), b.max(s.0))
+            });
+        // Heights within a narrow band (one distance) cannot separate multiplier and offset:
+        // then only the multiplier is fitted and the offset kept.
+        let (m, o) = if hi_h >= args.calibration_min_spread * lo_h {
+            let Some((m, o)) = fit_inverse_size(&goal_samples) else {
+                bail!("too few uncut goals ({}) to calibrate", goal_samples.len());
+            };
+            (m, o)
+        } else {
+            let o = rp.goals.distance_offset_cm;
+            let Some(m) = fit_inverse_size_multiplier(&goal_samples, o) else {
+                bail!("no uncut goal to calibrate from");
+            };
+            eprintln!(
+                "goal heights span only {lo_h:.1}–{hi_h:.1} px: fitting the multiplier only, \
+                 offset kept at {o:.1} cm"
+            );
+            (m, o)
         };
         if !(m > 0.0 && m.is_finite() && o.is_finite()) {
             let (lo, hi) = goal_samples

@@ -441,6 +441,20 @@ pub fn fit_inverse_size(samples: &[(f64, f64)]) -> Option<(f64, f64)> {
     })
 }
 
+/// Fits only the multiplier of distance = multiplier / height + `offset` (the offset kept), by
+/// least squares; for samples whose heights span too little to separate the two. `None`
+/// without a usable sample.
+#[must_use]
+pub fn fit_inverse_size_multiplier(samples: &[(f64, f64)], offset: f64) -> Option<f64> {
+    let (sxy, sxx) = samples
+        .iter()
+        .filter(|(h, d)| *h > 0.0 && h.is_finite() && d.is_finite())
+        .fold((0.0, 0.0), |(a, b), (h, d)| {
+            (a + (d - offset) / h, b + 1.0 / (h * h))
+        });
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -463,6 +477,9 @@ mod tests {
         let (m, o) = fit_inverse_size(&samples).expect("fit");
         assert!((m - 5757.0).abs() < 1e-6 && (o - 12.0).abs() < 1e-6);
         assert!(fit_inverse_size(&[(10.0, 5.0)]).is_none());
+        let m = fit_inverse_size_multiplier(&samples, 12.0).expect("fit");
+        assert!((m - 5757.0).abs() < 1e-6);
+        assert!(fit_inverse_size_multiplier(&[(0.0, 5.0)], 0.0).is_none());
     }
 
     #[test]

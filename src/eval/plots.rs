@@ -279,6 +279,12 @@ impl Chart {
     /// Legend entries in the plot area's top-left corner.
     fn legend(&mut self, entries: &[(&str, [u8; 3])]) {
         let (l, _, t, _) = self.area();
+        let widest = entries
+            .iter()
+            .map(|(s, _)| text_width(s))
+            .fold(0.0, f64::max);
+        let bottom = t + 8.0 + entries.len() as f64 * 20.0;
+        self.fill(l + 4.0, t + 3.0, l + 32.0 + widest, bottom, [255, 255, 255]);
         for (i, (label, c)) in entries.iter().enumerate() {
             let y = t + 8.0 + i as f64 * 20.0;
             self.fill(l + 10.0, y + 2.0, l + 20.0, y + 12.0, *c);
@@ -395,8 +401,8 @@ fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3
         let (px, py) = c.to_px(x0 + band_cm / 2.0, rate);
         c.text(&label, px - text_width(&label) / 2.0, py - 18.0, BLACK);
     }
-    let label = format!("{} band", tick_label(band_cm, 1.0));
-    c.legend(&[(format!("{label} cm").as_str(), colour)]);
+    let label = format!("{} cm bands", tick_label(band_cm, 1.0));
+    c.legend(&[(label.as_str(), colour)]);
     c
 }
 
@@ -461,7 +467,7 @@ pub fn write_eval_plots(dir: &Path, frames: &[FrameEval]) -> io::Result<Vec<Path
         (
             "goal_distance.png",
             distance_chart(
-                "goals (top and bottom in view): measured against true distance",
+                "goals (uncut): measured against true distance",
                 &[
                     ("yellow goal", YELLOW, goal_yellow.clone()),
                     ("sky-blue goal", SKY_BLUE, goal_blue.clone()),

@@ -15,6 +15,7 @@ use super::fit::{LineFit, Point, fit_line, rotate_about};
 use super::scan::{CutOff, scan_rotated_rect};
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 
 /// Settings of goal recognition.
@@ -39,9 +40,11 @@ pub struct GoalParams {
     pub split_tolerance: f64,
     /// A rotated box point within this many pixels of the image edge counts as at the edge.
     pub edge_margin_px: f64,
-    /// Distance = multiplier / height(px) + offset: multiplier, cm·px (pinhole: d × 30 cm).
+    /// Distance = multiplier / height(px) + offset: multiplier, cm·px (pinhole: d × 30 cm =
+    /// 5757). The default is the calibrated one: `eotn eval --calibrate-goals` on 720 rendered
+    /// frames (walk-and-pan, beacon-tour, goalkeeper; seed 11; goals 160–410 cm away).
     pub distance_multiplier: f64,
-    /// Distance offset, centimetres.
+    /// Distance offset, centimetres (calibrated with the multiplier).
     pub distance_offset_cm: f64,
     /// The goal-colour part's height is used when the soft sides add less than this fraction.
     pub soft_side_tolerance: f64,
@@ -51,6 +54,9 @@ pub struct GoalParams {
     /// The two posts' heights are used only when the shorter is at least this fraction of the
     /// goal's height (a robot in front of a post shortens it).
     pub post_height_agreement: f64,
+    /// Measure heights as the angle they subtend, corrected for the elevation (see
+    /// `equivalent_height`), instead of plain pixels.
+    pub off_axis_correction: bool,
     /// Below this distance (cm) the infra-red reading replaces the size-based distance.
     pub ir_max_cm: f64,
     /// Goals covering more than this fraction of the image skip the identification tests.
@@ -125,11 +131,12 @@ impl Default for GoalParams {
             line_up_overlap: 0.5,
             split_tolerance: 0.2,
             edge_margin_px: 1.5,
-            distance_multiplier: 191.9 * 30.0,
-            distance_offset_cm: 0.0,
+            distance_multiplier: 5762.0,
+            distance_offset_cm: -5.0,
             soft_side_tolerance: 0.15,
             post_height_band: 0.15,
             post_height_agreement: 0.75,
+            off_axis_correction: true,
             ir_max_cm: 60.0,
             fills_image_fraction: 0.6,
             max_cut_sides: 2.0,
@@ -515,7 +522,20 @@ fn examine(
     let h_all = e_all[3] - e_all[1];
     let h_basic = e_basic[3] - e_basic[1];
     let use_basic = (h_all - h_basic) <= p.soft_side_tolerance * h_all;
-    let mut height_px = if use_basic { h_basic } else { h_all };
+    let e_h = if use_basic { e_basic } else { e_all };
+    let level_height = e_h[3] - e_h[1];
+    let upright = |x: f64, top: f64, bottom: f64| {
+        let (a, b) = (
+            rotate_about((x, top), centre, -angle),
+            rotate_about((x, bottom), centre, -angle),
+        );
+        if p.off_axis_correction {
+            equivalent_height(ctx, a, b).unwrap_or(bottom - top)
+        } else {
+            bottom - top
+        }
+    };
+    let mut height_px = upright((e_h[0] + e_h[2]) / 2.0, e_h[1], e_h[3]);
     // Whole goal in view: the distance is that of the mouth's centre, between the two posts'
     // distances (the tallest level column near each side; the box's height is the nearer
     // post's). The equivalent height is their harmonic mean.
@@ -523,13 +543,13 @@ fn examine(
         let basic = |c: u8| c == colour.code();
         let any = is_goal_colour(colour);
         let pred: &dyn Fn(u8) -> bool = if use_basic { &basic } else { &any };
-        let e = if use_basic { e_basic } else { e_all };
-        let band = ((e[2] - e[0]) * p.post_height_band).max(3.0);
-        if let (Some(hl), Some(hr)) = (
-            side_height(img, pred, e, true, band, centre, angle),
-            side_height(img, pred, e, false, band, centre, angle),
-        ) && hl.min(hr) >= p.post_height_agreement * height_px
+        let band = ((e_h[2] - e_h[0]) * p.post_height_band).max(3.0);
+        if let (Some(l), Some(r)) = (
+            side_height(img, pred, e_h, true, band, centre, angle),
+            side_height(img, pred, e_h, false, band, centre, angle),
+        ) && (l.2 - l.1).min(r.2 - r.1) >= p.post_height_agreement * level_height
         {
+            let (hl, hr) = (upright(l.0, l.1, l.2), upright(r.0, r.1, r.2));
             height_px = 2.0 / (1.0 / hl + 1.0 / hr);
         }
     }
@@ -702,7 +722,7 @@ fn examine(
 }
 
 /// The tallest run of goal colour along level columns within `band` pixels inside one side of
-/// the level extent `e`: the height of the post on that side, pixels.
+/// the level extent `e`: the post on that side as (level x, top y, bottom y), pixels.
 fn side_height(
     img: &ClassifiedImage,
     is_goal: &dyn Fn(u8) -> bool,
@@ -711,10 +731,10 @@ fn side_height(
     band: f64,
     centre: Point,
     angle: f64,
-) -> Option<f64> {
+) -> Option<(f64, f64, f64)> {
     let columns = band.ceil() as usize;
     let rows = (e[3] - e[1]).ceil() as usize + 2;
-    let mut best: Option<f64> = None;
+    let mut best: Option<(f64, f64, f64)> = None;
     for k in 0..columns {
         let x = if left {
             e[0] + 0.5 + k as f64
@@ -723,22 +743,44 @@ fn side_height(
         };
         let (mut top, mut bottom) = (None, None);
         for i in 0..rows {
-            let y = e[1] - 1.0 + i as f64 + 0.5;
-            let q = rotate_about((x, y), centre, -angle);
+            let y = e[1] - 1.0 + i as f64;
+            let q = rotate_about((x, y + 0.5), centre, -angle);
             if img
                 .get_signed(q.0.floor() as i64, q.1.floor() as i64)
                 .is_some_and(is_goal)
             {
                 top.get_or_insert(y);
-                bottom = Some(y);
+                bottom = Some(y + 1.0);
             }
         }
-        if let (Some(t), Some(b)) = (top, bottom) {
-            let h: f64 = b - t + 1.0;
-            best = Some(best.map_or(h, |v| v.max(h)));
+        if let (Some(t), Some(b)) = (top, bottom)
+            && best.is_none_or(|(_, bt, bb)| b - t > bb - bt)
+        {
+            best = Some((x, t, b));
         }
     }
     best
+}
+
+/// The height in pixels that an upright segment from image point `top` to `bottom` would have
+/// seen face-on at the image centre: focal length × the angle it subtends ÷ the cosine of its
+/// elevation above the ground (the camera's own elevation without a pose). A pixel height
+/// alone shrinks off the optical axis and when looking up or down at a goal, so
+/// multiplier / height would not be a distance everywhere in the image.
+fn equivalent_height(ctx: &ViewContext, top: Point, bottom: Point) -> Option<f64> {
+    let ray = |p: Point| ctx.camera.unit_ray(ImagePoint::new(p.0, p.1)).coords;
+    let (a, b) = (ray(top), ray(bottom));
+    let phi = a.dot(&b).clamp(-1.0, 1.0).acos();
+    let mid = ((top.0 + bottom.0) / 2.0, (top.1 + bottom.1) / 2.0);
+    let elevation = match (
+        ctx.height_above_ground(mid, 100.0),
+        ctx.height_above_ground(mid, 0.0),
+    ) {
+        (Some(far), Some(near)) => ((far - near) / 100.0).clamp(-1.0, 1.0).asin(),
+        _ => ctx.camera_angles(mid).1,
+    };
+    let h = ctx.camera.focal_px * phi / elevation.cos();
+    (h.is_finite() && h > 0.0).then_some(h)
 }
 
 /// Scans from outside a level x position inward along a level row until a goal-coloured pixel;

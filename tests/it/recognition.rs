@@ -112,18 +112,43 @@ fn recognition_on_synthetic_scenarios() {
     let goals_eligible = sum(&|r| r.goals_eligible);
     let goals_found = sum(&|r| r.goals_found);
     eprintln!("goals found {goals_found}/{goals_eligible}");
-    assert!(goals_found as f64 >= 0.9 * goals_eligible as f64);
-    let keeper = report(ScenarioKind::Goalkeeper);
+    assert!(goals_eligible > 200, "scenarios must show goals");
+    assert!(goals_found as f64 >= 0.97 * goals_eligible as f64);
+    // The yellow box among the off-field clutter is not a goal (width and ground-at-foot tests).
     assert!(
-        keeper.posts_within_2px.is_some_and(|f| f >= 0.9),
+        clutter.goals_false <= 1,
+        "false goals in clutter frames {:?}",
+        clutter.goal_false_frames
+    );
+    let keeper = report(ScenarioKind::Goalkeeper);
+    let walk = report(ScenarioKind::WalkAndPan);
+    assert!(
+        keeper.posts_within_2px.is_some_and(|f| f >= 0.95),
         "{:?}",
         keeper.post_error_px
     );
     assert!(
-        keeper.gaps_within_3px.is_some_and(|f| f >= 0.9),
+        keeper.gaps_within_3px.is_some_and(|f| f >= 0.95),
         "{:?}",
         keeper.gap_error_px
     );
+    assert!(
+        walk.posts_within_2px.is_some_and(|f| f >= 0.7),
+        "{:?}",
+        walk.post_error_px
+    );
+    assert!(
+        walk.gaps_within_3px.is_some_and(|f| f >= 0.7),
+        "{:?}",
+        walk.gap_error_px
+    );
+    for r in [keeper, walk] {
+        assert!(
+            r.goal_distance_error.n >= 30 && r.goal_distance_error.p50 <= 0.05,
+            "{:?}",
+            r.goal_distance_error
+        );
+    }
 
     // Skew correction on the fast pans: the radius error with it against without it.
     let mut off = params;
