@@ -310,8 +310,11 @@ impl Chart {
     }
 }
 
+/// A labelled, coloured set of (true, measured) points.
+type Series<'a> = (&'a str, [u8; 3], Vec<(f64, f64)>);
+
 /// Measured against true distance with the line of perfect agreement.
-fn distance_chart(title: &str, series: &[(&str, [u8; 3], Vec<(f64, f64)>)]) -> Chart {
+fn distance_chart(title: &str, series: &[Series<'_>]) -> Chart {
     let all = || series.iter().flat_map(|s| s.2.iter());
     let x = range_of(all().map(|p| p.0), &[0.0]);
     let y = range_of(all().map(|p| p.1), &[0.0]);

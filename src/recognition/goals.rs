@@ -912,8 +912,16 @@ fn find_posts_and_gap(
     let mut run_start: Option<f64> = None;
     let mut last_goal = f64::NEG_INFINITY;
     let mut x = x0;
+    let (w, h) = (img.width() as f64, img.height() as f64);
     while x <= x1 {
-        let q = rotate_about((x + 0.5, y), centre, -angle);
+        // Where the scan row leaves the image (a goal at the top edge under a tilted horizon),
+        // look down the level column to the first row inside it, above the goal's bottom.
+        let mut yy = y;
+        let mut q = rotate_about((x + 0.5, yy), centre, -angle);
+        while (q.0 < 0.0 || q.1 < 0.0 || q.0 >= w || q.1 >= h) && yy + 1.0 < e[3] {
+            yy += 1.0;
+            q = rotate_about((x + 0.5, yy), centre, -angle);
+        }
         let goal = img
             .get_signed(q.0.floor() as i64, q.1.floor() as i64)
             .is_some_and(&is_goal);

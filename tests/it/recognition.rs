@@ -138,7 +138,7 @@ fn recognition_on_synthetic_scenarios() {
         walk.post_error_px
     );
     assert!(
-        walk.gaps_within_3px.is_some_and(|f| f >= 0.7),
+        walk.gaps_within_3px.is_some_and(|f| f >= 0.9),
         "{:?}",
         walk.gap_error_px
     );
