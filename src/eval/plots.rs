@@ -278,11 +278,17 @@ impl Chart {
 
     /// Legend entries in the plot area's top-left corner.
     fn legend(&mut self, entries: &[(&str, [u8; 3])]) {
-        let (l, _, t, _) = self.area();
+        self.legend_at(entries, false);
+    }
+
+    /// Legend entries on a white box in the plot area's top-left or top-right corner.
+    fn legend_at(&mut self, entries: &[(&str, [u8; 3])], right: bool) {
         let widest = entries
             .iter()
             .map(|(s, _)| text_width(s))
             .fold(0.0, f64::max);
+        let (l, r, t, _) = self.area();
+        let l = if right { r - widest - 40.0 } else { l };
         let bottom = t + 8.0 + entries.len() as f64 * 20.0;
         self.fill(l + 4.0, t + 3.0, l + 32.0 + widest, bottom, [255, 255, 255]);
         for (i, (label, c)) in entries.iter().enumerate() {
@@ -353,7 +359,8 @@ fn histogram_chart(title: &str, x_label: &str, values: &[f64], colour: [u8; 3]) 
         counts[i] += 1;
     }
     let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64 * 1.1;
-    let mut c = Chart::new(title, x_label, "frames", (lo, hi), (0.0, top));
+    let title = format!("{title} (n={})", v.len());
+    let mut c = Chart::new(&title, x_label, "count", (lo, hi), (0.0, top));
     for (i, n) in counts.iter().enumerate() {
         if *n > 0 {
             let x0 = lo + i as f64 * w;
@@ -366,8 +373,6 @@ fn histogram_chart(title: &str, x_label: &str, values: &[f64], colour: [u8; 3]) 
     if lo < 0.0 && hi > 0.0 {
         c.canvas.line((zx, zero_y0), (zx, zero_y1), RED);
     }
-    let label = format!("n={}", v.len());
-    c.legend(&[(label.as_str(), colour)]);
     c
 }
 
@@ -386,13 +391,8 @@ fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3
         found[i] += usize::from(*ok);
     }
     let x_hi = bands as f64 * band_cm;
-    let mut c = Chart::new(
-        title,
-        "true distance (cm)",
-        "found (%)",
-        (0.0, x_hi),
-        (0.0, 110.0),
-    );
+    let x_label = format!("true distance (cm), {} cm bands", tick_label(band_cm, 1.0));
+    let mut c = Chart::new(title, &x_label, "found (%)", (0.0, x_hi), (0.0, 115.0));
     for i in 0..bands {
         if n[i] == 0 {
             continue;
@@ -404,8 +404,6 @@ fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3
         let (px, py) = c.to_px(x0 + band_cm / 2.0, rate);
         c.text(&label, px - text_width(&label) / 2.0, py - 18.0, BLACK);
     }
-    let label = format!("{} cm bands", tick_label(band_cm, 1.0));
-    c.legend(&[(label.as_str(), colour)]);
     c
 }
 
@@ -578,11 +576,14 @@ pub fn write_calibration_plot(
         c.point(p.0, p.1, SKY_BLUE);
     }
     let n = format!("samples (n={})", pts.len());
-    c.legend(&[
-        (n.as_str(), SKY_BLUE),
-        ("fit", RED),
-        ("parameters before", GREY),
-    ]);
+    c.legend_at(
+        &[
+            (n.as_str(), SKY_BLUE),
+            ("fit", RED),
+            ("parameters before", GREY),
+        ],
+        true,
+    );
     c.save(path)
 }
 
