@@ -9,7 +9,7 @@
 
 #![allow(unsafe_code)]
 
-use super::{Run, u16_of};
+use super::{RowRuns, Run};
 
 /// Appends the runs of `row` with the AVX2 scan; `false` (and nothing appended) when the CPU
 /// has no AVX2, so the caller falls back to the portable scan.
@@ -36,17 +36,7 @@ fn encode_row_avx2(row: &[u8], y: u16, runs: &mut Vec<Run>) {
     use std::arch::x86_64::{__m256i, _mm256_cmpeq_epi8, _mm256_loadu_si256, _mm256_movemask_epi8};
 
     let Some(&first) = row.first() else { return };
-    let mut emit = |x0: usize, x1: usize, colour: u8| {
-        if colour != 0 {
-            runs.push(Run {
-                x0: u16_of(x0),
-                x1: u16_of(x1),
-                y,
-                colour,
-            });
-        }
-    };
-    let (mut start, mut colour) = (0, first);
+    let mut out = RowRuns::new(runs, y, first);
     // A block compares pixels x..x+32 with their left neighbours x-1..x+31, from x = 1. The
     // last block is moved back to end at the row's end; its boundaries before `x` were already
     // emitted and are masked off.
@@ -69,19 +59,11 @@ fn encode_row_avx2(row: &[u8], y: u16, runs: &mut Vec<Run>) {
         while changed != 0 {
             let p = at + changed.trailing_zeros() as usize;
             changed &= changed - 1;
-            emit(start, p, colour);
-            start = p;
-            colour = now[p - at];
+            out.boundary(p, now[p - at]);
         }
         x = at + 32;
     }
     // Rows shorter than 33 pixels.
-    for (p, &c) in row.iter().enumerate().skip(x) {
-        if c != colour {
-            emit(start, p, colour);
-            start = p;
-            colour = c;
-        }
-    }
-    emit(start, row.len(), colour);
+    out.scan_tail(row, x);
+    out.finish(row.len());
 }

@@ -410,20 +410,65 @@ fn encode_row(row: &[u8], y: u16, runs: &mut Vec<Run>, search: RunSearch) {
     encode_row_words(row, y, runs);
 }
 
+/// The runs of one row as its colour boundaries are found, shared by both run searches.
+struct RowRuns<'a> {
+    runs: &'a mut Vec<Run>,
+    y: u16,
+    /// First column of the run being built.
+    start: usize,
+    /// Its colour.
+    colour: u8,
+}
+
+impl<'a> RowRuns<'a> {
+    /// Starts row `y` whose first pixel has `first` colour.
+    fn new(runs: &'a mut Vec<Run>, y: u16, first: u8) -> Self {
+        Self {
+            runs,
+            y,
+            start: 0,
+            colour: first,
+        }
+    }
+
+    /// The run being built ends before column `x`; a run of `colour` starts there.
+    fn boundary(&mut self, x: usize, colour: u8) {
+        self.close(x);
+        self.start = x;
+        self.colour = colour;
+    }
+
+    /// Boundaries found pixel by pixel, for the columns `from..` of `row` no word covered.
+    fn scan_tail(&mut self, row: &[u8], from: usize) {
+        for (x, &c) in row.iter().enumerate().skip(from) {
+            if c != self.colour {
+                self.boundary(x, c);
+            }
+        }
+    }
+
+    /// Ends the last run at the row's end (`width`).
+    fn finish(mut self, width: usize) {
+        self.close(width);
+    }
+
+    /// Appends the run being built, ending before `x` (unclassified pixels make no runs).
+    fn close(&mut self, x: usize) {
+        if self.colour != 0 {
+            self.runs.push(Run {
+                x0: u16_of(self.start),
+                x1: u16_of(x),
+                y: self.y,
+                colour: self.colour,
+            });
+        }
+    }
+}
+
 /// The portable run search: 8 pixels per step in a 64-bit word.
 fn encode_row_words(row: &[u8], y: u16, runs: &mut Vec<Run>) {
     let Some(&first) = row.first() else { return };
-    let mut emit = |x0: usize, x1: usize, colour: u8| {
-        if colour != 0 {
-            runs.push(Run {
-                x0: u16_of(x0),
-                x1: u16_of(x1),
-                y,
-                colour,
-            });
-        }
-    };
-    let (mut start, mut colour) = (0, first);
+    let mut out = RowRuns::new(runs, y, first);
     let (words, tail) = row.as_chunks::<8>();
     // The byte before the current word, in the low byte; the first pixel is its own predecessor.
     let mut before = u64::from(first);
@@ -439,21 +484,11 @@ fn encode_row_words(row: &[u8], y: u16, runs: &mut Vec<Run>) {
         while changed != 0 {
             let byte = (changed.trailing_zeros() / 8) as usize;
             changed &= changed - 1;
-            let p = k * 8 + byte;
-            emit(start, p, colour);
-            start = p;
-            colour = bytes[byte];
+            out.boundary(k * 8 + byte, bytes[byte]);
         }
     }
-    let tail_start = row.len() - tail.len();
-    for (i, &c) in tail.iter().enumerate() {
-        if c != colour {
-            emit(start, tail_start + i, colour);
-            start = tail_start + i;
-            colour = c;
-        }
-    }
-    emit(start, row.len(), colour);
+    out.scan_tail(row, row.len() - tail.len());
+    out.finish(row.len());
 }
 
 /// Bit 7 of every non-zero byte of `t`, all other bits clear.
