@@ -9,6 +9,7 @@
 //! | `views.rs` | the enlarged view (zoom, pan, hover, clicks) and the thumbnails |
 //! | `overlays.rs` | drawing in image pixels through one transform: boxes, labels, markers |
 //! | `classify_panel.rs` | class picker, sensitivity, commit/undo/redo, try-on-stream |
+//! | `inspector.rs` | every recognition candidate with its confidence breakdown; selection |
 //! | `sensors_dialog.rs` | every sensor reading with units, plots over the stream |
 //! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
 //! | `menus.rs` | File, Classification, View, Stream, Windows |
@@ -16,6 +17,7 @@
 //! Only this folder names egui/eframe (`scripts/check.sh` checks it).
 
 pub mod classify_panel;
+pub mod inspector;
 pub mod journal;
 pub mod menus;
 pub mod overlays;
@@ -559,6 +561,7 @@ impl eframe::App for EotnApp {
         sensors_dialog::sensors_window(&ctx, &mut self.state);
         self.uv_plane.window(&ctx, &mut self.state, &mut commands);
         classify_panel::try_edit_window(&ctx, &mut self.state, &mut commands);
+        inspector::inspector_window(&ctx, &self.state, &mut commands);
         self.warnings_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
         if quit {
