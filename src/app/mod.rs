@@ -402,6 +402,16 @@ impl EotnApp {
             ui.separator();
             ui.label(&self.state.status);
         });
+        // This frame's own problems (NaN sensor readings, skipped channels) stay in view while
+        // it is shown, not only in the warnings list.
+        if let Some(c) = self.state.current()
+            && !c.warnings.is_empty()
+        {
+            let colour = ui.visuals().warn_fg_color;
+            for w in &c.warnings {
+                ui.colored_label(colour, format!("this frame: {w}"));
+            }
+        }
         ui.horizontal(|ui| views::pixel_readout_ui(ui, self.hovered.as_ref()));
     }
 

@@ -195,9 +195,10 @@ pub fn blob_box(painter: &Painter, xf: &ImageTransform, b: &Blob, label: bool) {
     painter.rect_stroke(rect, 0.0, Stroke::new(1.5, colour), StrokeKind::Outside);
     if label {
         let text = format!("{} {}×{}", b.class().name(), b.width(), b.height());
-        let pos = rect.left_top() - vec2(0.0, 2.0);
+        // Below the box: above it go recognition's object labels.
+        let pos = rect.left_bottom() + vec2(0.0, 3.0);
         let galley = painter.layout_no_wrap(text, FontId::proportional(11.0), colour);
-        let bg = Rect::from_min_size(pos - vec2(0.0, galley.size().y), galley.size()).expand(1.0);
+        let bg = Rect::from_min_size(pos, galley.size()).expand(1.0);
         painter.rect_filled(bg, 2.0, Color32::from_black_alpha(160));
         painter.galley(bg.min + vec2(1.0, 1.0), galley, colour);
     }
