@@ -84,13 +84,62 @@ impl Textures {
 }
 
 /// Display colours of every class code, transparent for unclassified.
-fn palette() -> [Color32; 256] {
+#[must_use]
+pub fn palette() -> [Color32; 256] {
     let mut p = [Color32::TRANSPARENT; 256];
     for (code, c) in p.iter_mut().enumerate().skip(1) {
         let [r, g, b] = crate::lut::code_display_rgb(u8::try_from(code).unwrap_or(0));
         *c = Color32::from_rgb(r, g, b);
     }
     p
+}
+
+/// The images the views are drawn from, before they go to the GPU.
+#[derive(Debug, Clone)]
+pub struct ViewImages {
+    /// The frame in colour.
+    pub raw: ColorImage,
+    /// Class colours, transparent where unclassified.
+    pub classified: ColorImage,
+}
+
+/// Builds the colour and class-colour images of the shown frame (`palette` from [`palette`]);
+/// `None` when no frame is open. This is the CPU side of a texture update.
+#[must_use]
+pub fn view_images(state: &AppState, palette: &[Color32; 256]) -> Option<ViewImages> {
+    let frame = state.frame()?;
+    let size = [frame.width(), frame.height()];
+    let raw = ColorImage::from_rgb(size, state.rgb());
+    let classified = ColorImage::new(
+        size,
+        state
+            .classified()
+            .codes()
+            .iter()
+            .map(|&c| palette[usize::from(c)])
+            .collect(),
+    );
+    Some(ViewImages { raw, classified })
+}
+
+/// The preview highlight image of the pending selection (class colour on selected pixels,
+/// dimmed elsewhere; transparent with no selection).
+#[must_use]
+pub fn preview_image(state: &AppState, size: [usize; 2]) -> ColorImage {
+    let mask = state.preview_mask();
+    let colour = state
+        .preview_colour()
+        .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
+    if mask.len() != size[0] * size[1] {
+        return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
+    }
+    // Unselected pixels are dimmed, so the highlight shows even where the class colour is
+    // the colour of the pixels themselves (orange on an orange ball).
+    let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
+    ColorImage::new(
+        size,
+        mask.iter().map(|&m| if m { colour } else { dim }).collect(),
+    )
 }
 
 /// The eframe application: the state plus the runtime resources of the window.
@@ -180,18 +229,10 @@ impl EotnApp {
             .textures
             .as_ref()
             .is_none_or(|t| t.frame_generation != fg);
-        let preview = self.preview_image(size);
-        if frame_changed {
-            let raw = ColorImage::from_rgb(size, self.state.rgb());
-            let classified = ColorImage::new(
-                size,
-                self.state
-                    .classified()
-                    .codes()
-                    .iter()
-                    .map(|&c| self.palette[usize::from(c)])
-                    .collect(),
-            );
+        let preview = preview_image(&self.state, size);
+        if frame_changed
+            && let Some(ViewImages { raw, classified }) = view_images(&self.state, &self.palette)
+        {
             match &mut self.textures {
                 Some(t) => {
                     t.raw.set(raw, opts);
@@ -216,24 +257,6 @@ impl EotnApp {
             t.frame_generation = fg;
             t.preview_generation = pg;
         }
-    }
-
-    fn preview_image(&self, size: [usize; 2]) -> ColorImage {
-        let mask = self.state.preview_mask();
-        let colour = self
-            .state
-            .preview_colour()
-            .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
-        if mask.len() != size[0] * size[1] {
-            return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
-        }
-        // Unselected pixels are dimmed, so the highlight shows even where the class colour is
-        // the colour of the pixels themselves (orange on an orange ball).
-        let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
-        ColorImage::new(
-            size,
-            mask.iter().map(|&m| if m { colour } else { dim }).collect(),
-        )
     }
 
     fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
@@ -508,22 +531,25 @@ impl EotnApp {
         if std::env::var_os("EOTN_STATS").is_some() {
             let t = &self.state.timings;
             eprintln!(
-                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms",
+                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms (our UI code {:.2} ms, eframe CPU {:.2} ms)",
                 t.steps_ms.len(),
                 state::median(&t.steps_ms),
                 t.frames_ms.len(),
                 state::median(&t.frames_ms),
                 t.playing_frames_ms.len(),
                 state::median(&t.playing_frames_ms),
+                state::median(&t.playing_ui_ms),
+                state::median(&t.playing_cpu_ms),
             );
         }
     }
 }
 
 impl eframe::App for EotnApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         let now = Instant::now();
+        let cpu = frame.info().cpu_usage;
         let dt = self.last_frame.map_or(Duration::ZERO, |t| now - t);
         self.last_frame = Some(now);
         if dt > Duration::ZERO {
@@ -589,6 +615,7 @@ impl eframe::App for EotnApp {
             || self.state.try_edit().is_some_and(|t| !t.done())
             || (self.state.settings.show_sensors
                 && self.state.sensor_series.points.len() < self.state.sensor_series.total);
+        self.state.record_ui_time(now.elapsed(), cpu);
         if busy {
             ctx.request_repaint();
         }

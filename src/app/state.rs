@@ -452,6 +452,12 @@ pub struct Timings {
     pub frames_ms: Vec<f64>,
     /// Recent UI frame intervals while playing, milliseconds.
     pub playing_frames_ms: Vec<f64>,
+    /// While playing: time our own UI code took per frame (layout and painting commands, not
+    /// tessellation or rasterisation), milliseconds.
+    pub playing_ui_ms: Vec<f64>,
+    /// While playing: eframe's CPU time per frame (our UI, tessellation, the renderer's
+    /// submission; not the wait for the display), milliseconds.
+    pub playing_cpu_ms: Vec<f64>,
 }
 
 fn push_capped(v: &mut Vec<f64>, x: f64) {
@@ -848,6 +854,16 @@ impl AppState {
         push_capped(&mut self.timings.frames_ms, ms);
         if self.playing {
             push_capped(&mut self.timings.playing_frames_ms, ms);
+        }
+    }
+
+    /// Records, while playing, how long our UI code and eframe's whole frame took (CPU time).
+    pub fn record_ui_time(&mut self, ui: Duration, cpu_s: Option<f32>) {
+        if self.playing {
+            push_capped(&mut self.timings.playing_ui_ms, ui.as_secs_f64() * 1e3);
+            if let Some(c) = cpu_s.filter(|c| c.is_finite()) {
+                push_capped(&mut self.timings.playing_cpu_ms, f64::from(c) * 1e3);
+            }
         }
     }
 
