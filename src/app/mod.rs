@@ -71,6 +71,8 @@ struct Textures {
     preview: TextureHandle,
     frame_generation: u64,
     preview_generation: u64,
+    /// The preview texture holds no highlight (nothing to re-upload while none is pending).
+    preview_empty: bool,
 }
 
 impl Textures {
@@ -229,7 +231,7 @@ impl EotnApp {
             .textures
             .as_ref()
             .is_none_or(|t| t.frame_generation != fg);
-        let preview = preview_image(&self.state, size);
+        let empty = self.state.selection().is_none();
         if frame_changed
             && let Some(ViewImages { raw, classified }) = view_images(&self.state, &self.palette)
         {
@@ -237,25 +239,32 @@ impl EotnApp {
                 Some(t) => {
                     t.raw.set(raw, opts);
                     t.classified.set(classified, opts);
-                    t.preview.set(preview, opts);
                 }
                 None => {
+                    let preview = preview_image(&self.state, size);
                     self.textures = Some(Textures {
                         raw: ctx.load_texture("raw", raw, opts),
                         classified: ctx.load_texture("classified", classified, opts),
                         preview: ctx.load_texture("preview", preview, opts),
                         frame_generation: fg,
                         preview_generation: pg,
+                        preview_empty: empty,
                     });
                 }
             }
-            self.state.record_upload(t0.elapsed());
-        } else if let Some(t) = &mut self.textures {
-            t.preview.set(preview, opts);
         }
         if let Some(t) = &mut self.textures {
+            // With nothing selected the preview is not drawn: an empty one is uploaded once,
+            // not on every step of playback.
+            if t.preview_generation != pg && !(empty && t.preview_empty) {
+                t.preview.set(preview_image(&self.state, size), opts);
+                t.preview_empty = empty;
+            }
             t.frame_generation = fg;
             t.preview_generation = pg;
+        }
+        if frame_changed {
+            self.state.record_upload(t0.elapsed());
         }
     }
 
@@ -611,8 +620,12 @@ impl eframe::App for EotnApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
             self.title = title;
         }
-        let busy = self.state.playing()
-            || self.state.try_edit().is_some_and(|t| !t.done())
+        // Playback redraws when the next frame is due, not as fast as it can: an unchanged
+        // frame costs the renderer as much as a new one.
+        if let Some(due) = self.state.next_frame_due() {
+            ctx.request_repaint_after(due);
+        }
+        let busy = self.state.try_edit().is_some_and(|t| !t.done())
             || (self.state.settings.show_sensors
                 && self.state.sensor_series.points.len() < self.state.sensor_series.total);
         self.state.record_ui_time(now.elapsed(), cpu);

@@ -848,6 +848,24 @@ impl AppState {
         }
     }
 
+    /// While playing, the wall time until the next frame is due (zero when playing every frame
+    /// or already late); `None` when not playing. The UI sleeps until then instead of redrawing
+    /// an unchanged frame.
+    #[must_use]
+    pub fn next_frame_due(&self) -> Option<Duration> {
+        if !self.playing {
+            return None;
+        }
+        let speed = f64::from(self.settings.speed);
+        let src = self.source.as_ref()?;
+        if speed <= 0.0 || self.index + 1 >= src.len() {
+            return Some(Duration::ZERO);
+        }
+        let next = src.time_ns(self.index + 1) as f64;
+        let wait_s = ((next - self.play_clock_ns) / speed / 1e9).max(0.0);
+        Some(Duration::from_secs_f64(wait_s.min(1.0)))
+    }
+
     /// Records one UI frame interval for the frame-time readout.
     pub fn record_frame_time(&mut self, dt: Duration) {
         let ms = dt.as_secs_f64() * 1e3;

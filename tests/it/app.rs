@@ -486,6 +486,9 @@ fn stream_steps_plays_and_plots_sensors() {
     st.run(Command::Seek(0));
     st.run(Command::SetSpeed(1.0));
     st.run(Command::SetPlaying(true));
+    // The window sleeps until the next frame is due (40 ms at 25 fps) instead of spinning.
+    let due = st.next_frame_due().expect("playing");
+    assert!((due.as_secs_f64() - 0.04).abs() < 1e-6, "{due:?}");
     st.tick(std::time::Duration::from_millis(200));
     assert_eq!(st.index(), 5);
     st.run(Command::SetSpeed(4.0));
