@@ -160,6 +160,7 @@ pub struct EotnApp {
     title: String,
     last_frame: Option<Instant>,
     palette: [Color32; 256],
+    was_playing: bool,
 }
 
 impl EotnApp {
@@ -196,6 +197,7 @@ impl EotnApp {
             title: String::new(),
             last_frame: None,
             palette: palette(),
+            was_playing: false,
         }
     }
 
@@ -415,11 +417,12 @@ impl EotnApp {
             let ms = |d: Duration| d.as_secs_f64() * 1e3;
             if self.state.settings.show_timings {
             ui.monospace(format!(
-                "step {:.1} ms (read {:.1} classify {:.1} blobs {:.1} prep {:.1} upload {:.1}) | frame {:.1} ms",
+                "step {:.1} ms (read {:.1} classify {:.1} blobs {:.1} recognition {:.1} prep {:.1} upload {:.1}) | frame {:.1} ms",
                 ms(s.total()),
                 ms(s.read),
                 ms(s.classify),
                 ms(s.blobs),
+                ms(s.recognition),
                 ms(s.prepare),
                 ms(s.upload),
                 self.state.timings.frames_ms.last().copied().unwrap_or(0.0),
@@ -629,6 +632,11 @@ impl eframe::App for EotnApp {
             || (self.state.settings.show_sensors
                 && self.state.sensor_series.points.len() < self.state.sensor_series.total);
         self.state.record_ui_time(now.elapsed(), cpu);
+        if self.was_playing && !self.state.playing() {
+            // The end of a playback is when its figures are complete.
+            self.report_stats();
+        }
+        self.was_playing = self.state.playing();
         if busy {
             ctx.request_repaint();
         }
