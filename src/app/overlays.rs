@@ -162,8 +162,17 @@ pub fn paint_view(
         .min_blob_pixels
         .saturating_mul(LABEL_SIZE_FACTOR);
     for b in &boxes {
-        let label = labels && b.pixels >= label_min;
-        blob_box(&painter, xf, b, label);
+        blob_box(&painter, xf, b);
+    }
+    if labels {
+        // Largest first, and none over another: a crowded frame shows its main blobs' labels
+        // instead of a heap of text.
+        let mut labelled: Vec<&Blob> = boxes.iter().filter(|b| b.pixels >= label_min).collect();
+        labelled.sort_by_key(|b| std::cmp::Reverse(b.pixels));
+        let mut placed: Vec<Rect> = Vec::new();
+        for b in labelled {
+            blob_label(&painter, xf, b, &mut placed);
+        }
     }
     if kind == ViewKind::Objects || (with_overlays && kind != ViewKind::Blobs) {
         let filter = if kind == ViewKind::Objects {
@@ -184,24 +193,42 @@ pub fn paint_view(
     }
 }
 
-/// One blob's box (pixel edges inclusive), optionally labelled with its class and size.
-pub fn blob_box(painter: &Painter, xf: &ImageTransform, b: &Blob, label: bool) {
-    let [r, g, bl] = box_colour(b.colour);
-    let colour = Color32::from_rgb(r, g, bl);
-    let rect = Rect::from_min_max(
+/// A blob's box on screen (pixel edges inclusive).
+fn blob_rect(xf: &ImageTransform, b: &Blob) -> Rect {
+    Rect::from_min_max(
         xf.to_screen(pos2(b.minx as f32, b.miny as f32)),
         xf.to_screen(pos2(b.maxx as f32 + 1.0, b.maxy as f32 + 1.0)),
+    )
+}
+
+/// One blob's box in its class's box colour.
+pub fn blob_box(painter: &Painter, xf: &ImageTransform, b: &Blob) {
+    let [r, g, bl] = box_colour(b.colour);
+    let colour = Color32::from_rgb(r, g, bl);
+    painter.rect_stroke(
+        blob_rect(xf, b),
+        0.0,
+        Stroke::new(1.5, colour),
+        StrokeKind::Outside,
     );
-    painter.rect_stroke(rect, 0.0, Stroke::new(1.5, colour), StrokeKind::Outside);
-    if label {
-        let text = format!("{} {}×{}", b.class().name(), b.width(), b.height());
-        // Below the box: above it go recognition's object labels.
-        let pos = rect.left_bottom() + vec2(0.0, 3.0);
-        let galley = painter.layout_no_wrap(text, FontId::proportional(11.0), colour);
-        let bg = Rect::from_min_size(pos, galley.size()).expand(1.0);
-        painter.rect_filled(bg, 2.0, Color32::from_black_alpha(160));
-        painter.galley(bg.min + vec2(1.0, 1.0), galley, colour);
+}
+
+/// A blob's class and size below its box, unless it would cover a label in `placed`; the
+/// label drawn is added to `placed`.
+pub fn blob_label(painter: &Painter, xf: &ImageTransform, b: &Blob, placed: &mut Vec<Rect>) {
+    let [r, g, bl] = box_colour(b.colour);
+    let colour = Color32::from_rgb(r, g, bl);
+    let text = format!("{} {}×{}", b.class().name(), b.width(), b.height());
+    // Below the box: above it go recognition's object labels.
+    let pos = blob_rect(xf, b).left_bottom() + vec2(0.0, 3.0);
+    let galley = painter.layout_no_wrap(text, FontId::proportional(11.0), colour);
+    let bg = Rect::from_min_size(pos, galley.size()).expand(1.0);
+    if placed.iter().any(|p| p.intersects(bg)) {
+        return;
     }
+    placed.push(bg);
+    painter.rect_filled(bg, 2.0, Color32::from_black_alpha(160));
+    painter.galley(bg.min + vec2(1.0, 1.0), galley, colour);
 }
 
 /// The colour of a primitive, as `eotn render` draws it (`crate::overlay`).
