@@ -168,6 +168,9 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
     out
 }
 
+/// Width of the candidate list, points.
+const LIST_WIDTH: f32 = 190.0;
+
 /// Green for accepted, red for rejected.
 fn verdict_colour(accepted: bool) -> Color32 {
     if accepted {
@@ -185,8 +188,9 @@ pub fn inspector_window(ctx: &Context, state: &AppState, commands: &mut Vec<Comm
     let mut open = true;
     egui::Window::new(Window::Inspector.name())
         .open(&mut open)
-        .default_width(560.0)
-        .default_pos([560.0, 90.0])
+        .default_width(600.0)
+        // Low and to the right: the interesting part of a robot's image is usually its middle.
+        .default_pos([640.0, 330.0])
         .show(ctx, |ui| inspector_ui(ui, state, commands));
     if !open {
         commands.push(Command::ShowWindow(Window::Inspector, false));
@@ -212,33 +216,39 @@ fn inspector_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
         }
     });
     ui.separator();
-    ui.columns(2, |cols| {
-        egui::ScrollArea::vertical()
-            .id_salt("inspector_list")
-            .max_height(360.0)
-            .show(&mut cols[0], |ui| {
-                for c in &list {
-                    let is_sel = selected == Some(c.owner.as_str());
-                    let text = RichText::new(format!(
-                        "{} {}  {:+.2}",
-                        if c.accepted { "accepted" } else { "rejected" },
-                        c.owner,
-                        c.confidence.total
-                    ))
-                    .color(verdict_colour(c.accepted));
-                    let r = ui.selectable_label(is_sel, text).on_hover_text(&c.kind);
-                    if r.clicked() {
-                        commands.push(Command::SelectObject((!is_sel).then(|| c.owner.clone())));
+    ui.horizontal_top(|ui| {
+        ui.vertical(|ui| {
+            ui.set_width(LIST_WIDTH);
+            egui::ScrollArea::vertical()
+                .id_salt("inspector_list")
+                .max_height(360.0)
+                .show(ui, |ui| {
+                    for c in &list {
+                        let is_sel = selected == Some(c.owner.as_str());
+                        let text = RichText::new(format!(
+                            "{} {}  {:+.2}",
+                            if c.accepted { "accepted" } else { "rejected" },
+                            c.owner,
+                            c.confidence.total
+                        ))
+                        .color(verdict_colour(c.accepted));
+                        let r = ui.selectable_label(is_sel, text).on_hover_text(&c.kind);
+                        if r.clicked() {
+                            commands
+                                .push(Command::SelectObject((!is_sel).then(|| c.owner.clone())));
+                        }
                     }
+                });
+        });
+        ui.add_space(8.0);
+        ui.vertical(
+            |ui| match list.iter().find(|c| Some(c.owner.as_str()) == selected) {
+                None => {
+                    ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
                 }
-            });
-        let ui = &mut cols[1];
-        match list.iter().find(|c| Some(c.owner.as_str()) == selected) {
-            None => {
-                ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
-            }
-            Some(c) => details_ui(ui, c),
-        }
+                Some(c) => details_ui(ui, c),
+            },
+        );
     });
 }
 

@@ -314,6 +314,11 @@ pub fn paint_primitives(
                 let bg =
                     Rect::from_min_size(anchor - vec2(0.0, galley.size().y + 2.0), galley.size())
                         .expand(2.0);
+                // Kept inside the view: a ball at the top edge still shows its distance.
+                let view = painter.clip_rect();
+                let dx = (view.max.x - bg.max.x).min(0.0) + (view.min.x - bg.min.x).max(0.0);
+                let dy = (view.max.y - bg.max.y).min(0.0) + (view.min.y - bg.min.y).max(0.0);
+                let bg = bg.translate(vec2(dx, dy));
                 let bg_alpha = if dim { 60 } else { 180 };
                 painter.rect_filled(bg, 3.0, Color32::from_black_alpha(bg_alpha));
                 painter.galley(bg.min + vec2(2.0, 2.0), galley, colour);
