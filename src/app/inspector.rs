@@ -169,7 +169,7 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
 }
 
 /// Width of the candidate list, points.
-const LIST_WIDTH: f32 = 190.0;
+const LIST_WIDTH: f32 = 230.0;
 
 /// Green for accepted, red for rejected.
 fn verdict_colour(accepted: bool) -> Color32 {

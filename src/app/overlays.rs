@@ -176,7 +176,10 @@ pub fn paint_view(
     }
     if kind == ViewKind::Objects || (with_overlays && kind != ViewKind::Blobs) {
         let filter = if kind == ViewKind::Objects {
-            PrimitiveFilter::objects(o, state.accepted_owners())
+            let mut f = PrimitiveFilter::objects(o, state.accepted_owners());
+            // A thumbnail is too small for text.
+            f.overlays.object_labels = with_overlays;
+            f
         } else {
             PrimitiveFilter::all(o)
         };
