@@ -52,6 +52,8 @@ pub struct BenchJson {
     pub connectivity: u8,
     /// Timed repetitions per frame.
     pub reps: usize,
+    /// The kernels used on this CPU: `avx2` or `portable`.
+    pub kernels: &'static str,
     /// Median classification time per pixel, ns.
     pub classify_ns_per_px: f64,
     /// Median blob-formation time per pixel, ns.
@@ -120,14 +122,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         lut_bits: bits,
         connectivity: connectivity.neighbours(),
         reps: args.reps.max(1),
+        kernels: crate::classify::active_kernels(),
         classify_ns_per_px: median(&mut classify),
         blobs_ns_per_px: median(&mut blobs),
         total_ns_per_px: median(&mut total),
         total_ms_per_frame: median(&mut total_ms),
     };
     println!(
-        "# eotn bench: {} frame(s), {} px/frame, lut b={}, conn={}, reps={}/frame",
-        result.frames, result.pixels_per_frame, result.lut_bits, result.connectivity, result.reps
+        "# eotn bench: {} frame(s), {} px/frame, lut b={}, conn={}, reps={}/frame, {} kernels",
+        result.frames,
+        result.pixels_per_frame,
+        result.lut_bits,
+        result.connectivity,
+        result.reps,
+        result.kernels
     );
     println!(
         "classify  median {:7.3} ns/pixel",

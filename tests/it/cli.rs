@@ -101,6 +101,10 @@ fn bench_json_ends_with_medians() {
             "{key} in {last}"
         );
     }
+    assert!(
+        matches!(last["kernels"].as_str(), Some("avx2" | "portable")),
+        "kernels in {last}"
+    );
 }
 
 #[test]

@@ -4,7 +4,10 @@
 //! the frame is walked in 4-byte pixel pairs, the shared U/V part of the cell index is built once
 //! per pair, and the table is a fixed-size array per resolution so the compiler can prove every
 //! index in bounds (no checks in the loop). Output goes into a caller-owned
-//! [`ClassifiedImage`] reused frame after frame.
+//! [`ClassifiedImage`] reused frame after frame. On CPUs with AVX2 a gather kernel does 16
+//! pixels per step instead (see `classify/avx2.rs`).
+
+mod avx2;
 
 use crate::frame::{Frame, PixelLayout};
 use crate::lut::{ColourClass, LookupTable, code_display_rgb};
@@ -139,7 +142,31 @@ pub fn classify_into(frame: &Frame, lut: &LookupTable, out: &mut ClassifiedImage
 
 /// Classifies raw UYVY bytes into `dst` (one code per pixel); `dst.len()` must be half of
 /// `src.len()`, extra bytes of either are left alone.
+///
+/// Uses the AVX2 kernel when the CPU has it (checked at run time), else
+/// [`classify_uyvy_portable`]; both give the same codes.
 pub fn classify_uyvy(src: &[u8], lut: &LookupTable, dst: &mut [u8]) {
+    let done = avx2::classify_uyvy(src, lut.cells(), u32::from(lut.bits()), dst);
+    let (src_rest, dst_rest) = (
+        src.get(done * 2..).unwrap_or(&[]),
+        dst.get_mut(done..).unwrap_or(&mut []),
+    );
+    classify_uyvy_portable(src_rest, lut, dst_rest);
+}
+
+/// The kernels [`classify_uyvy`] and blob formation use on this CPU: `"avx2"` or `"portable"`
+/// (`eotn bench` reports it, so figures from different machines can be told apart).
+#[must_use]
+pub fn active_kernels() -> &'static str {
+    if avx2::available() {
+        "avx2"
+    } else {
+        "portable"
+    }
+}
+
+/// [`classify_uyvy`] in safe portable Rust on every CPU (for comparison in benchmarks).
+pub fn classify_uyvy_portable(src: &[u8], lut: &LookupTable, dst: &mut [u8]) {
     let cells = lut.cells();
     match lut.bits() {
         6 => {
@@ -223,6 +250,35 @@ mod tests {
                 for x in 0..16 {
                     assert_eq!(img.get(x, y), Some(t.classify(frame.pixel(x, y).unwrap())));
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn fastest_kernel_equals_the_portable_loop() {
+        // Every length around the 16-pixel blocks, every resolution, cells with many codes and
+        // pixels that reach the table's last cells (the gather reads whole words).
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for bits in [6, 7, 8] {
+            let mut t = LookupTable::new(bits).unwrap();
+            for i in 0..t.cells().len() {
+                t.set(i, ColourClass::from_code((next() % 15) as u8).unwrap());
+            }
+            for pairs in [0usize, 1, 7, 8, 9, 15, 16, 17, 104, 333] {
+                let mut src: Vec<u8> = (0..pairs * 4).map(|_| next() as u8).collect();
+                if let Some(q) = src.first_chunk_mut::<4>() {
+                    *q = [255; 4];
+                }
+                let (mut fast, mut plain) = (vec![0u8; pairs * 2], vec![0u8; pairs * 2]);
+                classify_uyvy(&src, &t, &mut fast);
+                classify_uyvy_portable(&src, &t, &mut plain);
+                assert_eq!(fast, plain, "bits {bits}, {pairs} pairs");
             }
         }
     }
