@@ -709,3 +709,69 @@ fn snapshot_with_recognition_and_inspector() {
     h.run();
     h.snapshot("app_recognition");
 }
+
+#[test]
+fn nan_in_a_recorded_stream_shows_as_a_warning_of_its_frame() {
+    use eotn::sensors::SensorReadings;
+    use eotn::streams::{Compression, FrameRecord, StreamInfo, StreamWriter, WriterOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let (_, table) = fixture(dir.path());
+    let path = dir.path().join("nan.mcap");
+    let options = WriterOptions {
+        compression: Compression::None,
+        frames_per_chunk: Some(1),
+    };
+    let mut w = StreamWriter::create_with(&path, &StreamInfo::default(), options).unwrap();
+    for i in 0..3 {
+        let mut r = FrameRecord::new(i as u64 * 40_000_000, scene(i));
+        r.sensors = Some(SensorReadings {
+            head_pan_rad: if i == 1 { None } else { Some(0.1) },
+            ..SensorReadings::default()
+        });
+        w.write(&r).unwrap();
+    }
+    w.finish().unwrap();
+    // What Python's json.dumps writes for a NaN reading, in frame 1's message (same length, so
+    // the uncompressed chunk stays well-formed).
+    let mut bytes = std::fs::read(&path).unwrap();
+    let from = br#""head_pan_rad":null"#;
+    let at = bytes
+        .windows(from.len())
+        .position(|w| w == from)
+        .expect("frame 1 has no head pan");
+    bytes[at..at + from.len()].copy_from_slice(br#""head_pan_rad":NaN "#);
+    // The chunk's CRC no longer matches: 0 means "not computed" in MCAP. Walk the records
+    // (magic, then opcode u8 + length u64 + body) to the chunk holding the edit.
+    let mut pos = 8;
+    loop {
+        let len = u64::from_le_bytes(bytes[pos + 1..pos + 9].try_into().unwrap()) as usize;
+        let body = pos + 9;
+        if (body..body + len).contains(&at) {
+            assert_eq!(bytes[pos], 0x06, "a chunk record");
+            // start time u64, end time u64, uncompressed size u64, then the CRC u32.
+            bytes[body + 24..body + 28].fill(0);
+            break;
+        }
+        pos = body + len;
+    }
+    std::fs::write(&path, &bytes).unwrap();
+
+    let mut h = harness(vec![path, table]);
+    h.run();
+    assert!(h.query_by_label_contains("this frame:").is_none());
+    h.key_press(Key::ArrowRight);
+    h.run();
+    let s = state(&h);
+    let c = s.current().unwrap();
+    assert_eq!(s.index(), 1, "{:?}", s.warnings());
+    assert_eq!(c.sensors.unwrap().head_pan_rad, None, "{:?}", s.warnings());
+    assert!(
+        c.warnings
+            .iter()
+            .any(|w| w.contains("frame 1") && w.contains("NaN")),
+        "{:?}",
+        c.warnings
+    );
+    assert!(s.warnings().iter().any(|w| w.contains("NaN")));
+    assert!(h.query_by_label_contains("this frame:").is_some());
+}
