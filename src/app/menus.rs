@@ -317,16 +317,10 @@ fn view_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
             }
         }
     });
-    ui.separator();
-    let mut o: Overlays = state.settings.overlays;
-    let before = o;
-    ui.checkbox(&mut o.classified, "Classified over colour");
-    ui.add(egui::Slider::new(&mut o.opacity, 0.0..=1.0).text("opacity"));
-    ui.checkbox(&mut o.blob_boxes, "Blob boxes");
-    ui.checkbox(&mut o.labels, "Labels");
-    ui.checkbox(&mut o.preview, "Selection preview");
-    if o != before {
-        commands.push(Command::SetOverlays(o));
+    ui.menu_button("Overlays", |ui| overlays_menu_ui(ui, state, commands));
+    let mut inspector = state.window_open(Window::Inspector);
+    if ui.checkbox(&mut inspector, "Object inspector").changed() {
+        commands.push(Command::ShowWindow(Window::Inspector, inspector));
     }
     let mut timings = state.settings.show_timings;
     if ui.checkbox(&mut timings, "Frame-time readout").changed() {
@@ -341,6 +335,37 @@ fn view_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
         if ui.selectable_label(c == conn, name).clicked() {
             commands.push(Command::SetConnectivity(conn));
         }
+    }
+}
+
+/// View ▸ Overlays: every switch, the pipeline's first, then recognition's.
+fn overlays_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+    let mut o: Overlays = state.settings.overlays;
+    let before = o;
+    ui.checkbox(&mut o.classified, "Classified over colour");
+    ui.add(egui::Slider::new(&mut o.opacity, 0.0..=1.0).text("opacity"));
+    ui.checkbox(&mut o.blob_boxes, "Blob boxes");
+    ui.checkbox(&mut o.labels, "Blob labels");
+    ui.checkbox(&mut o.preview, "Selection preview");
+    ui.separator();
+    ui.weak("Recognition");
+    ui.checkbox(&mut o.candidates, "Candidate boxes");
+    ui.checkbox(&mut o.circles, "Circle fits");
+    ui.checkbox(&mut o.scan_areas, "Scan areas");
+    ui.checkbox(&mut o.scan_points, "Scan points");
+    ui.checkbox(&mut o.posts, "Goal posts");
+    ui.checkbox(&mut o.gaps, "Gaps");
+    ui.checkbox(&mut o.horizon, "Horizon");
+    ui.checkbox(&mut o.object_labels, "Object labels (distance, bearing)");
+    ui.horizontal(|ui| {
+        for (name, on) in [("All recognition", true), ("None", false)] {
+            if ui.button(name).clicked() {
+                o.set_recognition(on);
+            }
+        }
+    });
+    if o != before {
+        commands.push(Command::SetOverlays(o));
     }
 }
 

@@ -9,6 +9,7 @@
 //! | `views.rs` | the enlarged view (zoom, pan, hover, clicks) and the thumbnails |
 //! | `overlays.rs` | drawing in image pixels through one transform: boxes, labels, markers |
 //! | `classify_panel.rs` | class picker, sensitivity, commit/undo/redo, try-on-stream |
+//! | `inspector.rs` | every recognition candidate with its confidence breakdown; selection |
 //! | `sensors_dialog.rs` | every sensor reading with units, plots over the stream |
 //! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
 //! | `menus.rs` | File, Classification, View, Stream, Windows |
@@ -16,6 +17,7 @@
 //! Only this folder names egui/eframe (`scripts/check.sh` checks it).
 
 pub mod classify_panel;
+pub mod inspector;
 pub mod journal;
 pub mod menus;
 pub mod overlays;
@@ -69,6 +71,8 @@ struct Textures {
     preview: TextureHandle,
     frame_generation: u64,
     preview_generation: u64,
+    /// The preview texture holds no highlight (nothing to re-upload while none is pending).
+    preview_empty: bool,
 }
 
 impl Textures {
@@ -82,13 +86,62 @@ impl Textures {
 }
 
 /// Display colours of every class code, transparent for unclassified.
-fn palette() -> [Color32; 256] {
+#[must_use]
+pub fn palette() -> [Color32; 256] {
     let mut p = [Color32::TRANSPARENT; 256];
     for (code, c) in p.iter_mut().enumerate().skip(1) {
         let [r, g, b] = crate::lut::code_display_rgb(u8::try_from(code).unwrap_or(0));
         *c = Color32::from_rgb(r, g, b);
     }
     p
+}
+
+/// The images the views are drawn from, before they go to the GPU.
+#[derive(Debug, Clone)]
+pub struct ViewImages {
+    /// The frame in colour.
+    pub raw: ColorImage,
+    /// Class colours, transparent where unclassified.
+    pub classified: ColorImage,
+}
+
+/// Builds the colour and class-colour images of the shown frame (`palette` from [`palette`]);
+/// `None` when no frame is open. This is the CPU side of a texture update.
+#[must_use]
+pub fn view_images(state: &AppState, palette: &[Color32; 256]) -> Option<ViewImages> {
+    let frame = state.frame()?;
+    let size = [frame.width(), frame.height()];
+    let raw = ColorImage::from_rgb(size, state.rgb());
+    let classified = ColorImage::new(
+        size,
+        state
+            .classified()
+            .codes()
+            .iter()
+            .map(|&c| palette[usize::from(c)])
+            .collect(),
+    );
+    Some(ViewImages { raw, classified })
+}
+
+/// The preview highlight image of the pending selection (class colour on selected pixels,
+/// dimmed elsewhere; transparent with no selection).
+#[must_use]
+pub fn preview_image(state: &AppState, size: [usize; 2]) -> ColorImage {
+    let mask = state.preview_mask();
+    let colour = state
+        .preview_colour()
+        .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
+    if mask.len() != size[0] * size[1] {
+        return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
+    }
+    // Unselected pixels are dimmed, so the highlight shows even where the class colour is
+    // the colour of the pixels themselves (orange on an orange ball).
+    let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
+    ColorImage::new(
+        size,
+        mask.iter().map(|&m| if m { colour } else { dim }).collect(),
+    )
 }
 
 /// The eframe application: the state plus the runtime resources of the window.
@@ -107,6 +160,7 @@ pub struct EotnApp {
     title: String,
     last_frame: Option<Instant>,
     palette: [Color32; 256],
+    was_playing: bool,
 }
 
 impl EotnApp {
@@ -143,6 +197,7 @@ impl EotnApp {
             title: String::new(),
             last_frame: None,
             palette: palette(),
+            was_playing: false,
         }
     }
 
@@ -178,60 +233,41 @@ impl EotnApp {
             .textures
             .as_ref()
             .is_none_or(|t| t.frame_generation != fg);
-        let preview = self.preview_image(size);
-        if frame_changed {
-            let raw = ColorImage::from_rgb(size, self.state.rgb());
-            let classified = ColorImage::new(
-                size,
-                self.state
-                    .classified()
-                    .codes()
-                    .iter()
-                    .map(|&c| self.palette[usize::from(c)])
-                    .collect(),
-            );
+        let empty = self.state.selection().is_none();
+        if frame_changed
+            && let Some(ViewImages { raw, classified }) = view_images(&self.state, &self.palette)
+        {
             match &mut self.textures {
                 Some(t) => {
                     t.raw.set(raw, opts);
                     t.classified.set(classified, opts);
-                    t.preview.set(preview, opts);
                 }
                 None => {
+                    let preview = preview_image(&self.state, size);
                     self.textures = Some(Textures {
                         raw: ctx.load_texture("raw", raw, opts),
                         classified: ctx.load_texture("classified", classified, opts),
                         preview: ctx.load_texture("preview", preview, opts),
                         frame_generation: fg,
                         preview_generation: pg,
+                        preview_empty: empty,
                     });
                 }
             }
-            self.state.record_upload(t0.elapsed());
-        } else if let Some(t) = &mut self.textures {
-            t.preview.set(preview, opts);
         }
         if let Some(t) = &mut self.textures {
+            // With nothing selected the preview is not drawn: an empty one is uploaded once,
+            // not on every step of playback.
+            if t.preview_generation != pg && !(empty && t.preview_empty) {
+                t.preview.set(preview_image(&self.state, size), opts);
+                t.preview_empty = empty;
+            }
             t.frame_generation = fg;
             t.preview_generation = pg;
         }
-    }
-
-    fn preview_image(&self, size: [usize; 2]) -> ColorImage {
-        let mask = self.state.preview_mask();
-        let colour = self
-            .state
-            .preview_colour()
-            .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
-        if mask.len() != size[0] * size[1] {
-            return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
+        if frame_changed {
+            self.state.record_upload(t0.elapsed());
         }
-        // Unselected pixels are dimmed, so the highlight shows even where the class colour is
-        // the colour of the pixels themselves (orange on an orange ball).
-        let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
-        ColorImage::new(
-            size,
-            mask.iter().map(|&m| if m { colour } else { dim }).collect(),
-        )
     }
 
     fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
@@ -381,11 +417,12 @@ impl EotnApp {
             let ms = |d: Duration| d.as_secs_f64() * 1e3;
             if self.state.settings.show_timings {
             ui.monospace(format!(
-                "step {:.1} ms (read {:.1} classify {:.1} blobs {:.1} prep {:.1} upload {:.1}) | frame {:.1} ms",
+                "step {:.1} ms (read {:.1} classify {:.1} blobs {:.1} recognition {:.1} prep {:.1} upload {:.1}) | frame {:.1} ms",
                 ms(s.total()),
                 ms(s.read),
                 ms(s.classify),
                 ms(s.blobs),
+                ms(s.recognition),
                 ms(s.prepare),
                 ms(s.upload),
                 self.state.timings.frames_ms.last().copied().unwrap_or(0.0),
@@ -400,6 +437,16 @@ impl EotnApp {
             ui.separator();
             ui.label(&self.state.status);
         });
+        // This frame's own problems (NaN sensor readings, skipped channels) stay in view while
+        // it is shown, not only in the warnings list.
+        if let Some(c) = self.state.current()
+            && !c.warnings.is_empty()
+        {
+            let colour = ui.visuals().warn_fg_color;
+            for w in &c.warnings {
+                ui.colored_label(colour, format!("this frame: {w}"));
+            }
+        }
         ui.horizontal(|ui| views::pixel_readout_ui(ui, self.hovered.as_ref()));
     }
 
@@ -496,22 +543,25 @@ impl EotnApp {
         if std::env::var_os("EOTN_STATS").is_some() {
             let t = &self.state.timings;
             eprintln!(
-                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms",
+                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms (our UI code {:.2} ms, eframe CPU {:.2} ms)",
                 t.steps_ms.len(),
                 state::median(&t.steps_ms),
                 t.frames_ms.len(),
                 state::median(&t.frames_ms),
                 t.playing_frames_ms.len(),
                 state::median(&t.playing_frames_ms),
+                state::median(&t.playing_ui_ms),
+                state::median(&t.playing_cpu_ms),
             );
         }
     }
 }
 
 impl eframe::App for EotnApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         let now = Instant::now();
+        let cpu = frame.info().cpu_usage;
         let dt = self.last_frame.map_or(Duration::ZERO, |t| now - t);
         self.last_frame = Some(now);
         if dt > Duration::ZERO {
@@ -559,6 +609,7 @@ impl eframe::App for EotnApp {
         sensors_dialog::sensors_window(&ctx, &mut self.state);
         self.uv_plane.window(&ctx, &mut self.state, &mut commands);
         classify_panel::try_edit_window(&ctx, &mut self.state, &mut commands);
+        inspector::inspector_window(&ctx, &self.state, &mut commands);
         self.warnings_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
         if quit {
@@ -572,10 +623,20 @@ impl eframe::App for EotnApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
             self.title = title;
         }
-        let busy = self.state.playing()
-            || self.state.try_edit().is_some_and(|t| !t.done())
+        // Playback redraws when the next frame is due, not as fast as it can: an unchanged
+        // frame costs the renderer as much as a new one.
+        if let Some(due) = self.state.next_frame_due() {
+            ctx.request_repaint_after(due);
+        }
+        let busy = self.state.try_edit().is_some_and(|t| !t.done())
             || (self.state.settings.show_sensors
                 && self.state.sensor_series.points.len() < self.state.sensor_series.total);
+        self.state.record_ui_time(now.elapsed(), cpu);
+        if self.was_playing && !self.state.playing() {
+            // The end of a playback is when its figures are complete.
+            self.report_stats();
+        }
+        self.was_playing = self.state.playing();
         if busy {
             ctx.request_repaint();
         }

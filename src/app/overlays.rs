@@ -1,12 +1,18 @@
 //! Drawing in image-pixel coordinates: one [`ImagePainter`] owns zoom and pan, so no overlay
-//! does screen maths. Blob boxes, object labels, the sampled pixel and the preview highlight.
+//! does screen maths. Blob boxes, recognition's primitives (candidate boxes, scan areas and
+//! points, circles, posts, gaps, the horizon, object labels), the sampled pixel and the preview
+//! highlight.
 
 use egui::{
     Align2, Color32, FontId, Painter, Pos2, Rect, Stroke, StrokeKind, TextureId, pos2, vec2,
 };
 
-use super::state::{AppState, ViewKind, box_colour};
+use super::state::{AppState, PrimitiveFilter, ViewKind, box_colour};
 use crate::blobs::Blob;
+use crate::recognition::{LineRole, Primitive};
+
+/// Alpha of the overlays of objects other than the selected one.
+const DIMMED_ALPHA: f32 = 0.25;
 
 /// Blobs get a label outside the objects view when at least this many times the minimum size.
 const LABEL_SIZE_FACTOR: u32 = 20;
@@ -144,42 +150,183 @@ pub fn paint_view(
         painter.image(tex.preview, img, uv, Color32::WHITE);
     }
     let boxes = match kind {
-        ViewKind::Objects => state.largest_blobs(),
+        ViewKind::Objects => Vec::new(),
         ViewKind::Blobs => state.drawn_blobs(),
         _ if with_overlays && o.blob_boxes => state.drawn_blobs(),
         _ => Vec::new(),
     };
-    let labels = with_overlays && (o.labels || kind == ViewKind::Objects);
+    let labels = with_overlays && o.labels;
     // Outside the objects view only sizeable blobs get a label, or the field drowns in text.
     let label_min = state
         .settings
         .min_blob_pixels
         .saturating_mul(LABEL_SIZE_FACTOR);
     for b in &boxes {
-        let label = labels && (kind == ViewKind::Objects || b.pixels >= label_min);
-        blob_box(&painter, xf, b, label);
+        blob_box(&painter, xf, b);
+    }
+    if labels {
+        // Largest first, and none over another: a crowded frame shows its main blobs' labels
+        // instead of a heap of text.
+        let mut labelled: Vec<&Blob> = boxes.iter().filter(|b| b.pixels >= label_min).collect();
+        labelled.sort_by_key(|b| std::cmp::Reverse(b.pixels));
+        let mut placed: Vec<Rect> = Vec::new();
+        for b in labelled {
+            blob_label(&painter, xf, b, &mut placed);
+        }
+    }
+    if kind == ViewKind::Objects || (with_overlays && kind != ViewKind::Blobs) {
+        let filter = if kind == ViewKind::Objects {
+            let mut f = PrimitiveFilter::objects(o, state.accepted_owners());
+            // A thumbnail is too small for text.
+            f.overlays.object_labels = with_overlays;
+            f
+        } else {
+            PrimitiveFilter::all(o)
+        };
+        paint_primitives(
+            &painter,
+            xf,
+            state.primitives(),
+            &filter,
+            state.selected_object(),
+        );
     }
     if with_overlays && let Some((x, y)) = state.selection().and_then(|s| s.pixel) {
         sample_marker(&painter, xf, x, y);
     }
 }
 
-/// One blob's box (pixel edges inclusive), optionally labelled with its class and size.
-pub fn blob_box(painter: &Painter, xf: &ImageTransform, b: &Blob, label: bool) {
-    let [r, g, bl] = box_colour(b.colour);
-    let colour = Color32::from_rgb(r, g, bl);
-    let rect = Rect::from_min_max(
+/// A blob's box on screen (pixel edges inclusive).
+fn blob_rect(xf: &ImageTransform, b: &Blob) -> Rect {
+    Rect::from_min_max(
         xf.to_screen(pos2(b.minx as f32, b.miny as f32)),
         xf.to_screen(pos2(b.maxx as f32 + 1.0, b.maxy as f32 + 1.0)),
+    )
+}
+
+/// One blob's box in its class's box colour.
+pub fn blob_box(painter: &Painter, xf: &ImageTransform, b: &Blob) {
+    let [r, g, bl] = box_colour(b.colour);
+    let colour = Color32::from_rgb(r, g, bl);
+    painter.rect_stroke(
+        blob_rect(xf, b),
+        0.0,
+        Stroke::new(1.5, colour),
+        StrokeKind::Outside,
     );
-    painter.rect_stroke(rect, 0.0, Stroke::new(1.5, colour), StrokeKind::Outside);
-    if label {
-        let text = format!("{} {}×{}", b.class().name(), b.width(), b.height());
-        let pos = rect.left_top() - vec2(0.0, 2.0);
-        let galley = painter.layout_no_wrap(text, FontId::proportional(11.0), colour);
-        let bg = Rect::from_min_size(pos - vec2(0.0, galley.size().y), galley.size()).expand(1.0);
-        painter.rect_filled(bg, 2.0, Color32::from_black_alpha(160));
-        painter.galley(bg.min + vec2(1.0, 1.0), galley, colour);
+}
+
+/// A blob's class and size below its box, unless it would cover a label in `placed`; the
+/// label drawn is added to `placed`.
+pub fn blob_label(painter: &Painter, xf: &ImageTransform, b: &Blob, placed: &mut Vec<Rect>) {
+    let [r, g, bl] = box_colour(b.colour);
+    let colour = Color32::from_rgb(r, g, bl);
+    let text = format!("{} {}×{}", b.class().name(), b.width(), b.height());
+    // Below the box: above it go recognition's object labels.
+    let pos = blob_rect(xf, b).left_bottom() + vec2(0.0, 3.0);
+    let galley = painter.layout_no_wrap(text, FontId::proportional(11.0), colour);
+    let bg = Rect::from_min_size(pos, galley.size()).expand(1.0);
+    if placed.iter().any(|p| p.intersects(bg)) {
+        return;
+    }
+    placed.push(bg);
+    painter.rect_filled(bg, 2.0, Color32::from_black_alpha(160));
+    painter.galley(bg.min + vec2(1.0, 1.0), galley, colour);
+}
+
+/// The colour of a primitive, as `eotn render` draws it (`crate::overlay`).
+fn primitive_colour(p: &Primitive) -> Color32 {
+    match p {
+        Primitive::Box { colour, .. } => {
+            let [r, g, b] = box_colour(*colour);
+            Color32::from_rgb(r, g, b)
+        }
+        Primitive::ScanArea { .. } => Color32::from_rgb(255, 0, 255),
+        Primitive::ScanPoints { .. } => Color32::from_rgb(0, 255, 255),
+        Primitive::Circle { .. } => Color32::from_rgb(255, 255, 0),
+        Primitive::Line { role, .. } => match role {
+            LineRole::Horizon => Color32::from_rgb(255, 64, 64),
+            LineRole::Post => Color32::from_rgb(0, 255, 0),
+            LineRole::Gap => Color32::WHITE,
+            LineRole::Scan => Color32::from_rgb(128, 128, 255),
+        },
+        Primitive::Label { .. } => Color32::WHITE,
+    }
+}
+
+/// Draws recognition's primitives through the view's transform. With a `selected` owner, its
+/// primitives are drawn thicker and every other object's are dimmed (the horizon stays).
+pub fn paint_primitives(
+    painter: &Painter,
+    xf: &ImageTransform,
+    primitives: &[Primitive],
+    filter: &PrimitiveFilter<'_>,
+    selected: Option<&str>,
+) {
+    let at = |p: (f64, f64)| xf.to_screen(pos2(p.0 as f32, p.1 as f32));
+    // Edge points: a dot about a pixel wide, never smaller than 1.5 points.
+    let dot = (xf.zoom * 0.5).clamp(1.5, 4.0);
+    let clip = painter.clip_rect().expand(8.0);
+    for p in primitives.iter().filter(|p| filter.shows(p)) {
+        let mine = selected.is_some_and(|s| s == p.owner());
+        let dim = selected.is_some() && !mine && p.owner() != "horizon";
+        let mut colour = primitive_colour(p);
+        if dim {
+            colour = colour.gamma_multiply(DIMMED_ALPHA);
+        }
+        let width = if mine { 3.0 } else { 1.5 };
+        let stroke = Stroke::new(width, colour);
+        match p {
+            Primitive::Box { bounds, .. } => {
+                let [x0, y0, x1, y1] = bounds.map(|v| v as f32);
+                let rect = Rect::from_min_max(
+                    xf.to_screen(pos2(x0, y0)),
+                    xf.to_screen(pos2(x1 + 1.0, y1 + 1.0)),
+                );
+                painter.rect_stroke(rect, 0.0, stroke, StrokeKind::Outside);
+            }
+            Primitive::ScanArea { corners, .. } => {
+                let pts: Vec<Pos2> = corners.iter().map(|&c| at(c)).collect();
+                painter.add(egui::Shape::closed_line(pts, stroke));
+            }
+            Primitive::ScanPoints { points, .. } => {
+                // One mesh for all points: hundreds of separate circles cost far more to
+                // tessellate and rasterise.
+                let mut mesh = egui::Mesh::default();
+                for &q in points {
+                    let c = at(q);
+                    if clip.contains(c) {
+                        mesh.add_colored_rect(Rect::from_center_size(c, vec2(dot, dot)), colour);
+                    }
+                }
+                painter.add(mesh);
+            }
+            Primitive::Circle { center, radius, .. } => {
+                let r = (*radius as f32) * xf.zoom;
+                if r.is_finite() && r > 0.0 {
+                    painter.circle_stroke(at(*center), r, stroke);
+                }
+            }
+            Primitive::Line { from, to, .. } => {
+                painter.line_segment([at(*from), at(*to)], stroke);
+            }
+            Primitive::Label { at: pos, text, .. } => {
+                let galley =
+                    painter.layout_no_wrap(text.clone(), FontId::proportional(12.0), colour);
+                let anchor = at(*pos);
+                let bg =
+                    Rect::from_min_size(anchor - vec2(0.0, galley.size().y + 2.0), galley.size())
+                        .expand(2.0);
+                // Kept inside the view: a ball at the top edge still shows its distance.
+                let view = painter.clip_rect();
+                let dx = (view.max.x - bg.max.x).min(0.0) + (view.min.x - bg.min.x).max(0.0);
+                let dy = (view.max.y - bg.max.y).min(0.0) + (view.min.y - bg.min.y).max(0.0);
+                let bg = bg.translate(vec2(dx, dy));
+                let bg_alpha = if dim { 60 } else { 180 };
+                painter.rect_filled(bg, 3.0, Color32::from_black_alpha(bg_alpha));
+                painter.galley(bg.min + vec2(2.0, 2.0), galley, colour);
+            }
+        }
     }
 }
 

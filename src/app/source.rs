@@ -225,20 +225,44 @@ impl Source {
             Kind::Files(f) => {
                 let path = &f.paths[index];
                 let frame = load_frame(path, None)?;
+                let mut warnings = Vec::new();
+                let side = sensor_side_file(path);
+                let sensors = if side.exists() {
+                    match load_side_sensors(&side) {
+                        Ok((r, w)) => {
+                            warnings.extend(w);
+                            Some(r)
+                        }
+                        Err(e) => {
+                            warnings.push(format!("{e:#}; frame shown without sensor readings"));
+                            None
+                        }
+                    }
+                } else {
+                    None
+                };
                 Ok(LoadedFrame {
                     frame: Arc::new(frame),
                     time_ns,
-                    sensors: None,
+                    sensors,
                     extra: Vec::new(),
-                    warnings: Vec::new(),
+                    warnings,
                 })
             }
             Kind::Stream(s) => {
+                let seen = s.reader.warnings().len();
                 let record = s
                     .reader
                     .read(index)
                     .with_context(|| format!("frame {index}"))?;
-                let mut warnings = Vec::new();
+                // What the reader repaired in this frame (NaN readings read as missing, bad
+                // JSON skipped) belongs to this frame's warnings too.
+                let label = file_name(&s.path);
+                let mut warnings: Vec<String> = s.reader.warnings()
+                    [seen.min(s.reader.warnings().len())..]
+                    .iter()
+                    .map(|w| format!("{label}: {w}"))
+                    .collect();
                 let sensors = record.sensors.map(|r| {
                     let (clean, dropped) = r.sanitised();
                     if !dropped.is_empty() {
@@ -268,6 +292,71 @@ impl Source {
     }
 }
 
+/// The sensor side file of a frame file: `NAME.sensors.json` beside `NAME.uyvy` (or `.png`…),
+/// one JSON object with the fields of the sensor schema.
+#[must_use]
+pub fn sensor_side_file(frame: &Path) -> PathBuf {
+    let stem = frame
+        .file_stem()
+        .map_or_else(|| "frame".into(), |s| s.to_string_lossy().into_owned());
+    frame.with_file_name(format!("{stem}.sensors.json"))
+}
+
+/// Reads a sensor side file. `NaN`, `Infinity` (as Python writes them) and non-finite values are
+/// read as missing; the second value names each such reading, as warnings for the status area.
+///
+/// # Errors
+/// An unreadable file, text that is not JSON, or JSON that is not a sensor reading, naming the
+/// file.
+pub fn load_side_sensors(path: &Path) -> anyhow::Result<(SensorReadings, Vec<String>)> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let (value, replaced) = crate::streams::schema::parse_json_lenient(&bytes)
+        .map_err(|e| anyhow::anyhow!("{}: not JSON ({e})", path.display()))?;
+    let mut dropped: Vec<String> = if replaced {
+        non_finite_keys(&String::from_utf8_lossy(&bytes), &value)
+    } else {
+        Vec::new()
+    };
+    let readings: SensorReadings = serde_json::from_value(value)
+        .with_context(|| format!("{}: not a sensor reading", path.display()))?;
+    let (clean, more) = readings.sanitised();
+    dropped.extend(more.into_iter().map(str::to_owned));
+    let warnings = if dropped.is_empty() {
+        Vec::new()
+    } else {
+        vec![format!(
+            "{}: non-finite sensor readings read as missing: {}",
+            path.display(),
+            dropped.join(", ")
+        )]
+    };
+    Ok((clean, warnings))
+}
+
+/// Keys of the top-level object that became `null` because the text gave them `NaN`,
+/// `Infinity` or `-Infinity`.
+fn non_finite_keys(text: &str, value: &serde_json::Value) -> Vec<String> {
+    let Some(obj) = value.as_object() else {
+        return Vec::new();
+    };
+    obj.iter()
+        .filter(|(_, v)| v.is_null())
+        .filter(|(k, _)| {
+            let quoted = format!("\"{k}\"");
+            text.match_indices(&quoted).any(|(at, _)| {
+                let rest = text[at + quoted.len()..].trim_start();
+                rest.strip_prefix(':').is_some_and(|r| {
+                    let r = r.trim_start();
+                    ["NaN", "Infinity", "-Infinity"]
+                        .iter()
+                        .any(|t| r.starts_with(t))
+                })
+            })
+        })
+        .map(|(k, _)| k.clone())
+        .collect()
+}
+
 /// The file name of a path, for labels.
 #[must_use]
 pub fn file_name(path: &Path) -> String {
@@ -275,4 +364,53 @@ pub fn file_name(path: &Path) -> String {
         || path.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn side_file_names_non_finite_readings_and_keeps_the_rest() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.sensors.json");
+        std::fs::write(
+            &p,
+            r#"{"head_pan_rad": NaN, "head_tilt_rad": -0.2, "pan_pwm": -Infinity, "neck_tilt_rad": null}"#,
+        )
+        .unwrap();
+        let (r, w) = load_side_sensors(&p).unwrap();
+        assert_eq!(r.head_pan_rad, None);
+        assert_eq!(r.head_tilt_rad, Some(-0.2));
+        assert_eq!(r.pan_pwm, None);
+        assert_eq!(w.len(), 1);
+        assert!(
+            w[0].contains("head_pan_rad") && w[0].contains("pan_pwm"),
+            "{w:?}"
+        );
+        assert!(
+            !w[0].contains("neck_tilt_rad"),
+            "null is missing, not NaN: {w:?}"
+        );
+        assert!(w[0].contains("f.sensors.json"));
+    }
+
+    #[test]
+    fn side_file_errors_name_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("g.sensors.json");
+        std::fs::write(&p, "{\"head_pan_rad\": ").unwrap();
+        let e = format!("{:#}", load_side_sensors(&p).unwrap_err());
+        assert!(
+            e.contains("g.sensors.json") && e.contains("not JSON"),
+            "{e}"
+        );
+        std::fs::write(&p, "{\"head_pan_rad\": \"left\"}").unwrap();
+        let e = format!("{:#}", load_side_sensors(&p).unwrap_err());
+        assert!(e.contains("not a sensor reading"), "{e}");
+        assert_eq!(
+            sensor_side_file(Path::new("/x/a.uyvy")),
+            Path::new("/x/a.sensors.json")
+        );
+    }
 }

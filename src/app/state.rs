@@ -17,6 +17,7 @@ use crate::frame::{Frame, Yuv, save_rgb_png, yuv_to_rgb};
 use crate::lut::edit::Selection;
 use crate::lut::{ColourClass, EditHistory, EditRecord, LookupTable, Region, Sensitivity};
 use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::{LineRole, Primitive, Recognition};
 use crate::sensors::SensorReadings;
 
 /// How many warnings the status area keeps (oldest dropped first).
@@ -44,7 +45,8 @@ pub enum ViewKind {
     Classified,
     /// The classified image dimmed, with each blob's box.
     Blobs,
-    /// The colour image with the largest blob of each class labelled.
+    /// The colour image with the recognised objects: ball, goals with posts and gap, beacons,
+    /// labelled with distance and bearing.
     Objects,
 }
 
@@ -78,6 +80,36 @@ pub struct Overlays {
     pub labels: bool,
     /// The pending selection's preview highlight.
     pub preview: bool,
+    /// Recognition: the horizon (needs the camera pose from sensor readings).
+    pub horizon: bool,
+    /// Recognition: every candidate's box, accepted or rejected.
+    pub candidates: bool,
+    /// Recognition: the scanned areas (green below a ball).
+    pub scan_areas: bool,
+    /// Recognition: edge points found by the ball's and the posts' scans.
+    pub scan_points: bool,
+    /// Recognition: the ball's fitted circle.
+    pub circles: bool,
+    /// Recognition: fitted goal posts.
+    pub posts: bool,
+    /// Recognition: a goal's largest gap and its scan line.
+    pub gaps: bool,
+    /// Recognition: labels of accepted objects with distance (cm) and bearing (degrees).
+    pub object_labels: bool,
+}
+
+impl Overlays {
+    /// Switches every recognition overlay on or off.
+    pub fn set_recognition(&mut self, on: bool) {
+        self.horizon = on;
+        self.candidates = on;
+        self.scan_areas = on;
+        self.scan_points = on;
+        self.circles = on;
+        self.posts = on;
+        self.gaps = on;
+        self.object_labels = on;
+    }
 }
 
 impl Default for Overlays {
@@ -88,6 +120,14 @@ impl Default for Overlays {
             blob_boxes: true,
             labels: true,
             preview: true,
+            horizon: true,
+            candidates: true,
+            scan_areas: true,
+            scan_points: true,
+            circles: true,
+            posts: true,
+            gaps: true,
+            object_labels: true,
         }
     }
 }
@@ -156,6 +196,8 @@ pub struct Settings {
     pub show_try_edit: bool,
     /// The step and frame-time readout in the status bar.
     pub show_timings: bool,
+    /// The object inspector window open.
+    pub show_inspector: bool,
 }
 
 impl Default for Settings {
@@ -179,6 +221,7 @@ impl Default for Settings {
             uv_plane_y: 128,
             show_try_edit: false,
             show_timings: true,
+            show_inspector: false,
         }
     }
 }
@@ -265,6 +308,9 @@ pub enum Command {
     ShowWindow(Window, bool),
     /// Show or hide the frame-time readout.
     ShowTimings(bool),
+    /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
+    /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
+    SelectObject(Option<String>),
 }
 
 /// The app's extra windows.
@@ -276,11 +322,13 @@ pub enum Window {
     UvPlane,
     /// The whole-stream check of a pending edit.
     TryEdit,
+    /// Every recognition candidate with its confidence breakdown.
+    Inspector,
 }
 
 impl Window {
     /// Every window, for the Windows menu.
-    pub const ALL: [Self; 3] = [Self::Sensors, Self::UvPlane, Self::TryEdit];
+    pub const ALL: [Self; 4] = [Self::Sensors, Self::UvPlane, Self::TryEdit, Self::Inspector];
 
     /// Its title.
     #[must_use]
@@ -289,6 +337,7 @@ impl Window {
             Self::Sensors => "Sensors",
             Self::UvPlane => "U–V plane",
             Self::TryEdit => "Try edit on stream",
+            Self::Inspector => "Object inspector",
         }
     }
 }
@@ -298,6 +347,8 @@ impl Window {
 pub struct StepTiming {
     /// Reading (and decoding) the frame, or the cache hit.
     pub read: Duration,
+    /// Ball, goals, beacons.
+    pub recognition: Duration,
     /// Classification.
     pub classify: Duration,
     /// Blob formation.
@@ -312,7 +363,7 @@ impl StepTiming {
     /// Everything.
     #[must_use]
     pub fn total(&self) -> Duration {
-        self.read + self.classify + self.blobs + self.prepare + self.upload
+        self.read + self.classify + self.blobs + self.recognition + self.prepare + self.upload
     }
 }
 
@@ -401,6 +452,12 @@ pub struct Timings {
     pub frames_ms: Vec<f64>,
     /// Recent UI frame intervals while playing, milliseconds.
     pub playing_frames_ms: Vec<f64>,
+    /// While playing: time our own UI code took per frame (layout and painting commands, not
+    /// tessellation or rasterisation), milliseconds.
+    pub playing_ui_ms: Vec<f64>,
+    /// While playing: eframe's CPU time per frame (our UI, tessellation, the renderer's
+    /// submission; not the wait for the display), milliseconds.
+    pub playing_cpu_ms: Vec<f64>,
 }
 
 fn push_capped(v: &mut Vec<f64>, x: f64) {
@@ -451,6 +508,9 @@ pub struct AppState {
     try_edit: Option<TryEdit>,
     table_counts: crate::lut::ClassCounts,
     frame_counts: [usize; 256],
+    primitives: Vec<Primitive>,
+    accepted_owners: Vec<String>,
+    selected_object: Option<String>,
 }
 
 impl Default for AppState {
@@ -498,6 +558,9 @@ impl AppState {
             try_edit: None,
             table_counts,
             frame_counts: [0; 256],
+            primitives: Vec::new(),
+            accepted_owners: Vec::new(),
+            selected_object: None,
         }
     }
 
@@ -739,6 +802,15 @@ impl AppState {
             Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
             Command::ShowWindow(w, open) => *self.window_flag(w) = open,
             Command::ShowTimings(on) => self.settings.show_timings = on,
+            Command::SelectObject(owner) => {
+                if let Some(o) = &owner {
+                    anyhow::ensure!(
+                        self.primitives.iter().any(|p| p.owner() == o),
+                        "no object {o} in this frame"
+                    );
+                }
+                self.selected_object = owner;
+            }
         }
         Ok(())
     }
@@ -776,12 +848,40 @@ impl AppState {
         }
     }
 
+    /// While playing, the wall time until the next frame is due (zero when playing every frame
+    /// or already late); `None` when not playing. The UI sleeps until then instead of redrawing
+    /// an unchanged frame.
+    #[must_use]
+    pub fn next_frame_due(&self) -> Option<Duration> {
+        if !self.playing {
+            return None;
+        }
+        let speed = f64::from(self.settings.speed);
+        let src = self.source.as_ref()?;
+        if speed <= 0.0 || self.index + 1 >= src.len() {
+            return Some(Duration::ZERO);
+        }
+        let next = src.time_ns(self.index + 1) as f64;
+        let wait_s = ((next - self.play_clock_ns) / speed / 1e9).max(0.0);
+        Some(Duration::from_secs_f64(wait_s.min(1.0)))
+    }
+
     /// Records one UI frame interval for the frame-time readout.
     pub fn record_frame_time(&mut self, dt: Duration) {
         let ms = dt.as_secs_f64() * 1e3;
         push_capped(&mut self.timings.frames_ms, ms);
         if self.playing {
             push_capped(&mut self.timings.playing_frames_ms, ms);
+        }
+    }
+
+    /// Records, while playing, how long our UI code and eframe's whole frame took (CPU time).
+    pub fn record_ui_time(&mut self, ui: Duration, cpu_s: Option<f32>) {
+        if self.playing {
+            push_capped(&mut self.timings.playing_ui_ms, ui.as_secs_f64() * 1e3);
+            if let Some(c) = cpu_s.filter(|c| c.is_finite()) {
+                push_capped(&mut self.timings.playing_cpu_ms, f64::from(c) * 1e3);
+            }
         }
     }
 
@@ -860,6 +960,31 @@ impl AppState {
         self.pipeline.result().blobs
     }
 
+    /// What recognition made of the shown frame: every candidate with its evidence.
+    #[must_use]
+    pub fn recognition(&self) -> &Recognition {
+        self.pipeline.result().recognition
+    }
+
+    /// The shown frame's drawing primitives (image pixels), computed once per frame.
+    #[must_use]
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.primitives
+    }
+
+    /// Owners (`"ball#0"`, `"goal:yellow#1"`, `"beacon#0"`) of the accepted objects: what the
+    /// objects view shows.
+    #[must_use]
+    pub fn accepted_owners(&self) -> &[String] {
+        &self.accepted_owners
+    }
+
+    /// The candidate selected in the inspector, whose overlays are highlighted.
+    #[must_use]
+    pub fn selected_object(&self) -> Option<&str> {
+        self.selected_object.as_deref()
+    }
+
     /// Blobs large enough to draw, largest first within each class.
     #[must_use]
     pub fn drawn_blobs(&self) -> Vec<Blob> {
@@ -869,21 +994,6 @@ impl AppState {
             .filter(|b| b.pixels >= min)
             .copied()
             .collect()
-    }
-
-    /// The largest blob of each class (at least the minimum size): the objects view.
-    #[must_use]
-    pub fn largest_blobs(&self) -> Vec<Blob> {
-        let mut best: Vec<Blob> = Vec::new();
-        for b in self.drawn_blobs() {
-            match best.iter_mut().find(|x| x.colour == b.colour) {
-                Some(x) if x.pixels < b.pixels => *x = b,
-                Some(_) => {}
-                None => best.push(b),
-            }
-        }
-        best.sort_by_key(|b| b.colour);
-        best
     }
 
     /// Table cells per class code, kept up to date on every table change (counting 2M cells
@@ -967,6 +1077,7 @@ impl AppState {
             Window::Sensors => self.settings.show_sensors,
             Window::UvPlane => self.settings.show_uv_plane,
             Window::TryEdit => self.settings.show_try_edit,
+            Window::Inspector => self.settings.show_inspector,
         }
     }
 
@@ -975,6 +1086,7 @@ impl AppState {
             Window::Sensors => &mut self.settings.show_sensors,
             Window::UvPlane => &mut self.settings.show_uv_plane,
             Window::TryEdit => &mut self.settings.show_try_edit,
+            Window::Inspector => &mut self.settings.show_inspector,
         }
     }
 
@@ -1071,7 +1183,7 @@ impl AppState {
             }
         }
         let boxes = match kind {
-            ViewKind::Objects => self.largest_blobs(),
+            ViewKind::Objects => Vec::new(),
             ViewKind::Blobs => self.drawn_blobs(),
             _ if o.blob_boxes => self.drawn_blobs(),
             _ => Vec::new(),
@@ -1084,6 +1196,23 @@ impl AppState {
                 [b.minx, b.miny, b.maxx, b.maxy],
                 box_colour(b.colour),
             );
+        }
+        let filter = match kind {
+            ViewKind::Objects => Some(PrimitiveFilter::objects(o, &self.accepted_owners)),
+            ViewKind::Raw | ViewKind::Classified => Some(PrimitiveFilter::all(o)),
+            ViewKind::Blobs => None,
+        };
+        if let Some(f) = filter {
+            let shown: Vec<Primitive> = self
+                .primitives
+                .iter()
+                .filter(|p| f.shows(p))
+                .cloned()
+                .collect();
+            if let Some(mut canvas) = crate::overlay::Canvas::from_rgb(w, h, &out, 1) {
+                canvas.draw(&shown);
+                out = canvas.rgb;
+            }
         }
         Ok((w, h, out))
     }
@@ -1286,18 +1415,40 @@ impl AppState {
 
     /// Re-runs the pipeline on the shown frame (after a table or parameter change).
     fn reprocess(&mut self) {
-        if let Some(c) = &self.current {
-            let frame = c.frame.clone();
-            let t = self.pipeline.process_frame(&frame).timings;
+        if let Some(c) = self.current.take() {
+            let t = self.run_pipeline(&c);
+            self.current = Some(c);
             self.timings.last_step = StepTiming {
                 classify: t.classify,
                 blobs: t.blobs,
+                recognition: t.recognition,
                 ..StepTiming::default()
             };
             self.frame_generation += 1;
-            self.frame_counts = self.pipeline.result().classified.histogram();
         }
         self.refresh_preview();
+    }
+
+    /// Runs every stage on `loaded` with its sensor readings (recognition needs the camera
+    /// pose for heights and the horizon) and refreshes what is derived from the results.
+    fn run_pipeline(&mut self, loaded: &LoadedFrame) -> crate::pipeline::StageTimings {
+        let r = self
+            .pipeline
+            .process(&loaded.frame, loaded.sensors.as_ref());
+        let timings = r.timings;
+        let (w, h) = (loaded.frame.width(), loaded.frame.height());
+        let recognition = r.recognition;
+        self.primitives = recognition.primitives(w, h);
+        self.accepted_owners = accepted_owners(recognition);
+        self.frame_counts = self.pipeline.result().classified.histogram();
+        if self
+            .selected_object
+            .as_ref()
+            .is_some_and(|o| !self.primitives.iter().any(|p| p.owner() == o))
+        {
+            self.selected_object = None;
+        }
+        timings
     }
 
     fn refresh_preview(&mut self) {
@@ -1317,10 +1468,8 @@ impl AppState {
         let t0 = Instant::now();
         let loaded = src.read(index)?;
         let t1 = Instant::now();
-        let r = self.pipeline.process_frame(&loaded.frame);
-        let (classify, blobs) = (r.timings.classify, r.timings.blobs);
+        let t = self.run_pipeline(&loaded);
         let t2 = Instant::now();
-        self.frame_counts = self.pipeline.result().classified.histogram();
         loaded.frame.to_rgb_into(&mut self.rgb);
         for w in &loaded.warnings {
             if !self.warnings.contains(w) {
@@ -1333,8 +1482,9 @@ impl AppState {
         self.refresh_preview();
         self.timings.last_step = StepTiming {
             read: t1 - t0,
-            classify,
-            blobs,
+            classify: t.classify,
+            blobs: t.blobs,
+            recognition: t.recognition,
             prepare: t2.elapsed(),
             upload: Duration::ZERO,
         };
@@ -1402,6 +1552,84 @@ impl AppState {
             });
         }
     }
+}
+
+/// Which recognition primitives a view draws.
+#[derive(Debug, Clone, Copy)]
+pub struct PrimitiveFilter<'a> {
+    /// The overlay switches.
+    pub overlays: Overlays,
+    /// Only these owners (the objects view: accepted objects); `None` draws every candidate.
+    pub owners: Option<&'a [String]>,
+}
+
+impl<'a> PrimitiveFilter<'a> {
+    /// Every candidate, as the switches say.
+    #[must_use]
+    pub const fn all(overlays: Overlays) -> Self {
+        Self {
+            overlays,
+            owners: None,
+        }
+    }
+
+    /// Accepted objects only, always with their boxes and labels (the objects view).
+    #[must_use]
+    pub const fn objects(overlays: Overlays, accepted: &'a [String]) -> Self {
+        let mut o = overlays;
+        o.candidates = true;
+        o.object_labels = true;
+        Self {
+            overlays: o,
+            owners: Some(accepted),
+        }
+    }
+
+    /// Whether `p` is drawn.
+    #[must_use]
+    pub fn shows(&self, p: &Primitive) -> bool {
+        let o = &self.overlays;
+        let on = match p {
+            Primitive::Box { .. } => o.candidates,
+            Primitive::ScanArea { .. } => o.scan_areas,
+            Primitive::ScanPoints { .. } => o.scan_points,
+            Primitive::Circle { .. } => o.circles,
+            Primitive::Line { role, .. } => match role {
+                LineRole::Horizon => o.horizon,
+                LineRole::Post => o.posts,
+                LineRole::Gap | LineRole::Scan => o.gaps,
+            },
+            Primitive::Label { .. } => o.object_labels,
+        };
+        let horizon = matches!(
+            p,
+            Primitive::Line {
+                role: LineRole::Horizon,
+                ..
+            }
+        );
+        on && (horizon || self.owners.is_none_or(|w| w.iter().any(|x| x == p.owner())))
+    }
+}
+
+/// Owners of the accepted objects, named as their primitives name them.
+fn accepted_owners(r: &Recognition) -> Vec<String> {
+    let balls = r.ball.candidates.iter().enumerate();
+    let balls = balls
+        .filter(|(_, c)| c.accepted)
+        .map(|(i, _)| format!("ball#{i}"));
+    let goals = r
+        .goals
+        .candidates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.accepted);
+    let goals = goals.map(|(i, c)| format!("goal:{}#{i}", c.colour.name()));
+    let beacons = r.beacons.iter().enumerate().filter(|(_, b)| b.accepted);
+    balls
+        .chain(goals)
+        .chain(beacons.map(|(i, _)| format!("beacon#{i}")))
+        .collect()
 }
 
 fn seven_bit_table() -> LookupTable {

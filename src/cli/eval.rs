@@ -12,6 +12,7 @@ use super::detect::load_params;
 use super::inputs::load_lut_arg;
 use crate::eval::{
     EvalParams, EvalReport, FrameEval, Percentiles, evaluate_frame, fit_inverse_size,
+    fit_inverse_size_multiplier,
 };
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::{Recognition, RecognitionParams};
@@ -44,6 +45,14 @@ pub struct Args {
     /// a recognition-parameter JSON file.
     #[arg(long)]
     pub calibrate_goals: Option<PathBuf>,
+    /// Multiplier and offset are both fitted only when the tallest goal is at least this many
+    /// times the shortest (else the multiplier alone).
+    #[arg(long, default_value_t = 1.3)]
+    pub calibration_min_spread: f64,
+    /// Draw the evaluation as PNG charts into this folder (measured against true distance,
+    /// error histograms, found rates per distance band, post errors).
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -84,6 +93,8 @@ pub struct EvalOutput {
     pub differences: Vec<Difference>,
     /// Fitted goal distance relation (multiplier cm·px, offset cm), if asked for.
     pub goal_calibration: Option<(f64, f64)>,
+    /// Charts written by `--plots` (and the calibration plot is beside the calibration file).
+    pub plots: Vec<PathBuf>,
     /// Frames skipped, with the reason.
     pub skipped: Vec<String>,
 }
@@ -234,18 +245,63 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         bail!("no frame with robot-camera ground truth in the given streams");
     }
     let goal_calibration = if let Some(out) = &args.calibrate_goals {
-        let Some((m, o)) = fit_inverse_size(&goal_samples) else {
-            bail!("too few uncut goals ({}) to calibrate", goal_samples.len());
+        let (lo_h, hi_h) = goal_samples
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
+                (a.min(s.0), b.max(s.0))
+            });
+        // Heights within a narrow band (one distance) cannot separate multiplier and offset:
+        // then only the multiplier is fitted and the offset kept.
+        let (m, o) = if hi_h >= args.calibration_min_spread * lo_h {
+            let Some((m, o)) = fit_inverse_size(&goal_samples) else {
+                bail!("too few uncut goals ({}) to calibrate", goal_samples.len());
+            };
+            (m, o)
+        } else {
+            let o = rp.goals.distance_offset_cm;
+            let Some(m) = fit_inverse_size_multiplier(&goal_samples, o) else {
+                bail!("no uncut goal to calibrate from");
+            };
+            eprintln!(
+                "goal heights span only {lo_h:.1}–{hi_h:.1} px: fitting the multiplier only, \
+                 offset kept at {o:.1} cm"
+            );
+            (m, o)
         };
+        if !(m > 0.0 && m.is_finite() && o.is_finite()) {
+            let (lo, hi) = goal_samples
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
+                    (a.min(s.1), b.max(s.1))
+                });
+            bail!(
+                "goal calibration gives distance = {m:.1} / height + {o:.1} cm from {} goals \
+                 {lo:.0}–{hi:.0} cm away: not a size → distance relation; give streams with \
+                 goals over a wider range of distances",
+                goal_samples.len()
+            );
+        }
         let mut p = rp;
         p.goals.distance_multiplier = m;
         p.goals.distance_offset_cm = o;
         let json = serde_json::to_vec_pretty(&p)?;
         crate::atomic_file::write_atomic(out, &json)
             .with_context(|| format!("{}: cannot write", out.display()))?;
+        let plot = out.with_extension("png");
+        crate::eval::plots::write_calibration_plot(
+            &plot,
+            &goal_samples,
+            (m, o),
+            (rp.goals.distance_multiplier, rp.goals.distance_offset_cm),
+        )
+        .context("calibration plot")?;
         Some((m, o))
     } else {
         None
+    };
+    let plots = match &args.plots {
+        Some(dir) => crate::eval::plots::write_eval_plots(dir, &frames_a).context("plots")?,
+        None => Vec::new(),
     };
     let output = EvalOutput {
         report: EvalReport::from_frames(&frames_a),
@@ -257,6 +313,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         compare: other.is_some().then(|| EvalReport::from_frames(&frames_b)),
         differences,
         goal_calibration,
+        plots,
         skipped,
     };
     if args.json {
@@ -326,6 +383,12 @@ fn print_summary(o: &EvalOutput) {
     if !r.ball_false_frames.is_empty() {
         println!("false ball in frames   {:?}", r.ball_false_frames);
     }
+    if !r.goal_misses.is_empty() {
+        println!("goal missed in frames  {:?}", r.goal_misses);
+    }
+    if !r.goal_false_frames.is_empty() {
+        println!("false goal in frames   {:?}", r.goal_false_frames);
+    }
     if let Some(c) = &o.compare {
         println!(
             "compared: ball {}/{}, false {}, goals {}/{}; {} frame(s) differ",
@@ -342,6 +405,9 @@ fn print_summary(o: &EvalOutput) {
     }
     if let Some((m, off)) = o.goal_calibration {
         println!("goal distance          = {m:.1} / height_px + {off:.1} cm (written)");
+    }
+    if !o.plots.is_empty() {
+        println!("plots                  {} written", o.plots.len());
     }
     if !o.skipped.is_empty() {
         println!(

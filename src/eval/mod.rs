@@ -4,6 +4,8 @@
 //! Pure functions on [`Recognition`] and the renderer's [`RobotViewTruth`]; `eotn eval` reads
 //! streams and runs the pipeline, this module only compares.
 
+pub mod plots;
+
 use serde::{Deserialize, Serialize};
 
 use crate::lut::ColourClass;
@@ -24,7 +26,8 @@ pub struct EvalParams {
     pub ball_match_radius_fraction: f64,
     /// Smallest matching tolerance, pixels.
     pub ball_match_min_px: f64,
-    /// A goal must be found when at least this fraction of its mouth is inside the image.
+    /// A goal must be found when at least this fraction of its mouth (the area between the
+    /// posts, feet to tops) is inside the image.
     pub goal_min_mouth_fraction: f64,
     /// ... and it shows at least this many pixels.
     pub goal_min_pixels: usize,
@@ -79,6 +82,28 @@ pub struct FrameEval {
     pub gap_errors_px: Vec<f64>,
     /// Relative distance errors of found goals with uncut top and bottom.
     pub goal_distance_errors: Vec<f64>,
+    /// True camera distance of the ball when it had to be found, centimetres (for rates per
+    /// distance band).
+    pub ball_true_distance_cm: Option<f64>,
+    /// True and reported camera distance of a correct ball, centimetres.
+    pub ball_distances_cm: Option<(f64, f64)>,
+    /// Each goal that had to be found: its true camera distance (cm) and whether it was.
+    pub goal_detections: Vec<(f64, bool)>,
+    /// Found goals with uncut top and bottom: true and reported distance and the height used.
+    pub goal_distances_cm: Vec<GoalDistance>,
+}
+
+/// A found goal's distance against the truth (the data of plots and calibration).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct GoalDistance {
+    /// True camera distance of the goal mouth's centre, centimetres.
+    pub true_cm: f64,
+    /// Reported camera distance, centimetres.
+    pub measured_cm: f64,
+    /// Height the distance came from, pixels.
+    pub height_px: f64,
+    /// The sky-blue goal (else the yellow one).
+    pub sky_blue: bool,
 }
 
 /// The class code of a goal colour.
@@ -88,6 +113,35 @@ pub fn goal_class(c: GoalColour) -> ColourClass {
         GoalColour::Yellow => ColourClass::Yellow,
         GoalColour::SkyBlue => ColourClass::SkyBlue,
     }
+}
+
+/// Share of a goal's mouth — the quadrilateral between the two posts' feet and tops — that lies
+/// inside the image (sampled on a 21 × 21 grid); 0 when a post does not project.
+#[must_use]
+pub fn mouth_fraction_in_image(g: &crate::sim::truth::GoalTruth, width: f64, height: f64) -> f64 {
+    let [a, b] = &g.posts;
+    let (Some(lb), Some(lt), Some(rb), Some(rt)) =
+        (a.image_base, a.image_top, b.image_base, b.image_top)
+    else {
+        return 0.0;
+    };
+    let n = 20;
+    let mut inside = 0usize;
+    for i in 0..=n {
+        let u = f64::from(i) / f64::from(n);
+        for j in 0..=n {
+            let v = f64::from(j) / f64::from(n);
+            let lerp = |p: f64, q: f64, r: f64, s: f64| {
+                (1.0 - v) * ((1.0 - u) * p + u * q) + v * ((1.0 - u) * r + u * s)
+            };
+            let x = lerp(lt.x_px, rt.x_px, lb.x_px, rb.x_px);
+            let y = lerp(lt.y_px, rt.y_px, lb.y_px, rb.y_px);
+            if x >= 0.0 && y >= 0.0 && x < width && y < height {
+                inside += 1;
+            }
+        }
+    }
+    inside as f64 / f64::from((n + 1) * (n + 1))
 }
 
 /// Compares one frame's recognition with its truth.
@@ -112,6 +166,9 @@ pub fn evaluate_frame(
         e.ball_eligible = tb.visible_fraction >= p.ball_min_visible_fraction
             && 2.0 * radius >= p.ball_min_diameter_px;
         e.ball_cut = tb.cut_off.left || tb.cut_off.right || tb.cut_off.top || tb.cut_off.bottom;
+        if e.ball_eligible {
+            e.ball_true_distance_cm = Some(tb.relative.camera_distance_cm);
+        }
         if let (Some(b), Some(img)) = (reported, tb.relative.image) {
             // A ball cut by the image edge is matched within its radius, an uncut one within
             // half of it; anything within two radii is at least the ball (not a false one).
@@ -127,6 +184,7 @@ pub fn evaluate_frame(
             if e.ball_correct {
                 let d = tb.relative.camera_distance_cm;
                 e.ball_distance_error = Some((b.camera.distance_cm - d).abs() / d);
+                e.ball_distances_cm = Some((d, b.camera.distance_cm));
                 e.ball_bearing_error_rad =
                     Some((b.camera.bearing_rad - tb.relative.camera_bearing_rad).abs());
             }
@@ -139,22 +197,13 @@ pub fn evaluate_frame(
 
     for tg in &t.goals {
         let class = goal_class(tg.colour);
-        let mouth = match (tg.posts[0].image_base, tg.posts[1].image_base) {
-            (Some(a), Some(b)) => {
-                let (l, rr) = (a.x_px.min(b.x_px), a.x_px.max(b.x_px));
-                let inside = (rr.min(width) - l.max(0.0)).max(0.0);
-                if rr - l > 1e-9 {
-                    inside / (rr - l)
-                } else {
-                    0.0
-                }
-            }
-            _ => 0.0,
-        };
+        let mouth = mouth_fraction_in_image(tg, width, height);
         let eligible = mouth >= p.goal_min_mouth_fraction && tg.visible_pixels >= p.goal_min_pixels;
         let found = r.goals.goals().find(|g| g.colour == class);
         if eligible {
             e.goals_eligible += 1;
+            e.goal_detections
+                .push((tg.relative.camera_distance_cm, found.is_some()));
         }
         let Some(g) = found else { continue };
         if eligible {
@@ -164,6 +213,12 @@ pub fn evaluate_frame(
             let d = tg.relative.camera_distance_cm;
             e.goal_distance_errors
                 .push((g.camera.distance_cm - d).abs() / d);
+            e.goal_distances_cm.push(GoalDistance {
+                true_cm: d,
+                measured_cm: g.camera.distance_cm,
+                height_px: g.height_px,
+                sky_blue: class == ColourClass::SkyBlue,
+            });
         }
         for post in &g.posts {
             // The true post nearest this one at the foot row.
@@ -177,11 +232,14 @@ pub fn evaluate_frame(
                     })
                 })
                 .map(|(base, top)| {
+                    // The truth projects at the reference row's time: compare the post moved
+                    // there (the line through its skew-corrected ends).
+                    let (a, b) = (post.reference_top, post.reference_bottom);
                     let at = |y: f64| {
-                        if post.fit.steep {
-                            post.fit.at(y).0
+                        if (b.1 - a.1).abs() > 1e-9 {
+                            a.0 + (b.0 - a.0) * (y - a.1) / (b.1 - a.1)
                         } else {
-                            post.top.0
+                            a.0
                         }
                     };
                     (at(base.y_px) - base.x_px)
@@ -296,6 +354,9 @@ pub struct EvalReport {
     pub ball_false_frames: Vec<usize>,
     /// Frames where an eligible goal was missed.
     pub goal_misses: Vec<usize>,
+    /// Frames with a goal reported that is not in view (a yellow or sky-blue thing taken for
+    /// a goal).
+    pub goal_false_frames: Vec<usize>,
 }
 
 impl EvalReport {
@@ -332,6 +393,9 @@ impl EvalReport {
                 r.goal_misses.push(f.frame);
             }
             r.goals_false += f.goals_false;
+            if f.goals_false > 0 {
+                r.goal_false_frames.push(f.frame);
+            }
             gd.extend(&f.goal_distance_errors);
             posts.extend(&f.post_errors_px);
             gaps.extend(&f.gap_errors_px);
@@ -377,6 +441,20 @@ pub fn fit_inverse_size(samples: &[(f64, f64)]) -> Option<(f64, f64)> {
     })
 }
 
+/// Fits only the multiplier of distance = multiplier / height + `offset` (the offset kept), by
+/// least squares; for samples whose heights span too little to separate the two. `None`
+/// without a usable sample.
+#[must_use]
+pub fn fit_inverse_size_multiplier(samples: &[(f64, f64)], offset: f64) -> Option<f64> {
+    let (sxy, sxx) = samples
+        .iter()
+        .filter(|(h, d)| *h > 0.0 && h.is_finite() && d.is_finite())
+        .fold((0.0, 0.0), |(a, b), (h, d)| {
+            (a + (d - offset) / h, b + 1.0 / (h * h))
+        });
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -399,6 +477,9 @@ mod tests {
         let (m, o) = fit_inverse_size(&samples).expect("fit");
         assert!((m - 5757.0).abs() < 1e-6 && (o - 12.0).abs() < 1e-6);
         assert!(fit_inverse_size(&[(10.0, 5.0)]).is_none());
+        let m = fit_inverse_size_multiplier(&samples, 12.0).expect("fit");
+        assert!((m - 5757.0).abs() < 1e-6);
+        assert!(fit_inverse_size_multiplier(&[(0.0, 5.0)], 0.0).is_none());
     }
 
     #[test]

@@ -486,6 +486,9 @@ fn stream_steps_plays_and_plots_sensors() {
     st.run(Command::Seek(0));
     st.run(Command::SetSpeed(1.0));
     st.run(Command::SetPlaying(true));
+    // The window sleeps until the next frame is due (40 ms at 25 fps) instead of spinning.
+    let due = st.next_frame_due().expect("playing");
+    assert!((due.as_secs_f64() - 0.04).abs() < 1e-6, "{due:?}");
     st.tick(std::time::Duration::from_millis(200));
     assert_eq!(st.index(), 5);
     st.run(Command::SetSpeed(4.0));
@@ -493,4 +496,282 @@ fn stream_steps_plays_and_plots_sensors() {
     assert_eq!(st.index(), 19);
     assert!(!st.playing(), "stops at the end");
     h.run();
+}
+
+/// A file of the repository (sample streams and tables).
+fn repo_file(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// Circles drawn in the last frame with their stroke widths and alphas.
+fn drawn_circles(h: &Harness<'_, EotnApp>) -> Vec<(f32, u8)> {
+    h.output()
+        .shapes
+        .iter()
+        .filter_map(|c| match &c.shape {
+            egui::Shape::Circle(s) if s.fill == egui::Color32::TRANSPARENT => {
+                Some((s.stroke.width, s.stroke.color.a()))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn recognition_overlays_and_inspector_on_a_sim_stream() {
+    let stream = repo_file("streams/sim-walk-and-pan.mcap");
+    let table = repo_file("lookup_tables/sim.lut");
+    let mut h = harness(vec![stream, table]);
+    h.run();
+    let s = state(&h);
+    assert_eq!(s.index(), 0);
+    assert!(
+        s.current().unwrap().sensors.is_some(),
+        "the stream carries joints"
+    );
+    let ball = s
+        .recognition()
+        .ball
+        .ball
+        .clone()
+        .expect("frame 0 shows the ball");
+    let ball_owner = format!("ball#{}", ball.candidate);
+    assert!(s.accepted_owners().contains(&ball_owner));
+    let prims = s.primitives();
+    assert!(
+        prims
+            .iter()
+            .any(|p| matches!(p, eotn::recognition::Primitive::Circle { .. })),
+        "a circle fit"
+    );
+    assert!(
+        prims.iter().any(
+            |p| matches!(p, eotn::recognition::Primitive::Label { text, .. } if text.contains("cm"))
+        ),
+        "a label with the distance"
+    );
+    // The ball's circle is on screen, in every view that shows recognition (main + objects
+    // thumbnail).
+    assert!(!drawn_circles(&h).is_empty());
+
+    // View > Overlays > Circle fits switches the circles off everywhere but the objects view.
+    h.get_by_label("View").click();
+    h.run();
+    h.get_by_label("Overlays").click();
+    h.run();
+    h.get_by_label("Circle fits").click();
+    h.run();
+    assert!(!state(&h).settings.overlays.circles);
+    h.key_press(Key::Escape);
+    h.state_mut().state.run(Command::SetMainView(ViewKind::Raw));
+    h.run();
+    let with_objects_thumb = drawn_circles(&h).len();
+    let mut o = state(&h).settings.overlays;
+    o.set_recognition(false);
+    h.state_mut().state.run(Command::SetOverlays(o));
+    h.run();
+    assert_eq!(
+        drawn_circles(&h).len(),
+        with_objects_thumb,
+        "only the objects thumbnail still draws the ball's circle"
+    );
+    o.set_recognition(true);
+    h.state_mut().state.run(Command::SetOverlays(o));
+    h.run();
+    let all_circles = drawn_circles(&h);
+    assert!(all_circles.len() > with_objects_thumb);
+    assert!(all_circles.iter().all(|&(w, a)| w == 1.5 && a == 255));
+
+    // The inspector lists every candidate; selecting the ball shows its breakdown and
+    // highlights its overlays.
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Inspector, true));
+    h.run();
+    let n = eotn::app::inspector::candidates(state(&h).recognition()).len();
+    assert!(n >= 2, "ball and goal candidates, got {n}");
+    assert_eq!(
+        h.query_all_by_label_contains("accepted ").count()
+            + h.query_all_by_label_contains("rejected ").count(),
+        n,
+        "one row per candidate"
+    );
+    h.get_by_label_contains(&format!("accepted {ball_owner}"))
+        .click();
+    h.run();
+    assert_eq!(state(&h).selected_object(), Some(ball_owner.as_str()));
+    assert!(
+        h.query_all_by_label("pixel_ratio").count() == 1,
+        "{:#?}",
+        h.root()
+    );
+    assert!(h.query_all_by_label("passed").count() >= 1);
+    assert!(h.query_all_by_label_contains("bearing").count() >= 1);
+    let circles = drawn_circles(&h);
+    assert!(
+        circles.iter().any(|&(w, _)| w == 3.0),
+        "selected: thicker {circles:?}"
+    );
+    // Selecting another candidate dims the ball.
+    let goal = eotn::app::inspector::candidates(state(&h).recognition())
+        .into_iter()
+        .map(|c| c.owner)
+        .find(|o| *o != ball_owner)
+        .expect("another candidate in frame 0");
+    h.state_mut()
+        .state
+        .run(Command::SelectObject(Some(goal.clone())));
+    h.run();
+    let circles = drawn_circles(&h);
+    assert!(
+        circles.iter().all(|&(w, a)| w == 1.5 && a < 255),
+        "{circles:?}"
+    );
+    // An unknown owner is refused; stepping to a frame without it clears the selection.
+    let mut st = AppState::default();
+    assert!(
+        st.apply(Command::SelectObject(Some("ball#9".into())))
+            .is_err()
+    );
+    h.state_mut().state.run(Command::Seek(14));
+    let s = state(&h);
+    if !s.primitives().iter().any(|p| p.owner() == goal) {
+        assert_eq!(s.selected_object(), None);
+    }
+    // Export draws the same primitives.
+    let (w, hgt, rgb) = state(&h).compose_view_rgb(ViewKind::Objects).unwrap();
+    assert_eq!(rgb.len(), w * hgt * 3);
+}
+
+#[test]
+fn nan_sensor_readings_of_a_side_file_show_as_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    std::fs::write(
+        dir.path().join("f1.sensors.json"),
+        r#"{"head_pan_rad": NaN, "head_tilt_rad": -0.3, "neck_tilt_rad": 0.0, "ir_far_cm": Infinity}"#,
+    )
+    .unwrap();
+    let mut paths = frames;
+    paths.push(table);
+    let mut h = harness(paths);
+    h.run();
+    assert!(state(&h).warnings().is_empty());
+    assert!(h.query_by_label_contains("this frame:").is_none());
+    h.key_press(Key::ArrowRight);
+    h.run();
+    let s = state(&h);
+    assert_eq!(s.index(), 1);
+    let c = s.current().unwrap();
+    let r = c.sensors.unwrap();
+    assert_eq!((r.head_pan_rad, r.head_tilt_rad), (None, Some(-0.3)));
+    assert_eq!(r.ir_far_cm, None);
+    let w = s.warnings().last().expect("a warning").clone();
+    assert!(
+        w.contains("f1.sensors.json") && w.contains("head_pan_rad") && w.contains("ir_far_cm"),
+        "{w}"
+    );
+    assert!(h.query_by_label_contains("this frame:").is_some());
+    assert!(h.query_by_label("1 warnings").is_some());
+    // The next frame has no problems: the frame line goes, the list keeps the warning.
+    h.key_press(Key::ArrowRight);
+    h.run();
+    assert!(h.query_by_label_contains("this frame:").is_none());
+    assert_eq!(state(&h).warnings().len(), 1);
+}
+
+#[test]
+fn snapshot_with_recognition_and_inspector() {
+    let mut s = AppState::default();
+    s.apply(Command::Open(vec![
+        repo_file("streams/sim-walk-and-pan.mcap"),
+        repo_file("lookup_tables/sim.lut"),
+    ]))
+    .unwrap();
+    s.apply(Command::ShowTimings(false)).unwrap();
+    s.apply(Command::ShowWindow(Window::Inspector, true))
+        .unwrap();
+    let ball = s
+        .recognition()
+        .ball
+        .ball
+        .clone()
+        .expect("a ball in frame 0");
+    s.apply(Command::SelectObject(Some(format!(
+        "ball#{}",
+        ball.candidate
+    ))))
+    .unwrap();
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(1280.0, 800.0))
+        .wgpu()
+        .build_eframe(move |_| EotnApp::with_state(s));
+    h.run();
+    h.snapshot("app_recognition");
+}
+
+#[test]
+fn nan_in_a_recorded_stream_shows_as_a_warning_of_its_frame() {
+    use eotn::sensors::SensorReadings;
+    use eotn::streams::{Compression, FrameRecord, StreamInfo, StreamWriter, WriterOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let (_, table) = fixture(dir.path());
+    let path = dir.path().join("nan.mcap");
+    let options = WriterOptions {
+        compression: Compression::None,
+        frames_per_chunk: Some(1),
+    };
+    let mut w = StreamWriter::create_with(&path, &StreamInfo::default(), options).unwrap();
+    for i in 0..3 {
+        let mut r = FrameRecord::new(i as u64 * 40_000_000, scene(i));
+        r.sensors = Some(SensorReadings {
+            head_pan_rad: if i == 1 { None } else { Some(0.1) },
+            ..SensorReadings::default()
+        });
+        w.write(&r).unwrap();
+    }
+    w.finish().unwrap();
+    // What Python's json.dumps writes for a NaN reading, in frame 1's message (same length, so
+    // the uncompressed chunk stays well-formed).
+    let mut bytes = std::fs::read(&path).unwrap();
+    let from = br#""head_pan_rad":null"#;
+    let at = bytes
+        .windows(from.len())
+        .position(|w| w == from)
+        .expect("frame 1 has no head pan");
+    bytes[at..at + from.len()].copy_from_slice(br#""head_pan_rad":NaN "#);
+    // The chunk's CRC no longer matches: 0 means "not computed" in MCAP. Walk the records
+    // (magic, then opcode u8 + length u64 + body) to the chunk holding the edit.
+    let mut pos = 8;
+    loop {
+        let len = u64::from_le_bytes(bytes[pos + 1..pos + 9].try_into().unwrap()) as usize;
+        let body = pos + 9;
+        if (body..body + len).contains(&at) {
+            assert_eq!(bytes[pos], 0x06, "a chunk record");
+            // start time u64, end time u64, uncompressed size u64, then the CRC u32.
+            bytes[body + 24..body + 28].fill(0);
+            break;
+        }
+        pos = body + len;
+    }
+    std::fs::write(&path, &bytes).unwrap();
+
+    let mut h = harness(vec![path, table]);
+    h.run();
+    assert!(h.query_by_label_contains("this frame:").is_none());
+    h.key_press(Key::ArrowRight);
+    h.run();
+    let s = state(&h);
+    let c = s.current().unwrap();
+    assert_eq!(s.index(), 1, "{:?}", s.warnings());
+    assert_eq!(c.sensors.unwrap().head_pan_rad, None, "{:?}", s.warnings());
+    assert!(
+        c.warnings
+            .iter()
+            .any(|w| w.contains("frame 1") && w.contains("NaN")),
+        "{:?}",
+        c.warnings
+    );
+    assert!(s.warnings().iter().any(|w| w.contains("NaN")));
+    assert!(h.query_by_label_contains("this frame:").is_some());
 }

@@ -114,18 +114,43 @@ fn recognition_on_synthetic_scenarios() {
     let goals_eligible = sum(&|r| r.goals_eligible);
     let goals_found = sum(&|r| r.goals_found);
     eprintln!("goals found {goals_found}/{goals_eligible}");
-    assert!(goals_found as f64 >= 0.9 * goals_eligible as f64);
-    let keeper = report(ScenarioKind::Goalkeeper);
+    assert!(goals_eligible > 200, "scenarios must show goals");
+    assert!(goals_found as f64 >= 0.97 * goals_eligible as f64);
+    // The yellow box among the off-field clutter is not a goal (width and ground-at-foot tests).
     assert!(
-        keeper.posts_within_2px.is_some_and(|f| f >= 0.9),
+        clutter.goals_false <= 1,
+        "false goals in clutter frames {:?}",
+        clutter.goal_false_frames
+    );
+    let keeper = report(ScenarioKind::Goalkeeper);
+    let walk = report(ScenarioKind::WalkAndPan);
+    assert!(
+        keeper.posts_within_2px.is_some_and(|f| f >= 0.95),
         "{:?}",
         keeper.post_error_px
     );
     assert!(
-        keeper.gaps_within_3px.is_some_and(|f| f >= 0.9),
+        keeper.gaps_within_3px.is_some_and(|f| f >= 0.95),
         "{:?}",
         keeper.gap_error_px
     );
+    assert!(
+        walk.posts_within_2px.is_some_and(|f| f >= 0.7),
+        "{:?}",
+        walk.post_error_px
+    );
+    assert!(
+        walk.gaps_within_3px.is_some_and(|f| f >= 0.9),
+        "{:?}",
+        walk.gap_error_px
+    );
+    for r in [keeper, walk] {
+        assert!(
+            r.goal_distance_error.n >= 30 && r.goal_distance_error.p50 <= 0.05,
+            "{:?}",
+            r.goal_distance_error
+        );
+    }
 
     // Skew correction on the fast pans: the radius error with it against without it.
     let mut off = params;
@@ -295,9 +320,38 @@ fn debug_scenario() {
         if detail.contains(&i) {
             print_ball_detail(&r);
         }
-        for g in r.recognition.goals.candidates.iter().filter(|g| g.accepted) {
+        let fe = evaluate_frame(
+            i as usize,
+            r.recognition,
+            truth,
+            208.0,
+            160.0,
+            &EvalParams::default(),
+        );
+        eprintln!(
+            "    eval goals {}/{} false {} posts {:?} gaps {:?} dist {:?}",
+            fe.goals_found,
+            fe.goals_eligible,
+            fe.goals_false,
+            fe.post_errors_px
+                .iter()
+                .map(|e| (e * 10.0).round() / 10.0)
+                .collect::<Vec<_>>(),
+            fe.gap_errors_px
+                .iter()
+                .map(|e| (e * 10.0).round() / 10.0)
+                .collect::<Vec<_>>(),
+            fe.goal_distances_cm
+                .iter()
+                .map(|g| (g.true_cm.round(), g.measured_cm.round(), g.height_px))
+                .collect::<Vec<_>>(),
+        );
+        for g in &r.recognition.goals.candidates {
             eprintln!(
-                "    tests {:?}",
+                "    {} cut {:?} h {:.1} tests {:?}",
+                if g.accepted { "ACCEPTED" } else { "rejected" },
+                g.cut_off,
+                g.height_px,
                 g.confidence
                     .tests
                     .iter()
@@ -309,20 +363,25 @@ fn debug_scenario() {
                 .iter()
                 .find(|t| eotn::eval::goal_class(t.colour) == g.colour);
             eprintln!(
-                "    goal {:?} {:?} d {:.0} (truth {:?}) posts {:?} truth posts {:?}",
+                "    goal {:?} {:?} gap {:?} d {:.0} (truth {:?}) posts {:?} truth posts {:?}",
                 g.colour,
                 g.bounds,
+                g.gap
+                    .as_ref()
+                    .map(|g| (g.left.0.round(), g.right.0.round())),
                 g.camera.distance_cm,
                 t.map(|t| (t.relative.camera_distance_cm.round(), t.visible_pixels)),
                 g.posts
                     .iter()
-                    .map(|p| (p.top, p.bottom))
+                    .map(|p| (p.side, p.reference_top, p.reference_bottom))
                     .collect::<Vec<_>>(),
-                t.map(|t| t
-                    .posts
-                    .iter()
-                    .map(|p| (p.image_top, p.image_base))
-                    .collect::<Vec<_>>())
+                t.map(|t| (
+                    t.largest_gap.map(|g| (g.from_x_px, g.to_x_px + 1)),
+                    t.posts
+                        .iter()
+                        .map(|p| (p.image_top, p.image_base))
+                        .collect::<Vec<_>>()
+                ))
             );
         }
     }
@@ -457,17 +516,22 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     let png = image::open(render_dir.join("goalkeeper_000000.png")).unwrap();
     assert_eq!((png.width(), png.height()), (208 * 3, 160 * 3));
 
-    // Evaluation and calibration on a robot walking towards the goal (distances vary).
+    // Evaluation and calibration on a robot walking towards the goal (about 4 m away) and the
+    // goalkeeper frames (1.6 m): a size → distance fit needs a spread of distances.
     let (walk, _) = write_scenario(dir.path(), ScenarioKind::WalkAndPan, 60);
     let calibrated = dir.path().join("calibrated.json");
+    let plots = dir.path().join("plots");
     let out = super::common::eotn(&[
         "eval".as_ref(),
         walk.as_os_str(),
+        stream.as_os_str(),
         "--lut".as_ref(),
         lut.as_os_str(),
         "--json".as_ref(),
         "--calibrate-goals".as_ref(),
         calibrated.as_os_str(),
+        "--plots".as_ref(),
+        plots.as_os_str(),
     ]);
     assert!(
         out.status.success(),
@@ -475,7 +539,7 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
         String::from_utf8_lossy(&out.stderr)
     );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(report["report"]["frames"], 60);
+    assert_eq!(report["report"]["frames"], 72);
     assert!(
         report["report"]["ball_found"]
             .as_u64()
@@ -493,6 +557,48 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     assert_eq!(
         params["goals"]["distance_multiplier"], fitted[0],
         "the written parameters hold the fit"
+    );
+
+    // The charts: every one a 720×480 PNG; the distance charts show their data points in the
+    // series colours, the calibration plot its samples and the fitted curve.
+    let count = |img: &image::RgbImage, c: [u8; 3]| img.pixels().filter(|p| p.0 == c).count();
+    for name in [
+        "ball_distance.png",
+        "goal_distance.png",
+        "ball_distance_error.png",
+        "goal_distance_error.png",
+        "ball_detection.png",
+        "goal_detection.png",
+        "post_error.png",
+    ] {
+        let img = image::open(plots.join(name)).unwrap().to_rgb8();
+        assert_eq!((img.width(), img.height()), (720, 480), "{name}");
+        let dark = img.pixels().filter(|p| p.0.iter().all(|v| *v < 60)).count();
+        assert!(
+            dark > 500,
+            "{name}: axes and text drawn ({dark} dark pixels)"
+        );
+    }
+    let ball = image::open(plots.join("ball_distance.png"))
+        .unwrap()
+        .to_rgb8();
+    assert!(
+        count(&ball, [235, 120, 20]) >= 25 * 5,
+        "ball points and legend"
+    );
+    let goal = image::open(plots.join("goal_distance.png"))
+        .unwrap()
+        .to_rgb8();
+    assert!(count(&goal, [210, 170, 0]) >= 25 * 3, "yellow goal points");
+    let calibration = image::open(calibrated.with_extension("png"))
+        .unwrap()
+        .to_rgb8();
+    assert!(count(&calibration, [30, 140, 220]) >= 25 * 3, "samples");
+    assert!(count(&calibration, [200, 30, 30]) >= 100, "fitted curve");
+    assert_eq!(
+        report["plots"].as_array().map(Vec::len),
+        Some(7),
+        "{report}"
     );
 
     // A frame without truth is refused clearly, not a panic.

@@ -1,0 +1,316 @@
+//! The object inspector: every recognition candidate of the shown frame, accepted or rejected,
+//! in a list; the selected one's confidence breakdown (test, measured value, range, effect,
+//! outcome), why it was accepted or rejected, where it is (distance, bearing, elevation) and its
+//! flags. Selecting a candidate highlights its overlays in every view and dims the others.
+//!
+//! [`candidates`] turns a [`Recognition`] into plain rows (tested without a window);
+//! [`inspector_window`] draws them.
+
+use egui::{Color32, Context, RichText, Ui};
+
+use super::state::{AppState, Command, Window};
+use crate::recognition::confidence::{Confidence, TestOutcome};
+use crate::recognition::scan::CutOff;
+use crate::recognition::{Recognition, Relative};
+
+/// One candidate as the inspector lists it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CandidateInfo {
+    /// The owner its primitives carry (`"ball#0"`, `"goal:yellow#1"`, `"beacon#0"`).
+    pub owner: String,
+    /// What it would be: `"ball"`, `"yellow goal"`, `"beacon pink over yellow"`.
+    pub kind: String,
+    /// Accepted as an object.
+    pub accepted: bool,
+    /// The confidence with every test.
+    pub confidence: Confidence,
+    /// Why it was accepted or rejected, in words.
+    pub reason: String,
+    /// Camera-relative distance (cm), bearing and elevation (radians).
+    pub camera: Relative,
+    /// Body-relative placement, when the joints were known.
+    pub body: Option<Relative>,
+    /// The distance is only an upper bound (the object is cut off at top or bottom).
+    pub distance_is_max: bool,
+    /// Sides cut off by the image edge: `left`, `right`, `top`, `bottom`.
+    pub cut_sides: Vec<&'static str>,
+    /// Further evidence: circle fit refused, posts without a line, pixel counts.
+    pub notes: Vec<String>,
+}
+
+fn sides(cut: CutOff) -> Vec<&'static str> {
+    [
+        (cut.left, "left"),
+        (cut.right, "right"),
+        (cut.top, "top"),
+        (cut.bottom, "bottom"),
+    ]
+    .into_iter()
+    .filter_map(|(on, name)| on.then_some(name))
+    .collect()
+}
+
+/// Why a candidate ended as it did, from its confidence and whether it was accepted.
+fn reason(c: &Confidence, accepted: bool) -> String {
+    let failed: Vec<&str> = c
+        .tests
+        .iter()
+        .filter(|t| t.outcome == TestOutcome::Failed)
+        .map(|t| t.test.as_str())
+        .collect();
+    let failed = if failed.is_empty() {
+        "no test failed".to_owned()
+    } else {
+        format!("failed: {}", failed.join(", "))
+    };
+    if accepted {
+        format!("accepted: confidence {:+.2} > 0; {failed}", c.total)
+    } else if c.total > 0.0 {
+        format!(
+            "rejected although confidence {:+.2} > 0: another candidate won; {failed}",
+            c.total
+        )
+    } else {
+        format!("rejected: confidence {:+.2} ≤ 0; {failed}", c.total)
+    }
+}
+
+/// Every candidate of `r`: balls, goals, beacons, in that order.
+#[must_use]
+pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
+    let mut out = Vec::new();
+    for (i, c) in r.ball.candidates.iter().enumerate() {
+        let mut notes = vec![format!(
+            "{} pixels, {} orange; radius {:.1} px",
+            c.pixels, c.orange_pixels, c.radius_px
+        )];
+        match (&c.fit, &c.fit_rejected) {
+            (Some(_), _) => {
+                notes.push(format!("circle fit on {} edge points", c.edge_points.len()))
+            }
+            (None, Some(why)) => notes.push(format!("no circle fit: {why}")),
+            (None, None) => {}
+        }
+        // The accepted ball may carry a fused (ground-plane) placement.
+        let (camera, body) = match &r.ball.ball {
+            Some(b) if b.candidate == i => (b.camera, b.body),
+            _ => (c.camera, None),
+        };
+        out.push(CandidateInfo {
+            owner: format!("ball#{i}"),
+            kind: "ball".to_owned(),
+            accepted: c.accepted,
+            reason: reason(&c.confidence, c.accepted),
+            confidence: c.confidence.clone(),
+            camera,
+            body,
+            distance_is_max: false,
+            cut_sides: sides(c.cut_off),
+            notes,
+        });
+    }
+    for (i, g) in r.goals.candidates.iter().enumerate() {
+        let mut notes = vec![format!(
+            "{} pixels in {} blobs; height {:.1} px{}",
+            g.pixels,
+            g.blobs.len(),
+            g.height_px,
+            if g.distance_from_ir {
+                "; distance from the IR sensor"
+            } else {
+                ""
+            }
+        )];
+        notes.push(format!(
+            "{} posts fitted{}",
+            g.posts.len(),
+            g.gap
+                .as_ref()
+                .map(|gap| format!("; gap {:.0} px wide", gap.width_px))
+                .unwrap_or_default()
+        ));
+        notes.extend(
+            g.rejected_posts
+                .iter()
+                .map(|p| format!("post refused: {p}")),
+        );
+        out.push(CandidateInfo {
+            owner: format!("goal:{}#{i}", g.colour.name()),
+            kind: format!("{} goal", g.colour.name()),
+            accepted: g.accepted,
+            reason: reason(&g.confidence, g.accepted),
+            confidence: g.confidence.clone(),
+            camera: g.camera,
+            body: g.body,
+            distance_is_max: g.distance_is_max,
+            cut_sides: sides(g.cut_off),
+            notes,
+        });
+    }
+    for (i, b) in r.beacons.iter().enumerate() {
+        out.push(CandidateInfo {
+            owner: format!("beacon#{i}"),
+            kind: format!("beacon {}", b.kind.name()),
+            accepted: b.accepted,
+            reason: reason(&b.confidence, b.accepted),
+            confidence: b.confidence.clone(),
+            camera: b.camera,
+            body: b.body,
+            distance_is_max: b.cut_off,
+            cut_sides: if b.cut_off {
+                vec!["top or bottom"]
+            } else {
+                vec![]
+            },
+            notes: Vec::new(),
+        });
+    }
+    out
+}
+
+/// Width of the candidate list, points.
+const LIST_WIDTH: f32 = 230.0;
+
+/// Green for accepted, red for rejected.
+fn verdict_colour(accepted: bool) -> Color32 {
+    if accepted {
+        Color32::from_rgb(90, 200, 90)
+    } else {
+        Color32::from_rgb(230, 90, 80)
+    }
+}
+
+/// Shows the inspector while it is open; selecting pushes [`Command::SelectObject`].
+pub fn inspector_window(ctx: &Context, state: &AppState, commands: &mut Vec<Command>) {
+    if !state.window_open(Window::Inspector) {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new(Window::Inspector.name())
+        .open(&mut open)
+        .default_width(600.0)
+        // Low and to the right: the interesting part of a robot's image is usually its middle.
+        .default_pos([640.0, 330.0])
+        .show(ctx, |ui| inspector_ui(ui, state, commands));
+    if !open {
+        commands.push(Command::ShowWindow(Window::Inspector, false));
+    }
+}
+
+fn inspector_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+    if state.frame().is_none() {
+        ui.label("No frame open.");
+        return;
+    }
+    let list = candidates(state.recognition());
+    if list.is_empty() {
+        ui.label("No candidates in this frame: no ball, goal or beacon colour large enough.");
+        return;
+    }
+    let selected = state.selected_object();
+    ui.horizontal(|ui| {
+        let accepted = list.iter().filter(|c| c.accepted).count();
+        ui.label(format!("{} candidates, {accepted} accepted", list.len()));
+        if selected.is_some() && ui.button("Show all alike").clicked() {
+            commands.push(Command::SelectObject(None));
+        }
+    });
+    ui.separator();
+    ui.horizontal_top(|ui| {
+        ui.vertical(|ui| {
+            ui.set_width(LIST_WIDTH);
+            egui::ScrollArea::vertical()
+                .id_salt("inspector_list")
+                .max_height(360.0)
+                .show(ui, |ui| {
+                    for c in &list {
+                        let is_sel = selected == Some(c.owner.as_str());
+                        let text = RichText::new(format!(
+                            "{} {}  {:+.2}",
+                            if c.accepted { "accepted" } else { "rejected" },
+                            c.owner,
+                            c.confidence.total
+                        ))
+                        .color(verdict_colour(c.accepted));
+                        let r = ui.selectable_label(is_sel, text).on_hover_text(&c.kind);
+                        if r.clicked() {
+                            commands
+                                .push(Command::SelectObject((!is_sel).then(|| c.owner.clone())));
+                        }
+                    }
+                });
+        });
+        ui.add_space(8.0);
+        ui.vertical(
+            |ui| match list.iter().find(|c| Some(c.owner.as_str()) == selected) {
+                None => {
+                    ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
+                }
+                Some(c) => details_ui(ui, c),
+            },
+        );
+    });
+}
+
+fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
+    ui.heading(format!("{} ({})", c.kind, c.owner));
+    ui.colored_label(verdict_colour(c.accepted), &c.reason);
+    let deg = f64::to_degrees;
+    ui.label(format!(
+        "camera: {}{:.0} cm, bearing {:+.1}°, elevation {:+.1}°",
+        if c.distance_is_max { "≤ " } else { "" },
+        c.camera.distance_cm,
+        deg(c.camera.bearing_rad),
+        deg(c.camera.elevation_rad)
+    ));
+    if let Some(b) = &c.body {
+        ui.label(format!(
+            "body: {:.0} cm, bearing {:+.1}°, elevation {:+.1}°",
+            b.distance_cm,
+            deg(b.bearing_rad),
+            deg(b.elevation_rad)
+        ));
+    }
+    let mut flags = Vec::new();
+    if c.distance_is_max {
+        flags.push("distance is a maximum".to_owned());
+    }
+    if !c.cut_sides.is_empty() {
+        flags.push(format!("cut off: {}", c.cut_sides.join(", ")));
+    }
+    if !flags.is_empty() {
+        ui.label(format!("flags: {}", flags.join("; ")));
+    }
+    for n in &c.notes {
+        ui.weak(n);
+    }
+    ui.separator();
+    egui::Grid::new(("breakdown", &c.owner))
+        .striped(true)
+        .num_columns(5)
+        .show(ui, |ui| {
+            for h in ["test", "value", "range", "effect", "outcome"] {
+                ui.strong(h);
+            }
+            ui.end_row();
+            for t in &c.confidence.tests {
+                ui.monospace(&t.test);
+                ui.monospace(format!("{:.3}", t.value));
+                ui.monospace(format!("{:.3} … {:.3}", t.range[0], t.range[1]));
+                ui.monospace(format!("{:+.2}", t.effect));
+                let (text, colour) = match t.outcome {
+                    TestOutcome::Passed => ("passed", verdict_colour(true)),
+                    TestOutcome::Failed => ("failed", verdict_colour(false)),
+                    TestOutcome::Skipped => ("skipped", Color32::GRAY),
+                };
+                ui.colored_label(colour, text);
+                ui.end_row();
+            }
+            ui.strong("total");
+            ui.label("");
+            ui.label("");
+            ui.monospace(format!("{:+.2}", c.confidence.total));
+            ui.label("");
+            ui.end_row();
+        });
+}
