@@ -132,6 +132,10 @@ fn tick_label(v: f64, step: f64) -> String {
     }
 }
 
+/// Factor on the upper end of charts whose legend sits in a top corner, so that the largest
+/// points are not hidden under it.
+const LEGEND_HEADROOM: f64 = 1.25;
+
 /// A range that holds every value (and `extra`), widened a little; `(0, 1)` when empty.
 fn range_of(values: impl Iterator<Item = f64>, extra: &[f64]) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -324,7 +328,8 @@ fn distance_chart(title: &str, series: &[Series<'_>]) -> Chart {
     let all = || series.iter().flat_map(|s| s.2.iter());
     let x = range_of(all().map(|p| p.0), &[0.0]);
     let y = range_of(all().map(|p| p.1), &[0.0]);
-    let hi = x.1.max(y.1);
+    // Headroom above the data keeps the legend (top corner) off the points.
+    let hi = x.1.max(y.1) * LEGEND_HEADROOM;
     let mut c = Chart::new(
         title,
         "true distance (cm)",
@@ -557,9 +562,11 @@ pub fn write_calibration_plot(
         &title,
         "goal height (px)",
         "true distance (cm)",
-        (0.0, x.1),
-        (0.0, y.1),
+        (0.0, x.1 * LEGEND_HEADROOM),
+        (0.0, y.1 * LEGEND_HEADROOM),
     );
+    let x = (x.0, x.1 * LEGEND_HEADROOM);
+    let y = (y.0, y.1 * LEGEND_HEADROOM);
     let curve = |(m, o): (f64, f64)| -> Vec<(f64, f64)> {
         let lo = (x.1 / 200.0).max(0.5);
         (0..=200)
