@@ -116,6 +116,12 @@ pub struct GoalParams {
     pub gap_hole_px: u32,
     /// Move posts, gap and centre to the reference row's read-out time (rolling shutter).
     pub skew_correction: bool,
+    /// Do that through the body model (the camera pose at each row's read-out time, pan and
+    /// tilt, [`ViewContext::unskew_at`]) when the head's motion is known; when false, or
+    /// without the motion, the linear shear from the pan alone. On walk-and-pan the linear
+    /// shear is up to 4 px wrong at a post near the image top with the head tilted while
+    /// tracking; the body model is within 0.5 px of the renderer's rolling shutter.
+    pub pose_skew_model: bool,
     /// Penalty for a candidate overlapping an accepted beacon (its yellow or sky-blue band).
     pub beacon_overlap_penalty: f64,
 }
@@ -164,6 +170,7 @@ impl Default for GoalParams {
             gap_scan_height_cm: 15.0,
             gap_hole_px: 1,
             skew_correction: true,
+            pose_skew_model: true,
             beacon_overlap_penalty: 10.0,
         }
     }
@@ -582,7 +589,7 @@ fn examine(
         -angle,
     );
     if p.skew_correction {
-        mid = ctx.unskew(mid, false);
+        mid = unskew(ctx, p, mid, distance);
     }
     let camera = ctx.camera_relative(mid, distance);
     let body = ctx.body_relative(mid, distance);
@@ -784,7 +791,10 @@ fn equivalent_height(ctx: &ViewContext, top: Point, bottom: Point) -> Option<f64
 }
 
 /// Scans from outside a level x position inward along a level row until a goal-coloured pixel;
-/// returns the level x of the boundary.
+/// returns the level x where the scan line enters that pixel, pixels. Steps of one pixel find
+/// the pixel; bisection between the last sample outside and the first inside then finds the
+/// crossing of its border to 1/64 pixel. (Returning a whole step's sample instead puts the edge
+/// up to a pixel inward when the horizon is tilted, where samples fall anywhere in a pixel.)
 fn scan_level_row(
     img: &ClassifiedImage,
     is_goal: &impl Fn(u8) -> bool,
@@ -796,16 +806,39 @@ fn scan_level_row(
 ) -> Option<f64> {
     let dir = if to >= from { 1.0 } else { -1.0 };
     let steps = (to - from).abs().ceil() as usize;
+    let goal_at = |x: f64| {
+        let q = rotate_about((x, y), centre, -angle);
+        img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
+            .is_some_and(is_goal)
+    };
     for k in 0..=steps {
         let x = from + dir * k as f64;
-        let q = rotate_about((x, y), centre, -angle);
-        if let Some(code) = img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
-            && is_goal(code)
-        {
-            return Some(if dir > 0.0 { x } else { x + 1.0 });
+        if goal_at(x) {
+            if k == 0 {
+                return Some(x);
+            }
+            let (mut outside, mut inside) = (x - dir, x);
+            for _ in 0..6 {
+                let m = (outside + inside) / 2.0;
+                if goal_at(m) {
+                    inside = m;
+                } else {
+                    outside = m;
+                }
+            }
+            return Some((outside + inside) / 2.0);
         }
     }
     None
+}
+
+/// An image point of a goal `distance_cm` away moved to the reference row's read-out time.
+fn unskew(ctx: &ViewContext, p: &GoalParams, q: Point, distance_cm: f64) -> Point {
+    if p.pose_skew_model {
+        ctx.unskew_at(q, distance_cm, true)
+    } else {
+        ctx.unskew(q, false)
+    }
 }
 
 fn find_posts_and_gap(
@@ -881,7 +914,10 @@ fn find_posts_and_gap(
             image_pts[image_pts.len() - 1]
         };
         let (reference_top, reference_bottom) = if p.skew_correction {
-            (ctx.unskew(top, false), ctx.unskew(bottom, false))
+            (
+                unskew(ctx, p, top, distance),
+                unskew(ctx, p, bottom, distance),
+            )
         } else {
             (top, bottom)
         };
@@ -946,7 +982,10 @@ fn find_posts_and_gap(
         let left = rotate_about((a, y), centre, -angle);
         let right = rotate_about((b, y), centre, -angle);
         let (ref_left, ref_right) = if p.skew_correction {
-            (ctx.unskew(left, false), ctx.unskew(right, false))
+            (
+                unskew(ctx, p, left, distance),
+                unskew(ctx, p, right, distance),
+            )
         } else {
             (left, right)
         };

@@ -6,6 +6,7 @@
 mod app;
 mod cli;
 mod common;
+mod goal_posts;
 mod peer;
 mod real_data;
 mod recognition;

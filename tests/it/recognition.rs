@@ -19,7 +19,7 @@ const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
 ];
 
 /// A table learnt from every 10th frame of each robot scenario with seed 100.
-fn learnt_table() -> LookupTable {
+pub(crate) fn learnt_table() -> LookupTable {
     let mut builder = TableBuilder::new(7).expect("7 bits");
     for kind in ROBOT_SCENARIOS {
         let sim = Simulator::new(Scenario::new(kind, 100));

@@ -1,0 +1,162 @@
+//! Goal posts against the renderer's geometry: where each detected post line lies relative to
+//! the posts' corners as the rolling shutter imaged them (each row with its own camera pose)
+//! and as the reference instant sees them.
+
+use eotn::geometry::{CameraPose, Ers7Dimensions, Point};
+use eotn::pipeline::{Pipeline, PipelineParams};
+use eotn::sim::truth::GroundTruth;
+use eotn::sim::{FRAME_INTERVAL_S, Scenario, ScenarioKind, Simulator};
+
+/// Where a field point appears under the rolling shutter: the row whose own pose images the
+/// point on itself (fixed-point iteration from the reference pose's row).
+fn rolling_image(
+    scenario: &Scenario,
+    t: f64,
+    p: &Point<eotn::geometry::Field>,
+) -> Option<(f64, f64)> {
+    let dims = Ers7Dimensions::ERS7;
+    let camera = eotn::geometry::PinholeCamera::ers7();
+    let pose_at = |tr: f64| {
+        let (r, b, j) = scenario.observer_at(tr)?;
+        Some(CameraPose {
+            camera,
+            field_from_camera: b.field_from_body(&r) * dims.body_from_camera(&j),
+        })
+    };
+    let mut y = 80.0;
+    let mut x = 0.0;
+    for _ in 0..6 {
+        let tr = t + (y / 160.0 - 0.5) * FRAME_INTERVAL_S;
+        let q = pose_at(tr)?.image_from_field(p)?;
+        x = q.x_px;
+        y = q.y_px;
+    }
+    Some((x, y))
+}
+
+/// Per-post detail for one scenario: `EOTN_DEBUG_SCENARIO=walk-and-pan cargo test --test it
+/// debug_posts -- --ignored --nocapture`. For each detected post: signed error (detected − true,
+/// pixels, at mid-height) of the raw line against the rolling-shutter image of the post's front
+/// centre, front outer corner and back outer corner, and of the reference line against the
+/// reference-instant projection of the front centre (what `eotn eval` scores).
+#[test]
+#[ignore = "a debugging aid, not a check"]
+fn debug_posts() {
+    let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "walk-and-pan".into());
+    let kind = ScenarioKind::from_name(&name).expect("scenario name");
+    let lut = super::recognition::learnt_table();
+    let scenario = Scenario::new(kind, 7);
+    let sim = Simulator::new(scenario.clone());
+    let field = scenario.scene_at(0.0).field;
+    let mut pipeline = Pipeline::new(lut, PipelineParams::default());
+    for i in 0..90u64 {
+        let f = sim.frame(i).expect("frame");
+        let GroundTruth::Robot(truth) = &f.ground_truth else {
+            continue;
+        };
+        let t = i as f64 * FRAME_INTERVAL_S;
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        let (robot, _, _) = scenario.observer_at(t).expect("observer");
+        for g in r.recognition.goals.goals() {
+            let s = if g.colour == eotn::lut::ColourClass::Yellow {
+                1.0
+            } else {
+                -1.0
+            };
+            let tg = truth
+                .goals
+                .iter()
+                .find(|t| eotn::eval::goal_class(t.colour) == g.colour)
+                .expect("truth goal");
+            for post in &g.posts {
+                let line_x = |a: (f64, f64), b: (f64, f64), y: f64| {
+                    if (b.1 - a.1).abs() > 1e-9 {
+                        a.0 + (b.0 - a.0) * (y - a.1) / (b.1 - a.1)
+                    } else {
+                        a.0
+                    }
+                };
+                // Which field post is it: the one whose reference projection is nearest.
+                let mid_y = (post.top.1 + post.bottom.1) / 2.0;
+                let (k, tp) = tg
+                    .posts
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(k, tp)| Some((k, tp.image_base?, tp.image_top?)))
+                    .map(|(k, b, top)| {
+                        let x = line_x((top.x_px, top.y_px), (b.x_px, b.y_px), mid_y);
+                        (k, (x - line_x(post.top, post.bottom, mid_y)).abs())
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(k, _)| (k, tg.posts[k]))
+                    .expect("a truth post");
+                let y_post = tp.field_cm[1];
+                let outer = y_post.signum() * (field.goal_width_cm / 2.0 + field.goal_wall_cm);
+                let x0 = s * field.length_cm / 2.0;
+                let x1 = s * (field.length_cm / 2.0 + field.goal_depth_cm);
+                let z = field.goal_height_cm / 2.0;
+                let errs: Vec<Option<f64>> = [(x0, y_post), (x0, outer), (x1, outer)]
+                    .iter()
+                    .map(|(x, y)| {
+                        let q = rolling_image(&scenario, t, &Point::new(*x, *y, z))?;
+                        Some(line_x(post.top, post.bottom, q.1) - q.0)
+                    })
+                    .collect();
+                let reference = {
+                    let (b, top) = (tp.image_base.expect("b"), tp.image_top.expect("t"));
+                    let y = (b.y_px + top.y_px) / 2.0;
+                    let x = (b.x_px + top.x_px) / 2.0;
+                    line_x(post.reference_top, post.reference_bottom, y) - x
+                };
+                // The rolling shutter's true displacement of the front centre at mid-height
+                // (reference projection − rolling image) against the models' displacement of
+                // the raw point: linear shear and body model.
+                let ctx =
+                    PipelineParams::default()
+                        .recognition
+                        .context_for(208, 160, f.sensors.as_ref());
+                let fc = Point::new(x0, y_post, z);
+                let skew = rolling_image(&scenario, t, &fc).and_then(|q| {
+                    let pose = CameraPose {
+                        camera: eotn::geometry::PinholeCamera::ers7(),
+                        field_from_camera: {
+                            let (r, b, j) = scenario.observer_at(t)?;
+                            b.field_from_body(&r) * Ers7Dimensions::ERS7.body_from_camera(&j)
+                        },
+                    };
+                    let m = pose.image_from_field(&fc)?;
+                    let lin = ctx.unskew((q.0, q.1), false);
+                    let body = ctx.unskew_at((q.0, q.1), g.camera.distance_cm, true);
+                    Some((
+                        ((m.x_px - q.0) * 100.0).round() / 100.0,
+                        ((lin.0 - q.0) * 100.0).round() / 100.0,
+                        ((body.0 - q.0) * 100.0).round() / 100.0,
+                        q.1.round(),
+                    ))
+                });
+                eprintln!("    skew at post (true, linear, body model, row) {skew:?}");
+                // Camera outside the wall's outer plane (seen from the side it faces)?
+                let lateral =
+                    robot.y_cm.abs() > outer.abs() && robot.y_cm.signum() == outer.signum();
+                let r1 = |v: Option<f64>| v.map(|v| (v * 100.0).round() / 100.0);
+                eprintln!(
+                    "#{i:>2} {:?} post{k} {:?} pan {:+.3} dpan {:+.4} robot ({:.0},{:.0}) outer-face {} | raw vs front-centre {:?} front-outer {:?} back-outer {:?} | ref err {:+.2} | top-bottom dx {:+.2}",
+                    g.colour,
+                    post.side,
+                    f.sensors.and_then(|s| s.head_pan_rad).unwrap_or(f64::NAN),
+                    f.sensors
+                        .and_then(|s| Some(s.head_pan_rad? - s.previous_head_pan_rad?))
+                        .unwrap_or(f64::NAN),
+                    robot.x_cm,
+                    robot.y_cm,
+                    lateral,
+                    r1(errs[0]),
+                    r1(errs[1]),
+                    r1(errs[2]),
+                    reference,
+                    post.bottom.0 - post.top.0,
+                );
+            }
+        }
+    }
+}
