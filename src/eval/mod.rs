@@ -8,6 +8,7 @@ pub mod plots;
 
 use serde::{Deserialize, Serialize};
 
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::Recognition;
 use crate::sim::scene::GoalColour;
@@ -221,16 +222,16 @@ pub fn evaluate_frame(
             });
         }
         for post in &g.posts {
-            // The true post nearest this one at the foot row.
+            // The true post nearest this one, scored only when both its ends are in the
+            // image (a post whose partner runs out of the image is not compared with the
+            // goal's other post instead).
+            let inside = |q: &ImagePoint| {
+                q.x_px >= 0.0 && q.x_px <= width && q.y_px >= 0.0 && q.y_px <= height
+            };
             let best = tg
                 .posts
                 .iter()
                 .filter_map(|tp| Some((tp.image_base?, tp.image_top?)))
-                .filter(|(b, top)| {
-                    [b, top].iter().all(|q| {
-                        q.x_px >= 0.0 && q.x_px <= width && q.y_px >= 0.0 && q.y_px <= height
-                    })
-                })
                 .map(|(base, top)| {
                     // The truth projects at the reference row's time: compare the post moved
                     // there (the line through its skew-corrected ends).
@@ -242,11 +243,14 @@ pub fn evaluate_frame(
                             a.0
                         }
                     };
-                    (at(base.y_px) - base.x_px)
+                    let error = (at(base.y_px) - base.x_px)
                         .abs()
-                        .max((at(top.y_px) - top.x_px).abs())
+                        .max((at(top.y_px) - top.x_px).abs());
+                    (error, inside(&base) && inside(&top))
                 })
-                .fold(f64::INFINITY, f64::min);
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .filter(|(_, scored)| *scored)
+                .map_or(f64::INFINITY, |(error, _)| error);
             if best.is_finite() {
                 e.post_errors_px.push(best);
             }

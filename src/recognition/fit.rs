@@ -197,8 +197,8 @@ impl LineFit {
 
 /// Least-squares line through at least two distinct points from sums of squares. x and y are
 /// swapped when the points spread more vertically than horizontally, so vertical posts fit as
-/// well as horizontal bars. `None` for fewer than two points, all points equal, or non-finite
-/// input; never divides by zero.
+/// well as horizontal bars. `None` for fewer than two points, all points equal, non-finite
+/// input or sums that overflow; never divides by zero.
 #[must_use]
 pub fn fit_line(points: &[Point]) -> Option<LineFit> {
     if points.len() < 2 || points.iter().any(|p| !p.0.is_finite() || !p.1.is_finite()) {
@@ -227,6 +227,10 @@ pub fn fit_line(points: &[Point]) -> Option<LineFit> {
     }
     let slope = sxy / sii;
     let intercept = md - slope * mi;
+    if !(slope.is_finite() && intercept.is_finite()) {
+        // Sums overflowed (coordinates near f64::MAX): no usable line.
+        return None;
+    }
     let ss_res = (sdd - slope * sxy).max(0.0);
     let r_squared = if sdd > 0.0 {
         (1.0 - ss_res / sdd).clamp(0.0, 1.0)
@@ -326,6 +330,8 @@ mod tests {
         assert!(!n.steep && n.r_squared < 0.5 && n.residual_variance > 0.0);
         assert!(fit_line(&[(1.0, 1.0), (1.0, 1.0)]).is_none());
         assert!(fit_line(&[(1.0, 1.0)]).is_none());
+        assert!(fit_line(&[(1e300, 1e300), (-1e300, -1e300), (1e300, 1e300)]).is_none());
+        assert!(fit_line(&[(0.0, 0.0), (f64::INFINITY, 1.0)]).is_none());
     }
 
     #[test]

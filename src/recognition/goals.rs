@@ -106,6 +106,12 @@ pub struct GoalParams {
     pub size_bonus: f64,
     /// Number of scan lines per post.
     pub post_scans: usize,
+    /// How far the post's centre lies inside the goal's outer edge, centimetres: half the
+    /// side wall's thickness (2 cm walls in the simulator's 2005 field). The scans find the
+    /// outline; the post line is moved inward by this at the goal's distance (≈ 1.2 px at
+    /// 1.6 m). Where the camera sees a side wall's outer face (standing beside the goal) the
+    /// outline is the wall's back corner, farther out; that is not corrected.
+    pub post_inset_cm: f64,
     /// A post is accepted when r² is at least this, or the points hardly vary across the line.
     pub post_min_r_squared: f64,
     /// ... and the residual variance s² is at most this, pixels².
@@ -165,6 +171,7 @@ impl Default for GoalParams {
             apparent_width_weight: TestWeight::new(0.5, 6.0),
             size_bonus: 0.5,
             post_scans: 8,
+            post_inset_cm: 1.0,
             post_min_r_squared: 0.5,
             post_max_residual_variance: 2.0,
             gap_scan_height_cm: 15.0,
@@ -855,6 +862,11 @@ fn find_posts_and_gap(
     let distance = cand.camera.distance_cm;
     let height = e[3] - e[1];
     let n = p.post_scans.max(3);
+    let inset_px = if distance > 0.0 {
+        (p.post_inset_cm * ctx.camera.focal_px / distance).clamp(0.0, (e[2] - e[0]) / 4.0)
+    } else {
+        0.0
+    };
     for (side, cut, from, to) in [
         (
             PostSide::Left,
@@ -880,11 +892,17 @@ fn find_posts_and_gap(
                 level_pts.push((x, y));
             }
         }
+        cand.post_points
+            .extend(level_pts.iter().map(|q| rotate_about(*q, centre, -angle)));
+        // The scans find the outline's outer edge; the post's centre is half a wall inside it.
+        let shift = match side {
+            PostSide::Left => inset_px,
+            PostSide::Right => -inset_px,
+        };
         let image_pts: Vec<Point> = level_pts
             .iter()
-            .map(|q| rotate_about(*q, centre, -angle))
+            .map(|q| rotate_about((q.0 + shift, q.1), centre, -angle))
             .collect();
-        cand.post_points.extend(&image_pts);
         let Some(fit) = fit_line(&image_pts) else {
             cand.rejected_posts
                 .push(format!("{side:?}: {} points, no line", image_pts.len()));
@@ -1181,6 +1199,35 @@ mod tests {
         let g = &res.candidates[0];
         assert!(g.cut_off.bottom && !g.cut_off.top);
         assert!(g.distance_is_max && !g.distance_from_ground);
+    }
+
+    #[test]
+    fn level_scans_find_the_edge_to_a_fraction_of_a_pixel_under_a_tilted_horizon() {
+        // Yellow columns 40..60; level rows at 0.1 rad cross the edges between pixel samples.
+        let (w, h) = (208, 160);
+        let codes = (0..w * h)
+            .map(|k| {
+                if (40..60).contains(&(k % w)) {
+                    ColourClass::Yellow.code()
+                } else {
+                    ColourClass::Green.code()
+                }
+            })
+            .collect();
+        let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
+        let is_goal = is_goal_colour(ColourClass::Yellow);
+        let (centre, angle) = ((104.0, 80.0), 0.1);
+        for k in 0..20 {
+            let y = 60.0 + 1.37 * f64::from(k);
+            // The edges' level x at this row (the level frame turns image columns into slants).
+            let level = |x: f64| rotate_about((x, 70.0), centre, angle);
+            let (l0, r0) = (level(30.0).0 - 10.0, level(70.0).0 + 10.0);
+            for (from, to, edge) in [(l0, 110.0, 40.0), (r0, 20.0, 60.0)] {
+                let x = scan_level_row(&img, &is_goal, y, from, to, centre, angle).expect("edge");
+                let q = rotate_about((x, y), centre, -angle);
+                assert!((q.0 - edge).abs() < 0.05, "row {y}: {q:?} vs x = {edge}");
+            }
+        }
     }
 
     #[test]

@@ -125,7 +125,7 @@ fn recognition_on_synthetic_scenarios() {
     let keeper = report(ScenarioKind::Goalkeeper);
     let walk = report(ScenarioKind::WalkAndPan);
     assert!(
-        keeper.posts_within_2px.is_some_and(|f| f >= 0.95),
+        keeper.posts_within_2px.is_some_and(|f| f >= 0.98) && keeper.post_error_px.p50 <= 0.6,
         "{:?}",
         keeper.post_error_px
     );
@@ -135,7 +135,7 @@ fn recognition_on_synthetic_scenarios() {
         keeper.gap_error_px
     );
     assert!(
-        walk.posts_within_2px.is_some_and(|f| f >= 0.7),
+        walk.posts_within_2px.is_some_and(|f| f >= 0.98) && walk.post_error_px.p50 <= 1.1,
         "{:?}",
         walk.post_error_px
     );
