@@ -116,6 +116,15 @@ pub struct GoalParams {
     pub post_min_r_squared: f64,
     /// ... and the residual variance s² is at most this, pixels².
     pub post_max_residual_variance: f64,
+    /// ... and the line leans at most this far from the horizon's perpendicular, radians: a
+    /// post stands upright (the rolling shutter leans it by about 6° on the fastest simulated
+    /// pans); a flat line along a candidate's side is an edge of something else.
+    pub post_max_lean_rad: f64,
+    /// Candidates at least this tall (level frame, pixels), with a left or right side in the
+    /// image and not filling it, must show an upright post there.
+    pub post_test_min_height_px: f64,
+    /// Weight of that test.
+    pub post_weight: TestWeight,
     /// Height of the gap scan above the ground, centimetres (about a robot's shoulder).
     pub gap_scan_height_cm: f64,
     /// Holes up to this many pixels inside a goal-coloured run do not end it.
@@ -174,6 +183,9 @@ impl Default for GoalParams {
             post_inset_cm: 1.0,
             post_min_r_squared: 0.5,
             post_max_residual_variance: 2.0,
+            post_max_lean_rad: 0.35,
+            post_test_min_height_px: 8.0,
+            post_weight: TestWeight::new(0.0, 2.0),
             gap_scan_height_cm: 15.0,
             gap_hole_px: 1,
             skew_correction: true,
@@ -492,10 +504,28 @@ pub fn recognise_goals(
                     TestWeight::new(0.0, p.beacon_overlap_penalty),
                 );
             }
+            find_posts(img, &mut cand, colour, ctx, p);
+            let e = cand.level_extent;
+            let area = f64::from(cand.bounds[2] - cand.bounds[0] + 1)
+                * f64::from(cand.bounds[3] - cand.bounds[1] + 1);
+            let fills = area >= p.fills_image_fraction * img.width() as f64 * img.height() as f64;
+            let sides_in_view = !(cand.cut_off.left && cand.cut_off.right);
+            if fills || !sides_in_view || e[3] - e[1] < p.post_test_min_height_px {
+                cand.confidence.skipped("upright_posts", [1.0, 2.0]);
+            } else {
+                // A goal shows an upright post on a side in view; a band of goal colour along
+                // the edge of a line or a shadow does not.
+                cand.confidence.range_test(
+                    "upright_posts",
+                    cand.posts.len() as f64,
+                    [1.0, 2.0],
+                    p.post_weight,
+                );
+            }
             if !accepted_one && cand.confidence.accepted() {
                 cand.accepted = true;
                 accepted_one = true;
-                find_posts_and_gap(img, &mut cand, colour, ctx, p);
+                find_gap(img, &mut cand, colour, ctx, p);
             }
             result.candidates.push(cand);
         }
@@ -848,7 +878,9 @@ fn unskew(ctx: &ViewContext, p: &GoalParams, q: Point, distance_cm: f64) -> Poin
     }
 }
 
-fn find_posts_and_gap(
+/// Posts: level scans inward along each uncut side, a line fit through their edges, accepted
+/// when straight and upright.
+fn find_posts(
     img: &ClassifiedImage,
     cand: &mut GoalCandidate,
     colour: ColourClass,
@@ -931,6 +963,18 @@ fn find_posts_and_gap(
         } else {
             image_pts[image_pts.len() - 1]
         };
+        let (lt, lb) = (
+            rotate_about(top, centre, angle),
+            rotate_about(bottom, centre, angle),
+        );
+        let lean = (lb.0 - lt.0).abs().atan2((lb.1 - lt.1).abs());
+        if !(lean <= p.post_max_lean_rad) {
+            cand.rejected_posts.push(format!(
+                "{side:?}: leans {:.0}° from upright",
+                lean.to_degrees()
+            ));
+            continue;
+        }
         let (reference_top, reference_bottom) = if p.skew_correction {
             (
                 unskew(ctx, p, top, distance),
@@ -954,6 +998,22 @@ fn find_posts_and_gap(
             body: ctx.body_relative(mid, distance),
         });
     }
+}
+
+/// The gap: the longest goal-coloured run on a level row at shoulder height.
+fn find_gap(
+    img: &ClassifiedImage,
+    cand: &mut GoalCandidate,
+    colour: ColourClass,
+    ctx: &ViewContext,
+    p: &GoalParams,
+) {
+    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let angle = ctx.horizon_angle();
+    let e = cand.level_extent;
+    let is_goal = is_goal_colour(colour);
+    let distance = cand.camera.distance_cm;
+    let height = e[3] - e[1];
     // Gap scan: a level row at the shoulder height above the goal's bottom (from the foot's
     // distance when the top is cut off, since then the visible height is not the goal's).
     let y = if cand.distance_from_ground && distance > 0.0 {
