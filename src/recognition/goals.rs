@@ -120,6 +120,9 @@ pub struct GoalParams {
     /// post stands upright (the rolling shutter leans it by about 6° on the fastest simulated
     /// pans); a flat line along a candidate's side is an edge of something else.
     pub post_max_lean_rad: f64,
+    /// Up to this many scan points farthest from the line are dropped (one at a time,
+    /// refitting) while the fit fails and more than five points remain.
+    pub post_max_outliers: usize,
     /// Candidates at least this tall (level frame, pixels), with a left or right side in the
     /// image and not filling it, must show an upright post there.
     pub post_test_min_height_px: f64,
@@ -183,8 +186,9 @@ impl Default for GoalParams {
             post_inset_cm: 1.0,
             post_min_r_squared: 0.5,
             post_max_residual_variance: 2.0,
+            post_max_outliers: 2,
             post_max_lean_rad: 0.35,
-            post_test_min_height_px: 8.0,
+            post_test_min_height_px: 5.0,
             post_weight: TestWeight::new(0.0, 2.0),
             gap_scan_height_cm: 15.0,
             gap_hole_px: 1,
@@ -935,33 +939,59 @@ fn find_posts(
             .iter()
             .map(|q| rotate_about((q.0 + shift, q.1), centre, -angle))
             .collect();
-        let Some(fit) = fit_line(&image_pts) else {
+        let good = |f: &LineFit| {
+            f.residual_variance <= p.post_max_residual_variance
+                && (f.r_squared >= p.post_min_r_squared || f.steep)
+        };
+        // A stray point (a robot's leg or a shadow on one scan row) is dropped, farthest from
+        // the line first, while the fit fails and enough points remain.
+        let mut pts = image_pts;
+        let mut fit = fit_line(&pts);
+        let mut dropped = 0;
+        while let Some(f) = fit
+            && !good(&f)
+            && dropped < p.post_max_outliers
+            && pts.len() > 5
+        {
+            let off = |q: &Point| {
+                if f.steep {
+                    (q.0 - f.at(q.1).0).abs()
+                } else {
+                    (q.1 - f.at(q.0).1).abs()
+                }
+            };
+            let Some(worst) = (0..pts.len()).max_by(|a, b| off(&pts[*a]).total_cmp(&off(&pts[*b])))
+            else {
+                break;
+            };
+            pts.remove(worst);
+            dropped += 1;
+            fit = fit_line(&pts);
+        }
+        let Some(fit) = fit else {
             cand.rejected_posts
-                .push(format!("{side:?}: {} points, no line", image_pts.len()));
+                .push(format!("{side:?}: {} points, no line", pts.len()));
             continue;
         };
-        let straight = fit.residual_variance <= p.post_max_residual_variance;
-        if !(straight && (fit.r_squared >= p.post_min_r_squared || fit.steep))
-            || image_pts.len() < 3
-        {
+        if !good(&fit) || pts.len() < 3 {
             cand.rejected_posts.push(format!(
                 "{side:?}: r² {:.2}, s² {:.2} px² from {} points",
                 fit.r_squared,
                 fit.residual_variance,
-                image_pts.len()
+                pts.len()
             ));
             continue;
         }
-        let top_level = rotate_about(image_pts[0], centre, angle);
+        let top_level = rotate_about(pts[0], centre, angle);
         let top = if fit.steep {
             fit.at(rotate_about((top_level.0, e[1]), centre, -angle).1)
         } else {
-            image_pts[0]
+            pts[0]
         };
         let bottom = if fit.steep {
             fit.at(rotate_about((top_level.0, e[3]), centre, -angle).1)
         } else {
-            image_pts[image_pts.len() - 1]
+            pts[pts.len() - 1]
         };
         let (lt, lb) = (
             rotate_about(top, centre, angle),
