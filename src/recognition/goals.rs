@@ -998,7 +998,7 @@ fn find_posts(
             rotate_about(bottom, centre, angle),
         );
         let lean = (lb.0 - lt.0).abs().atan2((lb.1 - lt.1).abs());
-        if !(lean <= p.post_max_lean_rad) {
+        if lean.is_nan() || lean > p.post_max_lean_rad {
             cand.rejected_posts.push(format!(
                 "{side:?}: leans {:.0}° from upright",
                 lean.to_degrees()
