@@ -46,7 +46,7 @@ fn debug_posts() {
     let kind = ScenarioKind::from_name(&name).expect("scenario name");
     let lut = super::recognition::learnt_table();
     let scenario = Scenario::new(kind, 7);
-    let sim = Simulator::new(scenario.clone());
+    let sim = Simulator::new(scenario);
     let field = scenario.scene_at(0.0).field;
     let mut pipeline = Pipeline::new(lut, PipelineParams::default());
     for i in 0..90u64 {
