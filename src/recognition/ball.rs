@@ -10,7 +10,9 @@ use super::confidence::{Confidence, TestWeight};
 use super::context::{Relative, ViewContext};
 use super::draw::Primitive;
 use super::fit::{CircleFit, Point, fit_circle_trimmed};
-use super::scan::{CutOff, EdgeScanPattern, ScanArea, edge_points, scan_rotated_rect};
+use super::scan::{
+    CutOff, EdgeScanPattern, MixedEdge, ScanArea, edge_points_with_mixed, scan_rotated_rect,
+};
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
 use crate::lut::ColourClass;
@@ -59,6 +61,11 @@ pub struct BallParams {
     /// An edge scan stops at the first run of this many ball-coloured pixels, so single noisy
     /// pixels outside the ball are not taken for its outline.
     pub edge_run_px: u32,
+    /// Where an unclassified pixel right outside the ball's run counts as the ball's rim (see
+    /// [`MixedEdge`]): UYVY pixel pairs share their chroma, so a rim pixel paired with a carpet
+    /// pixel is classified as neither; without this the outline of a far ball is half a pixel
+    /// small and its distance 10–20% long.
+    pub mixed_edge: MixedEdge,
     /// A side touching the image border counts as cut off only when at least this share of the
     /// border pixels along the candidate's box are ball-coloured (a cut ball has a long chord on
     /// the border; a stray pixel reaching it does not make the ball cut).
@@ -109,6 +116,11 @@ pub struct BallParams {
     pub radius_bias_px: f64,
     /// Expected error of the fitted radius, pixels.
     pub radius_sigma_px: f64,
+    /// Expected error of the radius of a ball cut off by the image edge or hidden on a side, or
+    /// measured from its box (no circle fit), pixels: a partial outline, often in the darkened
+    /// image corners where classification loses rim pixels. The fusion then leans on the
+    /// ground plane.
+    pub radius_sigma_cut_px: f64,
     /// Expected error of the camera's pitch from the joints and body model, radians.
     pub pose_sigma_rad: f64,
     /// Remove the horizontal rolling-shutter shear (pan velocity) before fitting.
@@ -144,6 +156,7 @@ impl Default for BallParams {
             unclassified_around_weight: TestWeight::new(0.0, 2.0),
             edge_margin_px: 3,
             edge_run_px: 2,
+            mixed_edge: MixedEdge::ChromaPairs,
             border_cut_min_share: 0.25,
             fit_trim_sd: 2.5,
             fit_trim_min_px: 1.0,
@@ -161,6 +174,7 @@ impl Default for BallParams {
             ground_plane_fusion: true,
             radius_bias_px: 0.0,
             radius_sigma_px: 0.5,
+            radius_sigma_cut_px: 1.0,
             pose_sigma_rad: 0.01,
             skew_correction: true,
             pose_skew_model: true,
@@ -177,6 +191,7 @@ fn fuse_with_ground_plane(
     ctx: &ViewContext,
     center: Point,
     radius: f64,
+    radius_sigma_px: f64,
     size_distance: f64,
     params: &BallParams,
 ) -> f64 {
@@ -196,8 +211,95 @@ fn fuse_with_ground_plane(
         .max(1.0);
     let sigma_phi = params.pose_sigma_rad + params.radius_sigma_px / ctx.camera.focal_px;
     let var_plane = (plane * plane / h * sigma_phi).powi(2);
-    let var_size = (size_distance * params.radius_sigma_px / radius.max(0.5)).powi(2);
+    let var_size = (size_distance * radius_sigma_px / radius.max(0.5)).powi(2);
     (plane / var_plane + size_distance / var_size) / (1.0 / var_plane + 1.0 / var_size)
+}
+
+/// Distance (cm) to the centre of a ball of `diameter_cm` whose outline in the image is the
+/// circle (`center`, `radius` px), from the angle the ball subtends. A sphere off the optical
+/// axis projects to an ellipse stretched away from the axis (by 1/cos θ across and 1/cos² θ
+/// along the radial direction, θ the angle off the axis): at the side of the ERS-7's image a
+/// ball looks 15–25% wider than at the centre, and the original's d × 8.5 / diameter reads
+/// that much too close. The half-angle between the rays through opposite ends of a diameter is
+/// the ball's angular radius α for the ellipse's axes; the mean over the radial and the
+/// tangential diameter of the fitted circle undoes the stretch, and distance = R / sin α.
+/// Falls back to d × diameter / (2 × radius) when the rays are degenerate.
+#[must_use]
+pub fn distance_from_circle(
+    camera: &crate::geometry::PinholeCamera,
+    center: Point,
+    radius: f64,
+    diameter_cm: f64,
+) -> f64 {
+    use crate::geometry::ImagePoint;
+    let radius = radius.max(0.25);
+    let fallback = camera.focal_px * diameter_cm / (2.0 * radius);
+    let (dx, dy) = (center.0 - camera.centre.x_px, center.1 - camera.centre.y_px);
+    let off = dx.hypot(dy);
+    let u = if off > 1e-6 {
+        (dx / off, dy / off)
+    } else {
+        (1.0, 0.0)
+    };
+    let half_angle = |dir: (f64, f64)| {
+        let a = camera.unit_ray(ImagePoint::new(
+            center.0 + radius * dir.0,
+            center.1 + radius * dir.1,
+        ));
+        let b = camera.unit_ray(ImagePoint::new(
+            center.0 - radius * dir.0,
+            center.1 - radius * dir.1,
+        ));
+        a.coords.dot(&b.coords).clamp(-1.0, 1.0).acos() / 2.0
+    };
+    let alpha = (half_angle(u) + half_angle((-u.1, u.0))) / 2.0;
+    let d = diameter_cm / 2.0 / alpha.sin();
+    if d.is_finite() && d > 0.0 {
+        d
+    } else {
+        fallback
+    }
+}
+
+/// The ball's angular radius (radians) from its outline points: the points are turned into
+/// the view of a camera looking straight at `center` (gnomonic coordinates about the ray
+/// through it, scaled by d so that they stay in pixels), where a sphere's outline is an exact
+/// circle wherever it is in the image, and a circle is fitted there. Unlike
+/// [`distance_from_circle`] this also holds for a short arc (a ball cut by the image edge sees
+/// only the side facing the image centre, whose curvature is not the fitted circle's mean).
+/// `None` when the points do not fit a circle.
+fn angular_radius(
+    camera: &crate::geometry::PinholeCamera,
+    points: &[Point],
+    center: Point,
+    params: &BallParams,
+) -> Option<f64> {
+    use crate::geometry::ImagePoint;
+    let ray = |p: Point| camera.unit_ray(ImagePoint::new(p.0, p.1)).coords;
+    let e1 = ray(center);
+    let side = ray((center.0 + 1.0, center.1));
+    let e2 = (side - e1 * side.dot(&e1)).try_normalize(1e-12)?;
+    let e3 = e1.cross(&e2);
+    let f = camera.focal_px;
+    let turned: Vec<Point> = points
+        .iter()
+        .filter_map(|&p| {
+            let r = ray(p);
+            let along = r.dot(&e1);
+            (along > 1e-6).then(|| (f * r.dot(&e2) / along, f * r.dot(&e3) / along))
+        })
+        .collect();
+    if turned.len() < 5 {
+        return None;
+    }
+    let fit = fit_circle_trimmed(
+        &turned,
+        params.fit_trim_sd,
+        params.fit_trim_min_px,
+        params.fit_trim_max_share,
+    )?;
+    let alpha = (fit.radius / f).atan();
+    (alpha.is_finite() && alpha > 0.0).then_some(alpha)
 }
 
 /// The recognised ball.
@@ -468,13 +570,15 @@ pub fn recognise_ball(
         let cut = cut_off(img, &group, params.border_cut_min_share);
         let bounds = [group.minx, group.miny, group.maxx, group.maxy];
         let pattern = EdgeScanPattern::for_cut_off(cut);
-        let mut points = edge_points(
+        let mut points = edge_points_with_mixed(
             img,
             bounds,
             pattern,
             params.edge_margin_px,
             params.edge_run_px,
             is_ball_colour,
+            |c| c == ColourClass::Unclassified.code(),
+            params.mixed_edge,
         );
         let (box_centre, box_radius) = box_estimate(&group, cut);
         // Move every outline point to the read-out time of the reference row, the instant the
@@ -545,9 +649,21 @@ pub fn recognise_ball(
             _ => (box_centre, box_radius),
         };
         let radius = (radius + params.radius_bias_px).max(0.5);
-        let size_distance = d * params.diameter_cm / (2.0 * radius);
+        // With the fit's own points, the angle the ball subtends; else from the circle.
+        let alpha = use_fit
+            .then(|| angular_radius(&ctx.camera, &points, center, params))
+            .flatten();
+        let size_distance = match alpha {
+            Some(a) => params.diameter_cm / 2.0 / a.sin(),
+            None => distance_from_circle(&ctx.camera, center, radius, params.diameter_cm),
+        };
         let distance = if params.ground_plane_fusion {
-            fuse_with_ground_plane(ctx, center, radius, size_distance, params)
+            let sigma = if use_fit && !cut.any() {
+                params.radius_sigma_px
+            } else {
+                params.radius_sigma_cut_px
+            };
+            fuse_with_ground_plane(ctx, center, radius, sigma, size_distance, params)
         } else {
             size_distance
         };

@@ -613,3 +613,169 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("garbage.mcap"));
 }
+
+/// Prints one CSV line per correctly matched ball (prefix `BIAS,`) for studying the distance
+/// error's sign: `EOTN_BIAS_FRAMES=180 cargo test --test it ball_distance_bias -- --ignored
+/// --nocapture`. Columns: scenario, seed, frame, true distance, true radius, true centre x/y,
+/// cut, measured distance, radius, centre x/y, from circle fit, size-only distance, blob box
+/// width/height, truth box width/height.
+#[test]
+#[ignore = "a measuring aid, not a check"]
+fn ball_distance_bias() {
+    let frames: u64 = std::env::var("EOTN_BIAS_FRAMES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(90);
+    let seeds: Vec<u64> = std::env::var("EOTN_BIAS_SEEDS")
+        .unwrap_or_else(|_| "7".into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    let lut = learnt_table();
+    let params = PipelineParams::default();
+    let b = params.recognition.ball;
+    for kind in [
+        ScenarioKind::WalkAndPan,
+        ScenarioKind::BallEdge,
+        ScenarioKind::FastPans,
+        ScenarioKind::OrangeClutter,
+    ] {
+        for &seed in &seeds {
+            let sim = Simulator::new(Scenario::new(kind, seed));
+            let mut pipeline = Pipeline::new(lut.clone(), params);
+            for i in 0..frames {
+                let f = sim.frame(i).expect("frame");
+                let GroundTruth::Robot(truth) = &f.ground_truth else {
+                    continue;
+                };
+                let r = pipeline.process(&f.frame, f.sensors.as_ref());
+                let fe = evaluate_frame(
+                    i as usize,
+                    r.recognition,
+                    truth,
+                    208.0,
+                    160.0,
+                    &EvalParams::default(),
+                );
+                let (Some(tb), Some(ball)) = (truth.ball.as_ref(), &r.recognition.ball.ball) else {
+                    continue;
+                };
+                if !fe.ball_eligible || fe.ball_distance_error.is_none() {
+                    continue;
+                }
+                let cand = &r.recognition.ball.candidates[ball.candidate];
+                let img = tb.relative.image.expect("matched ball projects");
+                let [x0, y0, x1, y1] = cand.bounds;
+                let (tw, th) = tb.image_box.map_or((0, 0), |bx| {
+                    (bx.max_x + 1 - bx.min_x, bx.max_y + 1 - bx.min_y)
+                });
+                let ctx = params.recognition.context_for(208, 160, f.sensors.as_ref());
+                let plane = ctx
+                    .pose
+                    .and_then(|p| {
+                        let ip = eotn::geometry::ImagePoint::new(ball.center_x, ball.center_y);
+                        Some(p.point_on_plane(ip, 4.25)?.distance_to(&p.position()))
+                    })
+                    .unwrap_or(f64::NAN);
+                eprintln!(
+                    "BIAS,{},{seed},{i},{:.2},{:.3},{:.2},{:.2},{},{:.2},{:.3},{:.2},{:.2},{},{:.2},{},{},{tw},{th},{plane:.2}",
+                    kind.name(),
+                    tb.relative.camera_distance_cm,
+                    tb.image_radius_px.unwrap_or(0.0),
+                    img.x_px,
+                    img.y_px,
+                    u8::from(fe.ball_cut),
+                    ball.camera.distance_cm,
+                    ball.radius_px,
+                    ball.center_x,
+                    ball.center_y,
+                    u8::from(ball.from_circle_fit),
+                    191.9 * b.diameter_cm / (2.0 * ball.radius_px),
+                    x1 + 1 - x0,
+                    y1 + 1 - y0,
+                );
+            }
+        }
+    }
+}
+
+/// Which of the ball's true pixels classification loses, and to what (temporary study).
+#[test]
+#[ignore = "a measuring aid, not a check"]
+fn ball_rim_study() {
+    use eotn::lut::ColourClass;
+    let lut = learnt_table();
+    let params = PipelineParams::default();
+    let orange = ColourClass::Orange.code();
+    let mut tally: std::collections::BTreeMap<String, [usize; 2]> = Default::default();
+    for kind in [
+        ScenarioKind::WalkAndPan,
+        ScenarioKind::BallEdge,
+        ScenarioKind::FastPans,
+    ] {
+        let sim = Simulator::new(Scenario::new(kind, 7));
+        let mut pipeline = Pipeline::new(lut.clone(), params);
+        for i in 0..90 {
+            let f = sim.frame(i).expect("frame");
+            let GroundTruth::Robot(truth) = &f.ground_truth else {
+                continue;
+            };
+            let r = pipeline.process(&f.frame, f.sensors.as_ref());
+            let Some(tb) = truth.ball.as_ref().filter(|b| b.visible_fraction > 0.9) else {
+                continue;
+            };
+            let Some(bx) = tb.image_box else { continue };
+            let img = r.classified;
+            let w = 208usize;
+            let lab = |x: i64, y: i64| -> bool {
+                x >= 0
+                    && y >= 0
+                    && (x as usize) < w
+                    && (y as usize) < 160
+                    && f.labels[y as usize * w + x as usize] == orange
+            };
+            for y in bx.min_y..=bx.max_y {
+                for x in bx.min_x..=bx.max_x {
+                    let (xi, yi) = (x as i64, y as i64);
+                    if !lab(xi, yi) {
+                        continue;
+                    }
+                    let region = if !lab(xi, yi - 1) {
+                        "top"
+                    } else if !lab(xi, yi + 1) {
+                        "bottom"
+                    } else if !lab(xi - 1, yi) || !lab(xi + 1, yi) {
+                        // Left/right rim: is the pair partner also ball?
+                        let partner = xi ^ 1;
+                        if lab(partner, yi) {
+                            "side-pair-ball"
+                        } else {
+                            "side-pair-mixed"
+                        }
+                    } else {
+                        "inside"
+                    };
+                    let c = img.get(x, y).unwrap_or(0);
+                    let is_ball = eotn::recognition::ball::is_ball_colour(c);
+                    let e = tally
+                        .entry(format!("{} {region}", kind.name()))
+                        .or_default();
+                    e[usize::from(is_ball)] += 1;
+                    if !is_ball {
+                        *tally
+                            .entry(format!("  lost as {:?}", ColourClass::from_code(c)))
+                            .or_default()
+                            .get_mut(0)
+                            .expect("slot") += 1;
+                    }
+                }
+            }
+        }
+    }
+    for (k, [lost, kept]) in tally {
+        eprintln!(
+            "{k:40} lost {lost:5} kept {kept:5} ({:.0}% lost)",
+            100.0 * lost as f64 / (lost + kept).max(1) as f64
+        );
+    }
+}
