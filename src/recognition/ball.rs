@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::confidence::{Confidence, TestWeight};
 use super::context::{Relative, ViewContext};
-use super::draw::Primitive;
+use super::draw::{CircleRole, Primitive};
 use super::fit::{CircleFit, Point, fit_circle_trimmed};
 use super::scan::{
     CutOff, EdgeScanPattern, MixedEdge, ScanArea, edge_points_with_mixed, scan_rotated_rect,
@@ -307,10 +307,15 @@ fn angular_radius(
 pub struct Ball {
     /// Index of the accepted candidate in [`BallResult::candidates`].
     pub candidate: usize,
-    /// Centre x, image pixels.
+    /// Centre x, image pixels, at the reference row's read-out time (skew removed): where the
+    /// sensor readings place the ball.
     pub center_x: f64,
-    /// Centre y, image pixels.
+    /// Centre y, image pixels, at the reference read-out time.
     pub center_y: f64,
+    /// Centre where the ball appears in the image (each row at its own read-out time), pixels:
+    /// equal to the centre without skew; several pixels away on a fast pan.
+    #[serde(default)]
+    pub observed_center: Point,
     /// Radius, pixels.
     pub radius_px: f64,
     /// Camera-relative distance, bearing, elevation.
@@ -342,14 +347,21 @@ pub struct BallCandidate {
     pub pattern: EdgeScanPattern,
     /// Outline points after skew removal, pixels.
     pub edge_points: Vec<Point>,
+    /// The outline points where the scans found them in the image (before skew removal),
+    /// pixels: what the overlay draws.
+    #[serde(default)]
+    pub scanned_points: Vec<Point>,
     /// The circle fit, if one was found.
     pub fit: Option<CircleFit>,
     /// Why the circle fit was not used, if it was not.
     pub fit_rejected: Option<String>,
     /// The colour-below scan area.
     pub below: Option<ScanArea>,
-    /// Estimated centre, pixels.
+    /// Estimated centre, pixels, at the reference read-out time (skew removed).
     pub center: Point,
+    /// The centre where the ball appears in the image, pixels (see [`Ball::observed_center`]).
+    #[serde(default)]
+    pub observed_center: Point,
     /// Estimated radius, pixels.
     pub radius_px: f64,
     /// Camera-relative estimate.
@@ -586,6 +598,7 @@ pub fn recognise_ball(
         // pose says it is. The body model needs a depth: the distance the box's size implies.
         let depth = d * params.diameter_cm / (2.0 * box_radius.max(0.5));
         let unskew = |p: Point| unskew_point(ctx, params, p, depth);
+        let scanned_points = points.clone();
         let mut box_shift = (0.0, 0.0);
         if params.skew_correction {
             for p in &mut points {
@@ -668,6 +681,22 @@ pub fn recognise_ball(
             size_distance
         };
         let camera = ctx.camera_relative(center, distance);
+        // Back to where the ball is in the image: the point the skew removal moves onto the
+        // centre (a fixed-point iteration; the removal is nearly a shift over a ball's size).
+        let observed_center = if params.skew_correction {
+            let mut p = (center.0 - box_shift.0, center.1 - box_shift.1);
+            for _ in 0..3 {
+                let q = unskew(p);
+                p = (center.0 - (q.0 - p.0), center.1 - (q.1 - p.1));
+            }
+            if p.0.is_finite() && p.1.is_finite() {
+                p
+            } else {
+                center
+            }
+        } else {
+            center
+        };
 
         let mut confidence = Confidence::default();
         let area = w * h;
@@ -778,6 +807,7 @@ pub fn recognise_ball(
                 candidate: index,
                 center_x: center.0,
                 center_y: center.1,
+                observed_center,
                 radius_px: radius,
                 camera,
                 body: ctx.body_relative(center, distance),
@@ -794,10 +824,12 @@ pub fn recognise_ball(
             cut_off: cut,
             pattern,
             edge_points: points,
+            scanned_points,
             fit,
             fit_rejected,
             below: Some(below_scan.area),
             center,
+            observed_center,
             radius_px: radius,
             camera,
             accepted,
@@ -828,21 +860,33 @@ impl BallResult {
                     corners: area.corners,
                 });
             }
-            if !c.edge_points.is_empty() {
+            if !c.scanned_points.is_empty() {
                 out.push(Primitive::ScanPoints {
                     owner: owner.clone(),
-                    points: c.edge_points.clone(),
+                    points: c.scanned_points.clone(),
                 });
             }
             if c.accepted {
+                // On the ball as the image shows it; where the skew correction puts it as a
+                // second, dashed circle when that is visibly elsewhere.
+                let seen = c.observed_center;
                 out.push(Primitive::Circle {
                     owner: owner.clone(),
-                    center: c.center,
+                    center: seen,
                     radius: c.radius_px,
+                    role: CircleRole::Observed,
                 });
+                if (c.center.0 - seen.0).hypot(c.center.1 - seen.1) > 0.5 {
+                    out.push(Primitive::Circle {
+                        owner: owner.clone(),
+                        center: c.center,
+                        radius: c.radius_px,
+                        role: CircleRole::SkewCorrected,
+                    });
+                }
                 out.push(Primitive::Label {
                     owner,
-                    at: (c.center.0, c.center.1 - c.radius_px - 2.0),
+                    at: (seen.0, seen.1 - c.radius_px - 2.0),
                     text: format!(
                         "ball {:.0} cm {:+.0}°",
                         c.camera.distance_cm,
