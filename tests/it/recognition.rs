@@ -97,20 +97,41 @@ fn recognition_on_synthetic_scenarios() {
     );
     let false_balls = sum(&|r| r.ball_false);
     assert_eq!(false_balls, 0, "false balls in any scenario");
-    for (k, achieved) in [
-        (ScenarioKind::BallEdge, 0.04),
-        (ScenarioKind::FastPans, 0.04),
-        (ScenarioKind::WalkAndPan, 0.05),
+    // Distances come from the angle the ball subtends (its outline off the optical axis is a
+    // stretched ellipse) with the rim pixels that UYVY chroma pairs leave unclassified counted
+    // back: the median error is under 3% and the signed median (the bias) within ±3% on each.
+    for k in [
+        ScenarioKind::BallEdge,
+        ScenarioKind::FastPans,
+        ScenarioKind::WalkAndPan,
     ] {
         let r = report(k);
+        eprintln!(
+            "{}: ball distance error median {:.1}% (n = {}), signed median {:+.1}%; cut off \
+             {:.1}% (n = {}), signed {:+.1}%",
+            k.name(),
+            100.0 * r.ball_distance_error.p50,
+            r.ball_distance_error.n,
+            100.0 * r.ball_distance_bias.unwrap_or(f64::NAN),
+            100.0 * r.ball_distance_error_cut.p50,
+            r.ball_distance_error_cut.n,
+            100.0 * r.ball_distance_bias_cut.unwrap_or(f64::NAN),
+        );
         assert!(
-            r.ball_distance_error.p50 <= achieved,
+            r.ball_distance_error.p50 <= 0.03,
             "{}: {:?}",
             k.name(),
             r.ball_distance_error
         );
+        assert!(
+            r.ball_distance_bias.is_some_and(|b| b.abs() <= 0.03),
+            "{}: bias {:?}",
+            k.name(),
+            r.ball_distance_bias
+        );
     }
-    assert!(report(ScenarioKind::BallEdge).ball_distance_error_cut.p50 <= 0.08);
+    assert!(report(ScenarioKind::BallEdge).ball_distance_error_cut.p50 <= 0.04);
+    assert!(report(ScenarioKind::WalkAndPan).ball_distance_error_cut.p50 <= 0.04);
     let goals_eligible = sum(&|r| r.goals_eligible);
     let goals_found = sum(&|r| r.goals_found);
     eprintln!("goals found {goals_found}/{goals_eligible}");
