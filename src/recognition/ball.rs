@@ -984,21 +984,83 @@ mod tests {
     }
 
     #[test]
-    fn a_ball_cut_by_the_image_edge_keeps_its_radius() {
+    fn a_ball_cut_by_the_image_edge_keeps_its_distance() {
         let ctx = level_context();
-        let (c, r, dist) = true_ball(&ctx, 45.0, 0.0);
-        // Move it so a third of it is outside the left edge.
-        let img = scene(r * 0.4, c.1, r, 0.0);
+        let pose = ctx.pose.expect("pose");
+        // A ball on the field placed so that about a third of it is outside the left edge.
+        let (_, r0, _) = true_ball(&ctx, 45.0, 0.0);
+        let y = (0..400)
+            .map(|i| f64::from(i) * 0.1)
+            .min_by(|a, b| {
+                let off = |y: f64| (true_ball(&ctx, 45.0, y).0.0 - 0.4 * r0).abs();
+                off(*a).total_cmp(&off(*b))
+            })
+            .expect("positions");
+        let (c, _, dist) = true_ball(&ctx, 45.0, y);
+        // Rendered as a sphere, not a circle: a pixel shows the ball when its ray is within the
+        // ball's angular radius of the centre's direction (off the optical axis the outline is
+        // an ellipse, wider than a circle of the on-axis radius).
+        let towards = ctx
+            .camera
+            .unit_ray(
+                pose.image_from_field(&GeoPoint::new(45.0, y, 4.25))
+                    .expect("in front"),
+            )
+            .coords;
+        let cos_alpha = (4.25 / dist).asin().cos();
+        let (w, h) = (208usize, 160usize);
+        let codes = (0..w * h)
+            .map(|i| {
+                let ray = ctx
+                    .camera
+                    .unit_ray(crate::geometry::ImagePoint::pixel_centre(i % w, i / w));
+                if ray.coords.dot(&towards) >= cos_alpha {
+                    ColourClass::Orange.code()
+                } else {
+                    ColourClass::Green.code()
+                }
+            })
+            .collect();
+        let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
         let blobs = BlobSet::from_image(&img, Connectivity::Eight);
         let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
         let ball = res.ball.expect("ball");
         assert!(ball.cut_off.left && !ball.cut_off.right);
+        assert!(ball.from_circle_fit);
+        // The visible arc is the flatter inner side of the ellipse: the circle through it sits
+        // a little inwards.
         assert!(
-            (ball.radius_px - r).abs() / r < 0.08,
-            "{} vs {r}",
-            ball.radius_px
+            (ball.center_x - c.0).abs() < 3.0,
+            "{} vs {}",
+            ball.center_x,
+            c.0
         );
-        assert!((ball.camera.distance_cm - dist).abs() / dist < 0.08);
+        let err = (ball.camera.distance_cm - dist) / dist;
+        assert!(
+            err.abs() < 0.04,
+            "distance {} vs {dist}",
+            ball.camera.distance_cm
+        );
+        // The original's d × 8.5 / diameter reads the stretched outline much too close.
+        let naive = ctx.camera.focal_px * 8.5 / (2.0 * ball.radius_px);
+        assert!(naive < 0.95 * dist, "naive {naive} vs {dist}");
+    }
+
+    #[test]
+    fn distance_from_the_subtended_angle_holds_across_the_image() {
+        let camera = PinholeCamera::ers7();
+        // A sphere 100 cm away at the centre and 25° off the axis: its outline's mean
+        // semi-axis (see `distance_from_circle`) gives the distance back within 0.5%.
+        for theta_deg in [0.0_f64, 15.0, 25.0] {
+            let (t, alpha) = (theta_deg.to_radians(), (4.25_f64 / 100.0).asin());
+            let f = camera.focal_px;
+            let a = f / 2.0 * ((t + alpha).tan() - (t - alpha).tan());
+            let b = f * alpha.sin() / (t.cos().powi(2) - alpha.sin().powi(2)).sqrt();
+            let centre_x = camera.centre.x_px + f / 2.0 * ((t + alpha).tan() + (t - alpha).tan());
+            let d =
+                distance_from_circle(&camera, (centre_x, camera.centre.y_px), (a + b) / 2.0, 8.5);
+            assert!((d - 100.0).abs() < 0.5, "{theta_deg}°: {d}");
+        }
     }
 
     #[test]
