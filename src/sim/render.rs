@@ -219,6 +219,22 @@ impl World {
         }
     }
 
+    /// Moves the ball (if the scene has one) so its centre is at `centre` (field cm).
+    pub fn move_ball(&mut self, centre: Vector3<f64>) {
+        for obj in self
+            .objects
+            .iter_mut()
+            .filter(|o| o.id == object_id::BALL)
+        {
+            obj.bound_centre = centre;
+            for part in &mut obj.parts {
+                if let Prim::Sphere { centre: c, .. } = &mut part.prim {
+                    *c = centre;
+                }
+            }
+        }
+    }
+
     /// The colour (0..255 sRGB, unclipped) and object seen along a ray, with its material.
     fn trace(
         &self,
@@ -719,6 +735,26 @@ impl Renderer {
         skip: u16,
         rng: &mut SimRng,
     ) -> Result<Rendered, FrameError> {
+        self.render_moving_ball(world, field_from_camera_at_row, &|_| None, effects, skip, rng)
+    }
+
+    /// [`Self::render`] with the ball's own motion during read-out: `ball_centre_at_row(r)`
+    /// gives the ball's centre (field cm) while row `r` is exposed, `None` to leave it where
+    /// `world` has it. A ball rolling across the view comes out sheared, as a real rolling
+    /// shutter shows it.
+    ///
+    /// # Errors
+    /// [`FrameError`] only for an odd width (UYVY needs pixel pairs).
+    pub fn render_moving_ball(
+        &self,
+        world: &World,
+        field_from_camera_at_row: &dyn Fn(usize) -> Isometry3<f64>,
+        ball_centre_at_row: &dyn Fn(usize) -> Option<Vector3<f64>>,
+        effects: &CameraEffects,
+        skip: u16,
+        rng: &mut SimRng,
+    ) -> Result<Rendered, FrameError> {
+        let mut moving: Option<World> = None;
         let (w, h) = (self.width, self.height);
         if !w.is_multiple_of(2) {
             return Err(FrameError::OddWidth { width: w });
@@ -731,6 +767,12 @@ impl Renderer {
         let corner2 = cx * cx + cy * cy;
         let mut row_yuv = vec![[0.0_f64; 3]; w];
         for j in 0..h {
+            if let Some(c) = ball_centre_at_row(j) {
+                moving
+                    .get_or_insert_with(|| world.clone())
+                    .move_ball(c);
+            }
+            let world = moving.as_ref().unwrap_or(world);
             let pose = field_from_camera_at_row(j);
             let rot = pose.rotation.to_rotation_matrix().into_inner();
             let origin = pose.translation.vector;
