@@ -126,6 +126,11 @@ pub struct BallParams {
     /// camera's skew is removed, giving the ball's own image velocity. Beyond the original (its
     /// "future work"); off by default (see README for the measured effect).
     pub ellipse_fit: bool,
+    /// Let the ellipse fit find a vertical shear too. Off by default: on the rolling-ball
+    /// scenario the vertical stretch it must measure (tenths of a pixel) is swamped by the
+    /// classified outline's unevenness, and its errors turn into large ground-velocity errors;
+    /// with it off the vertical image velocity is reported as 0.
+    pub ellipse_vertical_shear: bool,
     /// Outline points the ellipse fit needs.
     pub ellipse_min_points: usize,
     /// The ellipse fit is used only when both shears' standard errors are below this, pixels
@@ -178,6 +183,7 @@ impl Default for BallParams {
             pose_skew_model: true,
             vertical_skew_correction: true,
             ellipse_fit: false,
+            ellipse_vertical_shear: false,
             ellipse_min_points: 12,
             ellipse_max_shear_sd: 0.03,
             default_frame_interval_s: 1.0 / 30.0,
@@ -599,7 +605,14 @@ pub fn recognise_ball(
         };
         let use_fit = fit.is_some() && fit_rejected.is_none();
         let ellipse = (params.ellipse_fit && use_fit && points.len() >= params.ellipse_min_points)
-            .then(|| fit_sheared_circle(&points, &rows, ctx.reference_row()))
+            .then(|| {
+                fit_sheared_circle(
+                    &points,
+                    &rows,
+                    ctx.reference_row(),
+                    params.ellipse_vertical_shear,
+                )
+            })
             .flatten();
         let moving = ellipse.filter(|e| ellipse_usable(e, fit.as_ref(), params));
         let (center, radius) = match (&fit, use_fit) {

@@ -178,6 +178,10 @@ impl ShearedCircleFit {
 /// parameters (centre, radius, two shears) by damped Gauss–Newton on the geometric distances
 /// of the points moved back to the reference row's time.
 ///
+/// With `vertical_shear` false the vertical shear is held at zero (four parameters): a vertical
+/// motion only stretches the outline vertically, by a few tenths of a pixel for a ball, which
+/// the classified outline's own unevenness (shading at top and bottom) can swamp.
+///
 /// `None` for fewer than 6 points (five parameters and at least one degree of freedom), a
 /// length mismatch, non-finite input, collinear points, or a fit that does not converge to a
 /// finite positive radius. A short arc leaves the shear poorly determined: callers should look
@@ -187,6 +191,7 @@ pub fn fit_sheared_circle(
     points: &[Point],
     rows: &[f64],
     reference_row: f64,
+    vertical_shear: bool,
 ) -> Option<ShearedCircleFit> {
     if points.len() < 6
         || rows.len() != points.len()
@@ -227,6 +232,15 @@ pub fn fit_sheared_circle(
                     jtj[row][col] += j[row] * j[col];
                 }
             }
+        }
+        if !vertical_shear {
+            // Hold the vertical shear: its equation becomes "step = 0".
+            for k in 0..5 {
+                jtj[4][k] = 0.0;
+                jtj[k][4] = 0.0;
+            }
+            jtj[4][4] = jtj[2][2].max(1.0);
+            jtr[4] = 0.0;
         }
         (jtj, jtr)
     };
@@ -295,7 +309,11 @@ pub fn fit_sheared_circle(
         shear_x: q[3],
         shear_y: q[4],
         shear_x_sd: (sigma2 * inv_diag(3)).sqrt(),
-        shear_y_sd: (sigma2 * inv_diag(4)).sqrt(),
+        shear_y_sd: if vertical_shear {
+            (sigma2 * inv_diag(4)).sqrt()
+        } else {
+            0.0
+        },
     })
 }
 
@@ -539,7 +557,7 @@ mod tests {
         let (ax, ay) = (0.15, 0.03);
         let data = moving_outline(90.0, 70.0, 20.0, ax, ay, 80.0);
         let (pts, rows): (Vec<Point>, Vec<f64>) = data.into_iter().unzip();
-        let f = fit_sheared_circle(&pts, &rows, 80.0).expect("fit");
+        let f = fit_sheared_circle(&pts, &rows, 80.0, true).expect("fit");
         assert!((f.shear_x - ax).abs() < 1e-6, "{f:?}");
         assert!((f.shear_y - ay).abs() < 1e-6, "{f:?}");
         assert!((f.circle.center_x - 90.0).abs() < 1e-5 && (f.circle.center_y - 70.0).abs() < 1e-5);
@@ -553,32 +571,38 @@ mod tests {
         // A still circle gives zero shear.
         let still = moving_outline(50.0, 50.0, 10.0, 0.0, 0.0, 80.0);
         let (pts, rows): (Vec<Point>, Vec<f64>) = still.into_iter().unzip();
-        let f = fit_sheared_circle(&pts, &rows, 80.0).expect("still");
+        let f = fit_sheared_circle(&pts, &rows, 80.0, true).expect("still");
         assert!(f.shear_x.abs() < 1e-9 && f.shear_y.abs() < 1e-9 && f.shear_x_sd < 1e-3);
+        // Horizontal motion only, fitted with the vertical shear held at zero.
+        let across = moving_outline(60.0, 90.0, 15.0, -0.2, 0.0, 80.0);
+        let (pts, rows): (Vec<Point>, Vec<f64>) = across.into_iter().unzip();
+        let f = fit_sheared_circle(&pts, &rows, 80.0, false).expect("across");
+        assert!((f.shear_x + 0.2).abs() < 1e-6 && f.shear_y == 0.0 && f.shear_y_sd == 0.0);
+        assert!((f.circle.radius - 15.0).abs() < 1e-5);
     }
 
     #[test]
     fn sheared_circle_refuses_degenerate_input() {
         let line: Vec<Point> = (0..10).map(|i| (f64::from(i), f64::from(i))).collect();
         let rows: Vec<f64> = line.iter().map(|p| p.1).collect();
-        assert!(fit_sheared_circle(&line, &rows, 80.0).is_none());
+        assert!(fit_sheared_circle(&line, &rows, 80.0, true).is_none());
         let five = arc(10.0, 10.0, 5.0, 0.0, 5.0, 5);
         let rows5: Vec<f64> = five.iter().map(|p| p.1).collect();
-        assert!(fit_sheared_circle(&five, &rows5, 80.0).is_none());
+        assert!(fit_sheared_circle(&five, &rows5, 80.0, true).is_none());
         let mut pts = arc(10.0, 10.0, 5.0, 0.0, 6.0, 12);
         let rows12: Vec<f64> = pts.iter().map(|p| p.1).collect();
-        assert!(fit_sheared_circle(&pts, &rows12[..11], 80.0).is_none());
-        assert!(fit_sheared_circle(&pts, &rows12, f64::NAN).is_none());
+        assert!(fit_sheared_circle(&pts, &rows12[..11], 80.0, true).is_none());
+        assert!(fit_sheared_circle(&pts, &rows12, f64::NAN, false).is_none());
         pts[3].1 = f64::NAN;
-        assert!(fit_sheared_circle(&pts, &rows12, 80.0).is_none());
+        assert!(fit_sheared_circle(&pts, &rows12, 80.0, true).is_none());
         let mut rows_nan = rows12.clone();
         rows_nan[0] = f64::INFINITY;
-        assert!(fit_sheared_circle(&arc(10.0, 10.0, 5.0, 0.0, 6.0, 12), &rows_nan, 80.0).is_none());
-        assert!(fit_sheared_circle(&[(4.0, 4.0); 8], &[4.0; 8], 80.0).is_none());
+        assert!(fit_sheared_circle(&arc(10.0, 10.0, 5.0, 0.0, 6.0, 12), &rows_nan, 80.0, true).is_none());
+        assert!(fit_sheared_circle(&[(4.0, 4.0); 8], &[4.0; 8], 80.0, false).is_none());
         // Points all on one row: the shear is undetermined; no panic, and either no fit or an
         // infinite / huge shear error.
         let one_row: Vec<Point> = (0..8).map(|i| (f64::from(i), 5.0 + f64::from(i % 2))).collect();
-        if let Some(f) = fit_sheared_circle(&one_row, &[5.0; 8], 80.0) {
+        if let Some(f) = fit_sheared_circle(&one_row, &[5.0; 8], 80.0, true) {
             assert!(f.shear_x_sd.is_nan() || f.shear_x_sd > 1.0 || f.shear_y_sd > 1.0);
         }
     }

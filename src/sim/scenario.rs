@@ -51,8 +51,8 @@ pub enum ScenarioKind {
     /// The overhead camera over a game of 4–8 robots and a moving ball, with each robot's noisy
     /// world-model estimate.
     OverheadGame,
-    /// Fast head pans past a close ball (26–50 cm ahead, 30–80 px across): the rolling shutter
-    /// shears it a lot, and the pans cut it at the image sides.
+    /// Fast head pans past a close ball (36–66 cm ahead, about 30–80 px across): the rolling
+    /// shutter shears it a lot, and the pans cut it at the image sides.
     ClosePans,
     /// A standing robot with a still head watches the ball roll across its view at 1–3 m/s:
     /// the ball itself moves while the rows are read out.
@@ -290,9 +290,10 @@ impl Scenario {
             }
             ScenarioKind::ClosePans => {
                 // A new ball spot each pan cycle, switched while the head looks away (pan
-                // phase −90°): 26–50 cm ahead, a little to the left.
-                const SPOTS_CM: [f64; 7] = [30.0, 38.0, 46.0, 26.0, 34.0, 50.0, 42.0];
-                let period = 1.2;
+                // phase −90°): 36–66 cm ahead of the body centre, a little to the left. The
+                // period is not a whole number of frames, so the ball is caught at many phases.
+                const SPOTS_CM: [f64; 7] = [40.0, 50.0, 60.0, 36.0, 45.0, 66.0, 55.0];
+                let period = 1.27;
                 let cycle = ((t_s - 0.9) / period).floor();
                 #[expect(
                     clippy::cast_possible_truncation,
