@@ -3,7 +3,7 @@
 //! of a ball rolling across a still camera (`rolling-ball`): its image and ground velocity, and
 //! whether it places the ball better than the plain circle.
 
-use eotn::eval::Percentiles;
+use eotn::eval::{EvalParams, EvalReport, Percentiles, evaluate_frame};
 use eotn::geometry::{Camera, Ers7Dimensions, Field, PinholeCamera, Point, Transform};
 use eotn::lut::LookupTable;
 use eotn::lut::learn::{LearnParams, TableBuilder};
@@ -247,6 +247,7 @@ fn skew_correction_on_close_balls_during_fast_pans() {
     fp_uncut.print("fast-pans, uncut balls");
     fp_cut.print("fast-pans, balls cut by the image side");
     let med = |v: &[f64]| Percentiles::of(v).p50;
+    let p90 = |v: &[f64]| Percentiles::of(v).p90;
     let all = |f: fn(&SkewErrors) -> &Vec<f64>| {
         let mut v = f(&uncut).clone();
         v.extend(f(&cut));
@@ -254,17 +255,72 @@ fn skew_correction_on_close_balls_during_fast_pans() {
     };
     let (raw, fixed) = (all(|e| &e.raw_r), all(|e| &e.fixed_r));
     eprintln!(
-        "close-pans, all balls: radius error median {:.3} px unskewed vs {:.3} px as read (n = {})",
+        "close-pans, all balls: radius error median {:.3} px unskewed vs {:.3} px as read, p90 \
+         {:.2} vs {:.2} (n = {})",
         med(&fixed),
         med(&raw),
+        p90(&fixed),
+        p90(&raw),
         raw.len()
     );
-    assert!(uncut.raw_r.len() >= 10 && cut.raw_r.len() >= 5);
-    // Achieved levels (see README): the correction at least halves the radius error of close
-    // balls cut by the image side, and of all close balls together.
-    assert!(med(&cut.fixed_r) * 2.0 <= med(&cut.raw_r));
-    assert!(med(&fixed) * 2.0 <= med(&raw));
-    assert!(med(&uncut.fixed_c) * 2.0 <= med(&uncut.raw_c));
+    // The whole pipeline with the correction on and off (eval's figures: radius against the
+    // on-axis size, which a close ball at the image side exceeds by up to 10% through
+    // perspective).
+    let mut off = params;
+    off.recognition.ball.skew_correction = false;
+    for (name, p) in [("on", params), ("off", off)] {
+        let r = eval_report(ScenarioKind::ClosePans, 150, &lut, p);
+        eprintln!(
+            "close-pans, skew correction {name}: found {}/{}, distance error median {:.4} (cut \
+             {:.4}), radius error median {:.3} px",
+            r.ball_found,
+            r.ball_eligible,
+            r.ball_distance_error.p50,
+            r.ball_distance_error_cut.p50,
+            r.ball_radius_error_px.p50
+        );
+    }
+    assert!(uncut.raw_r.len() >= 20 && cut.raw_r.len() >= 10);
+    // Achieved levels (see README). Where the skew matters to the radius — close balls cut by
+    // the image side, only one side's outline seen — the correction cuts the radius error by
+    // more than 4 (median) and 2 (p90), and the centre error by more than 5.
+    assert!(med(&cut.fixed_r) * 4.0 <= med(&cut.raw_r));
+    assert!(p90(&cut.fixed_r) * 2.0 <= p90(&cut.raw_r));
+    assert!(med(&cut.fixed_c) * 5.0 <= med(&cut.raw_c));
+    // On whole outlines a shear changes the fitted radius only at second order (≈ k²/8 · r,
+    // 0.1–0.2 px here): less than the classified outline's own bias, so no halving there; the
+    // correction must not cost more than that.
+    assert!(med(&uncut.fixed_r) <= med(&uncut.raw_r) + 0.15);
+    assert!(med(&fp_uncut.fixed_c) * 10.0 <= med(&fp_uncut.raw_c));
+}
+
+/// The evaluation report of `frames` frames of `kind` (seed 7), as `eotn eval` gives it.
+fn eval_report(
+    kind: ScenarioKind,
+    frames: u64,
+    lut: &LookupTable,
+    params: PipelineParams,
+) -> EvalReport {
+    let sim = Simulator::new(Scenario::new(kind, 7));
+    let mut pipeline = Pipeline::new(lut.clone(), params);
+    let mut evals = Vec::new();
+    for i in 0..frames {
+        let f = sim.frame(i).expect("frame");
+        let GroundTruth::Robot(truth) = &f.ground_truth else {
+            continue;
+        };
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        let (w, h) = (f.frame.width() as f64, f.frame.height() as f64);
+        evals.push(evaluate_frame(
+            i as usize,
+            r.recognition,
+            truth,
+            w,
+            h,
+            &EvalParams::default(),
+        ));
+    }
+    EvalReport::from_frames(&evals)
 }
 
 /// Per-ball errors on the rolling ball, for one parameter set.
