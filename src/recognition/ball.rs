@@ -953,6 +953,32 @@ mod tests {
     }
 
     #[test]
+    fn ellipse_fit_gives_the_image_velocity_of_a_moving_ball() {
+        let ctx = level_context();
+        let (c, r, _) = true_ball(&ctx, 45.0, 0.0);
+        // Moving right 0.25 px per line (1200 px/s at 160 lines in 1/30 s), centred on the
+        // reference row.
+        let img = scene(c.0, 80.0, r, 0.25);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let plain = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let plain = plain.ball.expect("plain");
+        assert!(plain.image_velocity_px_s.is_none() && plain.ground_velocity_cm_s.is_none());
+        let params = BallParams {
+            ellipse_fit: true,
+            ..BallParams::default()
+        };
+        let res = recognise_ball(&img, &blobs, &ctx, &params);
+        let ball = res.ball.clone().expect("ball");
+        let v = ball.image_velocity_px_s.expect("velocity");
+        assert!((v[0] - 1200.0).abs() < 120.0 && v[1] == 0.0, "{v:?}");
+        assert!(res.candidates[ball.candidate].ellipse.is_some());
+        // Moving right in the image, straight ahead: to the robot's right on the ground.
+        let g = ball.ground_velocity_cm_s.expect("ground velocity");
+        assert!(g[1] < 0.0 && g[1].abs() > 3.0 * g[0].abs(), "{g:?}");
+        assert!((ball.radius_px - r).abs() <= (plain.radius_px - r).abs() + 0.2);
+    }
+
+    #[test]
     fn soft_orange_joins_and_a_frame_without_orange_has_no_candidates() {
         let ctx = level_context();
         let (c, r, _) = true_ball(&ctx, 80.0, 0.0);

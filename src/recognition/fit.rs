@@ -235,9 +235,9 @@ pub fn fit_sheared_circle(
         }
         if !vertical_shear {
             // Hold the vertical shear: its equation becomes "step = 0".
-            for k in 0..5 {
-                jtj[4][k] = 0.0;
-                jtj[k][4] = 0.0;
+            jtj[4] = [0.0; 5];
+            for row in &mut jtj {
+                row[4] = 0.0;
             }
             jtj[4][4] = jtj[2][2].max(1.0);
             jtr[4] = 0.0;
@@ -336,8 +336,9 @@ fn solve_n(mut m: [[f64; 5]; 5], mut b: [f64; 5]) -> Option<[f64; 5]> {
         b.swap(col, pivot);
         for row in col + 1..5 {
             let f = m[row][col] / m[col][col];
-            for k in col..5 {
-                m[row][k] -= f * m[col][k];
+            let pivot_row = m[col];
+            for (a, p) in m[row].iter_mut().zip(pivot_row).skip(col) {
+                *a -= f * p;
             }
             b[row] -= f * b[col];
         }
@@ -536,7 +537,14 @@ mod tests {
 
     /// Outline points of a circle moving `(ax, ay)` px per line, read row by row like a rolling
     /// shutter: each row's left and right crossing, found at the row's own read-out time.
-    fn moving_outline(cx: f64, cy: f64, r: f64, ax: f64, ay: f64, reference: f64) -> Vec<(Point, f64)> {
+    fn moving_outline(
+        cx: f64,
+        cy: f64,
+        r: f64,
+        ax: f64,
+        ay: f64,
+        reference: f64,
+    ) -> Vec<(Point, f64)> {
         let mut out = Vec::new();
         for row in 0..400 {
             let y = f64::from(row) * 0.5;
@@ -597,11 +605,16 @@ mod tests {
         assert!(fit_sheared_circle(&pts, &rows12, 80.0, true).is_none());
         let mut rows_nan = rows12.clone();
         rows_nan[0] = f64::INFINITY;
-        assert!(fit_sheared_circle(&arc(10.0, 10.0, 5.0, 0.0, 6.0, 12), &rows_nan, 80.0, true).is_none());
+        assert!(
+            fit_sheared_circle(&arc(10.0, 10.0, 5.0, 0.0, 6.0, 12), &rows_nan, 80.0, true)
+                .is_none()
+        );
         assert!(fit_sheared_circle(&[(4.0, 4.0); 8], &[4.0; 8], 80.0, false).is_none());
         // Points all on one row: the shear is undetermined; no panic, and either no fit or an
         // infinite / huge shear error.
-        let one_row: Vec<Point> = (0..8).map(|i| (f64::from(i), 5.0 + f64::from(i % 2))).collect();
+        let one_row: Vec<Point> = (0..8)
+            .map(|i| (f64::from(i), 5.0 + f64::from(i % 2)))
+            .collect();
         if let Some(f) = fit_sheared_circle(&one_row, &[5.0; 8], 80.0, true) {
             assert!(f.shear_x_sd.is_nan() || f.shear_x_sd > 1.0 || f.shear_y_sd > 1.0);
         }

@@ -106,7 +106,9 @@ impl ScenarioKind {
             Self::OrangeClutter => "orange and yellow things off the field, and the real ball",
             Self::BeaconTour => "a robot circles the centre, panning past every beacon",
             Self::OverheadGame => "overhead view of 4-8 robots and the ball, with world models",
-            Self::ClosePans => "fast head pans past a close ball (30-80 px): strong skew, cut sides",
+            Self::ClosePans => {
+                "fast head pans past a close ball (30-80 px): strong skew, cut sides"
+            }
             Self::RollingBall => "the ball rolls across a still camera at 1-3 m/s",
         }
     }
@@ -300,15 +302,12 @@ impl Scenario {
                     clippy::cast_sign_loss,
                     reason = "small, clamped to ≥ 0"
                 )]
-                let k = (cycle + 1.0).max(0.0) as usize
-                    + usize::try_from(self.seed % 7).unwrap_or(0);
+                let k =
+                    (cycle + 1.0).max(0.0) as usize + usize::try_from(self.seed % 7).unwrap_or(0);
                 let d = SPOTS_CM[k % SPOTS_CM.len()] + 2.0 * j[0];
                 let bearing = 0.25 + 0.05 * j[1];
                 let pose = RobotPose::new(-60.0, 20.0, 0.0);
-                let ball = Ball::at(
-                    pose.x_cm + d * bearing.cos(),
-                    pose.y_cm + d * bearing.sin(),
-                );
+                let ball = Ball::at(pose.x_cm + d * bearing.cos(), pose.y_cm + d * bearing.sin());
                 scene.ball = Some(ball);
                 let body = BodyPose::ERS7_STANCE;
                 let track = look_at(&pose, &body, &Point::new(ball.x_cm, ball.y_cm, 4.25));
@@ -628,6 +627,24 @@ mod tests {
         }
         let game = Scenario::new(ScenarioKind::OverheadGame, 9).scene_at(2.0);
         assert!((4..=8).contains(&game.robots.len()));
+    }
+
+    #[test]
+    fn the_rolling_ball_rolls_at_one_to_three_metres_a_second() {
+        let s = Scenario::new(ScenarioKind::RollingBall, 7);
+        assert!(s.ball_moves_during_readout());
+        let mut speeds: Vec<f64> = (0..120)
+            .filter_map(|k| s.ball_velocity_cm_s(f64::from(k) / 30.0 + 0.01))
+            .map(|v| v[0].hypot(v[1]))
+            .collect();
+        speeds.sort_by(f64::total_cmp);
+        assert!(
+            speeds[5] >= 99.0 && speeds[speeds.len() - 5] <= 301.0,
+            "{speeds:?}"
+        );
+        let still = Scenario::new(ScenarioKind::FastPans, 7);
+        assert!(!still.ball_moves_during_readout());
+        assert_eq!(still.ball_velocity_cm_s(1.0), Some([0.0, 0.0]));
     }
 
     #[test]

@@ -155,10 +155,7 @@ pub fn add_ball_velocity(
         ))
     };
     ball.image_velocity_px_s = match (at(-1.0), at(1.0)) {
-        (Some(a), Some(b)) => Some([
-            (b.x_px - a.x_px) / (2.0 * h),
-            (b.y_px - a.y_px) / (2.0 * h),
-        ]),
+        (Some(a), Some(b)) => Some([(b.x_px - a.x_px) / (2.0 * h), (b.y_px - a.y_px) / (2.0 * h)]),
         _ => None,
     };
 }

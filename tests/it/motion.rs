@@ -48,9 +48,7 @@ fn outline_truth(
     pattern: EdgeScanPattern,
 ) -> Option<((f64, f64), f64)> {
     let camera = PinholeCamera::ers7();
-    let field_from_camera: Transform<Field, Camera> = truth
-        .body
-        .field_from_body(&truth.robot_pose)
+    let field_from_camera: Transform<Field, Camera> = truth.body.field_from_body(&truth.robot_pose)
         * Ers7Dimensions::ERS7.body_from_camera(&truth.joints);
     let [x, y] = ball.relative.field_cm;
     let c = (field_from_camera.inverse() * Point::<Field>::new(x, y, 4.25)).coords;
@@ -468,16 +466,15 @@ fn ellipse_fit_measures_a_rolling_ball() {
     across.recognition.ball.ellipse_fit = true;
     let mut both = across;
     both.recognition.ball.ellipse_vertical_shear = true;
-    let (eligible, e) = moving_errors(
-        ScenarioKind::RollingBall,
-        150,
-        &lut,
-        &[plain, across, both],
-    );
+    let (eligible, e) = moving_errors(ScenarioKind::RollingBall, 150, &lut, &[plain, across, both]);
     eprintln!("rolling-ball: {eligible} eligible balls");
-    for (name, e) in ["plain circle", "ellipse fit", "ellipse fit + vertical shear"]
-        .iter()
-        .zip(&e)
+    for (name, e) in [
+        "plain circle",
+        "ellipse fit",
+        "ellipse fit + vertical shear",
+    ]
+    .iter()
+    .zip(&e)
     {
         eprintln!("rolling-ball, {name}: {}", e.line());
     }
@@ -485,10 +482,17 @@ fn ellipse_fit_measures_a_rolling_ball() {
     let (plain_e, fit_e) = (&e[0], &e[1]);
     assert!(eligible >= 30 && fit_e.found >= plain_e.found);
     assert!(plain_e.vx.is_empty(), "no velocity without the ellipse fit");
-    assert!(fit_e.vx.len() * 4 >= fit_e.centre.len() * 3, "velocity for most balls");
+    assert!(
+        fit_e.vx.len() * 4 >= fit_e.centre.len() * 3,
+        "velocity for most balls"
+    );
     // Achieved levels (see README).
     assert!(med(&fit_e.vx_rel) <= 0.15, "{}", fit_e.line());
-    assert!(med(&fit_e.centre) < med(&plain_e.centre), "{}", fit_e.line());
+    assert!(
+        med(&fit_e.centre) < med(&plain_e.centre),
+        "{}",
+        fit_e.line()
+    );
 
     // On the camera's own motion (no ball motion) the ellipse fit should find no velocity.
     let (_, still) = moving_errors(ScenarioKind::ClosePans, 150, &lut, &[plain, across]);
