@@ -10,6 +10,7 @@ use egui::{Color32, Context, RichText, Ui};
 
 use super::state::{AppState, Command, Window};
 use crate::recognition::confidence::{Confidence, TestOutcome};
+use crate::recognition::draw::owner;
 use crate::recognition::scan::CutOff;
 use crate::recognition::{Recognition, Relative};
 
@@ -97,7 +98,7 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
             _ => (c.camera, None),
         };
         out.push(CandidateInfo {
-            owner: format!("ball#{i}"),
+            owner: owner::ball(i),
             kind: "ball".to_owned(),
             accepted: c.accepted,
             reason: reason(&c.confidence, c.accepted),
@@ -135,7 +136,7 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
                 .map(|p| format!("post refused: {p}")),
         );
         out.push(CandidateInfo {
-            owner: format!("goal:{}#{i}", g.colour.name()),
+            owner: owner::goal(g.colour, i),
             kind: format!("{} goal", g.colour.name()),
             accepted: g.accepted,
             reason: reason(&g.confidence, g.accepted),
@@ -149,7 +150,7 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
     }
     for (i, b) in r.beacons.iter().enumerate() {
         out.push(CandidateInfo {
-            owner: format!("beacon#{i}"),
+            owner: owner::beacon(i),
             kind: format!("beacon {}", b.kind.name()),
             accepted: b.accepted,
             reason: reason(&b.confidence, b.accepted),

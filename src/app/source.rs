@@ -119,11 +119,11 @@ impl Source {
     #[must_use]
     pub fn label(&self) -> String {
         match &self.kind {
-            Kind::Files(f) if f.paths.len() == 1 => file_name(&f.paths[0]),
+            Kind::Files(f) if f.paths.len() == 1 => crate::frame::display_name(&f.paths[0]),
             Kind::Files(f) => format!("{} frame files", f.paths.len()),
             Kind::Stream(s) => {
                 let info = s.reader.info();
-                format!("{} ({})", file_name(&s.path), info.source)
+                format!("{} ({})", crate::frame::display_name(&s.path), info.source)
             }
         }
     }
@@ -257,7 +257,7 @@ impl Source {
                     .with_context(|| format!("frame {index}"))?;
                 // What the reader repaired in this frame (NaN readings read as missing, bad
                 // JSON skipped) belongs to this frame's warnings too.
-                let label = file_name(&s.path);
+                let label = crate::frame::display_name(&s.path);
                 let mut warnings: Vec<String> = s.reader.warnings()
                     [seen.min(s.reader.warnings().len())..]
                     .iter()
@@ -355,15 +355,6 @@ fn non_finite_keys(text: &str, value: &serde_json::Value) -> Vec<String> {
         })
         .map(|(k, _)| k.clone())
         .collect()
-}
-
-/// The file name of a path, for labels.
-#[must_use]
-pub fn file_name(path: &Path) -> String {
-    path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    )
 }
 
 #[cfg(test)]

@@ -10,13 +10,14 @@ use anyhow::Context as _;
 use serde::{Deserialize, Serialize};
 
 use super::journal::{self, JournalEntry, now_unix_ms};
-use super::source::{LoadedFrame, Source, file_name};
+use super::source::{LoadedFrame, Source};
 use crate::blobs::{Blob, BlobSet, Connectivity};
 use crate::classify::ClassifiedImage;
 use crate::frame::{Frame, Yuv, save_rgb_png, yuv_to_rgb};
 use crate::lut::edit::Selection;
 use crate::lut::{ColourClass, EditHistory, EditRecord, LookupTable, Region, Sensitivity};
 use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::draw::owner;
 use crate::recognition::{LineRole, Primitive, Recognition};
 use crate::sensors::SensorReadings;
 
@@ -1102,7 +1103,7 @@ impl AppState {
         let table = self
             .table_path
             .as_deref()
-            .map_or_else(|| "untitled table".to_owned(), file_name);
+            .map_or_else(|| "untitled table".to_owned(), crate::frame::display_name);
         let mark = if self.dirty { " *" } else { "" };
         let source = self
             .source
@@ -1617,18 +1618,18 @@ fn accepted_owners(r: &Recognition) -> Vec<String> {
     let balls = r.ball.candidates.iter().enumerate();
     let balls = balls
         .filter(|(_, c)| c.accepted)
-        .map(|(i, _)| format!("ball#{i}"));
+        .map(|(i, _)| owner::ball(i));
     let goals = r
         .goals
         .candidates
         .iter()
         .enumerate()
         .filter(|(_, c)| c.accepted);
-    let goals = goals.map(|(i, c)| format!("goal:{}#{i}", c.colour.name()));
+    let goals = goals.map(|(i, c)| owner::goal(c.colour, i));
     let beacons = r.beacons.iter().enumerate().filter(|(_, b)| b.accepted);
     balls
         .chain(goals)
-        .chain(beacons.map(|(i, _)| format!("beacon#{i}")))
+        .chain(beacons.map(|(i, _)| owner::beacon(i)))
         .collect()
 }
 

@@ -4,27 +4,20 @@
 //! [`Pipeline`] the app uses, with every stage timed separately. Reported figures are medians
 //! over all timed repetitions of all frames, in ns per pixel and ms per frame.
 
-use std::path::PathBuf;
 use std::time::Duration;
 
 use serde::Serialize;
 
-use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
+use super::inputs::{InputArgs, parse_connectivity, progress};
 use crate::blobs::Connectivity;
 use crate::pipeline::{Pipeline, PipelineParams};
 
 /// Arguments of `eotn bench`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`).
-    #[arg(required = true)]
-    pub frames: Vec<PathBuf>,
-    /// Lookup table (`.lut`).
-    #[arg(long)]
-    pub lut: PathBuf,
-    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred.
-    #[arg(long, value_parser = parse_size)]
-    pub size: Option<(usize, usize)>,
+    /// Frames, table and raw frame size.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// 8: diagonal neighbours join a blob; 4: they do not.
     #[arg(long, default_value = "8", value_parser = parse_connectivity)]
     pub connectivity: Connectivity,
@@ -85,9 +78,9 @@ fn ns_per_px(d: Duration, pixels: usize) -> f64 {
 /// # Errors
 /// Unreadable inputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let lut = load_lut_arg(&args.lut)?;
+    let (lut, mut inputs) = args.input.open()?;
     let bits = lut.bits();
-    let mut inputs = FrameInputs::open(&args.frames, None)?;
+
     let connectivity = args.connectivity;
     let mut pipeline = Pipeline::new(
         lut,
@@ -101,7 +94,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut pixels = 0;
     let bar = progress(inputs.len(), "bench");
     for i in 0..inputs.len() {
-        let frame = inputs.load(i, args.size)?;
+        let frame = inputs.load(i, args.input.size)?;
         pixels = frame.pixel_count();
         for _ in 0..args.warmup {
             pipeline.process_frame(&frame);

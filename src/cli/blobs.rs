@@ -1,27 +1,20 @@
 //! `eotn blobs`: blobs of classified frames, as a table or as peer-compatible JSON Lines.
 
 use std::io::Write;
-use std::path::PathBuf;
 
 use anyhow::Context;
 use serde::Serialize;
 
-use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
+use super::inputs::{InputArgs, parse_connectivity, progress};
 use crate::blobs::{Blob, BlobSet, Connectivity};
 use crate::classify::ClassifiedImage;
 
 /// Arguments of `eotn blobs`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`).
-    #[arg(required = true)]
-    pub frames: Vec<PathBuf>,
-    /// Lookup table (`.lut`, 6, 7 or 8 bits per channel).
-    #[arg(long)]
-    pub lut: PathBuf,
-    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred from the file length.
-    #[arg(long, value_parser = parse_size)]
-    pub size: Option<(usize, usize)>,
+    /// Frames, table and raw frame size.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// 8: diagonal neighbours join a blob; 4: they do not.
     #[arg(long, default_value = "8", value_parser = parse_connectivity)]
     pub connectivity: Connectivity,
@@ -90,8 +83,8 @@ pub fn peer_sorted(blobs: impl Iterator<Item = Blob>, min_pixels: u32) -> Vec<Bl
 /// # Errors
 /// Unreadable or malformed inputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let lut = load_lut_arg(&args.lut)?;
-    let mut inputs = FrameInputs::open(&args.frames, None)?;
+    let (lut, mut inputs) = args.input.open()?;
+
     let connectivity = args.connectivity;
     let mut classified = ClassifiedImage::default();
     let mut set = BlobSet::default();
@@ -99,7 +92,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "blobs");
     for i in 0..inputs.len() {
-        let frame = inputs.load(i, args.size)?;
+        let frame = inputs.load(i, args.input.size)?;
         crate::classify::classify_into(&frame, &lut, &mut classified);
         set.find(&classified, connectivity);
         let blobs = peer_sorted(set.active().copied(), args.min_pixels);

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::inputs::{FrameInputs, load_lut_arg, parse_size, progress};
+use super::inputs::{InputArgs, progress};
 use crate::classify::ClassifiedImage;
 use crate::frame::save_rgb_png;
 use crate::lut::ColourClass;
@@ -14,15 +14,9 @@ use crate::lut::ColourClass;
 /// Arguments of `eotn classify`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`).
-    #[arg(required = true)]
-    pub frames: Vec<PathBuf>,
-    /// Lookup table (`.lut`).
-    #[arg(long)]
-    pub lut: PathBuf,
-    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred.
-    #[arg(long, value_parser = parse_size)]
-    pub size: Option<(usize, usize)>,
+    /// Frames, table and raw frame size.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Folder for the outputs (`NAME.classified.png`, and `NAME.cls` with `--raw`); created if
     /// missing. Without it nothing is written (useful with `--json`).
     #[arg(short, long)]
@@ -40,8 +34,8 @@ pub struct Args {
 /// # Errors
 /// Unreadable inputs or unwritable outputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let lut = load_lut_arg(&args.lut)?;
-    let mut inputs = FrameInputs::open(&args.frames, None)?;
+    let (lut, mut inputs) = args.input.open()?;
+
     if let Some(dir) = &args.output {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create folder", dir.display()))?;
@@ -51,7 +45,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "classify");
     for i in 0..inputs.len() {
-        let frame = inputs.load(i, args.size)?;
+        let frame = inputs.load(i, args.input.size)?;
         crate::classify::classify_into(&frame, &lut, &mut img);
         let name = inputs.name(i);
         if let Some(dir) = &args.output {

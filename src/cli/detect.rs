@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use serde::Serialize;
 
-use super::inputs::{FrameInputs, load_lut_arg, parse_connectivity, parse_size, progress};
+use super::inputs::{InputArgs, parse_connectivity, progress};
 use crate::blobs::Connectivity;
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::{GoalCandidate, Recognition, Relative};
@@ -16,16 +16,9 @@ use crate::sensors::SensorReadings;
 /// Arguments of `eotn detect`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (which carry their own
-    /// sensor readings).
-    #[arg(required = true)]
-    pub frames: Vec<PathBuf>,
-    /// Lookup table (`.lut`).
-    #[arg(long)]
-    pub lut: PathBuf,
-    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred from the file length.
-    #[arg(long, value_parser = parse_size)]
-    pub size: Option<(usize, usize)>,
+    /// Frames, table and raw frame size.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Sensor readings for raw frames: a JSON file holding one object with the fields of the
     /// sensor schema (applies to every frame) or an array of such objects in frame order.
     #[arg(long)]
@@ -310,13 +303,24 @@ pub fn load_params(
         .with_context(|| format!("{}: not valid recognition parameters", path.display()))
 }
 
+/// The sensor readings for frame `i`: the stream's own when it has them, else the `--sensors`
+/// file's (one entry for every frame, or one per frame in order).
+#[must_use]
+pub fn readings_for<'a>(
+    recorded: Option<&'a SensorReadings>,
+    file: Option<&'a [SensorReadings]>,
+    i: usize,
+) -> Option<&'a SensorReadings> {
+    recorded.or_else(|| file.and_then(|s| if s.len() == 1 { s.first() } else { s.get(i) }))
+}
+
 /// Runs `eotn detect`.
 ///
 /// # Errors
 /// Unreadable or malformed inputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let lut = load_lut_arg(&args.lut)?;
-    let mut inputs = FrameInputs::open(&args.frames, None)?;
+    let (lut, mut inputs) = args.input.open()?;
+
     let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
     let params = PipelineParams {
         connectivity: args.connectivity,
@@ -328,11 +332,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "detect");
     for i in 0..inputs.len() {
-        let (frame, recorded) = inputs.load_with_sensors(i, args.size)?;
-        let from_file = sensors
-            .as_ref()
-            .and_then(|s| if s.len() == 1 { s.first() } else { s.get(i) });
-        let readings = recorded.as_ref().or(from_file);
+        let (frame, recorded) = inputs.load_with_sensors(i, args.input.size)?;
+        let readings = readings_for(recorded.as_ref(), sensors.as_deref(), i);
         let result = pipeline.process(&frame, readings);
         let us = result.timings.recognition.as_secs_f64() * 1e6;
         let line = detect_json(inputs.name(i), result.recognition, us, args.evidence);

@@ -169,10 +169,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut global = 0usize;
     for path in &args.streams {
         let mut reader = StreamReader::open(path)?;
-        let name = path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
+        let name = crate::frame::display_name(path);
         let bar = super::inputs::progress(reader.len(), "eval");
         for i in 0..reader.len() {
             bar.inc(1);

@@ -27,10 +27,7 @@ pub fn run(log_path: &Path, output: &Path, options: WriterOptions) -> anyhow::Re
              one pixel per YUYV macropixel, every second camera row), joint and sensor data; \
              raw records on {RAW_TOPIC}. This product includes software developed by B-Human \
              (http://www.b-human.de); see streams/LICENSE-bhuman2009.txt.",
-            log_path.file_name().map_or_else(
-                || log_path.display().to_string(),
-                |n| n.to_string_lossy().into()
-            ),
+            crate::frame::display_name(log_path),
             log.frames.len()
         ),
     };

@@ -138,7 +138,7 @@ impl FrameInput {
     #[must_use]
     pub fn name(&self) -> String {
         match self {
-            Self::File(p) => frame_name(p),
+            Self::File(p) => crate::frame::display_name(p),
             Self::Stream { path, index } => {
                 let stem = path
                     .file_stem()
@@ -146,6 +146,34 @@ impl FrameInput {
                 format!("{stem}_{index:06}")
             }
         }
+    }
+}
+
+/// The arguments every frame-processing command takes (`classify`, `blobs`, `bench`, `detect`,
+/// `render`), flattened into each command's own arguments.
+#[derive(Debug, clap::Args)]
+pub struct InputArgs {
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`, which carry
+    /// their own sensor readings).
+    #[arg(required = true)]
+    pub frames: Vec<PathBuf>,
+    /// Lookup table (`.lut`, 6, 7 or 8 bits per channel).
+    #[arg(long)]
+    pub lut: PathBuf,
+    /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred from the file length.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+}
+
+impl InputArgs {
+    /// Loads the table and opens the frames, the first step of every frame command.
+    ///
+    /// # Errors
+    /// An unreadable table or frame file, naming it.
+    pub fn open(&self) -> anyhow::Result<(LookupTable, FrameInputs)> {
+        let lut = load_lut_arg(&self.lut)?;
+        let inputs = FrameInputs::open(&self.frames, None)?;
+        Ok((lut, inputs))
     }
 }
 
@@ -287,15 +315,6 @@ pub fn progress(len: usize, what: &str) -> ProgressBar {
     bar
 }
 
-/// The name of a frame file for JSON output: the file name without folders.
-#[must_use]
-pub fn frame_name(path: &Path) -> String {
-    path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -316,7 +335,7 @@ mod tests {
             std::fs::write(dir.path().join(n), b"").unwrap();
         }
         let got = expand_frame_paths(&[dir.path().to_owned()]).unwrap();
-        let names: Vec<_> = got.iter().map(|p| frame_name(p)).collect();
+        let names: Vec<_> = got.iter().map(|p| crate::frame::display_name(p)).collect();
         assert_eq!(names, ["a.uyvy", "b.uyvy", "c.png"]);
         assert!(expand_frame_paths(&[dir.path().join("nope")]).is_err());
     }

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::detect::{load_params, load_sensor_file};
-use super::inputs::{FrameInputs, load_lut_arg, parse_size};
+use super::detect::{load_params, load_sensor_file, readings_for};
+use super::inputs::InputArgs;
 use crate::frame::save_rgb_png;
 use crate::overlay::Canvas;
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -47,19 +47,12 @@ pub enum Overlay {
 /// Arguments of `eotn render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (which carry their own
-    /// sensor readings).
-    #[arg(required = true)]
-    pub frames: Vec<PathBuf>,
-    /// Lookup table (`.lut`).
-    #[arg(long)]
-    pub lut: PathBuf,
+    /// Frames, table and raw frame size.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Output folder; one PNG per frame, named after it.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Frame size of raw files, WxH.
-    #[arg(long, value_parser = parse_size)]
-    pub size: Option<(usize, usize)>,
     /// Sensor readings JSON (as for `eotn detect`).
     #[arg(long)]
     pub sensors: Option<PathBuf>,
@@ -101,8 +94,8 @@ fn wanted(overlays: &[Overlay], p: &Primitive) -> bool {
 /// # Errors
 /// Unreadable inputs or an unwritable output, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let lut = load_lut_arg(&args.lut)?;
-    let mut inputs = FrameInputs::open(&args.frames, None)?;
+    let (lut, mut inputs) = args.input.open()?;
+
     let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
     let params = PipelineParams {
         recognition: load_params(args.params.as_deref())?,
@@ -112,11 +105,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
     let mut pipeline = Pipeline::new(lut, params);
     for i in 0..inputs.len() {
-        let (frame, recorded) = inputs.load_with_sensors(i, args.size)?;
-        let from_file = sensors
-            .as_ref()
-            .and_then(|s| if s.len() == 1 { s.first() } else { s.get(i) });
-        let readings = recorded.as_ref().or(from_file);
+        let (frame, recorded) = inputs.load_with_sensors(i, args.input.size)?;
+        let readings = readings_for(recorded.as_ref(), sensors.as_deref(), i);
         let result = pipeline.process(&frame, readings);
         let (w, h) = (frame.width(), frame.height());
         let base = match args.view {

@@ -56,11 +56,18 @@ impl FrameSource {
     /// The file name without folders, for messages and the JSON `frame` field.
     #[must_use]
     pub fn name(&self) -> String {
-        self.path.file_name().map_or_else(
-            || self.path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        )
+        display_name(&self.path)
     }
+}
+
+/// A file's name without its folders, for messages, labels and the JSON `frame` field; the whole
+/// path when it has no file name (such as `..`).
+#[must_use]
+pub fn display_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }
 
 /// The frame size a raw UYVY file of `len` bytes has when none is given: 208×160 or 640×480.

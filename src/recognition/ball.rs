@@ -788,7 +788,7 @@ impl BallResult {
     pub fn primitives(&self) -> Vec<Primitive> {
         let mut out = Vec::new();
         for (i, c) in self.candidates.iter().enumerate() {
-            let owner = format!("ball#{i}");
+            let owner = super::draw::owner::ball(i);
             out.push(Primitive::Box {
                 owner: owner.clone(),
                 colour: ColourClass::Orange.code(),

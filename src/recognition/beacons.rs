@@ -195,7 +195,7 @@ pub fn recognise_beacons(blobs: &BlobSet, ctx: &ViewContext, p: &BeaconParams) -
 pub fn beacon_primitives(beacons: &[Beacon]) -> Vec<Primitive> {
     let mut out = Vec::new();
     for (i, b) in beacons.iter().enumerate() {
-        let owner = format!("beacon#{i}");
+        let owner = super::draw::owner::beacon(i);
         out.push(Primitive::Box {
             owner: owner.clone(),
             colour: ColourClass::Pink.code(),

@@ -6,6 +6,31 @@
 use serde::{Deserialize, Serialize};
 
 use super::fit::Point;
+use crate::lut::ColourClass;
+
+/// The `owner` names of primitives, made in one place so that recognition, the app's selection
+/// and its object inspector always agree on them. `i` is the candidate's index in its list.
+pub mod owner {
+    use super::ColourClass;
+
+    /// A ball candidate: `ball#i`.
+    #[must_use]
+    pub fn ball(i: usize) -> String {
+        format!("ball#{i}")
+    }
+
+    /// A goal candidate of a goal colour: `goal:yellow#i`.
+    #[must_use]
+    pub fn goal(colour: ColourClass, i: usize) -> String {
+        format!("goal:{}#{i}", colour.name())
+    }
+
+    /// A beacon candidate: `beacon#i`.
+    #[must_use]
+    pub fn beacon(i: usize) -> String {
+        format!("beacon#{i}")
+    }
+}
 
 /// One thing to draw over the image.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -971,7 +971,7 @@ impl GoalResult {
     pub fn primitives(&self) -> Vec<Primitive> {
         let mut out = Vec::new();
         for (i, c) in self.candidates.iter().enumerate() {
-            let owner = format!("goal:{}#{i}", c.colour.name());
+            let owner = super::draw::owner::goal(c.colour, i);
             out.push(Primitive::Box {
                 owner: owner.clone(),
                 colour: c.colour.code(),

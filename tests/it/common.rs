@@ -46,28 +46,29 @@ pub fn eotn(args: &[&std::ffi::OsStr]) -> Output {
 /// A python3 that has numpy and OpenCV, or `None` (with a "skipped" line) outside CI.
 /// Under `CI=true` their absence fails the test: the cross-check must never skip silently there.
 pub fn python_with_opencv() -> Option<PathBuf> {
-    let python = PathBuf::from(std::env::var_os("PYTHON").unwrap_or_else(|| "python3".into()));
-    let ok = Command::new(&python)
-        .args(["-c", "import numpy, cv2"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        return Some(python);
-    }
-    assert!(
-        !in_ci(),
-        "python3 with numpy and opencv-python-headless is required under CI=true (pip install numpy opencv-python-headless)"
-    );
-    eprintln!("SKIPPED: python3 with numpy + OpenCV not found; the peer cross-check did not run");
-    None
+    python_with(
+        "import numpy, cv2",
+        "numpy and opencv-python-headless",
+        "the peer cross-check",
+    )
 }
 
 /// A python3 with the `mcap` and `mcap_protobuf` readers (an independent MCAP implementation),
 /// or `None` (with a "skipped" line) outside CI. Under `CI=true` their absence fails the test.
 pub fn python_with_mcap() -> Option<PathBuf> {
+    python_with(
+        "import mcap, mcap_protobuf",
+        "mcap and mcap-protobuf-support",
+        "the independent-reader cross-check",
+    )
+}
+
+/// `$PYTHON` (default `python3`) when `import_line` runs in it; else fails under CI and skips
+/// with a line saying which `check` did not run.
+fn python_with(import_line: &str, packages: &str, check: &str) -> Option<PathBuf> {
     let python = PathBuf::from(std::env::var_os("PYTHON").unwrap_or_else(|| "python3".into()));
     let ok = Command::new(&python)
-        .args(["-c", "import mcap, mcap_protobuf"])
+        .args(["-c", import_line])
         .output()
         .is_ok_and(|o| o.status.success());
     if ok {
@@ -75,10 +76,8 @@ pub fn python_with_mcap() -> Option<PathBuf> {
     }
     assert!(
         !in_ci(),
-        "python3 with mcap and mcap-protobuf-support is required under CI=true (pip install mcap mcap-protobuf-support)"
+        "python3 with {packages} is required under CI=true (scripts/deps.sh installs them)"
     );
-    eprintln!(
-        "SKIPPED: python3 with the mcap + mcap_protobuf readers not found; the independent-reader cross-check did not run"
-    );
+    eprintln!("SKIPPED: python3 with {packages} not found; {check} did not run");
     None
 }
