@@ -6,6 +6,7 @@
 mod app;
 mod cli;
 mod common;
+mod motion;
 mod peer;
 mod real_data;
 mod recognition;
