@@ -731,8 +731,8 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
 /// Prints one CSV line per correctly matched ball (prefix `BIAS,`) for studying the distance
 /// error's sign: `EOTN_BIAS_FRAMES=180 cargo test --test it ball_distance_bias -- --ignored
 /// --nocapture`. Columns: scenario, seed, frame, true distance, true radius, true centre x/y,
-/// cut, measured distance, radius, centre x/y, from circle fit, size-only distance, blob box
-/// width/height, truth box width/height.
+/// cut, measured distance, radius, centre x/y, from circle fit, the original's d × 8.5 /
+/// diameter, blob box width/height, truth box width/height, ground-plane distance.
 #[test]
 #[ignore = "a measuring aid, not a check"]
 fn ball_distance_bias() {
@@ -813,7 +813,10 @@ fn ball_distance_bias() {
     }
 }
 
-/// Which of the ball's true pixels classification loses, and to what (temporary study).
+/// Which of the ball's true pixels classification loses, and to what, by where they are on the
+/// ball (top/bottom rim, left/right rim with the UYVY chroma partner on or off the ball,
+/// inside): how the half-pixel rim loss behind the long ball distances was found.
+/// `cargo test --test it ball_rim_study -- --ignored --nocapture`.
 #[test]
 #[ignore = "a measuring aid, not a check"]
 fn ball_rim_study() {
