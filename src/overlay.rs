@@ -7,7 +7,7 @@
 //! readable on 208×160 frames.
 
 use crate::lut::classes::code_display_rgb;
-use crate::recognition::{LineRole, Primitive};
+use crate::recognition::{CircleRole, LineRole, Primitive};
 
 /// Outlines the inclusive pixel box `[minx, miny, maxx, maxy]` on a packed RGB image of
 /// `width` × `height` at its own resolution (one-pixel lines), clamped to the image: blob boxes in
@@ -102,15 +102,24 @@ impl Canvas {
 
     /// A circle in source-image pixels.
     pub fn circle(&mut self, centre: (f64, f64), r: f64, c: [u8; 3]) {
+        self.circle_dashed(centre, r, c, None);
+    }
+
+    /// A circle in source-image pixels; with `dash` = Some(n), drawn as dashes n output pixels
+    /// long with equal gaps.
+    pub fn circle_dashed(&mut self, centre: (f64, f64), r: f64, c: [u8; 3], dash: Option<usize>) {
         if !(r.is_finite() && r > 0.0) {
             return;
         }
+        // One segment per output pixel of circumference.
         let n = ((r * self.scale as f64 * 6.3).ceil() as usize).clamp(8, 20_000);
         let mut prev = (centre.0 + r, centre.1);
         for i in 1..=n {
             let t = i as f64 / n as f64 * std::f64::consts::TAU;
             let p = (centre.0 + r * t.cos(), centre.1 + r * t.sin());
-            self.line(prev, p, c);
+            if dash.is_none_or(|d| (i - 1) / d.max(1) % 2 == 0) {
+                self.line(prev, p, c);
+            }
             prev = p;
         }
     }
@@ -149,8 +158,17 @@ impl Canvas {
                         );
                     }
                 }
-                Primitive::Circle { center, radius, .. } => {
-                    self.circle(*center, *radius, [255, 255, 0])
+                Primitive::Circle {
+                    center,
+                    radius,
+                    role,
+                    ..
+                } => {
+                    let dash = match role {
+                        CircleRole::Observed => None,
+                        CircleRole::SkewCorrected => Some(3),
+                    };
+                    self.circle_dashed(*center, *radius, [255, 255, 0], dash);
                 }
                 Primitive::Line { role, from, to, .. } => {
                     let c = match role {
@@ -191,6 +209,7 @@ mod tests {
                 owner: "c".into(),
                 center: (5.0, 5.0),
                 radius: 3.0,
+                role: CircleRole::Observed,
             },
         ]);
         let at = |x: usize, y: usize| &c.rgb[(y * 20 + x) * 3..(y * 20 + x) * 3 + 3];
@@ -202,5 +221,26 @@ mod tests {
             "circle's right edge at x = 8 source px"
         );
         assert!(Canvas::from_rgb(10, 10, &[0u8; 299], 1).is_none());
+    }
+
+    #[test]
+    fn a_skew_corrected_circle_is_dashed() {
+        let yellow = |c: &Canvas| c.rgb.chunks(3).filter(|p| p == &[255, 255, 0]).count();
+        let draw = |role| {
+            let mut c = Canvas::from_rgb(40, 40, &[0u8; 40 * 40 * 3], 2).expect("canvas");
+            c.draw(&[Primitive::Circle {
+                owner: "ball#0".into(),
+                center: (20.0, 20.0),
+                radius: 12.0,
+                role,
+            }]);
+            yellow(&c)
+        };
+        let (solid, dashed) = (draw(CircleRole::Observed), draw(CircleRole::SkewCorrected));
+        assert!(solid > 100, "{solid}");
+        assert!(
+            dashed * 10 > solid * 3 && dashed * 10 < solid * 7,
+            "about half drawn: {dashed} of {solid}"
+        );
     }
 }

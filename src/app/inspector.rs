@@ -92,6 +92,16 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
             (None, Some(why)) => notes.push(format!("no circle fit: {why}")),
             (None, None) => {}
         }
+        let (seen, fixed) = (c.observed_center, c.center);
+        notes.push(if (seen.0 - fixed.0).hypot(seen.1 - fixed.1) > 0.5 {
+            format!(
+                "centre ({:.1}, {:.1}) px in the image; ({:.1}, {:.1}) px skew-corrected \
+                     (dashed circle)",
+                seen.0, seen.1, fixed.0, fixed.1
+            )
+        } else {
+            format!("centre ({:.1}, {:.1}) px", fixed.0, fixed.1)
+        });
         // The accepted ball may carry a fused (ground-plane) placement.
         let (camera, body) = match &r.ball.ball {
             Some(b) if b.candidate == i => (b.camera, b.body),

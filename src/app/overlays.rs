@@ -9,7 +9,7 @@ use egui::{
 
 use super::state::{AppState, PrimitiveFilter, ViewKind, box_colour};
 use crate::blobs::Blob;
-use crate::recognition::{LineRole, Primitive};
+use crate::recognition::{CircleRole, LineRole, Primitive};
 
 /// Alpha of the overlays of objects other than the selected one.
 const DIMMED_ALPHA: f32 = 0.25;
@@ -301,10 +301,34 @@ pub fn paint_primitives(
                 }
                 painter.add(mesh);
             }
-            Primitive::Circle { center, radius, .. } => {
+            Primitive::Circle {
+                center,
+                radius,
+                role,
+                ..
+            } => {
                 let r = (*radius as f32) * xf.zoom;
-                if r.is_finite() && r > 0.0 {
-                    painter.circle_stroke(at(*center), r, stroke);
+                if !(r.is_finite() && r > 0.0) {
+                    continue;
+                }
+                match role {
+                    CircleRole::Observed => {
+                        painter.circle_stroke(at(*center), r, stroke);
+                    }
+                    CircleRole::SkewCorrected => {
+                        // Thin and dashed: where the skew correction puts the ball, beside
+                        // the solid circle on the ball's pixels.
+                        let c = at(*center);
+                        let n = ((r * 0.8) as usize).clamp(16, 256);
+                        let pts: Vec<Pos2> = (0..=n)
+                            .map(|i| {
+                                let t = i as f32 / n as f32 * std::f32::consts::TAU;
+                                c + vec2(r * t.cos(), r * t.sin())
+                            })
+                            .collect();
+                        let thin = Stroke::new(width * 0.6, colour);
+                        painter.extend(egui::Shape::dashed_line(&pts, thin, 4.0, 3.0));
+                    }
                 }
             }
             Primitive::Line { from, to, .. } => {

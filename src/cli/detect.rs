@@ -85,6 +85,12 @@ pub struct BallJson {
     pub cut_off: Vec<&'static str>,
     /// Whether a circle fit gave centre and radius.
     pub from_circle_fit: bool,
+    /// The ball's own image velocity `[x, y]`, pixels per second, from the ellipse fit (null
+    /// unless `ball.ellipse_fit` is on and the fit was determined).
+    pub image_velocity_px_s: Option<[f64; 2]>,
+    /// That velocity on the ground in the robot's frame `[ahead, left]`, cm/s (null without it
+    /// or without the camera pose).
+    pub ground_velocity_cm_s: Option<[f64; 2]>,
 }
 
 /// A goal post in `--json` output.
@@ -239,6 +245,8 @@ pub fn detect_json(
             confidence: b.confidence,
             cut_off: sides(b.cut_off),
             from_circle_fit: b.from_circle_fit,
+            image_velocity_px_s: b.image_velocity_px_s,
+            ground_velocity_cm_s: b.ground_velocity_cm_s,
         }),
         goals: r.goals.goals().map(goal_json).collect(),
         beacons: r

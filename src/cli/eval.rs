@@ -344,6 +344,13 @@ fn print_summary(o: &EvalOutput) {
         r.ball_distance_error_cut.p50 * 100.0,
         r.ball_distance_error_cut.n
     );
+    let signed =
+        |b: Option<f64>| b.map_or_else(|| "-".to_owned(), |v| format!("{:+.1}%", v * 100.0));
+    println!(
+        "ball distance bias     median signed {} (measured − true); cut off: {}",
+        signed(r.ball_distance_bias),
+        signed(r.ball_distance_bias_cut)
+    );
     println!(
         "ball bearing error     median {:.2}° p90 {:.2}°; radius error median {:.2} px",
         r.ball_bearing_error_deg.p50, r.ball_bearing_error_deg.p90, r.ball_radius_error_px.p50

@@ -330,6 +330,13 @@ pub struct EvalReport {
     pub ball_distance_error: Percentiles,
     /// Relative distance errors, balls cut off by the image edge.
     pub ball_distance_error_cut: Percentiles,
+    /// Median signed relative distance error (measured − true) / true of balls not cut off:
+    /// positive when distances read long (a bias, which the absolute error hides).
+    #[serde(default)]
+    pub ball_distance_bias: Option<f64>,
+    /// The same for balls cut off by the image edge.
+    #[serde(default)]
+    pub ball_distance_bias_cut: Option<f64>,
     /// Bearing errors, degrees.
     pub ball_bearing_error_deg: Percentiles,
     /// Radius errors, pixels.
@@ -373,6 +380,7 @@ impl EvalReport {
         };
         let (mut d, mut dc, mut b, mut rad, mut gd, mut posts, mut gaps) =
             (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+        let (mut s, mut sc) = (vec![], vec![]);
         for f in frames {
             if f.ball_eligible {
                 r.ball_eligible += 1;
@@ -388,6 +396,9 @@ impl EvalReport {
             }
             if let Some(x) = f.ball_distance_error {
                 if f.ball_cut { dc.push(x) } else { d.push(x) }
+            }
+            if let Some((t, m)) = f.ball_distances_cm.filter(|(t, _)| *t > 0.0) {
+                if f.ball_cut { &mut sc } else { &mut s }.push((m - t) / t);
             }
             b.extend(f.ball_bearing_error_rad.map(f64::to_degrees));
             rad.extend(f.ball_radius_error_px);
@@ -408,6 +419,8 @@ impl EvalReport {
         r.ball_false_rate = rate(r.ball_false, r.frames);
         r.ball_distance_error = Percentiles::of(&d);
         r.ball_distance_error_cut = Percentiles::of(&dc);
+        r.ball_distance_bias = (!s.is_empty()).then(|| Percentiles::of(&s).p50);
+        r.ball_distance_bias_cut = (!sc.is_empty()).then(|| Percentiles::of(&sc).p50);
         r.ball_bearing_error_deg = Percentiles::of(&b);
         r.ball_radius_error_px = Percentiles::of(&rad);
         r.goal_found_rate = rate(r.goals_found, r.goals_eligible);
@@ -495,6 +508,7 @@ mod tests {
                 ball_reported: true,
                 ball_correct: true,
                 ball_distance_error: Some(0.02),
+                ball_distances_cm: Some((100.0, 98.0)),
                 ..FrameEval::default()
             },
             FrameEval {
@@ -515,5 +529,11 @@ mod tests {
         assert_eq!(r.ball_false_frames, vec![2]);
         assert_eq!(r.ball_found_rate, Some(0.5));
         assert_eq!(r.ball_distance_error.p50, 0.02);
+        assert_eq!(
+            r.ball_distance_bias,
+            Some(-0.02),
+            "signed: the ball read short"
+        );
+        assert_eq!(r.ball_distance_bias_cut, None);
     }
 }

@@ -8,9 +8,11 @@ use serde::{Deserialize, Serialize};
 
 use super::confidence::{Confidence, TestWeight};
 use super::context::{Relative, ViewContext};
-use super::draw::Primitive;
-use super::fit::{CircleFit, Point, fit_circle_trimmed};
-use super::scan::{CutOff, EdgeScanPattern, ScanArea, edge_points, scan_rotated_rect};
+use super::draw::{CircleRole, Primitive};
+use super::fit::{CircleFit, Point, ShearedCircleFit, fit_circle_trimmed, fit_sheared_circle};
+use super::scan::{
+    CutOff, EdgeScanPattern, MixedEdge, ScanArea, edge_points_with_mixed, scan_rotated_rect,
+};
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
 use crate::lut::ColourClass;
@@ -59,6 +61,11 @@ pub struct BallParams {
     /// An edge scan stops at the first run of this many ball-coloured pixels, so single noisy
     /// pixels outside the ball are not taken for its outline.
     pub edge_run_px: u32,
+    /// Where an unclassified pixel right outside the ball's run counts as the ball's rim (see
+    /// [`MixedEdge`]): UYVY pixel pairs share their chroma, so a rim pixel paired with a carpet
+    /// pixel is classified as neither; without this the outline of a far ball is half a pixel
+    /// small and its distance 10–20% long.
+    pub mixed_edge: MixedEdge,
     /// A side touching the image border counts as cut off only when at least this share of the
     /// border pixels along the candidate's box are ball-coloured (a cut ball has a long chord on
     /// the border; a stray pixel reaching it does not make the ball cut).
@@ -109,6 +116,11 @@ pub struct BallParams {
     pub radius_bias_px: f64,
     /// Expected error of the fitted radius, pixels.
     pub radius_sigma_px: f64,
+    /// Expected error of the radius of a ball cut off by the image edge or hidden on a side, or
+    /// measured from its box (no circle fit), pixels: a partial outline, often in the darkened
+    /// image corners where classification loses rim pixels. The fusion then leans on the
+    /// ground plane.
+    pub radius_sigma_cut_px: f64,
     /// Expected error of the camera's pitch from the joints and body model, radians.
     pub pose_sigma_rad: f64,
     /// Remove the horizontal rolling-shutter shear (pan velocity) before fitting.
@@ -121,6 +133,23 @@ pub struct BallParams {
     /// scenario (the head tilts while tracking) it lowers the median distance error from 5.5%
     /// to 4.8% and changes nothing where the tilt is still.
     pub vertical_skew_correction: bool,
+    /// Fit the outline as a circle that moved while its rows were read out (a constrained
+    /// ellipse: circle plus one shear per axis, [`super::fit::fit_sheared_circle`]) after the
+    /// camera's skew is removed, giving the ball's own image velocity. Beyond the original (its
+    /// "future work"); off by default (see README for the measured effect).
+    pub ellipse_fit: bool,
+    /// Let the ellipse fit find a vertical shear too. Off by default: on the rolling-ball
+    /// scenario the vertical stretch it must measure (tenths of a pixel) is swamped by the
+    /// classified outline's unevenness, and its errors turn into large ground-velocity errors;
+    /// with it off the vertical image velocity is reported as 0.
+    pub ellipse_vertical_shear: bool,
+    /// Outline points the ellipse fit needs.
+    pub ellipse_min_points: usize,
+    /// The ellipse fit is used only when both shears' standard errors are below this, pixels
+    /// per line (a short arc of a cut ball leaves the shear undetermined).
+    pub ellipse_max_shear_sd: f64,
+    /// Frame interval assumed when the readings do not give one, seconds (the ERS-7: 1/30).
+    pub default_frame_interval_s: f64,
 }
 
 impl Default for BallParams {
@@ -144,6 +173,7 @@ impl Default for BallParams {
             unclassified_around_weight: TestWeight::new(0.0, 2.0),
             edge_margin_px: 3,
             edge_run_px: 2,
+            mixed_edge: MixedEdge::ChromaPairs,
             border_cut_min_share: 0.25,
             fit_trim_sd: 2.5,
             fit_trim_min_px: 1.0,
@@ -161,10 +191,16 @@ impl Default for BallParams {
             ground_plane_fusion: true,
             radius_bias_px: 0.0,
             radius_sigma_px: 0.5,
+            radius_sigma_cut_px: 1.0,
             pose_sigma_rad: 0.01,
             skew_correction: true,
             pose_skew_model: true,
             vertical_skew_correction: true,
+            ellipse_fit: false,
+            ellipse_vertical_shear: false,
+            ellipse_min_points: 12,
+            ellipse_max_shear_sd: 0.03,
+            default_frame_interval_s: 1.0 / 30.0,
         }
     }
 }
@@ -177,6 +213,7 @@ fn fuse_with_ground_plane(
     ctx: &ViewContext,
     center: Point,
     radius: f64,
+    radius_sigma_px: f64,
     size_distance: f64,
     params: &BallParams,
 ) -> f64 {
@@ -196,8 +233,95 @@ fn fuse_with_ground_plane(
         .max(1.0);
     let sigma_phi = params.pose_sigma_rad + params.radius_sigma_px / ctx.camera.focal_px;
     let var_plane = (plane * plane / h * sigma_phi).powi(2);
-    let var_size = (size_distance * params.radius_sigma_px / radius.max(0.5)).powi(2);
+    let var_size = (size_distance * radius_sigma_px / radius.max(0.5)).powi(2);
     (plane / var_plane + size_distance / var_size) / (1.0 / var_plane + 1.0 / var_size)
+}
+
+/// Distance (cm) to the centre of a ball of `diameter_cm` whose outline in the image is the
+/// circle (`center`, `radius` px), from the angle the ball subtends. A sphere off the optical
+/// axis projects to an ellipse stretched away from the axis (by 1/cos θ across and 1/cos² θ
+/// along the radial direction, θ the angle off the axis): at the side of the ERS-7's image a
+/// ball looks 15–25% wider than at the centre, and the original's d × 8.5 / diameter reads
+/// that much too close. The half-angle between the rays through opposite ends of a diameter is
+/// the ball's angular radius α for the ellipse's axes; the mean over the radial and the
+/// tangential diameter of the fitted circle undoes the stretch, and distance = R / sin α.
+/// Falls back to d × diameter / (2 × radius) when the rays are degenerate.
+#[must_use]
+pub fn distance_from_circle(
+    camera: &crate::geometry::PinholeCamera,
+    center: Point,
+    radius: f64,
+    diameter_cm: f64,
+) -> f64 {
+    use crate::geometry::ImagePoint;
+    let radius = radius.max(0.25);
+    let fallback = camera.focal_px * diameter_cm / (2.0 * radius);
+    let (dx, dy) = (center.0 - camera.centre.x_px, center.1 - camera.centre.y_px);
+    let off = dx.hypot(dy);
+    let u = if off > 1e-6 {
+        (dx / off, dy / off)
+    } else {
+        (1.0, 0.0)
+    };
+    let half_angle = |dir: (f64, f64)| {
+        let a = camera.unit_ray(ImagePoint::new(
+            center.0 + radius * dir.0,
+            center.1 + radius * dir.1,
+        ));
+        let b = camera.unit_ray(ImagePoint::new(
+            center.0 - radius * dir.0,
+            center.1 - radius * dir.1,
+        ));
+        a.coords.dot(&b.coords).clamp(-1.0, 1.0).acos() / 2.0
+    };
+    let alpha = (half_angle(u) + half_angle((-u.1, u.0))) / 2.0;
+    let d = diameter_cm / 2.0 / alpha.sin();
+    if d.is_finite() && d > 0.0 {
+        d
+    } else {
+        fallback
+    }
+}
+
+/// The ball's angular radius (radians) from its outline points: the points are turned into
+/// the view of a camera looking straight at `center` (gnomonic coordinates about the ray
+/// through it, scaled by d so that they stay in pixels), where a sphere's outline is an exact
+/// circle wherever it is in the image, and a circle is fitted there. Unlike
+/// [`distance_from_circle`] this also holds for a short arc (a ball cut by the image edge sees
+/// only the side facing the image centre, whose curvature is not the fitted circle's mean).
+/// `None` when the points do not fit a circle.
+fn angular_radius(
+    camera: &crate::geometry::PinholeCamera,
+    points: &[Point],
+    center: Point,
+    params: &BallParams,
+) -> Option<f64> {
+    use crate::geometry::ImagePoint;
+    let ray = |p: Point| camera.unit_ray(ImagePoint::new(p.0, p.1)).coords;
+    let e1 = ray(center);
+    let side = ray((center.0 + 1.0, center.1));
+    let e2 = (side - e1 * side.dot(&e1)).try_normalize(1e-12)?;
+    let e3 = e1.cross(&e2);
+    let f = camera.focal_px;
+    let turned: Vec<Point> = points
+        .iter()
+        .filter_map(|&p| {
+            let r = ray(p);
+            let along = r.dot(&e1);
+            (along > 1e-6).then(|| (f * r.dot(&e2) / along, f * r.dot(&e3) / along))
+        })
+        .collect();
+    if turned.len() < 5 {
+        return None;
+    }
+    let fit = fit_circle_trimmed(
+        &turned,
+        params.fit_trim_sd,
+        params.fit_trim_min_px,
+        params.fit_trim_max_share,
+    )?;
+    let alpha = (fit.radius / f).atan();
+    (alpha.is_finite() && alpha > 0.0).then_some(alpha)
 }
 
 /// The recognised ball.
@@ -205,10 +329,15 @@ fn fuse_with_ground_plane(
 pub struct Ball {
     /// Index of the accepted candidate in [`BallResult::candidates`].
     pub candidate: usize,
-    /// Centre x, image pixels.
+    /// Centre x, image pixels, at the reference row's read-out time (skew removed): where the
+    /// sensor readings place the ball.
     pub center_x: f64,
-    /// Centre y, image pixels.
+    /// Centre y, image pixels, at the reference read-out time.
     pub center_y: f64,
+    /// Centre where the ball appears in the image (each row at its own read-out time), pixels:
+    /// equal to the centre without skew; several pixels away on a fast pan.
+    #[serde(default)]
+    pub observed_center: Point,
     /// Radius, pixels.
     pub radius_px: f64,
     /// Camera-relative distance, bearing, elevation.
@@ -221,6 +350,15 @@ pub struct Ball {
     pub cut_off: CutOff,
     /// True when centre and radius come from the circle fit, false when from the blob box.
     pub from_circle_fit: bool,
+    /// The ball's own image velocity from the ellipse fit (camera skew removed), pixels per
+    /// second (x right, y down); `None` unless [`BallParams::ellipse_fit`] is on and the fit
+    /// was determined.
+    #[serde(default)]
+    pub image_velocity_px_s: Option<[f64; 2]>,
+    /// That velocity on the ground (plane of ball centres) in the robot's frame (x ahead, y
+    /// left), centimetres per second, through the camera pose; `None` without the pose.
+    #[serde(default)]
+    pub ground_velocity_cm_s: Option<[f64; 2]>,
 }
 
 /// One scored candidate, accepted or not, with everything that decided it.
@@ -240,14 +378,25 @@ pub struct BallCandidate {
     pub pattern: EdgeScanPattern,
     /// Outline points after skew removal, pixels.
     pub edge_points: Vec<Point>,
+    /// The outline points where the scans found them in the image (before skew removal),
+    /// pixels: what the overlay draws.
+    #[serde(default)]
+    pub scanned_points: Vec<Point>,
     /// The circle fit, if one was found.
     pub fit: Option<CircleFit>,
+    /// The moving-circle (constrained ellipse) fit, when [`BallParams::ellipse_fit`] is on and
+    /// it was tried.
+    #[serde(default)]
+    pub ellipse: Option<ShearedCircleFit>,
     /// Why the circle fit was not used, if it was not.
     pub fit_rejected: Option<String>,
     /// The colour-below scan area.
     pub below: Option<ScanArea>,
-    /// Estimated centre, pixels.
+    /// Estimated centre, pixels, at the reference read-out time (skew removed).
     pub center: Point,
+    /// The centre where the ball appears in the image, pixels (see [`Ball::observed_center`]).
+    #[serde(default)]
+    pub observed_center: Point,
     /// Estimated radius, pixels.
     pub radius_px: f64,
     /// Camera-relative estimate.
@@ -454,6 +603,35 @@ fn unskew_point(ctx: &ViewContext, params: &BallParams, p: Point, depth_cm: f64)
     }
 }
 
+/// Whether a moving-circle fit may replace the plain circle: both shears determined, and a
+/// radius within a quarter of the plain fit's (a wild fit on noisy points is not a ball).
+fn ellipse_usable(e: &ShearedCircleFit, plain: Option<&CircleFit>, params: &BallParams) -> bool {
+    e.shear_x_sd <= params.ellipse_max_shear_sd
+        && e.shear_y_sd <= params.ellipse_max_shear_sd
+        && plain.is_some_and(|f| (e.circle.radius - f.radius).abs() <= 0.25 * f.radius)
+}
+
+/// The ground velocity (robot frame, cm/s) of a ball at image point `center` moving at
+/// `v_px_s` pixels per second: where the ray through the centre meets the plane of ball
+/// centres now and 10 ms later.
+fn ground_velocity(
+    ctx: &ViewContext,
+    center: Point,
+    v_px_s: (f64, f64),
+    params: &BallParams,
+) -> Option<[f64; 2]> {
+    let pose = ctx.pose?;
+    let dt = 0.01;
+    let z = params.diameter_cm / 2.0;
+    let a = pose.point_on_plane(crate::geometry::ImagePoint::new(center.0, center.1), z)?;
+    let b = pose.point_on_plane(
+        crate::geometry::ImagePoint::new(center.0 + v_px_s.0 * dt, center.1 + v_px_s.1 * dt),
+        z,
+    )?;
+    let v = [(b.x() - a.x()) / dt, (b.y() - a.y()) / dt];
+    v.iter().all(|c| c.is_finite()).then_some(v)
+}
+
 /// Recognises the ball in a classified frame.
 #[must_use]
 pub fn recognise_ball(
@@ -468,13 +646,15 @@ pub fn recognise_ball(
         let cut = cut_off(img, &group, params.border_cut_min_share);
         let bounds = [group.minx, group.miny, group.maxx, group.maxy];
         let pattern = EdgeScanPattern::for_cut_off(cut);
-        let mut points = edge_points(
+        let mut points = edge_points_with_mixed(
             img,
             bounds,
             pattern,
             params.edge_margin_px,
             params.edge_run_px,
             is_ball_colour,
+            |c| c == ColourClass::Unclassified.code(),
+            params.mixed_edge,
         );
         let (box_centre, box_radius) = box_estimate(&group, cut);
         // Move every outline point to the read-out time of the reference row, the instant the
@@ -482,6 +662,8 @@ pub fn recognise_ball(
         // pose says it is. The body model needs a depth: the distance the box's size implies.
         let depth = d * params.diameter_cm / (2.0 * box_radius.max(0.5));
         let unskew = |p: Point| unskew_point(ctx, params, p, depth);
+        let scanned_points = points.clone();
+        let rows: Vec<f64> = points.iter().map(|p| p.1).collect();
         let mut box_shift = (0.0, 0.0);
         if params.skew_correction {
             for p in &mut points {
@@ -539,19 +721,73 @@ pub fn recognise_ball(
             Some(_) => None,
         };
         let use_fit = fit.is_some() && fit_rejected.is_none();
+        let ellipse = (params.ellipse_fit && use_fit && points.len() >= params.ellipse_min_points)
+            .then(|| {
+                fit_sheared_circle(
+                    &points,
+                    &rows,
+                    ctx.reference_row(),
+                    params.ellipse_vertical_shear,
+                )
+            })
+            .flatten();
+        let moving = ellipse.filter(|e| ellipse_usable(e, fit.as_ref(), params));
         let (center, radius) = match (&fit, use_fit) {
+            (Some(_), true) if moving.is_some() => moving.map_or(((0.0, 0.0), 0.0), |e| {
+                ((e.circle.center_x, e.circle.center_y), e.circle.radius)
+            }),
             (Some(f), true) => ((f.center_x, f.center_y), f.radius),
             _ if params.skew_correction => (unskew(box_centre), box_radius),
             _ => (box_centre, box_radius),
         };
         let radius = (radius + params.radius_bias_px).max(0.5);
-        let size_distance = d * params.diameter_cm / (2.0 * radius);
+        // With the fit's own points, the angle the ball subtends; else from the circle.
+        let alpha = use_fit
+            .then(|| angular_radius(&ctx.camera, &points, center, params))
+            .flatten();
+        let size_distance = match alpha {
+            Some(a) => params.diameter_cm / 2.0 / a.sin(),
+            None => distance_from_circle(&ctx.camera, center, radius, params.diameter_cm),
+        };
         let distance = if params.ground_plane_fusion {
-            fuse_with_ground_plane(ctx, center, radius, size_distance, params)
+            let sigma = if use_fit && !cut.any() {
+                params.radius_sigma_px
+            } else {
+                params.radius_sigma_cut_px
+            };
+            fuse_with_ground_plane(ctx, center, radius, sigma, size_distance, params)
         } else {
             size_distance
         };
         let camera = ctx.camera_relative(center, distance);
+        // Back to where the ball is in the image: the point the skew removal moves onto the
+        // centre (a fixed-point iteration; the removal is nearly a shift over a ball's size).
+        let observed_center = if params.skew_correction {
+            let mut p = (center.0 - box_shift.0, center.1 - box_shift.1);
+            for _ in 0..3 {
+                let q = unskew(p);
+                p = (center.0 - (q.0 - p.0), center.1 - (q.1 - p.1));
+            }
+            if p.0.is_finite() && p.1.is_finite() {
+                p
+            } else {
+                center
+            }
+        } else {
+            center
+        };
+        // A ball that moved on its own while read out sits where it was when its centre row was
+        // read.
+        let observed_center = match &moving {
+            Some(e) => {
+                let lines = observed_center.1 - ctx.reference_row();
+                (
+                    observed_center.0 + e.shear_x * lines,
+                    observed_center.1 + e.shear_y * lines,
+                )
+            }
+            None => observed_center,
+        };
 
         let mut confidence = Confidence::default();
         let area = w * h;
@@ -657,17 +893,26 @@ pub fn recognise_ball(
         }
         let accepted = result.ball.is_none() && confidence.accepted();
         let index = result.candidates.len();
+        let frame_s = ctx
+            .frame_interval_s
+            .unwrap_or(params.default_frame_interval_s);
+        let line_s = frame_s / ctx.camera.height_px.max(1) as f64;
+        let image_velocity = moving.map(|e| e.velocity_px_s(line_s));
         if accepted {
             result.ball = Some(Ball {
                 candidate: index,
                 center_x: center.0,
                 center_y: center.1,
+                observed_center,
                 radius_px: radius,
                 camera,
                 body: ctx.body_relative(center, distance),
                 confidence: confidence.total,
                 cut_off: cut,
                 from_circle_fit: use_fit,
+                image_velocity_px_s: image_velocity.map(|v| [v.0, v.1]),
+                ground_velocity_cm_s: image_velocity
+                    .and_then(|v| ground_velocity(ctx, center, v, params)),
             });
         }
         result.candidates.push(BallCandidate {
@@ -678,10 +923,13 @@ pub fn recognise_ball(
             cut_off: cut,
             pattern,
             edge_points: points,
+            scanned_points,
             fit,
+            ellipse,
             fit_rejected,
             below: Some(below_scan.area),
             center,
+            observed_center,
             radius_px: radius,
             camera,
             accepted,
@@ -712,21 +960,33 @@ impl BallResult {
                     corners: area.corners,
                 });
             }
-            if !c.edge_points.is_empty() {
+            if !c.scanned_points.is_empty() {
                 out.push(Primitive::ScanPoints {
                     owner: owner.clone(),
-                    points: c.edge_points.clone(),
+                    points: c.scanned_points.clone(),
                 });
             }
             if c.accepted {
+                // On the ball as the image shows it; where the skew correction puts it as a
+                // second, dashed circle when that is visibly elsewhere.
+                let seen = c.observed_center;
                 out.push(Primitive::Circle {
                     owner: owner.clone(),
-                    center: c.center,
+                    center: seen,
                     radius: c.radius_px,
+                    role: CircleRole::Observed,
                 });
+                if (c.center.0 - seen.0).hypot(c.center.1 - seen.1) > 0.5 {
+                    out.push(Primitive::Circle {
+                        owner: owner.clone(),
+                        center: c.center,
+                        radius: c.radius_px,
+                        role: CircleRole::SkewCorrected,
+                    });
+                }
                 out.push(Primitive::Label {
                     owner,
-                    at: (c.center.0, c.center.1 - c.radius_px - 2.0),
+                    at: (seen.0, seen.1 - c.radius_px - 2.0),
                     text: format!(
                         "ball {:.0} cm {:+.0}°",
                         c.camera.distance_cm,
@@ -824,21 +1084,83 @@ mod tests {
     }
 
     #[test]
-    fn a_ball_cut_by_the_image_edge_keeps_its_radius() {
+    fn a_ball_cut_by_the_image_edge_keeps_its_distance() {
         let ctx = level_context();
-        let (c, r, dist) = true_ball(&ctx, 45.0, 0.0);
-        // Move it so a third of it is outside the left edge.
-        let img = scene(r * 0.4, c.1, r, 0.0);
+        let pose = ctx.pose.expect("pose");
+        // A ball on the field placed so that about a third of it is outside the left edge.
+        let (_, r0, _) = true_ball(&ctx, 45.0, 0.0);
+        let y = (0..400)
+            .map(|i| f64::from(i) * 0.1)
+            .min_by(|a, b| {
+                let off = |y: f64| (true_ball(&ctx, 45.0, y).0.0 - 0.4 * r0).abs();
+                off(*a).total_cmp(&off(*b))
+            })
+            .expect("positions");
+        let (c, _, dist) = true_ball(&ctx, 45.0, y);
+        // Rendered as a sphere, not a circle: a pixel shows the ball when its ray is within the
+        // ball's angular radius of the centre's direction (off the optical axis the outline is
+        // an ellipse, wider than a circle of the on-axis radius).
+        let towards = ctx
+            .camera
+            .unit_ray(
+                pose.image_from_field(&GeoPoint::new(45.0, y, 4.25))
+                    .expect("in front"),
+            )
+            .coords;
+        let cos_alpha = (4.25 / dist).asin().cos();
+        let (w, h) = (208usize, 160usize);
+        let codes = (0..w * h)
+            .map(|i| {
+                let ray = ctx
+                    .camera
+                    .unit_ray(crate::geometry::ImagePoint::pixel_centre(i % w, i / w));
+                if ray.coords.dot(&towards) >= cos_alpha {
+                    ColourClass::Orange.code()
+                } else {
+                    ColourClass::Green.code()
+                }
+            })
+            .collect();
+        let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
         let blobs = BlobSet::from_image(&img, Connectivity::Eight);
         let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
         let ball = res.ball.expect("ball");
         assert!(ball.cut_off.left && !ball.cut_off.right);
+        assert!(ball.from_circle_fit);
+        // The visible arc is the flatter inner side of the ellipse: the circle through it sits
+        // a little inwards.
         assert!(
-            (ball.radius_px - r).abs() / r < 0.08,
-            "{} vs {r}",
-            ball.radius_px
+            (ball.center_x - c.0).abs() < 3.0,
+            "{} vs {}",
+            ball.center_x,
+            c.0
         );
-        assert!((ball.camera.distance_cm - dist).abs() / dist < 0.08);
+        let err = (ball.camera.distance_cm - dist) / dist;
+        assert!(
+            err.abs() < 0.04,
+            "distance {} vs {dist}",
+            ball.camera.distance_cm
+        );
+        // The original's d × 8.5 / diameter reads the stretched outline much too close.
+        let naive = ctx.camera.focal_px * 8.5 / (2.0 * ball.radius_px);
+        assert!(naive < 0.95 * dist, "naive {naive} vs {dist}");
+    }
+
+    #[test]
+    fn distance_from_the_subtended_angle_holds_across_the_image() {
+        let camera = PinholeCamera::ers7();
+        // A sphere 100 cm away at the centre and 25° off the axis: its outline's mean
+        // semi-axis (see `distance_from_circle`) gives the distance back within 0.5%.
+        for theta_deg in [0.0_f64, 15.0, 25.0] {
+            let (t, alpha) = (theta_deg.to_radians(), (4.25_f64 / 100.0).asin());
+            let f = camera.focal_px;
+            let a = f / 2.0 * ((t + alpha).tan() - (t - alpha).tan());
+            let b = f * alpha.sin() / (t.cos().powi(2) - alpha.sin().powi(2)).sqrt();
+            let centre_x = camera.centre.x_px + f / 2.0 * ((t + alpha).tan() + (t - alpha).tan());
+            let d =
+                distance_from_circle(&camera, (centre_x, camera.centre.y_px), (a + b) / 2.0, 8.5);
+            assert!((d - 100.0).abs() < 0.5, "{theta_deg}°: {d}");
+        }
     }
 
     #[test]
@@ -862,6 +1184,32 @@ mod tests {
         let e_plain = (plain.ball.expect("plain").radius_px - r).abs();
         let e_fixed = (fixed.ball.expect("fixed").radius_px - r).abs();
         assert!(e_fixed * 2.0 < e_plain, "fixed {e_fixed} plain {e_plain}");
+    }
+
+    #[test]
+    fn ellipse_fit_gives_the_image_velocity_of_a_moving_ball() {
+        let ctx = level_context();
+        let (c, r, _) = true_ball(&ctx, 45.0, 0.0);
+        // Moving right 0.25 px per line (1200 px/s at 160 lines in 1/30 s), centred on the
+        // reference row.
+        let img = scene(c.0, 80.0, r, 0.25);
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let plain = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let plain = plain.ball.expect("plain");
+        assert!(plain.image_velocity_px_s.is_none() && plain.ground_velocity_cm_s.is_none());
+        let params = BallParams {
+            ellipse_fit: true,
+            ..BallParams::default()
+        };
+        let res = recognise_ball(&img, &blobs, &ctx, &params);
+        let ball = res.ball.clone().expect("ball");
+        let v = ball.image_velocity_px_s.expect("velocity");
+        assert!((v[0] - 1200.0).abs() < 120.0 && v[1] == 0.0, "{v:?}");
+        assert!(res.candidates[ball.candidate].ellipse.is_some());
+        // Moving right in the image, straight ahead: to the robot's right on the ground.
+        let g = ball.ground_velocity_cm_s.expect("ground velocity");
+        assert!(g[1] < 0.0 && g[1].abs() > 3.0 * g[0].abs(), "{g:?}");
+        assert!((ball.radius_px - r).abs() <= (plain.radius_px - r).abs() + 0.2);
     }
 
     #[test]

@@ -90,6 +90,9 @@ pub struct ViewContext {
     /// The head's motion during read-out, when the joints now and one frame earlier were known
     /// (and the pose is known).
     pub motion: Option<HeadMotion>,
+    /// Time between frames, seconds, when the readings gave it; the read-out of all rows is
+    /// taken to last one frame interval (as the skew removal assumes).
+    pub frame_interval_s: Option<f64>,
 }
 
 impl ViewContext {
@@ -105,6 +108,7 @@ impl ViewContext {
             skew_y_per_line: 0.0,
             ir_distance_cm: None,
             motion: None,
+            frame_interval_s: None,
         }
     }
 
@@ -119,6 +123,9 @@ impl ViewContext {
         let (readings, _) = readings.sanitised();
         let mut ctx = Self::without_pose(camera);
         ctx.ir_distance_cm = readings.ir_near_cm.or(readings.ir_far_cm);
+        ctx.frame_interval_s = readings
+            .frame_interval_s
+            .filter(|s| s.is_finite() && *s > 0.0);
         if let Some(joints) = HeadJoints::from_sensors(&readings) {
             let body_from_camera = dims.body_from_camera(&joints);
             let body = BodyPose::from_sensors(&readings, &BodyPose::ERS7_STANCE);

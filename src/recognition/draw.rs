@@ -67,6 +67,10 @@ pub enum Primitive {
         center: Point,
         /// Radius, pixels.
         radius: f64,
+        /// Where the circle is: on the ball as the image shows it (drawn solid), or moved to
+        /// the reference read-out time by the skew correction (drawn thin and dashed).
+        #[serde(default)]
+        role: CircleRole,
     },
     /// A straight segment: a goal post, a gap, a horizon.
     Line {
@@ -88,6 +92,20 @@ pub enum Primitive {
         /// The text.
         text: String,
     },
+}
+
+/// What a [`Primitive::Circle`] shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CircleRole {
+    /// The outline as observed in the image (each row at its own read-out time): the circle
+    /// sits on the ball's pixels. Drawn solid.
+    #[default]
+    Observed,
+    /// The same ball moved to the reference row's read-out time by the rolling-shutter skew
+    /// correction: where the sensor readings place it, up to several pixels off the ball's
+    /// pixels on a fast pan. Drawn thin and dashed.
+    SkewCorrected,
 }
 
 /// What a [`Primitive::Line`] shows.

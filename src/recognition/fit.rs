@@ -144,6 +144,213 @@ pub fn fit_circle_trimmed(
     fit_circle(&keep).or(Some(first))
 }
 
+/// A circle seen by a rolling shutter while it moved: the constrained ellipse of a ball that
+/// moves in the image during read-out (after the camera's own skew is removed). Row `y` is read
+/// `y − reference_row` lines after the reference row, by which time the ball's centre has moved
+/// by `(shear_x, shear_y) · (y − reference_row)` pixels; undoing that puts every outline point
+/// on one circle. So the model is a circle plus one shear parameter per axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ShearedCircleFit {
+    /// The circle at the reference row's read-out time (centre, radius, residual SD), pixels.
+    pub circle: CircleFit,
+    /// Horizontal motion of the centre per image row read, pixels per line.
+    pub shear_x: f64,
+    /// Vertical motion of the centre per image row read, pixels per line.
+    pub shear_y: f64,
+    /// Standard error of `shear_x` from the fit's covariance, pixels per line.
+    pub shear_x_sd: f64,
+    /// Standard error of `shear_y`, pixels per line.
+    pub shear_y_sd: f64,
+}
+
+impl ShearedCircleFit {
+    /// The centre's image velocity, pixels per second, when one line takes `line_time_s`
+    /// seconds to read.
+    #[must_use]
+    pub fn velocity_px_s(&self, line_time_s: f64) -> (f64, f64) {
+        (self.shear_x / line_time_s, self.shear_y / line_time_s)
+    }
+}
+
+/// Fits a circle that moved while its rows were read out: `points[i]` was read at image row
+/// `rows[i]` (usually its own y before any skew removal moved it), and the centre moves
+/// `(shear_x, shear_y)` pixels per line. Starts from the plain circle fit and refines all five
+/// parameters (centre, radius, two shears) by damped Gauss–Newton on the geometric distances
+/// of the points moved back to the reference row's time.
+///
+/// With `vertical_shear` false the vertical shear is held at zero (four parameters): a vertical
+/// motion only stretches the outline vertically, by a few tenths of a pixel for a ball, which
+/// the classified outline's own unevenness (shading at top and bottom) can swamp.
+///
+/// `None` for fewer than 6 points (five parameters and at least one degree of freedom), a
+/// length mismatch, non-finite input, collinear points, or a fit that does not converge to a
+/// finite positive radius. A short arc leaves the shear poorly determined: callers should look
+/// at `shear_x_sd` / `shear_y_sd`.
+#[must_use]
+pub fn fit_sheared_circle(
+    points: &[Point],
+    rows: &[f64],
+    reference_row: f64,
+    vertical_shear: bool,
+) -> Option<ShearedCircleFit> {
+    if points.len() < 6
+        || rows.len() != points.len()
+        || !reference_row.is_finite()
+        || rows.iter().any(|r| !r.is_finite())
+    {
+        return None;
+    }
+    let start = fit_circle(points)?;
+    let s: Vec<f64> = rows.iter().map(|r| r - reference_row).collect();
+    // Parameters: cx, cy, r, a (shear_x), b (shear_y).
+    let mut q = [start.center_x, start.center_y, start.radius, 0.0, 0.0];
+    let cost = |q: &[f64; 5]| -> f64 {
+        points
+            .iter()
+            .zip(&s)
+            .map(|(p, s)| {
+                let (ux, uy) = (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1]);
+                ((ux * ux + uy * uy).sqrt() - q[2]).powi(2)
+            })
+            .sum()
+    };
+    let normal = |q: &[f64; 5]| -> ([[f64; 5]; 5], [f64; 5]) {
+        let mut jtj = [[0.0f64; 5]; 5];
+        let mut jtr = [0.0f64; 5];
+        for (p, s) in points.iter().zip(&s) {
+            let (ux, uy) = (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1]);
+            let d = (ux * ux + uy * uy).sqrt();
+            if d < 1e-12 {
+                continue;
+            }
+            let (nx, ny) = (ux / d, uy / d);
+            let j = [-nx, -ny, -1.0, -nx * s, -ny * s];
+            let res = d - q[2];
+            for row in 0..5 {
+                jtr[row] += j[row] * res;
+                for col in 0..5 {
+                    jtj[row][col] += j[row] * j[col];
+                }
+            }
+        }
+        if !vertical_shear {
+            // Hold the vertical shear: its equation becomes "step = 0".
+            jtj[4] = [0.0; 5];
+            for row in &mut jtj {
+                row[4] = 0.0;
+            }
+            jtj[4][4] = jtj[2][2].max(1.0);
+            jtr[4] = 0.0;
+        }
+        (jtj, jtr)
+    };
+    let mut current = cost(&q);
+    let mut lambda = 1e-3;
+    for _ in 0..60 {
+        let (jtj, jtr) = normal(&q);
+        let mut damped = jtj;
+        for (k, row) in damped.iter_mut().enumerate() {
+            row[k] += lambda * jtj[k][k].max(1e-9);
+        }
+        let Some(step) = solve_n(damped, jtr) else {
+            break;
+        };
+        let mut next = q;
+        for (v, d) in next.iter_mut().zip(step) {
+            *v -= d;
+        }
+        let c = cost(&next);
+        if c.is_finite() && c <= current {
+            let small = step.iter().all(|d| d.abs() < 1e-10);
+            q = next;
+            current = c;
+            lambda = (lambda * 0.3).max(1e-9);
+            if small {
+                break;
+            }
+        } else {
+            lambda *= 10.0;
+            if lambda > 1e8 {
+                break;
+            }
+        }
+    }
+    if !(q.iter().all(|v| v.is_finite()) && q[2] > 0.0) {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (jtj, _) = normal(&q);
+    let dof = (n - 5.0).max(1.0);
+    let sigma2 = current / dof;
+    // Standard errors from the diagonal of (JᵀJ)⁻¹ σ²; a singular matrix (shear undetermined)
+    // gives infinite errors.
+    let inv_diag = |k: usize| {
+        let mut e = [0.0; 5];
+        e[k] = 1.0;
+        solve_n(jtj, e).map_or(f64::INFINITY, |x| x[k].abs())
+    };
+    let var = points
+        .iter()
+        .zip(&s)
+        .map(|(p, s)| {
+            let (ux, uy) = (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1]);
+            ((ux * ux + uy * uy).sqrt() - q[2]).powi(2)
+        })
+        .sum::<f64>()
+        / n;
+    Some(ShearedCircleFit {
+        circle: CircleFit {
+            center_x: q[0],
+            center_y: q[1],
+            radius: q[2],
+            residual_sd: var.sqrt(),
+            points: points.len(),
+        },
+        shear_x: q[3],
+        shear_y: q[4],
+        shear_x_sd: (sigma2 * inv_diag(3)).sqrt(),
+        shear_y_sd: if vertical_shear {
+            (sigma2 * inv_diag(4)).sqrt()
+        } else {
+            0.0
+        },
+    })
+}
+
+/// Solves a 5×5 system by Gaussian elimination with partial pivoting; `None` when singular
+/// (relative to the matrix's scale) or not finite.
+fn solve_n(mut m: [[f64; 5]; 5], mut b: [f64; 5]) -> Option<[f64; 5]> {
+    let scale = m
+        .iter()
+        .flat_map(|r| r.iter())
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    if !(scale.is_finite() && scale > 0.0) {
+        return None;
+    }
+    for col in 0..5 {
+        let pivot = (col..5).max_by(|&i, &j| m[i][col].abs().total_cmp(&m[j][col].abs()))?;
+        if m[pivot][col].abs() <= 1e-13 * scale {
+            return None;
+        }
+        m.swap(col, pivot);
+        b.swap(col, pivot);
+        for row in col + 1..5 {
+            let f = m[row][col] / m[col][col];
+            let pivot_row = m[col];
+            for (a, p) in m[row].iter_mut().zip(pivot_row).skip(col) {
+                *a -= f * p;
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; 5];
+    for row in (0..5).rev() {
+        let tail: f64 = (row + 1..5).map(|k| m[row][k] * x[k]).sum();
+        x[row] = (b[row] - tail) / m[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
 /// Solves a 3×3 system by Cramer's rule; `None` when singular.
 fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
     let det3 = |m: &[[f64; 3]; 3]| {
@@ -332,6 +539,91 @@ mod tests {
         assert!(fit_line(&[(1.0, 1.0)]).is_none());
         assert!(fit_line(&[(1e300, 1e300), (-1e300, -1e300), (1e300, 1e300)]).is_none());
         assert!(fit_line(&[(0.0, 0.0), (f64::INFINITY, 1.0)]).is_none());
+    }
+
+    /// Outline points of a circle moving `(ax, ay)` px per line, read row by row like a rolling
+    /// shutter: each row's left and right crossing, found at the row's own read-out time.
+    fn moving_outline(
+        cx: f64,
+        cy: f64,
+        r: f64,
+        ax: f64,
+        ay: f64,
+        reference: f64,
+    ) -> Vec<(Point, f64)> {
+        let mut out = Vec::new();
+        for row in 0..400 {
+            let y = f64::from(row) * 0.5;
+            let s = y - reference;
+            let (x0, y0) = (cx + ax * s, cy + ay * s);
+            let dy = y - y0;
+            if dy.abs() < r {
+                let half = (r * r - dy * dy).sqrt();
+                out.push(((x0 - half, y), y));
+                out.push(((x0 + half, y), y));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn sheared_circle_recovers_shear_and_velocity_exactly() {
+        let (ax, ay) = (0.15, 0.03);
+        let data = moving_outline(90.0, 70.0, 20.0, ax, ay, 80.0);
+        let (pts, rows): (Vec<Point>, Vec<f64>) = data.into_iter().unzip();
+        let f = fit_sheared_circle(&pts, &rows, 80.0, true).expect("fit");
+        assert!((f.shear_x - ax).abs() < 1e-6, "{f:?}");
+        assert!((f.shear_y - ay).abs() < 1e-6, "{f:?}");
+        assert!((f.circle.center_x - 90.0).abs() < 1e-5 && (f.circle.center_y - 70.0).abs() < 1e-5);
+        assert!((f.circle.radius - 20.0).abs() < 1e-5 && f.circle.residual_sd < 1e-6);
+        // 160 lines in 1/30 s: 0.15 px per line is 720 px/s.
+        let (vx, vy) = f.velocity_px_s(1.0 / 30.0 / 160.0);
+        assert!((vx - 720.0).abs() < 1e-3 && (vy - 144.0).abs() < 1e-3);
+        // The plain circle fit of the same points is off in radius and centre.
+        let plain = fit_circle(&pts).expect("plain");
+        assert!((plain.center_x - 90.0).abs() > 0.1 || (plain.radius - 20.0).abs() > 0.1);
+        // A still circle gives zero shear.
+        let still = moving_outline(50.0, 50.0, 10.0, 0.0, 0.0, 80.0);
+        let (pts, rows): (Vec<Point>, Vec<f64>) = still.into_iter().unzip();
+        let f = fit_sheared_circle(&pts, &rows, 80.0, true).expect("still");
+        assert!(f.shear_x.abs() < 1e-9 && f.shear_y.abs() < 1e-9 && f.shear_x_sd < 1e-3);
+        // Horizontal motion only, fitted with the vertical shear held at zero.
+        let across = moving_outline(60.0, 90.0, 15.0, -0.2, 0.0, 80.0);
+        let (pts, rows): (Vec<Point>, Vec<f64>) = across.into_iter().unzip();
+        let f = fit_sheared_circle(&pts, &rows, 80.0, false).expect("across");
+        assert!((f.shear_x + 0.2).abs() < 1e-6 && f.shear_y == 0.0 && f.shear_y_sd == 0.0);
+        assert!((f.circle.radius - 15.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn sheared_circle_refuses_degenerate_input() {
+        let line: Vec<Point> = (0..10).map(|i| (f64::from(i), f64::from(i))).collect();
+        let rows: Vec<f64> = line.iter().map(|p| p.1).collect();
+        assert!(fit_sheared_circle(&line, &rows, 80.0, true).is_none());
+        let five = arc(10.0, 10.0, 5.0, 0.0, 5.0, 5);
+        let rows5: Vec<f64> = five.iter().map(|p| p.1).collect();
+        assert!(fit_sheared_circle(&five, &rows5, 80.0, true).is_none());
+        let mut pts = arc(10.0, 10.0, 5.0, 0.0, 6.0, 12);
+        let rows12: Vec<f64> = pts.iter().map(|p| p.1).collect();
+        assert!(fit_sheared_circle(&pts, &rows12[..11], 80.0, true).is_none());
+        assert!(fit_sheared_circle(&pts, &rows12, f64::NAN, false).is_none());
+        pts[3].1 = f64::NAN;
+        assert!(fit_sheared_circle(&pts, &rows12, 80.0, true).is_none());
+        let mut rows_nan = rows12.clone();
+        rows_nan[0] = f64::INFINITY;
+        assert!(
+            fit_sheared_circle(&arc(10.0, 10.0, 5.0, 0.0, 6.0, 12), &rows_nan, 80.0, true)
+                .is_none()
+        );
+        assert!(fit_sheared_circle(&[(4.0, 4.0); 8], &[4.0; 8], 80.0, false).is_none());
+        // Points all on one row: the shear is undetermined; no panic, and either no fit or an
+        // infinite / huge shear error.
+        let one_row: Vec<Point> = (0..8)
+            .map(|i| (f64::from(i), 5.0 + f64::from(i % 2)))
+            .collect();
+        if let Some(f) = fit_sheared_circle(&one_row, &[5.0; 8], 80.0, true) {
+            assert!(f.shear_x_sd.is_nan() || f.shear_x_sd > 1.0 || f.shear_y_sd > 1.0);
+        }
     }
 
     #[test]

@@ -32,7 +32,7 @@ use crate::sensors::SensorReadings;
 pub use ball::{Ball, BallParams, BallResult};
 pub use beacons::{Beacon, BeaconParams};
 pub use context::{Relative, ViewContext};
-pub use draw::{LineRole, Primitive};
+pub use draw::{CircleRole, LineRole, Primitive};
 pub use goals::{GoalCandidate, GoalParams, GoalResult};
 
 /// Settings of every recogniser, and the camera to assume for frames that are not the ERS-7's.

@@ -155,11 +155,59 @@ impl EdgeScanPattern {
 #[must_use]
 pub fn edge_points(
     img: &ClassifiedImage,
+    bounds: [u32; 4],
+    pattern: EdgeScanPattern,
+    margin: u32,
+    run: u32,
+    is_object: impl Fn(u8) -> bool,
+) -> Vec<Point> {
+    edge_points_with_mixed(
+        img,
+        bounds,
+        pattern,
+        margin,
+        run,
+        is_object,
+        |_| false,
+        MixedEdge::Never,
+    )
+}
+
+/// Where an edge scan counts an ambiguous pixel right outside the object's run as object.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MixedEdge {
+    /// Never: the outline is where the run starts.
+    Never,
+    /// On row scans, when the ambiguous pixel belongs to the neighbouring UYVY chroma pair
+    /// (pixels 2k and 2k+1 share U and V): a ball pixel paired with a carpet pixel gets their
+    /// mean chroma and is classified as neither, which without this takes about half a pixel
+    /// off each side of a ball. Column scans (no chroma sharing) as [`Self::Always`].
+    #[default]
+    ChromaPairs,
+    /// Always, on rows and columns.
+    Always,
+}
+
+/// [`edge_points`], moving a point one pixel outwards when the pixel right outside the run
+/// satisfies `is_mixed` (e.g. unclassified: neither the object's colour nor the background's)
+/// and `mode` allows it there. The classified outline of a small ball loses its rim pixels to
+/// mixed colours (UYVY chroma pairs, noise), which shrinks its radius by about half a pixel: 15%
+/// of the distance of a ball 3 px in radius.
+#[must_use]
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the scan's settings are independent; one call site"
+)]
+pub fn edge_points_with_mixed(
+    img: &ClassifiedImage,
     [minx, miny, maxx, maxy]: [u32; 4],
     pattern: EdgeScanPattern,
     margin: u32,
     run: u32,
     is_object: impl Fn(u8) -> bool,
+    is_mixed: impl Fn(u8) -> bool,
+    mode: MixedEdge,
 ) -> Vec<Point> {
     let run = i64::from(run.max(1));
     let (w, h) = (img.width() as i64, img.height() as i64);
@@ -189,10 +237,36 @@ pub fn edge_points(
         if (0..run).all(|k| at(start + k * dir)) {
             return None;
         }
+        let mixed_at = |t: i64| {
+            let code = if horizontal {
+                img.get_signed(t, fixed)
+            } else {
+                img.get_signed(fixed, t)
+            };
+            code.is_some_and(&is_mixed)
+        };
         let mut t = start;
         while (dir > 0 && t <= end) || (dir < 0 && t >= end) {
             if (0..run).all(|k| at(t + k * dir)) {
-                return Some(if dir > 0 { t as f64 } else { t as f64 + 1.0 });
+                // The pixel before the run: another chroma pair when the run starts at a pair's
+                // first pixel (scanning right) or ends at a pair's second (scanning left).
+                let before = t - dir;
+                let other_pair = before.div_euclid(2) != t.div_euclid(2);
+                let allowed = match mode {
+                    MixedEdge::Never => false,
+                    MixedEdge::ChromaPairs => !horizontal || other_pair,
+                    MixedEdge::Always => true,
+                };
+                let out = if allowed && mixed_at(before) {
+                    1.0
+                } else {
+                    0.0
+                };
+                return Some(if dir > 0 {
+                    t as f64 - out
+                } else {
+                    t as f64 + 1.0 + out
+                });
             }
             t += dir;
         }

@@ -183,9 +183,28 @@ impl Simulator {
                 };
                 let skip =
                     render::object_id::ROBOT + u16::try_from(observer_id).unwrap_or(0).min(899);
+                let moves = self.scenario.ball_moves_during_readout() && readout > 0.0;
+                #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+                let ball_at_row = |row: usize| {
+                    if !moves {
+                        return None;
+                    }
+                    let tr = t + ((row as f64 + 0.5) / height as f64 - 0.5) * readout;
+                    self.scenario
+                        .scene_at(tr)
+                        .ball
+                        .map(|b| nalgebra::Vector3::new(b.x_cm, b.y_cm, b.radius_cm))
+                };
                 let out = self
                     .renderer
-                    .render(&world, &row_pose, &self.effects, skip, &mut rng)
+                    .render_moving_ball(
+                        &world,
+                        &row_pose,
+                        &ball_at_row,
+                        &self.effects,
+                        skip,
+                        &mut rng,
+                    )
                     .map_err(frame_err)?;
                 let pose = CameraPose {
                     camera: self.head_camera,
@@ -206,7 +225,7 @@ impl Simulator {
                 let axis = mid * Vector::<crate::geometry::Camera>::new(1.0, 0.0, 0.0);
                 let d = world.distance_along(&mid.origin(), &axis, skip);
                 sensors.ir_far_cm = (10.0..=150.0).contains(&d).then_some(d);
-                let truth = truth::robot_view_truth(
+                let mut truth = truth::robot_view_truth(
                     &scene,
                     t,
                     observer_id,
@@ -217,6 +236,11 @@ impl Simulator {
                     sensors,
                     &out.objects,
                 );
+                if let (Some(b), Some(v)) =
+                    (truth.ball.as_mut(), self.scenario.ball_velocity_cm_s(t))
+                {
+                    truth::add_ball_velocity(b, v, &robot, &pose);
+                }
                 Ok(SimFrame {
                     time_ns,
                     frame: out.frame,

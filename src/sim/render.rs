@@ -219,6 +219,18 @@ impl World {
         }
     }
 
+    /// Moves the ball (if the scene has one) so its centre is at `centre` (field cm).
+    pub fn move_ball(&mut self, centre: Vector3<f64>) {
+        for obj in self.objects.iter_mut().filter(|o| o.id == object_id::BALL) {
+            obj.bound_centre = centre;
+            for part in &mut obj.parts {
+                if let Prim::Sphere { centre: c, .. } = &mut part.prim {
+                    *c = centre;
+                }
+            }
+        }
+    }
+
     /// The colour (0..255 sRGB, unclipped) and object seen along a ray, with its material.
     fn trace(
         &self,
@@ -719,6 +731,33 @@ impl Renderer {
         skip: u16,
         rng: &mut SimRng,
     ) -> Result<Rendered, FrameError> {
+        self.render_moving_ball(
+            world,
+            field_from_camera_at_row,
+            &|_| None,
+            effects,
+            skip,
+            rng,
+        )
+    }
+
+    /// [`Self::render`] with the ball's own motion during read-out: `ball_centre_at_row(r)`
+    /// gives the ball's centre (field cm) while row `r` is exposed, `None` to leave it where
+    /// `world` has it. A ball rolling across the view comes out sheared, as a real rolling
+    /// shutter shows it.
+    ///
+    /// # Errors
+    /// [`FrameError`] only for an odd width (UYVY needs pixel pairs).
+    pub fn render_moving_ball(
+        &self,
+        world: &World,
+        field_from_camera_at_row: &dyn Fn(usize) -> Isometry3<f64>,
+        ball_centre_at_row: &dyn Fn(usize) -> Option<Vector3<f64>>,
+        effects: &CameraEffects,
+        skip: u16,
+        rng: &mut SimRng,
+    ) -> Result<Rendered, FrameError> {
+        let mut moving: Option<World> = None;
         let (w, h) = (self.width, self.height);
         if !w.is_multiple_of(2) {
             return Err(FrameError::OddWidth { width: w });
@@ -731,6 +770,10 @@ impl Renderer {
         let corner2 = cx * cx + cy * cy;
         let mut row_yuv = vec![[0.0_f64; 3]; w];
         for j in 0..h {
+            if let Some(c) = ball_centre_at_row(j) {
+                moving.get_or_insert_with(|| world.clone()).move_ball(c);
+            }
+            let world = moving.as_ref().unwrap_or(world);
             let pose = field_from_camera_at_row(j);
             let rot = pose.rotation.to_rotation_matrix().into_inner();
             let origin = pose.translation.vector;
@@ -839,6 +882,60 @@ mod tests {
         let p = ball[ball.len() / 2];
         let yuv = out.frame.pixel(p % 208, p / 208).expect("in image");
         assert!(yuv.v > 150 && yuv.u < 110 && yuv.v > yuv.u + 40, "{yuv:?}");
+    }
+
+    #[test]
+    fn a_ball_moving_during_readout_comes_out_sheared() {
+        let mut scene = Scene::four_legged_2005();
+        scene.ball = Some(Ball::at(60.0, 0.0));
+        let world = World::compile(&scene);
+        let renderer = Renderer::pinhole(&PinholeCamera::ers7());
+        let joints = HeadJoints {
+            tilt1_rad: -0.25,
+            pan_rad: 0.0,
+            tilt2_rad: -0.1,
+        };
+        let pose = robot_camera_pose(RobotPose::default(), joints);
+        let render = |ball_at: &dyn Fn(usize) -> Option<Vector3<f64>>| {
+            renderer
+                .render_moving_ball(
+                    &world,
+                    &|_| pose,
+                    ball_at,
+                    &CameraEffects::NONE,
+                    0,
+                    &mut SimRng::new(1),
+                )
+                .expect("render")
+        };
+        // Leftmost ball column of each row that shows the ball.
+        let left_edges = |objects: &[u16]| -> Vec<(usize, usize)> {
+            (0..160)
+                .filter_map(|y| {
+                    (0..208)
+                        .find(|&x| objects[y * 208 + x] == object_id::BALL)
+                        .map(|x| (y, x))
+                })
+                .collect()
+        };
+        let still = render(&|_| None);
+        assert_eq!(
+            still.objects,
+            render(&|_| Some(Vector3::new(60.0, 0.0, 4.25))).objects
+        );
+        // The ball rolls to the right (−y) by 0.1 cm per row read.
+        #[expect(clippy::cast_precision_loss, reason = "row numbers are small")]
+        let moving = render(&|row| Some(Vector3::new(60.0, -0.1 * (row as f64 - 80.0), 4.25)));
+        let (a, b) = (left_edges(&still.objects), left_edges(&moving.objects));
+        let (top_a, bottom_a) = (a[0].1, a[a.len() - 1].1);
+        let (top_b, bottom_b) = (b[0].1, b[b.len() - 1].1);
+        // Rows read later see it further right: the left edge leans.
+        let lean_still = bottom_a as i64 - top_a as i64;
+        let lean_moving = bottom_b as i64 - top_b as i64;
+        assert!(
+            lean_moving >= lean_still + 4,
+            "{lean_still} vs {lean_moving}"
+        );
     }
 
     #[test]

@@ -51,11 +51,17 @@ pub enum ScenarioKind {
     /// The overhead camera over a game of 4–8 robots and a moving ball, with each robot's noisy
     /// world-model estimate.
     OverheadGame,
+    /// Fast head pans past a close ball (36–66 cm ahead, about 30–80 px across): the rolling
+    /// shutter shears it a lot, and the pans cut it at the image sides.
+    ClosePans,
+    /// A standing robot with a still head watches the ball roll across its view at 1–3 m/s:
+    /// the ball itself moves while the rows are read out.
+    RollingBall,
 }
 
 impl ScenarioKind {
     /// Every scenario in documentation order.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 9] = [
         Self::WalkAndPan,
         Self::BallEdge,
         Self::Goalkeeper,
@@ -63,6 +69,8 @@ impl ScenarioKind {
         Self::OrangeClutter,
         Self::BeaconTour,
         Self::OverheadGame,
+        Self::ClosePans,
+        Self::RollingBall,
     ];
 
     /// The command-line name (`walk-and-pan`, …).
@@ -76,6 +84,8 @@ impl ScenarioKind {
             Self::OrangeClutter => "orange-clutter",
             Self::BeaconTour => "beacon-tour",
             Self::OverheadGame => "overhead-game",
+            Self::ClosePans => "close-pans",
+            Self::RollingBall => "rolling-ball",
         }
     }
 
@@ -96,6 +106,10 @@ impl ScenarioKind {
             Self::OrangeClutter => "orange and yellow things off the field, and the real ball",
             Self::BeaconTour => "a robot circles the centre, panning past every beacon",
             Self::OverheadGame => "overhead view of 4-8 robots and the ball, with world models",
+            Self::ClosePans => {
+                "fast head pans past a close ball (30-80 px): strong skew, cut sides"
+            }
+            Self::RollingBall => "the ball rolls across a still camera at 1-3 m/s",
         }
     }
 }
@@ -140,6 +154,23 @@ impl Scenario {
                 observer_id: OBSERVER_ID,
             },
         }
+    }
+
+    /// Whether the renderer moves the ball while the rows are read out (its position at each
+    /// row's exposure time). Only the scenarios made for it: the older ones keep the ball still
+    /// during a frame so that figures measured on them stay comparable.
+    #[must_use]
+    pub fn ball_moves_during_readout(&self) -> bool {
+        matches!(self.kind, ScenarioKind::RollingBall)
+    }
+
+    /// The ball's field velocity at time `t_s`, centimetres per second (central difference over
+    /// ±1 ms), when the scene has a ball.
+    #[must_use]
+    pub fn ball_velocity_cm_s(&self, t_s: f64) -> Option<[f64; 2]> {
+        let h = 1e-3;
+        let (a, b) = (self.scene_at(t_s - h).ball?, self.scene_at(t_s + h).ball?);
+        Some([(b.x_cm - a.x_cm) / (2.0 * h), (b.y_cm - a.y_cm) / (2.0 * h)])
     }
 
     /// The world at time `t_s` (seconds from the start).
@@ -259,6 +290,45 @@ impl Scenario {
                     .robots
                     .push(standing(4, Team::Blue, 160.0, -100.0, 2.5));
             }
+            ScenarioKind::ClosePans => {
+                // A new ball spot each pan cycle, switched while the head looks away (pan
+                // phase −90°): 36–66 cm ahead of the body centre, a little to the left. The
+                // period is not a whole number of frames, so the ball is caught at many phases.
+                const SPOTS_CM: [f64; 7] = [40.0, 50.0, 60.0, 36.0, 45.0, 66.0, 55.0];
+                let period = 1.27;
+                let cycle = ((t_s - 0.9) / period).floor();
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    clippy::cast_sign_loss,
+                    reason = "small, clamped to ≥ 0"
+                )]
+                let k =
+                    (cycle + 1.0).max(0.0) as usize + usize::try_from(self.seed % 7).unwrap_or(0);
+                let d = SPOTS_CM[k % SPOTS_CM.len()] + 2.0 * j[0];
+                let bearing = 0.25 + 0.05 * j[1];
+                let pose = RobotPose::new(-60.0, 20.0, 0.0);
+                let ball = Ball::at(pose.x_cm + d * bearing.cos(), pose.y_cm + d * bearing.sin());
+                scene.ball = Some(ball);
+                let body = BodyPose::ERS7_STANCE;
+                let track = look_at(&pose, &body, &Point::new(ball.x_cm, ball.y_cm, 4.25));
+                let joints = HeadJoints {
+                    pan_rad: track.pan_rad + 0.9 * (TAU * t_s / period).sin(),
+                    ..track
+                };
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+            }
+            ScenarioKind::RollingBall => {
+                let pose = RobotPose::new(-100.0, 0.0, 0.0);
+                let (x, y) = rolling_pass(t_s + 0.2 * j[0]);
+                scene.ball = Some(Ball::at(pose.x_cm + x, pose.y_cm + y));
+                let body = BodyPose::ERS7_STANCE;
+                let joints = look_at(&pose, &body, &Point::new(pose.x_cm + 65.0, 0.0, 4.25));
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+            }
             ScenarioKind::OverheadGame => {
                 for k in 0..self.robot_count {
                     let team = if k % 2 == 0 { Team::Red } else { Team::Blue };
@@ -359,6 +429,33 @@ impl Scenario {
             })
             .collect()
     }
+}
+
+/// The rolling ball's position relative to the observer (cm, x ahead, y left) at `t_s`: a
+/// cycle of five passes, each a straight roll of 140 cm across the view at its own speed
+/// (1–3 m/s), distance ahead and direction, alternating left-to-right and right-to-left. The
+/// ball jumps between passes while outside the image.
+fn rolling_pass(t_s: f64) -> (f64, f64) {
+    const SPEED_CM_S: [f64; 5] = [100.0, 200.0, 300.0, 150.0, 250.0];
+    const AHEAD_CM: [f64; 5] = [55.0, 70.0, 50.0, 85.0, 60.0];
+    const ANGLE_RAD: [f64; 5] = [0.0, 0.4, -0.3, 0.2, -0.5];
+    const LENGTH_CM: f64 = 140.0;
+    let cycle: f64 = SPEED_CM_S.iter().map(|v| LENGTH_CM / v).sum();
+    let mut t = t_s.rem_euclid(cycle);
+    for (k, v) in SPEED_CM_S.iter().enumerate() {
+        let duration = LENGTH_CM / v;
+        if t < duration || k + 1 == SPEED_CM_S.len() {
+            // Travelled along the path, centred on the pass's mid-point.
+            let along = v * t.min(duration) - LENGTH_CM / 2.0;
+            let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+            let (s, c) = ANGLE_RAD[k].sin_cos();
+            // Direction: across the view (±y), turned by the pass's angle.
+            let (dx, dy) = (sign * s, sign * c);
+            return (AHEAD_CM[k] + along * dx, along * dy);
+        }
+        t -= duration;
+    }
+    (AHEAD_CM[0], 0.0)
 }
 
 fn robot(id: u32, team: Team, pose: RobotPose, body: BodyPose, joints: HeadJoints) -> Robot {
@@ -530,6 +627,24 @@ mod tests {
         }
         let game = Scenario::new(ScenarioKind::OverheadGame, 9).scene_at(2.0);
         assert!((4..=8).contains(&game.robots.len()));
+    }
+
+    #[test]
+    fn the_rolling_ball_rolls_at_one_to_three_metres_a_second() {
+        let s = Scenario::new(ScenarioKind::RollingBall, 7);
+        assert!(s.ball_moves_during_readout());
+        let mut speeds: Vec<f64> = (0..120)
+            .filter_map(|k| s.ball_velocity_cm_s(f64::from(k) / 30.0 + 0.01))
+            .map(|v| v[0].hypot(v[1]))
+            .collect();
+        speeds.sort_by(f64::total_cmp);
+        assert!(
+            speeds[5] >= 99.0 && speeds[speeds.len() - 5] <= 301.0,
+            "{speeds:?}"
+        );
+        let still = Scenario::new(ScenarioKind::FastPans, 7);
+        assert!(!still.ball_moves_during_readout());
+        assert_eq!(still.ball_velocity_cm_s(1.0), Some([0.0, 0.0]));
     }
 
     #[test]

@@ -120,6 +120,44 @@ pub struct BallTruth {
     pub cut_off: CutOff,
     /// Box of the visible ball pixels.
     pub image_box: Option<PixelBox>,
+    /// The ball's velocity on the ground in the observer's frame (x ahead, y left),
+    /// centimetres per second.
+    #[serde(default)]
+    pub ground_velocity_cm_s: Option<[f64; 2]>,
+    /// How fast the ball's centre moves in the image through its own motion, with the camera
+    /// held at its mid-readout pose, pixels per second (x right, y down): what a fit of the
+    /// ball's rolling-shutter shear should find once the camera's own skew is removed.
+    #[serde(default)]
+    pub image_velocity_px_s: Option<[f64; 2]>,
+}
+
+/// Fills in a ball's velocity truth from its field velocity `v_cm_s` (cm/s): turned into the
+/// observer's frame, and as the image motion of its centre through the mid-readout `pose`
+/// (a finite difference over ±1 ms).
+pub fn add_ball_velocity(
+    ball: &mut BallTruth,
+    v_cm_s: [f64; 2],
+    robot: &RobotPose,
+    pose: &CameraPose,
+) {
+    let (s, c) = robot.heading_rad.sin_cos();
+    ball.ground_velocity_cm_s = Some([
+        c * v_cm_s[0] + s * v_cm_s[1],
+        -s * v_cm_s[0] + c * v_cm_s[1],
+    ]);
+    let centre = ball.relative.field_cm;
+    let h = 1e-3;
+    let at = |k: f64| {
+        pose.image_from_field(&Point::<Field>::new(
+            centre[0] + k * h * v_cm_s[0],
+            centre[1] + k * h * v_cm_s[1],
+            4.25,
+        ))
+    };
+    ball.image_velocity_px_s = match (at(-1.0), at(1.0)) {
+        (Some(a), Some(b)) => Some([(b.x_px - a.x_px) / (2.0 * h), (b.y_px - a.y_px) / (2.0 * h)]),
+        _ => None,
+    };
 }
 
 /// A goal post: the front end of a side wall.
@@ -328,6 +366,8 @@ pub fn robot_view_truth(
             in_image_fraction: in_image,
             cut_off,
             image_box: cov.bbox,
+            ground_velocity_cm_s: None,
+            image_velocity_px_s: None,
         }
     });
     let f = &scene.field;

@@ -7,6 +7,7 @@ mod app;
 mod cli;
 mod common;
 mod goal_posts;
+mod motion;
 mod peer;
 mod real_data;
 mod recognition;

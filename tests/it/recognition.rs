@@ -97,20 +97,41 @@ fn recognition_on_synthetic_scenarios() {
     );
     let false_balls = sum(&|r| r.ball_false);
     assert_eq!(false_balls, 0, "false balls in any scenario");
-    for (k, achieved) in [
-        (ScenarioKind::BallEdge, 0.04),
-        (ScenarioKind::FastPans, 0.04),
-        (ScenarioKind::WalkAndPan, 0.05),
+    // Distances come from the angle the ball subtends (its outline off the optical axis is a
+    // stretched ellipse) with the rim pixels that UYVY chroma pairs leave unclassified counted
+    // back: the median error is under 3% and the signed median (the bias) within ±3% on each.
+    for k in [
+        ScenarioKind::BallEdge,
+        ScenarioKind::FastPans,
+        ScenarioKind::WalkAndPan,
     ] {
         let r = report(k);
+        eprintln!(
+            "{}: ball distance error median {:.1}% (n = {}), signed median {:+.1}%; cut off \
+             {:.1}% (n = {}), signed {:+.1}%",
+            k.name(),
+            100.0 * r.ball_distance_error.p50,
+            r.ball_distance_error.n,
+            100.0 * r.ball_distance_bias.unwrap_or(f64::NAN),
+            100.0 * r.ball_distance_error_cut.p50,
+            r.ball_distance_error_cut.n,
+            100.0 * r.ball_distance_bias_cut.unwrap_or(f64::NAN),
+        );
         assert!(
-            r.ball_distance_error.p50 <= achieved,
+            r.ball_distance_error.p50 <= 0.03,
             "{}: {:?}",
             k.name(),
             r.ball_distance_error
         );
+        assert!(
+            r.ball_distance_bias.is_some_and(|b| b.abs() <= 0.03),
+            "{}: bias {:?}",
+            k.name(),
+            r.ball_distance_bias
+        );
     }
-    assert!(report(ScenarioKind::BallEdge).ball_distance_error_cut.p50 <= 0.08);
+    assert!(report(ScenarioKind::BallEdge).ball_distance_error_cut.p50 <= 0.04);
+    assert!(report(ScenarioKind::WalkAndPan).ball_distance_error_cut.p50 <= 0.04);
     let goals_eligible = sum(&|r| r.goals_eligible);
     let goals_found = sum(&|r| r.goals_found);
     eprintln!("goals found {goals_found}/{goals_eligible}");
@@ -260,6 +281,99 @@ fn skew_radius_comparison(
     }
     let p = eotn::eval::Percentiles::of;
     ((p(&raw_r), p(&raw_c)), (p(&fixed_r), p(&fixed_c)))
+}
+
+/// The overlay draws the ball where the image shows it: on the fast pans the skew correction
+/// moves the centre several pixels (to the reference read-out time), but the solid circle must
+/// stay on the ball's pixels (the truth box of the pixels that show the ball), with the
+/// corrected circle as a second, dashed one.
+#[test]
+fn drawn_ball_circle_sits_on_the_observed_ball() {
+    use eotn::recognition::{CircleRole, Primitive};
+    let lut = learnt_table();
+    let sim = Simulator::new(Scenario::new(ScenarioKind::FastPans, 7));
+    let mut pipeline = Pipeline::new(lut, PipelineParams::default());
+    let (mut checked, mut apart, mut offsets) = (0, 0, Vec::new());
+    for i in 0..90 {
+        let f = sim.frame(i).expect("frame");
+        let GroundTruth::Robot(truth) = &f.ground_truth else {
+            continue;
+        };
+        let Some((tb, bx)) = truth
+            .ball
+            .as_ref()
+            .filter(|b| b.visible_fraction >= 0.95 && b.in_image_fraction >= 0.999)
+            .and_then(|b| Some((b, b.image_box?)))
+        else {
+            continue;
+        };
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        if r.recognition.ball.ball.is_none() {
+            continue;
+        }
+        let seen = (
+            (bx.min_x + bx.max_x + 1) as f64 / 2.0,
+            (bx.min_y + bx.max_y + 1) as f64 / 2.0,
+        );
+        let circles: Vec<_> = r
+            .recognition
+            .ball
+            .primitives()
+            .into_iter()
+            .filter_map(|p| match p {
+                Primitive::Circle {
+                    center,
+                    radius,
+                    role,
+                    ..
+                } => Some((center, radius, role)),
+                _ => None,
+            })
+            .collect();
+        let off = |c: (f64, f64)| (c.0 - seen.0).hypot(c.1 - seen.1);
+        let solid: Vec<_> = circles
+            .iter()
+            .filter(|c| c.2 == CircleRole::Observed)
+            .collect();
+        assert_eq!(solid.len(), 1, "frame {i}: one solid circle");
+        // The circle fitted to the outline points as scanned, before any skew removal.
+        let ball = r.recognition.ball.ball.as_ref().expect("ball");
+        let cand = &r.recognition.ball.candidates[ball.candidate];
+        let raw = eotn::recognition::fit::fit_circle(&cand.scanned_points).expect("raw fit");
+        let c = solid[0].0;
+        assert!(
+            (c.0 - raw.center_x).hypot(c.1 - raw.center_y) <= 1.0,
+            "frame {i}: solid circle at {c:?}, outline as scanned fits ({:.1}, {:.1})",
+            raw.center_x,
+            raw.center_y
+        );
+        offsets.push(off(c));
+        eprintln!(
+            "frame {i}: solid circle {:.2} px from the ball's pixels (radius {:.1} px)",
+            off(c),
+            tb.image_radius_px.unwrap_or(0.0)
+        );
+        if let Some(dashed) = circles.iter().find(|c| c.2 == CircleRole::SkewCorrected) {
+            apart += usize::from(off(dashed.0) > 3.0);
+        }
+        checked += 1;
+    }
+    eprintln!(
+        "drawn circle on the ball in {checked} frames; corrected circle > 3 px away in {apart}"
+    );
+    assert!(checked >= 15, "{checked} frames checked");
+    // Classification moves a ball's outline by a pixel or two now and then (its bright top in
+    // the darkened image corners): within 1.5 px in nine frames of ten.
+    let within = offsets.iter().filter(|o| **o <= 1.5).count();
+    assert!(
+        within * 10 >= offsets.len() * 9,
+        "solid circle within 1.5 px of the ball's pixels in {within} of {} frames",
+        offsets.len()
+    );
+    assert!(
+        apart >= 5,
+        "the fast pans must move the corrected centre off the ball ({apart} frames)"
+    );
 }
 
 /// Prints what happened per frame: `EOTN_DEBUG_SCENARIO=fast-pans cargo test --test it
@@ -612,4 +726,173 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("garbage.mcap"));
+}
+
+/// Prints one CSV line per correctly matched ball (prefix `BIAS,`) for studying the distance
+/// error's sign: `EOTN_BIAS_FRAMES=180 cargo test --test it ball_distance_bias -- --ignored
+/// --nocapture`. Columns: scenario, seed, frame, true distance, true radius, true centre x/y,
+/// cut, measured distance, radius, centre x/y, from circle fit, the original's d × 8.5 /
+/// diameter, blob box width/height, truth box width/height, ground-plane distance.
+#[test]
+#[ignore = "a measuring aid, not a check"]
+fn ball_distance_bias() {
+    let frames: u64 = std::env::var("EOTN_BIAS_FRAMES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(90);
+    let seeds: Vec<u64> = std::env::var("EOTN_BIAS_SEEDS")
+        .unwrap_or_else(|_| "7".into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    let lut = learnt_table();
+    let params = PipelineParams::default();
+    let b = params.recognition.ball;
+    for kind in [
+        ScenarioKind::WalkAndPan,
+        ScenarioKind::BallEdge,
+        ScenarioKind::FastPans,
+        ScenarioKind::OrangeClutter,
+    ] {
+        for &seed in &seeds {
+            let sim = Simulator::new(Scenario::new(kind, seed));
+            let mut pipeline = Pipeline::new(lut.clone(), params);
+            for i in 0..frames {
+                let f = sim.frame(i).expect("frame");
+                let GroundTruth::Robot(truth) = &f.ground_truth else {
+                    continue;
+                };
+                let r = pipeline.process(&f.frame, f.sensors.as_ref());
+                let fe = evaluate_frame(
+                    i as usize,
+                    r.recognition,
+                    truth,
+                    208.0,
+                    160.0,
+                    &EvalParams::default(),
+                );
+                let (Some(tb), Some(ball)) = (truth.ball.as_ref(), &r.recognition.ball.ball) else {
+                    continue;
+                };
+                if !fe.ball_eligible || fe.ball_distance_error.is_none() {
+                    continue;
+                }
+                let cand = &r.recognition.ball.candidates[ball.candidate];
+                let img = tb.relative.image.expect("matched ball projects");
+                let [x0, y0, x1, y1] = cand.bounds;
+                let (tw, th) = tb.image_box.map_or((0, 0), |bx| {
+                    (bx.max_x + 1 - bx.min_x, bx.max_y + 1 - bx.min_y)
+                });
+                let ctx = params.recognition.context_for(208, 160, f.sensors.as_ref());
+                let plane = ctx
+                    .pose
+                    .and_then(|p| {
+                        let ip = eotn::geometry::ImagePoint::new(ball.center_x, ball.center_y);
+                        Some(p.point_on_plane(ip, 4.25)?.distance_to(&p.position()))
+                    })
+                    .unwrap_or(f64::NAN);
+                eprintln!(
+                    "BIAS,{},{seed},{i},{:.2},{:.3},{:.2},{:.2},{},{:.2},{:.3},{:.2},{:.2},{},{:.2},{},{},{tw},{th},{plane:.2}",
+                    kind.name(),
+                    tb.relative.camera_distance_cm,
+                    tb.image_radius_px.unwrap_or(0.0),
+                    img.x_px,
+                    img.y_px,
+                    u8::from(fe.ball_cut),
+                    ball.camera.distance_cm,
+                    ball.radius_px,
+                    ball.center_x,
+                    ball.center_y,
+                    u8::from(ball.from_circle_fit),
+                    191.9 * b.diameter_cm / (2.0 * ball.radius_px),
+                    x1 + 1 - x0,
+                    y1 + 1 - y0,
+                );
+            }
+        }
+    }
+}
+
+/// Which of the ball's true pixels classification loses, and to what, by where they are on the
+/// ball (top/bottom rim, left/right rim with the UYVY chroma partner on or off the ball,
+/// inside): how the half-pixel rim loss behind the long ball distances was found.
+/// `cargo test --test it ball_rim_study -- --ignored --nocapture`.
+#[test]
+#[ignore = "a measuring aid, not a check"]
+fn ball_rim_study() {
+    use eotn::lut::ColourClass;
+    let lut = learnt_table();
+    let params = PipelineParams::default();
+    let orange = ColourClass::Orange.code();
+    let mut tally: std::collections::BTreeMap<String, [usize; 2]> = Default::default();
+    for kind in [
+        ScenarioKind::WalkAndPan,
+        ScenarioKind::BallEdge,
+        ScenarioKind::FastPans,
+    ] {
+        let sim = Simulator::new(Scenario::new(kind, 7));
+        let mut pipeline = Pipeline::new(lut.clone(), params);
+        for i in 0..90 {
+            let f = sim.frame(i).expect("frame");
+            let GroundTruth::Robot(truth) = &f.ground_truth else {
+                continue;
+            };
+            let r = pipeline.process(&f.frame, f.sensors.as_ref());
+            let Some(tb) = truth.ball.as_ref().filter(|b| b.visible_fraction > 0.9) else {
+                continue;
+            };
+            let Some(bx) = tb.image_box else { continue };
+            let img = r.classified;
+            let w = 208usize;
+            let lab = |x: i64, y: i64| -> bool {
+                x >= 0
+                    && y >= 0
+                    && (x as usize) < w
+                    && (y as usize) < 160
+                    && f.labels[y as usize * w + x as usize] == orange
+            };
+            for y in bx.min_y..=bx.max_y {
+                for x in bx.min_x..=bx.max_x {
+                    let (xi, yi) = (x as i64, y as i64);
+                    if !lab(xi, yi) {
+                        continue;
+                    }
+                    let region = if !lab(xi, yi - 1) {
+                        "top"
+                    } else if !lab(xi, yi + 1) {
+                        "bottom"
+                    } else if !lab(xi - 1, yi) || !lab(xi + 1, yi) {
+                        // Left/right rim: is the pair partner also ball?
+                        let partner = xi ^ 1;
+                        if lab(partner, yi) {
+                            "side-pair-ball"
+                        } else {
+                            "side-pair-mixed"
+                        }
+                    } else {
+                        "inside"
+                    };
+                    let c = img.get(x, y).unwrap_or(0);
+                    let is_ball = eotn::recognition::ball::is_ball_colour(c);
+                    let e = tally
+                        .entry(format!("{} {region}", kind.name()))
+                        .or_default();
+                    e[usize::from(is_ball)] += 1;
+                    if !is_ball {
+                        *tally
+                            .entry(format!("  lost as {:?}", ColourClass::from_code(c)))
+                            .or_default()
+                            .get_mut(0)
+                            .expect("slot") += 1;
+                    }
+                }
+            }
+        }
+    }
+    for (k, [lost, kept]) in tally {
+        eprintln!(
+            "{k:40} lost {lost:5} kept {kept:5} ({:.0}% lost)",
+            100.0 * lost as f64 / (lost + kept).max(1) as f64
+        );
+    }
 }
