@@ -6,7 +6,6 @@
 use eotn::eval::{EvalParams, EvalReport, Percentiles, evaluate_frame};
 use eotn::geometry::{Camera, Ers7Dimensions, Field, PinholeCamera, Point, Transform};
 use eotn::lut::LookupTable;
-use eotn::lut::learn::{LearnParams, TableBuilder};
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::recognition::ball::is_ball_colour;
 use eotn::recognition::fit::{fit_circle, fit_circle_trimmed};
@@ -17,21 +16,13 @@ use eotn::sim::{Scenario, ScenarioKind, Simulator};
 /// A table learnt from every 10th frame of a few robot scenarios with seed 100 (the test
 /// frames use seed 7).
 fn learnt_table() -> LookupTable {
-    let mut builder = TableBuilder::new(7).expect("7 bits");
-    for kind in [
+    crate::recognition::table_learnt_from(&[
         ScenarioKind::WalkAndPan,
         ScenarioKind::FastPans,
         ScenarioKind::BallEdge,
         ScenarioKind::ClosePans,
         ScenarioKind::RollingBall,
-    ] {
-        let sim = Simulator::new(Scenario::new(kind, 100));
-        for i in (0..90).step_by(10) {
-            let f = sim.frame(i).expect("frame");
-            builder.add_frame(&f.frame, &f.labels).expect("labels fit");
-        }
-    }
-    builder.build(&LearnParams::default())
+    ])
 }
 
 /// The circle a perfect outline of the ball fits at mid-readout, scanned the way the detector

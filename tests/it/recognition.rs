@@ -20,8 +20,13 @@ const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
 
 /// A table learnt from every 10th frame of each robot scenario with seed 100.
 pub(crate) fn learnt_table() -> LookupTable {
+    table_learnt_from(&ROBOT_SCENARIOS)
+}
+
+/// A table learnt from every 10th frame of `kinds` with seed 100 (test frames use seed 7).
+pub(crate) fn table_learnt_from(kinds: &[ScenarioKind]) -> LookupTable {
     let mut builder = TableBuilder::new(7).expect("7 bits");
-    for kind in ROBOT_SCENARIOS {
+    for &kind in kinds {
         let sim = Simulator::new(Scenario::new(kind, 100));
         for i in (0..90).step_by(10) {
             let f = sim.frame(i).expect("frame");
