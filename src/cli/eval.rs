@@ -10,8 +10,9 @@ use serde::Serialize;
 
 use super::detect::load_params;
 use super::inputs::load_lut_arg;
+use crate::eval::skew::{self, SkewReport};
 use crate::eval::{
-    EvalParams, EvalReport, FrameEval, Percentiles, evaluate_frame, fit_inverse_size,
+    EvalParams, EvalReport, FrameEval, evaluate_frame, fit_inverse_size,
     fit_inverse_size_multiplier,
 };
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -56,17 +57,6 @@ pub struct Args {
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
-}
-
-/// The skew-correction comparison.
-#[derive(Debug, Clone, Serialize)]
-pub struct SkewReport {
-    /// Fast-panning frames with a correct ball in both runs.
-    pub frames: usize,
-    /// Radius error with correction, pixels.
-    pub radius_error_with: Percentiles,
-    /// Radius error without correction, pixels.
-    pub radius_error_without: Percentiles,
 }
 
 /// A frame whose results differ between the two configurations.
@@ -162,7 +152,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let ep = EvalParams::default();
     let (mut frames_a, mut frames_b) = (Vec::<FrameEval>::new(), Vec::<FrameEval>::new());
-    let (mut skew_with, mut skew_without) = (Vec::new(), Vec::new());
+    let (mut skew_frames, mut skew_samples) = (0usize, Vec::new());
     let mut differences = Vec::new();
     let mut skipped = Vec::new();
     let mut goal_samples = Vec::new();
@@ -215,12 +205,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 .and_then(crate::sensors::SensorReadings::pan_velocity_rad_per_s)
                 .is_some_and(|v| v.abs() >= args.fast_pan_rad_per_s);
             if fast {
-                let rn = no_skew.process(&record.frame, sensors).recognition.clone();
-                let fnn = evaluate_frame(global, &rn, &truth, w, h, &ep);
-                if let (Some(a), Some(b)) = (fa.ball_radius_error_px, fnn.ball_radius_error_px) {
-                    skew_with.push(a);
-                    skew_without.push(b);
-                }
+                skew_frames += 1;
+                let rn = &no_skew.process(&record.frame, sensors).recognition;
+                let camera = rp.camera_for(record.frame.width(), record.frame.height());
+                skew_samples.extend(skew::compare_ball(&ra, rn, &truth, &camera, 2.0));
             }
             if let Some(o) = other.as_mut() {
                 let rb = o.process(&record.frame, sensors).recognition.clone();
@@ -302,11 +290,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let output = EvalOutput {
         report: EvalReport::from_frames(&frames_a),
-        skew: (!skew_with.is_empty()).then(|| SkewReport {
-            frames: skew_with.len(),
-            radius_error_with: Percentiles::of(&skew_with),
-            radius_error_without: Percentiles::of(&skew_without),
-        }),
+        skew: (skew_frames > 0).then(|| SkewReport::from_samples(skew_frames, &skew_samples)),
         compare: other.is_some().then(|| EvalReport::from_frames(&frames_b)),
         differences,
         goal_calibration,
@@ -357,9 +341,27 @@ fn print_summary(o: &EvalOutput) {
     );
     if let Some(s) = &o.skew {
         println!(
-            "skew correction        radius error median {:.2} px with, {:.2} px without (n={})",
-            s.radius_error_with.p50, s.radius_error_without.p50, s.frames
+            "skew correction        {} fast-panning frames, {} with a ball on the true one in both runs",
+            s.frames, s.compared
         );
+        for (name, e) in [
+            ("all balls", &s.all),
+            ("seen from one side", &s.one_sided),
+            ("whole outline", &s.whole),
+        ] {
+            if e.radius_with_px.n == 0 {
+                continue;
+            }
+            println!(
+                "  {name:<20} radius error median {:.2} px with, {:.2} without; centre {:.2} \
+                 px with, {:.2} without (n={})",
+                e.radius_with_px.p50,
+                e.radius_without_px.p50,
+                e.centre_with_px.p50,
+                e.centre_without_px.p50,
+                e.radius_with_px.n
+            );
+        }
     }
     println!(
         "goals found            {}/{} = {}   false {}; distance error median {:.1}%",

@@ -5,6 +5,7 @@
 //! streams and runs the pipeline, this module only compares.
 
 pub mod plots;
+pub mod skew;
 
 use serde::{Deserialize, Serialize};
 
