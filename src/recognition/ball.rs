@@ -148,8 +148,6 @@ pub struct BallParams {
     /// The ellipse fit is used only when both shears' standard errors are below this, pixels
     /// per line (a short arc of a cut ball leaves the shear undetermined).
     pub ellipse_max_shear_sd: f64,
-    /// Frame interval assumed when the readings do not give one, seconds (the ERS-7: 1/30).
-    pub default_frame_interval_s: f64,
 }
 
 impl Default for BallParams {
@@ -200,7 +198,6 @@ impl Default for BallParams {
             ellipse_vertical_shear: false,
             ellipse_min_points: 12,
             ellipse_max_shear_sd: 0.03,
-            default_frame_interval_s: 1.0 / 30.0,
         }
     }
 }
@@ -893,10 +890,8 @@ pub fn recognise_ball(
         }
         let accepted = result.ball.is_none() && confidence.accepted();
         let index = result.candidates.len();
-        let frame_s = ctx
-            .frame_interval_s
-            .unwrap_or(params.default_frame_interval_s);
-        let line_s = frame_s / ctx.camera.height_px.max(1) as f64;
+        // Rows are read out over the camera's read-out time, not the (logged) frame interval.
+        let line_s = ctx.readout_s / ctx.camera.height_px.max(1) as f64;
         let image_velocity = moving.map(|e| e.velocity_px_s(line_s));
         if accepted {
             result.ball = Some(Ball {
