@@ -50,8 +50,12 @@
 //! need an aspect correction, and the stream would be twice as large; the luma detail it keeps
 //! is half a macropixel, below what the table's 4-level cells resolve.
 //!
-//! **Sensors.** Each frame takes the last JointData and SensorData logged before it (the motion
-//! process logs them just before the cognition process logs its image). Mapped to
+//! **Sensors.** Each frame takes the last JointData and SensorData logged before it, except head
+//! pan and tilt: those are interpolated at the image's time between the JointData records
+//! logged around it. The log keeps about 8 joint records per second, taken up to ±180 ms from
+//! its images (the last one before an image is sometimes the previous image's too), so the
+//! head's velocity between two images comes out wrong by up to 5× from the last records (frame
+//! 63: 10 rad/s of pan instead of 2). Mapped to
 //! [`SensorReadings`]: head pan = B-Human's `headPan` (the Nao's HeadYaw, positive left, as
 //! ours); head tilt = `headTilt` (B-Human's joint is already positive *up*, the negated
 //! HeadPitch of the Nao, as ours: their `CameraMatrixProvider` turns the camera by −`headTilt`
@@ -548,8 +552,8 @@ pub fn parse_log(bytes: &[u8]) -> Result<BhumanLog, String> {
     let mut log = BhumanLog::default();
     let msgs = messages(bytes, &mut log.warnings)?;
     let mut joints: Option<JointRecord> = None;
+    let mut all_joints: Vec<JointRecord> = Vec::new();
     let mut sensors: Option<SensorRecord> = None;
-    let mut previous: Option<(u32, SensorReadings)> = None;
     // The frame whose image was logged in the current process cycle (since the last
     // ProcessBegin): the cycle's camera matrix and coordinate system belong to it.
     let mut cycle_frame: Option<usize> = None;
@@ -607,7 +611,10 @@ pub fn parse_log(bytes: &[u8]) -> Result<BhumanLog, String> {
                 }
             }
             ids::JOINT_DATA => match parse_joints(m.payload) {
-                Some(j) => joints = Some(j),
+                Some(j) => {
+                    all_joints.push(j.clone());
+                    joints = Some(j);
+                }
                 None => log.warnings.push(format!(
                     "message {index}: JointData of {} bytes, expected 180; skipped",
                     m.payload.len()
@@ -622,14 +629,7 @@ pub fn parse_log(bytes: &[u8]) -> Result<BhumanLog, String> {
             },
             ids::JPEG_IMAGE => match image(m.payload) {
                 Ok((time_ms, frame)) => {
-                    let mut s = map_sensors(joints.as_ref(), sensors.as_ref());
-                    if let Some((t0, prev)) = &previous {
-                        s.previous_head_pan_rad = prev.head_pan_rad;
-                        s.previous_head_tilt_rad = prev.head_tilt_rad;
-                        s.frame_interval_s =
-                            (time_ms > *t0).then(|| f64::from(time_ms - t0) / 1000.0);
-                    }
-                    previous = Some((time_ms, s));
+                    let s = map_sensors(joints.as_ref(), sensors.as_ref());
                     let mut raw = raw_json(joints.as_ref(), sensors.as_ref());
                     if let Some(obj) = raw.as_object_mut() {
                         obj.insert("image_time_ms".into(), time_ms.into());
@@ -650,7 +650,62 @@ pub fn parse_log(bytes: &[u8]) -> Result<BhumanLog, String> {
             _ => {}
         }
     }
+    head_at_image_times(&mut log.frames, &mut all_joints);
     Ok(log)
+}
+
+/// Head pan and tilt (B-Human's `headPan`, `headTilt`) at time `t_ms`, interpolated between the
+/// joint records around it (`joints` sorted by time), and the two records' times; the nearest
+/// record's angles outside their span. `None` without a usable record.
+fn head_at(joints: &[JointRecord], t_ms: u32) -> Option<((f64, f64), [u32; 2])> {
+    let usable: Vec<&JointRecord> = joints
+        .iter()
+        .filter(|j| reading(j.angles[0]).is_some() && reading(j.angles[1]).is_some())
+        .collect();
+    let after = usable.partition_point(|j| j.time_ms <= t_ms);
+    let (a, b) = match (
+        after.checked_sub(1).and_then(|i| usable.get(i)),
+        usable.get(after),
+    ) {
+        (Some(a), Some(b)) => (*a, *b),
+        (Some(a), None) => (*a, *a),
+        (None, Some(b)) => (*b, *b),
+        (None, None) => return None,
+    };
+    let span = f64::from(b.time_ms.saturating_sub(a.time_ms));
+    let f = if span > 0.0 {
+        (f64::from(t_ms.saturating_sub(a.time_ms)) / span).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let lerp = |i: usize| a.angles[i] + f * (b.angles[i] - a.angles[i]);
+    Some(((lerp(0), lerp(1)), [a.time_ms, b.time_ms]))
+}
+
+/// Sets each frame's head pan and tilt to their values at its image's time, interpolated
+/// between the joint records logged around it (the log keeps about 8 of them per second, taken
+/// up to ±180 ms from its images, so the last one before an image may be far from it, or even
+/// the same record as the previous image's), and the previous frame's as the previous values,
+/// with the time between the images as the interval.
+fn head_at_image_times(frames: &mut [BhumanFrame], joints: &mut [JointRecord]) {
+    joints.sort_by_key(|j| j.time_ms);
+    let mut previous: Option<(u32, SensorReadings)> = None;
+    for f in frames.iter_mut() {
+        if let Some(((pan, tilt), [ta, tb])) = head_at(joints, f.time_ms) {
+            f.sensors.head_pan_rad = Some(pan);
+            f.sensors.head_tilt_rad = Some(tilt);
+            if let Some(obj) = f.raw.as_object_mut() {
+                obj.insert("head_interpolated_between_ms".into(), vec![ta, tb].into());
+            }
+        }
+        if let Some((t0, prev)) = &previous {
+            f.sensors.previous_head_pan_rad = prev.head_pan_rad;
+            f.sensors.previous_head_tilt_rad = prev.head_tilt_rad;
+            f.sensors.frame_interval_s =
+                (f.time_ms > *t0).then(|| f64::from(f.time_ms - t0) / 1000.0);
+        }
+        previous = Some((f.time_ms, f.sensors));
+    }
 }
 
 /// Decodes a JPEGImage payload to its time and frame.
@@ -813,6 +868,54 @@ mod tests {
             log.warnings.iter().any(|w| w.contains("expected 100")),
             "{:?}",
             log.warnings
+        );
+    }
+
+    #[test]
+    fn head_angles_are_interpolated_at_the_image_time() {
+        let record = |time_ms: u32, pan: f64, tilt: f64| {
+            let mut angles = [0.0; 22];
+            angles[0] = pan;
+            angles[1] = tilt;
+            JointRecord { angles, time_ms }
+        };
+        let mut joints = vec![
+            record(300, 0.4, -0.2),
+            record(100, 0.0, 0.0),
+            record(200, 1000.0, 1000.0),
+        ];
+        joints.sort_by_key(|j| j.time_ms);
+        // The record marked "off" (1000) is passed over: 250 ms lies three quarters of the way
+        // from 100 to 300 ms.
+        let ((pan, tilt), span) = head_at(&joints, 250).expect("records");
+        assert_eq!(span, [100, 300]);
+        assert!(
+            (pan - 0.3).abs() < 1e-12 && (tilt + 0.15).abs() < 1e-12,
+            "{pan} {tilt}"
+        );
+        // Outside the records' span: the nearest one.
+        assert_eq!(head_at(&joints, 50).map(|h| h.0), Some((0.0, 0.0)));
+        assert_eq!(head_at(&joints, 900).map(|h| h.0), Some((0.4, -0.2)));
+        assert_eq!(head_at(&[], 100), None);
+        // Frames get those values, the previous frame's as previous, the image interval.
+        let frame = |time_ms: u32| BhumanFrame {
+            time_ms,
+            frame: Frame::from_uyvy(2, 1, vec![128, 16, 128, 16]).expect("frame"),
+            sensors: SensorReadings::default(),
+            camera_matrix: None,
+            raw: serde_json::json!({}),
+        };
+        let mut frames = vec![frame(150), frame(250)];
+        head_at_image_times(&mut frames, &mut joints);
+        let s = frames[1].sensors;
+        assert_eq!(s.previous_head_pan_rad, frames[0].sensors.head_pan_rad);
+        assert!((s.frame_interval_s.expect("interval") - 0.1).abs() < 1e-12);
+        assert!((s.head_pan_rad.expect("pan") - 0.3).abs() < 1e-12);
+        assert!((frames[0].sensors.head_pan_rad.expect("pan") - 0.1).abs() < 1e-12);
+        assert_eq!(frames[0].sensors.frame_interval_s, None);
+        assert_eq!(
+            frames[1].raw["head_interpolated_between_ms"],
+            serde_json::json!([100, 300])
         );
     }
 }

@@ -1309,4 +1309,108 @@ mod tests {
         );
         assert!(none.ball.is_none() && none.candidates.is_empty());
     }
+
+    /// A 320×240 green frame (no pose) with an orange disc, white wherever `white(x, y)`.
+    fn big_scene(cx: f64, cy: f64, r: f64, white: impl Fn(f64, f64) -> bool) -> ClassifiedImage {
+        let (w, h) = (320usize, 240usize);
+        let codes = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+                if (x - cx).hypot(y - cy) <= r {
+                    ColourClass::Orange.code()
+                } else if white(x, y) {
+                    ColourClass::White.code()
+                } else {
+                    ColourClass::Green.code()
+                }
+            })
+            .collect();
+        ClassifiedImage::from_codes(w, h, codes).expect("size")
+    }
+
+    #[test]
+    fn a_large_ball_on_a_white_line_is_round_not_hidden() {
+        let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+            320,
+            240,
+            45.0_f64.to_radians(),
+        ));
+        // A 40-px ball lying on a thick white line that runs behind it, with its white stand
+        // below: white borders most of its left, right and bottom sides, but it is round there.
+        let img = big_scene(160.0, 120.0, 40.0, |x, y| {
+            (95.0..150.0).contains(&y) || ((110.0..210.0).contains(&x) && y > 150.0)
+        });
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let ball = res.ball.expect("ball");
+        assert!(!ball.cut_off.any(), "{:?}", ball.cut_off);
+        assert!(ball.from_circle_fit);
+        assert!((ball.radius_px - 40.0).abs() < 1.0, "{}", ball.radius_px);
+        // The same ball behind a white robot leg whose straight edge cuts off its right third:
+        // a long chord, hidden.
+        let img = big_scene(160.0, 120.0, 40.0, |x, _| x > 187.0);
+        let mut codes = img.codes().to_vec();
+        for (i, c) in codes.iter_mut().enumerate() {
+            if (i % 320) as f64 + 0.5 > 187.0 {
+                *c = ColourClass::White.code();
+            }
+        }
+        let img = ClassifiedImage::from_codes(320, 240, codes).expect("size");
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        let ball = res.ball.expect("ball");
+        assert!(
+            ball.cut_off.right && !ball.cut_off.left,
+            "{:?}",
+            ball.cut_off
+        );
+        assert!((ball.radius_px - 40.0).abs() < 1.5, "{}", ball.radius_px);
+        // Taking every bordered side as hidden (the old rule) cuts the ball on the line too.
+        let old = BallParams {
+            hidden_min_chord_share: 0.0,
+            ..BallParams::default()
+        };
+        let img = big_scene(160.0, 120.0, 40.0, |x, y| {
+            (95.0..150.0).contains(&y) || ((110.0..210.0).contains(&x) && y > 150.0)
+        });
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &old);
+        assert!(res.ball.expect("ball").cut_off.any());
+    }
+
+    #[test]
+    fn a_thin_orange_arc_does_not_fill_its_circle() {
+        let ctx = level_context();
+        // The red-orange rim of a white toe: a 2-px arc of a 20-px circle, white inside.
+        let (w, h) = (208usize, 160usize);
+        let (cx, cy, r) = (104.0, 110.0, 20.0);
+        let codes = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+                let d = (x - cx).hypot(y - cy);
+                if y < cy && (r - 2.0..=r).contains(&d) {
+                    ColourClass::Orange.code()
+                } else if d < r || y >= cy {
+                    ColourClass::White.code()
+                } else {
+                    ColourClass::Green.code()
+                }
+            })
+            .collect();
+        let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
+        assert!(circle_fill(&img, (cx, cy), r).is_some_and(|f| f < 0.2));
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+        assert!(res.ball.is_none(), "{:?}", res.candidates[0].confidence);
+        let fill = res.candidates[0]
+            .confidence
+            .test("circle_fill")
+            .expect("circle fill test");
+        assert!(fill.effect < 0.0, "{fill:?}");
+        // A whole disc fills its circle; one outside the image has no fill.
+        let disc = scene(60.0, 60.0, 8.0, 0.0);
+        assert!(circle_fill(&disc, (60.0, 60.0), 8.0).is_some_and(|f| f > 0.95));
+        assert_eq!(circle_fill(&disc, (-50.0, 60.0), 8.0), None);
+        assert_eq!(circle_fill(&disc, (60.0, 60.0), f64::NAN), None);
+    }
 }
