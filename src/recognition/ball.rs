@@ -618,30 +618,33 @@ fn unclassified_around(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
 }
 
 /// Share of ball colours among the image pixels whose centres lie inside the circle (`center`,
-/// `radius` px); `None` when no pixel centre of the image lies inside.
+/// `radius` px), sampled every pixel up to a 24-pixel diameter and on a 24 × 24 grid over
+/// larger circles (a close ball or a robot's arm fills tens of thousands of pixels; the share
+/// needs a few hundred); `None` when no sample of the image lies inside.
 fn circle_fill(img: &ClassifiedImage, center: Point, radius: f64) -> Option<f64> {
     if !(center.0.is_finite() && center.1.is_finite() && radius.is_finite() && radius > 0.0) {
         return None;
     }
+    let step = (2.0 * radius / 24.0).max(1.0);
     let (w, h) = (img.width() as f64, img.height() as f64);
-    let x0 = (center.0 - radius).floor().max(0.0);
-    let x1 = (center.0 + radius).ceil().min(w - 1.0);
-    let y0 = (center.1 - radius).floor().max(0.0);
-    let y1 = (center.1 + radius).ceil().min(h - 1.0);
     let (mut n, mut ball) = (0u32, 0u32);
-    let mut y = y0;
-    while y <= y1 {
-        let mut x = x0;
-        while x <= x1 {
-            if (x + 0.5 - center.0).hypot(y + 0.5 - center.1) <= radius
-                && let Some(c) = img.get_signed(x as i64, y as i64)
+    let mut y = (center.1 - radius).floor() + 0.5;
+    while y <= center.1 + radius {
+        let mut x = (center.0 - radius).floor() + 0.5;
+        while x <= center.0 + radius {
+            if x >= 0.0
+                && y >= 0.0
+                && x < w
+                && y < h
+                && (x - center.0).hypot(y - center.1) <= radius
+                && let Some(c) = img.get_signed(x.floor() as i64, y.floor() as i64)
             {
                 n += 1;
                 ball += u32::from(is_ball_colour(c));
             }
-            x += 1.0;
+            x += step;
         }
-        y += 1.0;
+        y += step;
     }
     (n > 0).then(|| f64::from(ball) / f64::from(n))
 }

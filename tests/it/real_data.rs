@@ -499,9 +499,21 @@ fn bhuman_stream_against_its_hand_labels() {
     let labels =
         eotn::eval::labels::Labels::load(&repo_file("streams/bhuman2009.labels.json")).unwrap();
     assert_eq!(labels.frames.len(), 160);
-    let spl: eotn::recognition::RecognitionParams =
-        serde_json::from_str(&std::fs::read_to_string(repo_file("params/spl2009.json")).unwrap())
-            .unwrap();
+    let text = std::fs::read_to_string(repo_file("params/spl2009.json")).unwrap();
+    let spl: eotn::recognition::RecognitionParams = serde_json::from_str(&text).unwrap();
+    // Every key of the shipped file is a parameter (serde would pass over a misspelt one).
+    let given: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let used = serde_json::to_value(spl).unwrap();
+    for (section, values) in given.as_object().unwrap() {
+        match values.as_object() {
+            Some(fields) => {
+                for (k, v) in fields {
+                    assert_eq!(&used[section][k], v, "params/spl2009.json: {section}.{k}");
+                }
+            }
+            None => assert_eq!(&used[section], values, "params/spl2009.json: {section}"),
+        }
+    }
     let r = bhuman_labels_report(spl);
     eprintln!(
         "B-Human stream, spl2009 parameters: ball {}/{} (cut {}/{}), false {}, centre error \
