@@ -487,7 +487,7 @@ fn bhuman_labels_report(
             let rec = reader.read(i).unwrap();
             let label = labels.frame(i).expect("every frame is labelled");
             let r = pipeline.process(&rec.frame, rec.sensors.as_ref());
-            evaluate_labelled_frame(&r.recognition, label, 320.0, 240.0, &ep)
+            evaluate_labelled_frame(r.recognition, label, 320.0, 240.0, &ep)
         })
         .collect();
     LabelsReport::from_frames(&frames)
