@@ -51,6 +51,23 @@ pub struct SensorReadings {
     pub battery_percent: Option<f64>,
     /// Body temperature, degrees Celsius.
     pub temperature_c: Option<f64>,
+    /// The robot's own estimate of its camera's pose over the ground (B-Human's `CameraMatrix`):
+    /// camera position ahead of the robot's ground origin (the point on the ground between its
+    /// feet, or below its body centre), centimetres. With [`Self::camera_height_cm`] and
+    /// [`Self::camera_pitch_rad`] present recognition uses this pose instead of a body model
+    /// (`geometry::camera_pose_from_readings`).
+    pub camera_x_cm: Option<f64>,
+    /// Camera position to the left of the robot's ground origin, centimetres.
+    pub camera_y_cm: Option<f64>,
+    /// Camera height above the ground, centimetres.
+    pub camera_height_cm: Option<f64>,
+    /// Camera roll about its optical axis, radians, positive right side down.
+    pub camera_roll_rad: Option<f64>,
+    /// Camera pitch, radians, positive looking down.
+    pub camera_pitch_rad: Option<f64>,
+    /// Camera yaw relative to the robot's forward direction, radians, positive left; the
+    /// rotation is yaw · pitch · roll (about z, then the turned y, then the optical axis).
+    pub camera_yaw_rad: Option<f64>,
 }
 
 /// One field of [`SensorReadings`]: its name, unit and value, for tables and plots.
@@ -109,6 +126,12 @@ sensor_fields! {
     body_height_cm: "cm",
     battery_percent: "%",
     temperature_c: "°C",
+    camera_x_cm: "cm",
+    camera_y_cm: "cm",
+    camera_height_cm: "cm",
+    camera_roll_rad: "rad",
+    camera_pitch_rad: "rad",
+    camera_yaw_rad: "rad",
 }
 
 impl SensorReadings {
@@ -179,7 +202,7 @@ mod tests {
     #[test]
     fn fields_lists_every_reading_with_units() {
         let fields = SensorReadings::default().fields();
-        assert_eq!(fields.len(), 18);
+        assert_eq!(fields.len(), 24);
         assert!(
             fields
                 .iter()

@@ -1,7 +1,8 @@
 //! `eotn eval`: recognition against the ground truth of synthetic streams — detection and false
 //! identification rates, distance, bearing, post and gap errors, the frames that missed — and
 //! two tables or parameter sets side by side; `--calibrate-goals` fits the goal-distance
-//! relation to the truth and writes it as recognition parameters.
+//! relation to the truth and writes it as recognition parameters. `--labels` scores a real
+//! stream against hand labels instead (`eval_labels.rs`).
 
 use std::path::PathBuf;
 
@@ -54,6 +55,11 @@ pub struct Args {
     /// error histograms, found rates per distance band, post errors).
     #[arg(long)]
     pub plots: Option<PathBuf>,
+    /// Score a real stream against hand labels instead of ground truth (a labels JSON file,
+    /// see the README's "Hand labels"): ball found/missed/false, centre and radius errors,
+    /// goals found and false, goal distances from size beside those of their foot. One stream.
+    #[arg(long)]
+    pub labels: Option<PathBuf>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -113,6 +119,12 @@ fn differ(a: &Recognition, b: &Recognition) -> Option<String> {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let lut = load_lut_arg(&args.lut)?;
     let rp = load_params(args.params.as_deref())?;
+    if let Some(labels) = &args.labels {
+        let [stream] = args.streams.as_slice() else {
+            bail!("--labels scores one stream, {} given", args.streams.len());
+        };
+        return super::eval_labels::run(stream, labels, lut, rp, args.json);
+    }
     let params = PipelineParams {
         recognition: rp,
         ..PipelineParams::default()

@@ -8,6 +8,7 @@ mod blobs;
 mod classify;
 pub mod detect;
 mod eval;
+mod eval_labels;
 mod export;
 mod import;
 mod import_bhuman;
@@ -49,8 +50,9 @@ pub enum Command {
     Detect(detect::Args),
     /// Draw frames with recognition overlays (circles, posts, gaps, horizon, scans) as PNG.
     Render(render::Args),
-    /// Compare recognition with the ground truth of synthetic streams: rates, errors, misses;
-    /// two tables or parameter sets side by side; goal-distance calibration.
+    /// Compare recognition with the ground truth of synthetic streams (or a real stream's hand
+    /// labels, `--labels`): rates, errors, misses; two tables or parameter sets side by side;
+    /// goal-distance calibration.
     Eval(eval::Args),
     /// Build an MCAP stream from frame files and a CSV/JSON table of sensor readings.
     Import(import::Args),

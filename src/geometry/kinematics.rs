@@ -221,6 +221,45 @@ impl Default for BodyPose {
     }
 }
 
+/// The camera's pose over the ground as the robot itself estimated it, from the readings'
+/// `camera_*` fields: position (cm) in the robot's ground frame and the rotation yaw · pitch ·
+/// roll (pitch positive looking down, roll positive right side down, as [`super::PoseRecord`]).
+/// `None` unless height and pitch are present and finite; a missing x, y, roll or yaw is taken
+/// as 0 (a source that knows only how high its camera is and how far it looks down).
+#[must_use]
+pub fn camera_pose_from_readings(readings: &SensorReadings) -> Option<Transform<Field, Camera>> {
+    let finite = |v: Option<f64>| v.filter(|a| a.is_finite());
+    let height = finite(readings.camera_height_cm)?;
+    let pitch = finite(readings.camera_pitch_rad)?;
+    let or_zero = |v: Option<f64>| finite(v).unwrap_or(0.0);
+    Some(Transform::new(
+        Vector3::new(
+            or_zero(readings.camera_x_cm),
+            or_zero(readings.camera_y_cm),
+            height,
+        ),
+        rotation_z(or_zero(readings.camera_yaw_rad))
+            * rotation_y(pitch)
+            * rotation_x(or_zero(readings.camera_roll_rad)),
+    ))
+}
+
+/// Writes a camera pose into the readings' `camera_*` fields (the inverse of
+/// [`camera_pose_from_readings`]).
+pub fn write_camera_pose(
+    field_from_camera: &Transform<Field, Camera>,
+    readings: &mut SensorReadings,
+) {
+    let (roll, pitch, yaw) = field_from_camera.rotation().euler_angles();
+    let o = field_from_camera.origin();
+    readings.camera_x_cm = Some(o.x());
+    readings.camera_y_cm = Some(o.y());
+    readings.camera_height_cm = Some(o.z());
+    readings.camera_roll_rad = Some(roll);
+    readings.camera_pitch_rad = Some(pitch);
+    readings.camera_yaw_rad = Some(yaw);
+}
+
 /// Body pitch (positive nose down) and roll (positive right side down), radians, from a resting
 /// accelerometer reading (m/s², body axes). An accelerometer at rest measures the reaction to
 /// gravity: +g along body +z when level, −g·sin(pitch) along +x when the nose is down, and
@@ -368,5 +407,53 @@ mod tests {
         // Missing pan: no joints.
         readings.head_pan_rad = None;
         assert_eq!(HeadJoints::from_sensors(&readings), None);
+    }
+
+    #[test]
+    fn camera_pose_readings_round_trip_and_need_height_and_pitch() {
+        let pose: Transform<Field, Camera> = Transform::new(
+            Vector3::new(5.6, 0.4, 48.5),
+            rotation_z(0.3) * rotation_y(0.23) * rotation_x(-0.01),
+        );
+        let mut readings = SensorReadings::default();
+        write_camera_pose(&pose, &mut readings);
+        assert_relative_eq!(
+            readings.camera_height_cm.expect("height"),
+            48.5,
+            epsilon = 1e-12
+        );
+        assert_relative_eq!(
+            readings.camera_pitch_rad.expect("pitch"),
+            0.23,
+            epsilon = 1e-12
+        );
+        assert_relative_eq!(readings.camera_yaw_rad.expect("yaw"), 0.3, epsilon = 1e-12);
+        let back = camera_pose_from_readings(&readings).expect("pose");
+        assert_relative_eq!(back.isometry, pose.isometry, epsilon = 1e-12);
+        // Looking down: the optical axis points below the horizontal.
+        let axis = back * Vector::<Camera>::new(1.0, 0.0, 0.0);
+        assert!(axis.coords.z < 0.0);
+        // Height and pitch alone are enough; without either there is no pose.
+        let minimal = SensorReadings {
+            camera_height_cm: Some(50.0),
+            camera_pitch_rad: Some(0.1),
+            ..SensorReadings::default()
+        };
+        let p = camera_pose_from_readings(&minimal).expect("pose");
+        assert_relative_eq!(p.origin().z(), 50.0, epsilon = 1e-12);
+        assert!(
+            camera_pose_from_readings(&SensorReadings {
+                camera_pitch_rad: Some(f64::NAN),
+                ..minimal
+            })
+            .is_none()
+        );
+        assert!(
+            camera_pose_from_readings(&SensorReadings {
+                camera_height_cm: None,
+                ..minimal
+            })
+            .is_none()
+        );
     }
 }

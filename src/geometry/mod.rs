@@ -34,7 +34,9 @@ use serde::{Deserialize, Serialize};
 
 pub use camera::{CameraPose, ImagePoint, PinholeCamera};
 pub use horizon::Horizon;
-pub use kinematics::{BodyPose, Ers7Dimensions, HeadJoints, RobotPose};
+pub use kinematics::{
+    BodyPose, Ers7Dimensions, HeadJoints, RobotPose, camera_pose_from_readings, write_camera_pose,
+};
 pub use overhead::OverheadCamera;
 
 /// The field frame: origin at the centre spot, x towards the yellow goal, y left, z up (cm).

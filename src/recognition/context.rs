@@ -1,13 +1,15 @@
 //! What recognition knows about the camera for one frame: its intrinsics, its pose over the
-//! ground (from the joint readings through the ERS-7 body model), the horizon, the rolling-shutter
-//! skew implied by the head's motion, and the infra-red distance.
+//! ground (the robot's own estimate carried in the readings, or the joint readings through the
+//! ERS-7 body model), the horizon, the rolling-shutter skew implied by the head's motion during
+//! the camera's read-out time, and the infra-red distance.
 
 use serde::{Deserialize, Serialize};
 
 use super::fit::Point;
 use crate::geometry::{
     Body, BodyPose, Camera, CameraPose, Ers7Dimensions, Field, HeadJoints, Horizon, ImagePoint,
-    PinholeCamera, Point as GeoPoint, RobotPose, Transform,
+    PinholeCamera, Point as GeoPoint, RobotPose, Transform, camera_pose_from_readings, rotation_y,
+    rotation_z,
 };
 use crate::sensors::SensorReadings;
 
@@ -33,38 +35,96 @@ impl Relative {
     }
 }
 
-/// How the head moved while the frame was read out: the joints at the reference row and their
-/// change over one frame interval (from the previous frame's readings), with the body they sit
-/// on. It gives the camera pose at any row's read-out time, so the rolling shutter's skew can be
-/// removed through the body model rather than by a linear shear.
+/// Read-out time of a whole image, first row to last, seconds, when the camera's parameters do
+/// not say otherwise: the ERS-7's and the Nao's cameras deliver 30 frames per second and read
+/// their rows out over about one frame time (B-Human's later Nao code uses 34 ms).
+pub const DEFAULT_READOUT_S: f64 = 1.0 / 30.0;
+
+/// Where a frame's camera pose came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseSource {
+    /// The robot's own estimate of its camera's pose over the ground, carried in the readings
+    /// (`camera_height_cm`, `camera_pitch_rad`, …; see [`camera_pose_from_readings`]).
+    Readings,
+    /// The head joints through the ERS-7 chain ([`Ers7Dimensions`]) on a typical stance.
+    Ers7Joints,
+}
+
+/// How the camera turns while the rows are read out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MotionChain {
+    /// The ERS-7 head chain: the joints at the reference row and the body they sit on.
+    Ers7 {
+        /// Joint angles at the reference row's read-out time, radians.
+        joints: HeadJoints,
+        /// The body in the robot's ground frame (taken as still during the frame).
+        field_from_body: Transform<Field, Body>,
+        /// The head chain.
+        dims: Ers7Dimensions,
+    },
+    /// A camera pose given by the robot, with no head chain known: the pan turns the camera
+    /// about the vertical through its centre and the tilt about its own y axis (the few
+    /// centimetres between the joints and the lens move the image by well under a pixel over
+    /// one read-out).
+    Camera {
+        /// The camera at the reference row's read-out time.
+        field_from_camera: Transform<Field, Camera>,
+    },
+}
+
+/// How the head moved while the frame was read out: the pose at the reference row and the
+/// pan and tilt changes over one read-out (first row to last). The changes are the joints'
+/// velocities times the camera's read-out time, the velocities measured between the previous
+/// logged frame and this one — which may be several camera frames apart (the B-Human log kept
+/// about every sixth). It gives the camera pose at any row's read-out time, so the rolling
+/// shutter's skew can be removed through the body model rather than by a linear shear.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeadMotion {
-    /// Joint angles at the reference row's read-out time, radians.
-    pub joints: HeadJoints,
-    /// Pan change over one frame interval (now − previous), radians.
-    pub pan_per_frame_rad: f64,
-    /// Lower-tilt change over one frame interval (now − previous), radians.
-    pub tilt_per_frame_rad: f64,
-    /// The body in the robot's ground frame (taken as still during the frame).
-    pub field_from_body: Transform<Field, Body>,
-    /// The head chain.
-    pub dims: Ers7Dimensions,
+    /// Pan change over one read-out, radians (positive left).
+    pub pan_per_readout_rad: f64,
+    /// Tilt change over one read-out, radians (positive up).
+    pub tilt_per_readout_rad: f64,
+    /// What turns.
+    pub chain: MotionChain,
 }
 
 impl HeadMotion {
-    /// The camera pose `frames` frame intervals after the reference row's read-out time
-    /// (negative: before), the joints moving at their last measured rate; `with_tilt` false
-    /// keeps the tilt at its reference value (pan only).
+    /// The camera pose `readouts` read-out times after the reference row's read-out time
+    /// (negative: before; the first row is −0.5, the last +0.5), the joints moving at their
+    /// measured rate; `with_tilt` false keeps the tilt at its reference value (pan only).
     #[must_use]
-    pub fn pose_at(&self, camera: PinholeCamera, frames: f64, with_tilt: bool) -> CameraPose {
-        let mut joints = self.joints;
-        joints.pan_rad += frames * self.pan_per_frame_rad;
-        if with_tilt {
-            joints.tilt1_rad += frames * self.tilt_per_frame_rad;
-        }
+    pub fn pose_at(&self, camera: PinholeCamera, readouts: f64, with_tilt: bool) -> CameraPose {
+        let pan = readouts * self.pan_per_readout_rad;
+        let tilt = if with_tilt {
+            readouts * self.tilt_per_readout_rad
+        } else {
+            0.0
+        };
+        let field_from_camera = match self.chain {
+            MotionChain::Ers7 {
+                mut joints,
+                field_from_body,
+                dims,
+            } => {
+                joints.pan_rad += pan;
+                if with_tilt {
+                    joints.tilt1_rad += tilt;
+                }
+                field_from_body * dims.body_from_camera(&joints)
+            }
+            MotionChain::Camera { field_from_camera } => {
+                let iso = field_from_camera.isometry;
+                // Tilt positive up is a negative rotation about the camera's y axis.
+                Transform::from_isometry(nalgebra::Isometry3::from_parts(
+                    iso.translation,
+                    rotation_z(pan) * iso.rotation * rotation_y(-tilt),
+                ))
+            }
+        };
         CameraPose {
             camera,
-            field_from_camera: self.field_from_body * self.dims.body_from_camera(&joints),
+            field_from_camera,
         }
     }
 }
@@ -75,9 +135,12 @@ pub struct ViewContext {
     /// Intrinsics: size and effective distance d (pixels).
     pub camera: PinholeCamera,
     /// The camera's pose in the robot's ground frame (robot at the origin facing +x), when the
-    /// joint readings were available.
+    /// readings gave it or the joint readings were available.
     pub pose: Option<CameraPose>,
-    /// The camera in the body frame, when the joint readings were available.
+    /// Where the pose came from.
+    pub pose_source: Option<PoseSource>,
+    /// The camera in the body frame, when the pose is known. With a pose from the readings the
+    /// "body" is the robot's ground frame (origin on the ground below the robot, as the pose).
     pub body_from_camera: Option<Transform<Body, Camera>>,
     /// The horizon line, when the pose is known.
     pub horizon: Option<Horizon>,
@@ -87,12 +150,25 @@ pub struct ViewContext {
     pub skew_y_per_line: f64,
     /// Near infra-red distance, centimetres.
     pub ir_distance_cm: Option<f64>,
-    /// The head's motion during read-out, when the joints now and one frame earlier were known
-    /// (and the pose is known).
+    /// The head's motion during read-out, when the joints now and at the previous frame were
+    /// known (and the pose is known).
     pub motion: Option<HeadMotion>,
-    /// Time between frames, seconds, when the readings gave it; the read-out of all rows is
-    /// taken to last one frame interval (as the skew removal assumes).
+    /// Time between this frame and the previous one, seconds, when the readings gave it.
     pub frame_interval_s: Option<f64>,
+    /// Read-out time of the whole image, first row to last, seconds (a camera parameter,
+    /// [`DEFAULT_READOUT_S`] unless set).
+    pub readout_s: f64,
+}
+
+/// The angle one read-out time before `now`, at the rate measured between `before` (one frame
+/// interval earlier) and `now`; `scale` = read-out time / frame interval. With a scale of 1 (a
+/// stream that kept every camera frame) that is `before` itself.
+fn one_readout_before(now: f64, before: f64, scale: f64) -> f64 {
+    if scale == 1.0 {
+        before
+    } else {
+        now - (now - before) * scale
+    }
 }
 
 impl ViewContext {
@@ -102,6 +178,7 @@ impl ViewContext {
         Self {
             camera,
             pose: None,
+            pose_source: None,
             body_from_camera: None,
             horizon: None,
             skew_x_per_line: 0.0,
@@ -109,69 +186,126 @@ impl ViewContext {
             ir_distance_cm: None,
             motion: None,
             frame_interval_s: None,
+            readout_s: DEFAULT_READOUT_S,
         }
     }
 
-    /// The context of a frame with these sensor readings, through the ERS-7 chain `dims`.
-    /// Missing or non-finite readings leave the pose (and with it heights and the horizon) out.
+    /// The context of a frame with these sensor readings, through the ERS-7 chain `dims` when
+    /// the readings carry no camera pose, with the default read-out time
+    /// ([`Self::from_sensors_with_readout`]).
     #[must_use]
     pub fn from_sensors(
         camera: PinholeCamera,
         readings: &SensorReadings,
         dims: &Ers7Dimensions,
     ) -> Self {
+        Self::from_sensors_with_readout(camera, readings, dims, DEFAULT_READOUT_S)
+    }
+
+    /// The context of a frame with these sensor readings. The camera pose is the readings' own
+    /// ([`camera_pose_from_readings`]) when they carry one, else the joints through the ERS-7
+    /// chain `dims`; missing or non-finite readings leave the pose (and with it heights and the
+    /// horizon) out. The shutter skew is the pan (tilt) velocity between the previous frame and
+    /// this one times `readout_s`, the time the camera takes to read all rows; without a usable
+    /// frame interval (missing, zero, negative) the change since the previous frame is taken as
+    /// the change over one read-out, as the formula does.
+    #[must_use]
+    pub fn from_sensors_with_readout(
+        camera: PinholeCamera,
+        readings: &SensorReadings,
+        dims: &Ers7Dimensions,
+        readout_s: f64,
+    ) -> Self {
         let (readings, _) = readings.sanitised();
         let mut ctx = Self::without_pose(camera);
+        if readout_s.is_finite() && readout_s >= 0.0 {
+            ctx.readout_s = readout_s;
+        }
         ctx.ir_distance_cm = readings.ir_near_cm.or(readings.ir_far_cm);
         ctx.frame_interval_s = readings
             .frame_interval_s
             .filter(|s| s.is_finite() && *s > 0.0);
-        if let Some(joints) = HeadJoints::from_sensors(&readings) {
-            let body_from_camera = dims.body_from_camera(&joints);
-            let body = BodyPose::from_sensors(&readings, &BodyPose::ERS7_STANCE);
-            let field_from_body = body.field_from_body(&RobotPose::default());
-            let field_from_camera = field_from_body * body_from_camera;
-            let change = |now: Option<f64>, before: Option<f64>| match (now, before) {
-                (Some(a), Some(b)) if (a - b).is_finite() => Some(a - b),
-                _ => None,
-            };
-            let pan = change(readings.head_pan_rad, readings.previous_head_pan_rad);
-            let tilt = change(readings.head_tilt_rad, readings.previous_head_tilt_rad);
+        let scale = ctx
+            .frame_interval_s
+            .map_or(1.0, |interval| ctx.readout_s / interval);
+        // Each joint one read-out before now, when its previous reading is known.
+        let earlier = |now: Option<f64>, before: Option<f64>| match (now, before) {
+            (Some(a), Some(b)) if (a - b).is_finite() => Some((a, one_readout_before(a, b, scale))),
+            _ => None,
+        };
+        let pan = earlier(readings.head_pan_rad, readings.previous_head_pan_rad);
+        let tilt = earlier(readings.head_tilt_rad, readings.previous_head_tilt_rad);
+        let posed = match camera_pose_from_readings(&readings) {
+            Some(field_from_camera) => Some((
+                PoseSource::Readings,
+                field_from_camera,
+                Transform::<Body, Camera>::from_isometry(field_from_camera.isometry),
+                MotionChain::Camera { field_from_camera },
+            )),
+            None => HeadJoints::from_sensors(&readings).map(|joints| {
+                let body_from_camera = dims.body_from_camera(&joints);
+                let body = BodyPose::from_sensors(&readings, &BodyPose::ERS7_STANCE);
+                let field_from_body = body.field_from_body(&RobotPose::default());
+                (
+                    PoseSource::Ers7Joints,
+                    field_from_body * body_from_camera,
+                    body_from_camera,
+                    MotionChain::Ers7 {
+                        joints,
+                        field_from_body,
+                        dims: *dims,
+                    },
+                )
+            }),
+        };
+        if let Some((source, field_from_camera, body_from_camera, chain)) = posed {
             if pan.is_some() || tilt.is_some() {
                 ctx.motion = Some(HeadMotion {
-                    joints,
-                    pan_per_frame_rad: pan.unwrap_or(0.0),
-                    tilt_per_frame_rad: tilt.unwrap_or(0.0),
-                    field_from_body,
-                    dims: *dims,
+                    pan_per_readout_rad: pan.map_or(0.0, |(a, b)| a - b),
+                    tilt_per_readout_rad: tilt.map_or(0.0, |(a, b)| a - b),
+                    chain,
                 });
             }
             let pose = CameraPose {
                 camera,
                 field_from_camera,
             };
+            ctx.pose_source = Some(source);
             ctx.body_from_camera = Some(body_from_camera);
             ctx.horizon = pose.horizon();
             ctx.pose = Some(pose);
         }
         let d = camera.focal_px;
         let lines = camera.height_px.max(1) as f64;
-        if let (Some(now), Some(before)) = (readings.head_pan_rad, readings.previous_head_pan_rad) {
-            // The formula: Δx = d·tan(θ_current) − d·tan(θ_previous), spread over the
-            // lines of one frame.
+        // The formula, Δx = d·tan(θ_current) − d·tan(θ_previous), with θ_previous the
+        // angle one read-out earlier, spread over the lines of one image.
+        if let Some((now, before)) = pan {
             let dx = d * now.tan() - d * before.tan();
             if dx.is_finite() {
                 ctx.skew_x_per_line = dx / lines;
             }
         }
-        if let (Some(now), Some(before)) = (readings.head_tilt_rad, readings.previous_head_tilt_rad)
-        {
+        if let Some((now, before)) = tilt {
             let dy = d * now.tan() - d * before.tan();
             if dy.is_finite() {
                 ctx.skew_y_per_line = dy / lines;
             }
         }
         ctx
+    }
+
+    /// The same context without a pose that came from the ERS-7 chain (for frames of other
+    /// robots, whose head chain is not the ERS-7's); a pose from the readings is kept.
+    #[must_use]
+    pub fn without_joint_pose(mut self) -> Self {
+        if self.pose_source == Some(PoseSource::Ers7Joints) {
+            self.pose = None;
+            self.pose_source = None;
+            self.body_from_camera = None;
+            self.horizon = None;
+            self.motion = None;
+        }
+        self
     }
 
     /// The row whose read-out time the sensor readings describe (the middle of the read-out),
@@ -209,11 +343,11 @@ impl ViewContext {
             return self.unskew(p, with_tilt);
         };
         let lines = self.camera.height_px.max(1) as f64;
-        let frames = p.1 / lines - 0.5;
-        if !(frames.is_finite() && distance_cm.is_finite() && distance_cm > 0.0) {
+        let readouts = p.1 / lines - 0.5;
+        if !(readouts.is_finite() && distance_cm.is_finite() && distance_cm > 0.0) {
             return self.unskew(p, with_tilt);
         }
-        let then = motion.pose_at(self.camera, frames, with_tilt);
+        let then = motion.pose_at(self.camera, readouts, with_tilt);
         let field = then.field_from_camera * self.camera_point(p, distance_cm);
         match pose.image_from_field(&field) {
             Some(q) if q.x_px.is_finite() && q.y_px.is_finite() => (q.x_px, q.y_px),
@@ -265,12 +399,166 @@ impl ViewContext {
         Some(g.z())
     }
 
-    /// Ground distance (cm) to where the ray through `p` meets the plane at `z_cm`, when the pose
-    /// is known and the ray goes there.
+    /// Straight-line distance (cm) from the camera to where the ray through `p` meets the plane at
+    /// `z_cm`, when the pose is known and the ray goes there.
     #[must_use]
     pub fn distance_to_plane(&self, p: Point, z_cm: f64) -> Option<f64> {
         let pose = self.pose?;
         let hit = pose.point_on_plane(ImagePoint::new(p.0, p.1), z_cm)?;
         Some(hit.distance_to(&pose.position()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn panning(interval_s: Option<f64>, pan_rad_per_s: f64) -> SensorReadings {
+        let dt = interval_s.unwrap_or(DEFAULT_READOUT_S);
+        SensorReadings {
+            head_pan_rad: Some(0.2),
+            previous_head_pan_rad: Some(0.2 - pan_rad_per_s * dt),
+            head_tilt_rad: Some(-0.3),
+            previous_head_tilt_rad: Some(-0.3 + 0.5 * dt),
+            neck_tilt_rad: Some(0.0),
+            frame_interval_s: interval_s,
+            ..SensorReadings::default()
+        }
+    }
+
+    #[test]
+    fn a_5_hz_log_skews_like_a_30_hz_one_at_the_same_pan_velocity() {
+        let camera = PinholeCamera::ers7();
+        let dims = Ers7Dimensions::ERS7;
+        let fast = ViewContext::from_sensors(camera, &panning(Some(1.0 / 30.0), 3.0), &dims);
+        let slow = ViewContext::from_sensors(camera, &panning(Some(0.2), 3.0), &dims);
+        assert!(fast.skew_x_per_line.abs() > 0.1, "{}", fast.skew_x_per_line);
+        assert_relative_eq!(
+            slow.skew_x_per_line,
+            fast.skew_x_per_line,
+            max_relative = 1e-3
+        );
+        assert_relative_eq!(
+            slow.skew_y_per_line,
+            fast.skew_y_per_line,
+            max_relative = 1e-3
+        );
+        let (a, b) = (fast.motion.expect("motion"), slow.motion.expect("motion"));
+        assert_relative_eq!(a.pan_per_readout_rad, 0.1, epsilon = 1e-12);
+        assert_relative_eq!(b.pan_per_readout_rad, 0.1, epsilon = 1e-12);
+        assert_relative_eq!(
+            b.tilt_per_readout_rad,
+            a.tilt_per_readout_rad,
+            epsilon = 1e-12
+        );
+        // The same point moved to the reference time lands in the same place.
+        let p = (30.0, 10.0);
+        let (u, v) = (fast.unskew_at(p, 80.0, true), slow.unskew_at(p, 80.0, true));
+        assert!((u.0 - v.0).hypot(u.1 - v.1) < 0.01, "{u:?} vs {v:?}");
+        // A longer read-out time skews proportionally more.
+        let longer = ViewContext::from_sensors_with_readout(
+            camera,
+            &panning(Some(0.2), 3.0),
+            &dims,
+            2.0 / 30.0,
+        );
+        assert_relative_eq!(
+            longer.skew_x_per_line,
+            2.0 * fast.skew_x_per_line,
+            max_relative = 2e-2
+        );
+    }
+
+    #[test]
+    fn without_a_usable_interval_the_change_since_the_previous_frame_is_one_read_out() {
+        let camera = PinholeCamera::ers7();
+        let dims = Ers7Dimensions::ERS7;
+        let reference = ViewContext::from_sensors(camera, &panning(None, 3.0), &dims);
+        let d = camera.focal_px;
+        let expected = (d * 0.2_f64.tan() - d * 0.1_f64.tan()) / 160.0;
+        assert_relative_eq!(reference.skew_x_per_line, expected, epsilon = 1e-12);
+        for bad in [0.0, -0.1, f64::NAN, f64::INFINITY] {
+            let mut r = panning(None, 3.0);
+            r.frame_interval_s = Some(bad);
+            let ctx = ViewContext::from_sensors(camera, &r, &dims);
+            assert_eq!(ctx.frame_interval_s, None);
+            assert_relative_eq!(ctx.skew_x_per_line, expected, epsilon = 1e-12);
+        }
+        // Nonsense read-out times fall back to the default and never panic.
+        for bad in [f64::NAN, -1.0] {
+            let ctx = ViewContext::from_sensors_with_readout(
+                camera,
+                &panning(Some(0.2), 3.0),
+                &dims,
+                bad,
+            );
+            assert_eq!(ctx.readout_s, DEFAULT_READOUT_S);
+            assert!(ctx.skew_x_per_line.is_finite());
+        }
+    }
+
+    #[test]
+    fn a_camera_pose_in_the_readings_wins_for_any_frame_size() {
+        let readings = SensorReadings {
+            camera_x_cm: Some(5.6),
+            camera_y_cm: Some(0.4),
+            camera_height_cm: Some(48.5),
+            camera_pitch_rad: Some(0.23),
+            camera_roll_rad: Some(0.0),
+            camera_yaw_rad: Some(0.0),
+            head_pan_rad: Some(0.0),
+            previous_head_pan_rad: Some(-0.1),
+            head_tilt_rad: Some(-0.23),
+            frame_interval_s: Some(0.2),
+            ..SensorReadings::default()
+        };
+        let params = super::super::RecognitionParams::default();
+        let ctx = params.context_for(320, 240, Some(&readings));
+        assert_eq!(ctx.pose_source, Some(PoseSource::Readings));
+        let pose = ctx.pose.expect("pose");
+        assert_relative_eq!(pose.position().z(), 48.5, epsilon = 1e-12);
+        // Looking 0.23 rad down: the horizon lies d·tan(0.23) above the image centre.
+        let h = ctx.horizon.expect("horizon");
+        let y = h.y_at(160.0).expect("not vertical");
+        assert_relative_eq!(
+            y,
+            120.0 - ctx.camera.focal_px * 0.23_f64.tan(),
+            epsilon = 1e-6
+        );
+        // Heights: a point on the ground below the centre has height 0.
+        let centre = (160.0, 120.0);
+        let along = ctx.distance_to_plane(centre, 0.0).expect("looks down");
+        assert_relative_eq!(along, 48.5 / 0.23_f64.sin(), max_relative = 1e-9);
+        assert!(ctx.height_above_ground(centre, along).expect("pose").abs() < 1e-6);
+        assert!(ctx.body_relative(centre, along).is_some());
+        // The head's motion turns that camera about the vertical: at the first row's time it
+        // looked 0.5 · 0.1/0.2 · (1/30) rad further right (pan positive left).
+        let motion = ctx.motion.expect("motion");
+        let first = motion.pose_at(ctx.camera, -0.5, false);
+        let axis = |p: &CameraPose| {
+            let a = (p.field_from_camera * crate::geometry::Vector::<Camera>::new(1.0, 0.0, 0.0))
+                .coords;
+            a.y.atan2(a.x)
+        };
+        assert_relative_eq!(
+            axis(&first) - axis(&pose),
+            -0.5 * 0.5 / 30.0,
+            epsilon = 1e-9
+        );
+        // The same readings without the pose: a 320×240 frame gets no pose from the ERS-7 chain,
+        // a 208×160 one does.
+        let joints_only = SensorReadings {
+            camera_height_cm: None,
+            ..readings
+        };
+        assert!(
+            params
+                .context_for(320, 240, Some(&joints_only))
+                .pose
+                .is_none()
+        );
+        let ers7 = params.context_for(208, 160, Some(&joints_only));
+        assert_eq!(ers7.pose_source, Some(PoseSource::Ers7Joints));
     }
 }

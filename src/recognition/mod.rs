@@ -5,7 +5,7 @@
 //!
 //! | module | role |
 //! |---|---|
-//! | [`context`] | the frame's camera: intrinsics, pose from the joints, horizon, shutter skew |
+//! | [`context`] | the frame's camera: intrinsics, pose (from the readings or the joints), horizon, shutter skew |
 //! | [`confidence`] | named tests adding to or subtracting from a candidate's confidence |
 //! | [`fit`] | circle and line fits, rotation about a centre |
 //! | [`scan`] | horizon-parallel scan areas, the six edge-scan patterns, skew removal |
@@ -50,6 +50,9 @@ pub struct RecognitionParams {
     /// Horizontal field of view (degrees) for frames other than 208×160 (which are the ERS-7's
     /// 56.9°). 46.4° is the Nao's camera.
     pub other_camera_fov_deg: f64,
+    /// Time the camera takes to read out all rows of one image, seconds: the rolling shutter's
+    /// skew is the head's velocity times this (1/30 s for the ERS-7's and the Nao's cameras).
+    pub camera_readout_s: f64,
     /// Lengths of the head chain used to place the camera from the joints.
     pub body: Ers7Dimensions,
 }
@@ -62,6 +65,7 @@ impl Default for RecognitionParams {
             beacons: BeaconParams::default(),
             patterns: patterns::PatternParams::default(),
             other_camera_fov_deg: 46.4,
+            camera_readout_s: context::DEFAULT_READOUT_S,
             body: Ers7Dimensions::ERS7,
         }
     }
@@ -83,9 +87,10 @@ impl RecognitionParams {
         }
     }
 
-    /// The view context of a frame of this size with these readings (none: no pose). The body
-    /// model is the ERS-7's, so only 208×160 frames get a camera pose from the joints; frames of
-    /// other robots (the Nao's 320×240) get camera-relative recognition without heights or
+    /// The view context of a frame of this size with these readings (none: no pose). A camera
+    /// pose carried in the readings (the robot's own estimate) is used for any frame; otherwise
+    /// the pose comes from the joints through the ERS-7 body model, for 208×160 frames only, so
+    /// frames of other robots without a pose get camera-relative recognition without heights or
     /// horizon, but keep their infra-red and shutter-skew readings.
     #[must_use]
     pub fn context_for(
@@ -96,16 +101,18 @@ impl RecognitionParams {
     ) -> ViewContext {
         let camera = self.camera_for(width, height);
         match sensors {
-            Some(s) if (width, height) == (208, 160) => {
-                ViewContext::from_sensors(camera, s, &self.body)
-            }
             Some(s) => {
-                let mut ctx = ViewContext::from_sensors(camera, s, &self.body);
-                ctx.pose = None;
-                ctx.body_from_camera = None;
-                ctx.horizon = None;
-                ctx.motion = None;
-                ctx
+                let ctx = ViewContext::from_sensors_with_readout(
+                    camera,
+                    s,
+                    &self.body,
+                    self.camera_readout_s,
+                );
+                if (width, height) == (208, 160) {
+                    ctx
+                } else {
+                    ctx.without_joint_pose()
+                }
             }
             None => ViewContext::without_pose(camera),
         }

@@ -32,7 +32,13 @@ pub fn sensors_json_schema() -> serde_json::Value {
         "title": SENSORS_SCHEMA_NAME,
         "description": "The robot's sensor readings for one frame. Angles in radians (pan positive \
                         to the left, tilt positive up), lengths in centimetres, accelerations in \
-                        m/s². A missing or null field was not provided by the source.",
+                        m/s². A missing or null field was not provided by the source. \
+                        camera_x_cm, camera_y_cm, camera_height_cm, camera_roll_rad, \
+                        camera_pitch_rad, camera_yaw_rad: the robot's own estimate of its \
+                        camera's pose over the ground (position in its ground frame, x ahead, y \
+                        left; rotation yaw, then pitch positive looking down, then roll positive \
+                        right side down); recognition uses it, when height and pitch are given, \
+                        instead of a body model.",
         "type": "object",
         "properties": props,
     })

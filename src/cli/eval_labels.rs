@@ -1,0 +1,233 @@
+//! `eotn eval STREAM --labels FILE`: recognition on a real stream scored against hand labels
+//! (`crate::eval::labels`): ball found / missed / false counts and rates, centre and radius
+//! error percentiles, the frames that missed or saw a false ball, goals found and false, and
+//! each found goal's size-based distance beside the distance of its foot through the camera
+//! pose (the two agree when the goal model fits the field).
+
+use std::path::Path;
+
+use anyhow::{Context, bail};
+use serde::Serialize;
+
+use crate::eval::labels::{LabelledFrameEval, Labels, LabelsReport, evaluate_labelled_frame};
+use crate::eval::{EvalParams, Percentiles};
+use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::RecognitionParams;
+use crate::streams::StreamReader;
+
+/// A found goal's two distances: from its size and from its foot on the ground.
+#[derive(Debug, Clone, Serialize)]
+pub struct GoalDistances {
+    /// Frame index.
+    pub frame: usize,
+    /// The distance recognition reports (size-based unless top or bottom is cut), cm.
+    pub distance_cm: f64,
+    /// The distance of the goal's foot (the middle of its bottom edge) on the ground through
+    /// the camera pose, cm; `None` without a pose or with the bottom cut off.
+    pub foot_distance_cm: Option<f64>,
+    /// Whether the top or bottom is cut off (the reported distance is then a maximum or the
+    /// foot's).
+    pub cut_top_or_bottom: bool,
+}
+
+/// Everything `eotn eval --labels` reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct LabelsOutput {
+    /// The sums.
+    pub report: LabelsReport,
+    /// Found goals with both ends in the image: size-based / foot distance, percentiles.
+    pub goal_size_over_foot: Percentiles,
+    /// Every found goal's distances.
+    pub goal_distances: Vec<GoalDistances>,
+    /// Every labelled frame.
+    pub frames: Vec<LabelledFrameEval>,
+    /// Stream frames without a label, and labels without a frame.
+    pub unlabelled_frames: Vec<usize>,
+    /// Labels of frames the stream does not have.
+    pub labels_beyond_stream: Vec<usize>,
+}
+
+/// Runs the labels evaluation of one stream.
+///
+/// # Errors
+/// Unreadable stream or labels, labels made on another frame size, or no labelled frame.
+pub fn run(
+    stream: &Path,
+    labels_path: &Path,
+    lut: crate::lut::LookupTable,
+    params: RecognitionParams,
+    json: bool,
+) -> anyhow::Result<()> {
+    let labels = Labels::load(labels_path)?;
+    let mut reader = StreamReader::open(stream)?;
+    let mut pipeline = Pipeline::new(
+        lut,
+        PipelineParams {
+            recognition: params,
+            ..PipelineParams::default()
+        },
+    );
+    let ep = EvalParams::default();
+    let mut frames = Vec::new();
+    let mut unlabelled = Vec::new();
+    let mut goal_distances = Vec::new();
+    let bar = super::inputs::progress(reader.len(), "eval");
+    for i in 0..reader.len() {
+        bar.inc(1);
+        let Some(label) = labels.frame(i) else {
+            unlabelled.push(i);
+            continue;
+        };
+        let record = reader
+            .read(i)
+            .with_context(|| format!("{}: frame {i}", stream.display()))?;
+        let (w, h) = (record.frame.width(), record.frame.height());
+        if let (Some(lw), Some(lh)) = (labels.width, labels.height)
+            && (lw, lh) != (w, h)
+        {
+            bail!(
+                "{}: labels are for {lw}×{lh} frames, frame {i} of {} is {w}×{h}",
+                labels_path.display(),
+                stream.display()
+            );
+        }
+        let sensors = record.sensors.as_ref();
+        let ctx = params.context_for(w, h, sensors);
+        let result = pipeline.process(&record.frame, sensors);
+        let r = &result.recognition;
+        for g in r.goals.goals() {
+            let bottom = (
+                (g.level_extent[0] + g.level_extent[2]) / 2.0,
+                g.level_extent[3],
+            );
+            let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+            let foot = crate::recognition::fit::rotate_about(bottom, centre, -ctx.horizon_angle());
+            goal_distances.push(GoalDistances {
+                frame: i,
+                distance_cm: g.camera.distance_cm,
+                foot_distance_cm: (!g.cut_off.bottom)
+                    .then(|| ctx.distance_to_plane(foot, 0.0))
+                    .flatten(),
+                cut_top_or_bottom: g.cut_off.top || g.cut_off.bottom,
+            });
+        }
+        frames.push(evaluate_labelled_frame(r, label, w as f64, h as f64, &ep));
+    }
+    bar.finish_and_clear();
+    let labels_beyond_stream: Vec<usize> = labels
+        .frames
+        .iter()
+        .map(|f| f.frame)
+        .filter(|f| *f >= reader.len())
+        .collect();
+    if frames.is_empty() {
+        bail!(
+            "{}: no frame of {} is labelled",
+            labels_path.display(),
+            stream.display()
+        );
+    }
+    let ratios: Vec<f64> = goal_distances
+        .iter()
+        .filter(|g| !g.cut_top_or_bottom)
+        .filter_map(|g| g.foot_distance_cm.map(|f| g.distance_cm / f))
+        .collect();
+    let output = LabelsOutput {
+        report: LabelsReport::from_frames(&frames),
+        goal_size_over_foot: Percentiles::of(&ratios),
+        goal_distances,
+        frames,
+        unlabelled_frames: unlabelled,
+        labels_beyond_stream,
+    };
+    if json {
+        println!("{}", serde_json::to_string(&output)?);
+    } else {
+        print_summary(&output);
+    }
+    Ok(())
+}
+
+fn pct(r: Option<f64>) -> String {
+    r.map_or_else(|| "—".to_owned(), |v| format!("{:.1}%", v * 100.0))
+}
+
+fn print_summary(o: &LabelsOutput) {
+    let r = &o.report;
+    println!("labelled frames        {}", r.frames);
+    println!(
+        "ball found             {}/{} labelled visible = {}; cut by the image edge {}/{}; \
+         ≥ 60% in view and ≥ 6 px {}/{}",
+        r.ball_found,
+        r.ball_visible,
+        pct(r.ball_found_rate),
+        r.ball_cut_found,
+        r.ball_cut,
+        r.ball_eligible_found,
+        r.ball_eligible
+    );
+    println!(
+        "false ball             {} of {} frames = {} ({} frames without a ball)",
+        r.ball_false,
+        r.frames,
+        pct(r.ball_false_rate),
+        r.ball_absent
+    );
+    println!(
+        "ball centre error      median {:.2} px p90 {:.2} px (n={}); cut: median {:.2} px (n={})",
+        r.ball_center_error_px.p50,
+        r.ball_center_error_px.p90,
+        r.ball_center_error_px.n,
+        r.ball_center_error_cut_px.p50,
+        r.ball_center_error_cut_px.n
+    );
+    println!(
+        "ball radius error      median {:.2} px p90 {:.2} px, signed median {}; cut: median {:.2} px",
+        r.ball_radius_error_px.p50,
+        r.ball_radius_error_px.p90,
+        r.ball_radius_bias_px
+            .map_or_else(|| "—".to_owned(), |b| format!("{b:+.2} px")),
+        r.ball_radius_error_cut_px.p50
+    );
+    if !r.ball_missed_frames.is_empty() {
+        println!("ball missed in frames  {:?}", r.ball_missed_frames);
+    }
+    if !r.ball_near_frames.is_empty() {
+        println!("  of those, near       {:?}", r.ball_near_frames);
+    }
+    if !r.ball_false_frames.is_empty() {
+        println!("false ball in frames   {:?}", r.ball_false_frames);
+    }
+    if r.goal_frames > 0 {
+        println!(
+            "goals found            {}/{} = {}, false {} (in {} frames with goals labelled)",
+            r.goals_found,
+            r.goals_visible,
+            pct(r.goal_found_rate),
+            r.goals_false,
+            r.goal_frames
+        );
+        if !r.goal_missed_frames.is_empty() {
+            println!("goal missed in frames  {:?}", r.goal_missed_frames);
+        }
+        if !r.goal_false_frames.is_empty() {
+            println!("false goal in frames   {:?}", r.goal_false_frames);
+        }
+    }
+    if o.goal_size_over_foot.n > 0 {
+        println!(
+            "goal distance          size / foot on the ground: median {:.2}, p90 {:.2} (n={})",
+            o.goal_size_over_foot.p50, o.goal_size_over_foot.p90, o.goal_size_over_foot.n
+        );
+    }
+    if !o.unlabelled_frames.is_empty() {
+        println!("unlabelled frames      {}", o.unlabelled_frames.len());
+    }
+    if !o.labels_beyond_stream.is_empty() {
+        println!(
+            "labels beyond the stream's {} frames: {:?}",
+            r.frames + o.unlabelled_frames.len(),
+            o.labels_beyond_stream
+        );
+    }
+}
