@@ -4,6 +4,7 @@
 //! Pure functions on [`Recognition`] and the renderer's [`RobotViewTruth`]; `eotn eval` reads
 //! streams and runs the pipeline, this module only compares.
 
+pub mod patterns;
 pub mod plots;
 
 use serde::{Deserialize, Serialize};

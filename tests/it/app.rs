@@ -588,7 +588,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         .state
         .run(Command::ShowWindow(Window::Inspector, true));
     h.run();
-    let n = eotn::app::inspector::candidates(state(&h).recognition()).len();
+    let n = eotn::app::inspector::candidates(state(&h).recognition(), state(&h).places()).len();
     assert!(n >= 2, "ball and goal candidates, got {n}");
     assert_eq!(
         h.query_all_by_label_contains("accepted ").count()
@@ -613,7 +613,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         "selected: thicker {circles:?}"
     );
     // Selecting another candidate dims the ball.
-    let goal = eotn::app::inspector::candidates(state(&h).recognition())
+    let goal = eotn::app::inspector::candidates(state(&h).recognition(), state(&h).places())
         .into_iter()
         .map(|c| c.owner)
         .find(|o| *o != ball_owner)
