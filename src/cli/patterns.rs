@@ -405,6 +405,13 @@ fn print_learnt(o: &LearnOutput) {
         r.patterns_added.len(),
         r.views_merged
     );
+    if !r.patterns_refused.is_empty() {
+        println!(
+            "  {} further pattern(s) refused (within one region of another place's): places {:?}",
+            r.patterns_refused.len(),
+            r.patterns_refused
+        );
+    }
     for g in &r.groups_dropped {
         println!("  not learnt: {g}");
     }

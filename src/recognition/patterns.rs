@@ -165,17 +165,29 @@ pub struct PatternObservation {
     /// The ray to the blob's centre in the robot's ground frame, when the camera pose was
     /// known (joint readings); learning needs it.
     pub ray: Option<GroundRay>,
+    /// The rolling shutter's horizontal shear while the frame was read (pixels per row, from
+    /// the pan): the regions above and below are shifted by it, as the image shows them.
+    #[serde(default)]
+    pub shear_px_per_row: f64,
 }
 
 impl PatternObservation {
     /// Region `k`'s box (0..9, row by row), inclusive pixels `[minx, miny, maxx, maxy]`; it
-    /// may reach outside the image.
+    /// may reach outside the image. Regions are the pink blob's size side by side, the rows
+    /// above and below moved along the shear. (Taking the shear out of their width as well
+    /// measured worse: the pink blob's rim is often lost, so its box is narrower already.)
     #[must_use]
     pub fn region_bounds(&self, k: usize) -> [i64; 4] {
         let [x0, y0, x1, y1] = self.bounds.map(i64::from);
         let (w, h) = (x1 - x0 + 1, y1 - y0 + 1);
+        let shear = if self.shear_px_per_row.is_finite() {
+            self.shear_px_per_row
+        } else {
+            0.0
+        };
         let (gx, gy) = ((k % 3) as i64 - 1, (k / 3) as i64 - 1);
-        [x0 + gx * w, y0 + gy * h, x1 + gx * w, y1 + gy * h]
+        let dx = gx * w + (shear * (gy * h) as f64).round() as i64;
+        [x0 + dx, y0 + gy * h, x1 + dx, y1 + gy * h]
     }
 
     /// The blob's box centre, image pixels.
@@ -218,6 +230,10 @@ impl Default for PatternParams {
         }
     }
 }
+
+/// The distance assumed for removing the rolling shutter's skew from a marker before its
+/// distance is known, centimetres.
+const ASSUMED_DISTANCE_CM: f64 = 200.0;
 
 /// Regions larger than this many pixels are sampled on a grid instead of read whole, so a close
 /// marker costs no more than a middling one.
@@ -329,13 +345,22 @@ fn observe_blob(img: &ClassifiedImage, b: &Blob, ctx: &ViewContext) -> PatternOb
         pixels: b.pixels,
         regions_in_image: 0,
         ray: None,
+        shear_px_per_row: 0.0,
     };
+    // The rolling shutter through the body model (the linear shear of the pan formula grows
+    // with tan² of the pan angle and is far too large towards the sides); the distance only
+    // matters for the camera's own motion, so a typical one does.
+    let seen = obs.centre();
+    let centre = ctx.unskew_at(seen, ASSUMED_DISTANCE_CM, true);
+    let below = ctx.unskew_at((seen.0, seen.1 + 1.0), ASSUMED_DISTANCE_CM, true);
+    if (centre.0 - below.0).is_finite() {
+        obs.shear_px_per_row = centre.0 - below.0;
+    }
     for k in 0..9 {
         let (colours, inside) = region_colours(img, obs.region_bounds(k));
         obs.signature.0[k] = colours;
         obs.regions_in_image += usize::from(inside);
     }
-    let centre = ctx.unskew(obs.centre(), true);
     (obs.bearing_rad, obs.elevation_rad) = ctx.camera_angles(centre);
     obs.ray = ctx.pose.map(|pose| {
         let p = ImagePoint::new(centre.0, centre.1);
@@ -805,7 +830,7 @@ impl PatternMemory {
             c.identification = None;
         }
         if let Some(d) = c.identification.and_then(|m| m.distance_cm) {
-            let centre = ctx.unskew(obs.centre(), true);
+            let centre = ctx.unskew_at(obs.centre(), d, true);
             c.camera = Some(ctx.camera_relative(centre, d));
             c.body = ctx.body_relative(centre, d);
         }
@@ -988,6 +1013,9 @@ pub struct LearnReport {
     pub objects_created: Vec<usize>,
     /// Objects that got another pattern.
     pub patterns_added: Vec<usize>,
+    /// Objects whose further pattern was refused as too close to another object's (within one
+    /// region of a match).
+    pub patterns_refused: Vec<usize>,
     /// Views added to an object whose pattern they already matched.
     pub views_merged: usize,
     /// Groups that could not be learnt, with the reason.
@@ -1300,6 +1328,31 @@ impl PatternMemory {
                 }
             }
         }
+        // A further pattern of an object that comes within one region of another object's
+        // pattern is refused: it would let a single misread region of the other object's marker
+        // be identified as this one (a cut or misread view of one of two near-twin markers
+        // otherwise becomes the other twin's pattern). Each object keeps its first pattern.
+        let near_miss = recognition.min_agreement.saturating_sub(1);
+        let snapshot: Vec<(usize, Vec<Signature>)> = self
+            .objects
+            .iter()
+            .map(|o| (o.id, o.patterns.clone()))
+            .collect();
+        for o in &mut self.objects {
+            let id = o.id;
+            let mut k = 0;
+            o.patterns.retain(|sig| {
+                k += 1;
+                let close = snapshot.iter().any(|(other, pats)| {
+                    *other != id && pats.iter().any(|q| q.agreement(sig) >= near_miss)
+                });
+                let keep = k == 1 || !close;
+                if !keep {
+                    report.patterns_refused.push(id);
+                }
+                keep
+            });
+        }
         for (i, a) in self.objects.iter().enumerate() {
             for b in &self.objects[i + 1..] {
                 let matches = a.patterns.iter().any(|x| {
@@ -1394,6 +1447,38 @@ mod tests {
         assert_eq!(cut.regions_in_image, 6);
         assert_eq!(cut.signature.0[3], [0, 0], "outside the image: nothing");
         assert_eq!(cut.signature.0[5], [ColourClass::Green.code(), 0]);
+    }
+
+    #[test]
+    fn regions_follow_the_rolling_shutter_shear() {
+        // The tiles of a pan at 0.5 px per row: each row half a pixel further right.
+        let (w, h, t, shear) = (208usize, 160usize, 10.0, 0.5);
+        let mut codes = vec![ColourClass::Green.code(); w * h];
+        for y in 30..60 {
+            for x in 0..w {
+                let u = x as f64 - 60.0 - shear * (y as f64 - 45.0);
+                let col = (u / t).floor();
+                if (0.0..3.0).contains(&col) {
+                    let k = ((y - 30) / 10) * 3 + col as usize;
+                    codes[y * w + x] = PLACE[k].code();
+                }
+            }
+        }
+        let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
+        let blobs = BlobSet::from_image(&img, Connectivity::Four);
+        let mut panning = ctx();
+        panning.skew_x_per_line = shear;
+        let obs = observe(&img, &blobs, &panning, &PatternParams::default());
+        assert_eq!(obs.len(), 1);
+        let firsts: Vec<u8> = obs[0].signature.0.iter().map(|r| r[0]).collect();
+        let want: Vec<u8> = PLACE.iter().map(|c| c.code()).collect();
+        assert_eq!(firsts, want);
+        // Without the shear the box is too wide and the rows above and below miss.
+        let plain = observe(&img, &blobs, &ctx(), &PatternParams::default());
+        assert_eq!(plain[0].shear_px_per_row, 0.0);
+        assert!(obs[0].region_bounds(1)[0] <= plain[0].region_bounds(1)[0] - 5);
+        assert!(obs[0].region_bounds(7)[0] >= plain[0].region_bounds(7)[0] + 5);
+        assert_ne!(plain[0].signature, obs[0].signature);
     }
 
     #[test]
