@@ -122,7 +122,7 @@ fn pattern_candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<Ca
             }
             let reason = match (places, &c.identification) {
                 (None, _) => {
-                    "not identified: no places file open (Classification ▸ Open places…)".to_owned()
+                    "not identified: no places file open (Classification > Open places…)".to_owned()
                 }
                 (Some(_), Some(m)) => format!(
                     "accepted: place {}, {}/9 regions agree; confidence {:+.2}",
@@ -487,8 +487,7 @@ fn pattern_regions_ui(ui: &mut Ui, owner: &str, p: &PatternInfo) {
             for k in 0..9 {
                 let code = p.regions[k][0];
                 let [r, g, b] = crate::overlay::pattern_region_rgb(code);
-                let mut text = RichText::new(format!("■ {}", p.region_text(k)))
-                    .color(Color32::from_rgb(r, g, b));
+                let mut text = RichText::new(p.region_text(k)).color(Color32::from_rgb(r, g, b));
                 if k == 4 {
                     text = text.strong();
                 }

@@ -33,7 +33,7 @@ pub struct Args {
 pub enum PatternsCommand {
     /// Learn places from the pink markers of streams or frames and the robot's poses; write a
     /// places file for `eotn detect --patterns`.
-    Learn(LearnArgs),
+    Learn(Box<LearnArgs>),
     /// Print a places file: objects, patterns, the size → distance relation.
     Show(ShowArgs),
 }

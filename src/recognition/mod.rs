@@ -145,9 +145,7 @@ pub fn recognise(
         .map(|b| b.bounds)
         .collect();
     // A beacon's pink band is the beacon's, not a coloured-pattern marker.
-    let observations = patterns::observe(img, blobs, ctx, &params.patterns)
-        .into_iter()
-        .filter(|o| !beacon_boxes.iter().any(|b| patterns::inside(o.bounds, *b)));
+    let observations = patterns::observe(img, blobs, ctx, &params.patterns, &beacon_boxes);
     Recognition {
         ball: ball::recognise_ball(img, blobs, ctx, &params.ball),
         goals: goals::recognise_goals(img, blobs, ctx, &params.goals, &beacon_boxes),

@@ -239,17 +239,24 @@ const ASSUMED_DISTANCE_CM: f64 = 200.0;
 /// marker costs no more than a middling one.
 const REGION_SAMPLES: i64 = 256;
 
-/// Signatures of the pink markers in a classified frame.
+/// Signatures of the pink markers in a classified frame, leaving out pink blobs inside any of
+/// the boxes `except` (inclusive `[minx, miny, maxx, maxy]`: accepted beacons, whose bands are
+/// theirs).
 #[must_use]
 pub fn observe(
     img: &ClassifiedImage,
     blobs: &BlobSet,
     ctx: &ViewContext,
     params: &PatternParams,
+    except: &[[u32; 4]],
 ) -> Vec<PatternObservation> {
     blobs
         .of_class(ColourClass::Pink)
         .filter(|b| b.pixels >= params.min_pixels)
+        .filter(|b| {
+            let own = [b.minx, b.miny, b.maxx, b.maxy];
+            !except.iter().any(|e| inside(own, *e))
+        })
         .map(|b| observe_blob(img, b, ctx))
         .collect()
 }
@@ -472,7 +479,7 @@ impl SizeRelation {
             let dx = 1.0 / s[0] - mx;
             (a + dx * dx, b + dx * (s[1] - my))
         });
-        if !(sxx > 1e-18) {
+        if sxx.is_nan() || sxx <= 1e-18 {
             return None;
         }
         let m = sxy / sxx;
@@ -757,6 +764,16 @@ impl PatternMemory {
         params: &PatternParams,
     ) -> Option<PatternMatch> {
         let (best, next) = self.ranked(&obs.signature);
+        self.identify_ranked(obs, best, next, params)
+    }
+
+    fn identify_ranked(
+        &self,
+        obs: &PatternObservation,
+        best: Option<Closest>,
+        next: Option<Closest>,
+        params: &PatternParams,
+    ) -> Option<PatternMatch> {
         let best = best?;
         let tied = next
             .is_some_and(|n| (n.agreement, n.both_colours) == (best.agreement, best.both_colours));
@@ -824,7 +841,7 @@ impl PatternMemory {
             }
             _ => conf.skipped("margin", [0.1, 9.0]),
         }
-        c.identification = memory.identify(&obs, params);
+        c.identification = memory.identify_ranked(&obs, best, next, params);
         c.accepted = c.identification.is_some() && c.confidence.accepted();
         if !c.accepted {
             c.identification = None;
@@ -940,6 +957,15 @@ pub struct Triangulation {
 /// lies behind one of them.
 #[must_use]
 pub fn triangulate(rays: &[FieldRay], weights: &[f64]) -> Option<Triangulation> {
+    let t = least_squares_point(rays, weights)?;
+    rays.iter()
+        .all(|r| along_and_across(r, t.field_cm).0 > 0.0)
+        .then_some(t)
+}
+
+/// [`triangulate`] without the check that the point lies ahead of every ray (robust
+/// triangulation drops the rays it lies behind).
+fn least_squares_point(rays: &[FieldRay], weights: &[f64]) -> Option<Triangulation> {
     if rays.len() < 2 || weights.len() != rays.len() {
         return None;
     }
@@ -975,15 +1001,7 @@ pub fn triangulate(rays: &[FieldRay], weights: &[f64]) -> Option<Triangulation> 
         (a[1][1] * b[0] - a[0][1] * b[1]) / det,
         (a[0][0] * b[1] - a[1][0] * b[0]) / det,
     ];
-    let mut ss = 0.0;
-    for r in rays {
-        let (dx, dy) = (p[0] - r.origin_cm[0], p[1] - r.origin_cm[1]);
-        let (s, c) = r.heading_rad.sin_cos();
-        if c * dx + s * dy <= 0.0 {
-            return None;
-        }
-        ss += (-s * dx + c * dy).powi(2);
-    }
+    let ss: f64 = rays.iter().map(|r| along_and_across(r, p).1.powi(2)).sum();
     Some(Triangulation {
         field_cm: p,
         residual_cm: (ss / rays.len() as f64).sqrt(),
@@ -1023,6 +1041,23 @@ pub struct LearnReport {
     /// Pairs of objects whose patterns match each other: identification cannot tell them
     /// apart.
     pub indistinct: Vec<(usize, usize)>,
+}
+
+/// A group's result before it is merged into the memory.
+#[derive(Debug, Clone, Copy)]
+struct Learnt {
+    /// The group's consensus signature.
+    signature: Signature,
+    /// Where it was placed, field centimetres.
+    at: [f64; 2],
+    /// Its height, centimetres (triangulated groups).
+    height: Option<f64>,
+    /// Views in the group.
+    views: usize,
+    /// How it was placed.
+    placed_by: Placement,
+    /// Triangulation residual, centimetres.
+    residual_cm: f64,
 }
 
 /// A group of views taken to show one marker.
@@ -1075,29 +1110,32 @@ impl Group {
         loop {
             let rays: Vec<FieldRay> = self.views.iter().map(|v| v.0).collect();
             let mut weights = vec![1.0; rays.len()];
-            let mut t = triangulate(&rays, &weights);
+            let mut t = least_squares_point(&rays, &weights);
             for _ in 0..3 {
                 let Some(tt) = t else { break };
                 for (w, r) in weights.iter_mut().zip(&rays) {
                     let (along, _) = along_and_across(r, tt.field_cm);
                     *w = 1.0 / along.max(20.0).powi(2);
                 }
-                t = triangulate(&rays, &weights).or(t);
+                t = least_squares_point(&rays, &weights).or(t);
             }
             let Some(tt) = t else {
                 return (None, dropped);
             };
+            // The worst ray: one the point lies behind, else the one passing farthest off.
             let worst = rays
                 .iter()
                 .enumerate()
-                .map(|(i, r)| (i, along_and_across(r, tt.field_cm)))
-                .max_by(|a, b| a.1.1.total_cmp(&b.1.1));
+                .map(|(i, r)| {
+                    let (along, across) = along_and_across(r, tt.field_cm);
+                    (i, if along <= 0.0 { f64::INFINITY } else { across })
+                })
+                .max_by(|a, b| a.1.total_cmp(&b.1));
             match worst {
-                Some((i, (along, across)))
-                    if (across > p.outlier_cm || along <= 0.0) && self.views.len() > 2 =>
-                {
+                Some((i, off)) if off > p.outlier_cm && self.views.len() > 2 => {
                     dropped.push(self.views.swap_remove(i));
                 }
+                Some((_, off)) if off.is_infinite() => return (None, dropped),
                 _ => return (Some(tt), dropped),
             }
         }
@@ -1117,7 +1155,7 @@ fn theil_sen(samples: &[[f64; 2]]) -> Option<(f64, f64)> {
     for i in 0..n {
         for j in i + 1..n {
             k += 1;
-            if k % stride != 0 {
+            if !k.is_multiple_of(stride) {
                 continue;
             }
             let dx = 1.0 / samples[j][0] - 1.0 / samples[i][0];
@@ -1234,18 +1272,16 @@ impl PatternMemory {
         }
         self.relation = SizeRelation::fit(&self.samples).or(self.relation);
         // Objects from triangulated groups, then from narrow ones placed by size.
-        let mut learnt: Vec<(Signature, [f64; 2], Option<f64>, usize, Placement, f64)> = placed
+        let mut learnt: Vec<Learnt> = placed
             .iter()
             .zip(&heights)
-            .map(|((g, t), &z)| {
-                (
-                    g.consensus(),
-                    t.field_cm,
-                    Some(z),
-                    g.views.len(),
-                    Placement::Triangulation,
-                    t.residual_cm,
-                )
+            .map(|((g, t), &z)| Learnt {
+                signature: g.consensus(),
+                at: t.field_cm,
+                height: Some(z),
+                views: g.views.len(),
+                placed_by: Placement::Triangulation,
+                residual_cm: t.residual_cm,
             })
             .collect();
         for g in narrow {
@@ -1268,20 +1304,33 @@ impl PatternMemory {
             if xs.is_empty() {
                 continue;
             }
-            learnt.push((
-                g.consensus(),
-                [median(xs), median(ys)],
-                None,
-                g.views.len(),
-                Placement::SizeRelation,
-                0.0,
-            ));
+            learnt.push(Learnt {
+                signature: g.consensus(),
+                at: [median(xs), median(ys)],
+                height: None,
+                views: g.views.len(),
+                placed_by: Placement::SizeRelation,
+                residual_cm: 0.0,
+            });
         }
         // Merge into the memory, the best-seen groups first: they place the objects, groups
         // merged into them later only add their patterns (a handful of views of a cut or
         // misread marker would only pull a well-triangulated position off).
-        learnt.sort_by_key(|l| (l.4 != Placement::Triangulation, std::cmp::Reverse(l.3)));
-        for (sig, at, height, n, how, residual) in learnt {
+        learnt.sort_by_key(|l| {
+            (
+                l.placed_by != Placement::Triangulation,
+                std::cmp::Reverse(l.views),
+            )
+        });
+        for l in learnt {
+            let Learnt {
+                signature: sig,
+                at,
+                height,
+                views: n,
+                placed_by: how,
+                residual_cm: residual,
+            } = l;
             let near = self
                 .objects
                 .iter_mut()
@@ -1411,7 +1460,7 @@ mod tests {
 
     fn one(img: &ClassifiedImage) -> PatternObservation {
         let blobs = BlobSet::from_image(img, Connectivity::Four);
-        let obs = observe(img, &blobs, &ctx(), &PatternParams::default());
+        let obs = observe(img, &blobs, &ctx(), &PatternParams::default(), &[]);
         assert_eq!(obs.len(), 1);
         obs[0]
     }
@@ -1468,13 +1517,13 @@ mod tests {
         let blobs = BlobSet::from_image(&img, Connectivity::Four);
         let mut panning = ctx();
         panning.skew_x_per_line = shear;
-        let obs = observe(&img, &blobs, &panning, &PatternParams::default());
+        let obs = observe(&img, &blobs, &panning, &PatternParams::default(), &[]);
         assert_eq!(obs.len(), 1);
         let firsts: Vec<u8> = obs[0].signature.0.iter().map(|r| r[0]).collect();
         let want: Vec<u8> = PLACE.iter().map(|c| c.code()).collect();
         assert_eq!(firsts, want);
         // Without the shear the box is too wide and the rows above and below miss.
-        let plain = observe(&img, &blobs, &ctx(), &PatternParams::default());
+        let plain = observe(&img, &blobs, &ctx(), &PatternParams::default(), &[]);
         assert_eq!(plain[0].shear_px_per_row, 0.0);
         assert!(obs[0].region_bounds(1)[0] <= plain[0].region_bounds(1)[0] - 5);
         assert!(obs[0].region_bounds(7)[0] >= plain[0].region_bounds(7)[0] + 5);
