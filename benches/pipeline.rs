@@ -268,7 +268,18 @@ fn recognition(c: &mut Criterion) {
             )
         });
     });
-    // The coloured patterns' own share of that: signatures, then identification.
+    // The coloured patterns' own share of that: the signature alone, then with identification.
+    group.bench_function("patterns_observe_marker", |b| {
+        b.iter(|| {
+            eotn::recognition::patterns::observe(
+                black_box(&marked),
+                &marked_blobs,
+                &ctx,
+                &params.patterns,
+                &[],
+            )
+        });
+    });
     group.bench_function("patterns_marker_6_places", |b| {
         b.iter(|| {
             eotn::recognition::patterns::observe(

@@ -237,7 +237,7 @@ const ASSUMED_DISTANCE_CM: f64 = 200.0;
 
 /// Regions larger than this many pixels are sampled on a grid instead of read whole, so a close
 /// marker costs no more than a middling one.
-const REGION_SAMPLES: i64 = 256;
+const REGION_SAMPLES: i64 = 128;
 
 /// Signatures of the pink markers in a classified frame, leaving out pink blobs inside any of
 /// the boxes `except` (inclusive `[minx, miny, maxx, maxy]`: accepted beacons, whose bands are
@@ -281,19 +281,17 @@ fn region_colours(img: &ClassifiedImage, [x0, y0, x1, y1]: [i64; 4]) -> ([u8; 2]
         while area / (step * step) > REGION_SAMPLES {
             step += 1;
         }
-        let mut y = cy0;
-        while y <= cy1 {
-            let row = img.row(usize::try_from(y).unwrap_or(0));
-            let mut x = cx0;
-            while x <= cx1 {
-                if let Some(&c) = row.get(usize::try_from(x).unwrap_or(usize::MAX))
-                    && let Some(n) = counts.get_mut(usize::from(c))
-                {
-                    *n += 1;
+        // Clipped to the image above, so the conversions hold.
+        let (from, to) = (cx0 as usize, cx1 as usize);
+        let stride = step as usize;
+        for y in (cy0 as usize..=cy1 as usize).step_by(stride) {
+            if let Some(run) = img.row(y).get(from..=to) {
+                for &c in run.iter().step_by(stride) {
+                    if let Some(n) = counts.get_mut(usize::from(c)) {
+                        *n += 1;
+                    }
                 }
-                x += step;
             }
-            y += step;
         }
     }
     counts[0] = 0;
