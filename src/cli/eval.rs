@@ -142,7 +142,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     main.set_pattern_memory(places.clone());
     let pattern_params = crate::eval::patterns::PatternEvalParams::default();
     let mut pattern_frames = Vec::new();
-    let mut place_markers = Vec::new();
+    let mut place_markers: Vec<(usize, Option<usize>)> = Vec::new();
     let mut no_skew = Pipeline::new(
         lut.clone(),
         PipelineParams {
@@ -215,7 +215,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let ra = main.process(&record.frame, sensors).recognition.clone();
             let fa = evaluate_frame(global, &ra, &truth, w, h, &ep);
             if let Some(m) = &places {
-                if place_markers.is_empty() {
+                // Learnt places are matched to the markers of the first frame that lists any.
+                if !truth.markers.is_empty() && place_markers.iter().all(|(_, k)| k.is_none()) {
                     place_markers =
                         crate::eval::patterns::place_markers(m, &truth.markers, &pattern_params);
                 }

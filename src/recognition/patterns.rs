@@ -12,7 +12,9 @@
 //! distance) sample, and the linear relation distance = multiplier / size + offset is fitted to
 //! them. A group seen from too narrow a baseline is placed along its rays by that relation. A
 //! group placed within [`LearnParams::same_object_cm`] of a known object adds its signature to
-//! that object as another pattern; otherwise it becomes a new object.
+//! that object as another pattern (unless it comes within one region of another object's
+//! pattern); otherwise it becomes a new object. A recognised beacon's pink band is the beacon's
+//! and gets no signature.
 //!
 //! **Identification** ([`PatternMemory::identify`]) only identifies: the best object with enough
 //! agreeing regions, refused when another object agrees as well (the signature cannot tell
