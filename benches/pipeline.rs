@@ -184,7 +184,8 @@ fn kernels(c: &mut Criterion) {
 }
 
 /// The whole recognition step (ball, goals, beacons, pattern signatures) on the classified
-/// 208×160 scene, with joint readings so every test runs. Target: under 100 µs median.
+/// 208×160 scene, with joint readings so every test runs. Target: under 100 µs median. Then the
+/// same with a coloured-pattern marker and six learnt places, and the patterns' own part.
 fn recognition(c: &mut Criterion) {
     use eotn::recognition::{RecognitionParams, recognise};
     use eotn::sensors::SensorReadings;
@@ -205,6 +206,100 @@ fn recognition(c: &mut Criterion) {
     let mut group = c.benchmark_group("recognition_208x160");
     group.bench_function("recognise", |b| {
         b.iter(|| recognise(black_box(&img), &blobs, &ctx, &params, None));
+    });
+    // The same frame with a coloured-pattern marker (3 × 3 tiles of 9 px, pink in the middle)
+    // in the sky, identified against six learnt places.
+    let mut marked = img.clone();
+    let tiles = [
+        ColourClass::White,
+        ColourClass::Green,
+        ColourClass::White,
+        ColourClass::SkyBlue,
+        ColourClass::Pink,
+        ColourClass::Yellow,
+        ColourClass::Green,
+        ColourClass::White,
+        ColourClass::Green,
+    ];
+    for (k, t) in tiles.iter().enumerate() {
+        for y in 0..9 {
+            for x in 0..9 {
+                let (px, py) = (150 + 9 * (k % 3) + x, 2 + 9 * (k / 3) + y);
+                marked.codes_mut()[py * 208 + px] = t.code();
+            }
+        }
+    }
+    let marked_blobs = BlobSet::from_image(&marked, Connectivity::Eight);
+    let seen =
+        eotn::recognition::patterns::observe(&marked, &marked_blobs, &ctx, &params.patterns, &[]);
+    let memory = eotn::recognition::patterns::PatternMemory {
+        objects: (0..6)
+            .map(|id| eotn::recognition::patterns::PatternObject {
+                id,
+                field_cm: [0.0, 0.0],
+                height_cm: None,
+                // Place 0 is the marker; the others differ from it in two regions.
+                patterns: seen
+                    .iter()
+                    .map(|o| {
+                        let mut sig = o.signature;
+                        if id > 0 {
+                            sig.0[id - 1] = [ColourClass::Orange.code(), 0];
+                            sig.0[id + 2] = [ColourClass::Orange.code(), 0];
+                        }
+                        sig
+                    })
+                    .collect(),
+                views: 10,
+                placed_by: eotn::recognition::patterns::Placement::Triangulation,
+                residual_cm: 0.0,
+            })
+            .collect(),
+        ..Default::default()
+    };
+    group.bench_function("recognise_marker_6_places", |b| {
+        b.iter(|| {
+            recognise(
+                black_box(&marked),
+                &marked_blobs,
+                &ctx,
+                &params,
+                Some(&memory),
+            )
+        });
+    });
+    // The coloured patterns' own share of that: the signature alone, then with identification.
+    group.bench_function("patterns_observe_marker", |b| {
+        b.iter(|| {
+            eotn::recognition::patterns::observe(
+                black_box(&marked),
+                &marked_blobs,
+                &ctx,
+                &params.patterns,
+                &[],
+            )
+        });
+    });
+    group.bench_function("patterns_marker_6_places", |b| {
+        b.iter(|| {
+            eotn::recognition::patterns::observe(
+                black_box(&marked),
+                &marked_blobs,
+                &ctx,
+                &params.patterns,
+                &[],
+            )
+            .into_iter()
+            .map(|o| {
+                eotn::recognition::patterns::PatternMemory::candidate(
+                    Some(&memory),
+                    o,
+                    &ctx,
+                    &params.patterns,
+                )
+            })
+            .collect::<Vec<_>>()
+        });
     });
     group.finish();
 }

@@ -179,9 +179,42 @@ impl Canvas {
                     };
                     self.line(*from, *to, c);
                 }
+                Primitive::PatternRegion {
+                    bounds,
+                    colour,
+                    centre,
+                    ..
+                } => {
+                    let c = pattern_region_rgb(*colour);
+                    let [x0, y0, x1, y1] = bounds.map(|v| v as f64);
+                    let e = 0.5 / self.scale as f64;
+                    let inset = if *centre {
+                        1.0 / self.scale as f64
+                    } else {
+                        0.0
+                    };
+                    for d in [0.0, inset] {
+                        let (a, b) = ((x0 + d, y0 + d), (x1 + 1.0 - e - d, y1 + 1.0 - e - d));
+                        self.line(a, (b.0, a.1), c);
+                        self.line((b.0, a.1), b, c);
+                        self.line(b, (a.0, b.1), c);
+                        self.line((a.0, b.1), a, c);
+                    }
+                }
                 Primitive::Label { .. } => {}
             }
         }
+    }
+}
+
+/// The colour a pattern region is outlined in: its class's display colour, grey for "nothing"
+/// and white for black (which would vanish on a dark image).
+#[must_use]
+pub fn pattern_region_rgb(code: u8) -> [u8; 3] {
+    match code {
+        0 => [128, 128, 128],
+        9 => [255, 255, 255],
+        c => code_display_rgb(c),
     }
 }
 

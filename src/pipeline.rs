@@ -158,6 +158,12 @@ impl Pipeline {
         self.pattern_memory = memory;
     }
 
+    /// The learnt coloured patterns in use, if any.
+    #[must_use]
+    pub const fn pattern_memory(&self) -> Option<&PatternMemory> {
+        self.pattern_memory.as_ref()
+    }
+
     /// The stage settings.
     #[must_use]
     pub const fn params(&self) -> &PipelineParams {

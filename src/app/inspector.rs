@@ -9,8 +9,10 @@
 use egui::{Color32, Context, RichText, Ui};
 
 use super::state::{AppState, Command, Window};
+use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
 use crate::recognition::draw::owner;
+use crate::recognition::patterns::PatternMemory;
 use crate::recognition::scan::CutOff;
 use crate::recognition::{Recognition, Relative};
 
@@ -37,6 +39,129 @@ pub struct CandidateInfo {
     pub cut_sides: Vec<&'static str>,
     /// Further evidence: circle fit refused, posts without a line, pixel counts.
     pub notes: Vec<String>,
+    /// For a pink marker: its nine regions and how they compare with the closest place.
+    pub pattern: Option<PatternInfo>,
+}
+
+/// A pink marker's coloured pattern as the inspector shows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PatternInfo {
+    /// Each region's two most common class codes, row by row (0: nothing).
+    pub regions: [[u8; 2]; 9],
+    /// Whether each region's most common colour agrees with the closest place's best pattern
+    /// (`None` without a places file or a place).
+    pub agrees: Option<[bool; 9]>,
+    /// The closest place and how many regions agree with it.
+    pub closest: Option<(usize, usize)>,
+    /// The next closest place and its agreement.
+    pub runner_up: Option<(usize, usize)>,
+    /// The place it was identified as.
+    pub identified: Option<usize>,
+    /// The pink blob's size, pixels.
+    pub size_px: f64,
+    /// A places file was open.
+    pub with_places: bool,
+}
+
+impl PatternInfo {
+    /// One region as text: `yellow / white`, `nothing`.
+    #[must_use]
+    pub fn region_text(&self, k: usize) -> String {
+        let name = |c: u8| ColourClass::from_code(c).map_or("?", ColourClass::name);
+        match self.regions.get(k) {
+            Some([0, _]) | None => "nothing".to_owned(),
+            Some([a, 0]) => name(*a).to_owned(),
+            Some([a, b]) => format!("{} / {}", name(*a), name(*b)),
+        }
+    }
+}
+
+/// The inspector's rows for the pink markers of `r` (`places`: the open places file).
+fn pattern_candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<CandidateInfo> {
+    r.patterns
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let obs = &c.observation;
+            let agrees = c.closest.and_then(|best| {
+                let object = places?.object(best.id)?;
+                let pattern = object.patterns.iter().max_by_key(|p| {
+                    (
+                        p.agreement(&obs.signature),
+                        p.both_colours_agreement(&obs.signature),
+                    )
+                })?;
+                Some(std::array::from_fn(|k| {
+                    pattern.0[k][0] == obs.signature.0[k][0]
+                }))
+            });
+            let kind = match (&c.identification, &c.closest) {
+                (Some(m), _) => format!("pink marker: place {}", m.id),
+                (None, _) if places.is_none() => "pink marker (no places file)".to_owned(),
+                (None, _) if c.ambiguous => "pink marker: ambiguous".to_owned(),
+                (None, _) => "pink marker: unknown place".to_owned(),
+            };
+            let mut notes = vec![format!(
+                "{} pixels, size {:.1} px; {} of 9 regions in the image",
+                obs.pixels, obs.size_px, obs.regions_in_image
+            )];
+            if let Some(b) = c.closest {
+                notes.push(format!(
+                    "closest place {}: {}/9 regions agree ({} with both colours)",
+                    b.id, b.agreement, b.both_colours
+                ));
+            }
+            if let Some(n) = c.runner_up {
+                notes.push(format!("next place {}: {}/9", n.id, n.agreement));
+            }
+            if let Some(o) = c.identification.and_then(|m| places?.object(m.id)) {
+                notes.push(format!(
+                    "place {} is at ({:.0}, {:.0}) cm on the field, learnt from {} views",
+                    o.id, o.field_cm[0], o.field_cm[1], o.views
+                ));
+            }
+            let reason = match (places, &c.identification) {
+                (None, _) => {
+                    "not identified: no places file open (Classification > Open places…)".to_owned()
+                }
+                (Some(_), Some(m)) => format!(
+                    "accepted: place {}, {}/9 regions agree; confidence {:+.2}",
+                    m.id, m.agreement, c.confidence.total
+                ),
+                (Some(_), None) => reason(&c.confidence, false),
+            };
+            let (bearing, elevation) = (obs.bearing_rad, obs.elevation_rad);
+            CandidateInfo {
+                owner: owner::pattern(i),
+                kind,
+                accepted: c.accepted,
+                confidence: c.confidence.clone(),
+                reason,
+                camera: c.camera.unwrap_or(Relative {
+                    distance_cm: f64::NAN,
+                    bearing_rad: bearing,
+                    elevation_rad: elevation,
+                }),
+                body: c.body,
+                distance_is_max: false,
+                cut_sides: if c.cut_off {
+                    vec!["regions outside the image"]
+                } else {
+                    vec![]
+                },
+                notes,
+                pattern: Some(PatternInfo {
+                    regions: obs.signature.0,
+                    agrees,
+                    closest: c.closest.map(|b| (b.id, b.agreement)),
+                    runner_up: c.runner_up.map(|b| (b.id, b.agreement)),
+                    identified: c.identification.map(|m| m.id),
+                    size_px: obs.size_px,
+                    with_places: places.is_some(),
+                }),
+            }
+        })
+        .collect()
 }
 
 fn sides(cut: CutOff) -> Vec<&'static str> {
@@ -76,9 +201,10 @@ fn reason(c: &Confidence, accepted: bool) -> String {
     }
 }
 
-/// Every candidate of `r`: balls, goals, beacons, in that order.
+/// Every candidate of `r`: balls, goals, beacons, pink markers, in that order (`places`: the
+/// open places file pink markers were identified against).
 #[must_use]
-pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
+pub fn candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<CandidateInfo> {
     let mut out = Vec::new();
     for (i, c) in r.ball.candidates.iter().enumerate() {
         let mut notes = vec![format!(
@@ -118,6 +244,7 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
             distance_is_max: false,
             cut_sides: sides(c.cut_off),
             notes,
+            pattern: None,
         });
     }
     for (i, g) in r.goals.candidates.iter().enumerate() {
@@ -156,6 +283,7 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
             distance_is_max: g.distance_is_max,
             cut_sides: sides(g.cut_off),
             notes,
+            pattern: None,
         });
     }
     for (i, b) in r.beacons.iter().enumerate() {
@@ -174,8 +302,10 @@ pub fn candidates(r: &Recognition) -> Vec<CandidateInfo> {
                 vec![]
             },
             notes: Vec::new(),
+            pattern: None,
         });
     }
+    out.extend(pattern_candidates(r, places));
     out
 }
 
@@ -213,9 +343,12 @@ fn inspector_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
         ui.label("No frame open.");
         return;
     }
-    let list = candidates(state.recognition());
+    let list = candidates(state.recognition(), state.places());
     if list.is_empty() {
-        ui.label("No candidates in this frame: no ball, goal or beacon colour large enough.");
+        ui.label(
+            "No candidates in this frame: no ball, goal, beacon or pink marker colour large \
+             enough.",
+        );
         return;
     }
     let selected = state.selected_object();
@@ -267,10 +400,17 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
     ui.heading(format!("{} ({})", c.kind, c.owner));
     ui.colored_label(verdict_colour(c.accepted), &c.reason);
     let deg = f64::to_degrees;
+    let distance = if c.camera.distance_cm.is_finite() {
+        format!(
+            "{}{:.0} cm",
+            if c.distance_is_max { "≤ " } else { "" },
+            c.camera.distance_cm
+        )
+    } else {
+        "distance unknown".to_owned()
+    };
     ui.label(format!(
-        "camera: {}{:.0} cm, bearing {:+.1}°, elevation {:+.1}°",
-        if c.distance_is_max { "≤ " } else { "" },
-        c.camera.distance_cm,
+        "camera: {distance}, bearing {:+.1}°, elevation {:+.1}°",
         deg(c.camera.bearing_rad),
         deg(c.camera.elevation_rad)
     ));
@@ -294,6 +434,9 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
     }
     for n in &c.notes {
         ui.weak(n);
+    }
+    if let Some(p) = &c.pattern {
+        pattern_regions_ui(ui, &c.owner, p);
     }
     ui.separator();
     egui::Grid::new(("breakdown", &c.owner))
@@ -323,5 +466,45 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
             ui.monospace(format!("{:+.2}", c.confidence.total));
             ui.label("");
             ui.end_row();
+        });
+}
+
+/// The nine regions in their 3 × 3 layout: colours, and whether each agrees with the closest
+/// place.
+fn pattern_regions_ui(ui: &mut Ui, owner: &str, p: &PatternInfo) {
+    ui.separator();
+    ui.label(match (p.closest, p.with_places) {
+        (Some((id, a)), _) => {
+            format!("regions (most common / second colour), against place {id}: {a}/9 agree")
+        }
+        (None, true) => "regions (most common / second colour); no place to compare".to_owned(),
+        (None, false) => "regions (most common / second colour)".to_owned(),
+    });
+    egui::Grid::new(("pattern_regions", owner))
+        .striped(false)
+        .num_columns(3)
+        .show(ui, |ui| {
+            for k in 0..9 {
+                let code = p.regions[k][0];
+                let [r, g, b] = crate::overlay::pattern_region_rgb(code);
+                let mut text = RichText::new(p.region_text(k)).color(Color32::from_rgb(r, g, b));
+                if k == 4 {
+                    text = text.strong();
+                }
+                let verdict = match p.agrees.map(|a| a[k]) {
+                    Some(true) => " agrees",
+                    Some(false) => " differs",
+                    None => "",
+                };
+                ui.horizontal(|ui| {
+                    ui.label(text);
+                    if !verdict.is_empty() {
+                        ui.colored_label(verdict_colour(verdict == " agrees"), verdict.trim());
+                    }
+                });
+                if k % 3 == 2 {
+                    ui.end_row();
+                }
+            }
         });
 }

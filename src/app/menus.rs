@@ -39,7 +39,7 @@ pub fn open_path_window(ctx: &egui::Context, input: &mut MenuInput, commands: &m
         .show(ctx, |ui| {
             let edit = ui.add(
                 egui::TextEdit::singleline(&mut input.path)
-                    .hint_text("/path/to/stream.mcap, table.lut or frames")
+                    .hint_text("/path/to/stream.mcap, table.lut, places.json or frames")
                     .desired_width(420.0),
             );
             edit.request_focus();
@@ -281,6 +281,30 @@ fn classification_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Comm
     }
     ui.separator();
     if ui
+        .button("Open places…")
+        .on_hover_text(
+            "a places file from `eotn patterns learn`: pink markers are identified as its places",
+        )
+        .clicked()
+    {
+        if let Some(p) = pick_open("Open a places file", &[("Places", &["json"])]) {
+            commands.extend(p.into_iter().map(Command::OpenPlaces));
+        }
+        ui.close();
+    }
+    let places = state.places_path().map_or_else(
+        || "Close places".to_owned(),
+        |p| format!("Close places {}", crate::frame::display_name(p)),
+    );
+    if ui
+        .add_enabled(state.places_path().is_some(), egui::Button::new(places))
+        .clicked()
+    {
+        commands.push(Command::ClosePlaces);
+        ui.close();
+    }
+    ui.separator();
+    if ui
         .add_enabled(
             state.table_path().is_some(),
             egui::Button::new("Rebuild table from journal"),
@@ -356,6 +380,7 @@ fn overlays_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) 
     ui.checkbox(&mut o.posts, "Goal posts");
     ui.checkbox(&mut o.gaps, "Gaps");
     ui.checkbox(&mut o.horizon, "Horizon");
+    ui.checkbox(&mut o.patterns, "Coloured patterns (pink markers)");
     ui.checkbox(&mut o.object_labels, "Object labels (distance, bearing)");
     ui.horizontal(|ui| {
         for (name, on) in [("All recognition", true), ("None", false)] {

@@ -1,7 +1,7 @@
 //! Drawing in image-pixel coordinates: one [`ImagePainter`] owns zoom and pan, so no overlay
 //! does screen maths. Blob boxes, recognition's primitives (candidate boxes, scan areas and
-//! points, circles, posts, gaps, the horizon, object labels), the sampled pixel and the preview
-//! highlight.
+//! points, circles, posts, gaps, the horizon, coloured-pattern regions, object labels), the
+//! sampled pixel and the preview highlight.
 
 use egui::{
     Align2, Color32, FontId, Painter, Pos2, Rect, Stroke, StrokeKind, TextureId, pos2, vec2,
@@ -250,6 +250,10 @@ fn primitive_colour(p: &Primitive) -> Color32 {
             LineRole::Gap => Color32::WHITE,
             LineRole::Scan => Color32::from_rgb(128, 128, 255),
         },
+        Primitive::PatternRegion { colour, .. } => {
+            let [r, g, b] = crate::overlay::pattern_region_rgb(*colour);
+            Color32::from_rgb(r, g, b)
+        }
         Primitive::Label { .. } => Color32::WHITE,
     }
 }
@@ -333,6 +337,19 @@ pub fn paint_primitives(
             }
             Primitive::Line { from, to, .. } => {
                 painter.line_segment([at(*from), at(*to)], stroke);
+            }
+            Primitive::PatternRegion { bounds, centre, .. } => {
+                let [x0, y0, x1, y1] = bounds.map(|v| v as f32);
+                let rect = Rect::from_min_max(
+                    xf.to_screen(pos2(x0, y0)),
+                    xf.to_screen(pos2(x1 + 1.0, y1 + 1.0)),
+                );
+                let stroke = if *centre {
+                    Stroke::new(width + 1.0, colour)
+                } else {
+                    stroke
+                };
+                painter.rect_stroke(rect.shrink(1.0), 0.0, stroke, StrokeKind::Inside);
             }
             Primitive::Label { at: pos, text, .. } => {
                 let galley =

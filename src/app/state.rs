@@ -97,6 +97,8 @@ pub struct Overlays {
     pub gaps: bool,
     /// Recognition: labels of accepted objects with distance (cm) and bearing (degrees).
     pub object_labels: bool,
+    /// Recognition: the nine regions around each pink marker and its place.
+    pub patterns: bool,
 }
 
 impl Overlays {
@@ -110,6 +112,7 @@ impl Overlays {
         self.posts = on;
         self.gaps = on;
         self.object_labels = on;
+        self.patterns = on;
     }
 }
 
@@ -129,6 +132,7 @@ impl Default for Overlays {
             posts: true,
             gaps: true,
             object_labels: true,
+            patterns: true,
         }
     }
 }
@@ -165,6 +169,8 @@ pub struct Settings {
     pub recent: Vec<PathBuf>,
     /// The table to reopen at start.
     pub last_table: Option<PathBuf>,
+    /// The places file (learnt coloured patterns) to reopen at start.
+    pub last_places: Option<PathBuf>,
     /// The stream or frame files to reopen at start.
     pub last_source: Vec<PathBuf>,
     /// The frame that was shown.
@@ -206,6 +212,7 @@ impl Default for Settings {
         Self {
             recent: Vec::new(),
             last_table: None,
+            last_places: None,
             last_source: Vec::new(),
             last_index: 0,
             class: ColourClass::Orange,
@@ -234,6 +241,10 @@ pub enum Command {
     Open(Vec<PathBuf>),
     /// Open a lookup table.
     OpenTable(PathBuf),
+    /// Open a places file (`eotn patterns learn`): pink markers are identified as its places.
+    OpenPlaces(PathBuf),
+    /// Forget the places file: pink markers keep their signatures, unidentified.
+    ClosePlaces,
     /// A new empty table with the given bits per channel.
     NewTable(u8),
     /// Save the table where it came from.
@@ -507,6 +518,7 @@ pub struct AppState {
     /// The sensor series of the open stream.
     pub sensor_series: SensorSeries,
     try_edit: Option<TryEdit>,
+    places_path: Option<PathBuf>,
     table_counts: crate::lut::ClassCounts,
     frame_counts: [usize; 256],
     primitives: Vec<Primitive>,
@@ -557,6 +569,7 @@ impl AppState {
             timings: Timings::default(),
             sensor_series: SensorSeries::default(),
             try_edit: None,
+            places_path: None,
             table_counts,
             frame_counts: [0; 256],
             primitives: Vec::new(),
@@ -570,6 +583,9 @@ impl AppState {
     pub fn reopen_last(&mut self) {
         if let Some(t) = self.settings.last_table.clone() {
             self.run(Command::OpenTable(t));
+        }
+        if let Some(p) = self.settings.last_places.clone() {
+            self.run(Command::OpenPlaces(p));
         }
         let src = self.settings.last_source.clone();
         let index = self.settings.last_index;
@@ -599,6 +615,14 @@ impl AppState {
         match command {
             Command::Open(paths) => self.open(paths)?,
             Command::OpenTable(p) => self.open_table(&p)?,
+            Command::OpenPlaces(p) => self.open_places(&p)?,
+            Command::ClosePlaces => {
+                self.pipeline.set_pattern_memory(None);
+                self.places_path = None;
+                self.settings.last_places = None;
+                self.reprocess();
+                self.status = "places file closed: pink markers are not identified".to_owned();
+            }
             Command::NewTable(bits) => {
                 let lut = LookupTable::new(bits).map_err(|e| anyhow::anyhow!("new table: {e}"))?;
                 self.set_table(lut, None);
@@ -905,6 +929,18 @@ impl AppState {
     #[must_use]
     pub fn table_path(&self) -> Option<&Path> {
         self.table_path.as_deref()
+    }
+
+    /// The open places file, if any.
+    #[must_use]
+    pub fn places_path(&self) -> Option<&Path> {
+        self.places_path.as_deref()
+    }
+
+    /// The learnt places pink markers are identified against, if a places file is open.
+    #[must_use]
+    pub fn places(&self) -> Option<&crate::recognition::patterns::PatternMemory> {
+        self.pipeline.pattern_memory()
     }
 
     /// True when the table has edits not yet saved.
@@ -1257,6 +1293,8 @@ impl AppState {
                 .unwrap_or_default();
             if ext == "mcap" {
                 stream = Some(p);
+            } else if ext == "json" {
+                self.open_places(&p)?;
             } else if crate::cli::inputs::is_frame_file(&p) || p.is_dir() {
                 frames.push(p);
             } else {
@@ -1329,6 +1367,29 @@ impl AppState {
                 Err(e) => self.warn(format!("{e:#}")),
             }
         }
+        Ok(())
+    }
+
+    fn open_places(&mut self, path: &Path) -> anyhow::Result<()> {
+        let memory = crate::recognition::patterns::PatternMemory::load(path)?;
+        let (objects, relation) = (memory.objects.len(), memory.relation);
+        self.pipeline.set_pattern_memory(Some(memory));
+        self.places_path = Some(path.to_owned());
+        self.remember_recent(path);
+        self.settings.last_places =
+            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        self.reprocess();
+        self.status = format!(
+            "opened places {}: {objects} objects{}",
+            path.display(),
+            relation.map_or_else(
+                || ", no size relation (no distances)".to_owned(),
+                |r| format!(
+                    ", distance = {:.0} / size + {:.1} cm",
+                    r.multiplier_cm_px, r.offset_cm
+                )
+            )
+        );
         Ok(())
     }
 
@@ -1600,7 +1661,10 @@ impl<'a> PrimitiveFilter<'a> {
                 LineRole::Post => o.posts,
                 LineRole::Gap | LineRole::Scan => o.gaps,
             },
-            Primitive::Label { .. } => o.object_labels,
+            Primitive::PatternRegion { .. } => o.patterns,
+            Primitive::Label { owner, .. } => {
+                o.object_labels && (o.patterns || !owner::is_pattern(owner))
+            }
         };
         let horizon = matches!(
             p,
@@ -1627,9 +1691,11 @@ fn accepted_owners(r: &Recognition) -> Vec<String> {
         .filter(|(_, c)| c.accepted);
     let goals = goals.map(|(i, c)| owner::goal(c.colour, i));
     let beacons = r.beacons.iter().enumerate().filter(|(_, b)| b.accepted);
+    let patterns = r.patterns.iter().enumerate().filter(|(_, p)| p.accepted);
     balls
         .chain(goals)
         .chain(beacons.map(|(i, _)| owner::beacon(i)))
+        .chain(patterns.map(|(i, _)| owner::pattern(i)))
         .collect()
 }
 

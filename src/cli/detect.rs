@@ -10,6 +10,7 @@ use serde::Serialize;
 use super::inputs::{InputArgs, parse_connectivity, progress};
 use crate::blobs::Connectivity;
 use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::patterns::PatternMemory;
 use crate::recognition::{GoalCandidate, Recognition, Relative};
 use crate::sensors::SensorReadings;
 
@@ -35,6 +36,10 @@ pub struct Args {
     /// With `--json`: add every candidate with its confidence breakdown.
     #[arg(long)]
     pub evidence: bool,
+    /// A places file (`eotn patterns learn`): identify the pink markers' coloured patterns;
+    /// `--json` then lists them as `patterns`.
+    #[arg(long)]
+    pub patterns: Option<PathBuf>,
 }
 
 /// Camera- and body-relative position of an object, flattened for JSON.
@@ -161,6 +166,73 @@ pub struct BeaconJson {
     pub confidence: f64,
 }
 
+/// The place a pink marker was identified as, in `--json` output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct PlaceJson {
+    /// The place's id in the places file.
+    pub id: usize,
+    /// Regions agreeing on the most common colour, of nine.
+    pub agreement: usize,
+    /// Camera distance from the learnt size relation, centimetres (null without one).
+    pub distance_cm: Option<f64>,
+}
+
+/// A pink marker's coloured pattern in `--json` output.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct PatternJson {
+    /// The pink blob's box, inclusive pixels `[minx, miny, maxx, maxy]`.
+    pub bounds: [u32; 4],
+    /// The two most common class codes of each of the nine regions, row by row (0: nothing).
+    pub signature: [[u8; 2]; 9],
+    /// The pink blob's size (mean column height), pixels.
+    pub size_px: f64,
+    /// Camera bearing of its centre, radians, positive left.
+    pub bearing_rad: f64,
+    /// Camera elevation of its centre, radians, positive up.
+    pub elevation_rad: f64,
+    /// The identified place, or null.
+    #[serde(rename = "match")]
+    pub matched: Option<PlaceJson>,
+    /// Body-relative distance (cm), bearing and elevation (rad) of an identified marker with a
+    /// distance, when the joints were known.
+    pub body_distance_cm: Option<f64>,
+    /// Body-relative bearing, radians.
+    pub body_bearing_rad: Option<f64>,
+    /// Body-relative elevation, radians.
+    pub body_elevation_rad: Option<f64>,
+    /// The best-agreeing place and its agreement even when it did not match: `[id, regions]`.
+    pub closest: Option<[usize; 2]>,
+    /// Two places agree equally well.
+    pub ambiguous: bool,
+    /// Some regions reach outside the image.
+    pub cut_off: bool,
+    /// Total confidence.
+    pub confidence: f64,
+}
+
+fn pattern_json(c: &crate::recognition::patterns::PatternCandidate) -> PatternJson {
+    let o = &c.observation;
+    PatternJson {
+        bounds: o.bounds,
+        signature: o.signature.0,
+        size_px: o.size_px,
+        bearing_rad: o.bearing_rad,
+        elevation_rad: o.elevation_rad,
+        matched: c.identification.map(|m| PlaceJson {
+            id: m.id,
+            agreement: m.agreement,
+            distance_cm: m.distance_cm,
+        }),
+        body_distance_cm: c.body.map(|b| b.distance_cm),
+        body_bearing_rad: c.body.map(|b| b.bearing_rad),
+        body_elevation_rad: c.body.map(|b| b.elevation_rad),
+        closest: c.closest.map(|b| [b.id, b.agreement]),
+        ambiguous: c.ambiguous,
+        cut_off: c.cut_off,
+        confidence: c.confidence.total,
+    }
+}
+
 /// One frame's line of `eotn detect --json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct DetectJson {
@@ -172,6 +244,9 @@ pub struct DetectJson {
     pub goals: Vec<GoalJson>,
     /// Accepted beacons.
     pub beacons: Vec<BeaconJson>,
+    /// With `--patterns`: every pink marker, identified or not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub patterns: Option<Vec<PatternJson>>,
     /// Recognition time, microseconds.
     pub recognition_us: f64,
     /// With `--evidence`: every candidate and its confidence breakdown.
@@ -260,6 +335,7 @@ pub fn detect_json(
                 confidence: b.confidence.total,
             })
             .collect(),
+        patterns: None,
         recognition_us,
         evidence: evidence.then(|| r.clone()),
     }
@@ -328,6 +404,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         recognition: load_params(args.params.as_deref())?,
     };
     let mut pipeline = Pipeline::new(lut, params);
+    if let Some(p) = &args.patterns {
+        pipeline.set_pattern_memory(Some(PatternMemory::load(p)?));
+    }
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "detect");
@@ -336,7 +415,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let readings = readings_for(recorded.as_ref(), sensors.as_deref(), i);
         let result = pipeline.process(&frame, readings);
         let us = result.timings.recognition.as_secs_f64() * 1e6;
-        let line = detect_json(inputs.name(i), result.recognition, us, args.evidence);
+        let mut line = detect_json(inputs.name(i), result.recognition, us, args.evidence);
+        if args.patterns.is_some() {
+            line.patterns = Some(
+                result
+                    .recognition
+                    .patterns
+                    .iter()
+                    .map(pattern_json)
+                    .collect(),
+            );
+        }
         if args.json {
             serde_json::to_writer(&mut out, &line)?;
             writeln!(out)?;
@@ -379,6 +468,20 @@ fn write_summary(out: &mut impl Write, d: &DetectJson) -> std::io::Result<()> {
     }
     for b in &d.beacons {
         write!(out, "; beacon {} {:.0} cm", b.kind, b.placement.distance_cm)?;
+    }
+    for p in d.patterns.iter().flatten() {
+        match &p.matched {
+            Some(m) => write!(
+                out,
+                "; place {} ({}/9){}",
+                m.id,
+                m.agreement,
+                m.distance_cm
+                    .map(|d| format!(" {d:.0} cm"))
+                    .unwrap_or_default()
+            )?,
+            None => write!(out, "; pink marker, no place")?,
+        }
     }
     writeln!(out)
 }

@@ -60,6 +60,10 @@ pub struct Args {
     /// goals found and false, goal distances from size beside those of their foot. One stream.
     #[arg(long)]
     pub labels: Option<PathBuf>,
+    /// A places file (`eotn patterns learn`): also score the pink markers' identification
+    /// against the truth's markers (correct, wrong, missed; distance errors).
+    #[arg(long)]
+    pub patterns: Option<PathBuf>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -93,6 +97,8 @@ pub struct EvalOutput {
     pub plots: Vec<PathBuf>,
     /// Frames skipped, with the reason.
     pub skipped: Vec<String>,
+    /// Coloured patterns against the truth's markers, with `--patterns`.
+    pub patterns: Option<crate::eval::patterns::PatternEvalReport>,
 }
 
 fn differ(a: &Recognition, b: &Recognition) -> Option<String> {
@@ -130,6 +136,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         ..PipelineParams::default()
     };
     let mut main = Pipeline::new(lut.clone(), params);
+    let places = args
+        .patterns
+        .as_deref()
+        .map(crate::recognition::patterns::PatternMemory::load)
+        .transpose()?;
+    main.set_pattern_memory(places.clone());
+    let pattern_params = crate::eval::patterns::PatternEvalParams::default();
+    let mut pattern_frames = Vec::new();
+    let mut place_markers: Vec<(usize, Option<usize>)> = Vec::new();
     let mut no_skew = Pipeline::new(
         lut.clone(),
         PipelineParams {
@@ -201,6 +216,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let sensors = record.sensors.as_ref();
             let ra = main.process(&record.frame, sensors).recognition.clone();
             let fa = evaluate_frame(global, &ra, &truth, w, h, &ep);
+            if let Some(m) = &places {
+                // Learnt places are matched to the markers of the first frame that lists any.
+                if !truth.markers.is_empty() && place_markers.iter().all(|(_, k)| k.is_none()) {
+                    place_markers =
+                        crate::eval::patterns::place_markers(m, &truth.markers, &pattern_params);
+                }
+                pattern_frames.push(crate::eval::patterns::evaluate_patterns(
+                    global,
+                    &ra,
+                    &truth,
+                    &place_markers,
+                    &pattern_params,
+                ));
+            }
             for g in ra.goals.goals() {
                 if let Some(tg) = truth
                     .goals
@@ -308,6 +337,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         goal_calibration,
         plots,
         skipped,
+        patterns: places.is_some().then(|| {
+            crate::eval::patterns::PatternEvalReport::from_frames(&pattern_frames, place_markers)
+        }),
     };
     if args.json {
         println!("{}", serde_json::to_string(&output)?);
@@ -426,6 +458,39 @@ fn print_summary(o: &EvalOutput) {
     }
     if !o.plots.is_empty() {
         println!("plots                  {} written", o.plots.len());
+    }
+    if let Some(p) = &o.patterns {
+        println!(
+            "pink markers           {}/{} identified correctly = {}, wrongly {}, not at all {}; \
+             false identifications {}",
+            p.correct,
+            p.eligible,
+            pct(p.correct_rate),
+            p.wrong,
+            p.missed,
+            p.false_identifications
+        );
+        println!(
+            "marker distance error  median {:.1}% p90 {:.1}% p95 {:.1}% (n={}); signed median {}",
+            p.distance_error.p50 * 100.0,
+            p.distance_error.p90 * 100.0,
+            p.distance_error.p95 * 100.0,
+            p.distance_error.n,
+            p.distance_bias_cm
+                .map_or_else(|| "-".to_owned(), |b| format!("{b:+.1} cm"))
+        );
+        let lost: Vec<usize> = p
+            .places
+            .iter()
+            .filter(|(_, m)| m.is_none())
+            .map(|(id, _)| *id)
+            .collect();
+        if !lost.is_empty() {
+            println!("places near no marker  {lost:?}");
+        }
+        if !p.wrong_frames.is_empty() {
+            println!("wrong place in frames  {:?}", p.wrong_frames);
+        }
     }
     if !o.skipped.is_empty() {
         println!(

@@ -17,6 +17,7 @@ pub mod inputs;
 mod lut;
 mod lut_from_labels;
 pub mod open;
+pub mod patterns;
 mod render;
 mod sim;
 
@@ -50,6 +51,9 @@ pub enum Command {
     Detect(detect::Args),
     /// Draw frames with recognition overlays (circles, posts, gaps, horizon, scans) as PNG.
     Render(render::Args),
+    /// Coloured patterns: learn places from pink markers and robot poses (`learn`), print a
+    /// places file (`show`).
+    Patterns(patterns::Args),
     /// Compare recognition with the ground truth of synthetic streams (or a real stream's hand
     /// labels, `--labels`): rates, errors, misses; two tables or parameter sets side by side;
     /// goal-distance calibration.
@@ -85,6 +89,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Lut(a) => lut::run(&a),
         Command::Detect(a) => detect::run(&a),
         Command::Render(a) => render::run(&a),
+        Command::Patterns(a) => patterns::run(&a),
         Command::Eval(a) => eval::run(&a),
         Command::Open(a) => open::run(&a),
     }

@@ -40,6 +40,8 @@ pub enum Overlay {
     Gaps,
     /// The horizon.
     Horizon,
+    /// The nine regions around each pink marker and its identification (with `--patterns`).
+    Patterns,
     /// Everything above.
     All,
 }
@@ -71,6 +73,10 @@ pub struct Args {
     /// Smallest blob drawn by the `blobs` overlay, pixels.
     #[arg(long, default_value_t = 4)]
     pub min_blob_pixels: u32,
+    /// A places file (`eotn patterns learn`): pink markers are identified and labelled with
+    /// their place and distance by the `patterns` overlay.
+    #[arg(long)]
+    pub patterns: Option<PathBuf>,
 }
 
 fn wanted(overlays: &[Overlay], p: &Primitive) -> bool {
@@ -85,7 +91,10 @@ fn wanted(overlays: &[Overlay], p: &Primitive) -> bool {
             LineRole::Post => on(Overlay::Posts),
             LineRole::Gap | LineRole::Scan => on(Overlay::Gaps),
         },
-        Primitive::Label { .. } => false,
+        Primitive::PatternRegion { .. } => on(Overlay::Patterns),
+        Primitive::Label { owner, .. } => {
+            crate::recognition::draw::owner::is_pattern(owner) && on(Overlay::Patterns)
+        }
     }
 }
 
@@ -104,6 +113,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
     let mut pipeline = Pipeline::new(lut, params);
+    if let Some(p) = &args.patterns {
+        pipeline.set_pattern_memory(Some(crate::recognition::patterns::PatternMemory::load(p)?));
+    }
     for i in 0..inputs.len() {
         let (frame, recorded) = inputs.load_with_sensors(i, args.input.size)?;
         let readings = readings_for(recorded.as_ref(), sensors.as_deref(), i);
@@ -137,6 +149,22 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 .filter(|p| wanted(&args.overlays, p)),
         );
         canvas.draw(&prims);
+        // The canvas has no fonts: the patterns' labels are written in the plots' pixel font.
+        for p in &prims {
+            if let Primitive::Label { at, text, .. } = p {
+                let scale = i64::from(args.scale);
+                let (x, y) = ((at.0 * scale as f64) as i64, (at.1 * scale as f64) as i64);
+                let font = (scale / 2).max(1);
+                crate::eval::plots::label_on(
+                    &mut canvas,
+                    text,
+                    x,
+                    y - 8 * font,
+                    font,
+                    [255, 255, 255],
+                );
+            }
+        }
         let name = inputs.name(i);
         let stem = name.rsplit_once('.').map_or(name.as_str(), |(s, _)| s);
         let out = args.output.join(format!("{stem}.png"));

@@ -13,7 +13,7 @@ use crate::streams::{FrameRecord, StreamInfo, StreamWriter};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Scenario: walk-and-pan, ball-edge, goalkeeper, fast-pans, orange-clutter, beacon-tour,
-    /// overhead-game, close-pans, rolling-ball (`--list` describes them).
+    /// overhead-game, close-pans, rolling-ball, pattern-tour (`--list` describes them).
     #[arg(long, required_unless_present = "list")]
     pub scenario: Option<String>,
     /// Number of frames (30 a second).

@@ -594,6 +594,43 @@ pub fn write_calibration_plot(
     c.save(path)
 }
 
+/// Writes `text` on any canvas in the charts' built-in 5×7 font, `scale` canvas pixels per
+/// font pixel, its top-left corner at (`x`, `y`) canvas pixels, on a dark box so that it reads
+/// over a camera image (`eotn render` labels). Clipped to the canvas.
+pub fn label_on(canvas: &mut Canvas, text: &str, x: i64, y: i64, scale: i64, colour: [u8; 3]) {
+    let scale = scale.max(1);
+    let (w, h) = (canvas.width as i64, canvas.height as i64);
+    let n = text.chars().count() as i64;
+    // Kept inside the canvas, as the app keeps its labels inside the view.
+    let x = x.min(w - n * 6 * scale - 1).max(0);
+    let y = y.min(h - 9 * scale).max(0);
+    let mut put = |px: i64, py: i64, c: [u8; 3]| {
+        if (0..w).contains(&px) && (0..h).contains(&py) {
+            let i = (py as usize * canvas.width + px as usize) * 3;
+            canvas.rgb[i..i + 3].copy_from_slice(&c);
+        }
+    };
+    for py in y - scale..y + 8 * scale {
+        for px in x - scale..x + n * 6 * scale {
+            put(px, py, [0, 0, 0]);
+        }
+    }
+    for (k, ch) in text.chars().enumerate() {
+        let gx = x + k as i64 * 6 * scale;
+        for (row, bits) in glyph(ch).iter().enumerate() {
+            for col in 0..5 {
+                if bits & (0x10 >> col) != 0 {
+                    for dy in 0..scale {
+                        for dx in 0..scale {
+                            put(gx + col * scale + dx, y + row as i64 * scale + dy, colour);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -30,6 +30,18 @@ pub mod owner {
     pub fn beacon(i: usize) -> String {
         format!("beacon#{i}")
     }
+
+    /// A pink marker's coloured pattern: `pattern#i`.
+    #[must_use]
+    pub fn pattern(i: usize) -> String {
+        format!("pattern#{i}")
+    }
+
+    /// Whether an owner name is a coloured pattern's.
+    #[must_use]
+    pub fn is_pattern(owner: &str) -> bool {
+        owner.starts_with("pattern#")
+    }
 }
 
 /// One thing to draw over the image.
@@ -83,6 +95,17 @@ pub enum Primitive {
         /// End, pixels.
         to: Point,
     },
+    /// One of the nine regions of a coloured pattern around a pink marker.
+    PatternRegion {
+        /// Which pattern this belongs to (`pattern#i`).
+        owner: String,
+        /// Inclusive pixel box `[minx, miny, maxx, maxy]`; may reach outside the image.
+        bounds: [i64; 4],
+        /// The region's most common class code (0: nothing), whose display colour to use.
+        colour: u8,
+        /// The pink blob's own region (drawn thicker).
+        centre: bool,
+    },
     /// A text label at a point (object name, distance, bearing).
     Label {
         /// Which object this belongs to.
@@ -132,6 +155,7 @@ impl Primitive {
             | Self::ScanPoints { owner, .. }
             | Self::Circle { owner, .. }
             | Self::Line { owner, .. }
+            | Self::PatternRegion { owner, .. }
             | Self::Label { owner, .. } => owner,
         }
     }

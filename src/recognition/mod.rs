@@ -128,9 +128,9 @@ pub struct Recognition {
     pub goals: GoalResult,
     /// Beacon candidates; accepted ones are beacons.
     pub beacons: Vec<Beacon>,
-    /// Signatures around pink markers, with their identification when a pattern memory was
+    /// Pink markers with the signature around each, identified when a pattern memory was
     /// given.
-    pub patterns: Vec<(patterns::PatternObservation, Option<patterns::PatternMatch>)>,
+    pub patterns: Vec<patterns::PatternCandidate>,
     /// The horizon, when the camera pose was known.
     pub horizon: Option<Horizon>,
 }
@@ -145,30 +145,28 @@ pub fn recognise(
     params: &RecognitionParams,
     memory: Option<&patterns::PatternMemory>,
 ) -> Recognition {
-    let observations = patterns::observe(img, blobs, ctx.camera.focal_px, &params.patterns);
     let beacons = beacons::recognise_beacons(blobs, ctx, &params.beacons);
     let beacon_boxes: Vec<[u32; 4]> = beacons
         .iter()
         .filter(|b| b.accepted)
         .map(|b| b.bounds)
         .collect();
+    // A beacon's pink band is the beacon's, not a coloured-pattern marker.
+    let observations = patterns::observe(img, blobs, ctx, &params.patterns, &beacon_boxes);
     Recognition {
         ball: ball::recognise_ball(img, blobs, ctx, &params.ball),
         goals: goals::recognise_goals(img, blobs, ctx, &params.goals, &beacon_boxes),
         beacons,
         patterns: observations
             .into_iter()
-            .map(|o| {
-                let m = memory.and_then(|m| m.identify(&o, &params.patterns));
-                (o, m)
-            })
+            .map(|o| patterns::PatternMemory::candidate(memory, o, ctx, &params.patterns))
             .collect(),
         horizon: ctx.horizon,
     }
 }
 
 impl Recognition {
-    /// Every drawing primitive: horizon, ball, goals, beacons.
+    /// Every drawing primitive: horizon, ball, goals, beacons, coloured patterns.
     #[must_use]
     pub fn primitives(&self, width: usize, height: usize) -> Vec<Primitive> {
         let mut out = Vec::new();
@@ -186,6 +184,7 @@ impl Recognition {
         out.extend(self.ball.primitives());
         out.extend(self.goals.primitives());
         out.extend(beacons::beacon_primitives(&self.beacons));
+        out.extend(patterns::pattern_primitives(&self.patterns));
         out
     }
 }

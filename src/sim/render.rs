@@ -37,6 +37,10 @@ pub mod object_id {
     pub const ROBOT: u16 = 100;
     /// Clutter item `i` of the scene is `CLUTTER + i`.
     pub const CLUTTER: u16 = 1000;
+    /// The eight outer tiles and the post of coloured-pattern marker `i` are `MARKER + i`.
+    pub const MARKER: u16 = 62_000;
+    /// The pink middle tile of marker `i` is `MARKER_PINK + i`.
+    pub const MARKER_PINK: u16 = 63_000;
 }
 
 /// A rendered image with its per-pixel ground truth.
@@ -203,6 +207,12 @@ impl World {
                     paint: Paint::Solid(c.material),
                 }],
             ));
+        }
+        for (i, m) in scene.markers.iter().enumerate() {
+            let i = u16::try_from(i).unwrap_or(0).min(999);
+            let (frame, pink) = marker_parts(m);
+            objects.push(object(object_id::MARKER + i, frame));
+            objects.push(object(object_id::MARKER_PINK + i, vec![pink]));
         }
         let l = Vector3::from(scene.lighting.towards_lamp);
         let towards_lamp = if l.norm() > 1e-9 && l.iter().all(|a| a.is_finite()) {
@@ -440,6 +450,44 @@ fn oriented_box(centre: Vector3<f64>, yaw_rad: f64, half: Vector3<f64>) -> Prim 
             .transpose(),
         half,
     }
+}
+
+/// Thickness of a marker's panel, centimetres.
+const MARKER_PANEL_CM: f64 = 1.0;
+
+/// A marker's eight outer tiles and its post (one object), and its pink middle tile (its own
+/// object, so the truth can count its pixels).
+fn marker_parts(m: &super::scene::Marker) -> (Vec<Part>, Part) {
+    let (s, c) = m.facing_rad.sin_cos();
+    // Tile boxes sit behind the face plane, so the painted face is where the marker says.
+    let back = -MARKER_PANEL_CM / 2.0;
+    let tile = |k: usize| {
+        let (col, row) = ((k % 3) as f64 - 1.0, 1.0 - (k / 3) as f64);
+        let [x, y, z] = m.face_point(col, row);
+        Part {
+            prim: oriented_box(
+                Vector3::new(x + back * c, y + back * s, z),
+                m.facing_rad,
+                Vector3::new(MARKER_PANEL_CM / 2.0, m.tile_cm / 2.0, m.tile_cm / 2.0),
+            ),
+            paint: Paint::Solid(m.tiles[k]),
+        }
+    };
+    let mut frame: Vec<Part> = (0..9).filter(|&k| k != 4).map(tile).collect();
+    let bottom = (m.centre_height_cm - 1.5 * m.tile_cm).max(0.0);
+    if bottom > 0.0 {
+        let behind = -(MARKER_PANEL_CM + 1.5);
+        frame.push(Part {
+            prim: Prim::Cylinder {
+                base: Vector3::new(m.x_cm + behind * c, m.y_cm + behind * s, 0.0),
+                radius: 1.5,
+                height: bottom + 0.5 * m.tile_cm,
+            },
+            // Dark grey like clothing: wood's brown classifies orange here and there.
+            paint: Paint::Solid(Material::Cloth),
+        });
+    }
+    (frame, tile(4))
 }
 
 /// Centres and half sizes of a goal's back and side walls (cm).

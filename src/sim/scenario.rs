@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::rng::SimRng;
-use super::scene::{Ball, Clutter, Material, Robot, Scene, Shape, Team};
+use super::scene::{Ball, Clutter, Marker, Material, Robot, Scene, Shape, Team};
 use crate::geometry::{
     BodyPose, Camera, Ers7Dimensions, Field, HeadJoints, PinholeCamera, Point, RobotPose, Transform,
 };
@@ -57,11 +57,14 @@ pub enum ScenarioKind {
     /// A standing robot with a still head watches the ball roll across its view at 1–3 m/s:
     /// the ball itself moves while the rows are read out.
     RollingBall,
+    /// A robot walks round the centre with its head panning past six coloured-pattern markers
+    /// beside the field (two pairs that differ in only two tiles): the "almost SLAM" places.
+    PatternTour,
 }
 
 impl ScenarioKind {
     /// Every scenario in documentation order.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::WalkAndPan,
         Self::BallEdge,
         Self::Goalkeeper,
@@ -71,6 +74,7 @@ impl ScenarioKind {
         Self::OverheadGame,
         Self::ClosePans,
         Self::RollingBall,
+        Self::PatternTour,
     ];
 
     /// The command-line name (`walk-and-pan`, …).
@@ -86,6 +90,7 @@ impl ScenarioKind {
             Self::OverheadGame => "overhead-game",
             Self::ClosePans => "close-pans",
             Self::RollingBall => "rolling-ball",
+            Self::PatternTour => "pattern-tour",
         }
     }
 
@@ -110,6 +115,7 @@ impl ScenarioKind {
                 "fast head pans past a close ball (30-80 px): strong skew, cut sides"
             }
             Self::RollingBall => "the ball rolls across a still camera at 1-3 m/s",
+            Self::PatternTour => "a robot walks round the centre, panning past six pattern markers",
         }
     }
 }
@@ -329,6 +335,28 @@ impl Scenario {
                     .robots
                     .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
             }
+            ScenarioKind::PatternTour => {
+                scene.markers = pattern_markers();
+                // An ellipse round the centre, facing outwards, one lap in 16 s; the seed moves
+                // the start, the size of the ellipse and the pan's phase.
+                let angle = TAU * t_s / 16.0 + PI * j[0];
+                let (rx, ry) = (110.0 + 15.0 * j[1], 70.0 + 10.0 * j[2]);
+                let (x, y) = (rx * angle.cos(), ry * angle.sin());
+                let pose = RobotPose::new(x, y, y.atan2(x));
+                let body = walking_body(t_s, true);
+                let joints = HeadJoints {
+                    tilt1_rad: -0.05,
+                    pan_rad: 1.3 * (TAU * t_s / 3.0 + j[3]).sin(),
+                    tilt2_rad: 0.1,
+                };
+                scene.ball = Some(Ball::at(-30.0 + 20.0 * j[1], 40.0));
+                scene
+                    .robots
+                    .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+                scene
+                    .robots
+                    .push(standing(4, Team::Blue, 160.0, -100.0, 2.5));
+            }
             ScenarioKind::OverheadGame => {
                 for k in 0..self.robot_count {
                     let team = if k % 2 == 0 { Team::Red } else { Team::Blue };
@@ -528,6 +556,62 @@ pub fn look_at(robot: &RobotPose, body: &BodyPose, target: &Point<Field>) -> Hea
     joints
 }
 
+/// The pattern tour's six markers beside the field, each facing into it: two on each side line
+/// and one beside each goal. North-west and north-east differ only in their top-left and
+/// bottom-right tiles, south-west and south-east only in the middle row's outer tiles (swapped),
+/// so those pairs agree on seven of nine regions: one short of a match. Yellow and sky blue only
+/// ever sit left or right of the pink tile: above, below or at a corner the beacon recogniser
+/// takes the pair for a beacon. No two neighbouring tiles share a colour, and there is no green
+/// (the tables were never shown carpet on an upright face) and no orange (the ball).
+#[must_use]
+pub fn pattern_markers() -> Vec<Marker> {
+    use crate::sim::scene::Material::{
+        Pink as P, RobotBlack as K, SkyBlue as B, UniformDarkBlue as D,
+    };
+    use crate::sim::scene::Material::{UniformRed as R, White as W, Yellow as Y};
+    let marker = |name: &str, x_cm: f64, y_cm: f64, facing_rad: f64, tiles| Marker {
+        name: name.to_owned(),
+        x_cm,
+        y_cm,
+        centre_height_cm: 25.0,
+        facing_rad,
+        tile_cm: 8.0,
+        tiles,
+    };
+    vec![
+        marker(
+            "north_west",
+            -90.0,
+            225.0,
+            -FRAC_PI_2,
+            [W, K, R, Y, P, B, D, R, W],
+        ),
+        marker(
+            "north_east",
+            90.0,
+            225.0,
+            -FRAC_PI_2,
+            [D, K, R, Y, P, B, D, R, K],
+        ),
+        marker(
+            "south_west",
+            -90.0,
+            -225.0,
+            FRAC_PI_2,
+            [R, W, K, B, P, Y, K, D, R],
+        ),
+        marker(
+            "south_east",
+            90.0,
+            -225.0,
+            FRAC_PI_2,
+            [R, W, K, Y, P, B, K, D, R],
+        ),
+        marker("blue_goal", -330.0, 90.0, 0.0, [K, R, D, W, P, Y, R, W, D]),
+        marker("yellow_goal", 330.0, -90.0, PI, [D, W, R, K, P, W, W, K, D]),
+    ]
+}
+
 /// Off-field things in ball and goal colours: an orange chair, an orange ball-sized sphere on
 /// the table, a yellow box, an orange bag.
 fn orange_clutter() -> Vec<Clutter> {
@@ -645,6 +729,52 @@ mod tests {
         let still = Scenario::new(ScenarioKind::FastPans, 7);
         assert!(!still.ball_moves_during_readout());
         assert_eq!(still.ball_velocity_cm_s(1.0), Some([0.0, 0.0]));
+    }
+
+    #[test]
+    fn pattern_markers_follow_their_design_rules() {
+        let markers = pattern_markers();
+        let classes: Vec<[u8; 9]> = markers
+            .iter()
+            .map(|m| m.tiles.map(|t| t.class().code()))
+            .collect();
+        let agree = |a: &[u8; 9], b: &[u8; 9]| a.iter().zip(b).filter(|(x, y)| x == y).count();
+        let pink = Material::Pink.class().code();
+        for (i, m) in markers.iter().enumerate() {
+            assert_eq!(classes[i][4], pink, "{}: pink in the middle", m.name);
+            assert_eq!(classes[i].iter().filter(|&&c| c == pink).count(), 1);
+            for k in [0, 1, 2, 6, 7, 8] {
+                assert!(
+                    !matches!(m.tiles[k], Material::Yellow | Material::SkyBlue),
+                    "{}: a goal colour above or below pink is a beacon",
+                    m.name
+                );
+                assert!(!matches!(
+                    m.tiles[k],
+                    Material::Carpet | Material::BallOrange
+                ));
+            }
+            for k in 0..9 {
+                if k % 3 < 2 {
+                    assert_ne!(m.tiles[k], m.tiles[k + 1], "{} tiles {k}", m.name);
+                }
+                if k < 6 {
+                    assert_ne!(m.tiles[k], m.tiles[k + 3], "{} tiles {k}", m.name);
+                }
+            }
+            for j in i + 1..markers.len() {
+                let a = agree(&classes[i], &classes[j]);
+                let twins = matches!((i, j), (0, 1) | (2, 3));
+                if twins {
+                    assert_eq!(a, 7, "{} / {}", m.name, markers[j].name);
+                } else {
+                    assert!(a <= 3, "{} / {}: {a}", m.name, markers[j].name);
+                }
+            }
+        }
+        let s = Scenario::new(ScenarioKind::PatternTour, 1).scene_at(2.0);
+        assert_eq!(s.markers.len(), 6);
+        assert!(Scene::four_legged_2005().markers.is_empty());
     }
 
     #[test]

@@ -240,6 +240,48 @@ impl Beacon {
     }
 }
 
+/// A coloured-pattern marker: a flat square panel of 3 × 3 tiles, the middle one pink, on a thin
+/// dark post. The eight tiles around the pink one are the place's signature, which the
+/// "almost SLAM" recogniser learns and identifies (`recognition::patterns`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Marker {
+    /// A short name for ground truth, e.g. `"north_west"`.
+    pub name: String,
+    /// Field x of the panel's centre (the pink tile's centre), centimetres.
+    pub x_cm: f64,
+    /// Field y of the panel's centre, centimetres.
+    pub y_cm: f64,
+    /// Height of the panel's centre above the ground, centimetres.
+    pub centre_height_cm: f64,
+    /// The direction the painted front faces, radians counter-clockwise from +x.
+    pub facing_rad: f64,
+    /// Side of one tile, centimetres (the panel is three tiles across).
+    pub tile_cm: f64,
+    /// The tiles row by row as seen from the front, top-left first; `tiles[4]` is the middle.
+    pub tiles: [Material; 9],
+}
+
+impl Marker {
+    /// The unit vector (field x, y) along the panel to the right of someone facing its front.
+    #[must_use]
+    pub fn right(&self) -> [f64; 2] {
+        let (s, c) = self.facing_rad.sin_cos();
+        [-s, c]
+    }
+
+    /// Field point (cm) of the panel's face at `(across, up)` tiles from its centre (across
+    /// positive to the right seen from the front, up positive upwards).
+    #[must_use]
+    pub fn face_point(&self, across: f64, up: f64) -> [f64; 3] {
+        let r = self.right();
+        [
+            self.x_cm + r[0] * across * self.tile_cm,
+            self.y_cm + r[1] * across * self.tile_cm,
+            self.centre_height_cm + up * self.tile_cm,
+        ]
+    }
+}
+
 /// The ball.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Ball {
@@ -441,6 +483,9 @@ pub struct Scene {
     pub robots: Vec<Robot>,
     /// Things that are not field objects.
     pub clutter: Vec<Clutter>,
+    /// Coloured-pattern markers (none on the standard field; the pattern tour adds them).
+    #[serde(default)]
+    pub markers: Vec<Marker>,
     /// The light.
     #[serde(default)]
     pub lighting: Lighting,
@@ -486,6 +531,7 @@ impl Scene {
                 yaw_rad: 0.0,
                 material: Material::Wood,
             }],
+            markers: Vec::new(),
             lighting: Lighting::default(),
         };
         scene.clutter.extend(person(-200.0, 330.0));

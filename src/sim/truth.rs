@@ -80,6 +80,9 @@ pub struct RobotViewTruth {
     pub beacons: Vec<BeaconTruth>,
     /// Every other robot.
     pub robots: Vec<RobotTruth>,
+    /// Every coloured-pattern marker of the scene (none outside the pattern tour).
+    #[serde(default)]
+    pub markers: Vec<MarkerTruth>,
 }
 
 /// Where something is relative to the observing robot.
@@ -214,6 +217,100 @@ pub struct BeaconTruth {
     pub visible_pixels: usize,
     /// Box of those pixels.
     pub image_box: Option<PixelBox>,
+}
+
+/// A coloured-pattern marker in a robot's view.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MarkerTruth {
+    /// Its index in the scene's markers: the place's identity.
+    pub id: usize,
+    /// Its name in the scene.
+    pub name: String,
+    /// Relative position (reference point: the centre of the pink middle tile).
+    pub relative: Relative,
+    /// Height of the pink tile's centre above the ground, centimetres.
+    pub centre_height_cm: f64,
+    /// The class code of each of the nine tiles, row by row as seen from the front (the
+    /// signature a perfect classification gives).
+    pub tiles: [u8; 9],
+    /// Pixels that show the pink middle tile.
+    pub pink_pixels: usize,
+    /// Those pixels over the area of the tile's projection (0..1): less than 1 when cut by the
+    /// image border or hidden behind something.
+    pub pink_visible_fraction: f64,
+    /// Box of the visible pink pixels.
+    pub image_box: Option<PixelBox>,
+    /// Every corner of the whole 3 × 3 panel projects inside the image.
+    pub panel_in_image: bool,
+    /// Angle between the panel's facing direction and the direction to the camera, radians
+    /// (0: seen head-on).
+    pub view_angle_rad: f64,
+}
+
+/// The truth of every marker of `scene` seen through `pose`.
+fn marker_truths(
+    scene: &Scene,
+    pose: &CameraPose,
+    robot_pose: &RobotPose,
+    objects: &[u16],
+) -> Vec<MarkerTruth> {
+    let w = pose.camera.width_px;
+    let camera = pose.position();
+    scene
+        .markers
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let id = object_id::MARKER_PINK + u16::try_from(i).unwrap_or(0).min(999);
+            let cov = coverage(objects, w, id);
+            let project = |across: f64, up: f64| {
+                let [x, y, z] = m.face_point(across, up);
+                pose.image_from_field(&Point::new(x, y, z))
+            };
+            let quad: Option<Vec<ImagePoint>> =
+                [(-0.5, 0.5), (0.5, 0.5), (0.5, -0.5), (-0.5, -0.5)]
+                    .iter()
+                    .map(|&(a, u)| project(a, u))
+                    .collect();
+            let area = quad.map_or(0.0, |q| {
+                let twice: f64 = (0..4)
+                    .map(|k| {
+                        let (a, b) = (q[k], q[(k + 1) % 4]);
+                        a.x_px * b.y_px - b.x_px * a.y_px
+                    })
+                    .sum();
+                twice.abs() / 2.0
+            });
+            let panel_in_image = [(-1.5, 1.5), (1.5, 1.5), (1.5, -1.5), (-1.5, -1.5)]
+                .iter()
+                .all(|&(a, u)| project(a, u).is_some_and(|p| pose.camera.contains(p)));
+            let to_camera = (camera.x() - m.x_cm, camera.y() - m.y_cm);
+            let turn = to_camera.1.atan2(to_camera.0) - m.facing_rad;
+            let view_angle_rad = turn.sin().atan2(turn.cos()).abs();
+            #[expect(clippy::cast_precision_loss, reason = "pixel counts are small")]
+            let pink_visible_fraction = if area > 0.0 {
+                (cov.pixels as f64 / area).min(1.0)
+            } else {
+                0.0
+            };
+            MarkerTruth {
+                id: i,
+                name: m.name.clone(),
+                relative: relative(
+                    pose,
+                    robot_pose,
+                    &Point::new(m.x_cm, m.y_cm, m.centre_height_cm),
+                ),
+                centre_height_cm: m.centre_height_cm,
+                tiles: m.tiles.map(|t| t.class().code()),
+                pink_pixels: cov.pixels,
+                pink_visible_fraction,
+                image_box: cov.bbox,
+                panel_in_image,
+                view_angle_rad,
+            }
+        })
+        .collect()
 }
 
 /// Another robot in a robot's view.
@@ -443,6 +540,7 @@ pub fn robot_view_truth(
         goals,
         beacons,
         robots,
+        markers: marker_truths(scene, pose, &robot_pose, objects),
     }
 }
 

@@ -588,7 +588,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         .state
         .run(Command::ShowWindow(Window::Inspector, true));
     h.run();
-    let n = eotn::app::inspector::candidates(state(&h).recognition()).len();
+    let n = eotn::app::inspector::candidates(state(&h).recognition(), state(&h).places()).len();
     assert!(n >= 2, "ball and goal candidates, got {n}");
     assert_eq!(
         h.query_all_by_label_contains("accepted ").count()
@@ -613,7 +613,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         "selected: thicker {circles:?}"
     );
     // Selecting another candidate dims the ball.
-    let goal = eotn::app::inspector::candidates(state(&h).recognition())
+    let goal = eotn::app::inspector::candidates(state(&h).recognition(), state(&h).places())
         .into_iter()
         .map(|c| c.owner)
         .find(|o| *o != ball_owner)
@@ -774,4 +774,151 @@ fn nan_in_a_recorded_stream_shows_as_a_warning_of_its_frame() {
     );
     assert!(s.warnings().iter().any(|w| w.contains("NaN")));
     assert!(h.query_by_label_contains("this frame:").is_some());
+}
+
+/// Frames 8..32 of the pattern tour (seed 1), where a marker passes through the view, as a
+/// stream with the robot's readings.
+fn pattern_stream(dir: &Path) -> PathBuf {
+    use eotn::sim::{Scenario, ScenarioKind, Simulator};
+    use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
+    let path = dir.join("tour.mcap");
+    let info = StreamInfo {
+        source: "sim:pattern-tour".to_owned(),
+        description: "app test".to_owned(),
+    };
+    let mut w = StreamWriter::create(&path, &info).unwrap();
+    let sim = Simulator::new(Scenario::new(ScenarioKind::PatternTour, 1));
+    for i in 8..32 {
+        let f = sim.frame(i).unwrap();
+        let mut r = FrameRecord::new(f.time_ns, f.frame);
+        r.sensors = f.sensors;
+        w.write(&r).unwrap();
+    }
+    w.finish().unwrap();
+    path
+}
+
+#[test]
+fn inspector_shows_a_pattern_match_from_a_places_file() {
+    use eotn::recognition::patterns::{PatternMemory, PatternObject, Placement, SizeRelation};
+    let dir = tempfile::tempdir().unwrap();
+    let stream = pattern_stream(dir.path());
+    let table = repo_file("lookup_tables/sim.lut");
+    // Find a frame with a pink marker seen whole, and make a places file that knows it (as
+    // `eotn patterns learn` would; learning itself is tested in tests/it/patterns.rs).
+    let mut s = AppState::default();
+    s.apply(Command::Open(vec![stream.clone(), table.clone()]))
+        .unwrap();
+    let mut frame = None;
+    for i in 0..s.source().unwrap().len() {
+        s.apply(Command::Seek(i)).unwrap();
+        if let Some(c) = s.recognition().patterns.iter().find(|c| {
+            c.observation.regions_in_image == 9 && c.observation.signature.coloured_regions() == 9
+        }) {
+            frame = Some((i, c.observation.signature));
+            break;
+        }
+    }
+    let (index, signature) = frame.expect("a whole marker in one of the frames");
+    let places = dir.path().join("places.json");
+    PatternMemory {
+        objects: vec![PatternObject {
+            id: 7,
+            field_cm: [90.0, 225.0],
+            height_cm: Some(25.0),
+            patterns: vec![signature],
+            views: 12,
+            placed_by: Placement::Triangulation,
+            residual_cm: 1.0,
+        }],
+        relation: Some(SizeRelation {
+            multiplier_cm_px: 1535.0,
+            offset_cm: 0.0,
+            residual_cm: 5.0,
+            samples: 12,
+        }),
+        ..PatternMemory::default()
+    }
+    .save(&places)
+    .unwrap();
+
+    // The places file opens like any file (by its extension), and the marker is identified.
+    let mut h = harness(vec![stream, table, places.clone()]);
+    h.run();
+    assert_eq!(state(&h).places_path(), Some(places.as_path()));
+    h.state_mut().state.run(Command::Seek(index));
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Inspector, true));
+    h.run();
+    let s = state(&h);
+    let (k, c) = s
+        .recognition()
+        .patterns
+        .iter()
+        .enumerate()
+        .find(|(_, c)| c.accepted)
+        .expect("identified");
+    assert_eq!(c.identification.map(|m| (m.id, m.agreement)), Some((7, 9)));
+    let owner = format!("pattern#{k}");
+    assert!(
+        s.accepted_owners().contains(&owner),
+        "the objects view shows it"
+    );
+    assert!(
+        s.primitives()
+            .iter()
+            .filter(|p| matches!(p, eotn::recognition::Primitive::PatternRegion { owner: o, .. } if *o == owner))
+            .count()
+            == 9
+    );
+    // Its row in the inspector; selecting it shows the nine regions and the match.
+    h.get_by_label_contains(&format!("accepted {owner}"))
+        .click();
+    h.run();
+    assert_eq!(state(&h).selected_object(), Some(owner.as_str()));
+    assert!(
+        h.query_by_label_contains("pink marker: place 7").is_some(),
+        "{:#?}",
+        h.root()
+    );
+    assert_eq!(h.query_all_by_label("agrees").count(), 9);
+    assert!(
+        h.query_by_label_contains("against place 7: 9/9 agree")
+            .is_some()
+    );
+    assert!(
+        h.query_all_by_label_contains("pink").count() >= 2,
+        "the middle region is pink"
+    );
+    assert!(
+        h.query_all_by_label("agreement").count() == 1,
+        "the breakdown's test row"
+    );
+    // Closing the places file leaves the marker unidentified; a garbled one is a warning.
+    h.state_mut().state.run(Command::ClosePlaces);
+    h.run();
+    assert!(state(&h).recognition().patterns.iter().all(|c| !c.accepted));
+    assert_eq!(state(&h).settings.last_places, None);
+    let garbled = dir.path().join("garbled.json");
+    std::fs::write(&garbled, "{\"format\": \"eotn.places\", \"objects\": 3}").unwrap();
+    h.state_mut().state.run(Command::OpenPlaces(garbled));
+    h.run();
+    let w = state(&h).warnings().last().cloned().unwrap_or_default();
+    assert!(
+        w.contains("garbled.json") && w.contains("not a places file"),
+        "{w}"
+    );
+    assert_eq!(state(&h).places_path(), None);
+    // The menu offers it; the recent files list has it.
+    assert!(
+        state(&h)
+            .settings
+            .recent
+            .iter()
+            .any(|p| p.ends_with("places.json"))
+    );
+    h.get_by_label("Classification").click();
+    h.run();
+    assert!(h.query_by_label("Open places…").is_some());
 }

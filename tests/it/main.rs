@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod goal_posts;
 mod motion;
+mod patterns;
 mod peer;
 mod real_data;
 mod recognition;
