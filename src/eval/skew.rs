@@ -302,6 +302,7 @@ mod tests {
             goals: Vec::new(),
             beacons: Vec::new(),
             robots: Vec::new(),
+            markers: Vec::new(),
         }
     }
 
