@@ -1253,7 +1253,8 @@ mod tests {
                 ..BallParams::default()
             },
         );
-        ctx.skew_x_per_line = shear;
+        // The pan during one read-out that shifts rows near the image centre by `shear` px each.
+        ctx.pan_per_readout_rad = shear * ctx.camera.height_px as f64 / ctx.camera.focal_px;
         let fixed = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
         let e_plain = (plain.ball.expect("plain").radius_px - r).abs();
         let e_fixed = (fixed.ball.expect("fixed").radius_px - r).abs();

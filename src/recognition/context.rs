@@ -144,10 +144,16 @@ pub struct ViewContext {
     pub body_from_camera: Option<Transform<Body, Camera>>,
     /// The horizon line, when the pose is known.
     pub horizon: Option<Horizon>,
-    /// Horizontal rolling-shutter shear, pixels per image row (from the pan velocity).
+    /// Horizontal rolling-shutter shear, pixels per image row, by the formula
+    /// Δx = d·tan θ_now − d·tan θ_before over the rows (θ the head pan): the shift of an object
+    /// straight ahead of the body. Reported; [`Self::unskew`] uses each point's own angle.
     pub skew_x_per_line: f64,
-    /// Vertical rolling-shutter stretch, pixels per image row (from the tilt velocity).
+    /// Vertical rolling-shutter stretch, pixels per image row (the same from the tilt).
     pub skew_y_per_line: f64,
+    /// How far the head panned during one read-out (first row to last), radians, positive left.
+    pub pan_per_readout_rad: f64,
+    /// How far the head tilted during one read-out, radians, positive up.
+    pub tilt_per_readout_rad: f64,
     /// Near infra-red distance, centimetres.
     pub ir_distance_cm: Option<f64>,
     /// The head's motion during read-out, when the joints now and at the previous frame were
@@ -183,6 +189,8 @@ impl ViewContext {
             horizon: None,
             skew_x_per_line: 0.0,
             skew_y_per_line: 0.0,
+            pan_per_readout_rad: 0.0,
+            tilt_per_readout_rad: 0.0,
             ir_distance_cm: None,
             motion: None,
             frame_interval_s: None,
@@ -283,12 +291,14 @@ impl ViewContext {
             let dx = d * now.tan() - d * before.tan();
             if dx.is_finite() {
                 ctx.skew_x_per_line = dx / lines;
+                ctx.pan_per_readout_rad = now - before;
             }
         }
         if let Some((now, before)) = tilt {
             let dy = d * now.tan() - d * before.tan();
             if dy.is_finite() {
                 ctx.skew_y_per_line = dy / lines;
+                ctx.tilt_per_readout_rad = now - before;
             }
         }
         ctx
@@ -317,16 +327,29 @@ impl ViewContext {
 
     /// Moves an image point to where it would have been seen at the reference row's read-out
     /// time, removing the rolling shutter's horizontal shear (and, with `vertical`, the tilt's
-    /// stretch). Rows above the reference were read earlier, rows below later.
+    /// stretch), without a camera pose. Rows above the reference were read earlier, rows below
+    /// later. This is the Δx = d·tan θ_now − d·tan θ_before with θ the point's own angle
+    /// from the optical axis: the head panned by δ between the reference and the point's row,
+    /// so the point's angle then was its angle now plus δ. For an object straight ahead of the
+    /// body that angle is minus the head pan, as the formula has it; elsewhere the head-pan
+    /// version is wrong by the tangent's growth (13× for a point at the image centre with the
+    /// head panned 1.3 rad).
     #[must_use]
     pub fn unskew(&self, p: Point, vertical: bool) -> Point {
-        let lines = p.1 - self.reference_row();
+        let (c, d) = (self.camera.centre, self.camera.focal_px);
+        let readouts = p.1 / self.camera.height_px.max(1) as f64 - 0.5;
+        // x = cx − d·tan(angle left of the axis); y = cy − d·tan(angle above it).
+        let turn = |pos: f64, centre: f64, delta: f64| {
+            let moved = centre - d * (((centre - pos) / d).atan() + delta).tan();
+            if moved.is_finite() { moved } else { pos }
+        };
+        let x = turn(p.0, c.x_px, self.pan_per_readout_rad * readouts);
         let y = if vertical {
-            p.1 - self.skew_y_per_line * lines
+            turn(p.1, c.y_px, self.tilt_per_readout_rad * readouts)
         } else {
             p.1
         };
-        (p.0 - self.skew_x_per_line * lines, y)
+        (x, y)
     }
 
     /// Moves an image point to where it would have been seen at the reference row's read-out
@@ -425,6 +448,52 @@ mod tests {
             frame_interval_s: interval_s,
             ..SensorReadings::default()
         }
+    }
+
+    #[test]
+    fn unskew_turns_each_point_by_the_pan_at_its_own_angle() {
+        // The head panned far left (1.3 rad) and 0.1 rad more over the read-out. Something at
+        // body bearing 1.3 rad sits on the optical axis at the reference row's time; a row read
+        // 0.4375 read-outs later saw it 0.04375 rad further right. Undoing that puts it back on
+        // the axis (the camera turning about its own vertical, as `unskew` assumes).
+        let camera = PinholeCamera::ers7();
+        let readings = SensorReadings {
+            head_pan_rad: Some(1.3),
+            previous_head_pan_rad: Some(1.2),
+            ..SensorReadings::default()
+        };
+        let ctx = ViewContext::from_sensors(camera, &readings, &Ers7Dimensions::ERS7);
+        assert_relative_eq!(ctx.pan_per_readout_rad, 0.1, epsilon = 1e-12);
+        let (cx, d) = (camera.centre.x_px, camera.focal_px);
+        let row: f64 = 150.0;
+        let seen = cx - d * (-0.1 * (row / 160.0 - 0.5)).tan();
+        let (x, y) = ctx.unskew((seen, row), false);
+        assert_relative_eq!(x, cx, epsilon = 1e-9);
+        assert_relative_eq!(y, row);
+        // The formula with the head's pan angle shifts that row ten times too far.
+        let by_head_pan = ctx.skew_x_per_line * (row - ctx.reference_row());
+        assert!(
+            by_head_pan > 10.0 * (seen - cx),
+            "{by_head_pan} vs {}",
+            seen - cx
+        );
+        // Straight ahead of the body (the formula's own case) the two agree to first order.
+        let level = ViewContext::from_sensors(
+            camera,
+            &SensorReadings {
+                head_pan_rad: Some(0.01),
+                previous_head_pan_rad: Some(-0.01),
+                ..SensorReadings::default()
+            },
+            &Ers7Dimensions::ERS7,
+        );
+        let p = (cx, 10.0);
+        let shift = p.0 - level.unskew(p, false).0;
+        assert_relative_eq!(
+            shift,
+            level.skew_x_per_line * (p.1 - level.reference_row()),
+            max_relative = 1e-3
+        );
     }
 
     #[test]

@@ -1516,7 +1516,8 @@ mod tests {
         let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
         let blobs = BlobSet::from_image(&img, Connectivity::Four);
         let mut panning = ctx();
-        panning.skew_x_per_line = shear;
+        // The pan during one read-out that shifts rows near the image centre by `shear` px each.
+        panning.pan_per_readout_rad = shear * h as f64 / panning.camera.focal_px;
         let obs = observe(&img, &blobs, &panning, &PatternParams::default(), &[]);
         assert_eq!(obs.len(), 1);
         let firsts: Vec<u8> = obs[0].signature.0.iter().map(|r| r[0]).collect();
