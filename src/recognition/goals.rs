@@ -110,8 +110,14 @@ pub struct GoalParams {
     /// side wall's thickness (2 cm walls in the simulator's 2005 field). The scans find the
     /// outline; the post line is moved inward by this at the goal's distance (≈ 1.2 px at
     /// 1.6 m). Where the camera sees a side wall's outer face (standing beside the goal) the
-    /// outline is the wall's back corner, farther out; that is not corrected.
+    /// outline is the wall's back corner, farther out; `post_front_corner` finds the post
+    /// there.
     pub post_inset_cm: f64,
+    /// Look for a side wall seen from outside on each side (the camera beyond the wall's outer
+    /// face, beside a box goal): the outline's outer edge is then the wall's back corner, and
+    /// the post is moved to the wall's front corner, where its foot is lowest and the carpet
+    /// inside the mouth shows beyond it (see `front_corner_offset`).
+    pub post_front_corner: bool,
     /// A post is accepted when r² is at least this, or the points hardly vary across the line.
     pub post_min_r_squared: f64,
     /// ... and the residual variance s² is at most this, pixels².
@@ -184,6 +190,7 @@ impl Default for GoalParams {
             size_bonus: 0.5,
             post_scans: 8,
             post_inset_cm: 1.0,
+            post_front_corner: true,
             post_min_r_squared: 0.5,
             post_max_residual_variance: 2.0,
             post_max_outliers: 2,
@@ -231,6 +238,11 @@ pub struct Post {
     pub camera: Relative,
     /// Body-relative direction of the post's centre.
     pub body: Option<Relative>,
+    /// When the goal's side wall was seen from outside: how far inside the outline's outer
+    /// edge (the wall's back corner) its front corner was found at its foot, pixels; the post
+    /// is half a wall outside that corner.
+    #[serde(default)]
+    pub side_wall_px: Option<f64>,
 }
 
 /// The largest open stretch of goal between obstacles, along the gap scan.
@@ -930,14 +942,40 @@ fn find_posts(
         }
         cand.post_points
             .extend(level_pts.iter().map(|q| rotate_about(*q, centre, -angle)));
-        // The scans find the outline's outer edge; the post's centre is half a wall inside it.
-        let shift = match side {
-            PostSide::Left => inset_px,
-            PostSide::Right => -inset_px,
+        let dir = match side {
+            PostSide::Left => 1.0,
+            PostSide::Right => -1.0,
         };
+        let far_side_cut = match side {
+            PostSide::Left => cand.cut_off.right,
+            PostSide::Right => cand.cut_off.left,
+        };
+        let side_wall = if p.post_front_corner {
+            front_corner(
+                img,
+                &is_goal,
+                &level_pts,
+                e,
+                dir,
+                far_side_cut,
+                (centre, angle),
+            )
+        } else {
+            None
+        };
+        if let Some(w) = side_wall {
+            for c in std::iter::once(w.foot).chain(w.top) {
+                cand.post_points.push(rotate_about(c.at, centre, -angle));
+            }
+        }
+        // The scans find the outline's outer edge; the post's centre is half a wall inside it,
+        // or half a wall outside the front corner of a side wall seen from outside.
         let image_pts: Vec<Point> = level_pts
             .iter()
-            .map(|q| rotate_about((q.0 + shift, q.1), centre, -angle))
+            .map(|q| {
+                let shift = side_wall.map_or(inset_px, |w| w.offset_at(q.1) - inset_px);
+                rotate_about((q.0 + dir * shift, q.1), centre, -angle)
+            })
             .collect();
         let good = |f: &LineFit| {
             f.residual_variance <= p.post_max_residual_variance
@@ -1026,8 +1064,227 @@ fn find_posts(
             reference_bottom,
             camera: ctx.camera_relative(mid, distance),
             body: ctx.body_relative(mid, distance),
+            side_wall_px: side_wall.map(|w| w.foot.offset),
         });
     }
+}
+
+/// How much higher (sample rows) the foot of a side wall seen from outside must be at the
+/// outline, and just beyond the wall's front corner, than at the corner. One row is the
+/// classification's own noise along a goal's bottom: a partly covered row of pixels shows in
+/// some columns only.
+const FOOT_STEP_ROWS: usize = 2;
+
+/// The lowest foot of a side wall seen from outside lies at least this many columns (pixels)
+/// inside the outline. Two are seen on goals from in front: a partly covered bottom row can put
+/// a chroma pair of goal colour below the rest next to the post. A wall narrower than this
+/// moves the post by less than two pixels.
+const MIN_WALL_COLUMNS: usize = 3;
+
+/// A corner of a side wall seen from outside: where the wall ends towards the mouth on one
+/// level row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct WallCorner {
+    /// The corner, level frame, pixels.
+    at: Point,
+    /// Its distance inside the outline along the row, pixels.
+    offset: f64,
+}
+
+/// The front corner of a side wall seen from outside, found by [`front_corner`]: at its foot
+/// and, when the top shows it too, at its top.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SideWall {
+    /// The corner on the lowest foot row.
+    foot: WallCorner,
+    /// The corner on the highest top row, when it is clear and its offset differs from the
+    /// foot's by at most [`SideWall::MAX_LEAN`] of the rows between them.
+    top: Option<WallCorner>,
+}
+
+impl SideWall {
+    /// Largest accepted difference between the top's and the foot's offsets, as a fraction of
+    /// the rows between them. Both corners lie on one upright edge, which leans (rolling
+    /// shutter, perspective) as the back corner does, but the outline's fit through a few
+    /// scans of that far edge can lean a pixel or two differently; a larger difference is
+    /// noise at the top.
+    const MAX_LEAN: f64 = 0.2;
+
+    /// The offset inside the outline at level row `y`, pixels: between the foot's and the
+    /// top's, linearly (the foot's alone when the top gave none).
+    fn offset_at(&self, y: f64) -> f64 {
+        let f = self.foot;
+        match self.top {
+            Some(t) if (f.at.1 - t.at.1).abs() > f64::EPSILON => {
+                f.offset + (t.offset - f.offset) * (f.at.1 - y) / (f.at.1 - t.at.1)
+            }
+            _ => f.offset,
+        }
+    }
+}
+
+/// A box goal's side wall seen from outside (the camera beyond the wall's outer face, beside
+/// the goal). The outline's outer edge on that side is then the wall's back corner, and the
+/// post, the wall's front end, lies inside the goal-coloured region. Being nearer, the post is
+/// the side's tallest stretch: the wall's foot descends from the back corner to it, and just
+/// beyond it the carpet inside the mouth shows under the back wall, which is farther away and
+/// so ends higher (and its top lower). Seen from in front, the outline's edge is the post
+/// itself and the foot is lowest right there, so none of this applies.
+///
+/// `outline`: the side's scan points in the level frame; `dir`: +1 for the left side (inward
+/// is +x), −1 for the right; `far_side_cut`: the other side is cut off by the image edge;
+/// `level`: the image centre and horizon angle of the level frame. Columns run parallel to the
+/// outline one pixel apart; in each, the lowest and the highest goal sample within half the
+/// height of the extent's bottom and top. The front corner is accepted when every sign is
+/// there: the lowest foot at least [`MIN_WALL_COLUMNS`] inside the outline (in the near half
+/// of the goal, or across it when the other side is cut off) and [`FOOT_STEP_ROWS`] lower than
+/// at it, carpet (green or a white line) under the slanting foot in at least half of those
+/// columns (not a robot in front of the post), the foot higher again in the next two columns
+/// beyond the corner, by [`FOOT_STEP_ROWS`] in one of them, with carpet there, and the top at
+/// the corner at most a row lower than at the outline. Each corner is placed to 1/64 px by
+/// bisection along its row.
+fn front_corner(
+    img: &ClassifiedImage,
+    is_goal: &impl Fn(u8) -> bool,
+    outline: &[Point],
+    e: [f64; 4],
+    dir: f64,
+    far_side_cut: bool,
+    (centre, angle): (Point, f64),
+) -> Option<SideWall> {
+    let line = fit_line(outline).filter(|f| f.steep)?;
+    let edge_x = |y: f64| line.at(y).0;
+    let code_at = |x: f64, y: f64| {
+        let q = rotate_about((x, y), centre, -angle);
+        img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
+    };
+    let goal_at = |x: f64, y: f64| code_at(x, y).is_some_and(is_goal);
+    let ground = |c: Option<u8>| {
+        c.is_some_and(|c| c == ColourClass::Green.code() || c == ColourClass::White.code())
+    };
+    let height = e[3] - e[1];
+    if !(height.is_finite() && height > 0.0 && e[2] > e[0]) {
+        return None;
+    }
+    let rows = (height / 2.0).ceil() as usize;
+    let columns = (e[2] - e[0]).floor() as usize;
+    // The corner lies in the near half of the goal (anywhere across it when the other side is
+    // cut off) and no farther inside than the goal is tall: a side wall shows at most its
+    // depth, and the 2005 goals' walls are as deep as they are tall (30 cm).
+    let search = if far_side_cut { columns } else { columns / 2 }.min(height.ceil() as usize);
+    // Sample row i counted from below the extent's bottom (feet) and from above its top (tops).
+    let foot_y = |i: usize| e[3] + 0.5 - i as f64;
+    let top_y = |i: usize| e[1] - 0.5 + i as f64;
+    let column_x = |k: usize, y: f64| edge_x(y) + dir * (k as f64 + 0.5);
+    // Per column: the sample rows of its lowest and highest goal sample (smaller = farther out).
+    let profile: Vec<Option<(usize, usize)>> = (0..columns.min(search + 4))
+        .map(|k| {
+            let foot = (0..rows).find(|&i| goal_at(column_x(k, foot_y(i)), foot_y(i)));
+            let top = (0..rows).find(|&i| goal_at(column_x(k, top_y(i)), top_y(i)));
+            foot.zip(top)
+        })
+        .collect();
+    let foot = |k: usize| profile.get(k).copied().flatten().map(|f| f.0);
+    let top = |k: usize| profile.get(k).copied().flatten().map(|f| f.1);
+    // The lowest foot: its first column from the outline and the end of its plateau.
+    let (k0, lowest) = (0..search)
+        .filter_map(|k| foot(k).map(|f| (k, f)))
+        .min_by_key(|&(k, f)| (f, k))?;
+    let foot_at_edge = (0..2).filter_map(foot).max()?;
+    if k0 < MIN_WALL_COLUMNS
+        || (0..k0).any(|k| foot(k).is_none())
+        || foot_at_edge < lowest + FOOT_STEP_ROWS
+    {
+        return None;
+    }
+    let k1 = plateau_end(&foot, k0, lowest);
+    // Beyond the corner the foot jumps up (after at most one column between) and stays up: the
+    // back wall's bottom. On a goal seen from in front the feet go on down towards a nearer
+    // post instead. Outside the image nothing is known.
+    let yf = foot_y(lowest);
+    let up = |k: usize, step: usize| {
+        k < profile.len()
+            && code_at(column_x(k, yf), yf).is_some()
+            && foot(k).is_none_or(|f| f >= lowest + step)
+    };
+    let jumps = up(k1 + 1, 1)
+        && up(k1 + 2, 1)
+        && (up(k1 + 1, FOOT_STEP_ROWS) || up(k1 + 2, FOOT_STEP_ROWS));
+    if !jumps || !(1..=3).any(|d| ground(code_at(column_x(k1 + d, yf), yf))) {
+        return None;
+    }
+    // The corner is nearer, so its top is no lower than the outline's; it rises less than the
+    // foot descends when the camera is below the goal's top, and a row of it is noise.
+    let top_at_edge = (0..2).filter_map(top).min()?;
+    let highest = (0..=k1).filter_map(top).min()?;
+    if (k0..=k1).filter_map(top).min()? > top_at_edge + 1 {
+        return None;
+    }
+    // Carpet under the slanting foot, in at least half of those columns (the first row under
+    // it is often a mixed pixel): not a robot standing in front of the post.
+    let carpet_under = (0..k0)
+        .filter(|&k| {
+            foot(k).is_some_and(|f| {
+                (1..=2).any(|d| {
+                    let y = foot_y(f) + d as f64;
+                    ground(code_at(column_x(k, y), y))
+                })
+            })
+        })
+        .count();
+    if carpet_under * 2 < k0 {
+        return None;
+    }
+    let crossing = |k: usize, y: f64| {
+        let (mut inside, mut outside) = (column_x(k, y), column_x(k + 1, y));
+        for _ in 0..6 {
+            let m = (inside + outside) / 2.0;
+            if goal_at(m, y) {
+                inside = m;
+            } else {
+                outside = m;
+            }
+        }
+        let x = (inside + outside) / 2.0;
+        WallCorner {
+            at: (x, y),
+            offset: dir * (x - edge_x(y)),
+        }
+    };
+    let foot_corner = crossing(k1, yf);
+    // The top's corner: the end of the highest top's plateau, the top lower in the next two
+    // columns (the back wall's, farther away).
+    let top_corner = (0..=k1).find(|&k| top(k) == Some(highest)).and_then(|k| {
+        let end = plateau_end(&top, k, highest);
+        let lower = |k: usize| k < profile.len() && top(k).is_none_or(|t| t > highest);
+        let yt = top_y(highest);
+        let corner = crossing(end, yt);
+        (lower(end + 1)
+            && lower(end + 2)
+            && code_at(column_x(end + 1, yt), yt).is_some()
+            && (corner.offset - foot_corner.offset).abs() <= SideWall::MAX_LEAN * (yf - yt))
+            .then_some(corner)
+    });
+    Some(SideWall {
+        foot: foot_corner,
+        top: top_corner,
+    })
+}
+
+/// The last column of a plateau of `value` starting at column `from` in a profile: a single
+/// column one row off inside it is noise.
+fn plateau_end(profile: &impl Fn(usize) -> Option<usize>, from: usize, value: usize) -> usize {
+    let mut end = from;
+    let mut k = from + 1;
+    while let Some(v) = profile(k) {
+        if v == value {
+            end = k;
+        } else if !(v == value + 1 && profile(k + 1) == Some(value)) {
+            break;
+        }
+        k += 1;
+    }
+    end
 }
 
 /// The gap: the longest goal-coloured run on a level row at shoulder height.
