@@ -136,7 +136,8 @@ pub struct GoalParams {
     pub post_weight: TestWeight,
     /// Height of the gap scan above the ground, centimetres (about a robot's shoulder).
     pub gap_scan_height_cm: f64,
-    /// Holes up to this many pixels inside a goal-coloured run do not end it.
+    /// Holes up to this many pixels inside a goal-coloured run do not end it: two are one UYVY
+    /// pixel pair, whose shared chroma noise can leave both unclassified.
     pub gap_hole_px: u32,
     /// Move posts, gap and centre to the reference row's read-out time (rolling shutter).
     pub skew_correction: bool,
@@ -198,7 +199,7 @@ impl Default for GoalParams {
             post_test_min_height_px: 5.0,
             post_weight: TestWeight::new(0.0, 2.0),
             gap_scan_height_cm: 15.0,
-            gap_hole_px: 1,
+            gap_hole_px: 2,
             skew_correction: true,
             pose_skew_model: true,
             beacon_overlap_penalty: 10.0,
@@ -1309,9 +1310,11 @@ fn find_gap(
         e[3] - height * (p.gap_scan_height_cm / p.height_cm).clamp(0.0, 1.0)
     };
     let (x0, x1) = (e[0].floor(), e[2].ceil());
-    let mut best: Option<(f64, f64)> = None;
-    let mut run_start: Option<f64> = None;
-    let mut last_goal = f64::NEG_INFINITY;
+    // Runs as (start, its row, end, its row), level frame: an end whose sample was moved into
+    // the image is reported where it was seen.
+    let mut best: Option<(f64, f64, f64, f64)> = None;
+    let mut run_start: Option<(f64, f64)> = None;
+    let mut last_goal = (f64::NEG_INFINITY, y);
     let mut x = x0;
     let (w, h) = (img.width() as f64, img.height() as f64);
     while x <= x1 {
@@ -1323,18 +1326,29 @@ fn find_gap(
             yy += 1.0;
             q = rotate_about((x + 0.5, yy), centre, -angle);
         }
-        let goal = img
-            .get_signed(q.0.floor() as i64, q.1.floor() as i64)
-            .is_some_and(&is_goal);
-        if goal {
-            if run_start.is_none() || x - last_goal > f64::from(p.gap_hole_px) + 1.0 {
-                run_start = Some(x);
+        let goal_at = |q: Point| {
+            img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
+                .is_some_and(&is_goal)
+        };
+        // A sample moved into the image lies on its outermost rows, which vignetting and the
+        // shared chroma of a cut-off pixel pair leave unclassified now and then: the next row
+        // in counts too.
+        let seen_at = if goal_at(q) {
+            Some(yy)
+        } else {
+            let below = yy + 1.0;
+            (yy > y && below < e[3] && goal_at(rotate_about((x + 0.5, below), centre, -angle)))
+                .then_some(below)
+        };
+        if let Some(row) = seen_at {
+            if run_start.is_none() || x - last_goal.0 > f64::from(p.gap_hole_px) + 1.0 {
+                run_start = Some((x, row));
             }
-            last_goal = x;
-            if let Some(s) = run_start
-                && best.is_none_or(|(a, b)| last_goal + 1.0 - s > b - a)
+            last_goal = (x, row);
+            if let Some((s, s_row)) = run_start
+                && best.is_none_or(|(a, _, b, _)| last_goal.0 + 1.0 - s > b - a)
             {
-                best = Some((s, last_goal + 1.0));
+                best = Some((s, s_row, last_goal.0 + 1.0, row));
             }
         }
         x += 1.0;
@@ -1343,9 +1357,9 @@ fn find_gap(
         rotate_about((e[0], y), centre, -angle),
         rotate_about((e[2], y), centre, -angle),
     ));
-    if let Some((a, b)) = best {
-        let left = rotate_about((a, y), centre, -angle);
-        let right = rotate_about((b, y), centre, -angle);
+    if let Some((a, a_row, b, b_row)) = best {
+        let left = rotate_about((a, a_row), centre, -angle);
+        let right = rotate_about((b, b_row), centre, -angle);
         let (ref_left, ref_right) = if p.skew_correction {
             (
                 unskew(ctx, p, left, distance),
@@ -1486,7 +1500,12 @@ mod tests {
             .image_from_field(&crate::geometry::Point::new(191.9 * 30.0 / 25.0, 0.0, 0.0))
             .expect("in view");
         let bottom = foot.y_px.round() as usize;
-        let img = scene(40, 150, bottom - 25, bottom, Some((70, 90, bottom - 35)));
+        let mut img = scene(40, 150, bottom - 25, bottom, Some((70, 90, bottom - 35)));
+        // A noisy UYVY pixel pair on the gap scan's row (12.5 px above the bottom) leaves two
+        // pixels unclassified: the gap goes on across them.
+        for x in [120, 121] {
+            img.codes_mut()[(bottom - 13) * 208 + x] = ColourClass::Unclassified.code();
+        }
         let blobs = BlobSet::from_image(&img, Connectivity::Eight);
         let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default(), &[]);
         let goals: Vec<_> = res.goals().collect();
@@ -1513,6 +1532,8 @@ mod tests {
             .find(|p| p.side == PostSide::Right)
             .expect("right");
         assert!((right.top.0 - 150.0).abs() < 1.0);
+        // Seen from in front: no side wall's outer face.
+        assert!(g.posts.iter().all(|p| p.side_wall_px.is_none()));
         let gap = g.gap.as_ref().expect("gap");
         assert!(
             (gap.left.0 - 90.0).abs() < 1.5 && (gap.right.0 - 150.0).abs() < 1.5,
@@ -1520,6 +1541,77 @@ mod tests {
         );
         assert!(gap.left_bearing_rad > gap.right_bearing_rad);
         assert!(!res.primitives().is_empty());
+    }
+
+    #[test]
+    fn a_side_wall_seen_from_outside_puts_the_post_on_its_front_corner() {
+        // Standing beside a box goal: the left side wall's outer face shows from its back corner
+        // (x = 40, the outline) to its front corner (x = 48). The front is nearer, so the wall's
+        // foot descends towards it and its top rises; beyond it the back wall, farther away,
+        // ends two rows higher, with the carpet inside the mouth below it.
+        let ctx = ctx();
+        let pose = ctx.pose.expect("pose");
+        let foot = pose
+            .image_from_field(&crate::geometry::Point::new(191.9 * 30.0 / 25.0, 0.0, 0.0))
+            .expect("in view");
+        let bottom = foot.y_px.round() as usize;
+        let top = bottom - 25;
+        let (w, h) = (208, 160);
+        let extent = |x: usize| match x {
+            40..=41 => Some((top + 1, bottom - 2)),
+            42..=44 => Some((top + 1, bottom - 1)),
+            45..=47 => Some((top, bottom)),
+            48..=150 => Some((top + 2, bottom - 2)),
+            _ => None,
+        };
+        let codes = (0..w * h)
+            .map(|k| {
+                let (x, y) = (k % w, k / w);
+                match extent(x) {
+                    Some((t, b)) if (t..b).contains(&y) => ColourClass::Yellow.code(),
+                    Some((_, b)) if y >= b => ColourClass::Green.code(),
+                    None if y >= bottom - 2 => ColourClass::Green.code(),
+                    _ => ColourClass::White.code(),
+                }
+            })
+            .collect();
+        let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let p = GoalParams::default();
+        let res = recognise_goals(&img, &blobs, &ctx, &p, &[]);
+        let g = res.goals().next().expect("goal");
+        let left = g
+            .posts
+            .iter()
+            .find(|q| q.side == PostSide::Left)
+            .expect("left post");
+        // The post's centre is half a wall outside the corner.
+        let inset = p.post_inset_cm * ctx.camera.focal_px / g.camera.distance_cm;
+        let wall = left.side_wall_px.expect("side wall seen");
+        assert!((wall - 8.0).abs() < 0.5, "{wall}");
+        for x in [left.top.0, left.bottom.0] {
+            assert!((x - (48.0 - inset)).abs() < 0.5, "{left:?}");
+        }
+        // The right side is seen from in front: its post stays on the outline.
+        let right = g
+            .posts
+            .iter()
+            .find(|q| q.side == PostSide::Right)
+            .expect("right post");
+        assert!(right.side_wall_px.is_none() && (right.top.0 - 151.0).abs() < 1.5);
+        // Without the front-corner search the left post is the back corner's.
+        let off = GoalParams {
+            post_front_corner: false,
+            ..p
+        };
+        let res = recognise_goals(&img, &blobs, &ctx, &off, &[]);
+        let g = res.goals().next().expect("goal");
+        let left = g
+            .posts
+            .iter()
+            .find(|q| q.side == PostSide::Left)
+            .expect("left");
+        assert!(left.side_wall_px.is_none() && (left.top.0 - (40.0 + inset)).abs() < 0.5);
     }
 
     #[test]

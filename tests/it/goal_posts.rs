@@ -37,7 +37,7 @@ fn rolling_image(
 /// The debugging aids' table, seed and frame count: the learnt table, seed 7 and 90 frames
 /// unless `EOTN_DEBUG_LUT` (a table file), `EOTN_DEBUG_SEED` or `EOTN_DEBUG_NFRAMES` say
 /// otherwise.
-fn debug_setup() -> (eotn::lut::LookupTable, u64, u64) {
+pub(crate) fn debug_setup() -> (eotn::lut::LookupTable, u64, u64) {
     let lut = std::env::var("EOTN_DEBUG_LUT")
         .ok()
         .filter(|p| !p.is_empty())
