@@ -1155,8 +1155,14 @@ fn front_corner(
 ) -> Option<SideWall> {
     let line = fit_line(outline).filter(|f| f.steep)?;
     let edge_x = |y: f64| line.at(y).0;
+    // Level frame → image: `rotate_about` by −angle with its sine and cosine taken once.
+    let (sin, cos) = (-angle).sin_cos();
     let code_at = |x: f64, y: f64| {
-        let q = rotate_about((x, y), centre, -angle);
+        let (dx, dy) = (x - centre.0, y - centre.1);
+        let q = (
+            centre.0 + cos * dx - sin * dy,
+            centre.1 + sin * dx + cos * dy,
+        );
         img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
     };
     let goal_at = |x: f64, y: f64| code_at(x, y).is_some_and(is_goal);
@@ -1177,16 +1183,15 @@ fn front_corner(
     let foot_y = |i: usize| e[3] + 0.5 - i as f64;
     let top_y = |i: usize| e[1] - 0.5 + i as f64;
     let column_x = |k: usize, y: f64| edge_x(y) + dir * (k as f64 + 0.5);
-    // Per column: the sample rows of its lowest and highest goal sample (smaller = farther out).
-    let profile: Vec<Option<(usize, usize)>> = (0..columns.min(search + 4))
-        .map(|k| {
-            let foot = (0..rows).find(|&i| goal_at(column_x(k, foot_y(i)), foot_y(i)));
-            let top = (0..rows).find(|&i| goal_at(column_x(k, top_y(i)), top_y(i)));
-            foot.zip(top)
-        })
-        .collect();
-    let foot = |k: usize| profile.get(k).copied().flatten().map(|f| f.0);
-    let top = |k: usize| profile.get(k).copied().flatten().map(|f| f.1);
+    let foot_of = |k: usize| (0..rows).find(|&i| goal_at(column_x(k, foot_y(i)), foot_y(i)));
+    // Seen from in front, the outline's foot is the lowest already (most goals): done.
+    if (0..2).filter_map(foot_of).max()? < FOOT_STEP_ROWS {
+        return None;
+    }
+    // Per column: the sample row of its lowest goal sample (smaller = farther out); the tops
+    // are looked at only once the feet show a corner.
+    let feet: Vec<Option<usize>> = (0..columns.min(search + 4)).map(foot_of).collect();
+    let foot = |k: usize| feet.get(k).copied().flatten();
     // The lowest foot: its first column from the outline and the end of its plateau.
     let (k0, lowest) = (0..search)
         .filter_map(|k| foot(k).map(|f| (k, f)))
@@ -1204,7 +1209,7 @@ fn front_corner(
     // post instead. Outside the image nothing is known.
     let yf = foot_y(lowest);
     let up = |k: usize, step: usize| {
-        k < profile.len()
+        k < feet.len()
             && code_at(column_x(k, yf), yf).is_some()
             && foot(k).is_none_or(|f| f >= lowest + step)
     };
@@ -1212,13 +1217,6 @@ fn front_corner(
         && up(k1 + 2, 1)
         && (up(k1 + 1, FOOT_STEP_ROWS) || up(k1 + 2, FOOT_STEP_ROWS));
     if !jumps || !(1..=3).any(|d| ground(code_at(column_x(k1 + d, yf), yf))) {
-        return None;
-    }
-    // The corner is nearer, so its top is no lower than the outline's; it rises less than the
-    // foot descends when the camera is below the goal's top, and a row of it is noise.
-    let top_at_edge = (0..2).filter_map(top).min()?;
-    let highest = (0..=k1).filter_map(top).min()?;
-    if (k0..=k1).filter_map(top).min()? > top_at_edge + 1 {
         return None;
     }
     // Carpet under the slanting foot, in at least half of those columns (the first row under
@@ -1234,6 +1232,17 @@ fn front_corner(
         })
         .count();
     if carpet_under * 2 < k0 {
+        return None;
+    }
+    // The corner is nearer, so its top is no lower than the outline's; it rises less than the
+    // foot descends when the camera is below the goal's top, and a row of it is noise.
+    let tops: Vec<Option<usize>> = (0..feet.len())
+        .map(|k| (0..rows).find(|&i| goal_at(column_x(k, top_y(i)), top_y(i))))
+        .collect();
+    let top = |k: usize| tops.get(k).copied().flatten();
+    let top_at_edge = (0..2).filter_map(top).min()?;
+    let highest = (0..=k1).filter_map(top).min()?;
+    if (k0..=k1).filter_map(top).min()? > top_at_edge + 1 {
         return None;
     }
     let crossing = |k: usize, y: f64| {
@@ -1257,7 +1266,7 @@ fn front_corner(
     // columns (the back wall's, farther away).
     let top_corner = (0..=k1).find(|&k| top(k) == Some(highest)).and_then(|k| {
         let end = plateau_end(&top, k, highest);
-        let lower = |k: usize| k < profile.len() && top(k).is_none_or(|t| t > highest);
+        let lower = |k: usize| k < tops.len() && top(k).is_none_or(|t| t > highest);
         let yt = top_y(highest);
         let corner = crossing(end, yt);
         (lower(end + 1)
