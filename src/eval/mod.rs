@@ -13,7 +13,7 @@ use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::Recognition;
 use crate::sim::scene::GoalColour;
-use crate::sim::truth::RobotViewTruth;
+use crate::sim::truth::{GoalGap, RobotViewTruth};
 
 /// When an object counts as "should have been found", and when a detection matches.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -263,12 +263,12 @@ pub fn evaluate_frame(
         if let (Some(gap), Some(largest)) = (&g.gap, &tg.largest_gap) {
             // Scored against the largest open stretch, or against the second when that is as
             // wide within the tie tolerance and nearer (either is "the largest").
-            let error = |t: &crate::sim::truth::GoalGap| {
+            let error = |t: &GoalGap| {
                 let left = (gap.left.0 - t.from_x_px as f64).abs();
                 let right = (gap.right.0 - (t.to_x_px as f64 + 1.0)).abs();
                 left.max(right)
             };
-            let width = |t: &crate::sim::truth::GoalGap| (t.to_x_px - t.from_x_px) as f64;
+            let width = |t: &GoalGap| (t.to_x_px - t.from_x_px) as f64;
             let tied = tg
                 .second_gap
                 .filter(|s| width(s) + p.gap_tie_px >= width(largest))

@@ -116,7 +116,7 @@ pub struct GoalParams {
     /// Look for a side wall seen from outside on each side (the camera beyond the wall's outer
     /// face, beside a box goal): the outline's outer edge is then the wall's back corner, and
     /// the post is moved to the wall's front corner, where its foot is lowest and the carpet
-    /// inside the mouth shows beyond it (see `front_corner_offset`).
+    /// inside the mouth shows beyond it (see `front_corner`).
     pub post_front_corner: bool,
     /// A post is accepted when r² is at least this, or the points hardly vary across the line.
     pub post_min_r_squared: f64,
@@ -1078,8 +1078,8 @@ const FOOT_STEP_ROWS: usize = 2;
 
 /// The lowest foot of a side wall seen from outside lies at least this many columns (pixels)
 /// inside the outline. Two are seen on goals from in front: a partly covered bottom row can put
-/// a chroma pair of goal colour below the rest next to the post. A wall narrower than this
-/// moves the post by less than two pixels.
+/// a chroma pair of goal colour below the rest next to the post. A narrower wall moves the
+/// post by only about two pixels.
 const MIN_WALL_COLUMNS: usize = 3;
 
 /// A corner of a side wall seen from outside: where the wall ends towards the mouth on one
