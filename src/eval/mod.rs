@@ -15,7 +15,7 @@ use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::Recognition;
 use crate::sim::scene::GoalColour;
-use crate::sim::truth::RobotViewTruth;
+use crate::sim::truth::{GoalGap, RobotViewTruth};
 
 /// When an object counts as "should have been found", and when a detection matches.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -35,6 +35,9 @@ pub struct EvalParams {
     pub goal_min_mouth_fraction: f64,
     /// ... and it shows at least this many pixels.
     pub goal_min_pixels: usize,
+    /// A goal's second largest open stretch is as good an answer as its largest when it is at
+    /// most this much narrower, pixels (the gap target's tolerance).
+    pub gap_tie_px: f64,
 }
 
 impl Default for EvalParams {
@@ -46,6 +49,7 @@ impl Default for EvalParams {
             ball_match_min_px: 4.0,
             goal_min_mouth_fraction: 0.5,
             goal_min_pixels: 30,
+            gap_tie_px: 3.0,
         }
     }
 }
@@ -258,10 +262,20 @@ pub fn evaluate_frame(
                 e.post_errors_px.push(best);
             }
         }
-        if let (Some(gap), Some(tgap)) = (&g.gap, &tg.largest_gap) {
-            let left = (gap.left.0 - tgap.from_x_px as f64).abs();
-            let right = (gap.right.0 - (tgap.to_x_px as f64 + 1.0)).abs();
-            e.gap_errors_px.push(left.max(right));
+        if let (Some(gap), Some(largest)) = (&g.gap, &tg.largest_gap) {
+            // Scored against the largest open stretch, or against the second when that is as
+            // wide within the tie tolerance and nearer (either is "the largest").
+            let error = |t: &GoalGap| {
+                let left = (gap.left.0 - t.from_x_px as f64).abs();
+                let right = (gap.right.0 - (t.to_x_px as f64 + 1.0)).abs();
+                left.max(right)
+            };
+            let width = |t: &GoalGap| (t.to_x_px - t.from_x_px) as f64;
+            let tied = tg
+                .second_gap
+                .filter(|s| width(s) + p.gap_tie_px >= width(largest))
+                .map_or(f64::INFINITY, |s| error(&s));
+            e.gap_errors_px.push(error(largest).min(tied));
         }
     }
     let in_view: Vec<ColourClass> = t

@@ -110,8 +110,14 @@ pub struct GoalParams {
     /// side wall's thickness (2 cm walls in the simulator's 2005 field). The scans find the
     /// outline; the post line is moved inward by this at the goal's distance (≈ 1.2 px at
     /// 1.6 m). Where the camera sees a side wall's outer face (standing beside the goal) the
-    /// outline is the wall's back corner, farther out; that is not corrected.
+    /// outline is the wall's back corner, farther out; `post_front_corner` finds the post
+    /// there.
     pub post_inset_cm: f64,
+    /// Look for a side wall seen from outside on each side (the camera beyond the wall's outer
+    /// face, beside a box goal): the outline's outer edge is then the wall's back corner, and
+    /// the post is moved to the wall's front corner, where its foot is lowest and the carpet
+    /// inside the mouth shows beyond it (see `front_corner`).
+    pub post_front_corner: bool,
     /// A post is accepted when r² is at least this, or the points hardly vary across the line.
     pub post_min_r_squared: f64,
     /// ... and the residual variance s² is at most this, pixels².
@@ -130,7 +136,8 @@ pub struct GoalParams {
     pub post_weight: TestWeight,
     /// Height of the gap scan above the ground, centimetres (about a robot's shoulder).
     pub gap_scan_height_cm: f64,
-    /// Holes up to this many pixels inside a goal-coloured run do not end it.
+    /// Holes up to this many pixels inside a goal-coloured run do not end it: two are one UYVY
+    /// pixel pair, whose shared chroma noise can leave both unclassified.
     pub gap_hole_px: u32,
     /// Move posts, gap and centre to the reference row's read-out time (rolling shutter).
     pub skew_correction: bool,
@@ -184,6 +191,7 @@ impl Default for GoalParams {
             size_bonus: 0.5,
             post_scans: 8,
             post_inset_cm: 1.0,
+            post_front_corner: true,
             post_min_r_squared: 0.5,
             post_max_residual_variance: 2.0,
             post_max_outliers: 2,
@@ -191,7 +199,7 @@ impl Default for GoalParams {
             post_test_min_height_px: 5.0,
             post_weight: TestWeight::new(0.0, 2.0),
             gap_scan_height_cm: 15.0,
-            gap_hole_px: 1,
+            gap_hole_px: 2,
             skew_correction: true,
             pose_skew_model: true,
             beacon_overlap_penalty: 10.0,
@@ -231,6 +239,11 @@ pub struct Post {
     pub camera: Relative,
     /// Body-relative direction of the post's centre.
     pub body: Option<Relative>,
+    /// When the goal's side wall was seen from outside: how far inside the outline's outer
+    /// edge (the wall's back corner) its front corner was found at its foot, pixels; the post
+    /// is half a wall outside that corner.
+    #[serde(default)]
+    pub side_wall_px: Option<f64>,
 }
 
 /// The largest open stretch of goal between obstacles, along the gap scan.
@@ -930,14 +943,40 @@ fn find_posts(
         }
         cand.post_points
             .extend(level_pts.iter().map(|q| rotate_about(*q, centre, -angle)));
-        // The scans find the outline's outer edge; the post's centre is half a wall inside it.
-        let shift = match side {
-            PostSide::Left => inset_px,
-            PostSide::Right => -inset_px,
+        let dir = match side {
+            PostSide::Left => 1.0,
+            PostSide::Right => -1.0,
         };
+        let far_side_cut = match side {
+            PostSide::Left => cand.cut_off.right,
+            PostSide::Right => cand.cut_off.left,
+        };
+        let side_wall = if p.post_front_corner {
+            front_corner(
+                img,
+                &is_goal,
+                &level_pts,
+                e,
+                dir,
+                far_side_cut,
+                (centre, angle),
+            )
+        } else {
+            None
+        };
+        if let Some(w) = side_wall {
+            for c in std::iter::once(w.foot).chain(w.top) {
+                cand.post_points.push(rotate_about(c.at, centre, -angle));
+            }
+        }
+        // The scans find the outline's outer edge; the post's centre is half a wall inside it,
+        // or half a wall outside the front corner of a side wall seen from outside.
         let image_pts: Vec<Point> = level_pts
             .iter()
-            .map(|q| rotate_about((q.0 + shift, q.1), centre, -angle))
+            .map(|q| {
+                let shift = side_wall.map_or(inset_px, |w| w.offset_at(q.1) - inset_px);
+                rotate_about((q.0 + dir * shift, q.1), centre, -angle)
+            })
             .collect();
         let good = |f: &LineFit| {
             f.residual_variance <= p.post_max_residual_variance
@@ -1026,8 +1065,236 @@ fn find_posts(
             reference_bottom,
             camera: ctx.camera_relative(mid, distance),
             body: ctx.body_relative(mid, distance),
+            side_wall_px: side_wall.map(|w| w.foot.offset),
         });
     }
+}
+
+/// How much higher (sample rows) the foot of a side wall seen from outside must be at the
+/// outline, and just beyond the wall's front corner, than at the corner. One row is the
+/// classification's own noise along a goal's bottom: a partly covered row of pixels shows in
+/// some columns only.
+const FOOT_STEP_ROWS: usize = 2;
+
+/// The lowest foot of a side wall seen from outside lies at least this many columns (pixels)
+/// inside the outline. Two are seen on goals from in front: a partly covered bottom row can put
+/// a chroma pair of goal colour below the rest next to the post. A narrower wall moves the
+/// post by only about two pixels.
+const MIN_WALL_COLUMNS: usize = 3;
+
+/// A corner of a side wall seen from outside: where the wall ends towards the mouth on one
+/// level row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct WallCorner {
+    /// The corner, level frame, pixels.
+    at: Point,
+    /// Its distance inside the outline along the row, pixels.
+    offset: f64,
+}
+
+/// The front corner of a side wall seen from outside, found by [`front_corner`]: at its foot
+/// and, when the top shows it too, at its top.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SideWall {
+    /// The corner on the lowest foot row.
+    foot: WallCorner,
+    /// The corner on the highest top row, when it is clear and its offset differs from the
+    /// foot's by at most [`SideWall::MAX_LEAN`] of the rows between them.
+    top: Option<WallCorner>,
+}
+
+impl SideWall {
+    /// Largest accepted difference between the top's and the foot's offsets, as a fraction of
+    /// the rows between them. Both corners lie on one upright edge, which leans (rolling
+    /// shutter, perspective) as the back corner does, but the outline's fit through a few
+    /// scans of that far edge can lean a pixel or two differently; a larger difference is
+    /// noise at the top.
+    const MAX_LEAN: f64 = 0.2;
+
+    /// The offset inside the outline at level row `y`, pixels: between the foot's and the
+    /// top's, linearly (the foot's alone when the top gave none).
+    fn offset_at(&self, y: f64) -> f64 {
+        let f = self.foot;
+        match self.top {
+            Some(t) if (f.at.1 - t.at.1).abs() > f64::EPSILON => {
+                f.offset + (t.offset - f.offset) * (f.at.1 - y) / (f.at.1 - t.at.1)
+            }
+            _ => f.offset,
+        }
+    }
+}
+
+/// A box goal's side wall seen from outside (the camera beyond the wall's outer face, beside
+/// the goal). The outline's outer edge on that side is then the wall's back corner, and the
+/// post, the wall's front end, lies inside the goal-coloured region. Being nearer, the post is
+/// the side's tallest stretch: the wall's foot descends from the back corner to it, and just
+/// beyond it the carpet inside the mouth shows under the back wall, which is farther away and
+/// so ends higher (and its top lower). Seen from in front, the outline's edge is the post
+/// itself and the foot is lowest right there, so none of this applies.
+///
+/// `outline`: the side's scan points in the level frame; `dir`: +1 for the left side (inward
+/// is +x), −1 for the right; `far_side_cut`: the other side is cut off by the image edge;
+/// `level`: the image centre and horizon angle of the level frame. Columns run parallel to the
+/// outline one pixel apart; in each, the lowest and the highest goal sample within half the
+/// height of the extent's bottom and top. The front corner is accepted when every sign is
+/// there: the lowest foot at least [`MIN_WALL_COLUMNS`] inside the outline (in the near half
+/// of the goal, or across it when the other side is cut off) and [`FOOT_STEP_ROWS`] lower than
+/// at it, carpet (green or a white line) under the slanting foot in at least half of those
+/// columns (not a robot in front of the post), the foot higher again in the next two columns
+/// beyond the corner, by [`FOOT_STEP_ROWS`] in one of them, with carpet there, and the top at
+/// the corner at most a row lower than at the outline. Each corner is placed to 1/64 px by
+/// bisection along its row.
+fn front_corner(
+    img: &ClassifiedImage,
+    is_goal: &impl Fn(u8) -> bool,
+    outline: &[Point],
+    e: [f64; 4],
+    dir: f64,
+    far_side_cut: bool,
+    (centre, angle): (Point, f64),
+) -> Option<SideWall> {
+    let line = fit_line(outline).filter(|f| f.steep)?;
+    let edge_x = |y: f64| line.at(y).0;
+    // Level frame → image: `rotate_about` by −angle with its sine and cosine taken once.
+    let (sin, cos) = (-angle).sin_cos();
+    let code_at = |x: f64, y: f64| {
+        let (dx, dy) = (x - centre.0, y - centre.1);
+        let q = (
+            centre.0 + cos * dx - sin * dy,
+            centre.1 + sin * dx + cos * dy,
+        );
+        img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
+    };
+    let goal_at = |x: f64, y: f64| code_at(x, y).is_some_and(is_goal);
+    let ground = |c: Option<u8>| {
+        c.is_some_and(|c| c == ColourClass::Green.code() || c == ColourClass::White.code())
+    };
+    let height = e[3] - e[1];
+    if !(height.is_finite() && height > 0.0 && e[2] > e[0]) {
+        return None;
+    }
+    let rows = (height / 2.0).ceil() as usize;
+    let columns = (e[2] - e[0]).floor() as usize;
+    // The corner lies in the near half of the goal (anywhere across it when the other side is
+    // cut off) and no farther inside than the goal is tall: a side wall shows at most its
+    // depth, and the 2005 goals' walls are as deep as they are tall (30 cm).
+    let search = if far_side_cut { columns } else { columns / 2 }.min(height.ceil() as usize);
+    // Sample row i counted from below the extent's bottom (feet) and from above its top (tops).
+    let foot_y = |i: usize| e[3] + 0.5 - i as f64;
+    let top_y = |i: usize| e[1] - 0.5 + i as f64;
+    let column_x = |k: usize, y: f64| edge_x(y) + dir * (k as f64 + 0.5);
+    let foot_of = |k: usize| (0..rows).find(|&i| goal_at(column_x(k, foot_y(i)), foot_y(i)));
+    // Seen from in front, the outline's foot is the lowest already (most goals): done.
+    if (0..2).filter_map(foot_of).max()? < FOOT_STEP_ROWS {
+        return None;
+    }
+    // Per column: the sample row of its lowest goal sample (smaller = farther out); the tops
+    // are looked at only once the feet show a corner.
+    let feet: Vec<Option<usize>> = (0..columns.min(search + 4)).map(foot_of).collect();
+    let foot = |k: usize| feet.get(k).copied().flatten();
+    // The lowest foot: its first column from the outline and the end of its plateau.
+    let (k0, lowest) = (0..search)
+        .filter_map(|k| foot(k).map(|f| (k, f)))
+        .min_by_key(|&(k, f)| (f, k))?;
+    let foot_at_edge = (0..2).filter_map(foot).max()?;
+    if k0 < MIN_WALL_COLUMNS
+        || (0..k0).any(|k| foot(k).is_none())
+        || foot_at_edge < lowest + FOOT_STEP_ROWS
+    {
+        return None;
+    }
+    let k1 = plateau_end(&foot, k0, lowest);
+    // Beyond the corner the foot jumps up (after at most one column between) and stays up: the
+    // back wall's bottom. On a goal seen from in front the feet go on down towards a nearer
+    // post instead. Outside the image nothing is known.
+    let yf = foot_y(lowest);
+    let up = |k: usize, step: usize| {
+        k < feet.len()
+            && code_at(column_x(k, yf), yf).is_some()
+            && foot(k).is_none_or(|f| f >= lowest + step)
+    };
+    let jumps = up(k1 + 1, 1)
+        && up(k1 + 2, 1)
+        && (up(k1 + 1, FOOT_STEP_ROWS) || up(k1 + 2, FOOT_STEP_ROWS));
+    if !jumps || !(1..=3).any(|d| ground(code_at(column_x(k1 + d, yf), yf))) {
+        return None;
+    }
+    // Carpet under the slanting foot, in at least half of those columns (the first row under
+    // it is often a mixed pixel): not a robot standing in front of the post.
+    let carpet_under = (0..k0)
+        .filter(|&k| {
+            foot(k).is_some_and(|f| {
+                (1..=2).any(|d| {
+                    let y = foot_y(f) + d as f64;
+                    ground(code_at(column_x(k, y), y))
+                })
+            })
+        })
+        .count();
+    if carpet_under * 2 < k0 {
+        return None;
+    }
+    // The corner is nearer, so its top is no lower than the outline's; it rises less than the
+    // foot descends when the camera is below the goal's top, and a row of it is noise.
+    let tops: Vec<Option<usize>> = (0..feet.len())
+        .map(|k| (0..rows).find(|&i| goal_at(column_x(k, top_y(i)), top_y(i))))
+        .collect();
+    let top = |k: usize| tops.get(k).copied().flatten();
+    let top_at_edge = (0..2).filter_map(top).min()?;
+    let highest = (0..=k1).filter_map(top).min()?;
+    if (k0..=k1).filter_map(top).min()? > top_at_edge + 1 {
+        return None;
+    }
+    let crossing = |k: usize, y: f64| {
+        let (mut inside, mut outside) = (column_x(k, y), column_x(k + 1, y));
+        for _ in 0..6 {
+            let m = (inside + outside) / 2.0;
+            if goal_at(m, y) {
+                inside = m;
+            } else {
+                outside = m;
+            }
+        }
+        let x = (inside + outside) / 2.0;
+        WallCorner {
+            at: (x, y),
+            offset: dir * (x - edge_x(y)),
+        }
+    };
+    let foot_corner = crossing(k1, yf);
+    // The top's corner: the end of the highest top's plateau, the top lower in the next two
+    // columns (the back wall's, farther away).
+    let top_corner = (0..=k1).find(|&k| top(k) == Some(highest)).and_then(|k| {
+        let end = plateau_end(&top, k, highest);
+        let lower = |k: usize| k < tops.len() && top(k).is_none_or(|t| t > highest);
+        let yt = top_y(highest);
+        let corner = crossing(end, yt);
+        (lower(end + 1)
+            && lower(end + 2)
+            && code_at(column_x(end + 1, yt), yt).is_some()
+            && (corner.offset - foot_corner.offset).abs() <= SideWall::MAX_LEAN * (yf - yt))
+            .then_some(corner)
+    });
+    Some(SideWall {
+        foot: foot_corner,
+        top: top_corner,
+    })
+}
+
+/// The last column of a plateau of `value` starting at column `from` in a profile: a single
+/// column one row off inside it is noise.
+fn plateau_end(profile: &impl Fn(usize) -> Option<usize>, from: usize, value: usize) -> usize {
+    let mut end = from;
+    let mut k = from + 1;
+    while let Some(v) = profile(k) {
+        if v == value {
+            end = k;
+        } else if !(v == value + 1 && profile(k + 1) == Some(value)) {
+            break;
+        }
+        k += 1;
+    }
+    end
 }
 
 /// The gap: the longest goal-coloured run on a level row at shoulder height.
@@ -1052,9 +1319,11 @@ fn find_gap(
         e[3] - height * (p.gap_scan_height_cm / p.height_cm).clamp(0.0, 1.0)
     };
     let (x0, x1) = (e[0].floor(), e[2].ceil());
-    let mut best: Option<(f64, f64)> = None;
-    let mut run_start: Option<f64> = None;
-    let mut last_goal = f64::NEG_INFINITY;
+    // Runs as (start, its row, end, its row), level frame: an end whose sample was moved into
+    // the image is reported where it was seen.
+    let mut best: Option<(f64, f64, f64, f64)> = None;
+    let mut run_start: Option<(f64, f64)> = None;
+    let mut last_goal = (f64::NEG_INFINITY, y);
     let mut x = x0;
     let (w, h) = (img.width() as f64, img.height() as f64);
     while x <= x1 {
@@ -1066,18 +1335,29 @@ fn find_gap(
             yy += 1.0;
             q = rotate_about((x + 0.5, yy), centre, -angle);
         }
-        let goal = img
-            .get_signed(q.0.floor() as i64, q.1.floor() as i64)
-            .is_some_and(&is_goal);
-        if goal {
-            if run_start.is_none() || x - last_goal > f64::from(p.gap_hole_px) + 1.0 {
-                run_start = Some(x);
+        let goal_at = |q: Point| {
+            img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
+                .is_some_and(&is_goal)
+        };
+        // A sample moved into the image lies on its outermost rows, which vignetting and the
+        // shared chroma of a cut-off pixel pair leave unclassified now and then: the next row
+        // in counts too.
+        let seen_at = if goal_at(q) {
+            Some(yy)
+        } else {
+            let below = yy + 1.0;
+            (yy > y && below < e[3] && goal_at(rotate_about((x + 0.5, below), centre, -angle)))
+                .then_some(below)
+        };
+        if let Some(row) = seen_at {
+            if run_start.is_none() || x - last_goal.0 > f64::from(p.gap_hole_px) + 1.0 {
+                run_start = Some((x, row));
             }
-            last_goal = x;
-            if let Some(s) = run_start
-                && best.is_none_or(|(a, b)| last_goal + 1.0 - s > b - a)
+            last_goal = (x, row);
+            if let Some((s, s_row)) = run_start
+                && best.is_none_or(|(a, _, b, _)| last_goal.0 + 1.0 - s > b - a)
             {
-                best = Some((s, last_goal + 1.0));
+                best = Some((s, s_row, last_goal.0 + 1.0, row));
             }
         }
         x += 1.0;
@@ -1086,9 +1366,9 @@ fn find_gap(
         rotate_about((e[0], y), centre, -angle),
         rotate_about((e[2], y), centre, -angle),
     ));
-    if let Some((a, b)) = best {
-        let left = rotate_about((a, y), centre, -angle);
-        let right = rotate_about((b, y), centre, -angle);
+    if let Some((a, a_row, b, b_row)) = best {
+        let left = rotate_about((a, a_row), centre, -angle);
+        let right = rotate_about((b, b_row), centre, -angle);
         let (ref_left, ref_right) = if p.skew_correction {
             (
                 unskew(ctx, p, left, distance),
@@ -1229,7 +1509,12 @@ mod tests {
             .image_from_field(&crate::geometry::Point::new(191.9 * 30.0 / 25.0, 0.0, 0.0))
             .expect("in view");
         let bottom = foot.y_px.round() as usize;
-        let img = scene(40, 150, bottom - 25, bottom, Some((70, 90, bottom - 35)));
+        let mut img = scene(40, 150, bottom - 25, bottom, Some((70, 90, bottom - 35)));
+        // A noisy UYVY pixel pair on the gap scan's row (12.5 px above the bottom) leaves two
+        // pixels unclassified: the gap goes on across them.
+        for x in [120, 121] {
+            img.codes_mut()[(bottom - 13) * 208 + x] = ColourClass::Unclassified.code();
+        }
         let blobs = BlobSet::from_image(&img, Connectivity::Eight);
         let res = recognise_goals(&img, &blobs, &ctx, &GoalParams::default(), &[]);
         let goals: Vec<_> = res.goals().collect();
@@ -1256,6 +1541,8 @@ mod tests {
             .find(|p| p.side == PostSide::Right)
             .expect("right");
         assert!((right.top.0 - 150.0).abs() < 1.0);
+        // Seen from in front: no side wall's outer face.
+        assert!(g.posts.iter().all(|p| p.side_wall_px.is_none()));
         let gap = g.gap.as_ref().expect("gap");
         assert!(
             (gap.left.0 - 90.0).abs() < 1.5 && (gap.right.0 - 150.0).abs() < 1.5,
@@ -1263,6 +1550,77 @@ mod tests {
         );
         assert!(gap.left_bearing_rad > gap.right_bearing_rad);
         assert!(!res.primitives().is_empty());
+    }
+
+    #[test]
+    fn a_side_wall_seen_from_outside_puts_the_post_on_its_front_corner() {
+        // Standing beside a box goal: the left side wall's outer face shows from its back corner
+        // (x = 40, the outline) to its front corner (x = 48). The front is nearer, so the wall's
+        // foot descends towards it and its top rises; beyond it the back wall, farther away,
+        // ends two rows higher, with the carpet inside the mouth below it.
+        let ctx = ctx();
+        let pose = ctx.pose.expect("pose");
+        let foot = pose
+            .image_from_field(&crate::geometry::Point::new(191.9 * 30.0 / 25.0, 0.0, 0.0))
+            .expect("in view");
+        let bottom = foot.y_px.round() as usize;
+        let top = bottom - 25;
+        let (w, h) = (208, 160);
+        let extent = |x: usize| match x {
+            40..=41 => Some((top + 1, bottom - 2)),
+            42..=44 => Some((top + 1, bottom - 1)),
+            45..=47 => Some((top, bottom)),
+            48..=150 => Some((top + 2, bottom - 2)),
+            _ => None,
+        };
+        let codes = (0..w * h)
+            .map(|k| {
+                let (x, y) = (k % w, k / w);
+                match extent(x) {
+                    Some((t, b)) if (t..b).contains(&y) => ColourClass::Yellow.code(),
+                    Some((_, b)) if y >= b => ColourClass::Green.code(),
+                    None if y >= bottom - 2 => ColourClass::Green.code(),
+                    _ => ColourClass::White.code(),
+                }
+            })
+            .collect();
+        let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let p = GoalParams::default();
+        let res = recognise_goals(&img, &blobs, &ctx, &p, &[]);
+        let g = res.goals().next().expect("goal");
+        let left = g
+            .posts
+            .iter()
+            .find(|q| q.side == PostSide::Left)
+            .expect("left post");
+        // The post's centre is half a wall outside the corner.
+        let inset = p.post_inset_cm * ctx.camera.focal_px / g.camera.distance_cm;
+        let wall = left.side_wall_px.expect("side wall seen");
+        assert!((wall - 8.0).abs() < 0.5, "{wall}");
+        for x in [left.top.0, left.bottom.0] {
+            assert!((x - (48.0 - inset)).abs() < 0.5, "{left:?}");
+        }
+        // The right side is seen from in front: its post stays on the outline.
+        let right = g
+            .posts
+            .iter()
+            .find(|q| q.side == PostSide::Right)
+            .expect("right post");
+        assert!(right.side_wall_px.is_none() && (right.top.0 - 151.0).abs() < 1.5);
+        // Without the front-corner search the left post is the back corner's.
+        let off = GoalParams {
+            post_front_corner: false,
+            ..p
+        };
+        let res = recognise_goals(&img, &blobs, &ctx, &off, &[]);
+        let g = res.goals().next().expect("goal");
+        let left = g
+            .posts
+            .iter()
+            .find(|q| q.side == PostSide::Left)
+            .expect("left");
+        assert!(left.side_wall_px.is_none() && (left.top.0 - (40.0 + inset)).abs() < 0.5);
     }
 
     #[test]

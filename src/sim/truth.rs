@@ -174,7 +174,7 @@ pub struct PostTruth {
     pub image_top: Option<ImagePoint>,
 }
 
-/// The widest stretch of a goal not hidden by robots.
+/// An open stretch of a goal: not hidden by anything in front, along the gap scan.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GoalGap {
     /// Leftmost open column.
@@ -202,8 +202,13 @@ pub struct GoalTruth {
     /// Left and right post as seen from the field (left = +y side for the yellow goal seen
     /// from the centre).
     pub posts: [PostTruth; 2],
-    /// The largest stretch of goal columns with no robot in front, if any of the goal shows.
+    /// The largest open stretch of the goal along the gap scan (see `open_gaps`), if any of
+    /// the goal shows.
     pub largest_gap: Option<GoalGap>,
+    /// The second largest open stretch, if any: two of about equal width are both "the
+    /// largest" to within a pixel or two.
+    #[serde(default)]
+    pub second_gap: Option<GoalGap>,
 }
 
 /// A beacon in a robot's view.
@@ -483,13 +488,17 @@ pub fn robot_view_truth(
                 image_top: pose.image_from_field(&Point::new(x, y, f.goal_height_cm)),
             };
             let cov = coverage(objects, w, id);
+            let gaps = cov.bbox.map_or_else(Vec::new, |b| {
+                open_gaps(objects, w, id, &b, pose, &Point::new(x, 0.0, 0.0))
+            });
             GoalTruth {
                 colour,
                 relative: relative(pose, &robot_pose, &Point::new(x, 0.0, 0.0)),
                 visible_pixels: cov.pixels,
                 image_box: cov.bbox,
                 posts: [post(s * post_y), post(-s * post_y)],
-                largest_gap: cov.bbox.and_then(|b| largest_gap(objects, w, id, &b, pose)),
+                largest_gap: gaps.first().copied(),
+                second_gap: gaps.get(1).copied(),
             }
         })
         .collect();
@@ -578,53 +587,115 @@ fn disc_in_image(c: ImagePoint, r: f64, w: usize, h: usize) -> (f64, CutOff, f64
     )
 }
 
-/// The longest run of columns in the goal's box that show the goal and no robot within the
-/// box's rows.
-fn largest_gap(
+/// Height above the ground of the gap scan, centimetres: about an ERS-7's shoulder, where the
+/// requirement puts it (and the recognition's default `gap_scan_height_cm`).
+pub const GAP_SCAN_HEIGHT_CM: f64 = 15.0;
+
+/// The open stretches of a goal, widest first: runs of goal pixels, not hidden by anything in
+/// front, along the image line parallel to the horizon through the point 15 cm above the
+/// mouth's centre ([`GAP_SCAN_HEIGHT_CM`]), sampled every pixel across the goal's box. Where
+/// that line leaves the image (a goal cut off at the top under a tilted horizon), each sample
+/// moves down, perpendicular to the horizon, to the first row inside it within the box: what
+/// the camera shows of that stretch. Ends are the pixel columns of the first and last sample.
+fn open_gaps(
     objects: &[u16],
     w: usize,
     goal: u16,
     b: &PixelBox,
     pose: &CameraPose,
-) -> Option<GoalGap> {
-    let open = |x: usize| {
-        let mut goal_seen = false;
-        for y in b.min_y..=b.max_y {
-            match objects.get(y * w + x) {
-                Some(&o) if o == goal => goal_seen = true,
-                Some(&o) if (object_id::ROBOT..object_id::CLUTTER).contains(&o) => return false,
-                _ => {}
-            }
-        }
-        goal_seen
+    mouth: &Point<Field>,
+) -> Vec<GoalGap> {
+    let h = objects.len() / w.max(1);
+    let Some(at) = pose.image_from_field(&Point::new(
+        mouth.x(),
+        mouth.y(),
+        mouth.z() + GAP_SCAN_HEIGHT_CM,
+    )) else {
+        return Vec::new();
     };
-    let (mut best, mut run_start): (Option<(usize, usize)>, Option<usize>) = (None, None);
-    for x in b.min_x..=b.max_x + 1 {
-        if x <= b.max_x && open(x) {
-            run_start.get_or_insert(x);
-        } else if let Some(s) = run_start.take() {
-            let e = x - 1;
-            if best.is_none_or(|(bs, be)| e - s > be - bs) {
-                best = Some((s, e));
-            }
+    let c = pose.camera.centre;
+    let angle = pose.horizon().map_or(0.0, |h| h.angle_rad);
+    let (sin, cos) = angle.sin_cos();
+    // Image → level frame (the horizon horizontal) and back, about the optical centre.
+    let level = |x: f64, y: f64| {
+        let (dx, dy) = (x - c.x_px, y - c.y_px);
+        (c.x_px + cos * dx - sin * dy, c.y_px + sin * dx + cos * dy)
+    };
+    let image = |x: f64, y: f64| {
+        let (dx, dy) = (x - c.x_px, y - c.y_px);
+        (c.x_px + cos * dx + sin * dy, c.y_px - sin * dx + cos * dy)
+    };
+    #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+    let corners = [
+        level(b.min_x as f64, b.min_y as f64),
+        level((b.max_x + 1) as f64, b.min_y as f64),
+        level(b.min_x as f64, (b.max_y + 1) as f64),
+        level((b.max_x + 1) as f64, (b.max_y + 1) as f64),
+    ];
+    let x0 = corners
+        .iter()
+        .map(|p| p.0)
+        .fold(f64::INFINITY, f64::min)
+        .floor();
+    let x1 = corners
+        .iter()
+        .map(|p| p.0)
+        .fold(f64::NEG_INFINITY, f64::max)
+        .ceil();
+    let bottom = corners
+        .iter()
+        .map(|p| p.1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let row = level(at.x_px, at.y_px).1;
+    #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+    let (wf, hf) = (w as f64, h as f64);
+    let inside = |q: (f64, f64)| q.0 >= 0.0 && q.1 >= 0.0 && q.0 < wf && q.1 < hf;
+    // Per sample: the image point and whether it shows the goal.
+    let mut samples = Vec::new();
+    let mut x = x0;
+    while x <= x1 {
+        let mut y = row;
+        let mut q = image(x + 0.5, y);
+        while !inside(q) && y + 1.0 < bottom {
+            y += 1.0;
+            q = image(x + 0.5, y);
         }
+        #[expect(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            reason = "inside the image"
+        )]
+        let shows = inside(q) && objects.get(q.1 as usize * w + q.0 as usize) == Some(&goal);
+        samples.push((q, shows));
+        x += 1.0;
     }
-    best.map(|(s, e)| {
-        #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
-        let mid_y = (b.min_y + b.max_y) as f64 / 2.0 + 0.5;
-        #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
-        let (left, right) = (
-            pose.camera.bearing_rad(ImagePoint::new(s as f64, mid_y)),
-            pose.camera
-                .bearing_rad(ImagePoint::new((e + 1) as f64, mid_y)),
-        );
-        GoalGap {
-            from_x_px: s,
-            to_x_px: e,
-            centre_bearing_rad: (left + right) / 2.0,
-            width_rad: left - right,
-        }
-    })
+    let mut gaps: Vec<GoalGap> = samples
+        .chunk_by(|a, b| a.1 == b.1)
+        .filter(|run| run.first().is_some_and(|s| s.1))
+        .filter_map(|run| {
+            let (first, last) = (run.first()?.0, run.last()?.0);
+            #[expect(
+                clippy::cast_possible_truncation,
+                clippy::cast_sign_loss,
+                reason = "inside the image"
+            )]
+            let (s, e) = (first.0 as usize, (last.0 as usize).max(first.0 as usize));
+            #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
+            let (left, right) = (
+                pose.camera.bearing_rad(ImagePoint::new(s as f64, first.1)),
+                pose.camera
+                    .bearing_rad(ImagePoint::new((e + 1) as f64, last.1)),
+            );
+            Some(GoalGap {
+                from_x_px: s,
+                to_x_px: e,
+                centre_bearing_rad: (left + right) / 2.0,
+                width_rad: left - right,
+            })
+        })
+        .collect();
+    gaps.sort_by_key(|g| std::cmp::Reverse(g.to_x_px - g.from_x_px));
+    gaps
 }
 
 /// Builds the truth of an overhead frame.
@@ -684,6 +755,47 @@ mod tests {
         let (f, cut, _) = disc_in_image(ImagePoint::new(-50.0, 80.0), 10.0, 208, 160);
         assert_eq!(f, 0.0);
         assert_eq!(cut, CutOff::default());
+    }
+
+    #[test]
+    fn open_gaps_run_along_the_shoulder_row_and_stop_at_what_is_in_front() {
+        use crate::geometry::{PinholeCamera, Transform};
+        use nalgebra::{UnitQuaternion, Vector3};
+        // A level camera 20 cm up looking along +x: 15 cm above a mouth 200 cm ahead is
+        // 191.9 · 5 / 200 = 4.8 px below the centre, row 84.
+        let pose = CameraPose {
+            camera: PinholeCamera::ers7(),
+            field_from_camera: Transform::new(
+                Vector3::new(0.0, 0.0, 20.0),
+                UnitQuaternion::identity(),
+            ),
+        };
+        let (w, h, goal, robot) = (208, 160, 2_u16, object_id::ROBOT);
+        let mut objects = vec![0_u16; w * h];
+        for y in 70..96 {
+            for x in 60..150 {
+                objects[y * w + x] = goal;
+            }
+        }
+        // A robot hides columns 90..=100 below row 80, and a ball-sized thing 120..=121 only
+        // below the scan row.
+        for y in 80..96 {
+            for x in 90..=100 {
+                objects[y * w + x] = robot;
+            }
+        }
+        for y in 88..96 {
+            for x in 120..=121 {
+                objects[y * w + x] = object_id::BALL;
+            }
+        }
+        let b = coverage(&objects, w, goal).bbox.expect("goal");
+        let gaps = open_gaps(&objects, w, goal, &b, &pose, &Point::new(200.0, 0.0, 0.0));
+        let spans: Vec<(usize, usize)> = gaps.iter().map(|g| (g.from_x_px, g.to_x_px)).collect();
+        assert_eq!(spans, vec![(101, 149), (60, 89)]);
+        assert!(gaps[0].width_rad > gaps[1].width_rad && gaps[1].width_rad > 0.0);
+        // The centre bearing of the right stretch is right of the image centre (negative).
+        assert!(gaps[0].centre_bearing_rad < 0.0);
     }
 
     #[test]

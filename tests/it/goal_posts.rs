@@ -34,6 +34,29 @@ fn rolling_image(
     Some((x, y))
 }
 
+/// The debugging aids' table, seed and frame count: the learnt table, seed 7 and 90 frames
+/// unless `EOTN_DEBUG_LUT` (a table file), `EOTN_DEBUG_SEED` or `EOTN_DEBUG_NFRAMES` say
+/// otherwise.
+pub(crate) fn debug_setup() -> (eotn::lut::LookupTable, u64, u64) {
+    let lut = std::env::var("EOTN_DEBUG_LUT")
+        .ok()
+        .filter(|p| !p.is_empty())
+        .map_or_else(super::recognition::learnt_table, |path| {
+            eotn::lut::LookupTable::load(std::path::Path::new(&path)).expect("table")
+        });
+    let number = |name: &str, default: u64| {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    };
+    (
+        lut,
+        number("EOTN_DEBUG_SEED", 7),
+        number("EOTN_DEBUG_NFRAMES", 90),
+    )
+}
+
 /// Per-post detail for one scenario: `EOTN_DEBUG_SCENARIO=walk-and-pan cargo test --test it
 /// debug_posts -- --ignored --nocapture`. For each detected post: signed error (detected − true,
 /// pixels, at mid-height) of the raw line against the rolling-shutter image of the post's front
@@ -44,12 +67,12 @@ fn rolling_image(
 fn debug_posts() {
     let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "walk-and-pan".into());
     let kind = ScenarioKind::from_name(&name).expect("scenario name");
-    let lut = super::recognition::learnt_table();
-    let scenario = Scenario::new(kind, 7);
+    let (lut, seed, frames) = debug_setup();
+    let scenario = Scenario::new(kind, seed);
     let sim = Simulator::new(scenario);
     let field = scenario.scene_at(0.0).field;
     let mut pipeline = Pipeline::new(lut, PipelineParams::default());
-    for i in 0..90u64 {
+    for i in 0..frames {
         let f = sim.frame(i).expect("frame");
         let GroundTruth::Robot(truth) = &f.ground_truth else {
             continue;
@@ -102,11 +125,41 @@ fn debug_posts() {
                         Some(line_x(post.top, post.bottom, q.1) - q.0)
                     })
                     .collect();
+                // Raw (rolling-shutter) errors of the raw line at the foot and top of the front
+                // centre and of the back outer corner.
+                let raw_ends: Vec<Option<(f64, f64)>> = [(x0, y_post), (x1, outer)]
+                    .iter()
+                    .map(|(x, y)| {
+                        let err = |z: f64| {
+                            let q = rolling_image(&scenario, t, &Point::new(*x, *y, z))?;
+                            Some(
+                                ((line_x(post.top, post.bottom, q.1) - q.0) * 100.0).round()
+                                    / 100.0,
+                            )
+                        };
+                        Some((err(0.0)?, err(field.goal_height_cm)?))
+                    })
+                    .collect();
+                eprintln!(
+                    "    raw (foot, top) errors: front centre {:?}, back outer {:?}",
+                    raw_ends[0], raw_ends[1]
+                );
                 let reference = {
                     let (b, top) = (tp.image_base.expect("b"), tp.image_top.expect("t"));
                     let y = (b.y_px + top.y_px) / 2.0;
                     let x = (b.x_px + top.x_px) / 2.0;
                     line_x(post.reference_top, post.reference_bottom, y) - x
+                };
+                // What `eotn eval` scores: the reference line against the true foot and top.
+                let ends = {
+                    let (b, top) = (tp.image_base.expect("b"), tp.image_top.expect("t"));
+                    let at = |q: eotn::geometry::ImagePoint| {
+                        ((line_x(post.reference_top, post.reference_bottom, q.y_px) - q.x_px)
+                            * 100.0)
+                            .round()
+                            / 100.0
+                    };
+                    (at(b), at(top))
                 };
                 // The rolling shutter's true displacement of the front centre at mid-height
                 // (reference projection − rolling image) against the models' displacement of
@@ -140,7 +193,7 @@ fn debug_posts() {
                     robot.y_cm.abs() > outer.abs() && robot.y_cm.signum() == outer.signum();
                 let r1 = |v: Option<f64>| v.map(|v| (v * 100.0).round() / 100.0);
                 eprintln!(
-                    "#{i:>2} {:?} post{k} {:?} pan {:+.3} dpan {:+.4} robot ({:.0},{:.0}) outer-face {} | raw vs front-centre {:?} front-outer {:?} back-outer {:?} | ref err {:+.2} | top-bottom dx {:+.2}",
+                    "#{i:>2} {:?} post{k} {:?} pan {:+.3} dpan {:+.4} robot ({:.0},{:.0}) outer-face {} side wall {:?} | raw vs front-centre {:?} front-outer {:?} back-outer {:?} | ref err {:+.2} (foot, top) {:?} | top-bottom dx {:+.2}",
                     g.colour,
                     post.side,
                     f.sensors.and_then(|s| s.head_pan_rad).unwrap_or(f64::NAN),
@@ -150,12 +203,114 @@ fn debug_posts() {
                     robot.x_cm,
                     robot.y_cm,
                     lateral,
+                    r1(post.side_wall_px),
                     r1(errs[0]),
                     r1(errs[1]),
                     r1(errs[2]),
                     reference,
+                    ends,
                     post.bottom.0 - post.top.0,
                 );
+            }
+        }
+    }
+}
+
+/// Level-frame picture of each accepted goal's sides: `EOTN_DEBUG_SCENARIO=beacon-tour cargo
+/// test --test it debug_post_profiles -- --ignored --nocapture` (`EOTN_DEBUG_FRAMES=61,64`
+/// picks frames). One character per level pixel (`Y` goal colour, `g` green, `w` white, `.`
+/// other); below each picture the level x of the true front-post centre and back outer corner
+/// (rolling-shutter image at the goal's mid-height) and of the detected post.
+#[test]
+#[ignore = "a debugging aid, not a check"]
+fn debug_post_profiles() {
+    use eotn::lut::ColourClass;
+    use eotn::recognition::fit::rotate_about;
+    let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "beacon-tour".into());
+    let kind = ScenarioKind::from_name(&name).expect("scenario name");
+    let frames: Vec<u64> = std::env::var("EOTN_DEBUG_FRAMES")
+        .unwrap_or_default()
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    let (lut, seed, count) = debug_setup();
+    let scenario = Scenario::new(kind, seed);
+    let sim = Simulator::new(scenario);
+    let field = scenario.scene_at(0.0).field;
+    let mut pipeline = Pipeline::new(lut, PipelineParams::default());
+    for i in 0..count {
+        if !frames.is_empty() && !frames.contains(&i) {
+            continue;
+        }
+        let f = sim.frame(i).expect("frame");
+        let t = i as f64 * FRAME_INTERVAL_S;
+        let ctx = PipelineParams::default()
+            .recognition
+            .context_for(208, 160, f.sensors.as_ref());
+        let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+        let angle = ctx.horizon_angle();
+        let r = pipeline.process(&f.frame, f.sensors.as_ref());
+        let img = r.classified;
+        for g in r.recognition.goals.goals() {
+            let s = if g.colour == ColourClass::Yellow {
+                1.0
+            } else {
+                -1.0
+            };
+            let e = g.level_extent;
+            eprintln!(
+                "#{i} {:?} level extent {:.1?} cut {:?} d {:.0} angle {:.3}",
+                g.colour, e, g.cut_off, g.camera.distance_cm, angle
+            );
+            let x0 = s * field.length_cm / 2.0;
+            let x1 = s * (field.length_cm / 2.0 + field.goal_depth_cm);
+            let z = field.goal_height_cm / 2.0;
+            let level_of = |p: &Point<eotn::geometry::Field>| {
+                rolling_image(&scenario, t, p).map(|q| rotate_about(q, centre, angle).0)
+            };
+            let mut marks = Vec::new();
+            for side in [1.0, -1.0] {
+                let y_post = side * (field.goal_width_cm / 2.0 + field.goal_wall_cm / 2.0);
+                let outer = side * (field.goal_width_cm / 2.0 + field.goal_wall_cm);
+                marks.push(("front-centre", level_of(&Point::new(x0, y_post, z))));
+                marks.push(("back-outer", level_of(&Point::new(x1, outer, z))));
+            }
+            for post in &g.posts {
+                let m = (
+                    (post.top.0 + post.bottom.0) / 2.0,
+                    (post.top.1 + post.bottom.1) / 2.0,
+                );
+                marks.push(("detected", Some(rotate_about(m, centre, angle).0)));
+            }
+            for (label, x) in &marks {
+                eprintln!("    {label} {x:.2?}");
+            }
+            let (xa, xb) = (
+                e[0].floor() as i64 - 3,
+                (e[0].floor() as i64 + 40).min(e[2].ceil() as i64 + 3),
+            );
+            let (xa2, xb2) = ((e[2].ceil() as i64 - 40).max(xa), e[2].ceil() as i64 + 3);
+            for (a, b) in [(xa, xb), (xa2, xb2)] {
+                eprintln!("    columns {a}..{b}");
+                for y in (e[1].floor() as i64 - 2)..=(e[3].ceil() as i64 + 2) {
+                    let row: String = (a..b)
+                        .map(|x| {
+                            let q = rotate_about((x as f64 + 0.5, y as f64 + 0.5), centre, -angle);
+                            match img
+                                .get_signed(q.0.floor() as i64, q.1.floor() as i64)
+                                .and_then(ColourClass::from_code)
+                            {
+                                Some(c) if c == g.colour => 'Y',
+                                Some(c) if c.may_be_class(g.colour) => 'y',
+                                Some(ColourClass::Green) => 'g',
+                                Some(ColourClass::White) => 'w',
+                                None => ' ',
+                                Some(_) => '.',
+                            }
+                        })
+                        .collect();
+                    eprintln!("    {y:4} {row}");
+                }
             }
         }
     }
