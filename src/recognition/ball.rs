@@ -636,8 +636,8 @@ fn circle_fill(img: &ClassifiedImage, center: Point, radius: f64) -> Option<f64>
                 && y >= 0.0
                 && x < w
                 && y < h
-                && (x - center.0).hypot(y - center.1) <= radius
-                && let Some(c) = img.get_signed(x.floor() as i64, y.floor() as i64)
+                && (x - center.0).powi(2) + (y - center.1).powi(2) <= radius * radius
+                && let Some(c) = img.get_at(x, y)
             {
                 n += 1;
                 ball += u32::from(is_ball_colour(c));

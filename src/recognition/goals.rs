@@ -806,10 +806,7 @@ fn side_height(
         for i in 0..rows {
             let y = e[1] - 1.0 + i as f64;
             let q = rotate_about((x, y + 0.5), centre, -angle);
-            if img
-                .get_signed(q.0.floor() as i64, q.1.floor() as i64)
-                .is_some_and(is_goal)
-            {
+            if img.get_at(q.0, q.1).is_some_and(is_goal) {
                 top.get_or_insert(y);
                 bottom = Some(y + 1.0);
             }
@@ -862,8 +859,7 @@ fn scan_level_row(
     let steps = (to - from).abs().ceil() as usize;
     let goal_at = |x: f64| {
         let q = rotate_about((x, y), centre, -angle);
-        img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
-            .is_some_and(is_goal)
+        img.get_at(q.0, q.1).is_some_and(is_goal)
     };
     for k in 0..=steps {
         let x = from + dir * k as f64;
@@ -1163,7 +1159,7 @@ fn front_corner(
             centre.0 + cos * dx - sin * dy,
             centre.1 + sin * dx + cos * dy,
         );
-        img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
+        img.get_at(q.0, q.1)
     };
     let goal_at = |x: f64, y: f64| code_at(x, y).is_some_and(is_goal);
     let ground = |c: Option<u8>| {
@@ -1335,10 +1331,7 @@ fn find_gap(
             yy += 1.0;
             q = rotate_about((x + 0.5, yy), centre, -angle);
         }
-        let goal_at = |q: Point| {
-            img.get_signed(q.0.floor() as i64, q.1.floor() as i64)
-                .is_some_and(&is_goal)
-        };
+        let goal_at = |q: Point| img.get_at(q.0, q.1).is_some_and(&is_goal);
         // A sample moved into the image lies on its outermost rows, which vignetting and the
         // shared chroma of a cut-off pixel pair leave unclassified now and then: the next row
         // in counts too.

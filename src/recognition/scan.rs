@@ -80,7 +80,7 @@ pub fn scan_rotated_rect(
     for j in 0..=ny {
         for i in 0..=nx {
             let p = corner(left + i as f64 * step, top + j as f64 * step);
-            if let Some(code) = img.get_signed(p.0.floor() as i64, p.1.floor() as i64) {
+            if let Some(code) = img.get_at(p.0, p.1) {
                 count.scanned += 1;
                 count.per_class[usize::from(code & 15)] += 1;
             }
