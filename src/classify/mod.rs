@@ -334,7 +334,7 @@ mod tests {
         let img = ClassifiedImage::from_codes(4, 3, codes).expect("size");
         // Pixel (i, j) covers [i, i + 1) × [j, j + 1): the same as flooring, for any point.
         for (x, y) in [
-            (0.0, 0.0),
+            (0.0_f64, 0.0_f64),
             (0.99, 0.5),
             (1.0, 1.0),
             (3.999, 2.999),
