@@ -521,13 +521,24 @@ pub fn recognise_goals(
                     TestWeight::new(0.0, p.beacon_overlap_penalty),
                 );
             }
-            find_posts(img, &mut cand, colour, ctx, p);
+            // The post search is most of a candidate's cost. One that cannot reach a positive
+            // total even with the posts' reward (a tile of goal colour far too small or too
+            // high for a goal) is not searched: its breakdown says why it failed already.
+            let hopeless = cand.confidence.total + p.post_weight.reward <= 0.0;
+            if hopeless {
+                cand.rejected_posts.push(format!(
+                    "not searched: confidence {:.2} cannot turn positive",
+                    cand.confidence.total
+                ));
+            } else {
+                find_posts(img, &mut cand, colour, ctx, p);
+            }
             let e = cand.level_extent;
             let area = f64::from(cand.bounds[2] - cand.bounds[0] + 1)
                 * f64::from(cand.bounds[3] - cand.bounds[1] + 1);
             let fills = area >= p.fills_image_fraction * img.width() as f64 * img.height() as f64;
             let sides_in_view = !(cand.cut_off.left && cand.cut_off.right);
-            if fills || !sides_in_view || e[3] - e[1] < p.post_test_min_height_px {
+            if hopeless || fills || !sides_in_view || e[3] - e[1] < p.post_test_min_height_px {
                 cand.confidence.skipped("upright_posts", [1.0, 2.0]);
             } else {
                 // A goal shows an upright post on a side in view; a band of goal colour along
@@ -1691,6 +1702,38 @@ mod tests {
             1.5,
         );
         assert!(c.left && c.bottom && !c.top && !c.right);
+    }
+
+    #[test]
+    fn a_small_tile_of_goal_colour_in_the_sky_is_not_searched_for_posts() {
+        // A 9 × 9-pixel yellow tile high above the horizon (a coloured-pattern marker's): its
+        // other tests already rule it out, so the post search is not run, and says so.
+        let mut img = scene(0, 0, 0, 90, None);
+        for y in 2..11 {
+            for x in 150..159 {
+                img.codes_mut()[y * 208 + x] = ColourClass::Yellow.code();
+            }
+        }
+        let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+        let p = GoalParams::default();
+        let res = recognise_goals(&img, &blobs, &ctx(), &p, &[]);
+        assert_eq!(res.candidates.len(), 1);
+        let c = &res.candidates[0];
+        assert!(!c.accepted);
+        assert!(c.confidence.total + p.post_weight.reward <= 0.0);
+        assert!(c.posts.is_empty() && c.post_points.is_empty());
+        assert!(
+            c.rejected_posts
+                .iter()
+                .any(|r| r.starts_with("not searched")),
+            "{:?}",
+            c.rejected_posts
+        );
+        let posts = c.confidence.test("upright_posts").expect("posts test");
+        assert_eq!(
+            posts.outcome,
+            crate::recognition::confidence::TestOutcome::Skipped
+        );
     }
 
     #[test]
