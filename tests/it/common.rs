@@ -43,6 +43,18 @@ pub fn eotn(args: &[&std::ffi::OsStr]) -> Output {
         .expect("the eotn binary runs")
 }
 
+/// Runs the `eotn` binary and fails the test, showing its stderr, unless it succeeds.
+pub fn eotn_ok(args: &[&std::ffi::OsStr]) -> Output {
+    let out = eotn(args);
+    assert!(
+        out.status.success(),
+        "eotn {:?}: {}",
+        args,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// A python3 that has numpy and OpenCV, or `None` (with a "skipped" line) outside CI.
 /// Under `CI=true` their absence fails the test: the cross-check must never skip silently there.
 pub fn python_with_opencv() -> Option<PathBuf> {

@@ -18,7 +18,7 @@ use eotn::sim::scenario::pattern_markers;
 use eotn::sim::truth::GroundTruth;
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
-use crate::common::eotn;
+use crate::common::{eotn, eotn_ok};
 
 /// Learns from `frames` frames of the pattern tour with `seed`, the robot's pose from the truth
 /// (what its localisation would report), nothing else from the truth.
@@ -216,7 +216,7 @@ fn learn_and_detect_from_the_command_line() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let lut = root.join("lookup_tables/sim.lut");
     let stream = dir.path().join("tour.mcap");
-    let out = eotn(&[
+    eotn_ok(&[
         OsStr::new("sim"),
         OsStr::new("--scenario"),
         OsStr::new("pattern-tour"),
@@ -227,11 +227,6 @@ fn learn_and_detect_from_the_command_line() {
         OsStr::new("-o"),
         stream.as_os_str(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     // The robot's poses as its localisation would give them: a CSV table (here from the
     // scenario itself).
     let scenario = Scenario::new(ScenarioKind::PatternTour, 5);
@@ -271,7 +266,7 @@ fn learn_and_detect_from_the_command_line() {
     assert!(memory.relation.is_some());
 
     // Identification on the same stream: a `patterns` list per frame.
-    let out = eotn(&[
+    let out = eotn_ok(&[
         OsStr::new("detect"),
         stream.as_os_str(),
         OsStr::new("--lut"),
@@ -280,11 +275,6 @@ fn learn_and_detect_from_the_command_line() {
         places.as_os_str(),
         OsStr::new("--json"),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let lines: Vec<serde_json::Value> = out
         .stdout
         .split(|&b| b == b'\n')
@@ -305,7 +295,7 @@ fn learn_and_detect_from_the_command_line() {
     assert!(p["size_px"].is_f64() && p["bearing_rad"].is_f64() && p["bounds"].is_array());
 
     // Evaluation against the stream's truth.
-    let out = eotn(&[
+    let out = eotn_ok(&[
         OsStr::new("eval"),
         stream.as_os_str(),
         OsStr::new("--lut"),
@@ -314,11 +304,6 @@ fn learn_and_detect_from_the_command_line() {
         places.as_os_str(),
         OsStr::new("--json"),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let p = &v["patterns"];
     assert!(p["eligible"].as_u64() > Some(50), "{p}");
