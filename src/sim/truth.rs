@@ -292,12 +292,7 @@ fn marker_truths(
             let to_camera = (camera.x() - m.x_cm, camera.y() - m.y_cm);
             let turn = to_camera.1.atan2(to_camera.0) - m.facing_rad;
             let view_angle_rad = turn.sin().atan2(turn.cos()).abs();
-            #[expect(clippy::cast_precision_loss, reason = "pixel counts are small")]
-            let pink_visible_fraction = if area > 0.0 {
-                (cov.pixels as f64 / area).min(1.0)
-            } else {
-                0.0
-            };
+            let pink_visible_fraction = covered_fraction(cov.pixels, area);
             MarkerTruth {
                 id: i,
                 name: m.name.clone(),
@@ -454,12 +449,7 @@ pub fn robot_view_truth(
             (Some(c), Some(r)) => disc_in_image(c, r, w, h),
             _ => (0.0, CutOff::default(), 0.0),
         };
-        #[expect(clippy::cast_precision_loss, reason = "pixel counts are small")]
-        let visible_fraction = if area > 0.0 {
-            (cov.pixels as f64 / area).min(1.0)
-        } else {
-            0.0
-        };
+        let visible_fraction = covered_fraction(cov.pixels, area);
         BallTruth {
             relative: rel,
             image_radius_px: radius,
@@ -736,6 +726,17 @@ pub fn overhead_truth(
                 .pixels,
             })
             .collect(),
+    }
+}
+
+/// The share of an object's full image area (pixels²) that its visible pixels cover, 0 to 1
+/// (0 when the area is empty).
+#[expect(clippy::cast_precision_loss, reason = "pixel counts are small")]
+fn covered_fraction(pixels: usize, area: f64) -> f64 {
+    if area > 0.0 {
+        (pixels as f64 / area).min(1.0)
+    } else {
+        0.0
     }
 }
 
