@@ -9,8 +9,10 @@ cd "$(dirname "$0")/.."
 ROUNDS=${1:-5}
 SHARED=${EOTN_SHARED:-../shared}
 WORK=${TMPDIR:-/tmp}/eotn-bench-compare
+scripts/deps.sh --test   # numpy and OpenCV for the peer, in .venv/
+PYTHON=${PYTHON:-.venv/bin/python}
 mkdir -p "$WORK"
-[ -f "$WORK/sample_b7.lut" ] || python3 "$SHARED/bench/peer_pipeline.py" --make-sample "$WORK" --sample-frames 4 >/dev/null
+[ -f "$WORK/sample_b7.lut" ] || "$PYTHON" "$SHARED/bench/peer_pipeline.py" --make-sample "$WORK" --sample-frames 4 >/dev/null
 gcc -O3 -march=native -o "$WORK/floors" "$SHARED/bench/floors.c"
 cargo build --release --no-default-features --quiet
 EOTN=target/release/eotn
@@ -21,14 +23,14 @@ for size in 208x160 640x480; do
   : > "$WORK/$size.eotn"; : > "$WORK/$size.plain"; : > "$WORK/$size.avx2"; : > "$WORK/$size.peer"
   for _ in $(seq "$ROUNDS"); do
     "$EOTN" bench "$frame" --lut "$WORK/sample_b7.lut" --reps 400 --json | tail -1 \
-      | python3 -c 'import json,sys; print(json.load(sys.stdin)["total_ns_per_px"])' >> "$WORK/$size.eotn"
+      | "$PYTHON" -c 'import json,sys; print(json.load(sys.stdin)["total_ns_per_px"])' >> "$WORK/$size.eotn"
     out=$("$WORK/floors" "$frame" "$w" "$h" "$WORK/sample_b7.lut")
     echo "$out" | awk '/^classify\+cc8 \(pipeline\)/{print $(NF-1)}' >> "$WORK/$size.plain"
     echo "$out" | awk '/^classify\+cc8 simd-rle/{print $(NF-1)}' >> "$WORK/$size.avx2"
-    python3 "$SHARED/bench/peer_pipeline.py" "$frame" --lut "$WORK/sample_b7.lut" --width "$w" --height "$h" --bench 30 \
+    "$PYTHON" "$SHARED/bench/peer_pipeline.py" "$frame" --lut "$WORK/sample_b7.lut" --width "$w" --height "$h" --bench 30 \
       | awk '/^total/{print $(NF-1)}' >> "$WORK/$size.peer"
   done
-  python3 - "$WORK" "$size" <<'PY'
+  "$PYTHON" - "$WORK" "$size" <<'PY'
 import statistics, sys
 work, size = sys.argv[1], sys.argv[2]
 med = {k: statistics.median(float(x) for x in open(f"{work}/{size}.{k}")) for k in ("eotn", "plain", "avx2", "peer")}

@@ -10,7 +10,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 FRAMES=${1:-48}
 SHARED=${EOTN_SHARED:-../shared}
-PYTHON=${PYTHON:-python3}
+scripts/deps.sh --test   # numpy and OpenCV for peer_pipeline.py, in .venv/
+PYTHON=${PYTHON:-.venv/bin/python}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 

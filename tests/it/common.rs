@@ -75,10 +75,24 @@ pub fn python_with_mcap() -> Option<PathBuf> {
     )
 }
 
-/// `$PYTHON` (default `python3`) when `import_line` runs in it; else fails under CI and skips
-/// with a line saying which `check` did not run.
+/// The tests' Python: `$PYTHON` if set, else the project's `.venv/` that `scripts/deps.sh --test`
+/// makes from the system interpreter (with the pinned packages of `scripts/requirements-test.txt`),
+/// else `python3` from the PATH.
+pub fn test_python() -> PathBuf {
+    if let Some(p) = std::env::var_os("PYTHON") {
+        return PathBuf::from(p);
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
+    if venv.exists() {
+        return venv;
+    }
+    PathBuf::from("python3")
+}
+
+/// [`test_python`] when `import_line` runs in it; else fails under CI and skips with a line saying
+/// which `check` did not run.
 fn python_with(import_line: &str, packages: &str, check: &str) -> Option<PathBuf> {
-    let python = PathBuf::from(std::env::var_os("PYTHON").unwrap_or_else(|| "python3".into()));
+    let python = test_python();
     let ok = Command::new(&python)
         .args(["-c", import_line])
         .output()
@@ -88,7 +102,7 @@ fn python_with(import_line: &str, packages: &str, check: &str) -> Option<PathBuf
     }
     assert!(
         !in_ci(),
-        "python3 with {packages} is required under CI=true (scripts/deps.sh installs them)"
+        "python3 with {packages} is required under CI=true (scripts/deps.sh --test installs them into .venv/)"
     );
     eprintln!("SKIPPED: python3 with {packages} not found; {check} did not run");
     None
