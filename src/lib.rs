@@ -17,6 +17,7 @@
 //!
 //! See `ARCHITECTURE.md` for the map.
 
+pub mod annotate;
 pub mod atomic_file;
 pub mod blobs;
 pub mod classify;

@@ -10,10 +10,12 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         #[cfg(feature = "gui")]
-        Some(eotn::cli::Command::Open(args)) => eotn::app::run(args.files),
+        Some(eotn::cli::Command::Open(args)) => {
+            eotn::app::run(eotn::app::RunOptions::from_args(&args))
+        }
         Some(command) => eotn::cli::run(command),
         #[cfg(feature = "gui")]
-        None => eotn::app::run(Vec::new()),
+        None => eotn::app::run(eotn::app::RunOptions::default()),
         #[cfg(not(feature = "gui"))]
         None => Err(anyhow::anyhow!(
             "this eotn was built without the desktop app (cargo feature `gui`); see `eotn --help` for the headless commands"

@@ -139,13 +139,10 @@ impl Canvas {
     pub fn draw(&mut self, primitives: &[Primitive]) {
         for p in primitives {
             match p {
-                Primitive::Box { colour, bounds, .. } => {
-                    let c = code_display_rgb(*colour);
-                    self.rect(*bounds, c);
-                }
+                Primitive::Box { bounds, .. } => self.rect(*bounds, primitive_rgb(p)),
                 Primitive::ScanArea { corners, .. } => {
                     for i in 0..4 {
-                        self.line(corners[i], corners[(i + 1) % 4], [255, 0, 255]);
+                        self.line(corners[i], corners[(i + 1) % 4], primitive_rgb(p));
                     }
                 }
                 Primitive::ScanPoints { points, .. } => {
@@ -154,7 +151,7 @@ impl Canvas {
                         self.put(
                             (q.0 * s).floor() as i64,
                             (q.1 * s).floor() as i64,
-                            [0, 255, 255],
+                            primitive_rgb(p),
                         );
                     }
                 }
@@ -168,24 +165,11 @@ impl Canvas {
                         CircleRole::Observed => None,
                         CircleRole::SkewCorrected => Some(3),
                     };
-                    self.circle_dashed(*center, *radius, [255, 255, 0], dash);
+                    self.circle_dashed(*center, *radius, primitive_rgb(p), dash);
                 }
-                Primitive::Line { role, from, to, .. } => {
-                    let c = match role {
-                        LineRole::Horizon => [255, 64, 64],
-                        LineRole::Post => [0, 255, 0],
-                        LineRole::Gap => [255, 255, 255],
-                        LineRole::Scan => [128, 128, 255],
-                    };
-                    self.line(*from, *to, c);
-                }
-                Primitive::PatternRegion {
-                    bounds,
-                    colour,
-                    centre,
-                    ..
-                } => {
-                    let c = pattern_region_rgb(*colour);
+                Primitive::Line { from, to, .. } => self.line(*from, *to, primitive_rgb(p)),
+                Primitive::PatternRegion { bounds, centre, .. } => {
+                    let c = primitive_rgb(p);
                     let [x0, y0, x1, y1] = bounds.map(|v| v as f64);
                     let e = 0.5 / self.scale as f64;
                     let inset = if *centre {
@@ -204,6 +188,36 @@ impl Canvas {
                 Primitive::Label { .. } => {}
             }
         }
+    }
+}
+
+/// The one palette of the overlays: the colour a primitive is drawn in by `eotn render`, the app
+/// and the `foxglove.ImageAnnotations` of `eotn detect --annotate`.
+#[must_use]
+pub fn primitive_rgb(p: &Primitive) -> [u8; 3] {
+    match p {
+        Primitive::Box { colour, .. } => box_rgb(*colour),
+        Primitive::ScanArea { .. } => [255, 0, 255],
+        Primitive::ScanPoints { .. } => [0, 255, 255],
+        Primitive::Circle { .. } => [255, 255, 0],
+        Primitive::Line { role, .. } => match role {
+            LineRole::Horizon => [255, 64, 64],
+            LineRole::Post => [0, 255, 0],
+            LineRole::Gap => [255, 255, 255],
+            LineRole::Scan => [128, 128, 255],
+        },
+        Primitive::PatternRegion { colour, .. } => pattern_region_rgb(*colour),
+        Primitive::Label { .. } => [255, 255, 255],
+    }
+}
+
+/// The colour blob boxes of class `code` are outlined in: the class colour, white for black
+/// (which would vanish on a dark image).
+#[must_use]
+pub fn box_rgb(code: u8) -> [u8; 3] {
+    match code {
+        9 => [255, 255, 255],
+        c => code_display_rgb(c),
     }
 }
 

@@ -14,6 +14,8 @@ use crate::lut::{ColourClass, Sensitivity};
 pub struct MenuOutput {
     /// Quit was chosen.
     pub quit: bool,
+    /// Help ▸ About was chosen.
+    pub about: bool,
 }
 
 /// Path typed into File ▸ Open path (dialogs are not always available, e.g. under Xvfb).
@@ -78,6 +80,12 @@ pub fn menu_bar_ui(
         ui.menu_button("View", |ui| view_menu_ui(ui, state, commands));
         ui.menu_button("Stream", |ui| stream_menu_ui(ui, state, commands));
         ui.menu_button("Windows", |ui| windows_menu_ui(ui, state, commands));
+        ui.menu_button("Help", |ui| {
+            if ui.button("About eotn").clicked() {
+                out.about = true;
+                ui.close();
+            }
+        });
     });
     out
 }

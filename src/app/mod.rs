@@ -1,4 +1,4 @@
-//! The desktop app (feature `gui`): eframe on the wgpu renderer, embedding the same pipeline as
+//! The desktop app (feature `gui`): eframe on wgpu or OpenGL (see `renderer.rs`), embedding the same pipeline as
 //! the CLI. Laid out like egui's demo app and rerun's viewer:
 //!
 //! | file | role |
@@ -12,7 +12,8 @@
 //! | `inspector.rs` | every recognition candidate with its confidence breakdown; selection |
 //! | `sensors_dialog.rs` | every sensor reading with units, plots over the stream |
 //! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
-//! | `menus.rs` | File, Classification, View, Stream, Windows |
+//! | `menus.rs` | File, Classification, View, Stream, Windows, Help |
+//! | `renderer.rs` | wgpu on a GPU, OpenGL on a software rasteriser: the choice before the window opens |
 //!
 //! Only this folder names egui/eframe (`scripts/check.sh` checks it).
 
@@ -21,6 +22,7 @@ pub mod inspector;
 pub mod journal;
 pub mod menus;
 pub mod overlays;
+pub mod renderer;
 pub mod sensors_dialog;
 pub mod source;
 pub mod state;
@@ -43,25 +45,130 @@ const PREVIEW_DIM_ALPHA: u8 = 110;
 /// Key of the persisted [`Settings`] in eframe's storage.
 pub const SETTINGS_KEY: &str = "eotn-settings";
 
-/// Opens the app window on `paths` (streams, frames, tables; none reopens the last session).
+/// How the window starts (`eotn open` and its options).
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Streams, frames, tables to open; none reopens the last session.
+    pub files: Vec<PathBuf>,
+    /// `--renderer`: saved and used when given; else the saved setting, else auto.
+    pub renderer: Option<crate::cli::open::RendererSetting>,
+    /// `--play [--speed]`: start playing at once at this speed.
+    pub play: Option<crate::cli::open::PlaySpeed>,
+    /// `--quit-after`: close the window after this long.
+    pub quit_after: Option<Duration>,
+    /// `--all-overlays`: every overlay on.
+    pub all_overlays: bool,
+}
+
+impl RunOptions {
+    /// From `eotn open`'s arguments.
+    #[must_use]
+    pub fn from_args(args: &crate::cli::open::Args) -> Self {
+        Self {
+            files: args.files.clone(),
+            renderer: args.renderer,
+            play: args.play.then_some(args.speed),
+            quit_after: args
+                .quit_after
+                .filter(|s| s.is_finite() && *s >= 0.0)
+                .map(|s| Duration::from_secs_f64(s.min(1e9))),
+            all_overlays: args.all_overlays,
+        }
+    }
+}
+
+/// What draws the window, for the status bar and the About window.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RendererInfo {
+    /// The renderer running.
+    pub kind: renderer::RendererKind,
+    /// Why it was chosen.
+    pub reason: String,
+    /// The adapter it runs on, as it names itself (wgpu adapter, or GL_RENDERER and version).
+    pub adapter: String,
+    /// The setting it came from (`auto`, `wgpu`, `gl`).
+    pub setting: crate::cli::open::RendererSetting,
+}
+
+/// Opens the app window (streams, frames, tables; none reopens the last session), on the
+/// renderer [`renderer::choose`] picks; if that one cannot start, the other is tried once.
 ///
 /// # Errors
-/// The window or renderer could not be created (no display, no Vulkan/GL driver).
-pub fn run(paths: Vec<PathBuf>) -> anyhow::Result<()> {
+/// Neither renderer could create the window (no display, no Vulkan or GL driver).
+pub fn run(opts: RunOptions) -> anyhow::Result<()> {
+    let setting = match opts.renderer {
+        Some(s) => {
+            if let Err(e) = renderer::save_setting(s) {
+                log::warn!("the renderer setting is not saved: {e}");
+            }
+            s
+        }
+        None => renderer::saved_setting(),
+    };
+    let choice = renderer::choose(setting);
+    let first = start_window(choice.kind, &choice.reason, setting, &opts);
+    let Err(e) = first else { return Ok(()) };
+    let other = choice.kind.other();
+    eprintln!(
+        "eotn: the {} renderer could not start ({e}); trying {}",
+        choice.kind.name(),
+        other.name()
+    );
+    let reason = format!("{} could not start", choice.kind.name());
+    start_window(other, &reason, setting, &opts)
+        .map_err(|e| anyhow::anyhow!("cannot open the app window: {e}"))
+}
+
+/// Runs the window on one renderer until it closes.
+fn start_window(
+    kind: renderer::RendererKind,
+    reason: &str,
+    setting: crate::cli::open::RendererSetting,
+    opts: &RunOptions,
+) -> Result<(), eframe::Error> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("eotn")
             .with_app_id("eotn")
             .with_inner_size([1280.0, 800.0])
             .with_min_inner_size([640.0, 400.0]),
+        renderer: kind.eframe(),
+        // The views are whole-pixel NEAREST images and flat panels: dithering buys nothing
+        // there and costs a full-screen pass on a software rasteriser.
+        dithering: false,
         ..Default::default()
     };
+    let opts = opts.clone();
+    let reason = reason.to_owned();
     eframe::run_native(
         "eotn",
         options,
-        Box::new(move |cc| Ok(Box::new(EotnApp::new(cc, paths)))),
+        Box::new(move |cc| {
+            let info = RendererInfo {
+                kind,
+                reason,
+                adapter: renderer::live_adapter(cc),
+                setting,
+            };
+            eprintln!(
+                "eotn: drawing with {} on {} ({})",
+                info.kind.name(),
+                info.adapter,
+                info.reason
+            );
+            let mut app = EotnApp::new(cc, opts.files.clone());
+            app.renderer = Some(info);
+            if opts.all_overlays {
+                app.state.settings.overlays = state::Overlays::all_on();
+            }
+            if let Some(speed) = opts.play {
+                app.state.run(Command::SetSpeed(speed.as_factor()));
+                app.state.run(Command::SetPlaying(true));
+            }
+            app.quit_at = opts.quit_after.map(|d| Instant::now() + d);
+            Ok(Box::new(app))
+        }),
     )
-    .map_err(|e| anyhow::anyhow!("cannot open the app window: {e}"))
 }
 
 /// The textures of the shown frame and what they were built from.
@@ -161,6 +268,11 @@ pub struct EotnApp {
     last_frame: Option<Instant>,
     palette: [Color32; 256],
     was_playing: bool,
+    /// What draws the window (`None` in headless tests).
+    pub renderer: Option<RendererInfo>,
+    show_about: bool,
+    /// `--quit-after`: when to close.
+    quit_at: Option<Instant>,
 }
 
 impl EotnApp {
@@ -198,6 +310,9 @@ impl EotnApp {
             last_frame: None,
             palette: palette(),
             was_playing: false,
+            renderer: None,
+            show_about: false,
+            quit_at: None,
         }
     }
 
@@ -436,6 +551,16 @@ impl EotnApp {
             }
             ui.separator();
             ui.label(&self.state.status);
+            if let Some(r) = &self.renderer {
+                ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                    let b = ui
+                        .small_button(r.kind.name())
+                        .on_hover_text(format!("{}: {}", r.adapter, r.reason));
+                    if b.clicked() {
+                        self.show_about = !self.show_about;
+                    }
+                });
+            }
         });
         // This frame's own problems (NaN sensor readings, skipped channels) stay in view while
         // it is shown, not only in the warnings list.
@@ -476,6 +601,52 @@ impl EotnApp {
             open = false;
         }
         self.show_warnings = open;
+    }
+
+    /// Help ▸ About: the version and what draws the window.
+    fn about_window(&mut self, ctx: &egui::Context) {
+        if !self.show_about {
+            return;
+        }
+        let mut open = true;
+        egui::Window::new("About eotn")
+            .open(&mut open)
+            .default_width(420.0)
+            .show(ctx, |ui| {
+                ui.label(concat!(
+                    "eotn ",
+                    env!("CARGO_PKG_VERSION"),
+                    ": Eye Of The NUbot and the World Model Debugger"
+                ));
+                ui.separator();
+                match &self.renderer {
+                    Some(r) => {
+                        egui::Grid::new("about-renderer")
+                            .num_columns(2)
+                            .show(ui, |ui| {
+                                ui.label("Renderer");
+                                ui.label(r.kind.name());
+                                ui.end_row();
+                                ui.label("Adapter");
+                                ui.label(&r.adapter);
+                                ui.end_row();
+                                ui.label("Why");
+                                ui.label(&r.reason);
+                                ui.end_row();
+                                ui.label("Setting");
+                                ui.label(format!(
+                                    "{} (eotn open --renderer auto|wgpu|gl changes it)",
+                                    r.setting.name()
+                                ));
+                                ui.end_row();
+                            });
+                    }
+                    None => {
+                        ui.label("Renderer: none (headless)");
+                    }
+                }
+            });
+        self.show_about = open;
     }
 
     fn close_dialog(&mut self, ctx: &egui::Context, commands: &mut Vec<Command>) {
@@ -543,7 +714,7 @@ impl EotnApp {
         if std::env::var_os("EOTN_STATS").is_some() {
             let t = &self.state.timings;
             eprintln!(
-                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms (our UI code {:.2} ms, eframe CPU {:.2} ms)",
+                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms (our UI code {:.2} ms, eframe CPU {:.2} ms); played {} dropped {}; renderer {}",
                 t.steps_ms.len(),
                 state::median(&t.steps_ms),
                 t.frames_ms.len(),
@@ -552,6 +723,9 @@ impl EotnApp {
                 state::median(&t.playing_frames_ms),
                 state::median(&t.playing_ui_ms),
                 state::median(&t.playing_cpu_ms),
+                t.played_frames,
+                t.dropped_frames,
+                self.renderer.as_ref().map_or("none", |r| r.kind.name()),
             );
         }
     }
@@ -578,6 +752,7 @@ impl eframe::App for EotnApp {
         egui::Panel::top("menu").show(ui, |ui| {
             let out = menus::menu_bar_ui(ui, &self.state, &mut self.menu_input, &mut commands);
             quit |= out.quit;
+            self.show_about |= out.about;
         });
         egui::Panel::bottom("status").show(ui, |ui| self.status_ui(ui));
         if self.state.source().is_some() {
@@ -611,7 +786,17 @@ impl eframe::App for EotnApp {
         classify_panel::try_edit_window(&ctx, &mut self.state, &mut commands);
         inspector::inspector_window(&ctx, &self.state, &mut commands);
         self.warnings_window(&ctx);
+        self.about_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
+        if let Some(at) = self.quit_at {
+            if now >= at {
+                // Unsaved table edits still get the question: a timer never discards work.
+                self.quit_at = None;
+                quit = true;
+            } else {
+                ctx.request_repaint_after(at - now);
+            }
+        }
         if quit {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
@@ -646,7 +831,7 @@ impl eframe::App for EotnApp {
         eframe::set_value(storage, SETTINGS_KEY, &self.state.settings);
     }
 
-    fn on_exit(&mut self) {
+    fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
         self.report_stats();
     }
 }

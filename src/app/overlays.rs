@@ -9,7 +9,7 @@ use egui::{
 
 use super::state::{AppState, PrimitiveFilter, ViewKind, box_colour};
 use crate::blobs::Blob;
-use crate::recognition::{CircleRole, LineRole, Primitive};
+use crate::recognition::{CircleRole, Primitive};
 
 /// Alpha of the overlays of objects other than the selected one.
 const DIMMED_ALPHA: f32 = 0.25;
@@ -234,28 +234,10 @@ pub fn blob_label(painter: &Painter, xf: &ImageTransform, b: &Blob, placed: &mut
     painter.galley(bg.min + vec2(1.0, 1.0), galley, colour);
 }
 
-/// The colour of a primitive, as `eotn render` draws it (`crate::overlay`).
+/// The colour of a primitive: the one palette of `eotn render`, the app and the annotations.
 fn primitive_colour(p: &Primitive) -> Color32 {
-    match p {
-        Primitive::Box { colour, .. } => {
-            let [r, g, b] = box_colour(*colour);
-            Color32::from_rgb(r, g, b)
-        }
-        Primitive::ScanArea { .. } => Color32::from_rgb(255, 0, 255),
-        Primitive::ScanPoints { .. } => Color32::from_rgb(0, 255, 255),
-        Primitive::Circle { .. } => Color32::from_rgb(255, 255, 0),
-        Primitive::Line { role, .. } => match role {
-            LineRole::Horizon => Color32::from_rgb(255, 64, 64),
-            LineRole::Post => Color32::from_rgb(0, 255, 0),
-            LineRole::Gap => Color32::WHITE,
-            LineRole::Scan => Color32::from_rgb(128, 128, 255),
-        },
-        Primitive::PatternRegion { colour, .. } => {
-            let [r, g, b] = crate::overlay::pattern_region_rgb(*colour);
-            Color32::from_rgb(r, g, b)
-        }
-        Primitive::Label { .. } => Color32::WHITE,
-    }
+    let [r, g, b] = crate::overlay::primitive_rgb(p);
+    Color32::from_rgb(r, g, b)
 }
 
 /// Draws recognition's primitives through the view's transform. With a `selected` owner, its

@@ -102,6 +102,15 @@ pub struct Overlays {
 }
 
 impl Overlays {
+    /// Every overlay on, the classified colours at half opacity: the heaviest view.
+    #[must_use]
+    pub fn all_on() -> Self {
+        Self {
+            classified: true,
+            ..Self::default()
+        }
+    }
+
     /// Switches every recognition overlay on or off.
     pub fn set_recognition(&mut self, on: bool) {
         self.horizon = on;
@@ -470,6 +479,10 @@ pub struct Timings {
     /// While playing: eframe's CPU time per frame (our UI, tessellation, the renderer's
     /// submission; not the wait for the display), milliseconds.
     pub playing_cpu_ms: Vec<f64>,
+    /// Frames shown by playback since the app started.
+    pub played_frames: u64,
+    /// Frames playback skipped because the next one was already due (not ready in time).
+    pub dropped_frames: u64,
 }
 
 fn push_capped(v: &mut Vec<f64>, x: f64) {
@@ -866,6 +879,8 @@ impl AppState {
             return;
         }
         if target != self.index {
+            self.timings.played_frames += 1;
+            self.timings.dropped_frames += (target - self.index - 1) as u64;
             self.run(Command::Seek(target));
             if target + 1 >= len {
                 self.playing = false;

@@ -36,6 +36,11 @@ pub struct Args {
     /// With `--json`: add every candidate with its confidence breakdown.
     #[arg(long)]
     pub evidence: bool,
+    /// Also write the frames with their recognition to this MCAP stream: each frame with the
+    /// channels it came with, `/recognition` (the JSON line) and `/camera/annotations`
+    /// (`foxglove.ImageAnnotations`), so Foxglove and Rerun draw what eotn found.
+    #[arg(long, value_name = "OUT.mcap")]
+    pub annotate: Option<PathBuf>,
     /// A places file (`eotn patterns learn`): identify the pink markers' coloured patterns;
     /// `--json` then lists them as `patterns`.
     #[arg(long)]
@@ -407,13 +412,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(p) = &args.patterns {
         pipeline.set_pattern_memory(Some(PatternMemory::load(p)?));
     }
+    let mut annotated = args
+        .annotate
+        .as_deref()
+        .map(|p| annotated_writer(p, &args.input.frames))
+        .transpose()?;
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "detect");
     for i in 0..inputs.len() {
-        let (frame, recorded) = inputs.load_with_sensors(i, args.input.size)?;
-        let readings = readings_for(recorded.as_ref(), sensors.as_deref(), i);
-        let result = pipeline.process(&frame, readings);
+        let mut record = inputs.load_record(i, args.input.size)?;
+        let readings = readings_for(record.sensors.as_ref(), sensors.as_deref(), i);
+        let result = pipeline.process(&record.frame, readings);
         let us = result.timings.recognition.as_secs_f64() * 1e6;
         let mut line = detect_json(inputs.name(i), result.recognition, us, args.evidence);
         if args.patterns.is_some() {
@@ -426,6 +436,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     .collect(),
             );
         }
+        if let Some(w) = annotated.as_mut() {
+            let (width, height) = (record.frame.width(), record.frame.height());
+            record.annotations = Some(crate::annotate::image_annotations(
+                result.recognition,
+                width,
+                height,
+                record.time_ns,
+            ));
+            record.recognition = Some(serde_json::to_value(&line)?);
+            w.write(&record)?;
+        }
         if args.json {
             serde_json::to_writer(&mut out, &line)?;
             writeln!(out)?;
@@ -436,7 +457,42 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
     out.flush().context("writing output")?;
+    if let Some(w) = annotated {
+        w.finish()?;
+    }
     Ok(())
+}
+
+/// The writer of `--annotate OUT`, refusing to replace one of the inputs.
+fn annotated_writer(
+    path: &std::path::Path,
+    inputs: &[PathBuf],
+) -> anyhow::Result<crate::streams::StreamWriter> {
+    let out = path.canonicalize().ok();
+    if out.is_some() && inputs.iter().any(|i| i.canonicalize().ok() == out) {
+        anyhow::bail!(
+            "{}: --annotate would replace an input; name another file",
+            path.display()
+        );
+    }
+    // A stream's own source kind is kept (it says which camera the frames came from).
+    let source = inputs
+        .iter()
+        .find(|p| crate::streams::is_stream_file(p))
+        .and_then(|p| crate::streams::StreamReader::open(p).ok())
+        .map_or_else(|| "import".to_owned(), |r| r.info().source.clone());
+    let info = crate::streams::StreamInfo {
+        source,
+        description: format!(
+            "frames of {} with eotn's recognition as /recognition and /camera/annotations",
+            inputs
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    Ok(crate::streams::StreamWriter::create(path, &info)?)
 }
 
 /// The human-readable line for a frame.

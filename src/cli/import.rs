@@ -1,4 +1,5 @@
-//! `eotn import`: a folder of frames plus a table of sensor readings → one MCAP stream.
+//! `eotn import`: a folder of frames plus a table of sensor readings → one MCAP stream; or one
+//! stream rewritten in today's layout.
 
 use std::path::PathBuf;
 
@@ -6,9 +7,10 @@ use anyhow::{Context, bail};
 
 use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
 use crate::sensors::SensorReadings;
+use crate::streams::schema::ImageEncoding;
 use crate::streams::sensor_table::SensorTable;
 use crate::streams::{
-    Compression, FrameRecord, StreamInfo, StreamWriter, WriterOptions, is_stream_file,
+    Compression, FrameRecord, StreamInfo, StreamReader, StreamWriter, WriterOptions, is_stream_file,
 };
 
 /// Chunk compression on the command line.
@@ -26,7 +28,8 @@ pub enum CompressionArg {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them; a folder's frames are taken in name
-    /// order. PNG/JPEG frames are stored as UYVY.
+    /// order. PNG/JPEG frames are stored as UYVY. One stream (`.mcap`) instead is rewritten in
+    /// today's layout (image encoding, compression), every channel kept.
     #[arg(required_unless_present = "bhuman")]
     pub frames: Vec<PathBuf>,
     /// Import a B-Human 2009 Nao log (`logfile.log`) instead of frame files: its camera images
@@ -56,6 +59,10 @@ pub struct Args {
     /// Frames per chunk (default: about 1 MiB of images per chunk).
     #[arg(long)]
     pub frames_per_chunk: Option<usize>,
+    /// Byte order of the stored frames: `yuyv` (read by Foxglove and Rerun) or `uyvy` (read by
+    /// Foxglove; the cameras' own order). The same samples either way.
+    #[arg(long, default_value = "yuyv")]
+    pub image_encoding: ImageEncoding,
     /// The stream to write (`.mcap`); written as `OUT.partial` and renamed when complete.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -74,10 +81,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         bail!("--fps must be a positive number, not {}", args.fps);
     }
+    if let [stream] = args.frames.as_slice()
+        && is_stream_file(stream)
+    {
+        return rewrite_stream(stream, args);
+    }
     let paths = expand_frame_paths(&args.frames)?;
     if let Some(stream) = paths.iter().find(|p| is_stream_file(p)) {
         bail!(
-            "{}: import reads frame files; this is already a stream",
+            "{}: import reads frame files, or one stream to rewrite on its own",
             stream.display()
         );
     }
@@ -147,6 +159,56 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `eotn import OLD.mcap -o NEW.mcap`: the stream rewritten in today's layout and the chosen
+/// options (image encoding, compression, chunking), every frame with all its channels. Frames
+/// that cannot be read are skipped with a warning naming them.
+fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
+    if args.sensors.is_some() || args.size.is_some() {
+        bail!("--sensors and --size are for frame files; a stream keeps its own readings");
+    }
+    let same = match (input.canonicalize(), args.output.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same {
+        bail!(
+            "{}: the output would replace the stream it is read from; name another file",
+            args.output.display()
+        );
+    }
+    let mut reader = StreamReader::open(input)?;
+    for w in reader.warnings() {
+        log::warn!("{}: {w}", input.display());
+    }
+    let info = reader.info().clone();
+    let mut writer = StreamWriter::create_with(&args.output, &info, writer_options(args))?;
+    let bar = progress(reader.len(), "import");
+    let (mut written, mut skipped) = (0usize, Vec::new());
+    for index in 0..reader.len() {
+        bar.inc(1);
+        match reader.read(index) {
+            Ok(record) => {
+                writer
+                    .write(&record)
+                    .with_context(|| format!("{}: frame {index}", args.output.display()))?;
+                written += 1;
+            }
+            Err(e) => {
+                log::warn!("{}: frame {index} skipped: {e}", input.display());
+                skipped.push(index);
+            }
+        }
+    }
+    bar.finish_and_clear();
+    writer.finish()?;
+    eprintln!(
+        "eotn: wrote {written} frames to {} ({} skipped)",
+        args.output.display(),
+        skipped.len()
+    );
+    Ok(())
+}
+
 /// The writer options of the command line.
 fn writer_options(args: &Args) -> WriterOptions {
     WriterOptions {
@@ -156,6 +218,7 @@ fn writer_options(args: &Args) -> WriterOptions {
             CompressionArg::None => Compression::None,
         },
         frames_per_chunk: args.frames_per_chunk,
+        image_encoding: args.image_encoding,
     }
 }
 

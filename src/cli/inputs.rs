@@ -269,9 +269,32 @@ impl FrameInputs {
         i: usize,
         size: Option<(usize, usize)>,
     ) -> anyhow::Result<(Frame, Option<crate::sensors::SensorReadings>)> {
+        let record = self.load_record(i, size)?;
+        Ok((record.frame, record.sensors))
+    }
+
+    /// Loads frame `i` with everything its stream recorded for it (readings, truth, other
+    /// channels); a frame file gets a record of the image alone, timed at the nominal 25 fps.
+    ///
+    /// # Errors
+    /// The loader's error, naming the file.
+    pub fn load_record(
+        &mut self,
+        i: usize,
+        size: Option<(usize, usize)>,
+    ) -> anyhow::Result<crate::streams::FrameRecord> {
+        /// Interval of frame files, which carry no time: 25 fps, nanoseconds.
+        const FILE_INTERVAL_NS: u64 = 40_000_000;
         match self.items.get(i) {
             None => bail!("no input frame {i}"),
-            Some(FrameInput::File(p)) => Ok((load_frame_arg(p, size)?, None)),
+            Some(FrameInput::File(p)) => {
+                let t = u64::try_from(i).unwrap_or(u64::MAX / FILE_INTERVAL_NS);
+                let time_ns = t.saturating_mul(FILE_INTERVAL_NS);
+                Ok(crate::streams::FrameRecord::new(
+                    time_ns,
+                    load_frame_arg(p, size)?,
+                ))
+            }
             Some(FrameInput::Stream { path, index }) => {
                 if self.reader.as_ref().is_none_or(|r| r.path() != path) {
                     self.reader = Some(StreamReader::open(path)?);
@@ -279,8 +302,7 @@ impl FrameInputs {
                 let Some(reader) = self.reader.as_mut() else {
                     bail!("{}: stream not open", path.display());
                 };
-                let record = reader.read(*index)?;
-                Ok((record.frame, record.sensors))
+                Ok(reader.read(*index)?)
             }
         }
     }

@@ -7,7 +7,8 @@ use anyhow::Context;
 
 use super::inputs::progress;
 use crate::sim::{ScenarioKind, Simulator};
-use crate::streams::{FrameRecord, StreamInfo, StreamWriter};
+use crate::streams::schema::ImageEncoding;
+use crate::streams::{FrameRecord, StreamInfo, StreamWriter, WriterOptions};
 
 /// Arguments of `eotn sim`.
 #[derive(Debug, clap::Args)]
@@ -28,6 +29,9 @@ pub struct Args {
     /// Ideal frames: no noise, vignetting or rolling shutter.
     #[arg(long)]
     pub ideal: bool,
+    /// Byte order of the stored frames: `yuyv` (read by Foxglove and Rerun) or `uyvy`.
+    #[arg(long, default_value = "yuyv")]
+    pub image_encoding: ImageEncoding,
     /// List the scenarios and exit.
     #[arg(long)]
     pub list: bool,
@@ -68,7 +72,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             kind.description()
         ),
     };
-    let mut writer = StreamWriter::create(path, &info)?;
+    let options = WriterOptions {
+        image_encoding: args.image_encoding,
+        ..WriterOptions::default()
+    };
+    let mut writer = StreamWriter::create_with(path, &info, options)?;
     let bar = progress(usize::try_from(args.frames).unwrap_or(usize::MAX), "sim");
     let mut render_s = 0.0;
     let mut size = (0, 0);

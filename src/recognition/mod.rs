@@ -166,6 +166,27 @@ pub fn recognise(
 }
 
 impl Recognition {
+    /// The owner names (see [`draw::owner`]) of every accepted object: what a viewer shows
+    /// when it shows only what was found.
+    #[must_use]
+    pub fn accepted_owners(&self) -> Vec<String> {
+        let balls = self.ball.candidates.iter().enumerate();
+        let balls = balls
+            .filter(|(_, c)| c.accepted)
+            .map(|(i, _)| draw::owner::ball(i));
+        let goals = self.goals.candidates.iter().enumerate();
+        let goals = goals
+            .filter(|(_, c)| c.accepted)
+            .map(|(i, c)| draw::owner::goal(c.colour, i));
+        let beacons = self.beacons.iter().enumerate().filter(|(_, b)| b.accepted);
+        let patterns = self.patterns.iter().enumerate().filter(|(_, p)| p.accepted);
+        balls
+            .chain(goals)
+            .chain(beacons.map(|(i, _)| draw::owner::beacon(i)))
+            .chain(patterns.map(|(i, _)| draw::owner::pattern(i)))
+            .collect()
+    }
+
     /// Every drawing primitive: horizon, ball, goals, beacons, coloured patterns.
     #[must_use]
     pub fn primitives(&self, width: usize, height: usize) -> Vec<Primitive> {

@@ -37,6 +37,9 @@ pub const SENSORS_TOPIC: &str = "/sensors";
 pub const GROUND_TRUTH_TOPIC: &str = "/ground_truth";
 /// Topic of the recognition-results channel (JSON object, free form; written by the pipeline).
 pub const RECOGNITION_TOPIC: &str = "/recognition";
+/// Topic of the recognition results drawn as `foxglove.ImageAnnotations` (protobuf) over the
+/// camera image, so Foxglove and Rerun show eotn's overlays (`eotn detect --annotate`).
+pub const ANNOTATIONS_TOPIC: &str = "/camera/annotations";
 /// Name of the MCAP metadata record that holds the [`StreamInfo`].
 pub const METADATA_NAME: &str = "eotn.stream";
 /// Version of the stream layout written by this crate (metadata key `format_version`).
@@ -66,6 +69,8 @@ pub struct FrameRecord {
     pub recognition: Option<serde_json::Value>,
     /// Other JSON channels as (topic, value), e.g. `("/world_model/robot3", …)`.
     pub extra: Vec<(String, serde_json::Value)>,
+    /// Overlays for other viewers, channel [`ANNOTATIONS_TOPIC`].
+    pub annotations: Option<foxglove::messages::ImageAnnotations>,
 }
 
 impl FrameRecord {
@@ -79,6 +84,7 @@ impl FrameRecord {
             ground_truth: None,
             recognition: None,
             extra: Vec::new(),
+            annotations: None,
         }
     }
 }

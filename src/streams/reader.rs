@@ -5,13 +5,14 @@ use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
+use foxglove::Decode as _;
 use mcap::records::{Record, op};
 use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 
 use super::schema::{decode_image, parse_json_lenient};
 use super::{
-    FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME, RECOGNITION_TOPIC, SENSORS_TOPIC,
-    StreamError, StreamInfo,
+    ANNOTATIONS_TOPIC, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME,
+    RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
 };
 use crate::sensors::SensorReadings;
 
@@ -25,6 +26,8 @@ const MAX_INDEX_BYTES: u64 = 64 << 20;
 const MAX_WARNINGS: usize = 100;
 /// Name of the schema of frame images from other writers.
 const RAW_IMAGE_SCHEMA: &str = "foxglove.RawImage";
+/// Name of the schema of image overlays (`eotn detect --annotate`, or other tools').
+const ANNOTATIONS_SCHEMA: &str = "foxglove.ImageAnnotations";
 
 /// What a channel's messages are to a frame.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -33,6 +36,7 @@ enum Role {
     Sensors,
     GroundTruth,
     Recognition,
+    Annotations,
     Extra(String),
     Ignored,
 }
@@ -118,6 +122,11 @@ impl ChannelTable {
             }
             self.image = Some(id);
             Role::Image
+        } else if topic == ANNOTATIONS_TOPIC
+            && schema_name == Some(ANNOTATIONS_SCHEMA)
+            && encoding == "protobuf"
+        {
+            Role::Annotations
         } else if encoding != "json" {
             self.notes.push(format!(
                 "channel {topic} ({encoding}) is not read: only {IMAGE_TOPIC} and JSON channels are"
@@ -336,6 +345,15 @@ impl StreamReader {
             if role == Role::Ignored {
                 continue;
             }
+            if role == Role::Annotations {
+                match foxglove::messages::ImageAnnotations::decode(m.data.as_slice()) {
+                    Ok(a) => record.annotations = Some(a),
+                    Err(e) => self.warn(format!(
+                        "frame {index}: {ANNOTATIONS_TOPIC} is not a foxglove.ImageAnnotations ({e}); skipped"
+                    )),
+                }
+                continue;
+            }
             let value = match parse_json_lenient(&m.data) {
                 Ok((v, replaced)) => {
                     if replaced {
@@ -373,7 +391,7 @@ impl StreamReader {
                 Role::GroundTruth => record.ground_truth = Some(value),
                 Role::Recognition => record.recognition = Some(value),
                 Role::Extra(topic) => record.extra.push((topic, value)),
-                Role::Image | Role::Ignored => {}
+                Role::Image | Role::Annotations | Role::Ignored => {}
             }
         }
         Ok(record)
@@ -755,6 +773,7 @@ fn topic_of(role: &Role) -> &str {
         Role::Sensors => SENSORS_TOPIC,
         Role::GroundTruth => GROUND_TRUTH_TOPIC,
         Role::Recognition => RECOGNITION_TOPIC,
+        Role::Annotations => ANNOTATIONS_TOPIC,
         Role::Extra(t) => t,
         Role::Ignored => "an ignored channel",
     }
@@ -816,7 +835,7 @@ fn for_each_chunk_record(
 mod tests {
     use super::*;
     use crate::frame::{Frame, Yuv};
-    use crate::streams::schema::{encode_image, raw_image_schema};
+    use crate::streams::schema::{ImageEncoding, encode_image, raw_image_schema};
 
     /// A file from another writer: frames on another topic, times out of order, default
     /// chunking, no eotn metadata.
@@ -834,7 +853,7 @@ mod tests {
         let mut buf = Vec::new();
         for (i, &t) in times.iter().enumerate() {
             let f = Frame::filled_uyvy(4, 2, Yuv::new(u8::try_from(i).unwrap(), 128, 128)).unwrap();
-            encode_image(t, &f, &mut buf).unwrap();
+            encode_image(t, &f, ImageEncoding::Uyvy, &mut buf).unwrap();
             let header = |channel_id| mcap::records::MessageHeader {
                 channel_id,
                 sequence: 0,

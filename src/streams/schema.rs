@@ -62,13 +62,77 @@ pub fn raw_image_schema() -> Option<foxglove::Schema> {
     foxglove::messages::RawImage::get_schema()
 }
 
-/// Encodes a frame as a `foxglove.RawImage` with encoding `uyvy` and `step` = 2 × width bytes;
-/// 4:4:4 frames are converted to UYVY first.
+/// The byte order of 4:2:2 frames in a stream's `foxglove.RawImage` messages.
+///
+/// Both hold the same samples (a byte permutation of each pixel pair, no loss). Streams eotn
+/// writes use [`ImageEncoding::Yuyv`] by default because Rerun's MCAP importer reads `yuyv` but not
+/// `uyvy` (Foxglove reads both); `uyvy` keeps the cameras' own order for whoever wants it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ImageEncoding {
+    /// `yuyv` (Y0 U Y1 V), also named `yuv422_yuy2`.
+    #[default]
+    Yuyv,
+    /// `uyvy` (U Y0 V Y1), also named `yuv422`: the AIBO's and most cameras' order.
+    Uyvy,
+}
+
+impl ImageEncoding {
+    /// The encodings a reader accepts, by the names `foxglove.RawImage` uses.
+    pub const NAMES: &'static str = "yuyv, yuv422_yuy2, uyvy, yuv422";
+
+    /// The `encoding` field written for this order.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Yuyv => "yuyv",
+            Self::Uyvy => "uyvy",
+        }
+    }
+
+    /// The order a `foxglove.RawImage` `encoding` field names, if it is a 4:2:2 one we read.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "yuyv" | "yuv422_yuy2" => Some(Self::Yuyv),
+            "uyvy" | "yuv422" => Some(Self::Uyvy),
+            _ => None,
+        }
+    }
+}
+
+impl std::str::FromStr for ImageEncoding {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::from_name(s).ok_or_else(|| {
+            format!(
+                "image encoding '{s}' is not one of {} (the 4:2:2 orders)",
+                Self::NAMES
+            )
+        })
+    }
+}
+
+/// Swaps each pixel pair between UYVY (U Y0 V Y1) and YUYV (Y0 U Y1 V): its own inverse.
+fn swap_pairs(data: &mut [u8]) {
+    for q in data.chunks_exact_mut(4) {
+        q.swap(0, 1);
+        q.swap(2, 3);
+    }
+}
+
+/// Encodes a frame as a `foxglove.RawImage` in `encoding` with `step` = 2 × width bytes; 4:4:4
+/// frames are converted to 4:2:2 first.
 ///
 /// # Errors
 /// A message when the frame cannot become UYVY (odd width) or is too large for the message's
 /// 32-bit fields.
-pub fn encode_image(time_ns: u64, frame: &Frame, out: &mut Vec<u8>) -> Result<(), String> {
+pub fn encode_image(
+    time_ns: u64,
+    frame: &Frame,
+    encoding: ImageEncoding,
+    out: &mut Vec<u8>,
+) -> Result<(), String> {
     let converted;
     let uyvy = if frame.layout() == PixelLayout::Uyvy {
         frame
@@ -84,22 +148,26 @@ pub fn encode_image(time_ns: u64, frame: &Frame, out: &mut Vec<u8>) -> Result<()
         .ok_or_else(|| format!("{width}×{height} is too large"))?;
     let sec = u32::try_from(time_ns / 1_000_000_000).unwrap_or(u32::MAX);
     let nsec = u32::try_from(time_ns % 1_000_000_000).unwrap_or(0);
+    let mut data = uyvy.data().to_vec();
+    if encoding == ImageEncoding::Yuyv {
+        swap_pairs(&mut data);
+    }
     let msg = foxglove::messages::RawImage {
         timestamp: Some(foxglove::messages::Timestamp::new(sec, nsec)),
         frame_id: CAMERA_FRAME_ID.to_owned(),
         width,
         height,
-        encoding: "uyvy".to_owned(),
+        encoding: encoding.name().to_owned(),
         step,
-        data: uyvy.data().to_vec().into(),
+        data: data.into(),
     };
     out.clear();
     out.reserve(msg.encoded_len().unwrap_or(0));
     msg.encode(out).map_err(|e| e.to_string())
 }
 
-/// Decodes a `foxglove.RawImage` into a UYVY frame. Encodings `uyvy`/`yuv422` are taken as they
-/// are, `yuyv`/`yuv422_yuy2` are reordered; row padding (`step` > 2 × width) is dropped.
+/// Decodes a `foxglove.RawImage` into a UYVY frame (the pipeline's order). Encodings
+/// `uyvy`/`yuv422` are taken as they are, `yuyv`/`yuv422_yuy2` are reordered; row padding (`step` > 2 × width) is dropped.
 ///
 /// # Errors
 /// A message for undecodable protobuf, other encodings, or sizes that do not match the data.
@@ -107,14 +175,12 @@ pub fn decode_image(bytes: &[u8]) -> Result<Frame, String> {
     let msg = foxglove::messages::RawImage::decode(bytes)
         .map_err(|e| format!("image message is not a foxglove.RawImage: {e}"))?;
     let (w, h) = (msg.width as usize, msg.height as usize);
-    let swap = match msg.encoding.as_str() {
-        "uyvy" | "yuv422" => false,
-        "yuyv" | "yuv422_yuy2" => true,
-        other => {
-            return Err(format!(
-                "image encoding '{other}' is not supported (uyvy, yuv422, yuyv)"
-            ));
-        }
+    let Some(encoding) = ImageEncoding::from_name(&msg.encoding) else {
+        return Err(format!(
+            "image encoding '{}' is not supported ({})",
+            msg.encoding,
+            ImageEncoding::NAMES
+        ));
     };
     let row = w
         .checked_mul(2)
@@ -139,12 +205,8 @@ pub fn decode_image(bytes: &[u8]) -> Result<Frame, String> {
     for r in msg.data.chunks(step).take(h) {
         data.extend_from_slice(r.get(..row).unwrap_or(r));
     }
-    if swap {
-        for q in data.chunks_exact_mut(4) {
-            // Y0 U Y1 V → U Y0 V Y1
-            let (y0, u, y1, v) = (q[0], q[1], q[2], q[3]);
-            q.copy_from_slice(&[u, y0, v, y1]);
-        }
+    if encoding == ImageEncoding::Yuyv {
+        swap_pairs(&mut data);
     }
     Frame::from_uyvy(w, h, data).map_err(|e| e.to_string())
 }
@@ -214,16 +276,36 @@ mod tests {
     use crate::frame::Yuv;
 
     #[test]
-    fn image_round_trip_keeps_bytes_and_times() {
+    fn image_round_trip_keeps_bytes_and_times_in_both_orders() {
         let f = Frame::uyvy_from_fn(6, 4, |x, y| Yuv::new((x * 10 + y) as u8, 90, 200)).unwrap();
+        for encoding in [ImageEncoding::Yuyv, ImageEncoding::Uyvy] {
+            let mut buf = Vec::new();
+            encode_image(3_000_000_123, &f, encoding, &mut buf).unwrap();
+            let msg = foxglove::messages::RawImage::decode(buf.as_slice()).unwrap();
+            assert_eq!((msg.width, msg.height, msg.step), (6, 4, 12));
+            assert_eq!(msg.encoding, encoding.name());
+            let ts = msg.timestamp.unwrap();
+            assert_eq!((ts.sec(), ts.nsec()), (3, 123));
+            assert_eq!(decode_image(&buf).unwrap(), f);
+        }
+    }
+
+    #[test]
+    fn yuyv_messages_hold_luma_first() {
+        // One pixel pair: U=1 Y0=2 V=3 Y1=4 in the frame, Y0 U Y1 V in a yuyv message.
+        let f = Frame::from_uyvy(2, 1, vec![1, 2, 3, 4]).unwrap();
         let mut buf = Vec::new();
-        encode_image(3_000_000_123, &f, &mut buf).unwrap();
+        encode_image(0, &f, ImageEncoding::Yuyv, &mut buf).unwrap();
         let msg = foxglove::messages::RawImage::decode(buf.as_slice()).unwrap();
-        assert_eq!((msg.width, msg.height, msg.step), (6, 4, 12));
-        assert_eq!(msg.encoding, "uyvy");
-        let ts = msg.timestamp.unwrap();
-        assert_eq!((ts.sec(), ts.nsec()), (3, 123));
-        assert_eq!(decode_image(&buf).unwrap(), f);
+        assert_eq!(&msg.data[..], &[2, 1, 4, 3]);
+    }
+
+    #[test]
+    fn encoding_names_parse_with_their_aliases() {
+        assert_eq!("yuv422_yuy2".parse(), Ok(ImageEncoding::Yuyv));
+        assert_eq!("yuv422".parse(), Ok(ImageEncoding::Uyvy));
+        let err = "rgb8".parse::<ImageEncoding>().unwrap_err();
+        assert!(err.contains("rgb8") && err.contains("uyvy"), "{err}");
     }
 
     #[test]

@@ -5,15 +5,17 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
+use foxglove::Encode as _;
 use mcap::records::MessageHeader;
 
 use super::schema::{
-    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, RECOGNITION_SCHEMA_NAME, SENSORS_SCHEMA_NAME,
-    any_json_schema, encode_image, object_json_schema, raw_image_schema, sensors_json_schema,
+    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, ImageEncoding, RECOGNITION_SCHEMA_NAME,
+    SENSORS_SCHEMA_NAME, any_json_schema, encode_image, object_json_schema, raw_image_schema,
+    sensors_json_schema,
 };
 use super::{
-    FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME, RECOGNITION_TOPIC,
-    SENSORS_TOPIC, StreamError, StreamInfo,
+    ANNOTATIONS_TOPIC, FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME,
+    RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
 };
 
 /// How chunks are compressed.
@@ -37,6 +39,8 @@ pub struct WriterOptions {
     /// frames, 1 overhead frame). Fewer frames per chunk: faster random access, larger files,
     /// less lost in a crash.
     pub frames_per_chunk: Option<usize>,
+    /// Byte order of the frames in the stream (`yuyv` unless asked: Rerun reads only that one).
+    pub image_encoding: ImageEncoding,
 }
 
 /// Uncompressed image bytes aimed at per chunk when [`WriterOptions::frames_per_chunk`] is `None`.
@@ -57,7 +61,9 @@ pub struct StreamWriter {
     image_channel: u16,
     sensors_channel: u16,
     lazy_channels: HashMap<String, u16>,
+    annotations_channel: Option<u16>,
     frames_per_chunk: Option<usize>,
+    image_encoding: ImageEncoding,
     frames_in_chunk: usize,
     frames: u32,
     buf: Vec<u8>,
@@ -164,7 +170,9 @@ impl StreamWriter {
             image_channel,
             sensors_channel,
             lazy_channels: HashMap::new(),
+            annotations_channel: None,
             frames_per_chunk: options.frames_per_chunk.map(|n| n.max(1)),
+            image_encoding: options.image_encoding,
             frames_in_chunk: 0,
             frames: 0,
             buf: Vec::new(),
@@ -188,6 +196,29 @@ impl StreamWriter {
     }
 
     /// The channel for a JSON topic other than the sensors, added on first use.
+    /// The `foxglove.ImageAnnotations` channel, added with the first annotated frame.
+    fn annotations_channel(&mut self) -> Result<u16, StreamError> {
+        if let Some(id) = self.annotations_channel {
+            return Ok(id);
+        }
+        let schema = foxglove::messages::ImageAnnotations::get_schema().ok_or_else(|| {
+            StreamError::Corrupt {
+                path: self.partial.clone(),
+                detail: "the foxglove.ImageAnnotations schema is not available".to_owned(),
+            }
+        })?;
+        let schema_id = self
+            .mcap
+            .add_schema(&schema.name, &schema.encoding, &schema.data)
+            .map_err(self.mcap_err("cannot add the annotations schema"))?;
+        let id = self
+            .mcap
+            .add_channel(schema_id, ANNOTATIONS_TOPIC, "protobuf", &BTreeMap::new())
+            .map_err(self.mcap_err("cannot add the annotations channel"))?;
+        self.annotations_channel = Some(id);
+        Ok(id)
+    }
+
     fn json_channel(&mut self, topic: &str) -> Result<u16, StreamError> {
         if let Some(&id) = self.lazy_channels.get(topic) {
             return Ok(id);
@@ -251,6 +282,7 @@ impl StreamWriter {
                 SENSORS_TOPIC,
                 GROUND_TRUTH_TOPIC,
                 RECOGNITION_TOPIC,
+                ANNOTATIONS_TOPIC,
             ]
             .contains(&topic.as_str())
                 || !topic.starts_with('/')
@@ -261,7 +293,13 @@ impl StreamWriter {
             }
         }
         let mut image = std::mem::take(&mut self.buf);
-        encode_image(record.time_ns, &record.frame, &mut image).map_err(bad)?;
+        encode_image(
+            record.time_ns,
+            &record.frame,
+            self.image_encoding,
+            &mut image,
+        )
+        .map_err(bad)?;
         let written = self.put(self.image_channel, record.time_ns, &image);
         self.buf = image;
         written?;
@@ -281,6 +319,12 @@ impl StreamWriter {
                 let json = serde_json::to_vec(v).map_err(|e| bad(e.to_string()))?;
                 self.put(id, record.time_ns, &json)?;
             }
+        }
+        if let Some(a) = &record.annotations {
+            let id = self.annotations_channel()?;
+            let mut bytes = Vec::with_capacity(a.encoded_len().unwrap_or(0));
+            a.encode(&mut bytes).map_err(|e| bad(e.to_string()))?;
+            self.put(id, record.time_ns, &bytes)?;
         }
         self.frames = self.frames.saturating_add(1);
         self.frames_in_chunk += 1;

@@ -720,6 +720,7 @@ fn nan_in_a_recorded_stream_shows_as_a_warning_of_its_frame() {
     let options = WriterOptions {
         compression: Compression::None,
         frames_per_chunk: Some(1),
+        ..WriterOptions::default()
     };
     let mut w = StreamWriter::create_with(&path, &StreamInfo::default(), options).unwrap();
     for i in 0..3 {

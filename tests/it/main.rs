@@ -15,3 +15,6 @@ mod recognition;
 mod sim;
 mod sim_table;
 mod streams;
+mod viewers;
+#[cfg(feature = "gui")]
+mod window;

@@ -298,7 +298,13 @@ fn nan_sensor_values_are_sanitised_with_a_warning() {
             .add_channel(0, "/sensors", "json", &Default::default())
             .unwrap();
         let mut buf = Vec::new();
-        eotn::streams::schema::encode_image(5, &frame(0, 8, 4), &mut buf).unwrap();
+        eotn::streams::schema::encode_image(
+            5,
+            &frame(0, 8, 4),
+            eotn::streams::schema::ImageEncoding::Yuyv,
+            &mut buf,
+        )
+        .unwrap();
         let header = |channel_id| mcap::records::MessageHeader {
             channel_id,
             sequence: 0,
@@ -376,10 +382,16 @@ with open(sys.argv[1], "rb") as f:
     for (img, rec) in images.iter().zip(&records) {
         assert_eq!(img["t"].as_u64(), Some(rec.time_ns));
         assert_eq!(img["schema"], "foxglove.RawImage");
-        assert_eq!(img["enc"], "uyvy");
+        // Stored as yuyv (Y0 U Y1 V): the frame's UYVY bytes with each pair swapped.
+        assert_eq!(img["enc"], "yuyv");
         assert_eq!(img["w"].as_u64(), Some(32));
         assert_eq!(img["step"].as_u64(), Some(64));
-        assert_eq!(img["sha"].as_str().unwrap(), sha256_hex(rec.frame.data()));
+        let mut yuyv = rec.frame.data().to_vec();
+        for q in yuyv.chunks_exact_mut(4) {
+            q.swap(0, 1);
+            q.swap(2, 3);
+        }
+        assert_eq!(img["sha"].as_str().unwrap(), sha256_hex(&yuyv));
     }
     let sensors: Vec<_> = lines
         .iter()
