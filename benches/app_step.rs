@@ -11,8 +11,8 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use eotn::app::state::Command;
-use eotn::app::{AppState, palette, view_images};
+use eotn::app::{palette, view_images};
+use eotn::workspace::{Command, Workspace};
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
 
@@ -39,7 +39,7 @@ fn overhead_stream(dir: &Path) -> PathBuf {
 }
 
 fn bench_stream(c: &mut Criterion, name: &str, stream: PathBuf) {
-    let mut state = AppState::default();
+    let mut state = Workspace::default();
     state
         .apply(Command::Open(vec![stream, repo("lookup_tables/sim.lut")]))
         .expect("open");

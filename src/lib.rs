@@ -14,6 +14,8 @@
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
 //! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
+//! | [`sources`] | frame sources (stream, files, synthetic, V4L2 camera, network), recording |
+//! | [`workspace`] | what the app, the CLI and the tests share: table, source, playback, edits |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
@@ -31,7 +33,9 @@ pub mod pipeline;
 pub mod recognition;
 pub mod sensors;
 pub mod sim;
+pub mod sources;
 pub mod streams;
+pub mod workspace;
 
 pub mod cli;
 

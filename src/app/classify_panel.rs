@@ -3,7 +3,7 @@
 
 use egui::{Color32, Context, RichText, Sense, Ui, vec2};
 
-use super::state::{AppState, Command, TryEdit};
+use crate::workspace::{Command, TryEdit, Window, Workspace};
 use crate::lut::{ColourClass, Sensitivity};
 
 /// A colour swatch the size of a line of text.
@@ -14,7 +14,7 @@ pub fn swatch(ui: &mut Ui, rgb: [u8; 3]) {
 }
 
 /// The side panel's contents.
-pub fn classify_panel_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     ui.heading("Classify");
     ui.label(
         RichText::new("left-click: sample · right-click: commit")
@@ -124,17 +124,24 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Comma
 }
 
 /// The results of "Try on whole stream"; clicking a row shows that frame.
-pub fn try_edit_window(ctx: &Context, state: &mut AppState, commands: &mut Vec<Command>) {
-    let Some(t) = state.try_edit().cloned() else {
+/// Shown while the window is open and a check exists; it borrows the check (its edited table is
+/// megabytes: no copy per UI frame). Closing it sends [`Command::ShowWindow`].
+pub fn try_edit_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
+    if !state.window_open(Window::TryEdit) {
+        return;
+    }
+    let Some(t) = state.try_edit() else {
         return;
     };
-    let mut open = state.settings.show_try_edit;
-    egui::Window::new("Try edit on stream")
+    let mut open = true;
+    egui::Window::new(Window::TryEdit.name())
         .open(&mut open)
         .default_width(360.0)
         .default_pos([900.0, 420.0])
-        .show(ctx, |ui| try_edit_ui(ui, &t, state.index(), commands));
-    state.settings.show_try_edit = open;
+        .show(ctx, |ui| try_edit_ui(ui, t, state.index(), commands));
+    if !open {
+        commands.push(Command::ShowWindow(Window::TryEdit, false));
+    }
 }
 
 fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Command>) {

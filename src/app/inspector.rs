@@ -8,7 +8,7 @@
 
 use egui::{Color32, Context, RichText, Ui};
 
-use super::state::{AppState, Command, Window};
+use crate::workspace::{Workspace, Command, Window};
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
 use crate::recognition::draw::owner;
@@ -322,7 +322,7 @@ fn verdict_colour(accepted: bool) -> Color32 {
 }
 
 /// Shows the inspector while it is open; selecting pushes [`Command::SelectObject`].
-pub fn inspector_window(ctx: &Context, state: &AppState, commands: &mut Vec<Command>) {
+pub fn inspector_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
     if !state.window_open(Window::Inspector) {
         return;
     }
@@ -338,7 +338,7 @@ pub fn inspector_window(ctx: &Context, state: &AppState, commands: &mut Vec<Comm
     }
 }
 
-fn inspector_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     if state.frame().is_none() {
         ui.label("No frame open.");
         return;

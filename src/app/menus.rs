@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use egui::Ui;
 
-use super::state::{AppState, Command, Overlays, SPEEDS, ViewKind, Window, ZOOM_PRESETS};
+use crate::workspace::{Workspace, Command, Overlays, SPEEDS, ViewKind, Window, ZOOM_PRESETS};
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
 
@@ -65,7 +65,7 @@ fn pick_open(title: &str, filters: &[(&str, &[&str])]) -> Option<Vec<PathBuf>> {
 /// The menu bar.
 pub fn menu_bar_ui(
     ui: &mut Ui,
-    state: &AppState,
+    state: &Workspace,
     input: &mut MenuInput,
     commands: &mut Vec<Command>,
 ) -> MenuOutput {
@@ -92,7 +92,7 @@ pub fn menu_bar_ui(
 
 fn file_menu_ui(
     ui: &mut Ui,
-    state: &AppState,
+    state: &Workspace,
     input: &mut MenuInput,
     commands: &mut Vec<Command>,
     out: &mut MenuOutput,
@@ -211,7 +211,7 @@ fn file_menu_ui(
 
 /// `eotn-view-FRAME-VIEW.png`.
 #[must_use]
-pub fn default_export_name(state: &AppState) -> String {
+pub fn default_export_name(state: &Workspace) -> String {
     format!(
         "eotn-view-{:05}-{}.png",
         state.index(),
@@ -219,7 +219,7 @@ pub fn default_export_name(state: &AppState) -> String {
     )
 }
 
-fn classification_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+fn classification_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     ui.menu_button(format!("Class: {}", state.settings.class.name()), |ui| {
         for class in ColourClass::ALL {
             if ui
@@ -325,7 +325,7 @@ fn classification_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Comm
     }
 }
 
-fn view_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     ui.menu_button("Enlarged view", |ui| {
         for kind in ViewKind::ALL {
             if ui
@@ -371,7 +371,7 @@ fn view_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
 }
 
 /// View ▸ Overlays: every switch, the pipeline's first, then recognition's.
-fn overlays_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+fn overlays_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let mut o: Overlays = state.settings.overlays;
     let before = o;
     ui.checkbox(&mut o.classified, "Classified over colour");
@@ -402,7 +402,7 @@ fn overlays_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) 
     }
 }
 
-fn stream_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let open = state.source().is_some();
     for (label, cmd, key) in [
         ("Previous frame", Command::Step(-1), "Left"),
@@ -450,7 +450,7 @@ pub fn speed_name(s: f32) -> String {
     }
 }
 
-fn windows_menu_ui(ui: &mut Ui, state: &AppState, commands: &mut Vec<Command>) {
+fn windows_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     for w in Window::ALL {
         let mut open = state.window_open(w);
         if ui.checkbox(&mut open, w.name()).changed() {

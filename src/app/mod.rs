@@ -1,11 +1,10 @@
-//! The desktop app (feature `gui`): eframe on wgpu or OpenGL (see `renderer.rs`), embedding the same pipeline as
-//! the CLI. Laid out like egui's demo app and rerun's viewer:
+//! The desktop app (feature `gui`): eframe on wgpu or OpenGL (see `renderer.rs`), embedding the
+//! same pipeline as the CLI. Everything that is not a widget is the [`crate::workspace`] (it
+//! builds without this feature); this folder draws it and sends [`Command`]s. Laid out like egui's
+//! demo app and rerun's viewer:
 //!
 //! | file | role |
 //! |---|---|
-//! | `state.rs` | [`AppState`]: all non-UI state; [`Command`]s applied in one place |
-//! | `source.rs` | frames on demand from a stream or frame files, with a small cache |
-//! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `views.rs` | the enlarged view (zoom, pan, hover, clicks) and the thumbnails |
 //! | `overlays.rs` | drawing in image pixels through one transform: boxes, labels, markers |
 //! | `classify_panel.rs` | class picker, sensitivity, commit/undo/redo, try-on-stream |
@@ -19,13 +18,10 @@
 
 pub mod classify_panel;
 pub mod inspector;
-pub mod journal;
 pub mod menus;
 pub mod overlays;
 pub mod renderer;
 pub mod sensors_dialog;
-pub mod source;
-pub mod state;
 pub mod uv_plane;
 pub mod views;
 
@@ -34,10 +30,10 @@ use std::time::{Duration, Instant};
 
 use egui::{Color32, ColorImage, Key, KeyboardShortcut, Modifiers, TextureHandle, TextureOptions};
 
-pub use state::{AppState, Command, Settings, ViewKind};
+pub use crate::workspace::{Command, Settings, ViewKind, Workspace};
 
 use overlays::{FrameTextures, ImageTransform};
-use state::PixelInfo;
+use crate::workspace::{PixelInfo, SPEEDS, median};
 
 /// How much the pixels outside a pending selection are darkened (alpha of black over them).
 const PREVIEW_DIM_ALPHA: u8 = 110;
@@ -159,7 +155,7 @@ fn start_window(
             let mut app = EotnApp::new(cc, opts.files.clone());
             app.renderer = Some(info);
             if opts.all_overlays {
-                app.state.settings.overlays = state::Overlays::all_on();
+                app.state.settings.overlays = crate::workspace::Overlays::all_on();
             }
             if let Some(speed) = opts.play {
                 app.state.run(Command::SetSpeed(speed.as_factor()));
@@ -215,7 +211,7 @@ pub struct ViewImages {
 /// Builds the colour and class-colour images of the shown frame (`palette` from [`palette`]);
 /// `None` when no frame is open. This is the CPU side of a texture update.
 #[must_use]
-pub fn view_images(state: &AppState, palette: &[Color32; 256]) -> Option<ViewImages> {
+pub fn view_images(state: &Workspace, palette: &[Color32; 256]) -> Option<ViewImages> {
     let frame = state.frame()?;
     let size = [frame.width(), frame.height()];
     let raw = ColorImage::from_rgb(size, state.rgb());
@@ -234,7 +230,7 @@ pub fn view_images(state: &AppState, palette: &[Color32; 256]) -> Option<ViewIma
 /// The preview highlight image of the pending selection (class colour on selected pixels,
 /// dimmed elsewhere; transparent with no selection).
 #[must_use]
-pub fn preview_image(state: &AppState, size: [usize; 2]) -> ColorImage {
+pub fn preview_image(state: &Workspace, size: [usize; 2]) -> ColorImage {
     let mask = state.preview_mask();
     let colour = state
         .preview_colour()
@@ -254,7 +250,7 @@ pub fn preview_image(state: &AppState, size: [usize; 2]) -> ColorImage {
 /// The eframe application: the state plus the runtime resources of the window.
 pub struct EotnApp {
     /// Everything that is not a widget.
-    pub state: AppState,
+    pub state: Workspace,
     textures: Option<Textures>,
     menu_input: menus::MenuInput,
     uv_plane: uv_plane::UvPlane,
@@ -284,7 +280,7 @@ impl EotnApp {
             .storage
             .and_then(|s| eframe::get_value::<Settings>(s, SETTINGS_KEY))
             .unwrap_or_default();
-        let mut app = Self::with_state(AppState::new(settings));
+        let mut app = Self::with_state(Workspace::new(settings));
         if paths.is_empty() {
             app.state.reopen_last();
         } else {
@@ -295,7 +291,7 @@ impl EotnApp {
 
     /// The app around an existing state (tests build the state first).
     #[must_use]
-    pub fn with_state(state: AppState) -> Self {
+    pub fn with_state(state: Workspace) -> Self {
         Self {
             state,
             textures: None,
@@ -481,7 +477,7 @@ impl EotnApp {
                 .selected_text(menus::speed_name(speed))
                 .width(90.0)
                 .show_ui(ui, |ui| {
-                    for s in state::SPEEDS {
+                    for s in SPEEDS {
                         ui.selectable_value(&mut speed, s, menus::speed_name(s));
                     }
                 });
@@ -544,9 +540,9 @@ impl EotnApp {
             ))
             .on_hover_text(format!(
                 "medians: step {:.2} ms, frame {:.2} ms, playing {:.2} ms",
-                state::median(&self.state.timings.steps_ms),
-                state::median(&self.state.timings.frames_ms),
-                state::median(&self.state.timings.playing_frames_ms),
+                median(&self.state.timings.steps_ms),
+                median(&self.state.timings.frames_ms),
+                median(&self.state.timings.playing_frames_ms),
             ));
             }
             ui.separator();
@@ -716,13 +712,13 @@ impl EotnApp {
             eprintln!(
                 "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms (our UI code {:.2} ms, eframe CPU {:.2} ms); played {} dropped {}; renderer {}",
                 t.steps_ms.len(),
-                state::median(&t.steps_ms),
+                median(&t.steps_ms),
                 t.frames_ms.len(),
-                state::median(&t.frames_ms),
+                median(&t.frames_ms),
                 t.playing_frames_ms.len(),
-                state::median(&t.playing_frames_ms),
-                state::median(&t.playing_ui_ms),
-                state::median(&t.playing_cpu_ms),
+                median(&t.playing_frames_ms),
+                median(&t.playing_ui_ms),
+                median(&t.playing_cpu_ms),
                 t.played_frames,
                 t.dropped_frames,
                 self.renderer.as_ref().map_or("none", |r| r.kind.name()),
@@ -781,9 +777,9 @@ impl eframe::App for EotnApp {
                 self.last_view = out.transform;
             });
 
-        sensors_dialog::sensors_window(&ctx, &mut self.state);
-        self.uv_plane.window(&ctx, &mut self.state, &mut commands);
-        classify_panel::try_edit_window(&ctx, &mut self.state, &mut commands);
+        sensors_dialog::sensors_window(&ctx, &self.state, &mut commands);
+        self.uv_plane.window(&ctx, &self.state, &mut commands);
+        classify_panel::try_edit_window(&ctx, &self.state, &mut commands);
         inspector::inspector_window(&ctx, &self.state, &mut commands);
         self.warnings_window(&ctx);
         self.about_window(&ctx);

@@ -7,7 +7,7 @@ use egui::{
     Align2, Color32, FontId, Painter, Pos2, Rect, Stroke, StrokeKind, TextureId, pos2, vec2,
 };
 
-use super::state::{AppState, PrimitiveFilter, ViewKind, box_colour};
+use crate::workspace::{Workspace, PrimitiveFilter, ViewKind, box_colour};
 use crate::blobs::Blob;
 use crate::recognition::{CircleRole, Primitive};
 
@@ -44,7 +44,7 @@ impl ImageTransform {
 
     /// The transform of the enlarged view with the state's zoom and pan.
     #[must_use]
-    pub fn for_state(view: Rect, state: &AppState) -> Self {
+    pub fn for_state(view: Rect, state: &Workspace) -> Self {
         let (w, h) = state.image_size();
         let size = [w as f32, h as f32];
         let t = state.settings.transform;
@@ -121,7 +121,7 @@ pub fn paint_view(
     painter: &Painter,
     xf: &ImageTransform,
     kind: ViewKind,
-    state: &AppState,
+    state: &Workspace,
     tex: &FrameTextures,
     with_overlays: bool,
 ) {

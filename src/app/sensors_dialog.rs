@@ -5,21 +5,26 @@
 use egui::{Color32, Context, Id};
 use egui_plot::{Legend, Line, Plot, VLine};
 
-use super::state::AppState;
+use crate::workspace::{Command, Window, Workspace};
 use crate::sensors::SensorReadings;
 
-/// Shows the dialog while `state.settings.show_sensors` is set.
-pub fn sensors_window(ctx: &Context, state: &mut AppState) {
-    let mut open = state.settings.show_sensors;
-    egui::Window::new("Sensors")
+/// Shows the dialog while it is open; closing it sends [`Command::ShowWindow`].
+pub fn sensors_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
+    if !state.window_open(Window::Sensors) {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new(Window::Sensors.name())
         .open(&mut open)
         .default_width(420.0)
         .default_pos([700.0, 80.0])
         .show(ctx, |ui| sensors_ui(ui, state));
-    state.settings.show_sensors = open;
+    if !open {
+        commands.push(Command::ShowWindow(Window::Sensors, false));
+    }
 }
 
-fn sensors_ui(ui: &mut egui::Ui, state: &AppState) {
+fn sensors_ui(ui: &mut egui::Ui, state: &Workspace) {
     let Some(current) = state.current() else {
         ui.label("No frame open.");
         return;
@@ -72,7 +77,7 @@ fn readings_grid_ui(ui: &mut egui::Ui, r: &SensorReadings) {
         });
 }
 
-fn series_plots_ui(ui: &mut egui::Ui, state: &AppState, now_s: f64) {
+fn series_plots_ui(ui: &mut egui::Ui, state: &Workspace, now_s: f64) {
     let series = &state.sensor_series;
     if series.total == 0 {
         ui.weak("Plots need a recorded stream.");

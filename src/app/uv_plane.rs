@@ -8,7 +8,7 @@ use egui::{
     pos2, vec2,
 };
 
-use super::state::{AppState, Command};
+use crate::workspace::{Command, Window, Workspace};
 use crate::lut::edit::Selection;
 
 /// The U–V plane texture, rebuilt when the table, frame or Y changes.
@@ -19,18 +19,23 @@ pub struct UvPlane {
 }
 
 impl UvPlane {
-    /// Shows the window while `state.settings.show_uv_plane` is set.
-    pub fn window(&mut self, ctx: &Context, state: &mut AppState, commands: &mut Vec<Command>) {
-        let mut open = state.settings.show_uv_plane;
-        egui::Window::new("U–V plane")
+    /// Shows the window while it is open; closing it sends [`Command::ShowWindow`].
+    pub fn window(&mut self, ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
+        if !state.window_open(Window::UvPlane) {
+            return;
+        }
+        let mut open = true;
+        egui::Window::new(Window::UvPlane.name())
             .open(&mut open)
             .default_width(300.0)
             .default_pos([960.0, 60.0])
             .show(ctx, |ui| self.ui(ui, state, commands));
-        state.settings.show_uv_plane = open;
+        if !open {
+            commands.push(Command::ShowWindow(Window::UvPlane, false));
+        }
     }
 
-    fn ui(&mut self, ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+    fn ui(&mut self, ui: &mut egui::Ui, state: &Workspace, commands: &mut Vec<Command>) {
         let lut = state.lut();
         let n = lut.side();
         let shift = lut.shift();
@@ -109,7 +114,7 @@ impl UvPlane {
     }
 
     /// Cells in class colours (unclassified dark), brightened where the frame has pixels.
-    fn build(&self, state: &AppState, layer: usize) -> ColorImage {
+    fn build(&self, state: &Workspace, layer: usize) -> ColorImage {
         let lut = state.lut();
         let n = lut.side();
         let shift = lut.shift();

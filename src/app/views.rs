@@ -5,7 +5,7 @@
 use egui::{Align2, Color32, PointerButton, Sense, Ui, vec2};
 
 use super::overlays::{FrameTextures, ImageTransform, corner_text, paint_view};
-use super::state::{AppState, Command, PixelInfo, ViewKind};
+use crate::workspace::{Workspace, Command, PixelInfo, ViewKind};
 
 /// Screen points the mouse wheel must move for the zoom to double.
 const WHEEL_POINTS_PER_DOUBLING: f32 = 240.0;
@@ -22,7 +22,7 @@ pub struct MainViewOutput {
 /// The enlarged view, filling `ui`; pushes what the user did as commands.
 pub fn main_view_ui(
     ui: &mut Ui,
-    state: &AppState,
+    state: &Workspace,
     tex: Option<&FrameTextures>,
     commands: &mut Vec<Command>,
 ) -> MainViewOutput {
@@ -93,7 +93,7 @@ pub fn main_view_ui(
 /// The thumbnails of the other views in a row; clicking one enlarges it.
 pub fn thumbnails_ui(
     ui: &mut Ui,
-    state: &AppState,
+    state: &Workspace,
     tex: Option<&FrameTextures>,
     commands: &mut Vec<Command>,
 ) {

@@ -4,16 +4,18 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::blobs::Connectivity;
-use crate::frame::{Frame, is_image_file, load_frame};
-use crate::lut::LookupTable;
-use crate::streams::{StreamReader, is_stream_file};
+pub use crate::sources::{RAW_EXTENSIONS, expand_frame_paths, is_frame_file};
 
-/// File extensions read as raw UYVY frames.
-pub const RAW_EXTENSIONS: [&str; 3] = ["uyvy", "yuv", "raw"];
+use crate::blobs::Connectivity;
+use crate::frame::{Frame, load_frame};
+use crate::lut::LookupTable;
+use crate::sources::{
+    FileSource, NOMINAL_FRAME_INTERVAL_NS, RecordedSource, SourceFrame, StreamSource,
+};
+use crate::streams::is_stream_file;
 
 /// Parses `WxH` (e.g. `208x160`).
 ///
@@ -47,50 +49,6 @@ pub fn parse_connectivity(text: &str) -> Result<Connectivity, String> {
         .ok()
         .and_then(Connectivity::from_neighbours)
         .ok_or_else(|| format!("connectivity must be 4 or 8, not '{text}'"))
-}
-
-/// True for files the frame loaders read.
-#[must_use]
-pub fn is_frame_file(path: &Path) -> bool {
-    is_image_file(path)
-        || path
-            .extension()
-            .is_some_and(|e| RAW_EXTENSIONS.iter().any(|r| e.eq_ignore_ascii_case(r)))
-}
-
-/// Expands the arguments: files (frames and `.mcap` streams) stay, folders give their frame files
-/// sorted by name.
-///
-/// # Errors
-/// A path that does not exist, or a folder without frames.
-pub fn expand_frame_paths(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
-    let mut out = Vec::new();
-    for p in paths {
-        if p.is_dir() {
-            let mut found: Vec<PathBuf> = std::fs::read_dir(p)
-                .with_context(|| format!("{}: cannot list folder", p.display()))?
-                .filter_map(Result::ok)
-                .map(|e| e.path())
-                .filter(|f| f.is_file() && is_frame_file(f))
-                .collect();
-            if found.is_empty() {
-                bail!(
-                    "{}: no frame files (.uyvy, .yuv, .raw, .png, .jpg) in folder",
-                    p.display()
-                );
-            }
-            found.sort();
-            out.extend(found);
-        } else if p.exists() {
-            out.push(p.clone());
-        } else {
-            bail!("{}: no such file or folder", p.display());
-        }
-    }
-    if out.is_empty() {
-        bail!("no input frames given");
-    }
-    Ok(out)
 }
 
 /// Parses a frame range: `A..B` (B excluded), `A..=B`, `A..`, `..B`, or a single index `A`.
@@ -178,12 +136,13 @@ impl InputArgs {
 }
 
 /// The frames named on a command line, in order: frame files, folders of them, and MCAP streams
-/// (every frame of each, or those in `--frames`). Streams are read one frame at a time, so a long
+/// (every frame of each, or those in `--frames`), read through the frame sources of
+/// [`crate::sources`] as the app reads them. Streams are read one frame at a time, so a long
 /// stream costs no more memory than a short one.
 #[derive(Debug)]
 pub struct FrameInputs {
     items: Vec<FrameInput>,
-    reader: Option<StreamReader>,
+    stream: Option<StreamSource>,
 }
 
 impl FrameInputs {
@@ -196,14 +155,11 @@ impl FrameInputs {
         let mut items = Vec::new();
         for p in expand_frame_paths(paths)? {
             if is_stream_file(&p) {
-                let reader = StreamReader::open(&p)?;
-                for w in reader.warnings() {
+                let stream = StreamSource::open(&p)?;
+                for w in stream.warnings() {
                     log::warn!("{}: {w}", p.display());
                 }
-                if reader.is_empty() {
-                    bail!("{}: the stream holds no frames", p.display());
-                }
-                let all = 0..reader.len();
+                let all = 0..stream.len();
                 let take = range
                     .clone()
                     .map_or(all.clone(), |r| r.start.min(all.end)..r.end.min(all.end));
@@ -211,7 +167,7 @@ impl FrameInputs {
                     bail!(
                         "{}: --frames selects none of its {} frames",
                         p.display(),
-                        reader.len()
+                        stream.len()
                     );
                 }
                 items.extend(take.map(|index| FrameInput::Stream {
@@ -224,7 +180,7 @@ impl FrameInputs {
         }
         Ok(Self {
             items,
-            reader: None,
+            stream: None,
         })
     }
 
@@ -269,8 +225,9 @@ impl FrameInputs {
         i: usize,
         size: Option<(usize, usize)>,
     ) -> anyhow::Result<(Frame, Option<crate::sensors::SensorReadings>)> {
-        let record = self.load_record(i, size)?;
-        Ok((record.frame, record.sensors))
+        let f = self.load_source_frame(i, size)?;
+        let frame = std::sync::Arc::unwrap_or_clone(f.frame);
+        Ok((frame, f.sensors))
     }
 
     /// Loads frame `i` with everything its stream recorded for it (readings, truth, other
@@ -283,26 +240,39 @@ impl FrameInputs {
         i: usize,
         size: Option<(usize, usize)>,
     ) -> anyhow::Result<crate::streams::FrameRecord> {
-        /// Interval of frame files, which carry no time: 25 fps, nanoseconds.
-        const FILE_INTERVAL_NS: u64 = 40_000_000;
+        Ok(self.load_source_frame(i, size)?.into_record())
+    }
+
+    /// Loads frame `i` as its source delivers it: for a stream frame, with its sensor readings
+    /// and channels; for a frame file, the image alone (the CLI ignores sensor side files), timed
+    /// at the nominal 25 fps by its place in the list.
+    ///
+    /// # Errors
+    /// The loader's error, naming the file.
+    pub fn load_source_frame(
+        &mut self,
+        i: usize,
+        size: Option<(usize, usize)>,
+    ) -> anyhow::Result<SourceFrame> {
         match self.items.get(i) {
             None => bail!("no input frame {i}"),
             Some(FrameInput::File(p)) => {
-                let t = u64::try_from(i).unwrap_or(u64::MAX / FILE_INTERVAL_NS);
-                let time_ns = t.saturating_mul(FILE_INTERVAL_NS);
-                Ok(crate::streams::FrameRecord::new(
-                    time_ns,
-                    load_frame_arg(p, size)?,
-                ))
+                let mut file = FileSource::new(vec![p.clone()], size)?;
+                let mut f = file.read(0)?;
+                f.sensors = None;
+                f.warnings.clear();
+                let t = u64::try_from(i).unwrap_or(u64::MAX / NOMINAL_FRAME_INTERVAL_NS);
+                f.time_ns = t.saturating_mul(NOMINAL_FRAME_INTERVAL_NS);
+                Ok(f)
             }
             Some(FrameInput::Stream { path, index }) => {
-                if self.reader.as_ref().is_none_or(|r| r.path() != path) {
-                    self.reader = Some(StreamReader::open(path)?);
+                if self.stream.as_ref().is_none_or(|s| s.path() != path) {
+                    self.stream = Some(StreamSource::open(path)?);
                 }
-                let Some(reader) = self.reader.as_mut() else {
+                let Some(stream) = self.stream.as_mut() else {
                     bail!("{}: stream not open", path.display());
                 };
-                Ok(reader.read(*index)?)
+                Ok(stream.read(*index)?)
             }
         }
     }

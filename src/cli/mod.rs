@@ -20,6 +20,7 @@ pub mod open;
 pub mod patterns;
 mod render;
 mod sim;
+mod sources;
 
 use std::process::ExitCode;
 
@@ -68,6 +69,8 @@ pub enum Command {
     Sim(sim::Args),
     /// Lookup-table tools: `eotn lut convert` reads other teams' tables.
     Lut(lut::Args),
+    /// List the frame sources that can be connected: cameras found, synthetic scenarios.
+    Sources(sources::Args),
     /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
     Open(open::Args),
 }
@@ -91,6 +94,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Render(a) => render::run(&a),
         Command::Patterns(a) => patterns::run(&a),
         Command::Eval(a) => eval::run(&a),
+        Command::Sources(a) => sources::run(&a),
         Command::Open(a) => open::run(&a),
     }
 }

@@ -1,4 +1,4 @@
-//! The desktop app driven headlessly with egui_kittest: the real `EotnApp` and `AppState`, real
+//! The desktop app driven headlessly with egui_kittest: the real `EotnApp` and `Workspace`, real
 //! clicks and keys, assertions on state, on the saved table's bytes and on the journal.
 
 use std::path::{Path, PathBuf};
@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use egui::{Event, Key, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
-use eotn::app::journal;
-use eotn::app::state::{Command, ViewKind, Window};
-use eotn::app::{AppState, EotnApp};
+use eotn::workspace::journal;
+use eotn::app::EotnApp;
+use eotn::workspace::{Command, ViewKind, Window, Workspace};
 use eotn::frame::{Frame, Yuv};
 use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
 
@@ -81,7 +81,7 @@ fn click_at(h: &Harness<'_, EotnApp>, pos: Pos2, button: PointerButton) {
     }
 }
 
-fn state<'h>(h: &'h Harness<'_, EotnApp>) -> &'h AppState {
+fn state<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
     &h.state().state
 }
 
@@ -250,7 +250,7 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
 fn reopening_a_table_restores_undo_from_the_journal() {
     let dir = tempfile::tempdir().unwrap();
     let (frames, table) = fixture(dir.path());
-    let mut s = AppState::default();
+    let mut s = Workspace::default();
     s.apply(Command::Open(vec![table.clone(), frames[0].clone()]))
         .unwrap();
     let original = s.lut().clone();
@@ -264,7 +264,7 @@ fn reopening_a_table_restores_undo_from_the_journal() {
     let saved = s.lut().clone();
 
     // A new session: the journal gives back both undo steps.
-    let mut s2 = AppState::default();
+    let mut s2 = Workspace::default();
     s2.apply(Command::OpenTable(table.clone())).unwrap();
     assert_eq!(s2.lut(), &saved);
     assert_eq!(s2.history().undo_len(), 2);
@@ -276,7 +276,7 @@ fn reopening_a_table_restores_undo_from_the_journal() {
     // A crash before saving: the table on disk lags the journal, which recovers it.
     s2.apply(Command::Redo).unwrap();
     let unsaved = s2.lut().clone();
-    let mut s3 = AppState::default();
+    let mut s3 = Workspace::default();
     s3.apply(Command::OpenTable(table.clone())).unwrap();
     assert_eq!(s3.warnings().len(), 1, "{:?}", s3.warnings());
     s3.apply(Command::RebuildFromJournal).unwrap();
@@ -297,7 +297,7 @@ fn bad_files_are_reported_not_fatal() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("short.lut");
     std::fs::write(&bad, [0u8; 1000]).unwrap();
-    let mut s = AppState::default();
+    let mut s = Workspace::default();
     let err = s.apply(Command::Open(vec![bad.clone()])).unwrap_err();
     assert!(format!("{err:#}").contains("short.lut"), "{err:#}");
     let frame = dir.path().join("odd.uyvy");
@@ -312,7 +312,7 @@ fn bad_files_are_reported_not_fatal() {
 fn try_edit_lists_the_frames_that_would_change() {
     let dir = tempfile::tempdir().unwrap();
     let (frames, table) = fixture(dir.path());
-    let mut s = AppState::default();
+    let mut s = Workspace::default();
     let mut paths = frames;
     paths.push(table);
     s.apply(Command::Open(paths)).unwrap();
@@ -400,7 +400,7 @@ fn closing_with_unsaved_changes_asks_first() {
 fn snapshot_with_overlays() {
     let dir = tempfile::tempdir().unwrap();
     let (frames, table) = fixture(dir.path());
-    let mut s = AppState::default();
+    let mut s = Workspace::default();
     let mut paths = frames;
     paths.push(table);
     s.apply(Command::Open(paths)).unwrap();
@@ -471,7 +471,7 @@ fn stream_steps_plays_and_plots_sensors() {
     for i in 0..15 {
         h.state_mut().state.run(Command::Seek(i));
     }
-    assert!(state(&h).source().unwrap().cached() <= eotn::app::source::CACHE_FRAMES);
+    assert!(state(&h).source().unwrap().cached() <= eotn::workspace::source::CACHE_FRAMES);
     // The sensor dialog reads the whole series in the background.
     h.state_mut()
         .state
@@ -628,7 +628,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         "{circles:?}"
     );
     // An unknown owner is refused; stepping to a frame without it clears the selection.
-    let mut st = AppState::default();
+    let mut st = Workspace::default();
     assert!(
         st.apply(Command::SelectObject(Some("ball#9".into())))
             .is_err()
@@ -682,7 +682,7 @@ fn nan_sensor_readings_of_a_side_file_show_as_warnings() {
 
 #[test]
 fn snapshot_with_recognition_and_inspector() {
-    let mut s = AppState::default();
+    let mut s = Workspace::default();
     s.apply(Command::Open(vec![
         repo_file("streams/sim-walk-and-pan.mcap"),
         repo_file("lookup_tables/sim.lut"),
@@ -807,7 +807,7 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     let table = repo_file("lookup_tables/sim.lut");
     // Find a frame with a pink marker seen whole, and make a places file that knows it (as
     // `eotn patterns learn` would; learning itself is tested in tests/it/patterns.rs).
-    let mut s = AppState::default();
+    let mut s = Workspace::default();
     s.apply(Command::Open(vec![stream.clone(), table.clone()]))
         .unwrap();
     let mut frame = None;

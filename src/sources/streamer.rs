@@ -1,0 +1,333 @@
+//! Any source grabbed at a fixed rate on its own thread. The thread owns the source and the
+//! recorder; the UI (or a CLI loop) only polls a channel, so a camera waiting for its next frame
+//! or a renderer drawing one never blocks it. Recording happens on the thread too, so every
+//! grabbed frame is written even when the UI shows only the latest.
+
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, SyncSender, TrySendError};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use super::{FrameSource, Recorder, SourceError, SourceFrame, SourceInfo, SourceSettings};
+
+/// Frames waiting for the UI before new ones are dropped (the UI shows the latest anyway).
+const QUEUE_FRAMES: usize = 4;
+
+/// What the streaming thread reports.
+#[derive(Debug)]
+pub enum StreamerEvent {
+    /// A new frame.
+    Frame(SourceFrame),
+    /// The settings now in effect (after a change was asked for).
+    Settings(SourceSettings),
+    /// A recording finished: its file and frame count, or why it failed.
+    RecordingStopped {
+        /// The stream written.
+        path: std::path::PathBuf,
+        /// Frames written, or the error.
+        result: Result<usize, String>,
+    },
+    /// Something failed (a grab, a settings change, a write); streaming goes on.
+    Error(String),
+}
+
+enum Control {
+    SetSettings(SourceSettings),
+    SetRate(f64),
+    StartRecording(Box<Recorder>),
+    StopRecording,
+    Stop,
+}
+
+/// A source streaming on its own thread; see the module documentation.
+#[derive(Debug)]
+pub struct Streamer {
+    info: SourceInfo,
+    control: Sender<Control>,
+    /// Everything but frames: never dropped, never blocks the thread.
+    events: Receiver<StreamerEvent>,
+    /// Frames, at most [`QUEUE_FRAMES`] waiting; the thread drops new ones when it is full.
+    frames: Receiver<SourceFrame>,
+    thread: Option<JoinHandle<Box<dyn FrameSource>>>,
+    recording: Option<std::path::PathBuf>,
+    rate_hz: f64,
+}
+
+impl Streamer {
+    /// Connects `source` and starts grabbing `rate_hz` frames a second on a new thread.
+    ///
+    /// # Errors
+    /// The source cannot connect; a rate that is not positive and finite.
+    pub fn start(mut source: Box<dyn FrameSource>, rate_hz: f64) -> Result<Self, SourceError> {
+        let info = source.info();
+        if !(rate_hz.is_finite() && rate_hz > 0.0) {
+            return Err(SourceError::Unsupported {
+                label: info.label,
+                detail: format!("cannot stream at {rate_hz} frames a second"),
+            });
+        }
+        source.connect()?;
+        let (control, control_rx) = mpsc::channel();
+        let (events_tx, events) = mpsc::channel();
+        let (frames_tx, frames) = mpsc::sync_channel(QUEUE_FRAMES);
+        let thread = std::thread::Builder::new()
+            .name(format!("source {}", info.label))
+            .spawn(move || {
+                let out = Outbox {
+                    events: events_tx,
+                    frames: frames_tx,
+                };
+                run(source, rate_hz, &control_rx, &out)
+            })
+            .map_err(|e| SourceError::Device {
+                label: info.label.clone(),
+                detail: format!("cannot start its thread: {e}"),
+            })?;
+        Ok(Self {
+            info,
+            control,
+            events,
+            frames,
+            thread: Some(thread),
+            recording: None,
+            rate_hz,
+        })
+    }
+
+    /// What is streaming.
+    #[must_use]
+    pub const fn info(&self) -> &SourceInfo {
+        &self.info
+    }
+
+    /// Frames a second asked for.
+    #[must_use]
+    pub const fn rate_hz(&self) -> f64 {
+        self.rate_hz
+    }
+
+    /// Everything reported since the last call (settings, errors and recordings first, then
+    /// the frames, oldest first); never waits.
+    #[must_use]
+    pub fn poll(&self) -> Vec<StreamerEvent> {
+        let mut out: Vec<StreamerEvent> = self.events.try_iter().collect();
+        out.extend(self.frames.try_iter().map(StreamerEvent::Frame));
+        out
+    }
+
+    /// Waits up to `timeout` for the next frame (tests and CLI loops; the UI polls).
+    #[must_use]
+    pub fn wait_frame(&self, timeout: Duration) -> Option<SourceFrame> {
+        self.frames.recv_timeout(timeout).ok()
+    }
+
+    /// Waits up to `timeout` for the next event that is not a frame (frames meanwhile stay
+    /// queued or are dropped).
+    #[must_use]
+    pub fn wait_event(&self, timeout: Duration) -> Option<StreamerEvent> {
+        self.events.recv_timeout(timeout).ok()
+    }
+
+    /// Asks for other settings; the outcome arrives as [`StreamerEvent::Settings`] or
+    /// [`StreamerEvent::Error`].
+    pub fn set_settings(&self, wanted: SourceSettings) {
+        self.send(Control::SetSettings(wanted));
+    }
+
+    /// Grabs at another rate from now on (ignored unless positive and finite).
+    pub fn set_rate(&mut self, rate_hz: f64) {
+        if rate_hz.is_finite() && rate_hz > 0.0 {
+            self.rate_hz = rate_hz;
+            self.send(Control::SetRate(rate_hz));
+        }
+    }
+
+    /// Starts writing every grabbed frame to `recorder` (a recording in progress is finished
+    /// first).
+    pub fn start_recording(&mut self, recorder: Recorder) {
+        self.recording = Some(recorder.path().to_owned());
+        self.send(Control::StartRecording(Box::new(recorder)));
+    }
+
+    /// Finishes the recording; [`StreamerEvent::RecordingStopped`] says how it went.
+    pub fn stop_recording(&mut self) {
+        self.recording = None;
+        self.send(Control::StopRecording);
+    }
+
+    /// The stream being recorded, if any.
+    #[must_use]
+    pub fn recording(&self) -> Option<&std::path::Path> {
+        self.recording.as_deref()
+    }
+
+    /// Stops the thread (finishing a recording) and hands the source back, disconnected.
+    pub fn stop(mut self) -> Option<Box<dyn FrameSource>> {
+        self.send(Control::Stop);
+        self.thread.take().and_then(|t| t.join().ok())
+    }
+
+    fn send(&self, c: Control) {
+        // A send fails only when the thread has ended (it panicked): nothing left to control.
+        let _ = self.control.send(c);
+    }
+}
+
+impl Drop for Streamer {
+    fn drop(&mut self) {
+        if let Some(t) = self.thread.take() {
+            let _ = self.control.send(Control::Stop);
+            let _ = t.join();
+        }
+    }
+}
+
+/// Where the thread reports to.
+struct Outbox {
+    events: Sender<StreamerEvent>,
+    frames: SyncSender<SourceFrame>,
+}
+
+impl Outbox {
+    fn event(&self, e: StreamerEvent) {
+        // Fails only when the Streamer is gone; then nobody is listening.
+        let _ = self.events.send(e);
+    }
+}
+
+/// The thread: grab, record, hand over, wait for the next tick or a control message.
+fn run(
+    mut source: Box<dyn FrameSource>,
+    mut rate_hz: f64,
+    control: &Receiver<Control>,
+    out: &Outbox,
+) -> Box<dyn FrameSource> {
+    let mut recorder: Option<Box<Recorder>> = None;
+    let mut next = Instant::now();
+    let mut last_error = String::new();
+    loop {
+        match source.grab() {
+            Ok(frame) => {
+                last_error.clear();
+                if let Some(r) = recorder.as_mut()
+                    && let Err(e) = r.record(&frame)
+                {
+                    let path = r.path().to_owned();
+                    recorder = None;
+                    let result = Err(format!("{e}"));
+                    out.event(StreamerEvent::RecordingStopped { path, result });
+                }
+                match out.frames.try_send(frame) {
+                    Ok(()) | Err(TrySendError::Full(_)) => {}
+                    Err(TrySendError::Disconnected(_)) => break,
+                }
+            }
+            Err(e) => {
+                let msg = e.to_string();
+                if msg != last_error {
+                    out.event(StreamerEvent::Error(msg.clone()));
+                    last_error = msg;
+                }
+            }
+        }
+        next += Duration::from_secs_f64(1.0 / rate_hz);
+        let now = Instant::now();
+        if next < now {
+            // Behind (a slow source): start counting again rather than grabbing in a burst.
+            next = now;
+        }
+        let stop = loop {
+            let wait = next.saturating_duration_since(Instant::now());
+            match control.recv_timeout(wait) {
+                Ok(Control::Stop) | Err(RecvTimeoutError::Disconnected) => break true,
+                Ok(Control::SetSettings(s)) => {
+                    let event = match source.set_settings(&s) {
+                        Ok(now) => StreamerEvent::Settings(now),
+                        Err(e) => StreamerEvent::Error(e.to_string()),
+                    };
+                    out.event(event);
+                }
+                Ok(Control::SetRate(r)) => {
+                    rate_hz = r;
+                    next = Instant::now() + Duration::from_secs_f64(1.0 / r);
+                }
+                Ok(Control::StartRecording(r)) => {
+                    finish(recorder.replace(r), out);
+                }
+                Ok(Control::StopRecording) => finish(recorder.take(), out),
+                Err(RecvTimeoutError::Timeout) => break false,
+            }
+        };
+        if stop {
+            break;
+        }
+    }
+    finish(recorder, out);
+    source.disconnect();
+    source
+}
+
+fn finish(recorder: Option<Box<Recorder>>, out: &Outbox) {
+    if let Some(r) = recorder {
+        let path = r.path().to_owned();
+        let result = r.finish().map_err(|e| e.to_string());
+        out.event(StreamerEvent::RecordingStopped { path, result });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sources::{FileSource, StreamSource};
+
+    fn two_frames(dir: &std::path::Path) -> FileSource {
+        let paths = (0..2)
+            .map(|i| {
+                let p = dir.join(format!("{i}.uyvy"));
+                std::fs::write(&p, vec![128u8; 208 * 160 * 2]).unwrap();
+                p
+            })
+            .collect();
+        FileSource::new(paths, None).unwrap()
+    }
+
+    #[test]
+    fn a_streamed_source_delivers_frames_and_records_them_on_its_thread() {
+        let dir = tempfile::tempdir().unwrap();
+        let source = two_frames(dir.path());
+        let mut s = Streamer::start(Box::new(source), 200.0).unwrap();
+        assert!(s.wait_frame(Duration::from_secs(5)).is_some());
+        let out = dir.path().join("live.mcap");
+        s.start_recording(Recorder::create(&out, s.info()).unwrap());
+        // Up to QUEUE_FRAMES frames and one in flight were grabbed before recording began.
+        for _ in 0..QUEUE_FRAMES + 1 + 3 {
+            assert!(s.wait_frame(Duration::from_secs(5)).is_some());
+        }
+        s.stop_recording();
+        let done = s.wait_event(Duration::from_secs(5));
+        let Some(StreamerEvent::RecordingStopped { path, result }) = done else {
+            panic!("expected the recording to stop, got {done:?}");
+        };
+        assert_eq!(path, out);
+        assert!(result.unwrap() >= 3, "every frame grabbed while recording is written");
+        let source = s.stop().unwrap();
+        assert!(!source.is_connected(), "a stopped streamer disconnects its source");
+        let mut back = StreamSource::open(&out).unwrap();
+        assert!(back.recorded().unwrap().len() >= 3);
+    }
+
+    #[test]
+    fn a_settings_change_the_source_refuses_comes_back_as_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = Streamer::start(Box::new(two_frames(dir.path())), 50.0).unwrap();
+        s.set_settings(SourceSettings {
+            exposure: Some(10),
+            ..SourceSettings::default()
+        });
+        let e = s.wait_event(Duration::from_secs(5));
+        assert!(
+            matches!(&e, Some(StreamerEvent::Error(m)) if m.contains("exposure")),
+            "{e:?}"
+        );
+        assert!(Streamer::start(Box::new(two_frames(dir.path())), 0.0).is_err());
+    }
+}

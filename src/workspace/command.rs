@@ -1,0 +1,127 @@
+//! Everything the UI can ask of the workspace, and the windows it can open.
+
+use std::path::PathBuf;
+
+use super::settings::{Overlays, ViewKind};
+use crate::blobs::Connectivity;
+use crate::lut::{ColourClass, Sensitivity};
+
+/// Everything the UI can ask for.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// Open files by kind: `.mcap` streams, frame files (as one sequence), anything else as a table.
+    Open(Vec<PathBuf>),
+    /// Open a lookup table.
+    OpenTable(PathBuf),
+    /// Open a places file (`eotn patterns learn`): pink markers are identified as its places.
+    OpenPlaces(PathBuf),
+    /// Forget the places file: pink markers keep their signatures, unidentified.
+    ClosePlaces,
+    /// A new empty table with the given bits per channel.
+    NewTable(u8),
+    /// Save the table where it came from.
+    SaveTable,
+    /// Save the table under a new name (it becomes the table's path).
+    SaveTableAs(PathBuf),
+    /// Replace the table by replaying its journal.
+    RebuildFromJournal,
+    /// Move by this many frames.
+    Step(i64),
+    /// Go to a frame.
+    Seek(usize),
+    /// Start or stop playback.
+    SetPlaying(bool),
+    /// Playback speed, × recorded rate (0 = every frame).
+    SetSpeed(f32),
+    /// The class being defined.
+    SetClass(ColourClass),
+    /// Selection reach.
+    SetSensitivity(Sensitivity),
+    /// Change one channel's reach (0 = Y, 1 = U, 2 = V) by ± cells.
+    AdjustSensitivity {
+        /// 0 = Y, 1 = U, 2 = V.
+        channel: usize,
+        /// Cells to add (negative shrinks).
+        delta: i32,
+    },
+    /// Select around the pixel at (x, y), image pixels: the preview, nothing written.
+    Sample {
+        /// Column, pixels.
+        x: usize,
+        /// Row, pixels.
+        y: usize,
+    },
+    /// Select around a table cell (Y, U, V cell coordinates), as clicking the U–V plane.
+    SampleCell([usize; 3]),
+    /// Drop the pending selection.
+    ClearSelection,
+    /// Write the pending selection into the table with the current class.
+    Commit,
+    /// Undo the latest edit.
+    Undo,
+    /// Redo the latest undone edit.
+    Redo,
+    /// Enlarge another view.
+    SetMainView(ViewKind),
+    /// Overlay switches.
+    SetOverlays(Overlays),
+    /// Blob connectivity.
+    SetConnectivity(Connectivity),
+    /// Zoom to a value (screen points per pixel), keeping the centre; `None` fits.
+    SetZoom(Option<f32>),
+    /// Zoom by `factor` keeping the image point `about` (pixels) where it is on screen.
+    ZoomAbout {
+        /// Multiplier of the current zoom.
+        factor: f32,
+        /// Image point that stays put, pixels.
+        about: [f32; 2],
+        /// The fitted zoom of the view, for when no zoom was set yet.
+        fit: f32,
+    },
+    /// Move the view by image pixels (positive moves the image right/down).
+    Pan([f32; 2]),
+    /// Fit and centre.
+    ResetView,
+    /// Write the enlarged view with its overlays as a PNG.
+    ExportView(PathBuf),
+    /// Start the whole-stream check of the pending selection.
+    TryEditOnStream,
+    /// The Y of the U–V plane.
+    SetUvPlaneY(u8),
+    /// Open or close a window.
+    ShowWindow(Window, bool),
+    /// Show or hide the frame-time readout.
+    ShowTimings(bool),
+    /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
+    /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
+    SelectObject(Option<String>),
+}
+
+/// The app's extra windows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Window {
+    /// Sensor readings and plots.
+    Sensors,
+    /// The U–V plane of the table.
+    UvPlane,
+    /// The whole-stream check of a pending edit.
+    TryEdit,
+    /// Every recognition candidate with its confidence breakdown.
+    Inspector,
+}
+
+impl Window {
+    /// Every window, for the Windows menu.
+    pub const ALL: [Self; 4] = [Self::Sensors, Self::UvPlane, Self::TryEdit, Self::Inspector];
+
+    /// Its title.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Sensors => "Sensors",
+            Self::UvPlane => "U–V plane",
+            Self::TryEdit => "Try edit on stream",
+            Self::Inspector => "Object inspector",
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! The enlarged view composed on the CPU as packed RGB (what Export view writes), and which
+//! recognition primitives each view draws.
+
+use super::Workspace;
+use crate::lut::ColourClass;
+use super::settings::{Overlays, ViewKind};
+use crate::recognition::draw::owner;
+use crate::recognition::{LineRole, Primitive, Recognition};
+
+/// Which recognition primitives a view draws.
+#[derive(Debug, Clone, Copy)]
+pub struct PrimitiveFilter<'a> {
+    /// The overlay switches.
+    pub overlays: Overlays,
+    /// Only these owners (the objects view: accepted objects); `None` draws every candidate.
+    pub owners: Option<&'a [String]>,
+}
+
+impl<'a> PrimitiveFilter<'a> {
+    /// Every candidate, as the switches say.
+    #[must_use]
+    pub const fn all(overlays: Overlays) -> Self {
+        Self {
+            overlays,
+            owners: None,
+        }
+    }
+
+    /// Accepted objects only, always with their boxes and labels (the objects view).
+    #[must_use]
+    pub const fn objects(overlays: Overlays, accepted: &'a [String]) -> Self {
+        let mut o = overlays;
+        o.candidates = true;
+        o.object_labels = true;
+        Self {
+            overlays: o,
+            owners: Some(accepted),
+        }
+    }
+
+    /// Whether `p` is drawn.
+    #[must_use]
+    pub fn shows(&self, p: &Primitive) -> bool {
+        let o = &self.overlays;
+        let on = match p {
+            Primitive::Box { .. } => o.candidates,
+            Primitive::ScanArea { .. } => o.scan_areas,
+            Primitive::ScanPoints { .. } => o.scan_points,
+            Primitive::Circle { .. } => o.circles,
+            Primitive::Line { role, .. } => match role {
+                LineRole::Horizon => o.horizon,
+                LineRole::Post => o.posts,
+                LineRole::Gap | LineRole::Scan => o.gaps,
+            },
+            Primitive::PatternRegion { .. } => o.patterns,
+            Primitive::Label { owner, .. } => {
+                o.object_labels && (o.patterns || !owner::is_pattern(owner))
+            }
+        };
+        let horizon = matches!(
+            p,
+            Primitive::Line {
+                role: LineRole::Horizon,
+                ..
+            }
+        );
+        on && (horizon || self.owners.is_none_or(|w| w.iter().any(|x| x == p.owner())))
+    }
+}
+
+/// Owners of the accepted objects, named as their primitives name them.
+pub(super) fn accepted_owners(r: &Recognition) -> Vec<String> {
+    let balls = r.ball.candidates.iter().enumerate();
+    let balls = balls
+        .filter(|(_, c)| c.accepted)
+        .map(|(i, _)| owner::ball(i));
+    let goals = r
+        .goals
+        .candidates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.accepted);
+    let goals = goals.map(|(i, c)| owner::goal(c.colour, i));
+    let beacons = r.beacons.iter().enumerate().filter(|(_, b)| b.accepted);
+    let patterns = r.patterns.iter().enumerate().filter(|(_, p)| p.accepted);
+    balls
+        .chain(goals)
+        .chain(beacons.map(|(i, _)| owner::beacon(i)))
+        .chain(patterns.map(|(i, _)| owner::pattern(i)))
+        .collect()
+}
+
+fn mix(a: u8, b: u8, t: f32) -> u8 {
+    (f32::from(a) * (1.0 - t) + f32::from(b) * t).round() as u8
+}
+
+/// The colour blob boxes of class `code` are drawn in: the class colour, white for black blobs
+/// would vanish otherwise.
+#[must_use]
+pub fn box_colour(code: u8) -> [u8; 3] {
+    match code {
+        9 => [255, 255, 255],
+        c => crate::lut::code_display_rgb(c),
+    }
+}
+
+impl Workspace {
+
+    /// The view `kind` with the current overlays as packed RGB (what Export view writes):
+    /// (width, height, pixels).
+    ///
+    /// # Errors
+    /// No frame open.
+    pub fn compose_view_rgb(&self, kind: ViewKind) -> anyhow::Result<(usize, usize, Vec<u8>)> {
+        let (w, h) = self.image_size();
+        anyhow::ensure!(w > 0, "no frame to export");
+        let codes = self.classified().codes();
+        let o = self.settings.overlays;
+        let mut out = match kind {
+            ViewKind::Raw | ViewKind::Objects => {
+                let mut rgb = self.rgb.clone();
+                if o.classified {
+                    let a = o.opacity;
+                    for (px, &c) in rgb.chunks_exact_mut(3).zip(codes) {
+                        if c != 0 {
+                            let k = crate::lut::code_display_rgb(c);
+                            for i in 0..3 {
+                                px[i] = mix(px[i], k[i], a);
+                            }
+                        }
+                    }
+                }
+                rgb
+            }
+            ViewKind::Classified => self.classified().to_rgb(),
+            ViewKind::Blobs => {
+                let mut rgb = self.classified().to_rgb();
+                rgb.iter_mut().for_each(|v| *v /= 2);
+                rgb
+            }
+        };
+        if o.preview
+            && let Some(k) = self.preview_colour()
+        {
+            for (px, &m) in out.chunks_exact_mut(3).zip(&self.preview_mask) {
+                if m {
+                    px.copy_from_slice(&k);
+                } else {
+                    // As on screen: the rest is dimmed so the highlight always shows.
+                    px.iter_mut().for_each(|v| *v = mix(*v, 0, 110.0 / 255.0));
+                }
+            }
+        }
+        let boxes = match kind {
+            ViewKind::Objects => Vec::new(),
+            ViewKind::Blobs => self.drawn_blobs(),
+            _ if o.blob_boxes => self.drawn_blobs(),
+            _ => Vec::new(),
+        };
+        for b in boxes {
+            crate::overlay::outline_box(
+                &mut out,
+                w,
+                h,
+                [b.minx, b.miny, b.maxx, b.maxy],
+                box_colour(b.colour),
+            );
+        }
+        let filter = match kind {
+            ViewKind::Objects => Some(PrimitiveFilter::objects(o, &self.accepted_owners)),
+            ViewKind::Raw | ViewKind::Classified => Some(PrimitiveFilter::all(o)),
+            ViewKind::Blobs => None,
+        };
+        if let Some(f) = filter {
+            let shown: Vec<Primitive> = self
+                .primitives
+                .iter()
+                .filter(|p| f.shows(p))
+                .cloned()
+                .collect();
+            if let Some(mut canvas) = crate::overlay::Canvas::from_rgb(w, h, &out, 1) {
+                canvas.draw(&shown);
+                out = canvas.rgb;
+            }
+        }
+        Ok((w, h, out))
+    }
+
+    /// The colour of the preview highlight: the class being defined (magenta for
+    /// unclassified, which erases).
+    #[must_use]
+    pub fn preview_colour(&self) -> Option<[u8; 3]> {
+        self.selection.as_ref()?;
+        Some(match self.settings.class {
+            ColourClass::Unclassified => [255, 0, 255],
+            c => c.display_rgb(),
+        })
+    }
+}

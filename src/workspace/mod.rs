@@ -1,0 +1,768 @@
+//! The workspace: everything the app, the CLI and the tests share that is not a widget — the open
+//! table with its edit history and journal, the open frame source and its cache, the pipeline's
+//! results on the shown frame, the pending selection and its whole-stream try, playback, zoom and
+//! pan, settings. The UI reads it and sends [`Command`]s; [`Workspace::apply`] is the one place
+//! they change anything, so the kittest tests and the real window go through the same path. It
+//! builds without the `gui` feature.
+//!
+//! | file | role |
+//! |---|---|
+//! | `mod.rs` | [`Workspace`]: its fields, [`Workspace::apply`], what the UI reads |
+//! | `command.rs` | [`Command`]: everything the UI can ask for; [`Window`] |
+//! | `settings.rs` | [`Settings`] that persist; [`ViewKind`], [`Overlays`], [`ViewTransform`] |
+//! | `source.rs` | [`Source`]: the open recorded source with a cache of decoded frames |
+//! | `frames.rs` | opening sources, showing a frame, the sensor-series scan |
+//! | `player.rs` | [`Player`]: playback clock, `tick`, `next_frame_due` |
+//! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file |
+//! | `journal.rs` | the edit journal beside a table: append, replay |
+//! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
+//! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
+//! | `timings.rs` | step and frame-time measurements |
+
+mod command;
+mod compose;
+mod frames;
+pub mod journal;
+pub mod player;
+mod settings;
+pub mod source;
+mod table;
+mod timings;
+mod try_edit;
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::Context as _;
+
+pub use command::{Command, Window};
+pub use compose::{PrimitiveFilter, box_colour};
+pub use player::Player;
+pub use settings::{
+    MAX_RECENT, MAX_WARNINGS, Overlays, SPEEDS, Settings, ViewKind, ViewTransform, ZOOM_PRESETS,
+    ZOOM_RANGE,
+};
+pub use source::Source;
+pub use timings::{StepTiming, Timings, median};
+pub use try_edit::{TryEdit, TryEditRow};
+
+use compose::accepted_owners;
+use timings::push_capped;
+
+use crate::blobs::{Blob, BlobSet};
+use crate::classify::ClassifiedImage;
+use crate::frame::{Frame, Yuv, save_rgb_png, yuv_to_rgb};
+use crate::lut::edit::Selection;
+use crate::lut::{ColourClass, EditHistory, LookupTable, Region};
+use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::{Primitive, Recognition};
+use crate::sensors::SensorReadings;
+use crate::sources::{CameraKind, SourceFrame};
+
+/// Time per UI frame a whole-stream scan may take, so the window stays responsive.
+const SCAN_BUDGET: Duration = Duration::from_millis(12);
+
+/// What hovering a pixel shows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelInfo {
+    /// Column, pixels.
+    pub x: usize,
+    /// Row, pixels.
+    pub y: usize,
+    /// The camera's value.
+    pub yuv: Yuv,
+    /// Its display colour.
+    pub rgb: [u8; 3],
+    /// The table's class.
+    pub class: ColourClass,
+    /// The blob it belongs to.
+    pub blob: Option<Blob>,
+}
+
+/// A pending (previewed, unwritten) selection.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PendingSelection {
+    /// The cells.
+    pub region: Region,
+    /// The pixel it was made from, if any.
+    pub pixel: Option<(usize, usize)>,
+}
+
+/// Sensor readings of every frame of the stream, filled a few frames per UI frame.
+#[derive(Debug, Clone, Default)]
+pub struct SensorSeries {
+    /// (time in seconds, readings) per frame read so far, in frame order.
+    pub points: Vec<(f64, Option<SensorReadings>)>,
+    /// Frames in the source.
+    pub total: usize,
+}
+
+/// The workspace; see the module documentation.
+#[derive(Debug)]
+pub struct Workspace {
+    /// Persisted settings.
+    pub settings: Settings,
+    pipeline: Pipeline,
+    table_path: Option<PathBuf>,
+    history: EditHistory,
+    dirty: bool,
+    source: Option<Source>,
+    index: usize,
+    current: Option<SourceFrame>,
+    rgb: Vec<u8>,
+    selection: Option<PendingSelection>,
+    preview_mask: Vec<bool>,
+    warnings: Vec<String>,
+    /// The last message for the status line (what the last command did).
+    pub status: String,
+    frame_generation: u64,
+    preview_generation: u64,
+    table_generation: u64,
+    player: Player,
+    /// Measurements.
+    pub timings: Timings,
+    /// The sensor series of the open stream.
+    pub sensor_series: SensorSeries,
+    try_edit: Option<TryEdit>,
+    places_path: Option<PathBuf>,
+    table_counts: crate::lut::ClassCounts,
+    frame_counts: [usize; 256],
+    primitives: Vec<Primitive>,
+    accepted_owners: Vec<String>,
+    selected_object: Option<String>,
+}
+
+impl Default for Workspace {
+    fn default() -> Self {
+        Self::new(Settings::default())
+    }
+}
+
+impl Workspace {
+    /// A workspace with these settings, an empty table of their bits and nothing open.
+    #[must_use]
+    pub fn new(settings: Settings) -> Self {
+        let bits = if (6..=8).contains(&settings.new_table_bits) {
+            settings.new_table_bits
+        } else {
+            7
+        };
+        let lut = LookupTable::new(bits).unwrap_or_else(|_| seven_bit_table());
+        let params = PipelineParams {
+            connectivity: settings.connectivity,
+            ..PipelineParams::default()
+        };
+        let table_counts = lut.class_counts();
+        Self {
+            settings,
+            pipeline: Pipeline::new(lut, params),
+            table_path: None,
+            history: EditHistory::default(),
+            dirty: false,
+            source: None,
+            index: 0,
+            current: None,
+            rgb: Vec::new(),
+            selection: None,
+            preview_mask: Vec::new(),
+            warnings: Vec::new(),
+            status: String::new(),
+            frame_generation: 0,
+            preview_generation: 0,
+            table_generation: 0,
+            player: Player::default(),
+            timings: Timings::default(),
+            sensor_series: SensorSeries::default(),
+            try_edit: None,
+            places_path: None,
+            table_counts,
+            frame_counts: [0; 256],
+            primitives: Vec::new(),
+            accepted_owners: Vec::new(),
+            selected_object: None,
+        }
+    }
+
+    /// Reopens what the settings name (last table, last stream or frames), reporting failures
+    /// as warnings: a moved file must not stop the app from starting.
+    pub fn reopen_last(&mut self) {
+        if let Some(t) = self.settings.last_table.clone() {
+            self.run(Command::OpenTable(t));
+        }
+        if let Some(p) = self.settings.last_places.clone() {
+            self.run(Command::OpenPlaces(p));
+        }
+        let src = self.settings.last_source.clone();
+        let index = self.settings.last_index;
+        if !src.is_empty() {
+            self.run(Command::Open(src));
+            if self.source.is_some() && index > 0 {
+                self.run(Command::Seek(index));
+            }
+        }
+    }
+
+    /// Applies a command and reports a failure in the status area instead of returning it.
+    pub fn run(&mut self, command: Command) {
+        if let Err(e) = self.apply(command) {
+            let msg = format!("{e:#}");
+            self.status.clone_from(&msg);
+            self.warn(msg);
+        }
+    }
+
+    /// Applies a command: the one place state changes.
+    ///
+    /// # Errors
+    /// File problems (naming the file), nothing to commit or save, and the like; the state is
+    /// unchanged by a failed command.
+    pub fn apply(&mut self, command: Command) -> anyhow::Result<()> {
+        match command {
+            Command::Open(paths) => self.open(paths)?,
+            Command::OpenTable(p) => self.open_table(&p)?,
+            Command::OpenPlaces(p) => self.open_places(&p)?,
+            Command::ClosePlaces => self.close_places(),
+            Command::NewTable(bits) => self.new_table(bits)?,
+            Command::SaveTable => {
+                let path = self
+                    .table_path
+                    .clone()
+                    .context("the table has no file yet: use Save table as…")?;
+                self.save_table(&path)?;
+            }
+            Command::SaveTableAs(p) => self.save_table(&p)?,
+            Command::RebuildFromJournal => self.rebuild_from_journal()?,
+            Command::Step(delta) => self.step(delta)?,
+            Command::Seek(i) => self.seek(i)?,
+            Command::SetPlaying(p) => self.set_playing(p)?,
+            Command::SetSpeed(s) => {
+                self.settings.speed = if s.is_finite() { s.max(0.0) } else { 1.0 }
+            }
+            Command::SetClass(c) => self.settings.class = c,
+            Command::SetSensitivity(s) => self.set_sensitivity(s),
+            Command::AdjustSensitivity { channel, delta } => {
+                self.adjust_sensitivity(channel, delta)?;
+            }
+            Command::Sample { x, y } => self.sample(x, y)?,
+            Command::SampleCell(cell) => self.sample_cell(cell)?,
+            Command::ClearSelection => {
+                self.selection = None;
+                self.refresh_preview();
+            }
+            Command::Commit => self.commit()?,
+            Command::Undo => self.undo()?,
+            Command::Redo => self.redo()?,
+            Command::SetMainView(v) => self.settings.main_view = v,
+            Command::SetOverlays(o) => {
+                let mut o = o;
+                o.opacity = if o.opacity.is_finite() {
+                    o.opacity.clamp(0.0, 1.0)
+                } else {
+                    0.5
+                };
+                self.settings.overlays = o;
+            }
+            Command::SetConnectivity(c) => {
+                self.settings.connectivity = c;
+                let mut params = *self.pipeline.params();
+                params.connectivity = c;
+                self.pipeline.set_params(params);
+                self.reprocess();
+            }
+            Command::SetZoom(z) => {
+                self.settings.transform.zoom = z.filter(|z| z.is_finite()).map(clamp_zoom);
+            }
+            Command::ZoomAbout { factor, about, fit } => self.zoom_about(factor, about, fit)?,
+            Command::Pan(d) => {
+                let size = self.image_size_f32();
+                let t = &mut self.settings.transform;
+                let c = t.effective_centre(size);
+                t.centre = Some([c[0] - d[0], c[1] - d[1]]);
+            }
+            Command::ResetView => self.settings.transform = ViewTransform::default(),
+            Command::ExportView(p) => {
+                let (w, h, rgb) = self.compose_view_rgb(self.settings.main_view)?;
+                save_rgb_png(&p, w, h, &rgb)?;
+                self.status = format!("view saved as {}", p.display());
+            }
+            Command::TryEditOnStream => self.try_edit_on_stream()?,
+            Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
+            Command::ShowWindow(w, open) => *self.window_flag(w) = open,
+            Command::ShowTimings(on) => self.settings.show_timings = on,
+            Command::SelectObject(owner) => {
+                if let Some(o) = &owner {
+                    anyhow::ensure!(
+                        self.primitives.iter().any(|p| p.owner() == o),
+                        "no object {o} in this frame"
+                    );
+                }
+                self.selected_object = owner;
+            }
+        }
+        Ok(())
+    }
+
+    fn set_playing(&mut self, on: bool) -> anyhow::Result<()> {
+        if !on {
+            self.player.stop();
+            return Ok(());
+        }
+        let len = self.source.as_ref().context("no stream or frames open")?.len();
+        if self.index + 1 >= len {
+            // Playing from the end starts again.
+            self.seek(0)?;
+        }
+        if let Some(src) = &self.source {
+            self.player.play_from(src, self.index);
+        }
+        Ok(())
+    }
+
+    fn zoom_about(&mut self, factor: f32, about: [f32; 2], fit: f32) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            factor.is_finite() && factor > 0.0 && fit.is_finite() && fit > 0.0,
+            "bad zoom factor"
+        );
+        let size = self.image_size_f32();
+        let t = &mut self.settings.transform;
+        let old = t.effective_zoom(fit);
+        let new = clamp_zoom(old * factor);
+        let c = t.effective_centre(size);
+        // Keep `about` at the same screen offset from the view centre.
+        let k = old / new;
+        t.centre = Some([
+            about[0] - (about[0] - c[0]) * k,
+            about[1] - (about[1] - c[1]) * k,
+        ]);
+        t.zoom = Some(new);
+        Ok(())
+    }
+
+    fn try_edit_on_stream(&mut self) -> anyhow::Result<()> {
+        let sel = self
+            .selection
+            .clone()
+            .context("no pending selection to try")?;
+        let total = self.source.as_ref().context("no stream open")?.len();
+        self.try_edit = Some(TryEdit::new(
+            self.settings.class,
+            sel.region,
+            self.pipeline.lut(),
+            total,
+        ));
+        self.settings.show_try_edit = true;
+        Ok(())
+    }
+
+    /// Advances playback and background scans by `dt` of wall time. Called once per UI frame.
+    pub fn tick(&mut self, dt: Duration) {
+        self.scan_sensor_series();
+        if let (Some(t), Some(src)) = (self.try_edit.as_mut(), self.source.as_mut()) {
+            let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
+            t.scan(src, self.pipeline.lut(), conn, min, SCAN_BUDGET);
+        }
+        let Some(src) = self.source.as_ref() else {
+            self.player.stop();
+            return;
+        };
+        if let Some(target) = self.player.tick(dt, self.settings.speed, self.index, src) {
+            self.timings.played_frames += 1;
+            self.timings.dropped_frames += target.saturating_sub(self.index + 1) as u64;
+            self.run(Command::Seek(target));
+        }
+    }
+
+    /// While playing, the wall time until the next frame is due (zero when playing every frame
+    /// or already late); `None` when not playing. The UI sleeps until then instead of redrawing
+    /// an unchanged frame.
+    #[must_use]
+    pub fn next_frame_due(&self) -> Option<Duration> {
+        let src = self.source.as_ref()?;
+        self.player
+            .next_frame_due(self.settings.speed, self.index, src)
+    }
+
+    /// Which camera the shown frames come from (robot when nothing is open): it chooses the
+    /// recogniser and the lookup table.
+    #[must_use]
+    pub fn camera_kind(&self) -> CameraKind {
+        self.source
+            .as_ref()
+            .map_or(CameraKind::Robot, |s| s.info().camera)
+    }
+
+    /// Records one UI frame interval for the frame-time readout.
+    pub fn record_frame_time(&mut self, dt: Duration) {
+        let ms = dt.as_secs_f64() * 1e3;
+        push_capped(&mut self.timings.frames_ms, ms);
+        if self.player.playing() {
+            push_capped(&mut self.timings.playing_frames_ms, ms);
+        }
+    }
+
+    /// Records, while playing, how long our UI code and eframe's whole frame took (CPU time).
+    pub fn record_ui_time(&mut self, ui: Duration, cpu_s: Option<f32>) {
+        if self.player.playing() {
+            push_capped(&mut self.timings.playing_ui_ms, ui.as_secs_f64() * 1e3);
+            if let Some(c) = cpu_s.filter(|c| c.is_finite()) {
+                push_capped(&mut self.timings.playing_cpu_ms, f64::from(c) * 1e3);
+            }
+        }
+    }
+
+    /// Records the texture-upload part of the last step (measured by the UI).
+    pub fn record_upload(&mut self, d: Duration) {
+        self.timings.last_step.upload = d;
+        let total = self.timings.last_step.total().as_secs_f64() * 1e3;
+        push_capped(&mut self.timings.steps_ms, total);
+    }
+
+    // ---- reading ----
+
+    /// The table in use.
+    #[must_use]
+    pub fn lut(&self) -> &LookupTable {
+        self.pipeline.lut()
+    }
+
+    /// The table's file, if it has one.
+    #[must_use]
+    pub fn table_path(&self) -> Option<&Path> {
+        self.table_path.as_deref()
+    }
+
+    /// The open places file, if any.
+    #[must_use]
+    pub fn places_path(&self) -> Option<&Path> {
+        self.places_path.as_deref()
+    }
+
+    /// The learnt places pink markers are identified against, if a places file is open.
+    #[must_use]
+    pub fn places(&self) -> Option<&crate::recognition::patterns::PatternMemory> {
+        self.pipeline.pattern_memory()
+    }
+
+    /// True when the table has edits not yet saved.
+    #[must_use]
+    pub const fn dirty(&self) -> bool {
+        self.dirty
+    }
+
+    /// The undo/redo history.
+    #[must_use]
+    pub const fn history(&self) -> &EditHistory {
+        &self.history
+    }
+
+    /// The open stream or frames.
+    #[must_use]
+    pub const fn source(&self) -> Option<&Source> {
+        self.source.as_ref()
+    }
+
+    /// Index of the shown frame.
+    #[must_use]
+    pub const fn index(&self) -> usize {
+        self.index
+    }
+
+    /// The shown frame with its time and sensors.
+    #[must_use]
+    pub const fn current(&self) -> Option<&SourceFrame> {
+        self.current.as_ref()
+    }
+
+    /// The shown frame's image.
+    #[must_use]
+    pub fn frame(&self) -> Option<&Frame> {
+        self.current.as_ref().map(|c| c.frame.as_ref())
+    }
+
+    /// The shown frame as packed RGB.
+    #[must_use]
+    pub fn rgb(&self) -> &[u8] {
+        &self.rgb
+    }
+
+    /// The classified shown frame.
+    #[must_use]
+    pub fn classified(&self) -> &ClassifiedImage {
+        self.pipeline.result().classified
+    }
+
+    /// The shown frame's blobs.
+    #[must_use]
+    pub fn blobs(&self) -> &BlobSet {
+        self.pipeline.result().blobs
+    }
+
+    /// What recognition made of the shown frame: every candidate with its evidence.
+    #[must_use]
+    pub fn recognition(&self) -> &Recognition {
+        self.pipeline.result().recognition
+    }
+
+    /// The shown frame's drawing primitives (image pixels), computed once per frame.
+    #[must_use]
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.primitives
+    }
+
+    /// Owners (`"ball#0"`, `"goal:yellow#1"`, `"beacon#0"`) of the accepted objects: what the
+    /// objects view shows.
+    #[must_use]
+    pub fn accepted_owners(&self) -> &[String] {
+        &self.accepted_owners
+    }
+
+    /// The candidate selected in the inspector, whose overlays are highlighted.
+    #[must_use]
+    pub fn selected_object(&self) -> Option<&str> {
+        self.selected_object.as_deref()
+    }
+
+    /// Blobs large enough to draw, largest first within each class.
+    #[must_use]
+    pub fn drawn_blobs(&self) -> Vec<Blob> {
+        let min = self.settings.min_blob_pixels;
+        self.blobs()
+            .active()
+            .filter(|b| b.pixels >= min)
+            .copied()
+            .collect()
+    }
+
+    /// Table cells per class code, kept up to date on every table change (counting 2M cells
+    /// every UI frame would cost milliseconds).
+    #[must_use]
+    pub const fn table_counts(&self) -> &crate::lut::ClassCounts {
+        &self.table_counts
+    }
+
+    /// Pixels of the shown frame per class code.
+    #[must_use]
+    pub const fn frame_counts(&self) -> &[usize; 256] {
+        &self.frame_counts
+    }
+
+    /// The pending selection.
+    #[must_use]
+    pub const fn selection(&self) -> Option<&PendingSelection> {
+        self.selection.as_ref()
+    }
+
+    /// One flag per pixel: would the pending selection select it (empty when none)?
+    #[must_use]
+    pub fn preview_mask(&self) -> &[bool] {
+        &self.preview_mask
+    }
+
+    /// The pending selection resolved against the table.
+    #[must_use]
+    pub fn resolved_selection(&self) -> Option<Selection> {
+        self.selection
+            .as_ref()
+            .map(|s| s.region.select(self.pipeline.lut()))
+    }
+
+    /// Warnings collected so far, oldest first.
+    #[must_use]
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Forgets the collected warnings.
+    pub fn clear_warnings(&mut self) {
+        self.warnings.clear();
+    }
+
+    /// Changes when the shown frame or its results change (textures compare it).
+    #[must_use]
+    pub const fn frame_generation(&self) -> u64 {
+        self.frame_generation
+    }
+
+    /// Changes when the preview mask changes.
+    #[must_use]
+    pub const fn preview_generation(&self) -> u64 {
+        self.preview_generation
+    }
+
+    /// Changes when the table changes (the U–V plane compares it).
+    #[must_use]
+    pub const fn table_generation(&self) -> u64 {
+        self.table_generation
+    }
+
+    /// True while playing.
+    #[must_use]
+    pub const fn playing(&self) -> bool {
+        self.player.playing()
+    }
+
+    /// The whole-stream check of the pending edit.
+    #[must_use]
+    pub const fn try_edit(&self) -> Option<&TryEdit> {
+        self.try_edit.as_ref()
+    }
+
+    /// Whether a window is open.
+    #[must_use]
+    pub const fn window_open(&self, w: Window) -> bool {
+        match w {
+            Window::Sensors => self.settings.show_sensors,
+            Window::UvPlane => self.settings.show_uv_plane,
+            Window::TryEdit => self.settings.show_try_edit,
+            Window::Inspector => self.settings.show_inspector,
+        }
+    }
+
+    fn window_flag(&mut self, w: Window) -> &mut bool {
+        match w {
+            Window::Sensors => &mut self.settings.show_sensors,
+            Window::UvPlane => &mut self.settings.show_uv_plane,
+            Window::TryEdit => &mut self.settings.show_try_edit,
+            Window::Inspector => &mut self.settings.show_inspector,
+        }
+    }
+
+    /// The largest useful sensitivity for the table: half its side.
+    #[must_use]
+    pub fn max_sensitivity(&self) -> u8 {
+        u8::try_from(self.pipeline.lut().side() / 2).unwrap_or(u8::MAX)
+    }
+
+    /// The window title: table (with `*` when unsaved) and source.
+    #[must_use]
+    pub fn title(&self) -> String {
+        let table = self
+            .table_path
+            .as_deref()
+            .map_or_else(|| "untitled table".to_owned(), crate::frame::display_name);
+        let mark = if self.dirty { " *" } else { "" };
+        let source = self
+            .source
+            .as_ref()
+            .map(|s| format!(" — {}", s.label()))
+            .unwrap_or_default();
+        format!("eotn — {table}{mark}{source}")
+    }
+
+    /// What hovering (x, y) shows, or `None` outside the frame.
+    #[must_use]
+    pub fn pixel_info(&self, x: usize, y: usize) -> Option<PixelInfo> {
+        let yuv = self.frame()?.pixel(x, y)?;
+        Some(PixelInfo {
+            x,
+            y,
+            yuv,
+            rgb: yuv_to_rgb(yuv),
+            class: self.pipeline.lut().class_of(yuv),
+            blob: self.blobs().blob_at(x, y).copied(),
+        })
+    }
+
+    /// Frame size in pixels, (0, 0) when nothing is open.
+    #[must_use]
+    pub fn image_size(&self) -> (usize, usize) {
+        self.frame().map_or((0, 0), |f| (f.width(), f.height()))
+    }
+
+    fn image_size_f32(&self) -> [f32; 2] {
+        let (w, h) = self.image_size();
+        [w as f32, h as f32]
+    }
+
+    // ---- changing ----
+
+    pub(super) fn warn(&mut self, w: String) {
+        log::warn!("{w}");
+        if self.warnings.len() >= MAX_WARNINGS {
+            self.warnings.remove(0);
+        }
+        self.warnings.push(w);
+    }
+
+    pub(super) fn remember_recent(&mut self, path: &Path) {
+        let p = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned());
+        self.settings.recent.retain(|r| r != &p);
+        self.settings.recent.insert(0, p);
+        self.settings.recent.truncate(MAX_RECENT);
+    }
+}
+
+fn seven_bit_table() -> LookupTable {
+    // Bits are checked to be 6..=8 before this is needed, so it never runs in practice.
+    LookupTable::new(7).expect("7 bits per channel is a supported table size")
+}
+
+fn clamp_zoom(z: f32) -> f32 {
+    z.clamp(ZOOM_RANGE.0, ZOOM_RANGE.1)
+}
+
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zoom_about_keeps_the_point_under_the_cursor() {
+        let mut s = Workspace::default();
+        // No frame: image size 0; centre defaults to (0, 0).
+        s.apply(Command::ZoomAbout {
+            factor: 2.0,
+            about: [10.0, 20.0],
+            fit: 1.0,
+        })
+        .unwrap();
+        let t = s.settings.transform;
+        assert_eq!(t.zoom, Some(2.0));
+        // Screen offset of `about` from the centre: before (10 - 0) * 1, after (10 - c) * 2.
+        let c = t.centre.unwrap();
+        assert!(((10.0 - c[0]) * 2.0 - 10.0).abs() < 1e-4);
+        assert!(((20.0 - c[1]) * 2.0 - 20.0).abs() < 1e-4);
+        s.apply(Command::SetZoom(Some(1000.0))).unwrap();
+        assert_eq!(s.settings.transform.zoom, Some(ZOOM_RANGE.1));
+        s.apply(Command::ResetView).unwrap();
+        assert_eq!(s.settings.transform, ViewTransform::default());
+    }
+
+    #[test]
+    fn commands_without_data_fail_cleanly() {
+        let mut s = Workspace::default();
+        assert!(s.apply(Command::Commit).is_err());
+        assert!(s.apply(Command::Undo).is_err());
+        assert!(s.apply(Command::Step(1)).is_err());
+        assert!(s.apply(Command::SaveTable).is_err());
+        assert!(s.apply(Command::Sample { x: 0, y: 0 }).is_err());
+        s.run(Command::Undo);
+        assert_eq!(s.warnings().len(), 1);
+    }
+
+    #[test]
+    fn sensitivity_keys_clamp() {
+        let mut s = Workspace::default();
+        s.apply(Command::AdjustSensitivity {
+            channel: 1,
+            delta: -5,
+        })
+        .unwrap();
+        assert_eq!(s.settings.sensitivity.u, 0);
+        s.apply(Command::AdjustSensitivity {
+            channel: 2,
+            delta: 500,
+        })
+        .unwrap();
+        assert_eq!(s.settings.sensitivity.v, 64);
+        assert!(
+            s.apply(Command::AdjustSensitivity {
+                channel: 3,
+                delta: 1
+            })
+            .is_err()
+        );
+    }
+}
+
+

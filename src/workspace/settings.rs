@@ -1,0 +1,227 @@
+//! What persists between runs and what the views are: the settings, the four views, the
+//! overlay switches, zoom and pan.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::blobs::Connectivity;
+use crate::lut::{ColourClass, Sensitivity};
+
+/// How many warnings the status area keeps (oldest dropped first).
+pub const MAX_WARNINGS: usize = 200;
+/// How many recent files the File menu lists.
+pub const MAX_RECENT: usize = 10;
+/// Zoom limits, screen points per image pixel.
+pub const ZOOM_RANGE: (f32, f32) = (0.1, 64.0);
+/// Zoom presets of the View menu, screen points per image pixel.
+pub const ZOOM_PRESETS: [f32; 6] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
+/// Playback speeds offered, × recorded rate; 0 plays every frame as fast as the machine can.
+pub const SPEEDS: [f32; 7] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 0.0];
+
+/// The four image views; one is enlarged, the others are thumbnails.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum ViewKind {
+    /// The camera image in colour.
+    #[default]
+    Raw,
+    /// Every pixel in its class's display colour.
+    Classified,
+    /// The classified image dimmed, with each blob's box.
+    Blobs,
+    /// The colour image with the recognised objects: ball, goals with posts and gap, beacons,
+    /// labelled with distance and bearing.
+    Objects,
+}
+
+impl ViewKind {
+    /// All views in thumbnail order.
+    pub const ALL: [Self; 4] = [Self::Raw, Self::Classified, Self::Blobs, Self::Objects];
+
+    /// The name shown under a thumbnail and in menus.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Raw => "Raw",
+            Self::Classified => "Classified",
+            Self::Blobs => "Blobs",
+            Self::Objects => "Objects",
+        }
+    }
+}
+
+/// Which overlays are drawn on the enlarged view.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Overlays {
+    /// Classified colours over the colour image (raw and objects views).
+    pub classified: bool,
+    /// Opacity of the classified overlay, 0..=1.
+    pub opacity: f32,
+    /// Blob boxes on every view.
+    pub blob_boxes: bool,
+    /// Class names beside the boxes.
+    pub labels: bool,
+    /// The pending selection's preview highlight.
+    pub preview: bool,
+    /// Recognition: the horizon (needs the camera pose from sensor readings).
+    pub horizon: bool,
+    /// Recognition: every candidate's box, accepted or rejected.
+    pub candidates: bool,
+    /// Recognition: the scanned areas (green below a ball).
+    pub scan_areas: bool,
+    /// Recognition: edge points found by the ball's and the posts' scans.
+    pub scan_points: bool,
+    /// Recognition: the ball's fitted circle.
+    pub circles: bool,
+    /// Recognition: fitted goal posts.
+    pub posts: bool,
+    /// Recognition: a goal's largest gap and its scan line.
+    pub gaps: bool,
+    /// Recognition: labels of accepted objects with distance (cm) and bearing (degrees).
+    pub object_labels: bool,
+    /// Recognition: the nine regions around each pink marker and its place.
+    pub patterns: bool,
+}
+
+impl Overlays {
+    /// Every overlay on, the classified colours at half opacity: the heaviest view.
+    #[must_use]
+    pub fn all_on() -> Self {
+        Self {
+            classified: true,
+            ..Self::default()
+        }
+    }
+
+    /// Switches every recognition overlay on or off.
+    pub fn set_recognition(&mut self, on: bool) {
+        self.horizon = on;
+        self.candidates = on;
+        self.scan_areas = on;
+        self.scan_points = on;
+        self.circles = on;
+        self.posts = on;
+        self.gaps = on;
+        self.object_labels = on;
+        self.patterns = on;
+    }
+}
+
+impl Default for Overlays {
+    fn default() -> Self {
+        Self {
+            classified: false,
+            opacity: 0.5,
+            blob_boxes: true,
+            labels: true,
+            preview: true,
+            horizon: true,
+            candidates: true,
+            scan_areas: true,
+            scan_points: true,
+            circles: true,
+            posts: true,
+            gaps: true,
+            object_labels: true,
+            patterns: true,
+        }
+    }
+}
+
+/// Zoom and pan of the enlarged view, in image pixels so they survive a window resize.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ViewTransform {
+    /// Screen points per image pixel; `None` fits the image to the view.
+    pub zoom: Option<f32>,
+    /// The image point (pixels) shown at the centre of the view; `None` is the image centre.
+    pub centre: Option<[f32; 2]>,
+}
+
+impl ViewTransform {
+    /// The zoom in effect when the fitted zoom is `fit`.
+    #[must_use]
+    pub fn effective_zoom(&self, fit: f32) -> f32 {
+        self.zoom.unwrap_or(fit)
+    }
+
+    /// The centre in effect for an image of `size` (width, height) pixels.
+    #[must_use]
+    pub fn effective_centre(&self, size: [f32; 2]) -> [f32; 2] {
+        self.centre.unwrap_or([size[0] / 2.0, size[1] / 2.0])
+    }
+}
+
+/// Settings that persist between runs (eframe storage).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Settings {
+    /// Recently opened files, newest first.
+    pub recent: Vec<PathBuf>,
+    /// The table to reopen at start.
+    pub last_table: Option<PathBuf>,
+    /// The places file (learnt coloured patterns) to reopen at start.
+    pub last_places: Option<PathBuf>,
+    /// The stream or frame files to reopen at start.
+    pub last_source: Vec<PathBuf>,
+    /// The frame that was shown.
+    pub last_index: usize,
+    /// The class being defined.
+    pub class: ColourClass,
+    /// Selection reach per channel, table cells.
+    pub sensitivity: Sensitivity,
+    /// Overlay switches.
+    pub overlays: Overlays,
+    /// The enlarged view.
+    pub main_view: ViewKind,
+    /// Zoom and pan of the enlarged view.
+    pub transform: ViewTransform,
+    /// Playback speed, × recorded rate (0 = every frame, as fast as possible).
+    pub speed: f32,
+    /// Blob connectivity.
+    pub connectivity: Connectivity,
+    /// Blobs smaller than this many pixels get no box or label.
+    pub min_blob_pixels: u32,
+    /// Bits of a new table.
+    pub new_table_bits: u8,
+    /// Sensor dialog open.
+    pub show_sensors: bool,
+    /// U–V plane window open.
+    pub show_uv_plane: bool,
+    /// The Y value whose layer the U–V plane shows, 0..=255.
+    pub uv_plane_y: u8,
+    /// "Try edit on the stream" window open.
+    pub show_try_edit: bool,
+    /// The step and frame-time readout in the status bar.
+    pub show_timings: bool,
+    /// The object inspector window open.
+    pub show_inspector: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            recent: Vec::new(),
+            last_table: None,
+            last_places: None,
+            last_source: Vec::new(),
+            last_index: 0,
+            class: ColourClass::Orange,
+            sensitivity: Sensitivity::uniform(1),
+            overlays: Overlays::default(),
+            main_view: ViewKind::Raw,
+            transform: ViewTransform::default(),
+            speed: 1.0,
+            connectivity: Connectivity::default(),
+            min_blob_pixels: 10,
+            new_table_bits: 7,
+            show_sensors: false,
+            show_uv_plane: false,
+            uv_plane_y: 128,
+            show_try_edit: false,
+            show_timings: true,
+            show_inspector: false,
+        }
+    }
+}

@@ -1,0 +1,255 @@
+//! The lookup table side of the workspace: opening, saving, the edit history and its journal,
+//! the pending selection and its commit, the places file.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+
+use super::journal::{self, JournalEntry, now_unix_ms};
+use super::{PendingSelection, Workspace};
+use crate::frame::Yuv;
+use crate::lut::{EditRecord, LookupTable, Region, Sensitivity};
+
+impl Workspace {
+    pub(super) fn open_table(&mut self, path: &Path) -> anyhow::Result<()> {
+        let lut = LookupTable::load(path)?;
+        self.set_table(lut, Some(path.to_owned()));
+        self.remember_recent(path);
+        self.settings.last_table =
+            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        self.status = format!("opened table {}", path.display());
+        if journal::journal_path(path).exists() {
+            match journal::replay(path) {
+                Ok(r) if &r.table == self.pipeline.lut() => {
+                    let n = r.history.undo_len();
+                    self.history = r.history;
+                    self.status = format!("opened table {}; journal: {n} edits can be undone", path.display());
+                }
+                Ok(r) => self.warn(format!(
+                    "{}: the table differs from its journal's replay ({} edits; unsaved edits before a crash?): Classification > Rebuild from journal recovers them",
+                    path.display(),
+                    r.commits
+                )),
+                Err(e) => self.warn(format!("{e:#}")),
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn open_places(&mut self, path: &Path) -> anyhow::Result<()> {
+        let memory = crate::recognition::patterns::PatternMemory::load(path)?;
+        let (objects, relation) = (memory.objects.len(), memory.relation);
+        self.pipeline.set_pattern_memory(Some(memory));
+        self.places_path = Some(path.to_owned());
+        self.remember_recent(path);
+        self.settings.last_places =
+            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        self.reprocess();
+        self.status = format!(
+            "opened places {}: {objects} objects{}",
+            path.display(),
+            relation.map_or_else(
+                || ", no size relation (no distances)".to_owned(),
+                |r| format!(
+                    ", distance = {:.0} / size + {:.1} cm",
+                    r.multiplier_cm_px, r.offset_cm
+                )
+            )
+        );
+        Ok(())
+    }
+
+    fn set_table(&mut self, lut: LookupTable, path: Option<PathBuf>) {
+        self.pipeline.set_lut(lut);
+        self.table_path = path;
+        self.history.clear();
+        self.dirty = false;
+        self.table_changed();
+    }
+
+    pub(super) fn save_table(&mut self, path: &Path) -> anyhow::Result<()> {
+        let moved = self.table_path.as_deref() != Some(path);
+        self.pipeline.lut().save(path)?;
+        if moved && !journal::journal_path(path).exists() {
+            // The journal follows the table: a new file starts one from the table as saved.
+            if let Err(e) = journal::append(path, self.pipeline.lut(), &[]) {
+                self.warn(format!("{e:#}"));
+            }
+        }
+        self.table_path = Some(path.to_owned());
+        self.settings.last_table =
+            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        self.remember_recent(path);
+        self.dirty = false;
+        self.status = format!("saved {}", path.display());
+        Ok(())
+    }
+
+    fn journal(&mut self, entry: &JournalEntry) {
+        let Some(path) = self.table_path.clone() else {
+            return;
+        };
+        if let Err(e) = journal::append(&path, self.pipeline.lut(), std::slice::from_ref(entry)) {
+            self.warn(format!("{e:#}"));
+        }
+    }
+
+    pub(super) fn commit(&mut self) -> anyhow::Result<()> {
+        let sel = self
+            .selection
+            .clone()
+            .context("nothing selected: left-click a pixel first")?;
+        let record = EditRecord::now(self.settings.class, sel.region);
+        // The journal must start from the table before its first edit.
+        if let Some(path) = self.table_path.clone()
+            && !journal::journal_path(&path).exists()
+            && let Err(e) = journal::append(&path, self.pipeline.lut(), &[])
+        {
+            self.warn(format!("{e:#}"));
+        }
+        let changed = self.history.commit(self.pipeline.lut_mut(), record.clone());
+        self.journal(&JournalEntry::Commit { record });
+        self.dirty = true;
+        self.selection = None;
+        self.table_changed();
+        self.status = format!("{changed} cells set to {}", self.settings.class.name());
+        Ok(())
+    }
+
+    pub(super) fn set_sensitivity(&mut self, s: Sensitivity) {
+        let max = self.max_sensitivity();
+        let s = Sensitivity {
+            y: s.y.min(max),
+            u: s.u.min(max),
+            v: s.v.min(max),
+        };
+        self.settings.sensitivity = s;
+        if let Some(PendingSelection {
+            region: Region::AroundSample { sensitivity, .. },
+            ..
+        }) = &mut self.selection
+        {
+            *sensitivity = s;
+            self.refresh_preview();
+        }
+    }
+
+    fn table_changed(&mut self) {
+        self.table_generation += 1;
+        self.table_counts = self.pipeline.lut().class_counts();
+        self.try_edit = None;
+        self.reprocess();
+    }
+
+
+    pub(super) fn close_places(&mut self) {
+        self.pipeline.set_pattern_memory(None);
+        self.places_path = None;
+        self.settings.last_places = None;
+        self.reprocess();
+        self.status = "places file closed: pink markers are not identified".to_owned();
+    }
+
+    pub(super) fn new_table(&mut self, bits: u8) -> anyhow::Result<()> {
+        let lut = LookupTable::new(bits).map_err(|e| anyhow::anyhow!("new table: {e}"))?;
+        self.set_table(lut, None);
+        self.settings.new_table_bits = bits;
+        self.status = format!("new empty {bits}-bit table");
+        Ok(())
+    }
+
+    pub(super) fn rebuild_from_journal(&mut self) -> anyhow::Result<()> {
+        let path = self.table_path.clone().context("the table has no file")?;
+        let r = journal::replay(&path)?;
+        for w in r.warnings {
+            self.warn(w);
+        }
+        self.pipeline.set_lut(r.table);
+        self.history = r.history;
+        self.dirty = true;
+        self.table_changed();
+        self.status = format!("rebuilt from the journal: {} edits replayed", r.commits);
+        Ok(())
+    }
+
+    pub(super) fn undo(&mut self) -> anyhow::Result<()> {
+        let record = self
+            .history
+            .undo(self.pipeline.lut_mut())
+            .cloned()
+            .context("nothing to undo")?;
+        self.journal(&JournalEntry::Undo {
+            time_unix_ms: now_unix_ms(),
+        });
+        self.dirty = true;
+        self.table_changed();
+        self.status = format!("undid {} edit", record.class.name());
+        Ok(())
+    }
+
+    pub(super) fn redo(&mut self) -> anyhow::Result<()> {
+        let record = self
+            .history
+            .redo(self.pipeline.lut_mut())
+            .cloned()
+            .context("nothing to redo")?;
+        self.journal(&JournalEntry::Redo {
+            time_unix_ms: now_unix_ms(),
+        });
+        self.dirty = true;
+        self.table_changed();
+        self.status = format!("redid {} edit", record.class.name());
+        Ok(())
+    }
+
+    pub(super) fn adjust_sensitivity(&mut self, channel: usize, delta: i32) -> anyhow::Result<()> {
+        let mut s = self.settings.sensitivity;
+        let slot = match channel {
+            0 => &mut s.y,
+            1 => &mut s.u,
+            2 => &mut s.v,
+            _ => anyhow::bail!("channel {channel} is not 0 (Y), 1 (U) or 2 (V)"),
+        };
+        let max = i32::from(self.max_sensitivity());
+        *slot = u8::try_from((i32::from(*slot) + delta).clamp(0, max)).unwrap_or(0);
+        self.set_sensitivity(s);
+        Ok(())
+    }
+
+    pub(super) fn sample(&mut self, x: usize, y: usize) -> anyhow::Result<()> {
+        let frame = self.frame().context("no frame to sample")?;
+        let sample = frame
+            .pixel(x, y)
+            .with_context(|| format!("({x}, {y}) is outside the frame"))?;
+        self.selection = Some(PendingSelection {
+            region: Region::AroundSample {
+                sample,
+                sensitivity: self.settings.sensitivity,
+            },
+            pixel: Some((x, y)),
+        });
+        self.refresh_preview();
+        Ok(())
+    }
+
+    pub(super) fn sample_cell(&mut self, cell: [usize; 3]) -> anyhow::Result<()> {
+        let lut = self.pipeline.lut();
+        anyhow::ensure!(
+            cell.iter().all(|&c| c < lut.side()),
+            "cell {cell:?} is outside the {}-bit table",
+            lut.bits()
+        );
+        let shift = lut.shift();
+        let half = (1usize << shift) / 2;
+        let v = cell.map(|c| u8::try_from((c << shift) + half).unwrap_or(255));
+        self.selection = Some(PendingSelection {
+            region: Region::AroundSample {
+                sample: Yuv::new(v[0], v[1], v[2]),
+                sensitivity: self.settings.sensitivity,
+            },
+            pixel: None,
+        });
+        self.refresh_preview();
+        Ok(())
+    }
+}

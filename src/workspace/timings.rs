@@ -1,0 +1,73 @@
+//! Runtime measurements of the workspace's steps and the UI's frames, for the status readout and
+//! the exit report.
+
+use std::time::Duration;
+
+/// How many step and frame times are kept for the medians.
+const TIMING_SAMPLES: usize = 600;
+
+/// How long the parts of the last step took.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepTiming {
+    /// Reading (and decoding) the frame, or the cache hit.
+    pub read: Duration,
+    /// Ball, goals, beacons.
+    pub recognition: Duration,
+    /// Classification.
+    pub classify: Duration,
+    /// Blob formation.
+    pub blobs: Duration,
+    /// RGB conversion and preview mask.
+    pub prepare: Duration,
+    /// Building and uploading textures (filled in by the UI).
+    pub upload: Duration,
+}
+
+impl StepTiming {
+    /// Everything.
+    #[must_use]
+    pub fn total(&self) -> Duration {
+        self.read + self.classify + self.blobs + self.recognition + self.prepare + self.upload
+    }
+}
+
+/// Runtime measurements for the status readout and the exit report.
+#[derive(Debug, Clone, Default)]
+pub struct Timings {
+    /// The last step.
+    pub last_step: StepTiming,
+    /// Recent step totals, milliseconds.
+    pub steps_ms: Vec<f64>,
+    /// Recent UI frame intervals, milliseconds.
+    pub frames_ms: Vec<f64>,
+    /// Recent UI frame intervals while playing, milliseconds.
+    pub playing_frames_ms: Vec<f64>,
+    /// While playing: time our own UI code took per frame (layout and painting commands, not
+    /// tessellation or rasterisation), milliseconds.
+    pub playing_ui_ms: Vec<f64>,
+    /// While playing: eframe's CPU time per frame (our UI, tessellation, the renderer's
+    /// submission; not the wait for the display), milliseconds.
+    pub playing_cpu_ms: Vec<f64>,
+    /// Frames shown by playback since the app started.
+    pub played_frames: u64,
+    /// Frames playback skipped because the next one was already due (not ready in time).
+    pub dropped_frames: u64,
+}
+
+pub(crate) fn push_capped(v: &mut Vec<f64>, x: f64) {
+    if v.len() >= TIMING_SAMPLES {
+        v.remove(0);
+    }
+    v.push(x);
+}
+
+/// Median of a list of samples (0 for none).
+#[must_use]
+pub fn median(samples: &[f64]) -> f64 {
+    if samples.is_empty() {
+        return 0.0;
+    }
+    let mut s = samples.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[s.len() / 2]
+}
