@@ -12,9 +12,9 @@ use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use eotn::app::{palette, view_images};
-use eotn::workspace::{Command, Workspace};
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
+use eotn::workspace::{Command, Workspace};
 
 /// More frames than the app's cache holds, so every step reads and decodes.
 const FRAMES: usize = 24;

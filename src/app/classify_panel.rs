@@ -3,8 +3,8 @@
 
 use egui::{Color32, Context, RichText, Sense, Ui, vec2};
 
-use crate::workspace::{Command, TryEdit, Window, Workspace};
 use crate::lut::{ColourClass, Sensitivity};
+use crate::workspace::{Command, TryEdit, Window, Workspace};
 
 /// A colour swatch the size of a line of text.
 pub fn swatch(ui: &mut Ui, rgb: [u8; 3]) {

@@ -8,13 +8,13 @@
 
 use egui::{Color32, Context, RichText, Ui};
 
-use crate::workspace::{Workspace, Command, Window};
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
 use crate::recognition::draw::owner;
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::scan::CutOff;
 use crate::recognition::{Recognition, Relative};
+use crate::workspace::{Command, Window, Workspace};
 
 /// One candidate as the inspector lists it.
 #[derive(Debug, Clone, PartialEq)]

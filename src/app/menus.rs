@@ -5,9 +5,9 @@ use std::path::PathBuf;
 
 use egui::Ui;
 
-use crate::workspace::{Workspace, Command, Overlays, SPEEDS, ViewKind, Window, ZOOM_PRESETS};
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
+use crate::workspace::{Command, Overlays, SPEEDS, ViewKind, Window, Workspace, ZOOM_PRESETS};
 
 /// What the menus ask of the app besides commands.
 #[derive(Debug, Default, Clone, PartialEq, Eq)]

@@ -32,8 +32,8 @@ use egui::{Color32, ColorImage, Key, KeyboardShortcut, Modifiers, TextureHandle,
 
 pub use crate::workspace::{Command, Settings, ViewKind, Workspace};
 
-use overlays::{FrameTextures, ImageTransform};
 use crate::workspace::{PixelInfo, SPEEDS, median};
+use overlays::{FrameTextures, ImageTransform};
 
 /// How much the pixels outside a pending selection are darkened (alpha of black over them).
 const PREVIEW_DIM_ALPHA: u8 = 110;

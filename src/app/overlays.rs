@@ -7,9 +7,9 @@ use egui::{
     Align2, Color32, FontId, Painter, Pos2, Rect, Stroke, StrokeKind, TextureId, pos2, vec2,
 };
 
-use crate::workspace::{Workspace, PrimitiveFilter, ViewKind, box_colour};
 use crate::blobs::Blob;
 use crate::recognition::{CircleRole, Primitive};
+use crate::workspace::{PrimitiveFilter, ViewKind, Workspace, box_colour};
 
 /// Alpha of the overlays of objects other than the selected one.
 const DIMMED_ALPHA: f32 = 0.25;

@@ -5,8 +5,8 @@
 use egui::{Color32, Context, Id};
 use egui_plot::{Legend, Line, Plot, VLine};
 
-use crate::workspace::{Command, Window, Workspace};
 use crate::sensors::SensorReadings;
+use crate::workspace::{Command, Window, Workspace};
 
 /// Shows the dialog while it is open; closing it sends [`Command::ShowWindow`].
 pub fn sensors_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {

@@ -8,8 +8,8 @@ use egui::{
     pos2, vec2,
 };
 
-use crate::workspace::{Command, Window, Workspace};
 use crate::lut::edit::Selection;
+use crate::workspace::{Command, Window, Workspace};
 
 /// The U–V plane texture, rebuilt when the table, frame or Y changes.
 #[derive(Default)]

@@ -5,7 +5,7 @@
 use egui::{Align2, Color32, PointerButton, Sense, Ui, vec2};
 
 use super::overlays::{FrameTextures, ImageTransform, corner_text, paint_view};
-use crate::workspace::{Workspace, Command, PixelInfo, ViewKind};
+use crate::workspace::{Command, PixelInfo, ViewKind, Workspace};
 
 /// Screen points the mouse wheel must move for the zoom to double.
 const WHEEL_POINTS_PER_DOUBLING: f32 = 240.0;

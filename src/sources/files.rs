@@ -318,11 +318,18 @@ mod tests {
         let c = s.grab().unwrap();
         assert_eq!((luma(&a), luma(&b), luma(&c)), (10, 200, 10));
         assert_eq!(b.time_ns, NOMINAL_FRAME_INTERVAL_NS);
-        assert_eq!(c.time_ns, 2 * NOMINAL_FRAME_INTERVAL_NS, "times go on increasing");
+        assert_eq!(
+            c.time_ns,
+            2 * NOMINAL_FRAME_INTERVAL_NS,
+            "times go on increasing"
+        );
         s.disconnect();
         assert!(matches!(s.grab(), Err(SourceError::NotConnected(_))));
         let r = s.recorded().unwrap();
-        assert!(matches!(r.read(5), Err(SourceError::NoSuchFrame { len: 2, .. })));
+        assert!(matches!(
+            r.read(5),
+            Err(SourceError::NoSuchFrame { len: 2, .. })
+        ));
     }
 
     #[test]

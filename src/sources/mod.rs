@@ -319,9 +319,18 @@ pub trait FrameSource: Send {
     fn set_settings(&mut self, wanted: &SourceSettings) -> Result<SourceSettings, SourceError> {
         let now = self.settings();
         let refused = [
-            ("resolution", wanted.resolution.is_some() && wanted.resolution != now.resolution),
-            ("frame rate", wanted.frame_rate.is_some() && wanted.frame_rate != now.frame_rate),
-            ("exposure", wanted.exposure.is_some() && wanted.exposure != now.exposure),
+            (
+                "resolution",
+                wanted.resolution.is_some() && wanted.resolution != now.resolution,
+            ),
+            (
+                "frame rate",
+                wanted.frame_rate.is_some() && wanted.frame_rate != now.frame_rate,
+            ),
+            (
+                "exposure",
+                wanted.exposure.is_some() && wanted.exposure != now.exposure,
+            ),
             ("gain", wanted.gain.is_some() && wanted.gain != now.gain),
         ];
         if let Some((name, _)) = refused.iter().find(|(_, r)| *r) {
@@ -388,6 +397,91 @@ fn lap_ns(r: &dyn RecordedSource) -> u64 {
     span + interval
 }
 
+/// A source the user picked (Camera ▸ Connect…, the command line): turned into a connected
+/// source by [`SourceSpec::open`], the one place each kind is built.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SourceSpec {
+    /// A camera device (`/dev/video0`).
+    Camera(PathBuf),
+    /// A scenario of the synthetic renderer, played live.
+    Synthetic {
+        /// Which scenario.
+        scenario: crate::sim::ScenarioKind,
+        /// Its seed: the same seed plays the same frames.
+        seed: u64,
+    },
+    /// A recorded MCAP stream.
+    Stream(PathBuf),
+    /// Frame files, in order.
+    Files(Vec<PathBuf>),
+    /// A robot or camera server over the network (Foxglove WebSocket, `ws://HOST:PORT`).
+    Network(String),
+}
+
+impl SourceSpec {
+    /// The source's kind.
+    #[must_use]
+    pub const fn kind(&self) -> SourceKind {
+        match self {
+            Self::Camera(_) => SourceKind::Camera,
+            Self::Synthetic { .. } => SourceKind::Synthetic,
+            Self::Stream(_) => SourceKind::Stream,
+            Self::Files(_) => SourceKind::Files,
+            Self::Network(_) => SourceKind::Network,
+        }
+    }
+
+    /// True for sources whose frames are all there already (streams, frame files): they are
+    /// stepped and played; the others deliver frames live.
+    #[must_use]
+    pub const fn is_recorded(&self) -> bool {
+        matches!(self, Self::Stream(_) | Self::Files(_))
+    }
+
+    /// Builds the source and connects it.
+    ///
+    /// # Errors
+    /// The file, device or peer cannot be opened; a kind not built into this program.
+    pub fn open(&self) -> Result<Box<dyn FrameSource>, SourceError> {
+        let mut source: Box<dyn FrameSource> = match self {
+            Self::Camera(path) => open_camera(path)?,
+            Self::Synthetic { scenario, seed } => Box::new(SyntheticSource::new(*scenario, *seed)),
+            Self::Stream(path) => Box::new(StreamSource::open(path)?),
+            Self::Files(paths) => Box::new(FileSource::new(paths.clone(), None)?),
+            Self::Network(address) => {
+                return Err(SourceError::Unsupported {
+                    label: address.clone(),
+                    detail: "network sources are not built into this program yet".to_owned(),
+                });
+            }
+        };
+        source.connect()?;
+        Ok(source)
+    }
+
+    /// Builds a recorded source (stream or frame files) for stepping and playback.
+    ///
+    /// # Errors
+    /// As [`Self::open`]; a live source, which has no frames by index.
+    pub fn open_recorded(&self) -> Result<Box<dyn RecordedSource>, SourceError> {
+        match self {
+            Self::Stream(path) => Ok(Box::new(StreamSource::open(path)?)),
+            Self::Files(paths) => Ok(Box::new(FileSource::new(paths.clone(), None)?)),
+            other => Err(SourceError::Unsupported {
+                label: other.kind().name().to_owned(),
+                detail: "a live source has no recorded frames to step through".to_owned(),
+            }),
+        }
+    }
+}
+
+fn open_camera(path: &std::path::Path) -> Result<Box<dyn FrameSource>, SourceError> {
+    Err(SourceError::Unsupported {
+        label: path.display().to_string(),
+        detail: "cameras (V4L2) are not built into this program yet".to_owned(),
+    })
+}
+
 /// The sources that can be connected on this machine, for `eotn sources` and the Connect
 /// dialog: cameras found (with a one-line note when there are none) and the scenarios.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -427,7 +521,10 @@ fn list_cameras() -> (Vec<(PathBuf, String)>, Option<String>) {
         .unwrap_or_default();
     found.sort();
     if found.is_empty() {
-        return (Vec::new(), Some("no camera found (no /dev/video*)".to_owned()));
+        return (
+            Vec::new(),
+            Some("no camera found (no /dev/video*)".to_owned()),
+        );
     }
     let cameras = found
         .into_iter()
@@ -445,13 +542,19 @@ mod tests {
 
     #[test]
     fn overhead_streams_are_overhead_cameras_and_the_rest_robots() {
-        assert_eq!(CameraKind::of_stream_source("overhead"), CameraKind::Overhead);
+        assert_eq!(
+            CameraKind::of_stream_source("overhead"),
+            CameraKind::Overhead
+        );
         assert_eq!(
             CameraKind::of_stream_source("sim:overhead-game"),
             CameraKind::Overhead
         );
         assert_eq!(CameraKind::of_stream_source("robot"), CameraKind::Robot);
-        assert_eq!(CameraKind::of_stream_source("bhuman2009"), CameraKind::Robot);
+        assert_eq!(
+            CameraKind::of_stream_source("bhuman2009"),
+            CameraKind::Robot
+        );
         assert_eq!(CameraKind::of_stream_source(""), CameraKind::Robot);
     }
 

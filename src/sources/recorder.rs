@@ -119,7 +119,10 @@ mod tests {
         let mut rec = Recorder::create(&out, &files.info()).unwrap();
         for _ in 0..3 {
             let mut f = files.grab().unwrap();
-            f.extra.push(("/world_model/robot2".to_owned(), serde_json::json!({"x_cm": 1.0})));
+            f.extra.push((
+                "/world_model/robot2".to_owned(),
+                serde_json::json!({"x_cm": 1.0}),
+            ));
             assert!(rec.record(&f).unwrap());
         }
         assert_eq!(rec.finish().unwrap(), 3);

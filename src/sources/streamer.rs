@@ -15,8 +15,8 @@ const QUEUE_FRAMES: usize = 4;
 /// What the streaming thread reports.
 #[derive(Debug)]
 pub enum StreamerEvent {
-    /// A new frame.
-    Frame(SourceFrame),
+    /// A new frame (boxed: sensor readings make it large).
+    Frame(Box<SourceFrame>),
     /// The settings now in effect (after a change was asked for).
     Settings(SourceSettings),
     /// A recording finished: its file and frame count, or why it failed.
@@ -35,6 +35,8 @@ enum Control {
     SetRate(f64),
     StartRecording(Box<Recorder>),
     StopRecording,
+    SetStreaming(bool),
+    GrabOne,
     Stop,
 }
 
@@ -50,6 +52,7 @@ pub struct Streamer {
     thread: Option<JoinHandle<Box<dyn FrameSource>>>,
     recording: Option<std::path::PathBuf>,
     rate_hz: f64,
+    streaming: bool,
 }
 
 impl Streamer {
@@ -90,6 +93,7 @@ impl Streamer {
             thread: Some(thread),
             recording: None,
             rate_hz,
+            streaming: true,
         })
     }
 
@@ -110,7 +114,11 @@ impl Streamer {
     #[must_use]
     pub fn poll(&self) -> Vec<StreamerEvent> {
         let mut out: Vec<StreamerEvent> = self.events.try_iter().collect();
-        out.extend(self.frames.try_iter().map(StreamerEvent::Frame));
+        out.extend(
+            self.frames
+                .try_iter()
+                .map(|f| StreamerEvent::Frame(Box::new(f))),
+        );
         out
     }
 
@@ -139,6 +147,23 @@ impl Streamer {
             self.rate_hz = rate_hz;
             self.send(Control::SetRate(rate_hz));
         }
+    }
+
+    /// Grabs at the rate (`true`, as it starts) or only when asked ([`Self::grab_one`]).
+    pub fn set_streaming(&mut self, on: bool) {
+        self.streaming = on;
+        self.send(Control::SetStreaming(on));
+    }
+
+    /// True while grabbing at the rate.
+    #[must_use]
+    pub const fn streaming(&self) -> bool {
+        self.streaming
+    }
+
+    /// Grabs one frame now (while paused: the one image of "Grab image").
+    pub fn grab_one(&self) {
+        self.send(Control::GrabOne);
     }
 
     /// Starts writing every grabbed frame to `recorder` (a recording in progress is finished
@@ -194,76 +219,126 @@ impl Outbox {
     }
 }
 
+/// What the thread keeps between grabs.
+struct Worker {
+    source: Box<dyn FrameSource>,
+    rate_hz: f64,
+    recorder: Option<Box<Recorder>>,
+    streaming: bool,
+    /// The last error reported, so a failing source says so once, not 30 times a second.
+    last_error: String,
+}
+
+/// What the thread does after waiting.
+enum Next {
+    Grab,
+    Stop,
+}
+
 /// The thread: grab, record, hand over, wait for the next tick or a control message.
 fn run(
-    mut source: Box<dyn FrameSource>,
-    mut rate_hz: f64,
+    source: Box<dyn FrameSource>,
+    rate_hz: f64,
     control: &Receiver<Control>,
     out: &Outbox,
 ) -> Box<dyn FrameSource> {
-    let mut recorder: Option<Box<Recorder>> = None;
+    let mut w = Worker {
+        source,
+        rate_hz,
+        recorder: None,
+        streaming: true,
+        last_error: String::new(),
+    };
     let mut next = Instant::now();
-    let mut last_error = String::new();
     loop {
-        match source.grab() {
+        if !w.grab_and_send(out) {
+            break;
+        }
+        if w.streaming {
+            next += Duration::from_secs_f64(1.0 / w.rate_hz);
+            // Behind (a slow source): start counting again rather than grabbing in a burst.
+            next = next.max(Instant::now());
+        }
+        if matches!(w.wait(control, out, &mut next), Next::Stop) {
+            break;
+        }
+    }
+    finish(w.recorder.take(), out);
+    w.source.disconnect();
+    w.source
+}
+
+impl Worker {
+    /// Grabs one frame, records it and queues it; false when nobody listens any more.
+    fn grab_and_send(&mut self, out: &Outbox) -> bool {
+        match self.source.grab() {
             Ok(frame) => {
-                last_error.clear();
-                if let Some(r) = recorder.as_mut()
+                self.last_error.clear();
+                if let Some(r) = self.recorder.as_mut()
                     && let Err(e) = r.record(&frame)
                 {
                     let path = r.path().to_owned();
-                    recorder = None;
+                    self.recorder = None;
                     let result = Err(format!("{e}"));
                     out.event(StreamerEvent::RecordingStopped { path, result });
                 }
                 match out.frames.try_send(frame) {
-                    Ok(()) | Err(TrySendError::Full(_)) => {}
-                    Err(TrySendError::Disconnected(_)) => break,
+                    Ok(()) | Err(TrySendError::Full(_)) => true,
+                    Err(TrySendError::Disconnected(_)) => false,
                 }
             }
             Err(e) => {
                 let msg = e.to_string();
-                if msg != last_error {
+                if msg != self.last_error {
                     out.event(StreamerEvent::Error(msg.clone()));
-                    last_error = msg;
+                    self.last_error = msg;
                 }
+                true
             }
         }
-        next += Duration::from_secs_f64(1.0 / rate_hz);
-        let now = Instant::now();
-        if next < now {
-            // Behind (a slow source): start counting again rather than grabbing in a burst.
-            next = now;
-        }
-        let stop = loop {
-            let wait = next.saturating_duration_since(Instant::now());
-            match control.recv_timeout(wait) {
-                Ok(Control::Stop) | Err(RecvTimeoutError::Disconnected) => break true,
-                Ok(Control::SetSettings(s)) => {
-                    let event = match source.set_settings(&s) {
+    }
+
+    /// Handles control messages until the next grab is due (streaming) or asked for (paused).
+    fn wait(&mut self, control: &Receiver<Control>, out: &Outbox, next: &mut Instant) -> Next {
+        loop {
+            let message = if self.streaming {
+                match control.recv_timeout(next.saturating_duration_since(Instant::now())) {
+                    Ok(c) => c,
+                    Err(RecvTimeoutError::Timeout) => return Next::Grab,
+                    Err(RecvTimeoutError::Disconnected) => return Next::Stop,
+                }
+            } else {
+                match control.recv() {
+                    Ok(c) => c,
+                    Err(_) => return Next::Stop,
+                }
+            };
+            match message {
+                Control::Stop => return Next::Stop,
+                Control::SetSettings(s) => {
+                    let event = match self.source.set_settings(&s) {
                         Ok(now) => StreamerEvent::Settings(now),
                         Err(e) => StreamerEvent::Error(e.to_string()),
                     };
                     out.event(event);
                 }
-                Ok(Control::SetRate(r)) => {
-                    rate_hz = r;
-                    next = Instant::now() + Duration::from_secs_f64(1.0 / r);
+                Control::SetRate(r) => {
+                    self.rate_hz = r;
+                    *next = Instant::now() + Duration::from_secs_f64(1.0 / r);
                 }
-                Ok(Control::StartRecording(r)) => {
-                    finish(recorder.replace(r), out);
+                Control::StartRecording(r) => finish(self.recorder.replace(r), out),
+                Control::StopRecording => finish(self.recorder.take(), out),
+                Control::SetStreaming(on) => {
+                    self.streaming = on;
+                    if on {
+                        *next = Instant::now();
+                        return Next::Grab;
+                    }
                 }
-                Ok(Control::StopRecording) => finish(recorder.take(), out),
-                Err(RecvTimeoutError::Timeout) => break false,
+                Control::GrabOne => return Next::Grab,
             }
-        };
-        if stop {
-            break;
         }
     }
-    finish(recorder, out);
-    source.disconnect();
-    source
 }
 
 fn finish(recorder: Option<Box<Recorder>>, out: &Outbox) {
@@ -308,9 +383,15 @@ mod tests {
             panic!("expected the recording to stop, got {done:?}");
         };
         assert_eq!(path, out);
-        assert!(result.unwrap() >= 3, "every frame grabbed while recording is written");
+        assert!(
+            result.unwrap() >= 3,
+            "every frame grabbed while recording is written"
+        );
         let source = s.stop().unwrap();
-        assert!(!source.is_connected(), "a stopped streamer disconnects its source");
+        assert!(
+            !source.is_connected(),
+            "a stopped streamer disconnects its source"
+        );
         let mut back = StreamSource::open(&out).unwrap();
         assert!(back.recorded().unwrap().len() >= 3);
     }
@@ -329,5 +410,19 @@ mod tests {
             "{e:?}"
         );
         assert!(Streamer::start(Box::new(two_frames(dir.path())), 0.0).is_err());
+    }
+
+    #[test]
+    fn a_paused_streamer_grabs_only_when_asked() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut s = Streamer::start(Box::new(two_frames(dir.path())), 100.0).unwrap();
+        s.set_streaming(false);
+        // Whatever was grabbed before the pause took effect drains away; then nothing comes.
+        while s.wait_frame(Duration::from_millis(300)).is_some() {}
+        s.grab_one();
+        assert!(s.wait_frame(Duration::from_secs(5)).is_some());
+        assert!(s.wait_frame(Duration::from_millis(300)).is_none());
+        s.set_streaming(true);
+        assert!(s.wait_frame(Duration::from_secs(5)).is_some());
     }
 }

@@ -2,8 +2,8 @@
 //! recognition primitives each view draws.
 
 use super::Workspace;
-use crate::lut::ColourClass;
 use super::settings::{Overlays, ViewKind};
+use crate::lut::ColourClass;
 use crate::recognition::draw::owner;
 use crate::recognition::{LineRole, Primitive, Recognition};
 
@@ -105,7 +105,6 @@ pub fn box_colour(code: u8) -> [u8; 3] {
 }
 
 impl Workspace {
-
     /// The view `kind` with the current overlays as packed RGB (what Export view writes):
     /// (width, height, pixels).
     ///

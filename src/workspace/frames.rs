@@ -75,7 +75,6 @@ impl Workspace {
         Ok(())
     }
 
-
     /// Re-runs the pipeline on the shown frame (after a table or parameter change).
     pub(super) fn reprocess(&mut self) {
         if let Some(c) = self.current.take() {
@@ -187,5 +186,4 @@ impl Workspace {
             self.sensor_series.points.push((t, r));
         }
     }
-
 }

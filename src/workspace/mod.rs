@@ -307,7 +307,11 @@ impl Workspace {
             self.player.stop();
             return Ok(());
         }
-        let len = self.source.as_ref().context("no stream or frames open")?.len();
+        let len = self
+            .source
+            .as_ref()
+            .context("no stream or frames open")?
+            .len();
         if self.index + 1 >= len {
             // Playing from the end starts again.
             self.seek(0)?;
@@ -701,7 +705,6 @@ fn clamp_zoom(z: f32) -> f32 {
     z.clamp(ZOOM_RANGE.0, ZOOM_RANGE.1)
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -764,5 +767,3 @@ mod tests {
         );
     }
 }
-
-

@@ -137,7 +137,11 @@ mod tests {
         assert_eq!(p.tick(MS * 50, 1.0, 2, &t), None, "half a frame interval");
         assert!(about(p.next_frame_due(1.0, 2, &t), MS * 50));
         assert_eq!(p.tick(MS * 60, 1.0, 2, &t), Some(3));
-        assert_eq!(p.tick(MS * 200, 1.0, 3, &t), Some(5), "late frames are skipped");
+        assert_eq!(
+            p.tick(MS * 200, 1.0, 3, &t),
+            Some(5),
+            "late frames are skipped"
+        );
     }
 
     #[test]

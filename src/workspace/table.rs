@@ -141,7 +141,6 @@ impl Workspace {
         self.reprocess();
     }
 
-
     pub(super) fn close_places(&mut self) {
         self.pipeline.set_pattern_memory(None);
         self.places_path = None;

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use egui::{Event, Key, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
-use eotn::workspace::journal;
 use eotn::app::EotnApp;
-use eotn::workspace::{Command, ViewKind, Window, Workspace};
 use eotn::frame::{Frame, Yuv};
 use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
+use eotn::workspace::journal;
+use eotn::workspace::{Command, ViewKind, Window, Workspace};
 
 const GREEN: Yuv = Yuv::new(100, 110, 100);
 const ORANGE: Yuv = Yuv::new(120, 80, 190);
