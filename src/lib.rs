@@ -5,17 +5,25 @@
 //!
 //! | module | role |
 //! |---|---|
+//! | [`atomic_file`] | write-to-temporary, fsync, rename: how files the user cares about are saved |
 //! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
-//! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model |
+//! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model, other teams' formats |
 //! | [`classify`] | frame + table → classified image |
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
-//! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
 //! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
+//! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
+//! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
+//! | [`overlay`] | recognition's drawing primitives on RGB images (`eotn render`) |
+//! | [`annotate`] | those primitives as Foxglove image annotations (`eotn detect --annotate`) |
+//! | [`eval`] | recognition against ground truth or hand labels: rates, errors, plots |
+//! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
 //! | [`sources`] | frame sources (stream, files, synthetic, V4L2 camera, network), recording |
 //! | [`workspace`] | what the app, the CLI and the tests share: table, source, playback, edits |
+//! | [`cli`] | the `eotn` subcommands |
+//! | `app` | the desktop app (feature `gui`) |
 //!
 //! See `ARCHITECTURE.md` for the map.
 

@@ -17,8 +17,9 @@ use crate::eval::{
     fit_inverse_size_multiplier,
 };
 use crate::pipeline::{Pipeline, PipelineParams};
+use crate::recognition::patterns::PatternMemory;
 use crate::recognition::{Recognition, RecognitionParams};
-use crate::sim::truth::GroundTruth;
+use crate::sim::truth::{GroundTruth, RobotViewTruth};
 use crate::streams::StreamReader;
 
 /// Arguments of `eotn eval`.
@@ -118,6 +119,252 @@ fn differ(a: &Recognition, b: &Recognition) -> Option<String> {
     (!what.is_empty()).then(|| what.join(", "))
 }
 
+/// The pipelines one run compares: the given configuration, the same without skew correction
+/// (run on fast pans only), and the `--compare-*` one.
+struct Pipelines {
+    main: Pipeline,
+    no_skew: Pipeline,
+    other: Option<Pipeline>,
+}
+
+impl Pipelines {
+    fn new(
+        args: &Args,
+        lut: crate::lut::LookupTable,
+        rp: RecognitionParams,
+        places: Option<&PatternMemory>,
+    ) -> anyhow::Result<Self> {
+        let params = PipelineParams {
+            recognition: rp,
+            ..PipelineParams::default()
+        };
+        let mut main = Pipeline::new(lut.clone(), params);
+        main.set_pattern_memory(places.cloned());
+        let no_skew = Pipeline::new(
+            lut.clone(),
+            PipelineParams {
+                recognition: RecognitionParams {
+                    ball: crate::recognition::BallParams {
+                        skew_correction: false,
+                        ..rp.ball
+                    },
+                    ..rp
+                },
+                ..params
+            },
+        );
+        let other = if args.compare_lut.is_some() || args.compare_params.is_some() {
+            let l = match &args.compare_lut {
+                Some(p) => load_lut_arg(p)?,
+                None => lut,
+            };
+            let p = match &args.compare_params {
+                Some(p) => load_params(Some(p))?,
+                None => rp,
+            };
+            Some(Pipeline::new(
+                l,
+                PipelineParams {
+                    recognition: p,
+                    ..params
+                },
+            ))
+        } else {
+            None
+        };
+        Ok(Self {
+            main,
+            no_skew,
+            other,
+        })
+    }
+}
+
+/// What the frames of every stream add up to.
+#[derive(Default)]
+struct Collected {
+    frames_a: Vec<FrameEval>,
+    frames_b: Vec<FrameEval>,
+    skew_frames: usize,
+    skew_samples: Vec<skew::SkewSample>,
+    differences: Vec<Difference>,
+    skipped: Vec<String>,
+    /// `(height px, true distance cm)` of uncut goals, for `--calibrate-goals`.
+    goal_samples: Vec<(f64, f64)>,
+    pattern_frames: Vec<crate::eval::patterns::PatternFrameEval>,
+    place_markers: Vec<(usize, Option<usize>)>,
+}
+
+/// Frame `i` of `reader` with its robot-camera truth, or `None` with the reason in `skipped`.
+fn frame_with_truth(
+    reader: &mut StreamReader,
+    name: &str,
+    i: usize,
+    skipped: &mut Vec<String>,
+) -> Option<(crate::streams::FrameRecord, Box<RobotViewTruth>)> {
+    let record = match reader.read(i) {
+        Ok(r) => r,
+        Err(e) => {
+            skipped.push(format!("{name}#{i}: {e}"));
+            return None;
+        }
+    };
+    let Some(truth) = record.ground_truth.clone() else {
+        skipped.push(format!("{name}#{i}: no ground truth"));
+        return None;
+    };
+    match serde_json::from_value::<GroundTruth>(truth) {
+        Ok(GroundTruth::Robot(t)) => Some((record, t)),
+        Ok(GroundTruth::Overhead(_)) => {
+            skipped.push(format!("{name}#{i}: overhead frame"));
+            None
+        }
+        Err(e) => {
+            skipped.push(format!("{name}#{i}: ground truth unreadable: {e}"));
+            None
+        }
+    }
+}
+
+impl Collected {
+    /// Evaluates one frame with every pipeline (`global`: its index over all streams).
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "one frame's context, passed once per frame"
+    )]
+    fn add_frame(
+        &mut self,
+        pipelines: &mut Pipelines,
+        places: Option<&PatternMemory>,
+        args: &Args,
+        rp: &RecognitionParams,
+        (name, i, global): (&str, usize, usize),
+        record: &crate::streams::FrameRecord,
+        truth: &RobotViewTruth,
+    ) {
+        let ep = EvalParams::default();
+        let (w, h) = (record.frame.width() as f64, record.frame.height() as f64);
+        let sensors = record.sensors.as_ref();
+        let ra = pipelines
+            .main
+            .process(&record.frame, sensors)
+            .recognition
+            .clone();
+        if let Some(m) = places {
+            let pattern_params = crate::eval::patterns::PatternEvalParams::default();
+            // Learnt places are matched to the markers of the first frame that lists any.
+            if !truth.markers.is_empty() && self.place_markers.iter().all(|(_, k)| k.is_none()) {
+                self.place_markers =
+                    crate::eval::patterns::place_markers(m, &truth.markers, &pattern_params);
+            }
+            self.pattern_frames
+                .push(crate::eval::patterns::evaluate_patterns(
+                    global,
+                    &ra,
+                    truth,
+                    &self.place_markers,
+                    &pattern_params,
+                ));
+        }
+        for g in ra.goals.goals() {
+            if let Some(tg) = truth
+                .goals
+                .iter()
+                .find(|t| crate::eval::goal_class(t.colour) == g.colour)
+                && !g.cut_off.top
+                && !g.cut_off.bottom
+                && !g.distance_from_ir
+            {
+                self.goal_samples
+                    .push((g.height_px, tg.relative.camera_distance_cm));
+            }
+        }
+        let fast = sensors
+            .and_then(crate::sensors::SensorReadings::pan_velocity_rad_per_s)
+            .is_some_and(|v| v.abs() >= args.fast_pan_rad_per_s);
+        if fast {
+            self.skew_frames += 1;
+            let rn = &pipelines
+                .no_skew
+                .process(&record.frame, sensors)
+                .recognition;
+            let camera = rp.camera_for(record.frame.width(), record.frame.height());
+            self.skew_samples
+                .extend(skew::compare_ball(&ra, rn, truth, &camera, 2.0));
+        }
+        if let Some(o) = pipelines.other.as_mut() {
+            let rb = o.process(&record.frame, sensors).recognition.clone();
+            self.frames_b
+                .push(evaluate_frame(global, &rb, truth, w, h, &ep));
+            if let Some(what) = differ(&ra, &rb) {
+                self.differences.push(Difference {
+                    stream: name.to_owned(),
+                    frame: i,
+                    what,
+                });
+            }
+        }
+        self.frames_a
+            .push(evaluate_frame(global, &ra, truth, w, h, &ep));
+    }
+}
+
+/// Fits goal distance = multiplier / height + offset to `samples` (`(height px, distance cm)`),
+/// writes it over `rp` as a parameter file at `out` and draws the fit beside it.
+fn calibrate_goals(
+    out: &std::path::Path,
+    samples: &[(f64, f64)],
+    rp: &RecognitionParams,
+    min_spread: f64,
+) -> anyhow::Result<(f64, f64)> {
+    let (lo_h, hi_h) = samples.iter().fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
+        (a.min(s.0), b.max(s.0))
+    });
+    // Heights within a narrow band (one distance) cannot separate multiplier and offset:
+    // then only the multiplier is fitted and the offset kept.
+    let (m, o) = if hi_h >= min_spread * lo_h {
+        let Some((m, o)) = fit_inverse_size(samples) else {
+            bail!("too few uncut goals ({}) to calibrate", samples.len());
+        };
+        (m, o)
+    } else {
+        let o = rp.goals.distance_offset_cm;
+        let Some(m) = fit_inverse_size_multiplier(samples, o) else {
+            bail!("no uncut goal to calibrate from");
+        };
+        eprintln!(
+            "goal heights span only {lo_h:.1}–{hi_h:.1} px: fitting the multiplier only, \
+             offset kept at {o:.1} cm"
+        );
+        (m, o)
+    };
+    if !(m > 0.0 && m.is_finite() && o.is_finite()) {
+        let (lo, hi) = samples.iter().fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
+            (a.min(s.1), b.max(s.1))
+        });
+        bail!(
+            "goal calibration gives distance = {m:.1} / height + {o:.1} cm from {} goals \
+             {lo:.0}–{hi:.0} cm away: not a size → distance relation; give streams with \
+             goals over a wider range of distances",
+            samples.len()
+        );
+    }
+    let mut p = *rp;
+    p.goals.distance_multiplier = m;
+    p.goals.distance_offset_cm = o;
+    let json = serde_json::to_vec_pretty(&p)?;
+    crate::atomic_file::write_atomic(out, &json)
+        .with_context(|| format!("{}: cannot write", out.display()))?;
+    crate::eval::plots::write_calibration_plot(
+        &out.with_extension("png"),
+        samples,
+        (m, o),
+        (rp.goals.distance_multiplier, rp.goals.distance_offset_cm),
+    )
+    .context("calibration plot")?;
+    Ok((m, o))
+}
+
 /// Runs `eotn eval`.
 ///
 /// # Errors
@@ -131,58 +378,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         };
         return super::eval_labels::run(stream, labels, lut, rp, args.json);
     }
-    let params = PipelineParams {
-        recognition: rp,
-        ..PipelineParams::default()
-    };
-    let mut main = Pipeline::new(lut.clone(), params);
     let places = args
         .patterns
         .as_deref()
-        .map(crate::recognition::patterns::PatternMemory::load)
+        .map(PatternMemory::load)
         .transpose()?;
-    main.set_pattern_memory(places.clone());
-    let pattern_params = crate::eval::patterns::PatternEvalParams::default();
-    let mut pattern_frames = Vec::new();
-    let mut place_markers: Vec<(usize, Option<usize>)> = Vec::new();
-    let mut no_skew = Pipeline::new(
-        lut.clone(),
-        PipelineParams {
-            recognition: RecognitionParams {
-                ball: crate::recognition::BallParams {
-                    skew_correction: false,
-                    ..rp.ball
-                },
-                ..rp
-            },
-            ..params
-        },
-    );
-    let mut other = if args.compare_lut.is_some() || args.compare_params.is_some() {
-        let l = match &args.compare_lut {
-            Some(p) => load_lut_arg(p)?,
-            None => lut,
-        };
-        let p = match &args.compare_params {
-            Some(p) => load_params(Some(p))?,
-            None => rp,
-        };
-        Some(Pipeline::new(
-            l,
-            PipelineParams {
-                recognition: p,
-                ..params
-            },
-        ))
-    } else {
-        None
-    };
-    let ep = EvalParams::default();
-    let (mut frames_a, mut frames_b) = (Vec::<FrameEval>::new(), Vec::<FrameEval>::new());
-    let (mut skew_frames, mut skew_samples) = (0usize, Vec::new());
-    let mut differences = Vec::new();
-    let mut skipped = Vec::new();
-    let mut goal_samples = Vec::new();
+    let mut pipelines = Pipelines::new(args, lut, rp, places.as_ref())?;
+    let mut c = Collected::default();
     let mut global = 0usize;
     for path in &args.streams {
         let mut reader = StreamReader::open(path)?;
@@ -190,155 +392,52 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let bar = super::inputs::progress(reader.len(), "eval");
         for i in 0..reader.len() {
             bar.inc(1);
-            let record = match reader.read(i) {
-                Ok(r) => r,
-                Err(e) => {
-                    skipped.push(format!("{name}#{i}: {e}"));
-                    continue;
-                }
-            };
-            let Some(truth) = record.ground_truth.clone() else {
-                skipped.push(format!("{name}#{i}: no ground truth"));
+            let Some((record, truth)) = frame_with_truth(&mut reader, &name, i, &mut c.skipped)
+            else {
                 continue;
             };
-            let truth = match serde_json::from_value::<GroundTruth>(truth) {
-                Ok(GroundTruth::Robot(t)) => t,
-                Ok(GroundTruth::Overhead(_)) => {
-                    skipped.push(format!("{name}#{i}: overhead frame"));
-                    continue;
-                }
-                Err(e) => {
-                    skipped.push(format!("{name}#{i}: ground truth unreadable: {e}"));
-                    continue;
-                }
-            };
-            let (w, h) = (record.frame.width() as f64, record.frame.height() as f64);
-            let sensors = record.sensors.as_ref();
-            let ra = main.process(&record.frame, sensors).recognition.clone();
-            let fa = evaluate_frame(global, &ra, &truth, w, h, &ep);
-            if let Some(m) = &places {
-                // Learnt places are matched to the markers of the first frame that lists any.
-                if !truth.markers.is_empty() && place_markers.iter().all(|(_, k)| k.is_none()) {
-                    place_markers =
-                        crate::eval::patterns::place_markers(m, &truth.markers, &pattern_params);
-                }
-                pattern_frames.push(crate::eval::patterns::evaluate_patterns(
-                    global,
-                    &ra,
-                    &truth,
-                    &place_markers,
-                    &pattern_params,
-                ));
-            }
-            for g in ra.goals.goals() {
-                if let Some(tg) = truth
-                    .goals
-                    .iter()
-                    .find(|t| crate::eval::goal_class(t.colour) == g.colour)
-                    && !g.cut_off.top
-                    && !g.cut_off.bottom
-                    && !g.distance_from_ir
-                {
-                    goal_samples.push((g.height_px, tg.relative.camera_distance_cm));
-                }
-            }
-            let fast = sensors
-                .and_then(crate::sensors::SensorReadings::pan_velocity_rad_per_s)
-                .is_some_and(|v| v.abs() >= args.fast_pan_rad_per_s);
-            if fast {
-                skew_frames += 1;
-                let rn = &no_skew.process(&record.frame, sensors).recognition;
-                let camera = rp.camera_for(record.frame.width(), record.frame.height());
-                skew_samples.extend(skew::compare_ball(&ra, rn, &truth, &camera, 2.0));
-            }
-            if let Some(o) = other.as_mut() {
-                let rb = o.process(&record.frame, sensors).recognition.clone();
-                frames_b.push(evaluate_frame(global, &rb, &truth, w, h, &ep));
-                if let Some(what) = differ(&ra, &rb) {
-                    differences.push(Difference {
-                        stream: name.clone(),
-                        frame: i,
-                        what,
-                    });
-                }
-            }
-            frames_a.push(fa);
+            let at = (name.as_str(), i, global);
+            c.add_frame(
+                &mut pipelines,
+                places.as_ref(),
+                args,
+                &rp,
+                at,
+                &record,
+                &truth,
+            );
             global += 1;
         }
         bar.finish_and_clear();
     }
-    if frames_a.is_empty() {
+    if c.frames_a.is_empty() {
         bail!("no frame with robot-camera ground truth in the given streams");
     }
-    let goal_calibration = if let Some(out) = &args.calibrate_goals {
-        let (lo_h, hi_h) = goal_samples
-            .iter()
-            .fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
-                (a.min(s.0), b.max(s.0))
-            });
-        // Heights within a narrow band (one distance) cannot separate multiplier and offset:
-        // then only the multiplier is fitted and the offset kept.
-        let (m, o) = if hi_h >= args.calibration_min_spread * lo_h {
-            let Some((m, o)) = fit_inverse_size(&goal_samples) else {
-                bail!("too few uncut goals ({}) to calibrate", goal_samples.len());
-            };
-            (m, o)
-        } else {
-            let o = rp.goals.distance_offset_cm;
-            let Some(m) = fit_inverse_size_multiplier(&goal_samples, o) else {
-                bail!("no uncut goal to calibrate from");
-            };
-            eprintln!(
-                "goal heights span only {lo_h:.1}–{hi_h:.1} px: fitting the multiplier only, \
-                 offset kept at {o:.1} cm"
-            );
-            (m, o)
-        };
-        if !(m > 0.0 && m.is_finite() && o.is_finite()) {
-            let (lo, hi) = goal_samples
-                .iter()
-                .fold((f64::INFINITY, 0.0_f64), |(a, b), s| {
-                    (a.min(s.1), b.max(s.1))
-                });
-            bail!(
-                "goal calibration gives distance = {m:.1} / height + {o:.1} cm from {} goals \
-                 {lo:.0}–{hi:.0} cm away: not a size → distance relation; give streams with \
-                 goals over a wider range of distances",
-                goal_samples.len()
-            );
-        }
-        let mut p = rp;
-        p.goals.distance_multiplier = m;
-        p.goals.distance_offset_cm = o;
-        let json = serde_json::to_vec_pretty(&p)?;
-        crate::atomic_file::write_atomic(out, &json)
-            .with_context(|| format!("{}: cannot write", out.display()))?;
-        let plot = out.with_extension("png");
-        crate::eval::plots::write_calibration_plot(
-            &plot,
-            &goal_samples,
-            (m, o),
-            (rp.goals.distance_multiplier, rp.goals.distance_offset_cm),
-        )
-        .context("calibration plot")?;
-        Some((m, o))
-    } else {
-        None
-    };
+    let goal_calibration = args
+        .calibrate_goals
+        .as_deref()
+        .map(|out| calibrate_goals(out, &c.goal_samples, &rp, args.calibration_min_spread))
+        .transpose()?;
     let plots = match &args.plots {
-        Some(dir) => crate::eval::plots::write_eval_plots(dir, &frames_a).context("plots")?,
+        Some(dir) => crate::eval::plots::write_eval_plots(dir, &c.frames_a).context("plots")?,
         None => Vec::new(),
     };
     let output = EvalOutput {
-        report: EvalReport::from_frames(&frames_a),
-        skew: (skew_frames > 0).then(|| SkewReport::from_samples(skew_frames, &skew_samples)),
-        compare: other.is_some().then(|| EvalReport::from_frames(&frames_b)),
-        differences,
+        report: EvalReport::from_frames(&c.frames_a),
+        skew: (c.skew_frames > 0).then(|| SkewReport::from_samples(c.skew_frames, &c.skew_samples)),
+        compare: pipelines
+            .other
+            .is_some()
+            .then(|| EvalReport::from_frames(&c.frames_b)),
+        differences: c.differences,
         goal_calibration,
         plots,
-        skipped,
+        skipped: c.skipped,
         patterns: places.is_some().then(|| {
-            crate::eval::patterns::PatternEvalReport::from_frames(&pattern_frames, place_markers)
+            crate::eval::patterns::PatternEvalReport::from_frames(
+                &c.pattern_frames,
+                c.place_markers,
+            )
         }),
     };
     if args.json {

@@ -14,6 +14,7 @@ mod real_data;
 mod recognition;
 mod sim;
 mod sim_table;
+mod snapshots;
 mod streams;
 mod viewers;
 #[cfg(feature = "gui")]
