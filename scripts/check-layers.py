@@ -13,8 +13,8 @@ import sys
 # Data-flow order: frames in, results out, front ends last (STYLE.md, ARCHITECTURE.md).
 ORDER = [
     "atomic_file", "frame", "lut", "classify", "blobs", "sensors", "geometry", "sim", "import",
-    "recognition", "overhead", "pipeline", "overlay", "eval", "streams", "sources", "live",
-    "workspace", "cli", "app",
+    "recognition", "overhead", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
+    "live", "workspace", "cli", "app",
 ]
 
 root = pathlib.Path(__file__).resolve().parent.parent / "src"
