@@ -11,11 +11,13 @@
 //! | `inspector.rs` | every recognition candidate with its confidence breakdown; selection |
 //! | `sensors_dialog.rs` | every sensor reading with units, plots over the stream |
 //! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
-//! | `menus.rs` | File, Classification, View, Stream, Windows, Help |
+//! | `menus.rs` | File, Classification, View, Stream, Camera, Windows, Help |
+//! | `camera_menu.rs` | the Camera menu and its dialogs: connect, settings, grab, record |
 //! | `renderer.rs` | wgpu on a GPU, OpenGL on a software rasteriser: the choice before the window opens |
 //!
 //! Only this folder names egui/eframe (`scripts/check.sh` checks it).
 
+pub mod camera_menu;
 pub mod classify_panel;
 pub mod inspector;
 pub mod menus;
@@ -253,6 +255,8 @@ pub struct EotnApp {
     pub state: Workspace,
     textures: Option<Textures>,
     menu_input: menus::MenuInput,
+    /// What the Camera dialogs are editing.
+    pub camera: camera_menu::CameraDialogs,
     uv_plane: uv_plane::UvPlane,
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
@@ -296,6 +300,7 @@ impl EotnApp {
             state,
             textures: None,
             menu_input: menus::MenuInput::default(),
+            camera: camera_menu::CameraDialogs::default(),
             uv_plane: uv_plane::UvPlane::default(),
             hovered: None,
             last_view: None,
@@ -784,6 +789,7 @@ impl eframe::App for EotnApp {
         self.warnings_window(&ctx);
         self.about_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
+        camera_menu::camera_windows(&ctx, &self.state, &mut self.camera, &mut commands);
         if let Some(at) = self.quit_at {
             if now >= at {
                 // Unsaved table edits still get the question: a timer never discards work.

@@ -7,8 +7,8 @@
 //! | `stream.rs` | [`StreamSource`]: a recorded MCAP stream, random access by index and time |
 //! | `files.rs` | [`FileSource`]: frame files (`.uyvy`, PNG, JPEG) with their sensor side files |
 //! | `synthetic.rs` | [`SyntheticSource`]: a scenario of [`crate::sim`] rendered live at its frame rate |
-//! | `camera.rs` | [`CameraSource`]: a V4L2 camera (UVC webcams delivering YUYV or UYVY) |
-//! | `network.rs` | a robot over the network (Foxglove WebSocket): implements [`FrameSource`] |
+//! | `camera.rs` | `CameraSource`: a V4L2 camera (UVC webcams delivering YUYV or UYVY) |
+//! | `network.rs` | a robot over the network (Foxglove WebSocket), still to come: a type that implements [`FrameSource`] (frames from its own socket thread; `connect` returns at once), built by the [`SourceSpec::Network`] arm of [`SourceSpec::open`], which refuses until then |
 //! | `recorder.rs` | [`Recorder`]: any source's frames into an MCAP stream the user names |
 //! | `streamer.rs` | [`Streamer`]: any source grabbed at a fixed rate on its own thread |
 //!

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use crate::sources::{SourceSettings, SourceSpec};
+
 use super::settings::{Overlays, ViewKind};
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
@@ -92,6 +94,21 @@ pub enum Command {
     ShowWindow(Window, bool),
     /// Show or hide the frame-time readout.
     ShowTimings(bool),
+    /// Connect a source (Camera ▸ Connect…): a recorded one opens for stepping, a live one
+    /// streams on its own thread; what was connected before is disconnected.
+    Connect(SourceSpec),
+    /// Disconnect the live source or close the recorded one.
+    Disconnect,
+    /// Ask the live source for other settings (resolution, frame rate, exposure, gain).
+    SetSourceSettings(SourceSettings),
+    /// One new image: a live source stops streaming and grabs one; a recorded one steps on.
+    GrabImage,
+    /// Stream the live source at its rate again (true) or hold it (false).
+    SetStreaming(bool),
+    /// Record what the connected source delivers into this MCAP stream.
+    StartRecording(PathBuf),
+    /// Finish the recording.
+    StopRecording,
     /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
     /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
     SelectObject(Option<String>),
@@ -108,6 +125,12 @@ pub enum Window {
     TryEdit,
     /// Every recognition candidate with its confidence breakdown.
     Inspector,
+    /// Camera ▸ Connect…: pick a source.
+    Connect,
+    /// Camera ▸ Settings…: the live source's settings.
+    SourceSettings,
+    /// Camera ▸ Start recording…: name the stream.
+    Record,
 }
 
 impl Window {
@@ -122,6 +145,9 @@ impl Window {
             Self::UvPlane => "U–V plane",
             Self::TryEdit => "Try edit on stream",
             Self::Inspector => "Object inspector",
+            Self::Connect => "Connect a source",
+            Self::SourceSettings => "Source settings",
+            Self::Record => "Record into a stream",
         }
     }
 }

@@ -46,14 +46,19 @@ impl Workspace {
     }
 
     pub(super) fn set_source(&mut self, source: Source) -> anyhow::Result<()> {
+        let kind = source.info().camera;
+        let old_kind = self.table_kind;
         let old = self.source.replace(source);
+        self.use_table_of(kind);
         self.player.stop();
         self.try_edit = None;
         self.current = None;
         if let Err(e) = self.seek(0) {
             self.source = old;
+            self.use_table_of(old_kind);
             return Err(e);
         }
+        self.live = None;
         if let Some(src) = &self.source {
             self.settings.last_source = src
                 .paths()
@@ -93,7 +98,7 @@ impl Workspace {
 
     /// Runs every stage on `loaded` with its sensor readings (recognition needs the camera
     /// pose for heights and the horizon) and refreshes what is derived from the results.
-    fn run_pipeline(&mut self, loaded: &SourceFrame) -> crate::pipeline::StageTimings {
+    pub(super) fn run_pipeline(&mut self, loaded: &SourceFrame) -> crate::pipeline::StageTimings {
         let r = self
             .pipeline
             .process(&loaded.frame, loaded.sensors.as_ref());
@@ -151,6 +156,7 @@ impl Workspace {
                 self.warn(w.clone());
             }
         }
+        self.record_shown(&loaded);
         self.current = Some(loaded);
         self.index = index;
         self.settings.last_index = index;

@@ -13,7 +13,8 @@
 //! | `source.rs` | [`Source`]: the open recorded source with a cache of decoded frames |
 //! | `frames.rs` | opening sources, showing a frame, the sensor-series scan |
 //! | `player.rs` | [`Player`]: playback clock, `tick`, `next_frame_due` |
-//! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file |
+//! | `live.rs` | [`Live`]: a connected live source streaming on its thread; recording |
+//! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
@@ -23,6 +24,7 @@ mod command;
 mod compose;
 mod frames;
 pub mod journal;
+mod live;
 pub mod player;
 mod settings;
 pub mod source;
@@ -37,12 +39,14 @@ use anyhow::Context as _;
 
 pub use command::{Command, Window};
 pub use compose::{PrimitiveFilter, box_colour};
+pub use live::Live;
 pub use player::Player;
 pub use settings::{
     MAX_RECENT, MAX_WARNINGS, Overlays, SPEEDS, Settings, ViewKind, ViewTransform, ZOOM_PRESETS,
     ZOOM_RANGE,
 };
 pub use source::Source;
+pub use table::TableSlot;
 pub use timings::{StepTiming, Timings, median};
 pub use try_edit::{TryEdit, TryEditRow};
 
@@ -57,7 +61,7 @@ use crate::lut::{ColourClass, EditHistory, LookupTable, Region};
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::{Primitive, Recognition};
 use crate::sensors::SensorReadings;
-use crate::sources::{CameraKind, SourceFrame};
+use crate::sources::{CameraKind, Recorder, SourceFrame};
 
 /// Time per UI frame a whole-stream scan may take, so the window stays responsive.
 const SCAN_BUDGET: Duration = Duration::from_millis(12);
@@ -130,6 +134,13 @@ pub struct Workspace {
     primitives: Vec<Primitive>,
     accepted_owners: Vec<String>,
     selected_object: Option<String>,
+    live: Option<Live>,
+    /// Recording a recorded source's shown frames (a live source records on its thread).
+    recorder: Option<Recorder>,
+    /// Which camera's table the pipeline holds.
+    table_kind: CameraKind,
+    /// The other camera's table.
+    other_table: TableSlot,
 }
 
 impl Default for Workspace {
@@ -180,12 +191,21 @@ impl Workspace {
             primitives: Vec::new(),
             accepted_owners: Vec::new(),
             selected_object: None,
+            live: None,
+            recorder: None,
+            table_kind: CameraKind::Robot,
+            other_table: TableSlot::empty(bits),
         }
     }
 
     /// Reopens what the settings name (last table, last stream or frames), reporting failures
     /// as warnings: a moved file must not stop the app from starting.
     pub fn reopen_last(&mut self) {
+        if let Some(t) = self.settings.last_overhead_table.clone() {
+            self.use_table_of(CameraKind::Overhead);
+            self.run(Command::OpenTable(t));
+            self.use_table_of(CameraKind::Robot);
+        }
         if let Some(t) = self.settings.last_table.clone() {
             self.run(Command::OpenTable(t));
         }
@@ -289,6 +309,13 @@ impl Workspace {
             Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
             Command::ShowWindow(w, open) => *self.window_flag(w) = open,
             Command::ShowTimings(on) => self.settings.show_timings = on,
+            Command::Connect(spec) => self.connect(&spec)?,
+            Command::Disconnect => self.disconnect()?,
+            Command::SetSourceSettings(s) => self.set_source_settings(s)?,
+            Command::GrabImage => self.grab_image()?,
+            Command::SetStreaming(on) => self.set_streaming(on)?,
+            Command::StartRecording(p) => self.start_recording(&p)?,
+            Command::StopRecording => self.stop_recording()?,
             Command::SelectObject(owner) => {
                 if let Some(o) = &owner {
                     anyhow::ensure!(
@@ -360,6 +387,7 @@ impl Workspace {
 
     /// Advances playback and background scans by `dt` of wall time. Called once per UI frame.
     pub fn tick(&mut self, dt: Duration) {
+        self.poll_live();
         self.scan_sensor_series();
         if let (Some(t), Some(src)) = (self.try_edit.as_mut(), self.source.as_mut()) {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
@@ -381,6 +409,15 @@ impl Workspace {
     /// an unchanged frame.
     #[must_use]
     pub fn next_frame_due(&self) -> Option<Duration> {
+        if let Some(live) = self.live.as_ref().filter(|l| l.streaming()) {
+            // Frames arrive on their own thread: look for one about twice a frame interval.
+            let rate = live
+                .settings()
+                .frame_rate
+                .filter(|r| *r > 0.0)
+                .unwrap_or(30.0);
+            return Some(Duration::from_secs_f64(0.5 / rate.min(240.0)));
+        }
         let src = self.source.as_ref()?;
         self.player
             .next_frame_due(self.settings.speed, self.index, src)
@@ -390,9 +427,8 @@ impl Workspace {
     /// recogniser and the lookup table.
     #[must_use]
     pub fn camera_kind(&self) -> CameraKind {
-        self.source
-            .as_ref()
-            .map_or(CameraKind::Robot, |s| s.info().camera)
+        self.connected_info()
+            .map_or(CameraKind::Robot, |s| s.camera)
     }
 
     /// Records one UI frame interval for the frame-time readout.
@@ -619,6 +655,9 @@ impl Workspace {
             Window::UvPlane => self.settings.show_uv_plane,
             Window::TryEdit => self.settings.show_try_edit,
             Window::Inspector => self.settings.show_inspector,
+            Window::Connect => self.settings.show_connect,
+            Window::SourceSettings => self.settings.show_source_settings,
+            Window::Record => self.settings.show_record,
         }
     }
 
@@ -628,6 +667,9 @@ impl Workspace {
             Window::UvPlane => &mut self.settings.show_uv_plane,
             Window::TryEdit => &mut self.settings.show_try_edit,
             Window::Inspector => &mut self.settings.show_inspector,
+            Window::Connect => &mut self.settings.show_connect,
+            Window::SourceSettings => &mut self.settings.show_source_settings,
+            Window::Record => &mut self.settings.show_record,
         }
     }
 
@@ -637,7 +679,8 @@ impl Workspace {
         u8::try_from(self.pipeline.lut().side() / 2).unwrap_or(u8::MAX)
     }
 
-    /// The window title: table (with `*` when unsaved) and source.
+    /// The window title: table (with `*` when unsaved; the other camera's too when it has
+    /// unsaved edits) and source.
     #[must_use]
     pub fn title(&self) -> String {
         let table = self
@@ -645,12 +688,20 @@ impl Workspace {
             .as_deref()
             .map_or_else(|| "untitled table".to_owned(), crate::frame::display_name);
         let mark = if self.dirty { " *" } else { "" };
+        let other = if self.other_table.dirty() {
+            let name = self
+                .other_table
+                .path()
+                .map_or_else(|| "untitled table".to_owned(), crate::frame::display_name);
+            format!(" (+ {name} *)")
+        } else {
+            String::new()
+        };
         let source = self
-            .source
-            .as_ref()
-            .map(|s| format!(" — {}", s.label()))
+            .connected_info()
+            .map(|s| format!(" — {}", s.label))
             .unwrap_or_default();
-        format!("eotn — {table}{mark}{source}")
+        format!("eotn — {table}{mark}{other}{source}")
     }
 
     /// What hovering (x, y) shows, or `None` outside the frame.

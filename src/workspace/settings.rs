@@ -159,8 +159,10 @@ impl ViewTransform {
 pub struct Settings {
     /// Recently opened files, newest first.
     pub recent: Vec<PathBuf>,
-    /// The table to reopen at start.
+    /// The robot camera's table to reopen at start.
     pub last_table: Option<PathBuf>,
+    /// The overhead camera's table to reopen at start.
+    pub last_overhead_table: Option<PathBuf>,
     /// The places file (learnt coloured patterns) to reopen at start.
     pub last_places: Option<PathBuf>,
     /// The stream or frame files to reopen at start.
@@ -197,6 +199,15 @@ pub struct Settings {
     pub show_timings: bool,
     /// The object inspector window open.
     pub show_inspector: bool,
+    /// The Connect dialog open (not kept between runs, like the other Camera dialogs).
+    #[serde(skip)]
+    pub show_connect: bool,
+    /// The source settings dialog open.
+    #[serde(skip)]
+    pub show_source_settings: bool,
+    /// The "Start recording" dialog open.
+    #[serde(skip)]
+    pub show_record: bool,
 }
 
 impl Default for Settings {
@@ -204,6 +215,7 @@ impl Default for Settings {
         Self {
             recent: Vec::new(),
             last_table: None,
+            last_overhead_table: None,
             last_places: None,
             last_source: Vec::new(),
             last_index: 0,
@@ -222,6 +234,9 @@ impl Default for Settings {
             show_try_edit: false,
             show_timings: true,
             show_inspector: false,
+            show_connect: false,
+            show_source_settings: false,
+            show_record: false,
         }
     }
 }

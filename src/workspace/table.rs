@@ -9,14 +9,14 @@ use super::journal::{self, JournalEntry, now_unix_ms};
 use super::{PendingSelection, Workspace};
 use crate::frame::Yuv;
 use crate::lut::{EditRecord, LookupTable, Region, Sensitivity};
+use crate::sources::CameraKind;
 
 impl Workspace {
     pub(super) fn open_table(&mut self, path: &Path) -> anyhow::Result<()> {
         let lut = LookupTable::load(path)?;
         self.set_table(lut, Some(path.to_owned()));
         self.remember_recent(path);
-        self.settings.last_table =
-            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        self.remember_table(path);
         self.status = format!("opened table {}", path.display());
         if journal::journal_path(path).exists() {
             match journal::replay(path) {
@@ -77,8 +77,7 @@ impl Workspace {
             }
         }
         self.table_path = Some(path.to_owned());
-        self.settings.last_table =
-            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        self.remember_table(path);
         self.remember_recent(path);
         self.dirty = false;
         self.status = format!("saved {}", path.display());
@@ -250,5 +249,78 @@ impl Workspace {
         });
         self.refresh_preview();
         Ok(())
+    }
+}
+
+/// The lookup table not in use: the robot camera's while an overhead source is shown, and the
+/// other way round. Both cameras see colours differently, so each keeps its own table, file,
+/// undo history and unsaved mark.
+#[derive(Debug)]
+pub struct TableSlot {
+    pub(super) lut: LookupTable,
+    pub(super) path: Option<PathBuf>,
+    pub(super) history: crate::lut::EditHistory,
+    pub(super) dirty: bool,
+}
+
+impl TableSlot {
+    /// An empty table of `bits` per channel, without a file.
+    pub(super) fn empty(bits: u8) -> Self {
+        Self {
+            lut: LookupTable::new(bits).unwrap_or_else(|_| super::seven_bit_table()),
+            path: None,
+            history: crate::lut::EditHistory::default(),
+            dirty: false,
+        }
+    }
+
+    /// Its file, if it has one.
+    #[must_use]
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    /// True when it has edits not yet saved.
+    #[must_use]
+    pub const fn dirty(&self) -> bool {
+        self.dirty
+    }
+}
+
+impl Workspace {
+    /// Makes the table of camera `kind` the one in use (the other is kept as it is).
+    pub(super) fn use_table_of(&mut self, kind: CameraKind) {
+        if kind == self.table_kind {
+            return;
+        }
+        let o = &mut self.other_table;
+        std::mem::swap(self.pipeline.lut_mut(), &mut o.lut);
+        std::mem::swap(&mut self.table_path, &mut o.path);
+        std::mem::swap(&mut self.history, &mut o.history);
+        std::mem::swap(&mut self.dirty, &mut o.dirty);
+        self.table_kind = kind;
+        self.selection = None;
+        self.table_changed();
+    }
+
+    /// Which camera's table is in use.
+    #[must_use]
+    pub const fn table_kind(&self) -> CameraKind {
+        self.table_kind
+    }
+
+    /// The other camera's table.
+    #[must_use]
+    pub const fn other_table(&self) -> &TableSlot {
+        &self.other_table
+    }
+
+    /// Remembers `path` as the table of the camera in use, to reopen at start.
+    pub(super) fn remember_table(&mut self, path: &Path) {
+        let p = Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        match self.table_kind {
+            CameraKind::Robot => self.settings.last_table = p,
+            CameraKind::Overhead => self.settings.last_overhead_table = p,
+        }
     }
 }

@@ -4,6 +4,8 @@
 
 #[cfg(feature = "gui")]
 mod app;
+#[cfg(feature = "gui")]
+mod app_camera;
 mod cli;
 mod common;
 mod goal_posts;
