@@ -8,7 +8,7 @@
 //! | `files.rs` | [`FileSource`]: frame files (`.uyvy`, PNG, JPEG) with their sensor side files |
 //! | `synthetic.rs` | [`SyntheticSource`]: a scenario of [`crate::sim`] rendered live at its frame rate |
 //! | `camera.rs` | `CameraSource`: a V4L2 camera (UVC webcams delivering YUYV or UYVY) |
-//! | `network.rs` | a robot over the network (Foxglove WebSocket), still to come: a type that implements [`FrameSource`] (frames from its own socket thread; `connect` returns at once), built by the [`SourceSpec::Network`] arm of [`SourceSpec::open`], which refuses until then |
+//! | (network) | a robot over the network (Foxglove WebSocket) lives in `crate::live`, after this module in the data flow: it implements [`FrameSource`] (frames from its own socket thread; `connect` returns at once) and the workspace builds it for [`SourceSpec::Network`] |
 //! | `recorder.rs` | [`Recorder`]: any source's frames into an MCAP stream the user names |
 //! | `streamer.rs` | [`Streamer`]: any source grabbed at a fixed rate on its own thread |
 //!
@@ -449,9 +449,10 @@ impl SourceSpec {
             Self::Stream(path) => Box::new(StreamSource::open(path)?),
             Self::Files(paths) => Box::new(FileSource::new(paths.clone(), None)?),
             Self::Network(address) => {
+                // Built by `crate::workspace` from `crate::live`, which comes after this module.
                 return Err(SourceError::Unsupported {
                     label: address.clone(),
-                    detail: "network sources are not built into this program yet".to_owned(),
+                    detail: "a network source is opened through the workspace".to_owned(),
                 });
             }
         };
