@@ -69,7 +69,6 @@ fn add(out: &mut ImageAnnotations, p: &Primitive, stamp: Timestamp) {
             ));
         }
         Primitive::PatternRegion { bounds, .. } => {
-            #[expect(clippy::cast_precision_loss, reason = "image coordinates are small")]
             let [x0, y0, x1, y1] = bounds.map(|v| v as f64);
             out.points.push(points(
                 PointsType::LineLoop,

@@ -6,6 +6,7 @@
 //! | module | role |
 //! |---|---|
 //! | [`atomic_file`] | write-to-temporary, fsync, rename: how files the user cares about are saved |
+//! | [`stats`] | the median and the inverse-size least squares shared by recognition and evaluation |
 //! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
 //! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model, other teams' formats |
 //! | [`classify`] | frame + table → classified image |
@@ -42,6 +43,7 @@ pub mod recognition;
 pub mod sensors;
 pub mod sim;
 pub mod sources;
+pub mod stats;
 pub mod streams;
 pub mod workspace;
 

@@ -448,7 +448,7 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
             }
             ui.end_row();
             for t in &c.confidence.tests {
-                ui.monospace(&t.test);
+                ui.monospace(t.test.as_str());
                 ui.monospace(format!("{:.3}", t.value));
                 ui.monospace(format!("{:.3} … {:.3}", t.range[0], t.range[1]));
                 ui.monospace(format!("{:+.2}", t.effect));

@@ -133,7 +133,6 @@ impl Blob {
 
     /// Mean pixel centre in image coordinates (pixel (i, j) has its centre at (i + 0.5, j + 0.5)).
     #[must_use]
-    #[expect(clippy::cast_precision_loss, reason = "pixel sums are far below 2^52")]
     pub fn centroid(&self) -> (f64, f64) {
         let n = f64::from(self.pixels.max(1));
         (self.sum_x as f64 / n + 0.5, self.sum_y as f64 / n + 0.5)

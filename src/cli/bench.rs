@@ -57,18 +57,10 @@ pub struct BenchJson {
     pub total_ms_per_frame: f64,
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+fn median(v: &[f64]) -> f64 {
+    crate::stats::median(v).unwrap_or(f64::NAN)
 }
 
-#[expect(
-    clippy::cast_precision_loss,
-    reason = "nanosecond counts and pixel counts stay far below 2^52"
-)]
 fn ns_per_px(d: Duration, pixels: usize) -> f64 {
     d.as_nanos() as f64 / pixels as f64
 }
@@ -116,10 +108,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         connectivity: connectivity.neighbours(),
         reps: args.reps.max(1),
         kernels: crate::classify::active_kernels(),
-        classify_ns_per_px: median(&mut classify),
-        blobs_ns_per_px: median(&mut blobs),
-        total_ns_per_px: median(&mut total),
-        total_ms_per_frame: median(&mut total_ms),
+        classify_ns_per_px: median(&classify),
+        blobs_ns_per_px: median(&blobs),
+        total_ns_per_px: median(&total),
+        total_ms_per_frame: median(&total_ms),
     };
     println!(
         "# eotn bench: {} frame(s), {} px/frame, lut b={}, conn={}, reps={}/frame, {} kernels",

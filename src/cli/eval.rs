@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use super::detect::load_params;
 use super::inputs::load_lut_arg;
+use super::pct;
 use crate::eval::skew::{self, SkewReport};
 use crate::eval::{
     EvalParams, EvalReport, FrameEval, evaluate_frame, fit_inverse_size,
@@ -446,10 +447,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         print_summary(&output);
     }
     Ok(())
-}
-
-fn pct(r: Option<f64>) -> String {
-    r.map_or_else(|| "—".to_owned(), |v| format!("{:.1}%", v * 100.0))
 }
 
 fn print_summary(o: &EvalOutput) {

@@ -9,6 +9,7 @@ use std::path::Path;
 use anyhow::{Context, bail};
 use serde::Serialize;
 
+use super::pct;
 use crate::eval::labels::{LabelledFrameEval, Labels, LabelsReport, evaluate_labelled_frame};
 use crate::eval::{EvalParams, Percentiles};
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -146,10 +147,6 @@ pub fn run(
         print_summary(&output);
     }
     Ok(())
-}
-
-fn pct(r: Option<f64>) -> String {
-    r.map_or_else(|| "—".to_owned(), |v| format!("{:.1}%", v * 100.0))
 }
 
 fn print_summary(o: &LabelsOutput) {

@@ -239,18 +239,10 @@ fn fill_from_previous(
     }
 }
 
-#[expect(
-    clippy::cast_precision_loss,
-    reason = "frame counts are far below 2^52"
-)]
 fn frame_seconds(i: usize, fps: f64) -> f64 {
     i as f64 / fps
 }
 
-#[expect(
-    clippy::cast_precision_loss,
-    reason = "intervals between frames are far below 2^52 ns"
-)]
 fn ns_to_seconds(ns: u64) -> f64 {
     ns as f64 / 1e9
 }

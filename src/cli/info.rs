@@ -102,10 +102,6 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
 }
 
 /// Seconds spanned by `span_ns` and frames per second for `n` frames over it.
-#[expect(
-    clippy::cast_precision_loss,
-    reason = "a duration in ns and a frame count are far below 2^52"
-)]
 fn duration_and_rate(span_ns: u64, n: usize) -> (f64, f64) {
     let secs = span_ns as f64 / 1e9;
     (secs, n.saturating_sub(1) as f64 / secs)

@@ -26,6 +26,11 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+/// A rate as a percentage with one decimal, or a dash when there was nothing to rate.
+pub(crate) fn pct(r: Option<f64>) -> String {
+    r.map_or_else(|| "—".to_owned(), |v| format!("{:.1}%", v * 100.0))
+}
+
 /// eotn — Eye Of The NUbot: see what your robots see.
 ///
 /// With no command, opens the desktop app (when built with the `gui` feature).

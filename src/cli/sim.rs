@@ -96,7 +96,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     writer.finish()?;
     bar.finish_and_clear();
-    #[expect(clippy::cast_precision_loss, reason = "frame counts are small")]
     let ms = 1000.0 * render_s / args.frames.max(1) as f64;
     eprintln!(
         "{}: {} frames of {}x{} ({}), {ms:.1} ms/frame to render",

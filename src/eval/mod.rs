@@ -451,28 +451,11 @@ impl EvalReport {
 }
 
 /// Fits distance = multiplier / height + offset to (height px, true distance cm) pairs by least
-/// squares in 1/height; `None` with fewer than two distinct heights.
+/// squares in 1/height ([`crate::stats::fit_inverse_size`]); `None` with fewer than two distinct
+/// heights.
 #[must_use]
 pub fn fit_inverse_size(samples: &[(f64, f64)]) -> Option<(f64, f64)> {
-    let pts: Vec<(f64, f64)> = samples
-        .iter()
-        .filter(|(h, d)| *h > 0.0 && h.is_finite() && d.is_finite())
-        .map(|(h, d)| (1.0 / h, *d))
-        .collect();
-    let n = pts.len() as f64;
-    if pts.len() < 2 {
-        return None;
-    }
-    let (mx, my) = pts
-        .iter()
-        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
-    let (sxx, sxy) = pts.iter().fold((0.0, 0.0), |(a, b), p| {
-        (a + (p.0 - mx).powi(2), b + (p.0 - mx) * (p.1 - my))
-    });
-    (sxx > 0.0).then(|| {
-        let m = sxy / sxx;
-        (m, my - m * mx)
-    })
+    crate::stats::fit_inverse_size(samples)
 }
 
 /// Fits only the multiplier of distance = multiplier / height + `offset` (the offset kept), by

@@ -181,15 +181,21 @@ impl EditRecord {
     /// A record stamped with the current time.
     #[must_use]
     pub fn now(class: ColourClass, region: Region) -> Self {
-        let time_unix_ms = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| u64::try_from(d.as_millis()).unwrap_or(u64::MAX));
         Self {
             class,
             region,
-            time_unix_ms,
+            time_unix_ms: now_unix_ms(),
         }
     }
+}
+
+/// Milliseconds since the Unix epoch, 0 if the clock is before it: the time stamp of edits and
+/// journal entries.
+#[must_use]
+pub fn now_unix_ms() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| u64::try_from(d.as_millis()).unwrap_or(u64::MAX))
 }
 
 /// An edit that was applied: the record and the old code of every cell it changed.

@@ -290,10 +290,6 @@ impl Accuracy {
     }
 }
 
-#[expect(
-    clippy::cast_precision_loss,
-    reason = "pixel counts are far below 2^52"
-)]
 fn ratio(a: u64, b: u64) -> f64 {
     if b == 0 { 0.0 } else { a as f64 / b as f64 }
 }

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::confidence::{Confidence, TestWeight};
+use super::confidence::{Confidence, TestName, TestWeight};
 use super::context::{Relative, ViewContext};
 use super::draw::Primitive;
 use super::fit::rotate_about;
@@ -130,22 +130,27 @@ pub fn recognise_beacons(blobs: &BlobSet, ctx: &ViewContext, p: &BeaconParams) -
                 };
                 let gap = ((bottom_y - bottom_h / 2.0) - (top_y + top_h / 2.0)) / ph.max(oh);
                 let mut confidence = Confidence::default();
-                confidence.range_test("width_ratio", pw / ow, p.width_ratio, p.width_ratio_weight);
                 confidence.range_test(
-                    "alignment",
+                    TestName::WidthRatio,
+                    pw / ow,
+                    p.width_ratio,
+                    p.width_ratio_weight,
+                );
+                confidence.range_test(
+                    TestName::Alignment,
                     (px - ox).abs() / pw.max(ow),
                     p.alignment,
                     p.alignment_weight,
                 );
-                confidence.range_test("gap", gap, p.gap, p.gap_weight);
+                confidence.range_test(TestName::Gap, gap, p.gap, p.gap_weight);
                 let all = pink.merged_with(other);
                 let cut_off = all.miny == 0 || all.maxy + 1 >= height;
                 let bw = f64::from(all.maxx - all.minx + 1);
                 let bh = f64::from(all.maxy - all.miny + 1);
                 if cut_off {
-                    confidence.skipped("aspect", p.aspect);
+                    confidence.skipped(TestName::Aspect, p.aspect);
                 } else {
-                    confidence.range_test("aspect", bh / bw, p.aspect, p.aspect_weight);
+                    confidence.range_test(TestName::Aspect, bh / bw, p.aspect, p.aspect_weight);
                 }
                 let distance = if cut_off {
                     ctx.camera.focal_px * p.diameter_cm / bw

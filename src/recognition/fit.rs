@@ -2,6 +2,7 @@
 //! ball, straight lines for goal posts, and the rotation about a centre that turns "parallel to
 //! the horizon" into "parallel to the image rows".
 
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// A point in image coordinates, pixels (x right, y down; pixel centres at +0.5).
@@ -71,24 +72,21 @@ pub fn fit_circle(points: &[Point]) -> Option<CircleFit> {
         / n;
     // Gauss–Newton on residuals d_i − r.
     for _ in 0..20 {
-        let mut jtj = [[0.0f64; 3]; 3];
-        let mut jtr = [0.0f64; 3];
+        let mut jtj = Matrix3::<f64>::zeros();
+        let mut jtr = Vector3::<f64>::zeros();
         for p in points {
             let (dx, dy) = (p.0 - cx, p.1 - cy);
             let d = (dx * dx + dy * dy).sqrt();
             if d < 1e-12 {
                 continue;
             }
-            let j = [-dx / d, -dy / d, -1.0];
-            let res = d - r;
-            for row in 0..3 {
-                jtr[row] += j[row] * res;
-                for col in 0..3 {
-                    jtj[row][col] += j[row] * j[col];
-                }
-            }
+            let j = Vector3::new(-dx / d, -dy / d, -1.0);
+            jtr += j * (d - r);
+            jtj += j * j.transpose();
         }
-        let Some(step) = solve3(jtj, jtr) else { break };
+        let Some(step) = solve3(&jtj, &jtr) else {
+            break;
+        };
         cx -= step[0];
         cy -= step[1];
         r -= step[2];
@@ -214,9 +212,9 @@ pub fn fit_sheared_circle(
             })
             .sum()
     };
-    let normal = |q: &[f64; 5]| -> ([[f64; 5]; 5], [f64; 5]) {
-        let mut jtj = [[0.0f64; 5]; 5];
-        let mut jtr = [0.0f64; 5];
+    let normal = |q: &[f64; 5]| -> (Matrix5, Vector5) {
+        let mut jtj = Matrix5::zeros();
+        let mut jtr = Vector5::zeros();
         for (p, s) in points.iter().zip(&s) {
             let (ux, uy) = (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1]);
             let d = (ux * ux + uy * uy).sqrt();
@@ -224,22 +222,16 @@ pub fn fit_sheared_circle(
                 continue;
             }
             let (nx, ny) = (ux / d, uy / d);
-            let j = [-nx, -ny, -1.0, -nx * s, -ny * s];
-            let res = d - q[2];
-            for row in 0..5 {
-                jtr[row] += j[row] * res;
-                for col in 0..5 {
-                    jtj[row][col] += j[row] * j[col];
-                }
-            }
+            let j = Vector5::from([-nx, -ny, -1.0, -nx * s, -ny * s]);
+            jtr += j * (d - q[2]);
+            jtj += j * j.transpose();
         }
         if !vertical_shear {
             // Hold the vertical shear: its equation becomes "step = 0".
-            jtj[4] = [0.0; 5];
-            for row in &mut jtj {
-                row[4] = 0.0;
-            }
-            jtj[4][4] = jtj[2][2].max(1.0);
+            let keep = jtj[(2, 2)].max(1.0);
+            jtj.row_mut(4).fill(0.0);
+            jtj.column_mut(4).fill(0.0);
+            jtj[(4, 4)] = keep;
             jtr[4] = 0.0;
         }
         (jtj, jtr)
@@ -249,15 +241,15 @@ pub fn fit_sheared_circle(
     for _ in 0..60 {
         let (jtj, jtr) = normal(&q);
         let mut damped = jtj;
-        for (k, row) in damped.iter_mut().enumerate() {
-            row[k] += lambda * jtj[k][k].max(1e-9);
+        for k in 0..5 {
+            damped[(k, k)] += lambda * jtj[(k, k)].max(1e-9);
         }
-        let Some(step) = solve_n(damped, jtr) else {
+        let Some(step) = solve5(damped, &jtr) else {
             break;
         };
         let mut next = q;
-        for (v, d) in next.iter_mut().zip(step) {
-            *v -= d;
+        for (v, d) in next.iter_mut().zip(step.iter()) {
+            *v -= *d;
         }
         let c = cost(&next);
         if c.is_finite() && c <= current {
@@ -284,11 +276,8 @@ pub fn fit_sheared_circle(
     let sigma2 = current / dof;
     // Standard errors from the diagonal of (JᵀJ)⁻¹ σ²; a singular matrix (shear undetermined)
     // gives infinite errors.
-    let inv_diag = |k: usize| {
-        let mut e = [0.0; 5];
-        e[k] = 1.0;
-        solve_n(jtj, e).map_or(f64::INFINITY, |x| x[k].abs())
-    };
+    let inv_diag =
+        |k: usize| solve5(jtj, &Vector5::ith(k, 1.0)).map_or(f64::INFINITY, |x| x[k].abs());
     let var = points
         .iter()
         .zip(&s)
@@ -317,60 +306,31 @@ pub fn fit_sheared_circle(
     })
 }
 
-/// Solves a 5×5 system by Gaussian elimination with partial pivoting; `None` when singular
-/// (relative to the matrix's scale) or not finite.
-fn solve_n(mut m: [[f64; 5]; 5], mut b: [f64; 5]) -> Option<[f64; 5]> {
-    let scale = m
-        .iter()
-        .flat_map(|r| r.iter())
-        .fold(0.0f64, |a, v| a.max(v.abs()));
+type Matrix5 = SMatrix<f64, 5, 5>;
+type Vector5 = SVector<f64, 5>;
+
+/// Solves a 5×5 system by LU decomposition with partial pivoting; `None` when a pivot is
+/// negligible against the matrix's largest entry (singular: a shear the points do not
+/// determine) or the input or result is not finite.
+fn solve5(m: Matrix5, b: &Vector5) -> Option<Vector5> {
+    let scale = m.amax();
     if !(scale.is_finite() && scale > 0.0) {
         return None;
     }
-    for col in 0..5 {
-        let pivot = (col..5).max_by(|&i, &j| m[i][col].abs().total_cmp(&m[j][col].abs()))?;
-        if m[pivot][col].abs() <= 1e-13 * scale {
-            return None;
-        }
-        m.swap(col, pivot);
-        b.swap(col, pivot);
-        for row in col + 1..5 {
-            let f = m[row][col] / m[col][col];
-            let pivot_row = m[col];
-            for (a, p) in m[row].iter_mut().zip(pivot_row).skip(col) {
-                *a -= f * p;
-            }
-            b[row] -= f * b[col];
-        }
+    let lu = m.lu();
+    if lu.u().diagonal().amin() <= 1e-13 * scale {
+        return None;
     }
-    let mut x = [0.0; 5];
-    for row in (0..5).rev() {
-        let tail: f64 = (row + 1..5).map(|k| m[row][k] * x[k]).sum();
-        x[row] = (b[row] - tail) / m[row][row];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    lu.solve(b).filter(|x| x.iter().all(|v| v.is_finite()))
 }
 
-/// Solves a 3×3 system by Cramer's rule; `None` when singular.
-fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
-    let det3 = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det3(&m);
+/// Solves a 3×3 system; `None` when its determinant is negligible (collinear points).
+fn solve3(m: &Matrix3<f64>, b: &Vector3<f64>) -> Option<Vector3<f64>> {
+    let d = m.determinant();
     if !d.is_finite() || d.abs() < 1e-12 {
         return None;
     }
-    let mut out = [0.0; 3];
-    for (col, slot) in out.iter_mut().enumerate() {
-        let mut mc = m;
-        for row in 0..3 {
-            mc[row][col] = b[row];
-        }
-        *slot = det3(&mc) / d;
-    }
-    Some(out)
+    m.lu().solve(b)
 }
 
 /// A fitted straight line, pixels. Stored as `x = slope·y + intercept` when `steep` (near

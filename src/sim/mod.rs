@@ -122,10 +122,6 @@ impl Simulator {
     /// # Errors
     /// [`SimError`] if the scenario is inconsistent; never for valid scenarios.
     pub fn frame(&self, index: u64) -> Result<SimFrame, SimError> {
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "frame counts are far below 2^52"
-        )]
         let t = index as f64 * FRAME_INTERVAL_S;
         #[expect(
             clippy::cast_possible_truncation,
@@ -171,7 +167,6 @@ impl Simulator {
                     body.field_from_body(&robot) * dims.body_from_camera(&joints);
                 let height = self.head_camera.height_px;
                 let readout = self.effects.readout_s;
-                #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
                 let row_pose = |row: usize| {
                     let tr = t + ((row as f64 + 0.5) / height as f64 - 0.5) * readout;
                     match self.scenario.observer_at(tr) {
@@ -184,7 +179,6 @@ impl Simulator {
                 let skip =
                     render::object_id::ROBOT + u16::try_from(observer_id).unwrap_or(0).min(899);
                 let moves = self.scenario.ball_moves_during_readout() && readout > 0.0;
-                #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
                 let ball_at_row = |row: usize| {
                     if !moves {
                         return None;

@@ -426,7 +426,6 @@ fn object(id: u16, parts: Vec<Part>) -> Object {
         })
         .collect();
     let n = extents.len().max(1);
-    #[expect(clippy::cast_precision_loss, reason = "a handful of parts")]
     let centre = extents.iter().map(|e| e.0).sum::<Vector3<f64>>() / n as f64;
     let radius = extents
         .iter()
@@ -813,7 +812,6 @@ impl Renderer {
         let mut data = Vec::with_capacity(w * h * 2);
         let mut labels = Vec::with_capacity(w * h);
         let mut objects = Vec::with_capacity(w * h);
-        #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
         let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
         let corner2 = cx * cx + cy * cy;
         let mut row_yuv = vec![[0.0_f64; 3]; w];
@@ -836,7 +834,6 @@ impl Renderer {
                 let mut y = 16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0;
                 let mut u = 128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0;
                 let v = 128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0;
-                #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
                 let (dx, dy) = (i as f64 + 0.5 - cx, j as f64 + 0.5 - cy);
                 let rr = (dx * dx + dy * dy) / corner2;
                 y = 16.0 + (y - 16.0) * (1.0 - effects.vignetting * rr);
@@ -972,7 +969,6 @@ mod tests {
             render(&|_| Some(Vector3::new(60.0, 0.0, 4.25))).objects
         );
         // The ball rolls to the right (−y) by 0.1 cm per row read.
-        #[expect(clippy::cast_precision_loss, reason = "row numbers are small")]
         let moving = render(&|row| Some(Vector3::new(60.0, -0.1 * (row as f64 - 80.0), 4.25)));
         let (a, b) = (left_edges(&still.objects), left_edges(&moving.objects));
         let (top_a, bottom_a) = (a[0].1, a[a.len() - 1].1);

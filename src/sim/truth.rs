@@ -546,7 +546,6 @@ pub fn robot_view_truth(
 /// Fraction of a disc inside the image (sampled on a 41×41 grid), the borders it crosses, and
 /// its area in pixels.
 fn disc_in_image(c: ImagePoint, r: f64, w: usize, h: usize) -> (f64, CutOff, f64) {
-    #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
     let (wf, hf) = (w as f64, h as f64);
     let mut inside = 0_u32;
     let mut total = 0_u32;
@@ -615,7 +614,6 @@ fn open_gaps(
         let (dx, dy) = (x - c.x_px, y - c.y_px);
         (c.x_px + cos * dx + sin * dy, c.y_px - sin * dx + cos * dy)
     };
-    #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
     let corners = [
         level(b.min_x as f64, b.min_y as f64),
         level((b.max_x + 1) as f64, b.min_y as f64),
@@ -637,7 +635,6 @@ fn open_gaps(
         .map(|p| p.1)
         .fold(f64::NEG_INFINITY, f64::max);
     let row = level(at.x_px, at.y_px).1;
-    #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
     let (wf, hf) = (w as f64, h as f64);
     let inside = |q: (f64, f64)| q.0 >= 0.0 && q.1 >= 0.0 && q.0 < wf && q.1 < hf;
     // Per sample: the image point and whether it shows the goal.
@@ -670,7 +667,6 @@ fn open_gaps(
                 reason = "inside the image"
             )]
             let (s, e) = (first.0 as usize, (last.0 as usize).max(first.0 as usize));
-            #[expect(clippy::cast_precision_loss, reason = "image sides are small")]
             let (left, right) = (
                 pose.camera.bearing_rad(ImagePoint::new(s as f64, first.1)),
                 pose.camera
@@ -731,7 +727,6 @@ pub fn overhead_truth(
 
 /// The share of an object's full image area (pixels²) that its visible pixels cover, 0 to 1
 /// (0 when the area is empty).
-#[expect(clippy::cast_precision_loss, reason = "pixel counts are small")]
 fn covered_fraction(pixels: usize, area: f64) -> f64 {
     if area > 0.0 {
         (pixels as f64 / area).min(1.0)

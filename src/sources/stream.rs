@@ -96,10 +96,6 @@ impl FrameSource for StreamSource {
     fn settings(&self) -> SourceSettings {
         let n = self.reader.len();
         let span_ns = self.time_ns(n.saturating_sub(1));
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "frame counts and spans are small"
-        )]
         let frame_rate = (n > 1 && span_ns > 0).then(|| (n - 1) as f64 * 1e9 / span_ns as f64);
         SourceSettings {
             frame_rate,

@@ -45,13 +45,7 @@ pub enum JournalEntry {
     },
 }
 
-/// Milliseconds since the Unix epoch, 0 if the clock is before it.
-#[must_use]
-pub fn now_unix_ms() -> u64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| u64::try_from(d.as_millis()).unwrap_or(u64::MAX))
-}
+pub use crate::lut::edit::now_unix_ms;
 
 /// The journal file of a table: the table's file name with `.journal.jsonl` appended.
 #[must_use]

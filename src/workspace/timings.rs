@@ -64,10 +64,5 @@ pub(crate) fn push_capped(v: &mut Vec<f64>, x: f64) {
 /// Median of a list of samples (0 for none).
 #[must_use]
 pub fn median(samples: &[f64]) -> f64 {
-    if samples.is_empty() {
-        return 0.0;
-    }
-    let mut s = samples.to_vec();
-    s.sort_by(f64::total_cmp);
-    s[s.len() / 2]
+    crate::stats::median(samples).unwrap_or(0.0)
 }

@@ -8,7 +8,6 @@ mod app;
 mod app_camera;
 mod cli;
 mod common;
-mod goal_posts;
 mod motion;
 mod patterns;
 mod peer;

@@ -411,11 +411,13 @@ fn skew_report(
                 x.radius_px,
                 cx.pattern,
                 x.from_circle_fit,
-                cx.fit_rejected.as_deref().unwrap_or("-"),
+                cx.fit_rejected
+                    .map_or_else(|| "-".to_owned(), |r| r.to_string()),
                 y.radius_px,
                 cy.pattern,
                 y.from_circle_fit,
-                cy.fit_rejected.as_deref().unwrap_or("-"),
+                cy.fit_rejected
+                    .map_or_else(|| "-".to_owned(), |r| r.to_string()),
                 s.radius_error_with_px,
                 s.radius_error_without_px,
             );

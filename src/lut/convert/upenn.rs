@@ -69,7 +69,6 @@ fn ball_class(cells: &[u8]) -> (ColourClass, Option<f64>) {
     if n == 0 {
         return (ColourClass::Orange, None);
     }
-    #[allow(clippy::cast_precision_loss, reason = "cell counts are far below 2^52")]
     let mean_cr = sum as f64 / n as f64;
     let class = if mean_cr > 150.0 {
         ColourClass::Orange

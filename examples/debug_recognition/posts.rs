@@ -2,6 +2,7 @@
 //! the posts' corners as the rolling shutter imaged them (each row with its own camera pose)
 //! and as the reference instant sees them.
 
+use crate::debug_setup;
 use eotn::geometry::{CameraPose, Ers7Dimensions, Point};
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::sim::truth::GroundTruth;
@@ -34,37 +35,12 @@ fn rolling_image(
     Some((x, y))
 }
 
-/// The debugging aids' table, seed and frame count: the learnt table, seed 7 and 90 frames
-/// unless `EOTN_DEBUG_LUT` (a table file), `EOTN_DEBUG_SEED` or `EOTN_DEBUG_NFRAMES` say
-/// otherwise.
-pub(crate) fn debug_setup() -> (eotn::lut::LookupTable, u64, u64) {
-    let lut = std::env::var("EOTN_DEBUG_LUT")
-        .ok()
-        .filter(|p| !p.is_empty())
-        .map_or_else(super::recognition::learnt_table, |path| {
-            eotn::lut::LookupTable::load(std::path::Path::new(&path)).expect("table")
-        });
-    let number = |name: &str, default: u64| {
-        std::env::var(name)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(default)
-    };
-    (
-        lut,
-        number("EOTN_DEBUG_SEED", 7),
-        number("EOTN_DEBUG_NFRAMES", 90),
-    )
-}
-
 /// Per-post detail for one scenario: `EOTN_DEBUG_SCENARIO=walk-and-pan cargo test --test it
 /// debug_posts -- --ignored --nocapture`. For each detected post: signed error (detected − true,
 /// pixels, at mid-height) of the raw line against the rolling-shutter image of the post's front
 /// centre, front outer corner and back outer corner, and of the reference line against the
 /// reference-instant projection of the front centre (what `eotn eval` scores).
-#[test]
-#[ignore = "a debugging aid, not a check"]
-fn debug_posts() {
+pub fn debug_posts() {
     let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "walk-and-pan".into());
     let kind = ScenarioKind::from_name(&name).expect("scenario name");
     let (lut, seed, frames) = debug_setup();
@@ -221,9 +197,7 @@ fn debug_posts() {
 /// picks frames). One character per level pixel (`Y` goal colour, `g` green, `w` white, `.`
 /// other); below each picture the level x of the true front-post centre and back outer corner
 /// (rolling-shutter image at the goal's mid-height) and of the detected post.
-#[test]
-#[ignore = "a debugging aid, not a check"]
-fn debug_post_profiles() {
+pub fn debug_post_profiles() {
     use eotn::lut::ColourClass;
     use eotn::recognition::fit::rotate_about;
     let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "beacon-tour".into());

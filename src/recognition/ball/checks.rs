@@ -1,0 +1,242 @@
+//! The confidence tests of one ball candidate (colour, fill, shape, height, green below).
+
+use super::circle::{CircleStage, FitRejection};
+use super::outline::Outline;
+use super::{BallParams, is_ball_colour};
+use crate::blobs::Blob;
+use crate::classify::ClassifiedImage;
+use crate::lut::ColourClass;
+use crate::recognition::confidence::{Confidence, TestName, TestWeight};
+use crate::recognition::context::ViewContext;
+use crate::recognition::fit::Point;
+use crate::recognition::scan::{ScanArea, scan_rotated_rect};
+
+/// What the earlier stages measured of one candidate.
+pub(super) struct Measured<'a> {
+    /// The joined blobs.
+    pub group: &'a Blob,
+    /// Pixels of basic orange in them.
+    pub orange_pixels: u32,
+    /// The outline stage's result.
+    pub outline: &'a Outline,
+    /// The fit stage's result.
+    pub circle: &'a CircleStage,
+    /// Centre at the reference read-out time, pixels.
+    pub center: Point,
+    /// Centre where the image shows the ball, pixels.
+    pub observed_center: Point,
+    /// Radius, pixels.
+    pub radius: f64,
+    /// Camera distance, centimetres.
+    pub distance: f64,
+}
+
+/// Every test of one candidate, in order, and the colour-below scan area.
+pub(super) fn score(
+    img: &ClassifiedImage,
+    ctx: &ViewContext,
+    m: &Measured<'_>,
+    params: &BallParams,
+) -> (Confidence, ScanArea) {
+    let mut confidence = Confidence::default();
+    colour_tests(&mut confidence, img, m, params);
+    shape_tests(&mut confidence, m, params);
+    let below = place_tests(&mut confidence, img, ctx, m, params);
+    (confidence, below)
+}
+
+/// Orange share, circle fill, unclassified pixels around.
+fn colour_tests(
+    confidence: &mut Confidence,
+    img: &ClassifiedImage,
+    m: &Measured<'_>,
+    params: &BallParams,
+) {
+    confidence.range_test(
+        TestName::OrangeFraction,
+        f64::from(m.orange_pixels) / f64::from(m.group.pixels.max(1)),
+        params.orange_fraction,
+        params.orange_fraction_weight,
+    );
+    match circle_fill(img, m.observed_center, m.radius) {
+        Some(fill) => confidence.range_test(
+            TestName::CircleFill,
+            fill,
+            params.circle_fill,
+            params.circle_fill_weight,
+        ),
+        None => confidence.skipped(TestName::CircleFill, params.circle_fill),
+    }
+    if let Some(share) = unclassified_around(img, m.group) {
+        confidence.range_test(
+            TestName::UnclassifiedAround,
+            share,
+            params.unclassified_around,
+            params.unclassified_around_weight,
+        );
+    }
+}
+
+/// Cut extent, the circle fit's residual and points, pixel ratio and roundness.
+fn shape_tests(confidence: &mut Confidence, m: &Measured<'_>, params: &BallParams) {
+    let (w, h, cut) = (m.outline.width, m.outline.height, m.outline.cut);
+    let horizontal_cut = cut.left || cut.right;
+    let vertical_cut = cut.top || cut.bottom;
+    if horizontal_cut != vertical_cut {
+        let slack = params.extent_slack_px;
+        let ratio = if horizontal_cut {
+            w / (h + slack)
+        } else {
+            h / (w + slack)
+        };
+        confidence.range_test(
+            TestName::CutExtent,
+            ratio,
+            [0.0, params.max_cut_extent_ratio],
+            params.cut_extent_weight,
+        );
+    }
+    let fit = m.circle.fit.as_ref();
+    if let (Some(f), Some(FitRejection::ResidualTooLarge { .. })) = (fit, m.circle.rejection) {
+        confidence.range_test(
+            TestName::CircleResidualPx,
+            f.residual_sd,
+            [0.0, params.max_fit_residual_ratio * f.radius + 0.75],
+            TestWeight::new(0.0, params.bad_circle_penalty),
+        );
+    }
+    if let Some(f) = fit
+        && m.circle.used()
+        && f.radius >= params.circle_fit_min_radius_px
+    {
+        confidence.bonus_test(
+            TestName::CircleFitPoints,
+            f.points as f64,
+            [params.circle_fit_min_points as f64, f64::INFINITY],
+            params.circle_fit_bonus,
+        );
+    }
+    if fit.is_none() && m.outline.points.len() >= 5 {
+        // Enough outline points, but on a line: a straight edge.
+        confidence.range_test(
+            TestName::CircleFit,
+            0.0,
+            [1.0, 1.0],
+            TestWeight::new(0.0, params.bad_circle_penalty),
+        );
+    }
+    if cut.any() {
+        confidence.skipped(TestName::PixelRatio, params.pixel_ratio);
+        confidence.skipped(TestName::Roundness, params.aspect);
+    } else {
+        confidence.range_test(
+            TestName::PixelRatio,
+            f64::from(m.group.pixels) / (w * h),
+            params.pixel_ratio,
+            params.pixel_ratio_weight,
+        );
+        confidence.range_test(
+            TestName::Roundness,
+            w / h,
+            params.aspect,
+            params.aspect_weight,
+        );
+    }
+}
+
+/// Height above the ground and green below; returns the colour-below scan area.
+fn place_tests(
+    confidence: &mut Confidence,
+    img: &ClassifiedImage,
+    ctx: &ViewContext,
+    m: &Measured<'_>,
+    params: &BallParams,
+) -> ScanArea {
+    let (center, radius) = (m.center, m.radius);
+    // The pose's angular error turns into a height error that grows with distance.
+    let slack = m.distance * params.height_pose_slack_rad.tan();
+    let height_range = if slack.is_finite() && slack > 0.0 {
+        [params.height_cm[0] - slack, params.height_cm[1] + slack]
+    } else {
+        params.height_cm
+    };
+    match ctx.height_above_ground(center, m.distance) {
+        Some(z) => confidence.range_test(TestName::HeightCm, z, height_range, params.height_weight),
+        None => confidence.skipped(TestName::HeightCm, height_range),
+    }
+    // Colour below: an area under the ball, parallel to the horizon, where the ball is in
+    // the image (the centre before skew removal).
+    let shift = m.outline.box_shift;
+    let below_scan = scan_rotated_rect(
+        img,
+        (center.0 - shift.0, center.1 - shift.1),
+        [
+            -radius,
+            radius,
+            radius + 1.0,
+            radius + 1.0 + (radius * 0.8).max(2.0),
+        ],
+        -ctx.horizon_angle(),
+        (radius / 6.0).max(1.0),
+    );
+    match below_scan.ratio(|c| c == ColourClass::Green.code()) {
+        Some(green) => confidence.bonus_test(
+            TestName::GreenBelow,
+            green,
+            params.green_below,
+            params.green_below_bonus,
+        ),
+        None => confidence.skipped(TestName::GreenBelow, params.green_below),
+    }
+    below_scan.area
+}
+
+/// Share of unclassified pixels on the ring one pixel outside the box (pixels inside the image
+/// only); `None` when the ring lies wholly outside.
+fn unclassified_around(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
+    let (minx, miny) = (i64::from(b.minx) - 1, i64::from(b.miny) - 1);
+    let (maxx, maxy) = (i64::from(b.maxx) + 1, i64::from(b.maxy) + 1);
+    let ring = (minx..=maxx)
+        .flat_map(|x| [(x, miny), (x, maxy)])
+        .chain((miny + 1..maxy).flat_map(|y| [(minx, y), (maxx, y)]));
+    let (mut n, mut none) = (0u32, 0u32);
+    for (x, y) in ring {
+        if let Some(c) = img.get_signed(x, y) {
+            n += 1;
+            none += u32::from(c == ColourClass::Unclassified.code());
+        }
+    }
+    (n > 0).then(|| f64::from(none) / f64::from(n))
+}
+
+/// Share of ball colours among the image pixels whose centres lie inside the circle (`center`,
+/// `radius` px), sampled every pixel up to a 24-pixel diameter and on a 24 × 24 grid over
+/// larger circles (a close ball or a robot's arm fills tens of thousands of pixels; the share
+/// needs a few hundred); `None` when no sample of the image lies inside.
+pub(super) fn circle_fill(img: &ClassifiedImage, center: Point, radius: f64) -> Option<f64> {
+    if !(center.0.is_finite() && center.1.is_finite() && radius.is_finite() && radius > 0.0) {
+        return None;
+    }
+    let step = (2.0 * radius / 24.0).max(1.0);
+    let (w, h) = (img.width() as f64, img.height() as f64);
+    let (mut n, mut ball) = (0u32, 0u32);
+    let mut y = (center.1 - radius).floor() + 0.5;
+    while y <= center.1 + radius {
+        let mut x = (center.0 - radius).floor() + 0.5;
+        while x <= center.0 + radius {
+            if x >= 0.0
+                && y >= 0.0
+                && x < w
+                && y < h
+                && (x - center.0).powi(2) + (y - center.1).powi(2) <= radius * radius
+                && let Some(c) = img.get_at(x, y)
+            {
+                n += 1;
+                ball += u32::from(is_ball_colour(c));
+            }
+            x += step;
+        }
+        y += step;
+    }
+    (n > 0).then(|| f64::from(ball) / f64::from(n))
+}

@@ -1,0 +1,345 @@
+//! Ball recognition on small synthetic scenes.
+
+use super::checks::circle_fill;
+use super::*;
+use crate::blobs::Connectivity;
+use crate::geometry::{Ers7Dimensions, PinholeCamera, Point as GeoPoint};
+use crate::recognition::confidence::TestName;
+use crate::sensors::SensorReadings;
+
+fn level_context() -> ViewContext {
+    let readings = SensorReadings {
+        head_pan_rad: Some(0.0),
+        head_tilt_rad: Some(-0.2),
+        neck_tilt_rad: Some(0.0),
+        ..SensorReadings::default()
+    };
+    ViewContext::from_sensors(PinholeCamera::ers7(), &readings, &Ers7Dimensions::ERS7)
+}
+
+/// Green field with an orange disc; `shear` shifts row y by shear·(y − cy) pixels.
+fn scene(cx: f64, cy: f64, r: f64, shear: f64) -> ClassifiedImage {
+    let (w, h) = (208usize, 160usize);
+    let mut codes = vec![ColourClass::Green.code(); w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let yc = y as f64 + 0.5;
+            let dx = x as f64 + 0.5 - cx - shear * (yc - cy);
+            let dy = yc - cy;
+            if dx * dx + dy * dy <= r * r {
+                codes[y * w + x] = ColourClass::Orange.code();
+            }
+        }
+    }
+    ClassifiedImage::from_codes(w, h, codes).expect("size")
+}
+
+fn true_ball(ctx: &ViewContext, x: f64, y: f64) -> (Point, f64, f64) {
+    let pose = ctx.pose.expect("pose");
+    let centre = GeoPoint::new(x, y, 4.25);
+    let p = pose.image_from_field(&centre).expect("in front");
+    let cam = pose.position();
+    let dist = cam.distance_to(&centre);
+    ((p.x_px, p.y_px), ctx.camera.focal_px * 4.25 / dist, dist)
+}
+
+#[test]
+fn finds_a_ball_on_the_field_with_distance_from_the_circle() {
+    let ctx = level_context();
+    let (c, r, dist) = true_ball(&ctx, 90.0, 10.0);
+    let img = scene(c.0, c.1, r, 0.0);
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let ball = res.ball.clone().expect("ball");
+    assert!(ball.from_circle_fit);
+    assert!((ball.center_x - c.0).abs() < 0.6 && (ball.center_y - c.1).abs() < 0.6);
+    let err = (ball.camera.distance_cm - dist).abs() / dist;
+    assert!(err < 0.05, "distance {} vs {dist}", ball.camera.distance_cm);
+    assert!(ball.body.is_some());
+    let cand = &res.candidates[ball.candidate];
+    assert!(
+        cand.confidence
+            .test(TestName::HeightCm)
+            .is_some_and(|t| t.effect > 0.0)
+    );
+    assert!(
+        cand.confidence
+            .test(TestName::GreenBelow)
+            .is_some_and(|t| t.effect > 0.0)
+    );
+    assert!(!res.primitives().is_empty());
+}
+
+#[test]
+fn an_orange_thing_far_above_the_ground_is_not_a_ball() {
+    let ctx = level_context();
+    let img = scene(60.0, 12.0, 6.0, 0.0);
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    assert!(res.ball.is_none(), "{:?}", res.candidates[0].confidence);
+    let height = res.candidates[0]
+        .confidence
+        .test(TestName::HeightCm)
+        .expect("height test");
+    assert!(height.value > 20.0 && height.effect < 0.0);
+}
+
+#[test]
+fn a_ball_cut_by_the_image_edge_keeps_its_distance() {
+    let ctx = level_context();
+    let pose = ctx.pose.expect("pose");
+    // A ball on the field placed so that about a third of it is outside the left edge.
+    let (_, r0, _) = true_ball(&ctx, 45.0, 0.0);
+    let y = (0..400)
+        .map(|i| f64::from(i) * 0.1)
+        .min_by(|a, b| {
+            let off = |y: f64| (true_ball(&ctx, 45.0, y).0.0 - 0.4 * r0).abs();
+            off(*a).total_cmp(&off(*b))
+        })
+        .expect("positions");
+    let (c, _, dist) = true_ball(&ctx, 45.0, y);
+    // Rendered as a sphere, not a circle: a pixel shows the ball when its ray is within the
+    // ball's angular radius of the centre's direction (off the optical axis the outline is
+    // an ellipse, wider than a circle of the on-axis radius).
+    let towards = ctx
+        .camera
+        .unit_ray(
+            pose.image_from_field(&GeoPoint::new(45.0, y, 4.25))
+                .expect("in front"),
+        )
+        .coords;
+    let cos_alpha = (4.25 / dist).asin().cos();
+    let (w, h) = (208usize, 160usize);
+    let codes = (0..w * h)
+        .map(|i| {
+            let ray = ctx
+                .camera
+                .unit_ray(crate::geometry::ImagePoint::pixel_centre(i % w, i / w));
+            if ray.coords.dot(&towards) >= cos_alpha {
+                ColourClass::Orange.code()
+            } else {
+                ColourClass::Green.code()
+            }
+        })
+        .collect();
+    let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let ball = res.ball.expect("ball");
+    assert!(ball.cut_off.left && !ball.cut_off.right);
+    assert!(ball.from_circle_fit);
+    // The visible arc is the flatter inner side of the ellipse: the circle through it sits
+    // a little inwards.
+    assert!(
+        (ball.center_x - c.0).abs() < 3.0,
+        "{} vs {}",
+        ball.center_x,
+        c.0
+    );
+    let err = (ball.camera.distance_cm - dist) / dist;
+    assert!(
+        err.abs() < 0.04,
+        "distance {} vs {dist}",
+        ball.camera.distance_cm
+    );
+    // The original's d × 8.5 / diameter reads the stretched outline much too close.
+    let naive = ctx.camera.focal_px * 8.5 / (2.0 * ball.radius_px);
+    assert!(naive < 0.95 * dist, "naive {naive} vs {dist}");
+}
+
+#[test]
+fn distance_from_the_subtended_angle_holds_across_the_image() {
+    let camera = PinholeCamera::ers7();
+    // A sphere 100 cm away at the centre and 25° off the axis: its outline's mean
+    // semi-axis (see `distance_from_circle`) gives the distance back within 0.5%.
+    for theta_deg in [0.0_f64, 15.0, 25.0] {
+        let (t, alpha) = (theta_deg.to_radians(), (4.25_f64 / 100.0).asin());
+        let f = camera.focal_px;
+        let a = f / 2.0 * ((t + alpha).tan() - (t - alpha).tan());
+        let b = f * alpha.sin() / (t.cos().powi(2) - alpha.sin().powi(2)).sqrt();
+        let centre_x = camera.centre.x_px + f / 2.0 * ((t + alpha).tan() + (t - alpha).tan());
+        let d = distance_from_circle(&camera, (centre_x, camera.centre.y_px), (a + b) / 2.0, 8.5);
+        assert!((d - 100.0).abs() < 0.5, "{theta_deg}°: {d}");
+    }
+}
+
+#[test]
+fn skew_correction_restores_the_radius_of_a_sheared_ball() {
+    let mut ctx = level_context();
+    let (c, r, _) = true_ball(&ctx, 70.0, 0.0);
+    let shear = 0.6;
+    let img = scene(c.0, c.1, r, shear);
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let plain = recognise_ball(
+        &img,
+        &blobs,
+        &ctx,
+        &BallParams {
+            skew_correction: false,
+            ..BallParams::default()
+        },
+    );
+    // The pan during one read-out that shifts rows near the image centre by `shear` px each.
+    ctx.pan_per_readout_rad = shear * ctx.camera.height_px as f64 / ctx.camera.focal_px;
+    let fixed = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let e_plain = (plain.ball.expect("plain").radius_px - r).abs();
+    let e_fixed = (fixed.ball.expect("fixed").radius_px - r).abs();
+    assert!(e_fixed * 2.0 < e_plain, "fixed {e_fixed} plain {e_plain}");
+}
+
+#[test]
+fn ellipse_fit_gives_the_image_velocity_of_a_moving_ball() {
+    let ctx = level_context();
+    let (c, r, _) = true_ball(&ctx, 45.0, 0.0);
+    // Moving right 0.25 px per line (1200 px/s at 160 lines in 1/30 s), centred on the
+    // reference row.
+    let img = scene(c.0, 80.0, r, 0.25);
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let plain = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let plain = plain.ball.expect("plain");
+    assert!(plain.image_velocity_px_s.is_none() && plain.ground_velocity_cm_s.is_none());
+    let params = BallParams {
+        ellipse_fit: true,
+        ..BallParams::default()
+    };
+    let res = recognise_ball(&img, &blobs, &ctx, &params);
+    let ball = res.ball.clone().expect("ball");
+    let v = ball.image_velocity_px_s.expect("velocity");
+    assert!((v[0] - 1200.0).abs() < 120.0 && v[1] == 0.0, "{v:?}");
+    assert!(res.candidates[ball.candidate].ellipse.is_some());
+    // Moving right in the image, straight ahead: to the robot's right on the ground.
+    let g = ball.ground_velocity_cm_s.expect("ground velocity");
+    assert!(g[1] < 0.0 && g[1].abs() > 3.0 * g[0].abs(), "{g:?}");
+    assert!((ball.radius_px - r).abs() <= (plain.radius_px - r).abs() + 0.2);
+}
+
+#[test]
+fn soft_orange_joins_and_a_frame_without_orange_has_no_candidates() {
+    let ctx = level_context();
+    let (c, r, _) = true_ball(&ctx, 80.0, 0.0);
+    let mut img = scene(c.0, c.1, r, 0.0);
+    // Paint the lower half of the ball red-orange (shadow).
+    let w = img.width();
+    let codes = img.codes_mut();
+    for (i, code) in codes.iter_mut().enumerate() {
+        if *code == ColourClass::Orange.code() && (i / w) as f64 > c.1 {
+            *code = ColourClass::RedOrange.code();
+        }
+    }
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let ball = res.ball.expect("ball");
+    assert!((ball.radius_px - r).abs() < 1.0);
+    let green = scene(0.0, 0.0, 0.0, 0.0);
+    let none = recognise_ball(
+        &green,
+        &BlobSet::from_image(&green, Connectivity::Eight),
+        &ctx,
+        &BallParams::default(),
+    );
+    assert!(none.ball.is_none() && none.candidates.is_empty());
+}
+
+/// A 320×240 green frame (no pose) with an orange disc, white wherever `white(x, y)`.
+fn big_scene(cx: f64, cy: f64, r: f64, white: impl Fn(f64, f64) -> bool) -> ClassifiedImage {
+    let (w, h) = (320usize, 240usize);
+    let codes = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+            if (x - cx).hypot(y - cy) <= r {
+                ColourClass::Orange.code()
+            } else if white(x, y) {
+                ColourClass::White.code()
+            } else {
+                ColourClass::Green.code()
+            }
+        })
+        .collect();
+    ClassifiedImage::from_codes(w, h, codes).expect("size")
+}
+
+#[test]
+fn a_large_ball_on_a_white_line_is_round_not_hidden() {
+    let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+        320,
+        240,
+        45.0_f64.to_radians(),
+    ));
+    // A 40-px ball lying on a thick white line that runs behind it, with its white stand
+    // below: white borders most of its left, right and bottom sides, but it is round there.
+    let img = big_scene(160.0, 120.0, 40.0, |x, y| {
+        (95.0..150.0).contains(&y) || ((110.0..210.0).contains(&x) && y > 150.0)
+    });
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let ball = res.ball.expect("ball");
+    assert!(!ball.cut_off.any(), "{:?}", ball.cut_off);
+    assert!(ball.from_circle_fit);
+    assert!((ball.radius_px - 40.0).abs() < 1.0, "{}", ball.radius_px);
+    // The same ball behind a white robot leg whose straight edge cuts off its right third:
+    // a long chord, hidden.
+    let img = big_scene(160.0, 120.0, 40.0, |x, _| x > 187.0);
+    let mut codes = img.codes().to_vec();
+    for (i, c) in codes.iter_mut().enumerate() {
+        if (i % 320) as f64 + 0.5 > 187.0 {
+            *c = ColourClass::White.code();
+        }
+    }
+    let img = ClassifiedImage::from_codes(320, 240, codes).expect("size");
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let ball = res.ball.expect("ball");
+    assert!(
+        ball.cut_off.right && !ball.cut_off.left,
+        "{:?}",
+        ball.cut_off
+    );
+    assert!((ball.radius_px - 40.0).abs() < 1.5, "{}", ball.radius_px);
+    // Taking every bordered side as hidden (the old rule) cuts the ball on the line too.
+    let old = BallParams {
+        hidden_min_chord_share: 0.0,
+        ..BallParams::default()
+    };
+    let img = big_scene(160.0, 120.0, 40.0, |x, y| {
+        (95.0..150.0).contains(&y) || ((110.0..210.0).contains(&x) && y > 150.0)
+    });
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &old);
+    assert!(res.ball.expect("ball").cut_off.any());
+}
+
+#[test]
+fn a_thin_orange_arc_does_not_fill_its_circle() {
+    let ctx = level_context();
+    // The red-orange rim of a white toe: a 2-px arc of a 20-px circle, white inside.
+    let (w, h) = (208usize, 160usize);
+    let (cx, cy, r) = (104.0, 110.0, 20.0);
+    let codes = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+            let d = (x - cx).hypot(y - cy);
+            if y < cy && (r - 2.0..=r).contains(&d) {
+                ColourClass::Orange.code()
+            } else if d < r || y >= cy {
+                ColourClass::White.code()
+            } else {
+                ColourClass::Green.code()
+            }
+        })
+        .collect();
+    let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
+    assert!(circle_fill(&img, (cx, cy), r).is_some_and(|f| f < 0.2));
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    assert!(res.ball.is_none(), "{:?}", res.candidates[0].confidence);
+    let fill = res.candidates[0]
+        .confidence
+        .test(TestName::CircleFill)
+        .expect("circle fill test");
+    assert!(fill.effect < 0.0, "{fill:?}");
+    // A whole disc fills its circle; one outside the image has no fill.
+    let disc = scene(60.0, 60.0, 8.0, 0.0);
+    assert!(circle_fill(&disc, (60.0, 60.0), 8.0).is_some_and(|f| f > 0.95));
+    assert_eq!(circle_fill(&disc, (-50.0, 60.0), 8.0), None);
+    assert_eq!(circle_fill(&disc, (60.0, 60.0), f64::NAN), None);
+}
