@@ -81,7 +81,7 @@ fn identify(
 }
 
 /// Prints learning and identification figures for several tables:
-/// `cargo test --test it debug_patterns -- --ignored --nocapture`.
+/// `cargo run --example debug_recognition --no-default-features -- patterns`.
 pub fn debug_patterns() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let tables = [

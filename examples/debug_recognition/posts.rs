@@ -35,8 +35,8 @@ fn rolling_image(
     Some((x, y))
 }
 
-/// Per-post detail for one scenario: `EOTN_DEBUG_SCENARIO=walk-and-pan cargo test --test it
-/// debug_posts -- --ignored --nocapture`. For each detected post: signed error (detected − true,
+/// Per-post detail for one scenario: `EOTN_DEBUG_SCENARIO=walk-and-pan
+/// cargo run --example debug_recognition --no-default-features -- posts`. For each detected post: signed error (detected − true,
 /// pixels, at mid-height) of the raw line against the rolling-shutter image of the post's front
 /// centre, front outer corner and back outer corner, and of the reference line against the
 /// reference-instant projection of the front centre (what `eotn eval` scores).
@@ -192,8 +192,8 @@ pub fn debug_posts() {
     }
 }
 
-/// Level-frame picture of each accepted goal's sides: `EOTN_DEBUG_SCENARIO=beacon-tour cargo
-/// test --test it debug_post_profiles -- --ignored --nocapture` (`EOTN_DEBUG_FRAMES=61,64`
+/// Level-frame picture of each accepted goal's sides: `EOTN_DEBUG_SCENARIO=beacon-tour
+/// cargo run --example debug_recognition --no-default-features -- post-profiles` (`EOTN_DEBUG_FRAMES=61,64`
 /// picks frames). One character per level pixel (`Y` goal colour, `g` green, `w` white, `.`
 /// other); below each picture the level x of the true front-post centre and back outer corner
 /// (rolling-shutter image at the goal's mid-height) and of the detected post.

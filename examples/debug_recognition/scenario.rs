@@ -7,8 +7,8 @@ use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
 use crate::{debug_setup, learnt_table};
 
-/// Prints what happened per frame: `EOTN_DEBUG_SCENARIO=fast-pans cargo test --test it
-/// debug_scenario -- --ignored --nocapture`.
+/// Prints what happened per frame: `EOTN_DEBUG_SCENARIO=fast-pans
+/// cargo run --example debug_recognition --no-default-features -- scenario`.
 pub fn debug_scenario() {
     let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "walk-and-pan".into());
     let kind = ScenarioKind::from_name(&name).expect("scenario name");
@@ -187,8 +187,8 @@ fn print_ball_detail(r: &eotn::pipeline::FrameResult<'_>) {
 }
 
 /// Prints one CSV line per correctly matched ball (prefix `BIAS,`) for studying the distance
-/// error's sign: `EOTN_BIAS_FRAMES=180 cargo test --test it ball_distance_bias -- --ignored
-/// --nocapture`. Columns: scenario, seed, frame, true distance, true radius, true centre x/y,
+/// error's sign: `EOTN_BIAS_FRAMES=180
+/// cargo run --example debug_recognition --no-default-features -- bias`. Columns: scenario, seed, frame, true distance, true radius, true centre x/y,
 /// cut, measured distance, radius, centre x/y, from circle fit, the original's d × 8.5 /
 /// diameter, blob box width/height, truth box width/height, ground-plane distance.
 pub fn ball_distance_bias() {
@@ -272,7 +272,7 @@ pub fn ball_distance_bias() {
 /// Which of the ball's true pixels classification loses, and to what, by where they are on the
 /// ball (top/bottom rim, left/right rim with the UYVY chroma partner on or off the ball,
 /// inside): how the half-pixel rim loss behind the long ball distances was found.
-/// `cargo test --test it ball_rim_study -- --ignored --nocapture`.
+/// `cargo run --example debug_recognition --no-default-features -- rim`.
 pub fn ball_rim_study() {
     use eotn::lut::ColourClass;
     let lut = learnt_table();
