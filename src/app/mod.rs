@@ -1,6 +1,6 @@
 //! The desktop app (feature `gui`): eframe on wgpu or OpenGL (see `renderer.rs`), embedding the
 //! same pipeline as the CLI. Everything that is not a widget is the [`crate::workspace`] (it
-//! builds without this feature); this folder draws it and sends [`Command`]s. Laid out like egui's
+//! builds without this feature); this folder draws it and sends [`Command`](crate::workspace::Command)s. Laid out like egui's
 //! demo app and rerun's viewer:
 //!
 //! | file | role |

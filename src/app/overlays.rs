@@ -1,4 +1,4 @@
-//! Drawing in image-pixel coordinates: one [`ImagePainter`] owns zoom and pan, so no overlay
+//! Drawing in image-pixel coordinates: one [`ImageTransform`] owns zoom and pan, so no overlay
 //! does screen maths. Blob boxes, recognition's primitives (candidate boxes, scan areas and
 //! points, circles, posts, gaps, the horizon, coloured-pattern regions, object labels), the
 //! sampled pixel and the preview highlight.

@@ -251,10 +251,10 @@ impl SizeRelation {
 /// What the recogniser has learnt: the places file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PatternMemory {
-    /// Always [`PLACES_FORMAT`].
+    /// Always `"eotn.places"`.
     #[serde(default = "places::places_format")]
     pub format: String,
-    /// [`PLACES_VERSION`].
+    /// The places format's version (1).
     #[serde(default = "places::places_version")]
     pub version: u32,
     /// Known objects.
