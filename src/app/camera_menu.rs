@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use egui::{Context, Ui};
 
 use crate::sim::ScenarioKind;
-use crate::sources::{Available, SourceKind, SourceSettings, SourceSpec, available};
+use crate::sources::{Available, CameraKind, SourceKind, SourceSettings, SourceSpec, available};
 use crate::workspace::{Command, Window, Workspace};
 
 /// What the Camera dialogs are editing.
@@ -18,6 +18,8 @@ pub struct CameraDialogs {
     pub kind: SourceKind,
     /// The camera device picked.
     pub device: Option<PathBuf>,
+    /// The camera picked looks down at the field (an overhead camera), not out of a robot.
+    pub overhead: bool,
     /// The scenario picked.
     pub scenario: ScenarioKind,
     /// Its seed.
@@ -39,6 +41,7 @@ impl Default for CameraDialogs {
         Self {
             kind: SourceKind::Synthetic,
             device: None,
+            overhead: false,
             scenario: ScenarioKind::WalkAndPan,
             seed: 1,
             stream_path: String::new(),
@@ -118,8 +121,8 @@ pub fn camera_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command
         "table of the {} camera in use; {} camera's: {}",
         state.table_kind().name(),
         match state.table_kind() {
-            crate::sources::CameraKind::Robot => "overhead",
-            crate::sources::CameraKind::Overhead => "robot",
+            CameraKind::Robot => "overhead",
+            CameraKind::Overhead => "robot",
         },
         other
             .path()
@@ -206,7 +209,15 @@ fn connect_ui(ui: &mut Ui, d: &mut CameraDialogs, commands: &mut Vec<Command>) {
                 let label = format!("{} ({name})", path.display());
                 ui.radio_value(&mut d.device, Some(path.clone()), label);
             }
-            d.device.clone().map(SourceSpec::Camera)
+            ui.checkbox(&mut d.overhead, "overhead camera (looks down at the field)");
+            let kind = if d.overhead {
+                CameraKind::Overhead
+            } else {
+                CameraKind::Robot
+            };
+            d.device
+                .clone()
+                .map(|device| SourceSpec::Camera { device, kind })
         }
         SourceKind::Synthetic => {
             egui::ComboBox::from_label("scenario")

@@ -7,7 +7,7 @@
 //! | `stream.rs` | [`StreamSource`]: a recorded MCAP stream, random access by index and time |
 //! | `files.rs` | [`FileSource`]: frame files (`.uyvy`, PNG, JPEG) with their sensor side files |
 //! | `synthetic.rs` | [`SyntheticSource`]: a scenario of [`crate::sim`] rendered live at its frame rate |
-//! | `camera.rs` | `CameraSource`: a V4L2 camera (UVC webcams delivering YUYV or UYVY) |
+//! | `camera.rs` | `CameraSource`: a V4L2 camera (UVC webcams delivering YUYV or UYVY; Linux) |
 //! | (network) | a robot over the network (Foxglove WebSocket) lives in `crate::live`, after this module in the data flow: it implements [`FrameSource`] (frames from its own socket thread; `connect` returns at once) and the workspace builds it for [`SourceSpec::Network`] |
 //! | `recorder.rs` | [`Recorder`]: any source's frames into an MCAP stream the user names |
 //! | `streamer.rs` | [`Streamer`]: any source grabbed at a fixed rate on its own thread |
@@ -21,6 +21,8 @@
 //! Which camera a source films with, the robot's head camera or the overhead camera above the
 //! field, is decided in one place: [`CameraKind::of_stream_source`].
 
+#[cfg(target_os = "linux")]
+mod camera;
 mod files;
 mod recorder;
 mod stream;
@@ -30,6 +32,8 @@ mod synthetic;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+#[cfg(target_os = "linux")]
+pub use camera::CameraSource;
 pub use files::{
     FileSource, RAW_EXTENSIONS, expand_frame_paths, is_frame_file, load_side_sensors,
     sensor_side_file,
@@ -153,6 +157,13 @@ impl CameraKind {
         } else {
             Self::Robot
         }
+    }
+
+    /// The stream source kind a recording of a live camera of this kind gets (`"robot camera"`,
+    /// `"overhead camera"`), which [`Self::of_stream_source`] reads back as this kind.
+    #[must_use]
+    pub fn stream_source(self) -> String {
+        format!("{} camera", self.name())
     }
 
     /// The name shown in the app and listings.
@@ -401,8 +412,14 @@ fn lap_ns(r: &dyn RecordedSource) -> u64 {
 /// source by [`SourceSpec::open`], the one place each kind is built.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum SourceSpec {
-    /// A camera device (`/dev/video0`).
-    Camera(PathBuf),
+    /// A camera device (`/dev/video0`) and which camera it is: a robot's or one above the field
+    /// (a USB camera can be either; the user says which).
+    Camera {
+        /// The device.
+        device: PathBuf,
+        /// Robot or overhead camera.
+        kind: CameraKind,
+    },
     /// A scenario of the synthetic renderer, played live.
     Synthetic {
         /// Which scenario.
@@ -423,7 +440,7 @@ impl SourceSpec {
     #[must_use]
     pub const fn kind(&self) -> SourceKind {
         match self {
-            Self::Camera(_) => SourceKind::Camera,
+            Self::Camera { .. } => SourceKind::Camera,
             Self::Synthetic { .. } => SourceKind::Synthetic,
             Self::Stream(_) => SourceKind::Stream,
             Self::Files(_) => SourceKind::Files,
@@ -444,7 +461,7 @@ impl SourceSpec {
     /// The file, device or peer cannot be opened; a kind not built into this program.
     pub fn open(&self) -> Result<Box<dyn FrameSource>, SourceError> {
         let mut source: Box<dyn FrameSource> = match self {
-            Self::Camera(path) => open_camera(path)?,
+            Self::Camera { device, kind } => open_camera(device, *kind)?,
             Self::Synthetic { scenario, seed } => Box::new(SyntheticSource::new(*scenario, *seed)),
             Self::Stream(path) => Box::new(StreamSource::open(path)?),
             Self::Files(paths) => Box::new(FileSource::new(paths.clone(), None)?),
@@ -476,10 +493,22 @@ impl SourceSpec {
     }
 }
 
-fn open_camera(path: &std::path::Path) -> Result<Box<dyn FrameSource>, SourceError> {
+#[cfg(target_os = "linux")]
+fn open_camera(
+    path: &std::path::Path,
+    kind: CameraKind,
+) -> Result<Box<dyn FrameSource>, SourceError> {
+    Ok(Box::new(CameraSource::new(path, kind)))
+}
+
+#[cfg(not(target_os = "linux"))]
+fn open_camera(
+    path: &std::path::Path,
+    _kind: CameraKind,
+) -> Result<Box<dyn FrameSource>, SourceError> {
     Err(SourceError::Unsupported {
         label: path.display().to_string(),
-        detail: "cameras (V4L2) are not built into this program yet".to_owned(),
+        detail: "cameras are read through V4L2, which only Linux has".to_owned(),
     })
 }
 
@@ -506,35 +535,37 @@ pub fn available() -> Available {
     }
 }
 
-/// Camera devices (`/dev/video*`) with their names, or a one-line note why there are none.
+/// Camera devices (`/dev/video*`) with the names their drivers give, or a one-line note why there
+/// are none.
+#[cfg(target_os = "linux")]
 fn list_cameras() -> (Vec<(PathBuf, String)>, Option<String>) {
-    let mut found: Vec<PathBuf> = std::fs::read_dir("/dev")
-        .map(|d| {
-            d.filter_map(Result::ok)
-                .map(|e| e.path())
-                .filter(|p| {
-                    p.file_name()
-                        .and_then(|n| n.to_str())
-                        .is_some_and(|n| n.starts_with("video"))
-                })
-                .collect()
+    let mut cameras: Vec<(PathBuf, String)> = v4l::context::enum_devices()
+        .into_iter()
+        .map(|node| {
+            let path = node.path().to_owned();
+            let name = node
+                .name()
+                .unwrap_or_else(|| crate::frame::display_name(&path));
+            (path, name)
         })
-        .unwrap_or_default();
-    found.sort();
-    if found.is_empty() {
+        .collect();
+    cameras.sort();
+    if cameras.is_empty() {
         return (
             Vec::new(),
             Some("no camera found (no /dev/video*)".to_owned()),
         );
     }
-    let cameras = found
-        .into_iter()
-        .map(|p| {
-            let name = crate::frame::display_name(&p);
-            (p, name)
-        })
-        .collect();
     (cameras, None)
+}
+
+/// Camera devices: none where there is no V4L2.
+#[cfg(not(target_os = "linux"))]
+fn list_cameras() -> (Vec<(PathBuf, String)>, Option<String>) {
+    (
+        Vec::new(),
+        Some("no camera found (cameras need Linux's V4L2)".to_owned()),
+    )
 }
 
 #[cfg(test)]
@@ -557,6 +588,9 @@ mod tests {
             CameraKind::Robot
         );
         assert_eq!(CameraKind::of_stream_source(""), CameraKind::Robot);
+        for k in [CameraKind::Robot, CameraKind::Overhead] {
+            assert_eq!(CameraKind::of_stream_source(&k.stream_source()), k);
+        }
     }
 
     #[test]

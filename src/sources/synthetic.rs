@@ -50,16 +50,12 @@ impl SyntheticSource {
 
 impl FrameSource for SyntheticSource {
     fn info(&self) -> SourceInfo {
-        let camera = match self.sim.scenario().view() {
-            View::Overhead => CameraKind::Overhead,
-            View::Robot { .. } => CameraKind::Robot,
-        };
+        // As `eotn sim` records it; the overhead scenario's name says "overhead".
         let stream_source = format!("sim:{}", self.sim.scenario().kind.name());
-        debug_assert_eq!(CameraKind::of_stream_source(&stream_source), camera);
         SourceInfo {
             kind: SourceKind::Synthetic,
             label: self.label(),
-            camera,
+            camera: CameraKind::of_stream_source(&stream_source),
             paths: Vec::new(),
             stream_source,
         }
@@ -143,6 +139,11 @@ mod tests {
         assert_eq!(overhead.stream_source, "sim:overhead-game");
         let robot = SyntheticSource::named("walk-and-pan", 1).unwrap().info();
         assert_eq!(robot.camera, CameraKind::Robot);
+        for k in ScenarioKind::ALL {
+            let overhead = Scenario::new(k, 1).view() == View::Overhead;
+            let camera = SyntheticSource::new(k, 1).info().camera;
+            assert_eq!(camera == CameraKind::Overhead, overhead, "{}", k.name());
+        }
         let e = SyntheticSource::named("nope", 1).unwrap_err().to_string();
         assert!(e.contains("walk-and-pan"), "{e}");
     }

@@ -159,3 +159,26 @@ fn classify_writes_png_and_raw_codes() {
     assert_eq!(v["pixels"]["orange"].as_u64(), Some(orange as u64));
     assert!(outdir.join("ball.uyvy.classified.png").exists());
 }
+
+#[test]
+fn sources_lists_cameras_or_says_there_are_none_in_one_line_and_every_scenario() {
+    let out = eotn_ok(&["sources".as_ref()]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let cameras = eotn::sources::available().cameras;
+    if cameras.is_empty() {
+        assert_eq!(
+            text.lines()
+                .filter(|l| l.contains("no camera found"))
+                .count(),
+            1,
+            "{text}"
+        );
+    } else {
+        for (path, _) in cameras {
+            assert!(text.contains(&path.display().to_string()), "{text}");
+        }
+    }
+    for k in eotn::sim::ScenarioKind::ALL {
+        assert!(text.contains(k.name()), "{} missing: {text}", k.name());
+    }
+}
