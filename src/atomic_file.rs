@@ -37,6 +37,7 @@ pub fn write_atomic_with(
     path: &Path,
     write: impl FnOnce(&mut io::BufWriter<File>) -> io::Result<()>,
 ) -> io::Result<()> {
+    clean_stale_temporaries(path);
     let tmp = temp_path_for(path);
     let result = (|| {
         let mut out = io::BufWriter::new(File::create(&tmp)?);
@@ -53,6 +54,38 @@ pub fn write_atomic_with(
         let _ = fs::remove_file(&tmp);
     }
     result
+}
+
+/// Removes temporaries of `path` left by writers of ours that were killed (`kill -9`, a power
+/// cut): `.NAME.tmp-PID-N` files whose process no longer runs. Only our own naming is touched,
+/// and only where the system says which processes run (`/proc`).
+fn clean_stale_temporaries(path: &Path) {
+    let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return;
+    };
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let prefix = format!(".{name}.tmp-");
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let Some(pid) = rest.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// Flushes the folder entry of a renamed file, so the rename itself survives a power cut.
@@ -76,6 +109,25 @@ fn sync_parent(path: &Path) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn temporaries_of_dead_writers_are_cleaned_on_the_next_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.lut");
+        // PID 999999999 is beyond any pid_max, so dead; a live one (ours) must be kept.
+        let dead = dir.path().join(".t.lut.tmp-999999999-3");
+        let live = dir
+            .path()
+            .join(format!(".t.lut.tmp-{}-77", std::process::id()));
+        let other = dir.path().join(".u.lut.tmp-999999999-3");
+        for f in [&dead, &live, &other] {
+            fs::write(f, b"x").unwrap();
+        }
+        write_atomic(&p, b"new").unwrap();
+        assert!(!dead.exists(), "a dead writer's temporary stays");
+        assert!(live.exists() && other.exists());
+        assert_eq!(fs::read(&p).unwrap(), b"new");
+    }
 
     #[test]
     fn replaces_contents() {

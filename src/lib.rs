@@ -36,6 +36,7 @@ pub mod eval;
 pub mod frame;
 pub mod geometry;
 pub mod import;
+pub mod input_file;
 pub mod lut;
 pub mod overlay;
 pub mod pipeline;

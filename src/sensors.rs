@@ -81,6 +81,29 @@ pub struct SensorField {
     pub value: Option<f64>,
 }
 
+/// Whether `v` can be a reading of the field `name` in `unit`: finite, and within what any
+/// robot can report (angles within ±8π rad, lengths within ±1 km and heights and ranges not
+/// below the ground, durations from 0 to an hour, duty cycles within ±1, accelerations within
+/// ±1000 m/s², the battery within 0–100 %, temperatures within −100 to 200 °C).
+#[must_use]
+pub fn plausible(name: &str, unit: &str, v: f64) -> bool {
+    if !v.is_finite() {
+        return false;
+    }
+    let not_below_ground = name.ends_with("height_cm") || name.starts_with("ir_");
+    match unit {
+        "rad" => v.abs() <= 8.0 * std::f64::consts::PI,
+        "cm" if not_below_ground => (0.0..=1e5).contains(&v),
+        "cm" => v.abs() <= 1e5,
+        "s" => (0.0..=3600.0).contains(&v),
+        "duty" => v.abs() <= 1.0,
+        "m/s²" => v.abs() <= 1000.0,
+        "%" => (0.0..=100.0).contains(&v),
+        "°C" => (-100.0..=200.0).contains(&v),
+        _ => true,
+    }
+}
+
 macro_rules! sensor_fields {
     ($($field:ident : $unit:literal),* $(,)?) => {
         impl SensorReadings {
@@ -90,13 +113,14 @@ macro_rules! sensor_fields {
                 vec![$(SensorField { name: stringify!($field), unit: $unit, value: self.$field }),*]
             }
 
-            /// The readings with every non-finite value removed, and the names of the fields
-            /// that were removed (so the caller can warn instead of computing with NaN).
+            /// The readings with every non-finite or impossible value removed (see
+            /// [`plausible`]), and the names of the fields that were removed, so the caller can
+            /// warn instead of computing with NaN or a 1e300-radian pan.
             #[must_use]
             pub fn sanitised(mut self) -> (Self, Vec<&'static str>) {
                 let mut dropped = Vec::new();
                 $(
-                    if self.$field.is_some_and(|v| !v.is_finite()) {
+                    if self.$field.is_some_and(|v| !plausible(stringify!($field), $unit, v)) {
                         self.$field = None;
                         dropped.push(stringify!($field));
                     }
@@ -165,6 +189,23 @@ mod tests {
         assert_eq!(clean.head_tilt_rad, Some(0.1));
         assert_eq!(clean.ir_far_cm, None);
         assert_eq!(dropped, vec!["head_pan_rad", "ir_far_cm"]);
+    }
+
+    #[test]
+    fn sanitised_drops_impossible_values_too() {
+        let readings = SensorReadings {
+            head_pan_rad: Some(1e300),
+            camera_height_cm: Some(-20.0),
+            camera_x_cm: Some(-20.0),
+            battery_percent: Some(101.0),
+            ..SensorReadings::default()
+        };
+        let (clean, dropped) = readings.sanitised();
+        assert_eq!(
+            dropped,
+            vec!["head_pan_rad", "battery_percent", "camera_height_cm"]
+        );
+        assert_eq!(clean.camera_x_cm, Some(-20.0));
     }
 
     #[test]

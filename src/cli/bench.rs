@@ -113,7 +113,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         total_ns_per_px: median(&total),
         total_ms_per_frame: median(&total_ms),
     };
-    println!(
+    outln!(
         "# eotn bench: {} frame(s), {} px/frame, lut b={}, conn={}, reps={}/frame, {} kernels",
         result.frames,
         result.pixels_per_frame,
@@ -122,17 +122,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         result.reps,
         result.kernels
     );
-    println!(
+    outln!(
         "classify  median {:7.3} ns/pixel",
         result.classify_ns_per_px
     );
-    println!("blobs     median {:7.3} ns/pixel", result.blobs_ns_per_px);
-    println!(
+    outln!("blobs     median {:7.3} ns/pixel", result.blobs_ns_per_px);
+    outln!(
         "total     median {:7.3} ns/pixel  {:8.4} ms/frame",
-        result.total_ns_per_px, result.total_ms_per_frame
+        result.total_ns_per_px,
+        result.total_ms_per_frame
     );
     if args.json {
-        println!("{}", serde_json::to_string(&result)?);
+        outln!("{}", serde_json::to_string(&result)?);
     }
     Ok(())
 }

@@ -92,7 +92,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "blobs");
     for i in 0..inputs.len() {
-        let frame = inputs.load(i, args.input.size)?;
+        let Some(frame) = inputs
+            .load_record_or_skip(i, args.input.size)?
+            .map(|r| r.frame)
+        else {
+            continue;
+        };
         crate::classify::classify_into(&frame, &lut, &mut classified);
         set.find(&classified, connectivity);
         let blobs = peer_sorted(set.active().copied(), args.min_pixels);

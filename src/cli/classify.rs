@@ -43,17 +43,26 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut img = ClassifiedImage::default();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
+    let files = inputs.files();
     let bar = progress(inputs.len(), "classify");
     for i in 0..inputs.len() {
-        let frame = inputs.load(i, args.input.size)?;
+        let Some(frame) = inputs
+            .load_record_or_skip(i, args.input.size)?
+            .map(|r| r.frame)
+        else {
+            bar.inc(1);
+            continue;
+        };
         crate::classify::classify_into(&frame, &lut, &mut img);
         let name = inputs.name(i);
         if let Some(dir) = &args.output {
             let png = dir.join(format!("{name}.classified.png"));
+            super::inputs::refuse_overwriting(&png, &files)?;
             save_rgb_png(&png, img.width(), img.height(), &img.to_rgb())?;
             if args.raw {
                 let cls = dir.join(format!("{name}.cls"));
-                std::fs::write(&cls, img.codes())
+                super::inputs::refuse_overwriting(&cls, &files)?;
+                crate::atomic_file::write_atomic(&cls, img.codes())
                     .with_context(|| format!("{}: cannot write", cls.display()))?;
             }
         }

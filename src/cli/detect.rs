@@ -346,42 +346,79 @@ pub fn detect_json(
     }
 }
 
-/// Sensor readings from `--sensors`: one object for every frame, or one per frame.
+/// Sensor readings from `--sensors`: one object for every frame, or one per frame. Python's
+/// `NaN` reads as missing (as in side files); an unknown field or an impossible value is an
+/// error naming the entry and the field.
 ///
 /// # Errors
-/// An unreadable file or JSON that is neither shape, naming the file.
+/// An unreadable file, JSON that is neither shape, an unknown field or an impossible value,
+/// naming the file.
 pub fn load_sensor_file(path: &std::path::Path) -> anyhow::Result<Vec<SensorReadings>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let bytes = crate::input_file::read_bounded(
+        path,
+        crate::input_file::MAX_SIDE_FILE_BYTES,
+        "a sensor file",
+    )
+    .with_context(|| format!("{}: cannot read", path.display()))?;
+    let (value, _) = crate::streams::schema::parse_json_lenient(&bytes)
+        .map_err(|e| anyhow::anyhow!("{}: not JSON ({e})", path.display()))?;
     let list = match value {
         serde_json::Value::Array(items) => items,
         other => vec![other],
     };
+    let known: Vec<&str> = SensorReadings::default()
+        .fields()
+        .iter()
+        .map(|f| f.name)
+        .collect();
     list.into_iter()
         .enumerate()
         .map(|(i, v)| {
-            serde_json::from_value(v)
-                .with_context(|| format!("{}: entry {i} is not a sensor reading", path.display()))
+            if let Some(unknown) = v
+                .as_object()
+                .and_then(|o| o.keys().find(|k| !known.contains(&k.as_str())))
+            {
+                anyhow::bail!(
+                    "{}: entry {i}: '{unknown}' is not a sensor field (fields: {})",
+                    path.display(),
+                    known.join(", ")
+                );
+            }
+            let r: SensorReadings = serde_json::from_value(v).map_err(|e| {
+                anyhow::anyhow!(
+                    "{}: entry {i} is not a sensor reading ({e})",
+                    path.display()
+                )
+            })?;
+            if let Some(f) = r.fields().into_iter().find(|f| {
+                f.value
+                    .is_some_and(|x| x.is_finite() && !crate::sensors::plausible(f.name, f.unit, x))
+            }) {
+                anyhow::bail!(
+                    "{}: entry {i}: {} = {} {} is not a possible reading",
+                    path.display(),
+                    f.name,
+                    f.value.unwrap_or_default(),
+                    f.unit
+                );
+            }
+            Ok(r.sanitised().0)
         })
         .collect()
 }
 
-/// Loads `--params`: recognition parameters as JSON over the defaults.
+/// Loads `--params`: recognition parameters as JSON over the defaults, every key and range
+/// checked ([`crate::recognition::params_file`]).
 ///
 /// # Errors
-/// An unreadable file or JSON that does not fit, naming the file.
+/// An unreadable file, an unknown key or a value out of range, naming the file and the field.
 pub fn load_params(
     path: Option<&std::path::Path>,
 ) -> anyhow::Result<crate::recognition::RecognitionParams> {
     let Some(path) = path else {
         return Ok(crate::recognition::RecognitionParams::default());
     };
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    serde_json::from_str(&text)
-        .with_context(|| format!("{}: not valid recognition parameters", path.display()))
+    Ok(crate::recognition::params_file::load(path)?)
 }
 
 /// The sensor readings for frame `i`: the stream's own when it has them, else the `--sensors`
@@ -421,7 +458,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "detect");
     for i in 0..inputs.len() {
-        let mut record = inputs.load_record(i, args.input.size)?;
+        let Some(mut record) = inputs.load_record_or_skip(i, args.input.size)? else {
+            bar.inc(1);
+            continue;
+        };
         let readings = readings_for(record.sensors.as_ref(), sensors.as_deref(), i);
         let result = pipeline.process(&record.frame, readings);
         let us = result.timings.recognition.as_secs_f64() * 1e6;
@@ -468,13 +508,7 @@ fn annotated_writer(
     path: &std::path::Path,
     inputs: &[PathBuf],
 ) -> anyhow::Result<crate::streams::StreamWriter> {
-    let out = path.canonicalize().ok();
-    if out.is_some() && inputs.iter().any(|i| i.canonicalize().ok() == out) {
-        anyhow::bail!(
-            "{}: --annotate would replace an input; name another file",
-            path.display()
-        );
-    }
+    super::inputs::refuse_overwriting(path, &super::inputs::expand_frame_paths(inputs)?)?;
     // A stream's own source kind is kept (it says which camera the frames came from).
     let source = inputs
         .iter()

@@ -142,7 +142,7 @@ pub fn run(
         labels_beyond_stream,
     };
     if json {
-        println!("{}", serde_json::to_string(&output)?);
+        outln!("{}", serde_json::to_string(&output)?);
     } else {
         print_summary(&output);
     }
@@ -151,8 +151,8 @@ pub fn run(
 
 fn print_summary(o: &LabelsOutput) {
     let r = &o.report;
-    println!("labelled frames        {}", r.frames);
-    println!(
+    outln!("labelled frames        {}", r.frames);
+    outln!(
         "ball found             {}/{} labelled visible = {}; cut by the image edge {}/{}; \
          ≥ 60% in view and ≥ 6 px {}/{}",
         r.ball_found,
@@ -163,14 +163,14 @@ fn print_summary(o: &LabelsOutput) {
         r.ball_eligible_found,
         r.ball_eligible
     );
-    println!(
+    outln!(
         "false ball             {} of {} frames = {} ({} frames without a ball)",
         r.ball_false,
         r.frames,
         pct(r.ball_false_rate),
         r.ball_absent
     );
-    println!(
+    outln!(
         "ball centre error      median {:.2} px p90 {:.2} px (n={}); cut: median {:.2} px (n={})",
         r.ball_center_error_px.p50,
         r.ball_center_error_px.p90,
@@ -178,7 +178,7 @@ fn print_summary(o: &LabelsOutput) {
         r.ball_center_error_cut_px.p50,
         r.ball_center_error_cut_px.n
     );
-    println!(
+    outln!(
         "ball radius error      median {:.2} px p90 {:.2} px, signed median {}; cut: median {:.2} px",
         r.ball_radius_error_px.p50,
         r.ball_radius_error_px.p90,
@@ -187,16 +187,16 @@ fn print_summary(o: &LabelsOutput) {
         r.ball_radius_error_cut_px.p50
     );
     if !r.ball_missed_frames.is_empty() {
-        println!("ball missed in frames  {:?}", r.ball_missed_frames);
+        outln!("ball missed in frames  {:?}", r.ball_missed_frames);
     }
     if !r.ball_near_frames.is_empty() {
-        println!("  of those, near       {:?}", r.ball_near_frames);
+        outln!("  of those, near       {:?}", r.ball_near_frames);
     }
     if !r.ball_false_frames.is_empty() {
-        println!("false ball in frames   {:?}", r.ball_false_frames);
+        outln!("false ball in frames   {:?}", r.ball_false_frames);
     }
     if r.goal_frames > 0 {
-        println!(
+        outln!(
             "goals found            {}/{} = {}, false {} (in {} frames with goals labelled)",
             r.goals_found,
             r.goals_visible,
@@ -205,23 +205,25 @@ fn print_summary(o: &LabelsOutput) {
             r.goal_frames
         );
         if !r.goal_missed_frames.is_empty() {
-            println!("goal missed in frames  {:?}", r.goal_missed_frames);
+            outln!("goal missed in frames  {:?}", r.goal_missed_frames);
         }
         if !r.goal_false_frames.is_empty() {
-            println!("false goal in frames   {:?}", r.goal_false_frames);
+            outln!("false goal in frames   {:?}", r.goal_false_frames);
         }
     }
     if o.goal_size_over_foot.n > 0 {
-        println!(
+        outln!(
             "goal distance          size / foot on the ground: median {:.2}, p90 {:.2} (n={})",
-            o.goal_size_over_foot.p50, o.goal_size_over_foot.p90, o.goal_size_over_foot.n
+            o.goal_size_over_foot.p50,
+            o.goal_size_over_foot.p90,
+            o.goal_size_over_foot.n
         );
     }
     if !o.unlabelled_frames.is_empty() {
-        println!("unlabelled frames      {}", o.unlabelled_frames.len());
+        outln!("unlabelled frames      {}", o.unlabelled_frames.len());
     }
     if !o.labels_beyond_stream.is_empty() {
-        println!(
+        outln!(
             "labels beyond the stream's {} frames: {:?}",
             r.frames + o.unlabelled_frames.len(),
             o.labels_beyond_stream

@@ -82,9 +82,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut classified = ClassifiedImage::default();
     let mut blobs = BlobSet::default();
     let mut rgb = Vec::new();
+    let files = inputs.files();
     let bar = progress(inputs.len(), "export");
     for i in 0..inputs.len() {
-        let frame = inputs.load(i, args.size)?;
+        let Some(frame) = inputs.load_record_or_skip(i, args.size)?.map(|r| r.frame) else {
+            bar.inc(1);
+            continue;
+        };
         let (w, h) = (frame.width(), frame.height());
         match (args.view, &lut) {
             (View::Classified, Some(lut)) => {
@@ -110,6 +114,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let png = args
             .output
             .join(format!("{}.{}.png", inputs.name(i), args.view.suffix()));
+        super::inputs::refuse_overwriting(&png, &files)?;
         save_rgb_png(&png, w, h, &rgb)?;
         bar.inc(1);
     }

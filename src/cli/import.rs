@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 
-use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
+use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress, refuse_overwriting};
 use crate::sensors::SensorReadings;
 use crate::streams::schema::ImageEncoding;
 use crate::streams::sensor_table::SensorTable;
@@ -78,8 +78,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         eprintln!("eotn: wrote {n} frames to {}", args.output.display());
         return Ok(());
     }
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        bail!("--fps must be a positive number, not {}", args.fps);
+    if !(args.fps.is_finite() && (0.001..=10_000.0).contains(&args.fps)) {
+        bail!(
+            "--fps must be between 0.001 and 10000 frames a second, not {:.3e}",
+            args.fps
+        );
     }
     if let [stream] = args.frames.as_slice()
         && is_stream_file(stream)
@@ -87,6 +90,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         return rewrite_stream(stream, args);
     }
     let paths = expand_frame_paths(&args.frames)?;
+    refuse_overwriting(&args.output, &paths)?;
     if let Some(stream) = paths.iter().find(|p| is_stream_file(p)) {
         bail!(
             "{}: import reads frame files, or one stream to rewrite on its own",
@@ -135,8 +139,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 )
             })?,
             None => seconds_to_ns(frame_seconds(i, args.fps))
-                .with_context(|| format!("frame {i} at {} fps is too late", args.fps))?,
+                .with_context(|| format!("frame {i} at {:.3} fps is too late", args.fps))?,
         };
+        if let Some((before, _)) = previous.as_ref()
+            && time_ns < *before
+        {
+            log::warn!(
+                "{}: frame {i} is at {:.3} s, before frame {} ({:.3} s): times go backwards",
+                args.sensors.as_deref().unwrap_or(path).display(),
+                ns_to_seconds(time_ns),
+                i - 1,
+                ns_to_seconds(*before)
+            );
+        }
         let mut sensors = row.map(|r| r.readings);
         if let (Some(s), Some((t0, before))) = (sensors.as_mut(), previous.as_ref()) {
             fill_from_previous(s, *t0, time_ns, before.as_ref());
@@ -166,14 +181,26 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
     if args.sensors.is_some() || args.size.is_some() {
         bail!("--sensors and --size are for frame files; a stream keeps its own readings");
     }
-    let same = match (input.canonicalize(), args.output.canonicalize()) {
+    refuse_overwriting(&args.output, &[input.to_owned()])?;
+    // The writer writes OUT.partial first: that must not be the input either (finishing
+    // `rec.mcap.partial` as `rec.mcap` would truncate what it reads).
+    let mut partial = args.output.as_os_str().to_owned();
+    partial.push(".partial");
+    let same_partial = match (
+        std::path::Path::new(&partial).canonicalize(),
+        input.canonicalize(),
+    ) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     };
-    if same {
+    if same_partial {
         bail!(
-            "{}: the output would replace the stream it is read from; name another file",
-            args.output.display()
+            "{}: writing it goes through {}, the stream being read; finish it into another name (e.g. -o {}-recovered.mcap)",
+            args.output.display(),
+            input.display(),
+            args.output
+                .file_stem()
+                .map_or_else(|| "stream".into(), |s| s.to_string_lossy())
         );
     }
     let mut reader = StreamReader::open(input)?;

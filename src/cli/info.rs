@@ -49,7 +49,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             })
         };
         if args.json {
-            println!("{value}");
+            outln!("{value}");
         } else {
             print_human(&value);
         }
@@ -57,8 +57,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A stream's description: source, frames, times, frame size, which channels frame 0 has,
-/// and the reader's warnings.
+/// A stream's description: source, frames, times, frame size, which channels the first readable
+/// frame has, and the reader's warnings.
 fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
     let mut reader = StreamReader::open(path)?;
     let n = reader.len();
@@ -80,8 +80,19 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
         value["duration_s"] = secs.into();
         value["fps"] = fps.into();
     }
-    if n > 0 {
-        let r = reader.read(0)?;
+    // The first readable frame: a damaged first chunk costs its frames, not the description.
+    let mut unreadable = Vec::new();
+    let first_readable = (0..n).find_map(|i| match reader.read(i) {
+        Ok(r) => Some((i, r)),
+        Err(e) => {
+            unreadable.push(format!("frame {i}: {e}"));
+            None
+        }
+    });
+    if let Some((i, r)) = first_readable {
+        if i > 0 {
+            value["first_readable_frame"] = i.into();
+        }
         value["width"] = r.frame.width().into();
         value["height"] = r.frame.height().into();
         let mut channels = vec!["/camera/image".to_owned()];
@@ -97,7 +108,18 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
         channels.extend(r.extra.iter().map(|(t, _)| t.clone()));
         value["frame0_channels"] = channels.into();
     }
-    value["warnings"] = reader.warnings().to_vec().into();
+    let mut warnings = reader.warnings().to_vec();
+    if let (Some(first), Some(last)) = (unreadable.first(), unreadable.last()) {
+        warnings.push(if unreadable.len() == 1 {
+            first.clone()
+        } else {
+            format!(
+                "{} frames unreadable before the first readable one ({first} … {last})",
+                unreadable.len()
+            )
+        });
+    }
+    value["warnings"] = warnings.into();
     Ok(value)
 }
 
@@ -110,16 +132,16 @@ fn duration_and_rate(span_ns: u64, n: usize) -> (f64, f64) {
 fn print_human(v: &serde_json::Value) {
     let Some(obj) = v.as_object() else { return };
     let file = obj.get("file").and_then(|f| f.as_str()).unwrap_or("?");
-    println!("{file}");
+    outln!("{file}");
     for (k, val) in obj.iter().filter(|(k, _)| k.as_str() != "file") {
         match val.as_object() {
             Some(inner) => {
-                println!("  {k}:");
+                outln!("  {k}:");
                 for (ik, iv) in inner {
-                    println!("    {ik:<14} {iv}");
+                    outln!("    {ik:<14} {iv}");
                 }
             }
-            None => println!(
+            None => outln!(
                 "  {k}: {}",
                 val.as_str().map_or_else(|| val.to_string(), str::to_owned)
             ),

@@ -143,6 +143,45 @@ impl InputArgs {
 pub struct FrameInputs {
     items: Vec<FrameInput>,
     stream: Option<StreamSource>,
+    skipped: SkippedFrames,
+}
+
+/// Runs of consecutive stream frames skipped as unreadable, warned about once per run (when the
+/// run ends, or when the inputs are dropped).
+#[derive(Debug, Default)]
+struct SkippedFrames {
+    run: Option<(PathBuf, usize, usize, String)>,
+}
+
+impl SkippedFrames {
+    fn note(&mut self, path: &Path, index: usize, why: &str) {
+        if let Some((p, _, last, _)) = self.run.as_mut()
+            && p == path
+            && *last + 1 == index
+        {
+            *last = index;
+            return;
+        }
+        self.flush();
+        self.run = Some((path.to_owned(), index, index, why.to_owned()));
+    }
+
+    fn flush(&mut self) {
+        if let Some((path, first, last, why)) = self.run.take() {
+            let frames = if first == last {
+                format!("frame {first}")
+            } else {
+                format!("frames {first}–{last}")
+            };
+            log::warn!("{}: {frames} skipped, unreadable: {why}", path.display());
+        }
+    }
+}
+
+impl Drop for SkippedFrames {
+    fn drop(&mut self) {
+        self.flush();
+    }
 }
 
 impl FrameInputs {
@@ -181,6 +220,7 @@ impl FrameInputs {
         Ok(Self {
             items,
             stream: None,
+            skipped: SkippedFrames::default(),
         })
     }
 
@@ -200,6 +240,21 @@ impl FrameInputs {
     #[must_use]
     pub fn items(&self) -> &[FrameInput] {
         &self.items
+    }
+
+    /// Every file read: frame files and stream files (each once), for [`refuse_overwriting`].
+    #[must_use]
+    pub fn files(&self) -> Vec<PathBuf> {
+        let mut out: Vec<PathBuf> = Vec::new();
+        for item in &self.items {
+            let p = match item {
+                FrameInput::File(p) | FrameInput::Stream { path: p, .. } => p,
+            };
+            if out.last() != Some(p) {
+                out.push(p.clone());
+            }
+        }
+        out
     }
 
     /// The name of frame `i` (see [`FrameInput::name`]).
@@ -228,6 +283,35 @@ impl FrameInputs {
         let f = self.load_source_frame(i, size)?;
         let frame = std::sync::Arc::unwrap_or_clone(f.frame);
         Ok((frame, f.sensors))
+    }
+
+    /// Like [`Self::load_record`], but a frame of a stream that cannot be read (a damaged
+    /// chunk) is skipped: `None`, with one warning per run of lost frames naming them. Frame files
+    /// that cannot be read are still errors (the user named them one by one).
+    ///
+    /// # Errors
+    /// A frame file that cannot be read, or a stream that cannot be opened.
+    pub fn load_record_or_skip(
+        &mut self,
+        i: usize,
+        size: Option<(usize, usize)>,
+    ) -> anyhow::Result<Option<crate::streams::FrameRecord>> {
+        let Some(FrameInput::Stream { path, index }) = self.items.get(i).cloned() else {
+            return self.load_record(i, size).map(Some);
+        };
+        if self.stream.as_ref().is_none_or(|s| s.path() != path) {
+            self.stream = Some(StreamSource::open(&path)?);
+        }
+        let Some(stream) = self.stream.as_mut() else {
+            bail!("{}: stream not open", path.display());
+        };
+        match stream.read(index) {
+            Ok(f) => Ok(Some(f.into_record())),
+            Err(e) => {
+                self.skipped.note(&path, index, &e.to_string());
+                Ok(None)
+            }
+        }
     }
 
     /// Loads frame `i` with everything its stream recorded for it (readings, truth, other
@@ -278,11 +362,53 @@ impl FrameInputs {
     }
 }
 
+/// Refuses an output that is one of the inputs (also through a symlink or another spelling of
+/// the path): a command never replaces what it reads. `inputs` are the files read, after
+/// folders are expanded; for an input frame its label mask (`NAME.cls`, `NAME.uyvy.cls`) counts
+/// too, since `lut-from-labels` reads it.
+///
+/// # Errors
+/// The output names an input.
+pub fn refuse_overwriting(output: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
+    // An output that does not exist yet cannot be an input; one that does is compared by what
+    // it resolves to.
+    let Ok(out) = output.canonicalize() else {
+        return Ok(());
+    };
+    let masks = inputs.iter().flat_map(|p| {
+        let mut beside = p.as_os_str().to_owned();
+        beside.push(".cls");
+        [p.with_extension("cls"), PathBuf::from(beside)]
+    });
+    let clash = inputs
+        .iter()
+        .cloned()
+        .chain(masks)
+        .find(|p| p.canonicalize().is_ok_and(|c| c == out));
+    if let Some(p) = clash {
+        bail!(
+            "{}: the output would replace the input {}; name another file",
+            output.display(),
+            p.display()
+        );
+    }
+    Ok(())
+}
+
 /// Loads one frame with the error naming the file.
 ///
 /// # Errors
 /// The loader's error.
 pub fn load_frame_arg(path: &Path, size: Option<(usize, usize)>) -> anyhow::Result<Frame> {
+    if size.is_some() && crate::frame::is_image_file(path) {
+        static WARNED: std::sync::Once = std::sync::Once::new();
+        WARNED.call_once(|| {
+            log::warn!(
+                "--size applies to raw frames only; {} and other PNG/JPEG frames keep their own size",
+                path.display()
+            );
+        });
+    }
     Ok(load_frame(path, size)?)
 }
 

@@ -101,22 +101,25 @@ fn run_convert(args: &ConvertArgs) -> anyhow::Result<()> {
             "cells_per_class": ours,
             "notes": converted.notes,
         });
-        println!("{value}");
+        outln!("{value}");
     } else {
         let [y, u, v] = converted.source_bits;
-        println!(
+        outln!(
             "{} ({}, {y}/{u}/{v} bits) → {} ({} bits)",
             args.input.display(),
             converted.format,
             args.output.display(),
             converted.table.bits()
         );
-        println!(
+        outln!(
             "  {:>5}  {:<24} {:<14} {:>9}",
-            "value", "source class", "eotn class", "cells"
+            "value",
+            "source class",
+            "eotn class",
+            "cells"
         );
         for s in &converted.source_classes {
-            println!(
+            outln!(
                 "  {:>5}  {:<24} {:<14} {:>9}",
                 s.value,
                 s.name,
@@ -124,9 +127,9 @@ fn run_convert(args: &ConvertArgs) -> anyhow::Result<()> {
                 s.cells
             );
         }
-        println!("  cells per eotn class at {} bits:", converted.table.bits());
+        outln!("  cells per eotn class at {} bits:", converted.table.bits());
         for (c, n) in ColourClass::ALL.iter().zip(counts).filter(|(_, n)| *n > 0) {
-            println!("    {:<14} {n:>9}", c.name());
+            outln!("    {:<14} {n:>9}", c.name());
         }
     }
     for note in &converted.notes {

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
+use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress, refuse_overwriting};
 use crate::frame::Frame;
 use crate::lut::ColourClass;
 use crate::lut::learn::{Accuracy, LearnParams, TableBuilder};
@@ -51,9 +51,19 @@ pub struct Args {
     pub json: bool,
 }
 
+/// The label mask of a frame: `NAME.cls` beside `NAME.uyvy`, or `NAME.uyvy.cls` as
+/// `eotn classify --raw` writes it.
 fn load_mask(frame_path: &Path, frame: &Frame) -> anyhow::Result<Vec<u8>> {
-    let mask = frame_path.with_extension("cls");
-    let bytes = std::fs::read(&mask)
+    let mut beside = frame_path.as_os_str().to_owned();
+    beside.push(".cls");
+    let beside = std::path::PathBuf::from(beside);
+    let mask = if beside.exists() {
+        beside
+    } else {
+        frame_path.with_extension("cls")
+    };
+    let max = crate::frame::MAX_FRAME_PIXELS;
+    let bytes = crate::input_file::read_bounded(&mask, max, "a label mask")
         .with_context(|| format!("{}: cannot read label mask", mask.display()))?;
     let pixels = frame.width() * frame.height();
     anyhow::ensure!(
@@ -100,6 +110,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     } else {
         expand_frame_paths(&args.frames)?
     };
+    refuse_overwriting(&args.output, &paths)?;
     for path in &paths {
         let frame = load_frame_arg(path, args.size)?;
         let labels = load_mask(path, &frame)?;
@@ -147,7 +158,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .iter()
             .map(|(n, r)| (n.clone(), serde_json::json!(r)))
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::json!({
                 "table": args.output.display().to_string(),
@@ -161,21 +172,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             })
         );
     } else {
-        println!(
+        outln!(
             "{}: {}-bit table from {} labelled pixels ({} cells seen)",
             args.output.display(),
             args.bits,
             builder.pixel_count(),
             builder.cells_seen()
         );
-        println!(
+        outln!(
             "held back {} frames: colour accuracy {:.2}%, false colour on unlabelled pixels {:.2}%",
             held_back.len(),
             100.0 * accuracy.colour_accuracy(),
             100.0 * accuracy.false_colour_rate()
         );
         for (name, r) in &recalls {
-            println!("  {name:<12} {:.2}%", 100.0 * r);
+            outln!("  {name:<12} {:.2}%", 100.0 * r);
         }
     }
     Ok(())

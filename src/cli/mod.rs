@@ -3,6 +3,14 @@
 //! One file per subcommand, each with its clap `Args` and a `run` function. Errors carry
 //! `anyhow` context naming the file; `main` prints them as one line and exits non-zero.
 
+/// `println!` for command output: a closed pipe (`eotn detect … | head`) ends the process
+/// quietly with success, as Unix tools end, instead of panicking.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::cli::write_stdout(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 mod bench;
 mod blobs;
 mod classify;
@@ -104,9 +112,59 @@ pub fn run(command: Command) -> anyhow::Result<()> {
     }
 }
 
-/// Prints an error as one line, `eotn: …`, and gives the failure exit code.
+/// Writes command output to stdout; when stdout is a closed pipe, ends the process with
+/// success at once (the reader has what it wanted), and on any other write error with failure.
+pub fn write_stdout(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("eotn: cannot write the output: {e}");
+        std::process::exit(1);
+    }
+}
+
+/// Whether an error is stdout closed by its reader (`| head`): not a failure.
+fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    let pipe = Some(std::io::ErrorKind::BrokenPipe);
+    err.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>().map(std::io::Error::kind) == pipe
+            || c.downcast_ref::<serde_json::Error>()
+                .and_then(serde_json::Error::io_error_kind)
+                == pipe
+    })
+}
+
+/// One line for an error: its messages from the outside in, each said once. Layers that repeat
+/// their cause's text in their own (`X: msg: msg`) are shortened to the first saying.
+#[must_use]
+pub fn error_line(err: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        let text = text.trim();
+        if text.is_empty() || line.contains(text) {
+            continue;
+        }
+        // A layer whose message ends with what was already said adds only its own prefix.
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(text);
+    }
+    // Causes printed on their own lines by some decoders become one line.
+    line.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Prints an error as one line, `eotn: …`, and gives the failure exit code; a closed output
+/// pipe ends quietly with success.
 #[must_use]
 pub fn report(err: &anyhow::Error) -> ExitCode {
-    eprintln!("eotn: {err:#}");
+    if is_broken_pipe(err) {
+        return ExitCode::SUCCESS;
+    }
+    eprintln!("eotn: {}", error_line(err));
     ExitCode::FAILURE
 }

@@ -131,8 +131,12 @@ pub struct PoseRow {
 /// Unreadable file, a row that is not four numbers, an unknown column, a non-finite value or a
 /// frame given twice, naming the file (and the line for CSV).
 pub fn load_pose_table(path: &Path) -> anyhow::Result<HashMap<usize, RobotPose>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = crate::input_file::read_text_bounded(
+        path,
+        crate::input_file::MAX_SIDE_FILE_BYTES,
+        "a pose table",
+    )
+    .with_context(|| format!("{}: cannot read", path.display()))?;
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
@@ -366,7 +370,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         PatternsCommand::Learn(a) => {
             let out = learn(a)?;
             if a.json {
-                println!("{}", serde_json::to_string(&out)?);
+                outln!("{}", serde_json::to_string(&out)?);
             } else {
                 print_learnt(&out);
             }
@@ -375,7 +379,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         PatternsCommand::Show(a) => {
             let memory = PatternMemory::load(&a.places)?;
             if a.json {
-                println!("{}", serde_json::to_string(&memory)?);
+                outln!("{}", serde_json::to_string(&memory)?);
             } else {
                 print_places(&memory);
             }
@@ -386,18 +390,25 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 fn print_learnt(o: &LearnOutput) {
     let p = &o.poses;
-    println!(
+    outln!(
         "frames                 {} (robot pose from: --poses {}, --pose {}, /robot_pose {}, \
          /ground_truth {}; none {})",
-        o.frames, p.table, p.typed, p.robot_pose_channel, p.ground_truth, p.none
+        o.frames,
+        p.table,
+        p.typed,
+        p.robot_pose_channel,
+        p.ground_truth,
+        p.none
     );
     let r = &o.report;
-    println!(
+    outln!(
         "pink markers seen      {} ({} without a camera pose, {} with too little colour \
          around)",
-        r.views, r.views_without_ray, r.views_without_colour
+        r.views,
+        r.views_without_ray,
+        r.views_without_colour
     );
-    println!(
+    outln!(
         "learnt                 {} new object(s) {:?}, {} pattern(s) added to known objects, \
          {} view(s) of known patterns",
         r.objects_created.len(),
@@ -406,27 +417,27 @@ fn print_learnt(o: &LearnOutput) {
         r.views_merged
     );
     if !r.patterns_refused.is_empty() {
-        println!(
+        outln!(
             "  {} further pattern(s) refused (within one region of another place's): places {:?}",
             r.patterns_refused.len(),
             r.patterns_refused
         );
     }
     for g in &r.groups_dropped {
-        println!("  not learnt: {g}");
+        outln!("  not learnt: {g}");
     }
     for (a, b) in &r.indistinct {
-        println!(
+        outln!(
             "  warning: places {a} and {b} have matching patterns: identification cannot tell \
              them apart"
         );
     }
     print_places(&o.places);
-    println!("written                {}", o.output.display());
+    outln!("written                {}", o.output.display());
 }
 
 fn print_places(m: &PatternMemory) {
-    println!("objects                {}", m.objects.len());
+    outln!("objects                {}", m.objects.len());
     for o in &m.objects {
         let how = match o.placed_by {
             Placement::Triangulation => {
@@ -434,7 +445,7 @@ fn print_places(m: &PatternMemory) {
             }
             Placement::SizeRelation => "placed by size".to_owned(),
         };
-        println!(
+        outln!(
             "  place {:<3} at ({:7.1}, {:7.1}) cm{}, {} view(s), {} pattern(s), {how}",
             o.id,
             o.field_cm[0],
@@ -446,16 +457,19 @@ fn print_places(m: &PatternMemory) {
             o.patterns.len()
         );
         for p in &o.patterns {
-            println!("      {}", p.short_text());
+            outln!("      {}", p.short_text());
         }
     }
     match &m.relation {
-        Some(r) => println!(
+        Some(r) => outln!(
             "size → distance        distance = {:.1} / size_px + {:.1} cm (rms residual {:.1} cm \
              over {} samples)",
-            r.multiplier_cm_px, r.offset_cm, r.residual_cm, r.samples
+            r.multiplier_cm_px,
+            r.offset_cm,
+            r.residual_cm,
+            r.samples
         ),
-        None => println!("size → distance        not learnt (no triangulated place)"),
+        None => outln!("size → distance        not learnt (no triangulated place)"),
     }
 }
 

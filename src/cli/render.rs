@@ -46,6 +46,10 @@ pub enum Overlay {
     All,
 }
 
+/// Most pixels a rendered picture may have (64 Mpx, 192 MiB of RGB): `--scale` beyond it is
+/// refused before anything is drawn.
+const MAX_PICTURE_PIXELS: u64 = 64_000_000;
+
 /// Arguments of `eotn render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -116,11 +120,26 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(p) = &args.patterns {
         pipeline.set_pattern_memory(Some(crate::recognition::patterns::PatternMemory::load(p)?));
     }
+    let files = inputs.files();
     for i in 0..inputs.len() {
-        let (frame, recorded) = inputs.load_with_sensors(i, args.input.size)?;
+        let Some(record) = inputs.load_record_or_skip(i, args.input.size)? else {
+            continue;
+        };
+        let (frame, recorded) = (record.frame, record.sensors);
         let readings = readings_for(recorded.as_ref(), sensors.as_deref(), i);
         let result = pipeline.process(&frame, readings);
         let (w, h) = (frame.width(), frame.height());
+        let scaled = (w as u64 * u64::from(args.scale)) * (h as u64 * u64::from(args.scale));
+        if scaled > MAX_PICTURE_PIXELS {
+            anyhow::bail!(
+                "{}: {w}×{h} at --scale {} makes a {}×{} picture, larger than the {} Mpx a render may be; use a smaller --scale",
+                inputs.name(i),
+                args.scale,
+                w * usize::from(args.scale),
+                h * usize::from(args.scale),
+                MAX_PICTURE_PIXELS / 1_000_000
+            );
+        }
         let base = match args.view {
             View::Raw => frame.to_rgb(),
             View::Classified => result.classified.to_rgb(),
@@ -168,6 +187,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let name = inputs.name(i);
         let stem = name.rsplit_once('.').map_or(name.as_str(), |(s, _)| s);
         let out = args.output.join(format!("{stem}.png"));
+        super::inputs::refuse_overwriting(&out, &files)?;
         save_rgb_png(&out, canvas.width, canvas.height, &canvas.rgb)?;
     }
     Ok(())

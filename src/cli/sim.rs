@@ -44,7 +44,7 @@ pub struct Args {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.list {
         for k in ScenarioKind::ALL {
-            println!("{:<15} {}", k.name(), k.description());
+            outln!("{:<15} {}", k.name(), k.description());
         }
         return Ok(());
     }
@@ -56,6 +56,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let Some(path) = &args.output else {
         anyhow::bail!("--output is required");
     };
+    if args.frames == 0 {
+        anyhow::bail!("--frames must be at least 1: a stream without frames shows nothing");
+    }
     let scenario = crate::sim::Scenario::new(kind, args.seed);
     let mut sim = Simulator::new(scenario);
     if args.ideal {

@@ -153,7 +153,12 @@ impl Labels {
     /// a frame listed twice, a non-finite or non-positive value.
     pub fn load(path: &Path) -> Result<Self, LabelsError> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| LabelsError::Io {
+        let text = crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SIDE_FILE_BYTES,
+            "a labels file",
+        )
+        .map_err(|source| LabelsError::Io {
             path: name.clone(),
             source,
         })?;

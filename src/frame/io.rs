@@ -6,6 +6,14 @@ use thiserror::Error;
 
 use super::{AIBO_SIZE, Frame, FrameError, OVERHEAD_SIZE, PixelLayout, rgb_to_yuv};
 
+/// Most pixels a frame may have: 4096 × 4096 (16.8 Mpx; 50 MiB as 4:4:4), far beyond the
+/// cameras' 208×160 to 1920×1080. Larger images are refused before they are decoded.
+pub const MAX_FRAME_PIXELS: u64 = 4096 * 4096;
+/// Largest side of a frame, pixels.
+pub const MAX_FRAME_SIDE: u32 = 16384;
+/// Largest PNG/JPEG file read, bytes.
+const MAX_IMAGE_FILE_BYTES: u64 = 512 << 20;
+
 /// Why a frame file could not be read or written; always names the file.
 #[derive(Debug, Error)]
 pub enum FrameFileError {
@@ -34,6 +42,18 @@ pub enum FrameFileError {
         path: PathBuf,
         /// The frame error.
         source: FrameError,
+    },
+    /// The image is larger than any frame eotn takes ([`MAX_FRAME_PIXELS`]).
+    #[error(
+        "{path}: {width}×{height} is larger than the frames eotn takes (at most 4096×4096 pixels)"
+    )]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its width, pixels.
+        width: u64,
+        /// Its height, pixels.
+        height: u64,
     },
     /// The image decoder or encoder failed.
     #[error("{path}: {source}")]
@@ -83,10 +103,11 @@ pub fn infer_uyvy_size(len: usize) -> Option<(usize, usize)> {
 /// # Errors
 /// [`FrameFileError`] naming the file: unreadable, unknown size, or wrong length.
 pub fn load_raw_uyvy(path: &Path, size: Option<(usize, usize)>) -> Result<Frame, FrameFileError> {
-    let data = std::fs::read(path).map_err(|source| FrameFileError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let data = crate::input_file::read_bounded(path, MAX_FRAME_PIXELS * 2, "a UYVY frame")
+        .map_err(|source| FrameFileError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
     let (width, height) = match size.or_else(|| infer_uyvy_size(data.len())) {
         Some(s) => s,
         None => {
@@ -122,12 +143,7 @@ pub fn load_frame(path: &Path, size: Option<(usize, usize)>) -> Result<Frame, Fr
     if !is_image_file(path) {
         return load_raw_uyvy(path, size);
     }
-    let img = image::open(path)
-        .map_err(|source| FrameFileError::Image {
-            path: path.to_owned(),
-            source,
-        })?
-        .into_rgb8();
+    let img = decode_image_file(path)?.into_rgb8();
     let (w, h) = (img.width() as usize, img.height() as usize);
     Frame::yuv444_from_fn(w, h, |x, y| {
         // x < w and y < h, so get_pixel_checked always answers.
@@ -142,7 +158,46 @@ pub fn load_frame(path: &Path, size: Option<(usize, usize)>) -> Result<Frame, Fr
     })
 }
 
-/// Writes packed RGB (3 bytes a pixel) as a PNG.
+/// Decodes a PNG or JPEG after checking from its header that it is no larger than a frame may be.
+fn decode_image_file(path: &Path) -> Result<image::DynamicImage, FrameFileError> {
+    let image_err = |source| FrameFileError::Image {
+        path: path.to_owned(),
+        source,
+    };
+    let bytes = crate::input_file::read_bounded(path, MAX_IMAGE_FILE_BYTES, "an image frame")
+        .map_err(|source| FrameFileError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(|source| FrameFileError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+    let (w, h) = reader.into_dimensions().map_err(image_err)?;
+    if w > MAX_FRAME_SIDE || h > MAX_FRAME_SIDE || u64::from(w) * u64::from(h) > MAX_FRAME_PIXELS {
+        return Err(FrameFileError::TooLarge {
+            path: path.to_owned(),
+            width: u64::from(w),
+            height: u64::from(h),
+        });
+    }
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(|source| FrameFileError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_FRAME_SIDE);
+    limits.max_image_height = Some(MAX_FRAME_SIDE);
+    limits.max_alloc = Some(MAX_FRAME_PIXELS * 8);
+    reader.limits(limits);
+    reader.decode().map_err(image_err)
+}
+
+/// Writes packed RGB (3 bytes a pixel) as a PNG, atomically.
 ///
 /// # Errors
 /// [`FrameFileError`] naming the file when the buffer is the wrong length or writing fails.
@@ -167,11 +222,17 @@ pub fn save_rgb_png(
         u32::try_from(height).map_err(|_| bad())?,
     );
     let img = image::RgbImage::from_raw(w, h, rgb.to_vec()).ok_or_else(bad)?;
-    img.save_with_format(path, image::ImageFormat::Png)
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|source| FrameFileError::Image {
             path: path.to_owned(),
             source,
-        })
+        })?;
+    // Atomically: a killed export leaves the old file or the new one, never a truncated PNG.
+    crate::atomic_file::write_atomic(path, &png).map_err(|source| FrameFileError::Io {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 #[cfg(test)]

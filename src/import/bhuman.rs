@@ -256,10 +256,13 @@ pub struct BhumanLog {
 /// [`BhumanError`] naming the file when it cannot be read, has no valid header, or holds no
 /// decodable image; lesser damage becomes [`BhumanLog::warnings`].
 pub fn read_log(path: &Path) -> Result<BhumanLog, BhumanError> {
-    let bytes = std::fs::read(path).map_err(|source| BhumanError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let bytes =
+        crate::input_file::read_bounded(path, 4 << 30, "a B-Human log").map_err(|source| {
+            BhumanError::Io {
+                path: path.to_owned(),
+                source,
+            }
+        })?;
     let log = parse_log(&bytes).map_err(|problem| BhumanError::Invalid {
         path: path.to_owned(),
         problem,

@@ -130,10 +130,14 @@ impl LookupTable {
     /// # Errors
     /// [`LutFileError`] naming the file: unreadable, wrong size, or an unknown code.
     pub fn load(path: &Path) -> Result<Self, LutFileError> {
-        let bytes = std::fs::read(path).map_err(|source| LutFileError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
+        // The largest table (8 bits per channel) is 16 MiB: anything larger is refused unread.
+        let bytes =
+            crate::input_file::read_bounded(path, 1 << 24, "a lookup table").map_err(|source| {
+                LutFileError::Io {
+                    path: path.to_owned(),
+                    source,
+                }
+            })?;
         Self::from_bytes(bytes).map_err(|source| LutFileError::Invalid {
             path: path.to_owned(),
             source,

@@ -20,6 +20,7 @@ pub mod context;
 pub mod draw;
 pub mod fit;
 pub mod goals;
+pub mod params_file;
 pub mod patterns;
 pub mod scan;
 

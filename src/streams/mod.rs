@@ -148,9 +148,14 @@ pub enum StreamError {
     },
 }
 
-/// True when the path looks like an MCAP stream (extension `.mcap`, any case).
+/// True when the path looks like an MCAP stream (`.mcap`, or `.mcap.partial` as a killed writer
+/// leaves it; any case).
 #[must_use]
 pub fn is_stream_file(path: &std::path::Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    // `NAME.mcap.partial` is a stream whose writer was killed: readable to its last chunk.
+    name.ends_with(".mcap") || name.ends_with(".mcap.partial")
 }

@@ -157,7 +157,14 @@ impl StreamReader {
             source,
         };
         let file = File::open(path).map_err(io)?;
-        let file_len = file.metadata().map_err(io)?.len();
+        let meta = file.metadata().map_err(io)?;
+        if !meta.is_file() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file, so it cannot be a stream",
+            )));
+        }
+        let file_len = meta.len();
         let mut reader = Self {
             path: path.to_owned(),
             file: BufReader::with_capacity(64 << 10, file),
@@ -378,7 +385,7 @@ impl StreamReader {
                         let (clean, dropped) = s.sanitised();
                         if !dropped.is_empty() {
                             self.warn(format!(
-                                "frame {index}: non-finite sensor values dropped: {}",
+                                "frame {index}: non-finite or impossible sensor values dropped: {}",
                                 dropped.join(", ")
                             ));
                         }

@@ -70,7 +70,12 @@ impl SensorTable {
             path: path.to_owned(),
             detail,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+        let text = crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SIDE_FILE_BYTES,
+            "a sensor table",
+        )
+        .map_err(|e| err(e.to_string()))?;
         let is_json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));

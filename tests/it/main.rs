@@ -8,6 +8,7 @@ mod app;
 mod app_camera;
 mod cli;
 mod common;
+mod hardening;
 mod motion;
 mod patterns;
 mod peer;

@@ -258,7 +258,7 @@ fn detect_annotate_refuses_to_replace_its_input() {
         copy.as_os_str(),
     ]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("replace an input"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("would replace the input"));
     assert_eq!(std::fs::read(&copy).unwrap(), before);
 }
 

@@ -326,10 +326,13 @@ pub fn convert_file(
     format: Option<SourceFormat>,
     col: Option<&Path>,
 ) -> Result<Converted, ConvertError> {
-    let bytes = std::fs::read(path).map_err(|source| ConvertError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let bytes =
+        crate::input_file::read_bounded(path, 256 << 20, "a colour table").map_err(|source| {
+            ConvertError::Io {
+                path: path.to_owned(),
+                source,
+            }
+        })?;
     let format = match format {
         Some(f) => f,
         None => SourceFormat::detect(path, &bytes).ok_or(ConvertError::Unknown {
@@ -350,11 +353,15 @@ pub fn convert_file(
                     invalid("no .col file names its classes: give one with --col FILE.col".into())
                 })?,
             };
-            let col_text =
-                std::fs::read_to_string(&col_path).map_err(|source| ConvertError::Io {
-                    path: col_path.clone(),
-                    source,
-                })?;
+            let col_text = crate::input_file::read_text_bounded(
+                &col_path,
+                crate::input_file::MAX_SIDE_FILE_BYTES,
+                "a colour file",
+            )
+            .map_err(|source| ConvertError::Io {
+                path: col_path.clone(),
+                source,
+            })?;
             let classes =
                 tekkotsu::parse_col(&col_text).map_err(|problem| ConvertError::Invalid {
                     path: col_path.clone(),

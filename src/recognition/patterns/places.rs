@@ -58,7 +58,12 @@ impl PatternMemory {
     /// # Errors
     /// [`PlacesError`] naming the file and the problem.
     pub fn load(path: &Path) -> Result<Self, PlacesError> {
-        let text = std::fs::read_to_string(path).map_err(|source| PlacesError::Io {
+        let text = crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SIDE_FILE_BYTES,
+            "a places file",
+        )
+        .map_err(|source| PlacesError::Io {
             path: path.to_owned(),
             source,
         })?;
