@@ -5,7 +5,7 @@ use super::Workspace;
 use super::settings::{Overlays, ViewKind};
 use crate::lut::ColourClass;
 use crate::recognition::draw::owner;
-use crate::recognition::{LineRole, Primitive, Recognition};
+use crate::recognition::{LineRole, Primitive};
 
 /// Which recognition primitives a view draws.
 #[derive(Debug, Clone, Copy)]
@@ -66,28 +66,6 @@ impl<'a> PrimitiveFilter<'a> {
         );
         on && (horizon || self.owners.is_none_or(|w| w.iter().any(|x| x == p.owner())))
     }
-}
-
-/// Owners of the accepted objects, named as their primitives name them.
-pub(super) fn accepted_owners(r: &Recognition) -> Vec<String> {
-    let balls = r.ball.candidates.iter().enumerate();
-    let balls = balls
-        .filter(|(_, c)| c.accepted)
-        .map(|(i, _)| owner::ball(i));
-    let goals = r
-        .goals
-        .candidates
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.accepted);
-    let goals = goals.map(|(i, c)| owner::goal(c.colour, i));
-    let beacons = r.beacons.iter().enumerate().filter(|(_, b)| b.accepted);
-    let patterns = r.patterns.iter().enumerate().filter(|(_, p)| p.accepted);
-    balls
-        .chain(goals)
-        .chain(beacons.map(|(i, _)| owner::beacon(i)))
-        .chain(patterns.map(|(i, _)| owner::pattern(i)))
-        .collect()
 }
 
 fn mix(a: u8, b: u8, t: f32) -> u8 {

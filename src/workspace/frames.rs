@@ -8,7 +8,7 @@ use anyhow::Context as _;
 
 use super::source::Source;
 use super::timings::StepTiming;
-use super::{SCAN_BUDGET, SensorSeries, Workspace, accepted_owners};
+use super::{SCAN_BUDGET, SensorSeries, Workspace};
 use crate::sources::SourceFrame;
 
 impl Workspace {
@@ -106,7 +106,7 @@ impl Workspace {
         let (w, h) = (loaded.frame.width(), loaded.frame.height());
         let recognition = r.recognition;
         self.primitives = recognition.primitives(w, h);
-        self.accepted_owners = accepted_owners(recognition);
+        self.accepted_owners = recognition.accepted_owners();
         self.frame_counts = self.pipeline.result().classified.histogram();
         if self
             .selected_object

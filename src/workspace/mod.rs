@@ -50,7 +50,6 @@ pub use table::TableSlot;
 pub use timings::{StepTiming, Timings, median};
 pub use try_edit::{TryEdit, TryEditRow};
 
-use compose::accepted_owners;
 use timings::push_capped;
 
 use crate::blobs::{Blob, BlobSet};
