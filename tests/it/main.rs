@@ -12,6 +12,7 @@ mod hardening;
 mod motion;
 mod patterns;
 mod peer;
+mod properties;
 mod real_data;
 mod recognition;
 mod sim;
