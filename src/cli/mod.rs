@@ -165,6 +165,14 @@ pub fn report(err: &anyhow::Error) -> ExitCode {
     if is_broken_pipe(err) {
         return ExitCode::SUCCESS;
     }
-    eprintln!("eotn: {}", error_line(err));
+    // The library says a raw frame's size must be given; on the command line that is `--size`.
+    let unknown_size = err.chain().any(|e| {
+        matches!(
+            e.downcast_ref::<crate::frame::FrameFileError>(),
+            Some(crate::frame::FrameFileError::UnknownSize { .. })
+        )
+    });
+    let hint = if unknown_size { " (--size WxH)" } else { "" };
+    eprintln!("eotn: {}{hint}", error_line(err));
     ExitCode::FAILURE
 }

@@ -27,7 +27,7 @@ pub enum FrameFileError {
     },
     /// A raw file's length matches no known size and none was given.
     #[error(
-        "{path}: {len} bytes is not a known UYVY frame size (208×160 or 640×480); give the size with --size WxH"
+        "{path}: {len} bytes is not a known UYVY frame size (208×160 or 640×480); its width and height must be given"
     )]
     UnknownSize {
         /// The file.
