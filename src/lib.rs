@@ -17,6 +17,7 @@
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
 //! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
+//! | [`overhead`] | overhead camera: field descriptions, calibration, ball and robot markers |
 //! | [`overlay`] | recognition's drawing primitives on RGB images (`eotn render`) |
 //! | [`annotate`] | those primitives as Foxglove image annotations (`eotn detect --annotate`) |
 //! | [`eval`] | recognition against ground truth or hand labels: rates, errors, plots |
@@ -38,6 +39,7 @@ pub mod geometry;
 pub mod import;
 pub mod input_file;
 pub mod lut;
+pub mod overhead;
 pub mod overlay;
 pub mod pipeline;
 pub mod recognition;

@@ -66,6 +66,13 @@ pub struct Args {
     /// against the truth's markers (correct, wrong, missed; distance errors).
     #[arg(long)]
     pub patterns: Option<PathBuf>,
+    /// Overhead streams: the calibration to read them through (`eotn overhead calibrate`);
+    /// without it each stream's true camera is used.
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// Overhead streams: the field description (ball radius, plate height).
+    #[arg(long)]
+    pub field: Option<PathBuf>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -371,6 +378,22 @@ fn calibrate_goals(
 /// # Errors
 /// Unreadable inputs or streams without ground truth, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    let overhead = args
+        .streams
+        .iter()
+        .filter(|p| super::eval_overhead::is_overhead_stream(p))
+        .count();
+    if overhead == args.streams.len() {
+        return super::eval_overhead::run(
+            &args.streams,
+            &args.lut,
+            args.calibration.as_deref(),
+            args.field.as_deref(),
+            args.json,
+        );
+    } else if overhead > 0 {
+        bail!("give overhead streams and robot-camera streams to separate `eotn eval` runs");
+    }
     let lut = load_lut_arg(&args.lut)?;
     let rp = load_params(args.params.as_deref())?;
     if let Some(labels) = &args.labels {

@@ -17,6 +17,7 @@ mod classify;
 pub mod detect;
 mod eval;
 mod eval_labels;
+mod eval_overhead;
 mod export;
 mod import;
 mod import_bhuman;
@@ -25,6 +26,7 @@ pub mod inputs;
 mod lut;
 mod lut_from_labels;
 pub mod open;
+pub mod overhead;
 pub mod patterns;
 mod render;
 mod sim;
@@ -84,6 +86,10 @@ pub enum Command {
     Lut(lut::Args),
     /// List the frame sources that can be connected: cameras found, synthetic scenarios.
     Sources(sources::Args),
+    /// The overhead camera: printable robot markers (`marker`), calibration from clicked points
+    /// (`calibrate`), ball and robots in field coordinates (`detect`), points from a synthetic
+    /// stream's truth (`sim-points`).
+    Overhead(overhead::Args),
     /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
     Open(open::Args),
 }
@@ -108,6 +114,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Patterns(a) => patterns::run(&a),
         Command::Eval(a) => eval::run(&a),
         Command::Sources(a) => sources::run(&a),
+        Command::Overhead(a) => overhead::run(&a),
         Command::Open(a) => open::run(&a),
     }
 }

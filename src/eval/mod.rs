@@ -5,6 +5,7 @@
 //! streams and runs the pipeline, this module only compares.
 
 pub mod labels;
+pub mod overhead;
 pub mod patterns;
 pub mod plots;
 pub mod skew;

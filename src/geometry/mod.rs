@@ -19,11 +19,13 @@
 //! grows with −y and image y with −z.
 //!
 //! Modules: [`camera`] (the ERS-7 pinhole head camera), [`kinematics`] (joint readings → camera
-//! pose), [`horizon`] (the horizon line in the image), [`overhead`] (a fish-eye overhead camera).
+//! pose), [`horizon`] (the horizon line in the image), [`overhead`] (a fish-eye overhead camera),
+//! [`marker`] (the overhead robot marker).
 
 pub mod camera;
 pub mod horizon;
 pub mod kinematics;
+pub mod marker;
 pub mod overhead;
 
 use std::marker::PhantomData;
@@ -37,6 +39,7 @@ pub use horizon::Horizon;
 pub use kinematics::{
     BodyPose, Ers7Dimensions, HeadJoints, RobotPose, camera_pose_from_readings, write_camera_pose,
 };
+pub use marker::{MarkerIdentity, MarkerTeam, RobotMarker};
 pub use overhead::OverheadCamera;
 
 /// The field frame: origin at the centre spot, x towards the yellow goal, y left, z up (cm).

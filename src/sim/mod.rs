@@ -87,7 +87,7 @@ impl Simulator {
     #[must_use]
     pub fn new(scenario: Scenario) -> Self {
         let head_camera = PinholeCamera::ers7();
-        let overhead_camera = OverheadCamera::above_field_2005();
+        let overhead_camera = scenario.overhead_camera();
         let (renderer, effects) = match scenario.view() {
             View::Robot { .. } => (Renderer::pinhole(&head_camera), CameraEffects::ERS7),
             View::Overhead => (

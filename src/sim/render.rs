@@ -19,6 +19,7 @@ use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use super::rng::SimRng;
 use super::scene::{CameraEffects, GoalColour, Lighting, Material, Scene, Shape};
 use crate::frame::{Frame, FrameError};
+use crate::lut::ColourClass;
 use crate::geometry::{Ers7Dimensions, OverheadCamera, PinholeCamera, rotation_z};
 
 /// Object identities in [`Rendered::objects`]: what each pixel shows.
@@ -37,6 +38,8 @@ pub mod object_id {
     pub const ROBOT: u16 = 100;
     /// Clutter item `i` of the scene is `CLUTTER + i`.
     pub const CLUTTER: u16 = 1000;
+    /// The overhead marker plate of the robot with id `n` is `ROBOT_MARKER + n`.
+    pub const ROBOT_MARKER: u16 = 61_000;
     /// The eight outer tiles and the post of coloured-pattern marker `i` are `MARKER + i`.
     pub const MARKER: u16 = 62_000;
     /// The pink middle tile of marker `i` is `MARKER_PINK + i`.
@@ -59,6 +62,13 @@ enum Paint {
     Solid(Material),
     /// Bands by world height: `(upper z in cm, material)`, ascending.
     BandsZ(Vec<(f64, Material)>),
+    /// An overhead robot marker's top: dots by position relative to the plate's centre (field
+    /// x, y, cm) turned by the robot's heading (radians); black on the plate's rim.
+    Marker {
+        marker: crate::geometry::RobotMarker,
+        centre: [f64; 2],
+        heading_rad: f64,
+    },
     /// A band across a box's local x range, `base` elsewhere.
     BandX {
         base: Material,
@@ -172,8 +182,14 @@ impl World {
             ));
         }
         for r in &scene.robots {
-            let id = object_id::ROBOT + u16::try_from(r.id).unwrap_or(0).min(899);
-            objects.push(object(id, robot_parts(r)));
+            let n = u16::try_from(r.id).unwrap_or(0).min(899);
+            objects.push(object(object_id::ROBOT + n, robot_parts(r)));
+            if let Some(marker) = r.marker {
+                objects.push(object(
+                    object_id::ROBOT_MARKER + n,
+                    vec![marker_plate(&marker, &r.pose)],
+                ));
+            }
         }
         for (i, c) in scene.clutter.iter().enumerate() {
             let [x, y, z] = c.position_cm;
@@ -521,8 +537,30 @@ fn goal_boxes(
     ]
 }
 
+/// Thickness of an overhead marker's plate, centimetres.
+const MARKER_PLATE_THICKNESS_CM: f64 = 0.5;
+
+/// An overhead marker's plate: a thin black disc whose top is at the plate height, painted with
+/// the team and identity dots.
+fn marker_plate(marker: &crate::geometry::RobotMarker, pose: &crate::geometry::RobotPose) -> Part {
+    let top = marker.plate_height_cm;
+    Part {
+        prim: Prim::Cylinder {
+            base: Vector3::new(pose.x_cm, pose.y_cm, top - MARKER_PLATE_THICKNESS_CM),
+            radius: crate::geometry::marker::PLATE_DIAMETER_CM / 2.0,
+            height: MARKER_PLATE_THICKNESS_CM,
+        },
+        paint: Paint::Marker {
+            marker: *marker,
+            centre: [pose.x_cm, pose.y_cm],
+            heading_rad: pose.heading_rad,
+        },
+    }
+}
+
 /// The ERS-7 as boxes and a sphere: body with a uniform band, four black legs, white head with
-/// a black face.
+/// a black face. A robot wearing an overhead marker has no head: the plate above it hides the
+/// head from the overhead camera, and the head would poke through the plate at 22.5 cm.
 fn robot_parts(r: &super::scene::Robot) -> Vec<Part> {
     let field_from_body = r.body.field_from_body(&r.pose);
     let rot = field_from_body.rotation().to_rotation_matrix().into_inner();
@@ -555,6 +593,9 @@ fn robot_parts(r: &super::scene::Robot) -> Vec<Part> {
             ),
             paint: Paint::Solid(Material::RobotBlack),
         });
+    }
+    if r.marker.is_some() {
+        return parts;
     }
     let body_from_head = Ers7Dimensions::ERS7.body_from_head(&r.joints);
     let field_from_head = field_from_body * body_from_head;
@@ -695,6 +736,22 @@ fn paint_at(paint: &Paint, prim: &Prim, p: &Vector3<f64>) -> Material {
             .find(|(top, _)| p.z <= *top)
             .or(bands.last())
             .map_or(Material::White, |b| b.1),
+        Paint::Marker {
+            marker,
+            centre,
+            heading_rad,
+        } => {
+            let (dx, dy) = (p.x - centre[0], p.y - centre[1]);
+            let (s, c) = heading_rad.sin_cos();
+            let class = marker.class_at(c * dx + s * dy, -s * dx + c * dy);
+            match class {
+                Some(ColourClass::Pink) => Material::Pink,
+                Some(ColourClass::Green) => Material::Carpet,
+                Some(ColourClass::SkyBlue) => Material::SkyBlue,
+                Some(ColourClass::Yellow) => Material::Yellow,
+                _ => Material::RobotBlack,
+            }
+        }
         Paint::BandX {
             base,
             band,

@@ -13,8 +13,11 @@ use serde::{Deserialize, Serialize};
 
 use super::rng::SimRng;
 use super::scene::{Ball, Clutter, Marker, Material, Robot, Scene, Shape, Team};
+use nalgebra::UnitQuaternion;
+
 use crate::geometry::{
-    BodyPose, Camera, Ers7Dimensions, Field, HeadJoints, PinholeCamera, Point, RobotPose, Transform,
+    BodyPose, Camera, Ers7Dimensions, Field, HeadJoints, MarkerIdentity, MarkerTeam,
+    OverheadCamera, PinholeCamera, Point, RobotMarker, RobotPose, Transform,
 };
 
 /// Which camera a scenario films with.
@@ -361,7 +364,7 @@ impl Scenario {
                 for k in 0..self.robot_count {
                     let team = if k % 2 == 0 { Team::Red } else { Team::Blue };
                     let (x, y, heading) = self.game_path(k, t_s);
-                    scene.robots.push(robot(
+                    let mut r = robot(
                         k + 1,
                         team,
                         RobotPose::new(x, y, heading),
@@ -371,7 +374,9 @@ impl Scenario {
                             pan_rad: 0.8 * (TAU * t_s / 2.5 + f64::from(k)).sin(),
                             tilt2_rad: 0.0,
                         },
-                    ));
+                    );
+                    r.marker = Some(self.game_marker(k, team));
+                    scene.robots.push(r);
                 }
                 let w = 0.35;
                 scene.ball = Some(Ball::at(
@@ -381,6 +386,50 @@ impl Scenario {
             }
         }
         scene
+    }
+
+    /// Robot `k`'s overhead marker in the overhead game: red robots wear yellow team dots, blue
+    /// ones sky blue; identities differ within a team and move round all 16 with the seed.
+    fn game_marker(&self, k: u32, team: Team) -> RobotMarker {
+        let marker_team = match team {
+            Team::Red => MarkerTeam::Yellow,
+            Team::Blue => MarkerTeam::Blue,
+        };
+        // 5 is prime to 16, so the four members of a team (k / 2 = 0..3) get distinct values.
+        let value = (self.seed.wrapping_mul(7) + u64::from(k / 2) * 5 + u64::from(k % 2) * 3) % 16;
+        let identity = MarkerIdentity::new(u8::try_from(value).unwrap_or(0))
+            .unwrap_or(MarkerIdentity::MIN);
+        RobotMarker::new(marker_team, identity)
+    }
+
+    /// The overhead camera of this scenario: the 2005 rig (350 cm above the centre spot, focal
+    /// 420 px, k1 = −0.18, k2 = 0.03) moved, turned and refocused a little by the seed, so that
+    /// calibration is measured on many cameras rather than tuned to one.
+    #[must_use]
+    pub fn overhead_camera(&self) -> OverheadCamera {
+        let mut rng = SimRng::derived(self.seed, 0x0CA3_E7A5);
+        let mut camera = OverheadCamera::looking_down(
+            640,
+            480,
+            rng.range(335.0, 370.0),
+            rng.range(400.0, 440.0),
+            rng.range(-0.21, -0.15),
+            rng.range(0.015, 0.04),
+        );
+        camera.centre.x_px += rng.range(-8.0, 8.0);
+        camera.centre.y_px += rng.range(-6.0, 6.0);
+        camera.pose.position_cm[0] += rng.range(-15.0, 15.0);
+        camera.pose.position_cm[1] += rng.range(-10.0, 10.0);
+        let tilt = UnitQuaternion::from_euler_angles(
+            rng.range(-0.03, 0.03),
+            rng.range(-0.03, 0.03),
+            rng.range(-0.04, 0.04),
+        );
+        let t: Transform<Field, Camera> = camera.field_from_camera();
+        let turned: Transform<Field, Camera> =
+            Transform::new(t.origin().coords.coords, tilt * t.rotation());
+        camera.pose = crate::geometry::PoseRecord::from_transform(&turned);
+        camera
     }
 
     /// Robot `k`'s smooth path in the overhead game: position (cm) and heading along the
@@ -493,6 +542,7 @@ fn robot(id: u32, team: Team, pose: RobotPose, body: BodyPose, joints: HeadJoint
         pose,
         body,
         joints,
+        marker: None,
     }
 }
 

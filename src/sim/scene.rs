@@ -22,7 +22,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{BodyPose, HeadJoints, RobotPose};
+use crate::geometry::{BodyPose, HeadJoints, RobotMarker, RobotPose};
 use crate::lut::ColourClass;
 
 /// A surface's paint: its colour under full light and the colour class it should classify as.
@@ -339,6 +339,10 @@ pub struct Robot {
     pub body: BodyPose,
     /// Head joints.
     pub joints: HeadJoints,
+    /// The overhead marker on its back, if it wears one (the overhead scenes put one on every
+    /// robot).
+    #[serde(default)]
+    pub marker: Option<RobotMarker>,
 }
 
 /// Shapes for clutter.
@@ -584,6 +588,10 @@ mod tests {
             pose: RobotPose::new(10.0, 20.0, 0.5),
             body: BodyPose::ERS7_STANCE,
             joints: HeadJoints::default(),
+            marker: Some(RobotMarker::new(
+                crate::geometry::MarkerTeam::Blue,
+                crate::geometry::MarkerIdentity::new(11).expect("in range"),
+            )),
         });
         let json = serde_json::to_string_pretty(&scene).expect("serialise");
         assert!(json.contains("\"pink_yellow\""));

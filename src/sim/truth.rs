@@ -10,10 +10,10 @@
 use serde::{Deserialize, Serialize};
 
 use super::render::object_id;
-use super::scene::{GoalColour, Scene, Team};
+use super::scene::{GoalColour, Robot, Scene, Team};
 use crate::geometry::{
-    BodyPose, CameraPose, Field, HeadJoints, Horizon, ImagePoint, OverheadCamera, Point,
-    PoseRecord, RobotPose,
+    BodyPose, CameraPose, Field, HeadJoints, Horizon, ImagePoint, MarkerIdentity, MarkerTeam,
+    OverheadCamera, Point, PoseRecord, RobotMarker, RobotPose,
 };
 use crate::sensors::SensorReadings;
 
@@ -369,6 +369,33 @@ pub struct OverheadRobot {
     pub image: Option<ImagePoint>,
     /// Pixels that show it.
     pub visible_pixels: usize,
+    /// Its overhead marker, if it wears one.
+    #[serde(default)]
+    pub marker: Option<OverheadMarkerTruth>,
+}
+
+/// A robot's overhead marker as the overhead camera sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct OverheadMarkerTruth {
+    /// Team dot colour.
+    pub team: MarkerTeam,
+    /// Identity, 0–15.
+    pub identity: MarkerIdentity,
+    /// Height of the plate's top, centimetres.
+    pub plate_height_cm: f64,
+    /// Image position of the plate's centre.
+    pub image: Option<ImagePoint>,
+    /// Share of the plate's full image area that shows, 0 to 1 (less when another robot's
+    /// plate covers it or the image edge cuts it).
+    pub visible_fraction: f64,
+}
+
+impl OverheadMarkerTruth {
+    /// Whether the whole plate shows (at least 98% of it: the outline's pixels are shared).
+    #[must_use]
+    pub fn fully_visible(&self) -> bool {
+        self.visible_fraction >= 0.98
+    }
 }
 
 /// Pixel statistics of one object in an object buffer.
@@ -720,8 +747,46 @@ pub fn overhead_truth(
                     object_id::ROBOT + u16::try_from(r.id).unwrap_or(0).min(899),
                 )
                 .pixels,
+                marker: r.marker.map(|m| overhead_marker_truth(&m, r, camera, objects)),
             })
             .collect(),
+    }
+}
+
+fn overhead_marker_truth(
+    m: &RobotMarker,
+    r: &Robot,
+    camera: &OverheadCamera,
+    objects: &[u16],
+) -> OverheadMarkerTruth {
+    let n = u16::try_from(r.id).unwrap_or(0).min(899);
+    let pixels = coverage(objects, camera.width_px, object_id::ROBOT_MARKER + n).pixels;
+    // The plate's full image area: the projected outline as a 64-gon (shoelace formula).
+    let radius = crate::geometry::marker::PLATE_DIAMETER_CM / 2.0;
+    let outline: Option<Vec<ImagePoint>> = (0..64)
+        .map(|k| {
+            let a = f64::from(k) * std::f64::consts::TAU / 64.0;
+            camera.image_from_field(&Point::new(
+                r.pose.x_cm + radius * a.cos(),
+                r.pose.y_cm + radius * a.sin(),
+                m.plate_height_cm,
+            ))
+        })
+        .collect();
+    let area = outline.map_or(0.0, |o| {
+        let twice: f64 = o
+            .iter()
+            .zip(o.iter().cycle().skip(1))
+            .map(|(a, b)| a.x_px * b.y_px - b.x_px * a.y_px)
+            .sum();
+        twice.abs() / 2.0
+    });
+    OverheadMarkerTruth {
+        team: m.team,
+        identity: m.identity,
+        plate_height_cm: m.plate_height_cm,
+        image: camera.image_from_field(&Point::new(r.pose.x_cm, r.pose.y_cm, m.plate_height_cm)),
+        visible_fraction: covered_fraction(pixels, area),
     }
 }
 

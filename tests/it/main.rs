@@ -10,6 +10,7 @@ mod cli;
 mod common;
 mod hardening;
 mod motion;
+mod overhead;
 mod patterns;
 mod peer;
 mod properties;

@@ -1,0 +1,180 @@
+//! `eotn eval` on overhead streams: the overhead recogniser against the truth (ball and robot
+//! position errors, identity and heading accuracy) and each robot's world model against the
+//! overhead truth and the overhead detections.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+
+use super::inputs::load_lut_arg;
+use super::overhead::{load_field, params_for};
+use crate::eval::overhead::{
+    OverheadEvalParams, OverheadEvalReport, WorldModel, evaluate_overhead_frame,
+    evaluate_world_model,
+};
+use crate::overhead::{Calibration, OverheadPipeline};
+use crate::sim::truth::GroundTruth;
+use crate::streams::StreamReader;
+
+/// Whether the first frame of a stream carries overhead ground truth.
+#[must_use]
+pub fn is_overhead_stream(path: &Path) -> bool {
+    StreamReader::open(path)
+        .ok()
+        .filter(|r| !r.is_empty())
+        .and_then(|mut r| r.read(0).ok())
+        .and_then(|rec| rec.ground_truth)
+        .and_then(|t| serde_json::from_value::<GroundTruth>(t).ok())
+        .is_some_and(|t| matches!(t, GroundTruth::Overhead(_)))
+}
+
+/// Runs the overhead evaluation of `eotn eval`. Without a calibration each stream is read
+/// through its own true camera (a perfect calibration), which the output says.
+///
+/// # Errors
+/// Unreadable inputs, naming the file; no overhead frame at all.
+pub fn run(
+    streams: &[PathBuf],
+    lut: &Path,
+    calibration: Option<&Path>,
+    field: Option<&Path>,
+    json: bool,
+) -> anyhow::Result<()> {
+    let lut = load_lut_arg(lut)?;
+    let field = load_field(field)?;
+    let cal = calibration.map(Calibration::load).transpose()?;
+    let ep = OverheadEvalParams::default();
+    let (mut frames, mut models, mut skipped) = (Vec::new(), Vec::new(), Vec::<String>::new());
+    let mut global = 0usize;
+    for path in streams {
+        let mut reader = StreamReader::open(path)?;
+        let name = crate::frame::display_name(path);
+        let mut pipeline: Option<OverheadPipeline> = None;
+        let bar = super::inputs::progress(reader.len(), "eval overhead");
+        for i in 0..reader.len() {
+            bar.inc(1);
+            let record = match reader.read(i) {
+                Ok(r) => r,
+                Err(e) => {
+                    skipped.push(format!("{name}#{i}: {e}"));
+                    continue;
+                }
+            };
+            let truth = match record
+                .ground_truth
+                .map(serde_json::from_value::<GroundTruth>)
+            {
+                Some(Ok(GroundTruth::Overhead(t))) => t,
+                Some(Ok(GroundTruth::Robot(_))) => {
+                    skipped.push(format!("{name}#{i}: robot-camera frame"));
+                    continue;
+                }
+                Some(Err(e)) => {
+                    skipped.push(format!("{name}#{i}: ground truth unreadable: {e}"));
+                    continue;
+                }
+                None => {
+                    skipped.push(format!("{name}#{i}: no ground truth"));
+                    continue;
+                }
+            };
+            let p = pipeline.get_or_insert_with(|| {
+                let camera = cal.as_ref().map_or(truth.camera, |c| c.camera);
+                OverheadPipeline::new(lut.clone(), camera, params_for(&field))
+            });
+            let detections = p.process(&record.frame).clone();
+            frames.push(evaluate_overhead_frame(global, &detections, &truth, &ep));
+            for (topic, value) in &record.extra {
+                if !topic.starts_with("/world_model/") {
+                    continue;
+                }
+                match serde_json::from_value::<WorldModel>(value.clone()) {
+                    Ok(m) => models.extend(evaluate_world_model(&m, &truth, Some(&detections))),
+                    Err(e) => skipped.push(format!("{name}#{i} {topic}: {e}")),
+                }
+            }
+            global += 1;
+        }
+        bar.finish_and_clear();
+    }
+    if frames.is_empty() {
+        bail!("no frame with overhead ground truth in the given streams");
+    }
+    let report = OverheadEvalReport::from_frames(&frames, &models);
+    let calibration_name = calibration.map_or_else(
+        || "the streams' true cameras (no --calibration)".to_owned(),
+        |p| p.display().to_string(),
+    );
+    if json {
+        let out = serde_json::json!({
+            "overhead": report,
+            "calibration": calibration_name,
+            "skipped": skipped,
+        });
+        println!("{}", serde_json::to_string(&out).context("report")?);
+    } else {
+        print_report(&report, &calibration_name, &skipped);
+    }
+    Ok(())
+}
+
+fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
+    let pct = |n: usize, d: usize| {
+        if d == 0 {
+            "—".to_owned()
+        } else {
+            format!("{:.1}%", 100.0 * n as f64 / d as f64)
+        }
+    };
+    println!("overhead frames        {} (calibration: {calibration})", r.frames);
+    println!(
+        "ball found             {}/{} = {}   false {}",
+        r.ball_found,
+        r.ball_eligible,
+        pct(r.ball_found, r.ball_eligible),
+        r.ball_false
+    );
+    println!(
+        "ball position error    median {:.2} cm p90 {:.2} p95 {:.2} (n={})",
+        r.ball_error_cm.p50, r.ball_error_cm.p90, r.ball_error_cm.p95, r.ball_error_cm.n
+    );
+    println!(
+        "robots found           {}/{} fully visible markers = {}   false {}",
+        r.robots_found,
+        r.robots_eligible,
+        pct(r.robots_found, r.robots_eligible),
+        r.robots_false
+    );
+    println!(
+        "identity right         {}/{} = {}",
+        r.identity_right,
+        r.robots_eligible,
+        pct(r.identity_right, r.robots_eligible)
+    );
+    println!(
+        "robot position error   median {:.2} cm p90 {:.2} p95 {:.2} (n={})",
+        r.robot_error_cm.p50, r.robot_error_cm.p90, r.robot_error_cm.p95, r.robot_error_cm.n
+    );
+    println!(
+        "heading error          median {:.2}° p90 {:.2}° p95 {:.2}°",
+        r.heading_error_deg.p50, r.heading_error_deg.p90, r.heading_error_deg.p95
+    );
+    for (t, read) in &r.wrong_identities {
+        println!("  wrong identity: {t} read as {read}");
+    }
+    for m in &r.world_models {
+        println!(
+            "world model robot{:<2}   self median {:.1} cm p95 {:.1} (vs overhead {:.1}), \
+             heading {:.1}°, ball median {:.1} cm",
+            m.robot_id,
+            m.self_error_cm.p50,
+            m.self_error_cm.p95,
+            m.self_error_vs_overhead_cm.p50,
+            m.heading_error_deg.p50,
+            m.ball_error_cm.p50
+        );
+    }
+    if !skipped.is_empty() {
+        println!("skipped                {} (first: {})", skipped.len(), skipped[0]);
+    }
+}

@@ -1,0 +1,429 @@
+//! `eotn overhead`: the overhead camera's tools — the printable marker, calibration from a
+//! points file, detection of ball and robots in field coordinates, and clicked points made from
+//! a synthetic stream's truth.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use serde::Serialize;
+
+use super::inputs::{FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress};
+use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
+use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
+use crate::overhead::drawing::marker_svg;
+use crate::overhead::field::FieldDescription;
+use crate::overhead::lines::projected_field_lines;
+use crate::overhead::points::{CalibrationPoint, PointsFile};
+use crate::overhead::recognise::{OverheadDetections, OverheadParams};
+use crate::overhead::OverheadPipeline;
+use crate::sim::{GroundTruth, SimRng};
+use crate::streams::StreamReader;
+
+/// Arguments of `eotn overhead`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: OverheadCommand,
+}
+
+/// The `eotn overhead` subcommands.
+#[derive(Debug, clap::Subcommand)]
+pub enum OverheadCommand {
+    /// Write the printable robot marker of a team and identity as SVG at real size.
+    Marker(MarkerArgs),
+    /// Fit the camera (pose, focal, principal point, k1, k2) to a points file; print the
+    /// parameters and each point's reprojection error.
+    Calibrate(CalibrateArgs),
+    /// Find ball and robots in overhead frames: one JSON line per frame with `--json`.
+    Detect(DetectArgs),
+    /// Write a points file from a synthetic overhead stream's true camera: every visible
+    /// landmark "clicked" with Gaussian noise (for tests and figures).
+    SimPoints(SimPointsArgs),
+}
+
+/// Arguments of `eotn overhead marker`.
+#[derive(Debug, clap::Args)]
+pub struct MarkerArgs {
+    /// Team dot colour: `blue` or `yellow`.
+    #[arg(long)]
+    pub team: String,
+    /// Identity, 0–15.
+    #[arg(long)]
+    pub id: u8,
+    /// Output SVG.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// Arguments of `eotn overhead calibrate`.
+#[derive(Debug, clap::Args)]
+pub struct CalibrateArgs {
+    /// The clicked landmarks (`*.points.json`).
+    #[arg(long)]
+    pub points: PathBuf,
+    /// Where to write the calibration (JSON).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// A frame of the camera: refine along its field lines and write the lines projected over
+    /// it as `CAL.lines.png` beside the calibration.
+    #[arg(long)]
+    pub image: Option<PathBuf>,
+    /// Field description (landmarks, lines, heights); the 2005 Four-Legged field by default.
+    #[arg(long)]
+    pub field: Option<PathBuf>,
+    /// Frame size of a raw `--image`, WxH.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+    /// Do not refine along the lines even with `--image`.
+    #[arg(long)]
+    pub no_lines: bool,
+}
+
+/// Arguments of `eotn overhead detect`.
+#[derive(Debug, clap::Args)]
+pub struct DetectArgs {
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams.
+    #[arg(required = true)]
+    pub frames: Vec<PathBuf>,
+    /// Lookup table of the overhead camera.
+    #[arg(long)]
+    pub lut: PathBuf,
+    /// Calibration (`eotn overhead calibrate`).
+    #[arg(long)]
+    pub calibration: PathBuf,
+    /// Field description for the ball radius and plate height; the 2005 field by default.
+    #[arg(long)]
+    pub field: Option<PathBuf>,
+    /// Frame size of raw files, WxH.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+    /// One JSON object per frame per line.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `eotn overhead sim-points`.
+#[derive(Debug, clap::Args)]
+pub struct SimPointsArgs {
+    /// A synthetic overhead stream (`eotn sim --scenario overhead-game`).
+    #[arg(long)]
+    pub stream: PathBuf,
+    /// Click noise, pixels (standard deviation per axis).
+    #[arg(long, default_value_t = 1.0)]
+    pub noise_px: f64,
+    /// Seed of the noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Field description; the 2005 field by default.
+    #[arg(long)]
+    pub field: Option<PathBuf>,
+    /// Output points file.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// Runs `eotn overhead`.
+///
+/// # Errors
+/// Whatever the subcommand reports, naming the file.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    match &args.command {
+        OverheadCommand::Marker(a) => run_marker(a),
+        OverheadCommand::Calibrate(a) => run_calibrate(a),
+        OverheadCommand::Detect(a) => run_detect(a),
+        OverheadCommand::SimPoints(a) => run_sim_points(a),
+    }
+}
+
+/// The field description of `--field`, or the 2005 field.
+///
+/// # Errors
+/// The loader's error, naming the file.
+pub fn load_field(path: Option<&Path>) -> anyhow::Result<FieldDescription> {
+    Ok(match path {
+        Some(p) => FieldDescription::load(p)?,
+        None => FieldDescription::four_legged_2005(),
+    })
+}
+
+fn run_marker(a: &MarkerArgs) -> anyhow::Result<()> {
+    let team = MarkerTeam::from_name(&a.team)
+        .with_context(|| format!("team {:?}: must be blue or yellow", a.team))?;
+    let id = MarkerIdentity::new(a.id).with_context(|| format!("id {}: must be 0-15", a.id))?;
+    crate::atomic_file::write_atomic(&a.output, marker_svg(team, id).as_bytes())
+        .with_context(|| format!("{}: cannot write", a.output.display()))?;
+    eprintln!("{}: marker team {} id {id}", a.output.display(), team.name());
+    Ok(())
+}
+
+fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
+    let field = load_field(a.field.as_deref())?;
+    let points = PointsFile::load(&a.points)?;
+    let frame = a
+        .image
+        .as_deref()
+        .map(|p| load_frame_arg(p, a.size))
+        .transpose()?;
+    if let Some(f) = &frame {
+        if (f.width(), f.height()) != (points.width, points.height) {
+            bail!(
+                "{}: the frame is {}x{}, the points are for {}x{}",
+                a.image.as_deref().map(Path::display).map(|d| d.to_string()).unwrap_or_default(),
+                f.width(),
+                f.height(),
+                points.width,
+                points.height
+            );
+        }
+    }
+    let params = CalibrationParams {
+        refine_lines: !a.no_lines,
+        ..CalibrationParams::default()
+    };
+    let cal = calibrate(&points, &field, frame.as_ref(), &params)
+        .with_context(|| format!("{}", a.points.display()))?;
+    cal.save(&a.output)?;
+    print_calibration(&cal);
+    if let Some(f) = &frame {
+        let png = a.output.with_extension("lines.png");
+        write_lines_png(&png, f, &field, &cal.camera)?;
+        println!("field lines over the image: {}", png.display());
+    }
+    Ok(())
+}
+
+fn print_calibration(cal: &Calibration) {
+    let c = &cal.camera;
+    let [x, y, z] = c.pose.position_cm;
+    println!("camera at ({x:.1}, {y:.1}, {z:.1}) cm, yaw {:.2}° pitch {:.2}° roll {:.2}°",
+        c.pose.yaw_rad.to_degrees(), c.pose.pitch_rad.to_degrees(), c.pose.roll_rad.to_degrees());
+    println!(
+        "focal {:.2} px, principal point ({:.2}, {:.2}) px, k1 {:.5}, k2 {:.5}",
+        c.focal_px, c.centre.x_px, c.centre.y_px, c.k1, c.k2
+    );
+    println!("reprojection error per point:");
+    for p in &cal.points {
+        println!(
+            "  {:<42} {:6.2} px  (clicked {:.1}, {:.1})",
+            p.name, p.error_px, p.image_px[0], p.image_px[1]
+        );
+    }
+    println!("median {:.3} px over {} points", cal.median_point_error_px(), cal.points.len());
+    if let Some(rms) = cal.line_rms_px {
+        println!("line refinement: {} samples, rms {rms:.3} px", cal.line_samples);
+    }
+}
+
+/// The frame with the field lines projected through `camera` drawn over it, as a PNG.
+fn write_lines_png(
+    path: &Path,
+    frame: &crate::frame::Frame,
+    field: &FieldDescription,
+    camera: &OverheadCamera,
+) -> anyhow::Result<()> {
+    let mut canvas = crate::overlay::Canvas::from_rgb(frame.width(), frame.height(), &frame.to_rgb(), 1)
+        .context("frame size")?;
+    for curve in projected_field_lines(field, camera) {
+        for pair in curve.windows(2) {
+            canvas.line(
+                (pair[0].x_px, pair[0].y_px),
+                (pair[1].x_px, pair[1].y_px),
+                [255, 40, 200],
+            );
+        }
+    }
+    crate::frame::save_rgb_png(path, canvas.width, canvas.height, &canvas.rgb)?;
+    Ok(())
+}
+
+/// The ball in `eotn overhead detect --json`.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BallJson {
+    /// Field x, centimetres.
+    pub x_cm: f64,
+    /// Field y, centimetres.
+    pub y_cm: f64,
+    /// Image centre `[x, y]`, pixels.
+    pub image_px: [f64; 2],
+    /// Image radius, pixels.
+    pub radius_px: f64,
+    /// Confidence, 0–1.
+    pub confidence: f64,
+}
+
+/// A robot in `eotn overhead detect --json`.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct RobotJson {
+    /// `blue` or `yellow`.
+    pub team: &'static str,
+    /// Identity 0–15.
+    pub id: u8,
+    /// Field x, centimetres.
+    pub x_cm: f64,
+    /// Field y, centimetres.
+    pub y_cm: f64,
+    /// Heading, radians counter-clockwise from +x.
+    pub heading_rad: f64,
+    /// Confidence, 0–1.
+    pub confidence: f64,
+}
+
+/// One line of `eotn overhead detect --json` (the interface is fixed: other tools read it).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct OverheadJson {
+    /// Frame name (file name, or `STEM_NNNNNN` for a stream frame).
+    pub frame: String,
+    /// The ball, or null.
+    pub ball: Option<BallJson>,
+    /// The robots.
+    pub robots: Vec<RobotJson>,
+    /// Time of the whole overhead processing (classification, blobs, recognition), µs.
+    pub overhead_us: f64,
+}
+
+/// The JSON line of one frame's detections.
+#[must_use]
+pub fn overhead_json(frame: String, d: &OverheadDetections, overhead_us: f64) -> OverheadJson {
+    OverheadJson {
+        frame,
+        ball: d.ball.map(|b| BallJson {
+            x_cm: b.field_cm[0],
+            y_cm: b.field_cm[1],
+            image_px: [b.image.x_px, b.image.y_px],
+            radius_px: b.radius_px,
+            confidence: b.confidence,
+        }),
+        robots: d
+            .robots
+            .iter()
+            .map(|r| RobotJson {
+                team: r.team.name(),
+                id: r.identity.value(),
+                x_cm: r.field_cm[0],
+                y_cm: r.field_cm[1],
+                heading_rad: r.heading_rad,
+                confidence: r.confidence,
+            })
+            .collect(),
+        overhead_us,
+    }
+}
+
+/// The recogniser's settings for a field.
+#[must_use]
+pub fn params_for(field: &FieldDescription) -> OverheadParams {
+    OverheadParams {
+        ball_radius_cm: field.ball_radius_cm,
+        plate_height_cm: field.plate_height_cm,
+        ..OverheadParams::default()
+    }
+}
+
+fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
+    let lut = load_lut_arg(&a.lut)?;
+    let cal = Calibration::load(&a.calibration)?;
+    let field = load_field(a.field.as_deref())?;
+    let mut pipeline = OverheadPipeline::new(lut, cal.camera, params_for(&field));
+    let mut inputs = FrameInputs::open(&a.frames, None)?;
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    let bar = progress(inputs.len(), "overhead detect");
+    for i in 0..inputs.len() {
+        let frame = inputs.load(i, a.size)?;
+        pipeline.process(&frame);
+        let us = pipeline.timings().total().as_secs_f64() * 1e6;
+        let line = overhead_json(inputs.name(i), pipeline.detections(), us);
+        if a.json {
+            serde_json::to_writer(&mut out, &line)?;
+            writeln!(out)?;
+        } else {
+            write!(out, "{}:", line.frame)?;
+            match &line.ball {
+                Some(b) => write!(out, " ball ({:.1}, {:.1}) cm", b.x_cm, b.y_cm)?,
+                None => write!(out, " no ball")?,
+            }
+            for r in &line.robots {
+                write!(
+                    out,
+                    "; {} {} ({:.1}, {:.1}) cm {:.0}°",
+                    r.team,
+                    r.id,
+                    r.x_cm,
+                    r.y_cm,
+                    r.heading_rad.to_degrees()
+                )?;
+            }
+            writeln!(out)?;
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    out.flush().context("writing output")?;
+    Ok(())
+}
+
+/// Every landmark of `field` that `camera` sees inside the image, "clicked" with Gaussian
+/// noise of `noise_px` per axis.
+#[must_use]
+pub fn simulated_clicks(
+    camera: &OverheadCamera,
+    field: &FieldDescription,
+    noise_px: f64,
+    seed: u64,
+) -> PointsFile {
+    let mut rng = SimRng::derived(seed, 0xC11C);
+    let mut file = PointsFile::new(camera.width_px, camera.height_px);
+    let (w, h) = (camera.width_px as f64, camera.height_px as f64);
+    for l in &field.landmarks {
+        let p = Point::new(l.field_cm[0], l.field_cm[1], l.height_cm);
+        let Some(q) = camera.image_from_field(&p) else {
+            continue;
+        };
+        if q.x_px < 2.0 || q.y_px < 2.0 || q.x_px > w - 2.0 || q.y_px > h - 2.0 {
+            continue;
+        }
+        file.points.push(CalibrationPoint {
+            name: l.name.clone(),
+            field_cm: l.field_cm,
+            height_cm: l.height_cm,
+            image_px: [q.x_px + noise_px * rng.normal(), q.y_px + noise_px * rng.normal()],
+        });
+    }
+    file
+}
+
+/// The true overhead camera of a synthetic stream (from its first frame's truth).
+///
+/// # Errors
+/// A stream without overhead truth.
+pub fn stream_truth_camera(path: &Path) -> anyhow::Result<OverheadCamera> {
+    let mut reader = StreamReader::open(path)?;
+    let record = reader.read(0)?;
+    let truth = record
+        .ground_truth
+        .with_context(|| format!("{}: frame 0 has no ground truth", path.display()))?;
+    match serde_json::from_value::<GroundTruth>(truth) {
+        Ok(GroundTruth::Overhead(t)) => Ok(t.camera),
+        Ok(GroundTruth::Robot(_)) => bail!("{}: a robot-camera stream, not overhead", path.display()),
+        Err(e) => bail!("{}: unreadable ground truth: {e}", path.display()),
+    }
+}
+
+fn run_sim_points(a: &SimPointsArgs) -> anyhow::Result<()> {
+    if !(a.noise_px.is_finite() && a.noise_px >= 0.0) {
+        bail!("--noise-px must be a non-negative number");
+    }
+    let field = load_field(a.field.as_deref())?;
+    let camera = stream_truth_camera(&a.stream)?;
+    let file = simulated_clicks(&camera, &field, a.noise_px, a.seed);
+    file.save(&a.output)?;
+    eprintln!(
+        "{}: {} landmarks with {} px noise",
+        a.output.display(),
+        file.points.len(),
+        a.noise_px
+    );
+    Ok(())
+}

@@ -1,0 +1,615 @@
+//! Overhead camera calibration: camera pose, focal length, principal point and two radial
+//! distortion terms from clicked landmarks, refined along the painted lines.
+//!
+//! The model is [`OverheadCamera`]'s (pinhole plus `1 + k1·r² + k2·r⁴`). Its eleven parameters
+//! (position 3, rotation 3 as a small rotation vector on the starting rotation, focal 1,
+//! principal point 2, k1, k2) are solved by Levenberg–Marquardt (the `levenberg-marquardt`
+//! crate) on pixel residuals: each clicked point's projection minus its click, and, when the
+//! image is given, each line sample's distance across its projected line from the line centre
+//! found in the image's luma ([`super::lines`]). A camera looking almost straight down at a flat
+//! field cannot tell its height from its focal length by ground points alone (both scale the
+//! image alike), so goal-post tops above the ground pin it when clicked, and a weak prior on
+//! the field description's height guess keeps the problem well posed when they are not.
+//!
+//! The start comes from a closed-form 2-D similarity between the ground points and the image
+//! (scale, turn and mirror of a camera looking straight down), so no guess of the camera's
+//! turn is needed.
+
+use std::path::Path;
+
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra_lm::{DMatrix, DVector, Dyn, Owned};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::field::FieldDescription;
+use super::lines::{LineObservation, find_line_observations};
+use super::points::PointsFile;
+use crate::atomic_file::write_atomic;
+use crate::frame::Frame;
+use crate::geometry::{
+    Camera, Field, ImagePoint, OverheadCamera, Point, PoseRecord, Transform,
+};
+
+/// Settings of the calibration.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CalibrationParams {
+    /// Refine along the painted lines when an image is given.
+    pub refine_lines: bool,
+    /// How far across a projected line to look for its centre, pixels.
+    pub line_search_px: f64,
+    /// Rounds of "find the lines, solve again".
+    pub line_rounds: usize,
+    /// Standard deviation of the prior on the camera's height, as a fraction of the field
+    /// description's guess (0.15: ±52 cm for a 350 cm guess).
+    pub height_prior_fraction: f64,
+    /// Line samples about this far apart along the lines, centimetres.
+    pub line_step_cm: f64,
+}
+
+impl Default for CalibrationParams {
+    fn default() -> Self {
+        Self {
+            refine_lines: true,
+            line_search_px: 7.0,
+            line_rounds: 3,
+            height_prior_fraction: 0.15,
+            line_step_cm: 6.0,
+        }
+    }
+}
+
+/// Why a calibration failed.
+#[derive(Debug, Error)]
+pub enum CalibrationError {
+    /// Too few points to solve eleven parameters.
+    #[error("{count} calibration points, at least 6 are needed (3 of them on the ground)")]
+    TooFewPoints {
+        /// Points given.
+        count: usize,
+    },
+    /// The ground points all lie on one line (or on one spot): no start can be made.
+    #[error("the ground points lie on a line: click landmarks spread over the field")]
+    Degenerate,
+    /// The solver ended without a usable camera.
+    #[error("the solver found no camera that fits ({reason})")]
+    NoFit {
+        /// Why.
+        reason: String,
+    },
+    /// Reading or writing a calibration file.
+    #[error("{path}: {what}")]
+    File {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        what: String,
+    },
+}
+
+/// One clicked point's fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PointResidual {
+    /// Landmark name.
+    pub name: String,
+    /// Where it was clicked, pixels.
+    pub image_px: [f64; 2],
+    /// Where the fitted camera puts it, pixels.
+    pub projected_px: [f64; 2],
+    /// Distance between the two, pixels.
+    pub error_px: f64,
+}
+
+/// A solved calibration: the camera and how well it fits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Calibration {
+    /// The fitted camera.
+    pub camera: OverheadCamera,
+    /// Name of the field description it was fitted against.
+    pub field: String,
+    /// Each clicked point's reprojection error.
+    pub points: Vec<PointResidual>,
+    /// Line samples used in the last round of line refinement.
+    pub line_samples: usize,
+    /// Root-mean-square distance of those samples from their projected lines, pixels.
+    pub line_rms_px: Option<f64>,
+}
+
+/// The file format's tag, so that other JSON is refused clearly.
+const FORMAT: &str = "eotn-overhead-calibration-1";
+
+#[derive(Serialize, Deserialize)]
+struct CalibrationFile {
+    format: String,
+    #[serde(flatten)]
+    calibration: Calibration,
+}
+
+impl Calibration {
+    /// Median of the clicked points' reprojection errors, pixels.
+    #[must_use]
+    pub fn median_point_error_px(&self) -> f64 {
+        let mut e: Vec<f64> = self.points.iter().map(|p| p.error_px).collect();
+        median(&mut e)
+    }
+
+    /// Writes the calibration atomically as JSON.
+    ///
+    /// # Errors
+    /// [`CalibrationError::File`] when it cannot be written.
+    pub fn save(&self, path: &Path) -> Result<(), CalibrationError> {
+        let file = CalibrationFile {
+            format: FORMAT.into(),
+            calibration: self.clone(),
+        };
+        let err = |what: String| CalibrationError::File {
+            path: path.display().to_string(),
+            what,
+        };
+        let mut text = serde_json::to_string_pretty(&file).map_err(|e| err(e.to_string()))?;
+        text.push('\n');
+        write_atomic(path, text.as_bytes()).map_err(|e| err(e.to_string()))
+    }
+
+    /// Reads a calibration file.
+    ///
+    /// # Errors
+    /// [`CalibrationError::File`] for a missing file, other JSON, or a camera with non-finite
+    /// or non-positive values.
+    pub fn load(path: &Path) -> Result<Self, CalibrationError> {
+        let err = |what: String| CalibrationError::File {
+            path: path.display().to_string(),
+            what,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+        let file: CalibrationFile = serde_json::from_str(&text)
+            .map_err(|e| err(format!("not an overhead calibration: {e}")))?;
+        if file.format != FORMAT {
+            return Err(err(format!(
+                "format {:?}, expected {FORMAT:?}",
+                file.format
+            )));
+        }
+        let c = &file.calibration.camera;
+        let values = [
+            c.focal_px,
+            c.centre.x_px,
+            c.centre.y_px,
+            c.k1,
+            c.k2,
+            c.pose.yaw_rad,
+            c.pose.pitch_rad,
+            c.pose.roll_rad,
+        ];
+        if !values.iter().chain(&c.pose.position_cm).all(|v| v.is_finite())
+            || c.focal_px <= 0.0
+            || c.width_px == 0
+            || c.height_px == 0
+        {
+            return Err(err("the camera has a value that is not usable".into()));
+        }
+        Ok(file.calibration)
+    }
+}
+
+/// Median of a list (sorted in place), NaN when empty.
+#[must_use]
+pub fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        (values[n / 2 - 1] + values[n / 2]) / 2.0
+    }
+}
+
+/// Calibrates an overhead camera from a points file, refined along the lines of `image` when
+/// one is given.
+///
+/// # Errors
+/// [`CalibrationError`] when there are too few or degenerate points or the solver fails.
+pub fn calibrate(
+    points: &PointsFile,
+    field: &FieldDescription,
+    image: Option<&Frame>,
+    params: &CalibrationParams,
+) -> Result<Calibration, CalibrationError> {
+    let targets: Vec<Target> = points
+        .points
+        .iter()
+        .map(|p| Target {
+            field: Point::new(p.field_cm[0], p.field_cm[1], p.height_cm),
+            image: p.image(),
+        })
+        .collect();
+    let ground = targets.iter().filter(|t| t.field.z() == 0.0).count();
+    if targets.len() < 6 || ground < 3 {
+        return Err(CalibrationError::TooFewPoints {
+            count: targets.len(),
+        });
+    }
+    let start = starting_camera(points.width, points.height, &targets, field)?;
+    let height_prior = HeightPrior {
+        height_cm: field.camera_height_guess_cm,
+        sd_cm: params.height_prior_fraction * field.camera_height_guess_cm,
+    };
+    let mut camera = solve(start, &targets, &[], height_prior)?;
+    let mut lines: Vec<LineObservation> = Vec::new();
+    if let (Some(frame), true) = (image, params.refine_lines) {
+        let samples = field.line_samples(params.line_step_cm);
+        let margin = (5.0 * field.line_width_cm).max(10.0);
+        let samples = super::lines::away_from_crossings(field, &samples, margin);
+        for _ in 0..params.line_rounds {
+            let found = find_line_observations(frame, &camera, &samples, params.line_search_px);
+            lines = reject_outliers(&camera, found);
+            if lines.len() < 10 {
+                break;
+            }
+            camera = solve(camera, &targets, &lines, height_prior)?;
+        }
+        lines = reject_outliers(&camera, lines);
+    }
+    let residuals = points
+        .points
+        .iter()
+        .zip(&targets)
+        .map(|(p, t)| {
+            let projected = camera
+                .image_from_field(&t.field)
+                .unwrap_or(ImagePoint::new(f64::NAN, f64::NAN));
+            PointResidual {
+                name: p.name.clone(),
+                image_px: p.image_px,
+                projected_px: [projected.x_px, projected.y_px],
+                error_px: projected.distance_to(&t.image),
+            }
+        })
+        .collect();
+    let line_rms_px = (!lines.is_empty()).then(|| {
+        let s: f64 = lines.iter().map(|l| l.distance_px(&camera).powi(2)).sum();
+        (s / lines.len() as f64).sqrt()
+    });
+    Ok(Calibration {
+        camera,
+        field: field.name.clone(),
+        points: residuals,
+        line_samples: lines.len(),
+        line_rms_px,
+    })
+}
+
+/// Keeps the line observations within three times the median distance (at least 1 px).
+fn reject_outliers(camera: &OverheadCamera, found: Vec<LineObservation>) -> Vec<LineObservation> {
+    let mut d: Vec<f64> = found.iter().map(|l| l.distance_px(camera).abs()).collect();
+    let limit = (3.0 * median(&mut d)).max(1.0);
+    found
+        .into_iter()
+        .filter(|l| l.distance_px(camera).abs() <= limit)
+        .collect()
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Target {
+    field: Point<Field>,
+    image: ImagePoint,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct HeightPrior {
+    height_cm: f64,
+    sd_cm: f64,
+}
+
+/// A camera looking straight down from the similarity that best maps the ground points to the
+/// image: `w = a·z + b` in complex numbers, field `z = x + iy`, image `w = u − iv` (image y
+/// points down, so the image is the field seen in a mirror).
+fn starting_camera(
+    width: usize,
+    height: usize,
+    targets: &[Target],
+    field: &FieldDescription,
+) -> Result<OverheadCamera, CalibrationError> {
+    let ground: Vec<&Target> = targets.iter().filter(|t| t.field.z() == 0.0).collect();
+    let n = ground.len() as f64;
+    let (zx, zy) = ground.iter().fold((0.0, 0.0), |(a, b), t| {
+        (a + t.field.x() / n, b + t.field.y() / n)
+    });
+    let (wx, wy) = ground.iter().fold((0.0, 0.0), |(a, b), t| {
+        (a + t.image.x_px / n, b - t.image.y_px / n)
+    });
+    // a = Σ conj(z − z̄)(w − w̄) / Σ |z − z̄|².
+    let (mut re, mut im, mut norm) = (0.0, 0.0, 0.0);
+    for t in &ground {
+        let (dx, dy) = (t.field.x() - zx, t.field.y() - zy);
+        let (du, dv) = (t.image.x_px - wx, -t.image.y_px - wy);
+        re += dx * du + dy * dv;
+        im += dx * dv - dy * du;
+        norm += dx * dx + dy * dy;
+    }
+    let scale = re.hypot(im) / norm.max(f64::MIN_POSITIVE);
+    if norm < 1.0 || !scale.is_finite() || scale <= 0.0 {
+        return Err(CalibrationError::Degenerate);
+    }
+    let theta = im.atan2(re);
+    let (ar, ai) = (scale * theta.cos(), scale * theta.sin());
+    // The field point under the image centre: z0 = (w_c − b)/a with b = w̄ − a·z̄.
+    let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
+    let (br, bi) = (wx - (ar * zx - ai * zy), wy - (ar * zy + ai * zx));
+    let (nr, ni) = (cx - br, -cy - bi);
+    let d = ar * ar + ai * ai;
+    let (x0, y0) = ((nr * ar + ni * ai) / d, (ni * ar - nr * ai) / d);
+    let h = field.camera_height_guess_cm;
+    // Camera axes in the field: optical axis down; image right is e^{−iθ}, image up i·e^{−iθ}.
+    let (s, c) = theta.sin_cos();
+    let m = Matrix3::from_columns(&[
+        Vector3::new(0.0, 0.0, -1.0),
+        Vector3::new(-c, s, 0.0),
+        Vector3::new(s, c, 0.0),
+    ]);
+    let rotation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
+    let t: Transform<Field, Camera> = Transform::new(Vector3::new(x0, y0, h), rotation);
+    Ok(OverheadCamera {
+        width_px: width,
+        height_px: height,
+        focal_px: scale * h,
+        centre: ImagePoint::new(cx, cy),
+        k1: 0.0,
+        k2: 0.0,
+        pose: PoseRecord::from_transform(&t),
+    })
+}
+
+/// Number of camera parameters.
+const PARAMS: usize = 11;
+
+/// The least-squares problem: parameters `[x, y, z, ωx, ωy, ωz, f, cx, cy, k1, k2]` with the
+/// rotation `exp(ω)·R0`.
+struct Problem<'a> {
+    base: OverheadCamera,
+    base_rotation: UnitQuaternion<f64>,
+    targets: &'a [Target],
+    lines: &'a [LineObservation],
+    prior: HeightPrior,
+    params: [f64; PARAMS],
+}
+
+/// Residual of a point the camera cannot see, pixels: large, so the solver moves away, but
+/// finite, so it keeps going.
+const UNSEEN_PX: f64 = 1000.0;
+
+impl Problem<'_> {
+    /// The camera of a parameter vector, and its `field_from_camera` built directly (the
+    /// camera's pose record goes through Euler angles, which lose digits near straight down).
+    fn model(&self, p: &[f64; PARAMS]) -> (OverheadCamera, Transform<Field, Camera>) {
+        let rotation =
+            UnitQuaternion::from_scaled_axis(Vector3::new(p[3], p[4], p[5])) * self.base_rotation;
+        let t: Transform<Field, Camera> = Transform::new(Vector3::new(p[0], p[1], p[2]), rotation);
+        let camera = OverheadCamera {
+            focal_px: p[6],
+            centre: ImagePoint::new(p[7], p[8]),
+            k1: p[9],
+            k2: p[10],
+            pose: PoseRecord::from_transform(&t),
+            ..self.base
+        };
+        (camera, t)
+    }
+
+    fn camera(&self, p: &[f64; PARAMS]) -> OverheadCamera {
+        self.model(p).0
+    }
+
+    fn residuals_at(&self, p: &[f64; PARAMS]) -> Vec<f64> {
+        let (camera, field_from_camera) = self.model(p);
+        let camera_from_field = field_from_camera.inverse();
+        let mut r = Vec::with_capacity(2 * self.targets.len() + self.lines.len() + 1);
+        for t in self.targets {
+            match camera.image_from_camera(&(camera_from_field * t.field)) {
+                Some(q) => {
+                    r.push(q.x_px - t.image.x_px);
+                    r.push(q.y_px - t.image.y_px);
+                }
+                None => r.extend([UNSEEN_PX, UNSEEN_PX]),
+            }
+        }
+        for l in self.lines {
+            let d = l.distance_px_with(&camera, &camera_from_field);
+            r.push(if d.is_finite() { d } else { UNSEEN_PX });
+        }
+        // The height prior in pixel-like units: one "pixel" per standard deviation.
+        r.push((p[2] - self.prior.height_cm) / self.prior.sd_cm.max(1e-6));
+        r
+    }
+}
+
+fn params_of(camera: &OverheadCamera) -> [f64; PARAMS] {
+    let o = camera.pose.position_cm;
+    [
+        o[0],
+        o[1],
+        o[2],
+        0.0,
+        0.0,
+        0.0,
+        camera.focal_px,
+        camera.centre.x_px,
+        camera.centre.y_px,
+        camera.k1,
+        camera.k2,
+    ]
+}
+
+/// Finite-difference steps per parameter: small against each one's scale.
+const STEPS: [f64; PARAMS] = [1e-3, 1e-3, 1e-3, 1e-6, 1e-6, 1e-6, 1e-3, 1e-3, 1e-3, 1e-6, 1e-6];
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        for (p, v) in self.params.iter_mut().zip(x.iter()) {
+            *p = *v;
+        }
+    }
+
+    fn params(&self) -> DVector<f64> {
+        DVector::from_column_slice(&self.params)
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let r = self.residuals_at(&self.params);
+        r.iter().all(|v| v.is_finite()).then(|| DVector::from_vec(r))
+    }
+
+    /// Central differences: the projection through the lens has no tidy closed-form
+    /// derivative, and eleven parameters make this cheap.
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let rows = self.residuals_at(&self.params).len();
+        let mut j = DMatrix::zeros(rows, PARAMS);
+        for k in 0..PARAMS {
+            let (mut hi, mut lo) = (self.params, self.params);
+            hi[k] += STEPS[k];
+            lo[k] -= STEPS[k];
+            let (a, b) = (self.residuals_at(&hi), self.residuals_at(&lo));
+            for (row, (x, y)) in a.iter().zip(&b).enumerate() {
+                j[(row, k)] = (x - y) / (2.0 * STEPS[k]);
+            }
+        }
+        j.iter().all(|v| v.is_finite()).then_some(j)
+    }
+}
+
+fn solve(
+    start: OverheadCamera,
+    targets: &[Target],
+    lines: &[LineObservation],
+    prior: HeightPrior,
+) -> Result<OverheadCamera, CalibrationError> {
+    let problem = Problem {
+        base: start,
+        base_rotation: start.field_from_camera().rotation(),
+        targets,
+        lines,
+        prior,
+        params: params_of(&start),
+    };
+    let (problem, report) = LevenbergMarquardt::new()
+        .with_patience(200)
+        .minimize(problem);
+    let camera = problem.camera(&problem.params);
+    let finite = problem.params.iter().all(|v| v.is_finite());
+    if !finite || !report.objective_function.is_finite() || camera.focal_px <= 0.0 {
+        return Err(CalibrationError::NoFit {
+            reason: format!("{:?}", report.termination),
+        });
+    }
+    Ok(camera)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::overhead::points::CalibrationPoint;
+    use crate::sim::SimRng;
+
+    fn clicked(camera: &OverheadCamera, field: &FieldDescription, noise_px: f64) -> PointsFile {
+        let mut rng = SimRng::derived(5, 9);
+        let mut file = PointsFile::new(camera.width_px, camera.height_px);
+        for l in &field.landmarks {
+            let p = Point::new(l.field_cm[0], l.field_cm[1], l.height_cm);
+            if let Some(q) = camera.image_from_field(&p) {
+                if q.x_px > 0.0 && q.y_px > 0.0 && q.x_px < 640.0 && q.y_px < 480.0 {
+                    file.points.push(CalibrationPoint {
+                        name: l.name.clone(),
+                        field_cm: l.field_cm,
+                        height_cm: l.height_cm,
+                        image_px: [
+                            q.x_px + noise_px * rng.normal(),
+                            q.y_px + noise_px * rng.normal(),
+                        ],
+                    });
+                }
+            }
+        }
+        file
+    }
+
+    #[test]
+    fn exact_clicks_give_back_the_camera() {
+        let truth = crate::sim::Scenario::new(crate::sim::ScenarioKind::OverheadGame, 3)
+            .overhead_camera();
+        let field = FieldDescription::four_legged_2005();
+        let points = clicked(&truth, &field, 0.0);
+        assert!(points.points.len() >= 20, "{}", points.points.len());
+        let cal = calibrate(&points, &field, None, &CalibrationParams::default()).expect("fits");
+        assert!(cal.median_point_error_px() < 0.05, "{cal:?}");
+        for (x, y) in [(0.0, 0.0), (250.0, 170.0), (-200.0, 100.0)] {
+            let p = Point::new(x, y, 22.5);
+            let a = truth.image_from_field(&p).expect("seen");
+            let b = cal.camera.image_from_field(&p).expect("seen");
+            assert!(a.distance_to(&b) < 0.1, "({x}, {y}): {a:?} vs {b:?}");
+        }
+    }
+
+    #[test]
+    fn a_turned_camera_is_found_without_a_turn_guess() {
+        let mut truth = OverheadCamera::above_field_2005();
+        truth.pose.yaw_rad += 2.0;
+        let field = FieldDescription::four_legged_2005();
+        let points = clicked(&truth, &field, 0.3);
+        let cal = calibrate(&points, &field, None, &CalibrationParams::default()).expect("fits");
+        assert!(cal.median_point_error_px() < 0.6, "{cal:?}");
+    }
+
+    #[test]
+    fn too_few_or_collinear_points_are_refused() {
+        let field = FieldDescription::four_legged_2005();
+        let camera = OverheadCamera::above_field_2005();
+        let mut points = clicked(&camera, &field, 0.0);
+        points.points.truncate(5);
+        assert!(matches!(
+            calibrate(&points, &field, None, &CalibrationParams::default()),
+            Err(CalibrationError::TooFewPoints { count: 5 })
+        ));
+        let mut line = PointsFile::new(640, 480);
+        for k in 0..8 {
+            line.points.push(CalibrationPoint {
+                name: format!("p{k}"),
+                field_cm: [0.0, 0.0],
+                height_cm: 0.0,
+                image_px: [320.0, 240.0],
+            });
+        }
+        assert!(matches!(
+            calibrate(&line, &field, None, &CalibrationParams::default()),
+            Err(CalibrationError::Degenerate)
+        ));
+    }
+
+    #[test]
+    fn a_saved_calibration_loads_back_and_other_json_is_refused() {
+        let field = FieldDescription::four_legged_2005();
+        let camera = OverheadCamera::above_field_2005();
+        let cal = calibrate(
+            &clicked(&camera, &field, 0.0),
+            &field,
+            None,
+            &CalibrationParams::default(),
+        )
+        .expect("fits");
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("cal.json");
+        cal.save(&path).expect("saves");
+        assert_eq!(Calibration::load(&path).expect("loads"), cal);
+        std::fs::write(&path, r#"{"format": "something else"}"#).expect("write");
+        let err = Calibration::load(&path).expect_err("not ours");
+        assert!(err.to_string().contains("cal.json"), "{err}");
+    }
+}

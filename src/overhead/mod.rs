@@ -1,0 +1,29 @@
+//! The World Model Debugger's overhead side: an overhead camera over the whole field says where
+//! the ball and every robot really are.
+//!
+//! - [`field`]: field descriptions (landmarks by name, painted lines, heights).
+//! - [`points`]: calibration points files (`*.points.json`, `FORMATS.md`).
+//! - [`calibration`]: camera pose, focal length, principal point and radial distortion by
+//!   Levenberg–Marquardt from clicked points, refined along the lines ([`lines`]); saved as a
+//!   file.
+//! - [`recognise`]: ball and robot markers in a classified image → field coordinates;
+//!   [`pipeline`] runs classification, blobs and it on a frame.
+//! - [`undistort`]: the undistorted view; [`drawing`]: the printable marker (SVG).
+//!
+//! The marker's layout itself is a geometry type (`geometry::marker`) because the simulator
+//! paints it too.
+
+pub mod calibration;
+pub mod drawing;
+pub mod field;
+pub mod lines;
+pub mod pipeline;
+pub mod points;
+pub mod recognise;
+pub mod undistort;
+
+pub use calibration::{Calibration, CalibrationError, CalibrationParams, calibrate};
+pub use field::FieldDescription;
+pub use pipeline::OverheadPipeline;
+pub use points::{CalibrationPoint, PointsFile};
+pub use recognise::{OverheadDetections, OverheadParams, recognise_overhead};

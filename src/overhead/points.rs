@@ -1,0 +1,212 @@
+//! Calibration points files (`*.points.json`, `FORMATS.md`): image points of named field
+//! landmarks, as a user clicks them in the app or a tool writes them.
+//!
+//! `{"width": 640, "height": 480, "points": [{"name": "centre", "field_cm": [0, 0],
+//! "image_px": [321.4, 238.0]}, …]}`. `field_cm` lie on the ground; `image_px` are in the
+//! distorted image as the camera delivers it (pixel centres at +0.5). The project adds one
+//! optional key per point, `height_cm`, for landmarks above the ground (goal-post tops): other
+//! readers ignore it, and without it the point is on the ground as the format says.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::atomic_file::write_atomic;
+use crate::geometry::ImagePoint;
+
+/// One clicked landmark.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CalibrationPoint {
+    /// The landmark's name.
+    pub name: String,
+    /// Field position `[x, y]`, centimetres.
+    pub field_cm: [f64; 2],
+    /// Height above the ground, centimetres (an extension of the format; 0 when absent).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub height_cm: f64,
+    /// Where it is in the distorted image `[x, y]`, pixels.
+    pub image_px: [f64; 2],
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+impl CalibrationPoint {
+    /// The image position.
+    #[must_use]
+    pub fn image(&self) -> ImagePoint {
+        ImagePoint::new(self.image_px[0], self.image_px[1])
+    }
+}
+
+/// A points file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PointsFile {
+    /// Image width, pixels.
+    pub width: usize,
+    /// Image height, pixels.
+    pub height: usize,
+    /// The clicked landmarks.
+    pub points: Vec<CalibrationPoint>,
+}
+
+/// Why a points file could not be read or written.
+#[derive(Debug, Error)]
+pub enum PointsError {
+    /// The file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// Not a points file.
+    #[error("{path}: not a calibration points file: {source}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// The error.
+        source: serde_json::Error,
+    },
+    /// A value is unusable.
+    #[error("{path}: {what}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        what: String,
+    },
+}
+
+impl PointsFile {
+    /// An empty file for an image size.
+    #[must_use]
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            points: Vec::new(),
+        }
+    }
+
+    /// Reads and checks a points file.
+    ///
+    /// # Errors
+    /// [`PointsError`] for a missing file, bad JSON, a zero image size or a non-finite value.
+    pub fn load(path: &Path) -> Result<Self, PointsError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| PointsError::Io {
+            path: name.clone(),
+            source,
+        })?;
+        let file: Self = serde_json::from_str(&text).map_err(|source| PointsError::Parse {
+            path: name.clone(),
+            source,
+        })?;
+        file.check()
+            .map_err(|what| PointsError::Invalid { path: name, what })?;
+        Ok(file)
+    }
+
+    fn check(&self) -> Result<(), String> {
+        if self.width == 0 || self.height == 0 {
+            return Err(format!("image size {}x{} is empty", self.width, self.height));
+        }
+        for p in &self.points {
+            let values = [
+                p.field_cm[0],
+                p.field_cm[1],
+                p.height_cm,
+                p.image_px[0],
+                p.image_px[1],
+            ];
+            if !values.iter().all(|v| v.is_finite()) {
+                return Err(format!("point {:?} has a value that is not a number", p.name));
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the file atomically (pretty JSON).
+    ///
+    /// # Errors
+    /// [`PointsError::Io`] when it cannot be written.
+    pub fn save(&self, path: &Path) -> Result<(), PointsError> {
+        let mut text = serde_json::to_string_pretty(self).map_err(|source| PointsError::Parse {
+            path: path.display().to_string(),
+            source,
+        })?;
+        text.push('\n');
+        write_atomic(path, text.as_bytes()).map_err(|source| PointsError::Io {
+            path: path.display().to_string(),
+            source,
+        })
+    }
+
+    /// Adds a point, replacing an earlier one of the same name (a re-click).
+    pub fn set(&mut self, point: CalibrationPoint) {
+        match self.points.iter_mut().find(|p| p.name == point.name) {
+            Some(old) => *old = point,
+            None => self.points.push(point),
+        }
+    }
+
+    /// Removes the point of this name; whether there was one.
+    pub fn remove(&mut self, name: &str) -> bool {
+        let before = self.points.len();
+        self.points.retain(|p| p.name != name);
+        self.points.len() != before
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_formats_example_parses_and_round_trips() {
+        let text = r#"{"width": 640, "height": 480, "points": [{"name": "centre",
+            "field_cm": [0, 0], "image_px": [321.4, 238.0]}]}"#;
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("a.points.json");
+        std::fs::write(&path, text).expect("write");
+        let file = PointsFile::load(&path).expect("loads");
+        assert_eq!(file.points[0].image_px, [321.4, 238.0]);
+        assert_eq!(file.points[0].height_cm, 0.0);
+        let out = dir.path().join("b.points.json");
+        file.save(&out).expect("saves");
+        let written = std::fs::read_to_string(&out).expect("read");
+        assert!(!written.contains("height_cm"), "ground points stay in the fixed format");
+        assert_eq!(PointsFile::load(&out).expect("loads"), file);
+    }
+
+    #[test]
+    fn a_re_click_replaces_the_point_of_that_name() {
+        let mut file = PointsFile::new(640, 480);
+        let p = |x| CalibrationPoint {
+            name: "centre".into(),
+            field_cm: [0.0, 0.0],
+            height_cm: 0.0,
+            image_px: [x, 10.0],
+        };
+        file.set(p(1.0));
+        file.set(p(2.0));
+        assert_eq!(file.points.len(), 1);
+        assert_eq!(file.points[0].image_px[0], 2.0);
+        assert!(file.remove("centre") && !file.remove("centre"));
+    }
+
+    #[test]
+    fn nan_and_empty_sizes_are_refused_with_the_file_name() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("bad.points.json");
+        std::fs::write(&path, r#"{"width": 0, "height": 480, "points": []}"#).expect("write");
+        let err = PointsFile::load(&path).expect_err("empty size");
+        assert!(err.to_string().contains("bad.points.json"), "{err}");
+        std::fs::write(&path, "{\"width\": 640").expect("write");
+        assert!(matches!(PointsFile::load(&path), Err(PointsError::Parse { .. })));
+    }
+}

@@ -1,0 +1,486 @@
+//! The overhead recogniser: ball and robot markers in a classified overhead image, in field
+//! coordinates through a calibrated camera.
+//!
+//! - **Ball**: orange blobs whose size matches the ball's image size at that place (the
+//!   calibration says how large an 8.5 cm sphere looks there), refined by a circle fit on the
+//!   blob's outline (`recognition::fit`), placed on the plane at the ball centre's height.
+//! - **Robots**: sky-blue or yellow blobs the size and shape of a team dot, placed on the plane
+//!   of the marker plates; around each, the four identity dots are looked for where the layout
+//!   puts them: a ring of samples 10 cm from the centre gives the heading (the dots' uneven
+//!   spacing fixes it), then each dot's own pixels give its colour (its bit) and its centroid,
+//!   and the four centroids refine the heading.
+//!
+//! Output per frame: [`OverheadDetections`], plus the rejected candidates with their reasons
+//! for the overlays.
+
+use serde::{Deserialize, Serialize};
+
+use crate::blobs::{Blob, BlobSet};
+use crate::classify::ClassifiedImage;
+use crate::geometry::marker::{
+    ID_DOT_ANGLES_DEG, ID_DOT_DIAMETER_CM, ID_DOT_RADIUS_CM, TEAM_DOT_DIAMETER_CM,
+};
+use crate::geometry::{Field, ImagePoint, MarkerIdentity, MarkerTeam, OverheadCamera, Point};
+use crate::lut::ColourClass;
+use crate::recognition::fit::fit_circle;
+
+/// Settings of the overhead recogniser.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OverheadParams {
+    /// Ball radius, centimetres.
+    pub ball_radius_cm: f64,
+    /// Height of the marker plates, centimetres.
+    pub plate_height_cm: f64,
+    /// Smallest and largest blob area as a share of the expected image area (ball, team dot).
+    pub area_ratio: [f64; 2],
+    /// Smallest share of the ring samples that must agree with the marker layout at the best
+    /// heading for a robot to be reported.
+    pub min_layout_agreement: f64,
+}
+
+impl Default for OverheadParams {
+    fn default() -> Self {
+        Self {
+            ball_radius_cm: 4.25,
+            plate_height_cm: crate::geometry::marker::DEFAULT_PLATE_HEIGHT_CM,
+            area_ratio: [0.35, 1.8],
+            min_layout_agreement: 0.75,
+        }
+    }
+}
+
+/// The ball seen from above.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct OverheadBall {
+    /// Field position of its centre projected down, centimetres `[x, y]`.
+    pub field_cm: [f64; 2],
+    /// Image position of its centre, pixels.
+    pub image: ImagePoint,
+    /// Image radius, pixels.
+    pub radius_px: f64,
+    /// Confidence, 0 to 1.
+    pub confidence: f64,
+}
+
+/// A robot read from its marker.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct OverheadRobot {
+    /// Team dot colour.
+    pub team: MarkerTeam,
+    /// Identity read from the four dots.
+    pub identity: MarkerIdentity,
+    /// Field position of the plate's centre projected down, centimetres `[x, y]`.
+    pub field_cm: [f64; 2],
+    /// Heading, radians counter-clockwise from +x, in (−π, π].
+    pub heading_rad: f64,
+    /// Image position of the plate's centre, pixels.
+    pub image: ImagePoint,
+    /// Image positions of the four identity dots (bit 0 first), pixels.
+    pub dots: [ImagePoint; 4],
+    /// Confidence, 0 to 1.
+    pub confidence: f64,
+}
+
+/// Why a blob was not taken for a ball or a team dot.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum OverheadRejection {
+    /// Its area is far from the expected image area there.
+    Size {
+        /// Blob pixels.
+        pixels: u32,
+        /// Expected pixels.
+        expected: f64,
+    },
+    /// It is not round enough (box aspect or fill).
+    Shape {
+        /// Box width / height.
+        aspect: f64,
+    },
+    /// The camera does not see its place on the field.
+    OffField,
+    /// No marker layout around a team dot.
+    NoMarker {
+        /// Share of the ring samples that agreed at the best heading.
+        agreement: f64,
+    },
+    /// Another candidate was better.
+    Duplicate,
+}
+
+/// A rejected candidate, for overlays.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RejectedCandidate {
+    /// Blob box `[minx, miny, maxx, maxy]`, inclusive pixels.
+    pub bounds: [u32; 4],
+    /// Blob class code.
+    pub colour: u8,
+    /// Why.
+    pub reason: OverheadRejection,
+}
+
+/// What one overhead frame shows.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct OverheadDetections {
+    /// The ball, if found.
+    pub ball: Option<OverheadBall>,
+    /// Robots, in image order of their team dots.
+    pub robots: Vec<OverheadRobot>,
+    /// Candidates not taken.
+    pub rejected: Vec<RejectedCandidate>,
+}
+
+/// Recognises ball and robots in a classified overhead image.
+#[must_use]
+pub fn recognise_overhead(
+    image: &ClassifiedImage,
+    blobs: &BlobSet,
+    camera: &OverheadCamera,
+    params: &OverheadParams,
+) -> OverheadDetections {
+    let mut out = OverheadDetections::default();
+    out.ball = find_ball(blobs, camera, params, &mut out.rejected);
+    let mut robots = Vec::new();
+    for blob in blobs.active() {
+        let Some(team) = MarkerTeam::from_class(blob.class()) else {
+            continue;
+        };
+        match read_marker(image, blob, team, camera, params) {
+            Ok(r) => robots.push(r),
+            Err(reason) => out.rejected.push(rejected(blob, reason)),
+        }
+    }
+    // Two candidates within a plate of each other: keep the more confident.
+    robots.sort_by(|a, b| b.confidence.total_cmp(&a.confidence));
+    let mut kept: Vec<OverheadRobot> = Vec::new();
+    for r in robots {
+        let close = kept.iter().any(|k| {
+            (k.field_cm[0] - r.field_cm[0]).hypot(k.field_cm[1] - r.field_cm[1]) < 20.0
+        });
+        if close {
+            out.rejected.push(RejectedCandidate {
+                bounds: box_around(r.image, 4.0),
+                colour: r.team.class().code(),
+                reason: OverheadRejection::Duplicate,
+            });
+        } else {
+            kept.push(r);
+        }
+    }
+    kept.sort_by(|a, b| {
+        (a.image.y_px, a.image.x_px)
+            .partial_cmp(&(b.image.y_px, b.image.x_px))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    out.robots = kept;
+    out
+}
+
+fn rejected(blob: &Blob, reason: OverheadRejection) -> RejectedCandidate {
+    RejectedCandidate {
+        bounds: [blob.minx, blob.miny, blob.maxx, blob.maxy],
+        colour: blob.colour,
+        reason,
+    }
+}
+
+fn box_around(p: ImagePoint, r: f64) -> [u32; 4] {
+    let c = |v: f64| v.max(0.0) as u32;
+    [c(p.x_px - r), c(p.y_px - r), c(p.x_px + r), c(p.y_px + r)]
+}
+
+/// Image radius (pixels) of a disc or sphere of `radius_cm` centred at field point `p`: the
+/// mean image distance of four points `radius_cm` away across the viewing ray.
+fn image_radius_px(camera: &OverheadCamera, p: &Point<Field>, radius_cm: f64) -> Option<f64> {
+    let c = camera.image_from_field(p)?;
+    let mut sum = 0.0;
+    for (dx, dy) in [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)] {
+        let q = camera.image_from_field(&Point::new(
+            p.x() + dx * radius_cm,
+            p.y() + dy * radius_cm,
+            p.z(),
+        ))?;
+        sum += q.distance_to(&c);
+    }
+    Some(sum / 4.0)
+}
+
+/// Checks a blob's size against a disc of `radius_cm` at height `z_cm`; gives its field point.
+fn sized_like(
+    blob: &Blob,
+    camera: &OverheadCamera,
+    z_cm: f64,
+    radius_cm: f64,
+    params: &OverheadParams,
+) -> Result<(Point<Field>, f64, f64), OverheadRejection> {
+    let (cx, cy) = blob.centroid();
+    let ground = camera
+        .field_from_image(ImagePoint::new(cx, cy), z_cm)
+        .ok_or(OverheadRejection::OffField)?;
+    let expected_r = image_radius_px(camera, &ground, radius_cm).ok_or(OverheadRejection::OffField)?;
+    let expected = std::f64::consts::PI * expected_r * expected_r;
+    let ratio = f64::from(blob.pixels) / expected.max(1e-9);
+    if !(params.area_ratio[0]..=params.area_ratio[1]).contains(&ratio) {
+        return Err(OverheadRejection::Size {
+            pixels: blob.pixels,
+            expected,
+        });
+    }
+    let aspect = f64::from(blob.width()) / f64::from(blob.height());
+    let fill = f64::from(blob.pixels) / blob.area() as f64;
+    if !(0.5..=2.0).contains(&aspect) || fill < 0.5 {
+        return Err(OverheadRejection::Shape { aspect });
+    }
+    Ok((ground, expected_r, ratio))
+}
+
+fn find_ball(
+    blobs: &BlobSet,
+    camera: &OverheadCamera,
+    params: &OverheadParams,
+    rejected_out: &mut Vec<RejectedCandidate>,
+) -> Option<OverheadBall> {
+    let r_cm = params.ball_radius_cm;
+    let mut best: Option<OverheadBall> = None;
+    for blob in blobs.of_class(ColourClass::Orange) {
+        let (_, expected_r, ratio) = match sized_like(blob, camera, r_cm, r_cm, params) {
+            Ok(v) => v,
+            Err(reason) => {
+                if blob.pixels >= 3 {
+                    rejected_out.push(rejected(blob, reason));
+                }
+                continue;
+            }
+        };
+        // Outline points: both ends of every run of the blob.
+        let outline: Vec<(f64, f64)> = blobs
+            .runs_of(blob.number)
+            .flat_map(|run| {
+                let y = f64::from(run.y) + 0.5;
+                [(f64::from(run.x0), y), (f64::from(run.x1), y)]
+            })
+            .collect();
+        let (cx, cy) = blob.centroid();
+        let (centre, radius) = match fit_circle(&outline) {
+            Some(fit)
+                if (fit.radius - expected_r).abs() < 0.5 * expected_r
+                    && (fit.center_x - cx).hypot(fit.center_y - cy) < expected_r =>
+            {
+                (ImagePoint::new(fit.center_x, fit.center_y), fit.radius)
+            }
+            _ => (ImagePoint::new(cx, cy), (f64::from(blob.pixels) / std::f64::consts::PI).sqrt()),
+        };
+        let Some(ground) = camera.field_from_image(centre, r_cm) else {
+            continue;
+        };
+        let size_match = (-((ratio.ln()) / 0.5).powi(2)).exp();
+        let confidence = size_match.clamp(0.0, 1.0);
+        if best.is_none_or(|b| confidence > b.confidence) {
+            if let Some(old) = best {
+                rejected_out.push(RejectedCandidate {
+                    bounds: box_around(old.image, old.radius_px),
+                    colour: ColourClass::Orange.code(),
+                    reason: OverheadRejection::Duplicate,
+                });
+            }
+            best = Some(OverheadBall {
+                field_cm: [ground.x(), ground.y()],
+                image: centre,
+                radius_px: radius,
+                confidence,
+            });
+        }
+    }
+    best
+}
+
+/// Ring samples per turn for the heading search.
+const RING_SAMPLES: usize = 180;
+
+/// Whether a class belongs to an identity dot.
+fn is_dot(code: u8) -> bool {
+    code == ColourClass::Pink.code() || code == ColourClass::Green.code()
+}
+
+fn read_marker(
+    image: &ClassifiedImage,
+    blob: &Blob,
+    team: MarkerTeam,
+    camera: &OverheadCamera,
+    params: &OverheadParams,
+) -> Result<OverheadRobot, OverheadRejection> {
+    let z = params.plate_height_cm;
+    let (centre, _, ratio) = sized_like(blob, camera, z, TEAM_DOT_DIAMETER_CM / 2.0, params)?;
+    // Ring of samples through the dots' centres: which angles show a dot.
+    let ring: Vec<bool> = (0..RING_SAMPLES)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / RING_SAMPLES as f64;
+            let p = Point::new(
+                centre.x() + ID_DOT_RADIUS_CM * a.cos(),
+                centre.y() + ID_DOT_RADIUS_CM * a.sin(),
+                z,
+            );
+            camera
+                .image_from_field(&p)
+                .and_then(|q| image.get_at(q.x_px, q.y_px))
+                .is_some_and(is_dot)
+        })
+        .collect();
+    let (heading, agreement) = best_layout_heading(&ring);
+    if agreement < params.min_layout_agreement {
+        return Err(OverheadRejection::NoMarker { agreement });
+    }
+    // Each dot's own pixels: colour (majority) and centroid.
+    let dot_r = ID_DOT_DIAMETER_CM / 2.0;
+    let mut bits = [false; 4];
+    let mut dots = [ImagePoint::default(); 4];
+    let mut heading_sum = (0.0, 0.0);
+    for (k, angle_deg) in ID_DOT_ANGLES_DEG.iter().enumerate() {
+        let a = heading + angle_deg.to_radians();
+        let expected = Point::new(
+            centre.x() + ID_DOT_RADIUS_CM * a.cos(),
+            centre.y() + ID_DOT_RADIUS_CM * a.sin(),
+            z,
+        );
+        let Some(q) = camera.image_from_field(&expected) else {
+            return Err(OverheadRejection::OffField);
+        };
+        let r_px = image_radius_px(camera, &expected, 1.35 * dot_r).unwrap_or(4.0);
+        let dot = dot_pixels(image, q, r_px);
+        bits[k] = dot.pink > dot.green;
+        dots[k] = dot.centroid.unwrap_or(q);
+        if let Some(g) = dot.centroid.and_then(|c| camera.field_from_image(c, z)) {
+            let measured = (g.y() - centre.y()).atan2(g.x() - centre.x());
+            let h = measured - angle_deg.to_radians();
+            let w = f64::from(dot.pink + dot.green);
+            heading_sum.0 += w * h.cos();
+            heading_sum.1 += w * h.sin();
+        }
+    }
+    let refined = if heading_sum.0.hypot(heading_sum.1) > 0.0 {
+        heading_sum.1.atan2(heading_sum.0)
+    } else {
+        heading
+    };
+    let size_match = (-((ratio.ln()) / 0.6).powi(2)).exp();
+    let image_centre = camera.image_from_field(&centre).unwrap_or(ImagePoint::new(
+        blob.centroid().0,
+        blob.centroid().1,
+    ));
+    Ok(OverheadRobot {
+        team,
+        identity: MarkerIdentity::from_bits(bits),
+        field_cm: [centre.x(), centre.y()],
+        heading_rad: refined,
+        image: image_centre,
+        dots,
+        confidence: (agreement * size_match).clamp(0.0, 1.0),
+    })
+}
+
+/// The heading (radians) whose four dot arcs best match the ring, and the share of ring
+/// samples that agree with the layout there (dot inside an arc, none outside).
+fn best_layout_heading(ring: &[bool]) -> (f64, f64) {
+    let n = ring.len();
+    let half_width = (ID_DOT_DIAMETER_CM / 2.0 / ID_DOT_RADIUS_CM).asin();
+    let step = std::f64::consts::TAU / n as f64;
+    let template: Vec<bool> = (0..n)
+        .map(|k| {
+            let a = k as f64 * step;
+            ID_DOT_ANGLES_DEG.iter().any(|d| {
+                let diff = (a - d.to_radians() + std::f64::consts::PI)
+                    .rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI;
+                diff.abs() <= half_width
+            })
+        })
+        .collect();
+    let mut best = (0, 0);
+    for shift in 0..n {
+        let agree = (0..n)
+            .filter(|&k| ring[(k + shift) % n] == template[k])
+            .count();
+        if agree > best.1 {
+            best = (shift, agree);
+        }
+    }
+    let heading = best.0 as f64 * step;
+    let heading = (heading + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+        - std::f64::consts::PI;
+    (heading, best.1 as f64 / n as f64)
+}
+
+#[derive(Debug, Default)]
+struct DotPixels {
+    pink: u32,
+    green: u32,
+    centroid: Option<ImagePoint>,
+}
+
+/// Pink and green pixels within `r_px` of `q`, and their centroid.
+fn dot_pixels(image: &ClassifiedImage, q: ImagePoint, r_px: f64) -> DotPixels {
+    let mut d = DotPixels::default();
+    let (mut sx, mut sy) = (0.0, 0.0);
+    let (x0, x1) = ((q.x_px - r_px).floor().max(0.0), (q.x_px + r_px).ceil());
+    let (y0, y1) = ((q.y_px - r_px).floor().max(0.0), (q.y_px + r_px).ceil());
+    let r2 = r_px * r_px;
+    for y in y0 as usize..=(y1.max(0.0) as usize) {
+        for x in x0 as usize..=(x1.max(0.0) as usize) {
+            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+            if (px - q.x_px).powi(2) + (py - q.y_px).powi(2) > r2 {
+                continue;
+            }
+            match image.get(x, y) {
+                Some(c) if c == ColourClass::Pink.code() => d.pink += 1,
+                Some(c) if c == ColourClass::Green.code() => d.green += 1,
+                _ => continue,
+            }
+            sx += px;
+            sy += py;
+        }
+    }
+    let n = d.pink + d.green;
+    if n > 0 {
+        d.centroid = Some(ImagePoint::new(sx / f64::from(n), sy / f64::from(n)));
+    }
+    d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_layout_heading_is_found_from_a_ring_alone() {
+        for heading_deg in [0.0f64, 37.0, -100.0, 170.0] {
+            let h = heading_deg.to_radians();
+            let half = (0.3f64).asin();
+            let ring: Vec<bool> = (0..RING_SAMPLES)
+                .map(|k| {
+                    let a = k as f64 * std::f64::consts::TAU / RING_SAMPLES as f64;
+                    ID_DOT_ANGLES_DEG.iter().any(|d| {
+                        let diff = (a - h - d.to_radians() + std::f64::consts::PI)
+                            .rem_euclid(std::f64::consts::TAU)
+                            - std::f64::consts::PI;
+                        diff.abs() <= half
+                    })
+                })
+                .collect();
+            let (found, agreement) = best_layout_heading(&ring);
+            let err = (found - h + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            assert!(err.abs() < 0.04, "{heading_deg}: {found}");
+            assert!(agreement > 0.97, "{agreement}");
+        }
+    }
+
+    #[test]
+    fn an_all_black_ring_is_no_marker() {
+        let (_, agreement) = best_layout_heading(&[false; RING_SAMPLES]);
+        assert!(
+            agreement < OverheadParams::default().min_layout_agreement,
+            "{agreement}"
+        );
+    }
+}
