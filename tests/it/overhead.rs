@@ -30,7 +30,7 @@ fn overhead_truth(f: &SimFrame) -> &OverheadTruth {
 fn overhead_table() -> LookupTable {
     let sim = Simulator::new(Scenario::new(ScenarioKind::OverheadGame, 99));
     let mut builder = TableBuilder::new(7).unwrap();
-    for index in [0, 45, 90, 135] {
+    for index in (0..300).step_by(30) {
         let f = sim.frame(index).unwrap();
         builder.add_frame(&f.frame, &f.labels).unwrap();
     }
@@ -283,3 +283,4 @@ fn a_points_file_with_too_few_points_fails_in_one_line() {
     assert!(err.contains("at least 6"), "{err}");
     assert!(!dir.path().join("c.json").exists());
 }
+
