@@ -34,7 +34,11 @@ fn overhead(c: &mut Criterion) {
     let blobs = BlobSet::from_image(&classified, Connectivity::Eight);
     c.bench_function("overhead_recognise_640x480", |b| {
         b.iter(|| {
-            black_box(recognise_overhead(&classified, &blobs, &truth.camera, &params).robots.len())
+            black_box(
+                recognise_overhead(&classified, &blobs, &truth.camera, &params)
+                    .robots
+                    .len(),
+            )
         });
     });
 }

@@ -126,7 +126,10 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
             format!("{:.1}%", 100.0 * n as f64 / d as f64)
         }
     };
-    println!("overhead frames        {} (calibration: {calibration})", r.frames);
+    println!(
+        "overhead frames        {} (calibration: {calibration})",
+        r.frames
+    );
     println!(
         "ball found             {}/{} = {}   false {}",
         r.ball_found,
@@ -175,6 +178,10 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         );
     }
     if !skipped.is_empty() {
-        println!("skipped                {} (first: {})", skipped.len(), skipped[0]);
+        println!(
+            "skipped                {} (first: {})",
+            skipped.len(),
+            skipped[0]
+        );
     }
 }

@@ -10,13 +10,13 @@ use serde::Serialize;
 
 use super::inputs::{FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress};
 use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
+use crate::overhead::OverheadPipeline;
 use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
 use crate::overhead::drawing::marker_svg;
 use crate::overhead::field::FieldDescription;
 use crate::overhead::lines::projected_field_lines;
 use crate::overhead::points::{CalibrationPoint, PointsFile};
 use crate::overhead::recognise::{OverheadDetections, OverheadParams};
-use crate::overhead::OverheadPipeline;
 use crate::sim::{GroundTruth, SimRng};
 use crate::streams::StreamReader;
 
@@ -154,7 +154,11 @@ fn run_marker(a: &MarkerArgs) -> anyhow::Result<()> {
     let id = MarkerIdentity::new(a.id).with_context(|| format!("id {}: must be 0-15", a.id))?;
     crate::atomic_file::write_atomic(&a.output, marker_svg(team, id).as_bytes())
         .with_context(|| format!("{}: cannot write", a.output.display()))?;
-    eprintln!("{}: marker team {} id {id}", a.output.display(), team.name());
+    eprintln!(
+        "{}: marker team {} id {id}",
+        a.output.display(),
+        team.name()
+    );
     Ok(())
 }
 
@@ -166,17 +170,20 @@ fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|p| load_frame_arg(p, a.size))
         .transpose()?;
-    if let Some(f) = &frame {
-        if (f.width(), f.height()) != (points.width, points.height) {
-            bail!(
-                "{}: the frame is {}x{}, the points are for {}x{}",
-                a.image.as_deref().map(Path::display).map(|d| d.to_string()).unwrap_or_default(),
-                f.width(),
-                f.height(),
-                points.width,
-                points.height
-            );
-        }
+    if let Some(f) = &frame
+        && (f.width(), f.height()) != (points.width, points.height)
+    {
+        bail!(
+            "{}: the frame is {}x{}, the points are for {}x{}",
+            a.image
+                .as_deref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default(),
+            f.width(),
+            f.height(),
+            points.width,
+            points.height
+        );
     }
     let params = CalibrationParams {
         refine_lines: !a.no_lines,
@@ -197,8 +204,12 @@ fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
 fn print_calibration(cal: &Calibration) {
     let c = &cal.camera;
     let [x, y, z] = c.pose.position_cm;
-    println!("camera at ({x:.1}, {y:.1}, {z:.1}) cm, yaw {:.2}° pitch {:.2}° roll {:.2}°",
-        c.pose.yaw_rad.to_degrees(), c.pose.pitch_rad.to_degrees(), c.pose.roll_rad.to_degrees());
+    println!(
+        "camera at ({x:.1}, {y:.1}, {z:.1}) cm, yaw {:.2}° pitch {:.2}° roll {:.2}°",
+        c.pose.yaw_rad.to_degrees(),
+        c.pose.pitch_rad.to_degrees(),
+        c.pose.roll_rad.to_degrees()
+    );
     println!(
         "focal {:.2} px, principal point ({:.2}, {:.2}) px, k1 {:.5}, k2 {:.5}",
         c.focal_px, c.centre.x_px, c.centre.y_px, c.k1, c.k2
@@ -210,9 +221,16 @@ fn print_calibration(cal: &Calibration) {
             p.name, p.error_px, p.image_px[0], p.image_px[1]
         );
     }
-    println!("median {:.3} px over {} points", cal.median_point_error_px(), cal.points.len());
+    println!(
+        "median {:.3} px over {} points",
+        cal.median_point_error_px(),
+        cal.points.len()
+    );
     if let Some(rms) = cal.line_rms_px {
-        println!("line refinement: {} samples, rms {rms:.3} px", cal.line_samples);
+        println!(
+            "line refinement: {} samples, rms {rms:.3} px",
+            cal.line_samples
+        );
     }
 }
 
@@ -223,8 +241,9 @@ fn write_lines_png(
     field: &FieldDescription,
     camera: &OverheadCamera,
 ) -> anyhow::Result<()> {
-    let mut canvas = crate::overlay::Canvas::from_rgb(frame.width(), frame.height(), &frame.to_rgb(), 1)
-        .context("frame size")?;
+    let mut canvas =
+        crate::overlay::Canvas::from_rgb(frame.width(), frame.height(), &frame.to_rgb(), 1)
+            .context("frame size")?;
     for curve in projected_field_lines(field, camera) {
         for pair in curve.windows(2) {
             canvas.line(
@@ -388,7 +407,10 @@ pub fn simulated_clicks(
             name: l.name.clone(),
             field_cm: l.field_cm,
             height_cm: l.height_cm,
-            image_px: [q.x_px + noise_px * rng.normal(), q.y_px + noise_px * rng.normal()],
+            image_px: [
+                q.x_px + noise_px * rng.normal(),
+                q.y_px + noise_px * rng.normal(),
+            ],
         });
     }
     file
@@ -406,7 +428,9 @@ pub fn stream_truth_camera(path: &Path) -> anyhow::Result<OverheadCamera> {
         .with_context(|| format!("{}: frame 0 has no ground truth", path.display()))?;
     match serde_json::from_value::<GroundTruth>(truth) {
         Ok(GroundTruth::Overhead(t)) => Ok(t.camera),
-        Ok(GroundTruth::Robot(_)) => bail!("{}: a robot-camera stream, not overhead", path.display()),
+        Ok(GroundTruth::Robot(_)) => {
+            bail!("{}: a robot-camera stream, not overhead", path.display())
+        }
         Err(e) => bail!("{}: unreadable ground truth: {e}", path.display()),
     }
 }

@@ -266,7 +266,10 @@ impl OverheadEvalReport {
     #[must_use]
     pub fn from_frames(frames: &[OverheadFrameEval], models: &[WorldModelFrameEval]) -> Self {
         let ball: Vec<f64> = frames.iter().filter_map(|f| f.ball_error_cm).collect();
-        let robots: Vec<f64> = frames.iter().flat_map(|f| f.robot_errors_cm.clone()).collect();
+        let robots: Vec<f64> = frames
+            .iter()
+            .flat_map(|f| f.robot_errors_cm.clone())
+            .collect();
         let headings: Vec<f64> = frames
             .iter()
             .flat_map(|f| f.heading_errors_deg.clone())
@@ -381,12 +384,19 @@ mod tests {
                 radius_px: 5.0,
                 confidence: 1.0,
             }),
-            robots: vec![detected(1, -98.0, 0.5 + 0.1), detected(7, 101.0, 0.5), detected(3, 0.0, 0.0)],
+            robots: vec![
+                detected(1, -98.0, 0.5 + 0.1),
+                detected(7, 101.0, 0.5),
+                detected(3, 0.0, 0.0),
+            ],
             rejected: Vec::new(),
         };
         let e = evaluate_overhead_frame(0, &d, &truth(), &OverheadEvalParams::default());
         assert_eq!(e.ball_error_cm, Some(5.0));
-        assert_eq!((e.robots_eligible, e.robots_found, e.identity_right), (2, 2, 1));
+        assert_eq!(
+            (e.robots_eligible, e.robots_found, e.identity_right),
+            (2, 2, 1)
+        );
         assert_eq!(e.robots_false, 1);
         assert_eq!(e.wrong_identities, vec![("blue 2".into(), "blue 7".into())]);
         assert!((e.heading_errors_deg[0] - 0.1f64.to_degrees()).abs() < 1e-9);
@@ -411,6 +421,16 @@ mod tests {
         assert!((e.self_error_cm.expect("error") - 5.0).abs() < 1e-9);
         assert!((e.ball_error_cm.expect("error") - 10.0).abs() < 1e-9);
         assert!((e.self_error_vs_overhead_cm.expect("error") - 5.0).abs() < 1e-9);
-        assert!(evaluate_world_model(&WorldModel { robot_id: 9, ..model }, &truth(), None).is_none());
+        assert!(
+            evaluate_world_model(
+                &WorldModel {
+                    robot_id: 9,
+                    ..model
+                },
+                &truth(),
+                None
+            )
+            .is_none()
+        );
     }
 }

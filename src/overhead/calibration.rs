@@ -28,9 +28,7 @@ use super::lines::{LineObservation, find_line_observations};
 use super::points::PointsFile;
 use crate::atomic_file::write_atomic;
 use crate::frame::Frame;
-use crate::geometry::{
-    Camera, Field, ImagePoint, OverheadCamera, Point, PoseRecord, Transform,
-};
+use crate::geometry::{Camera, Field, ImagePoint, OverheadCamera, Point, PoseRecord, Transform};
 
 /// Settings of the calibration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -183,7 +181,10 @@ impl Calibration {
             c.pose.pitch_rad,
             c.pose.roll_rad,
         ];
-        if !values.iter().chain(&c.pose.position_cm).all(|v| v.is_finite())
+        if !values
+            .iter()
+            .chain(&c.pose.position_cm)
+            .all(|v| v.is_finite())
             || c.focal_px <= 0.0
             || c.width_px == 0
             || c.height_px == 0
@@ -446,7 +447,9 @@ fn params_of(camera: &OverheadCamera) -> [f64; PARAMS] {
 }
 
 /// Finite-difference steps per parameter: small against each one's scale.
-const STEPS: [f64; PARAMS] = [1e-3, 1e-3, 1e-3, 1e-6, 1e-6, 1e-6, 1e-3, 1e-3, 1e-3, 1e-6, 1e-6];
+const STEPS: [f64; PARAMS] = [
+    1e-3, 1e-3, 1e-3, 1e-6, 1e-6, 1e-6, 1e-3, 1e-3, 1e-3, 1e-6, 1e-6,
+];
 
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     type ResidualStorage = Owned<f64, Dyn>;
@@ -465,7 +468,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 
     fn residuals(&self) -> Option<DVector<f64>> {
         let r = self.residuals_at(&self.params);
-        r.iter().all(|v| v.is_finite()).then(|| DVector::from_vec(r))
+        r.iter()
+            .all(|v| v.is_finite())
+            .then(|| DVector::from_vec(r))
     }
 
     /// Central differences: the projection through the lens has no tidy closed-form
@@ -524,18 +529,21 @@ mod tests {
         let mut file = PointsFile::new(camera.width_px, camera.height_px);
         for l in &field.landmarks {
             let p = Point::new(l.field_cm[0], l.field_cm[1], l.height_cm);
-            if let Some(q) = camera.image_from_field(&p) {
-                if q.x_px > 0.0 && q.y_px > 0.0 && q.x_px < 640.0 && q.y_px < 480.0 {
-                    file.points.push(CalibrationPoint {
-                        name: l.name.clone(),
-                        field_cm: l.field_cm,
-                        height_cm: l.height_cm,
-                        image_px: [
-                            q.x_px + noise_px * rng.normal(),
-                            q.y_px + noise_px * rng.normal(),
-                        ],
-                    });
-                }
+            if let Some(q) = camera.image_from_field(&p)
+                && q.x_px > 0.0
+                && q.y_px > 0.0
+                && q.x_px < 640.0
+                && q.y_px < 480.0
+            {
+                file.points.push(CalibrationPoint {
+                    name: l.name.clone(),
+                    field_cm: l.field_cm,
+                    height_cm: l.height_cm,
+                    image_px: [
+                        q.x_px + noise_px * rng.normal(),
+                        q.y_px + noise_px * rng.normal(),
+                    ],
+                });
             }
         }
         file
@@ -543,8 +551,8 @@ mod tests {
 
     #[test]
     fn exact_clicks_give_back_the_camera() {
-        let truth = crate::sim::Scenario::new(crate::sim::ScenarioKind::OverheadGame, 3)
-            .overhead_camera();
+        let truth =
+            crate::sim::Scenario::new(crate::sim::ScenarioKind::OverheadGame, 3).overhead_camera();
         let field = FieldDescription::four_legged_2005();
         let points = clicked(&truth, &field, 0.0);
         assert!(points.points.len() >= 20, "{}", points.points.len());

@@ -95,8 +95,18 @@ mod tests {
             .lines()
             .find(|l| l.contains(&pink))
             .expect("one pink dot");
-        let x: f64 = line.split("cx=\"").nth(1).and_then(|s| s.split('"').next()).and_then(|s| s.parse().ok()).expect("cx");
-        let y: f64 = line.split("cy=\"").nth(1).and_then(|s| s.split('"').next()).and_then(|s| s.parse().ok()).expect("cy");
+        let x: f64 = line
+            .split("cx=\"")
+            .nth(1)
+            .and_then(|s| s.split('"').next())
+            .and_then(|s| s.parse().ok())
+            .expect("cx");
+        let y: f64 = line
+            .split("cy=\"")
+            .nth(1)
+            .and_then(|s| s.split('"').next())
+            .and_then(|s| s.parse().ok())
+            .expect("cy");
         assert!(x < 160.0 && y < 160.0, "{line}");
         assert!(((x - 160.0).hypot(y - 160.0) - 100.0).abs() < 1e-2);
         assert_eq!(svg.matches(&pink).count(), 1);

@@ -127,7 +127,9 @@ impl FieldDescription {
             path: name.clone(),
             source,
         })?;
-        field.check().map_err(|what| FieldError::Invalid { path: name, what })?;
+        field
+            .check()
+            .map_err(|what| FieldError::Invalid { path: name, what })?;
         Ok(field)
     }
 
@@ -136,11 +138,19 @@ impl FieldDescription {
             .landmarks
             .iter()
             .flat_map(|l| [l.field_cm[0], l.field_cm[1], l.height_cm])
-            .chain(self.lines.iter().flat_map(|l| {
-                [l.from_cm[0], l.from_cm[1], l.to_cm[0], l.to_cm[1]]
-            }))
+            .chain(
+                self.lines
+                    .iter()
+                    .flat_map(|l| [l.from_cm[0], l.from_cm[1], l.to_cm[0], l.to_cm[1]]),
+            )
             .chain(self.arcs.iter().flat_map(|a| {
-                [a.centre_cm[0], a.centre_cm[1], a.radius_cm, a.from_rad, a.to_rad]
+                [
+                    a.centre_cm[0],
+                    a.centre_cm[1],
+                    a.radius_cm,
+                    a.from_rad,
+                    a.to_rad,
+                ]
             }))
             .all(f64::is_finite);
         if !finite {
@@ -194,7 +204,10 @@ impl FieldDescription {
                 let angle = a.from_rad + sweep * k as f64 / n;
                 let (s, c) = angle.sin_cos();
                 out.push(LineSample {
-                    field_cm: [a.centre_cm[0] + a.radius_cm * c, a.centre_cm[1] + a.radius_cm * s],
+                    field_cm: [
+                        a.centre_cm[0] + a.radius_cm * c,
+                        a.centre_cm[1] + a.radius_cm * s,
+                    ],
                     direction: [-s, c],
                 });
             }
@@ -223,7 +236,12 @@ impl FieldDescription {
         for (goal, s) in [("yellow", 1.0), ("blue", -1.0)] {
             // "left" and "right" as seen from the centre spot facing that goal.
             for (side, t) in [("left", s), ("right", -s)] {
-                landmarks.push(landmark(&format!("{goal} {side} corner"), s * gx, t * sy, 0.0));
+                landmarks.push(landmark(
+                    &format!("{goal} {side} corner"),
+                    s * gx,
+                    t * sy,
+                    0.0,
+                ));
                 landmarks.push(landmark(
                     &format!("{goal} goal {side} post foot"),
                     s * hl,
@@ -313,7 +331,8 @@ mod tests {
 
     #[test]
     fn shipped_four_legged_description_matches_the_simulator_field() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/fields/four-legged-2005.json");
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("params/fields/four-legged-2005.json");
         let shipped = FieldDescription::load(&path).expect("shipped description loads");
         assert_eq!(shipped, FieldDescription::four_legged_2005());
     }
@@ -348,7 +367,10 @@ mod tests {
         let dir = tempfile::tempdir().expect("tempdir");
         let p = dir.path().join("f.json");
         std::fs::write(&p, "{").expect("write");
-        assert!(matches!(FieldDescription::load(&p), Err(FieldError::Parse { .. })));
+        assert!(matches!(
+            FieldDescription::load(&p),
+            Err(FieldError::Parse { .. })
+        ));
         let mut f = FieldDescription::four_legged_2005();
         f.camera_height_guess_cm = -3.0;
         std::fs::write(&p, serde_json::to_string(&f).expect("json")).expect("write");

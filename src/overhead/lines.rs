@@ -78,9 +78,13 @@ pub fn away_from_crossings(
                 .filter(|a| {
                     let r = (x - a.centre_cm[0]).hypot(y - a.centre_cm[1]);
                     let angle = (y - a.centre_cm[1]).atan2(x - a.centre_cm[0]);
-                    let within = [angle, angle + std::f64::consts::TAU, angle - std::f64::consts::TAU]
-                        .iter()
-                        .any(|t| (a.from_rad - 0.05..=a.to_rad + 0.05).contains(t));
+                    let within = [
+                        angle,
+                        angle + std::f64::consts::TAU,
+                        angle - std::f64::consts::TAU,
+                    ]
+                    .iter()
+                    .any(|t| (a.from_rad - 0.05..=a.to_rad + 0.05).contains(t));
                     within && (r - a.radius_cm).abs() < margin_cm
                 })
                 .count();
@@ -131,7 +135,10 @@ pub fn line_centre_across(
     let mut profile = Vec::with_capacity(2 * n as usize + 1);
     for k in -n..=n {
         let t = k as f64 * STEP;
-        profile.push((t, luma_at(frame, p.x_px + t * normal.0, p.y_px + t * normal.1)?));
+        profile.push((
+            t,
+            luma_at(frame, p.x_px + t * normal.0, p.y_px + t * normal.1)?,
+        ));
     }
     let (peak_at, peak) = profile
         .iter()
@@ -140,7 +147,11 @@ pub fn line_centre_across(
         .map(|(i, s)| (i, s.1))?;
     let ends = 3.min(profile.len() / 4).max(1);
     let left = profile[..ends].iter().map(|s| s.1).sum::<f64>() / ends as f64;
-    let right = profile[profile.len() - ends..].iter().map(|s| s.1).sum::<f64>() / ends as f64;
+    let right = profile[profile.len() - ends..]
+        .iter()
+        .map(|s| s.1)
+        .sum::<f64>()
+        / ends as f64;
     let base = left.max(right);
     if peak - base < MIN_CONTRAST || peak_at < ends || peak_at >= profile.len() - ends {
         return None;
@@ -212,9 +223,8 @@ pub fn projected_field_lines(
     camera: &OverheadCamera,
 ) -> Vec<Vec<ImagePoint>> {
     let (w, h) = (camera.width_px as f64, camera.height_px as f64);
-    let inside = |p: &ImagePoint| {
-        p.x_px > -20.0 && p.y_px > -20.0 && p.x_px < w + 20.0 && p.y_px < h + 20.0
-    };
+    let inside =
+        |p: &ImagePoint| p.x_px > -20.0 && p.y_px > -20.0 && p.x_px < w + 20.0 && p.y_px < h + 20.0;
     let mut curves: Vec<Vec<[f64; 2]>> = Vec::new();
     for l in &field.lines {
         let len = (l.to_cm[0] - l.from_cm[0]).hypot(l.to_cm[1] - l.from_cm[1]);
@@ -299,7 +309,11 @@ mod tests {
         let kept = away_from_crossings(&field, &all, 12.0);
         assert!(kept.len() < all.len() && kept.len() > all.len() / 2);
         // Nothing kept on the centre line near the centre circle, which crosses it.
-        assert!(!kept.iter().any(|s| s.field_cm[0].abs() < 1e-9 && s.field_cm[1].abs() < 25.0));
+        assert!(
+            !kept
+                .iter()
+                .any(|s| s.field_cm[0].abs() < 1e-9 && s.field_cm[1].abs() < 25.0)
+        );
     }
 
     #[test]

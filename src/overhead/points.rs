@@ -113,7 +113,10 @@ impl PointsFile {
 
     fn check(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 {
-            return Err(format!("image size {}x{} is empty", self.width, self.height));
+            return Err(format!(
+                "image size {}x{} is empty",
+                self.width, self.height
+            ));
         }
         for p in &self.points {
             let values = [
@@ -124,7 +127,10 @@ impl PointsFile {
                 p.image_px[1],
             ];
             if !values.iter().all(|v| v.is_finite()) {
-                return Err(format!("point {:?} has a value that is not a number", p.name));
+                return Err(format!(
+                    "point {:?} has a value that is not a number",
+                    p.name
+                ));
             }
         }
         Ok(())
@@ -179,7 +185,10 @@ mod tests {
         let out = dir.path().join("b.points.json");
         file.save(&out).expect("saves");
         let written = std::fs::read_to_string(&out).expect("read");
-        assert!(!written.contains("height_cm"), "ground points stay in the fixed format");
+        assert!(
+            !written.contains("height_cm"),
+            "ground points stay in the fixed format"
+        );
         assert_eq!(PointsFile::load(&out).expect("loads"), file);
     }
 
@@ -207,6 +216,9 @@ mod tests {
         let err = PointsFile::load(&path).expect_err("empty size");
         assert!(err.to_string().contains("bad.points.json"), "{err}");
         std::fs::write(&path, "{\"width\": 640").expect("write");
-        assert!(matches!(PointsFile::load(&path), Err(PointsError::Parse { .. })));
+        assert!(matches!(
+            PointsFile::load(&path),
+            Err(PointsError::Parse { .. })
+        ));
     }
 }

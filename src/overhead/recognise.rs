@@ -155,9 +155,9 @@ pub fn recognise_overhead(
     robots.sort_by(|a, b| b.confidence.total_cmp(&a.confidence));
     let mut kept: Vec<OverheadRobot> = Vec::new();
     for r in robots {
-        let close = kept.iter().any(|k| {
-            (k.field_cm[0] - r.field_cm[0]).hypot(k.field_cm[1] - r.field_cm[1]) < 20.0
-        });
+        let close = kept
+            .iter()
+            .any(|k| (k.field_cm[0] - r.field_cm[0]).hypot(k.field_cm[1] - r.field_cm[1]) < 20.0);
         if close {
             out.rejected.push(RejectedCandidate {
                 bounds: box_around(r.image, 4.0),
@@ -219,7 +219,8 @@ fn sized_like(
     let ground = camera
         .field_from_image(ImagePoint::new(cx, cy), z_cm)
         .ok_or(OverheadRejection::OffField)?;
-    let expected_r = image_radius_px(camera, &ground, radius_cm).ok_or(OverheadRejection::OffField)?;
+    let expected_r =
+        image_radius_px(camera, &ground, radius_cm).ok_or(OverheadRejection::OffField)?;
     let expected = std::f64::consts::PI * expected_r * expected_r;
     let ratio = f64::from(blob.pixels) / expected.max(1e-9);
     if !(params.area_ratio[0]..=params.area_ratio[1]).contains(&ratio) {
@@ -272,15 +273,16 @@ fn find_ball(
     let r_cm = params.ball_radius_cm;
     let mut best: Option<OverheadBall> = None;
     for blob in blobs.of_class(ColourClass::Orange) {
-        let (_, expected_r, ratio) = match sized_like(blob, camera, r_cm, r_cm, BALL_MIN_FILL, params) {
-            Ok(v) => v,
-            Err(reason) => {
-                if blob.pixels >= 3 {
-                    rejected_out.push(rejected(blob, reason));
+        let (_, expected_r, ratio) =
+            match sized_like(blob, camera, r_cm, r_cm, BALL_MIN_FILL, params) {
+                Ok(v) => v,
+                Err(reason) => {
+                    if blob.pixels >= 3 {
+                        rejected_out.push(rejected(blob, reason));
+                    }
+                    continue;
                 }
-                continue;
-            }
-        };
+            };
         let outline = outline_points(blobs, blob);
         let (cx, cy) = blob.centroid();
         let (centre, radius) = match fit_circle(&outline) {
@@ -290,7 +292,10 @@ fn find_ball(
             {
                 (ImagePoint::new(fit.center_x, fit.center_y), fit.radius)
             }
-            _ => (ImagePoint::new(cx, cy), (f64::from(blob.pixels) / std::f64::consts::PI).sqrt()),
+            _ => (
+                ImagePoint::new(cx, cy),
+                (f64::from(blob.pixels) / std::f64::consts::PI).sqrt(),
+            ),
         };
         let Some(ground) = camera.field_from_image(centre, r_cm) else {
             continue;
@@ -332,8 +337,14 @@ fn read_marker(
     params: &OverheadParams,
 ) -> Result<OverheadRobot, OverheadRejection> {
     let z = params.plate_height_cm;
-    let (centre, _, ratio) =
-        sized_like(blob, camera, z, TEAM_DOT_DIAMETER_CM / 2.0, DOT_MIN_FILL, params)?;
+    let (centre, _, ratio) = sized_like(
+        blob,
+        camera,
+        z,
+        TEAM_DOT_DIAMETER_CM / 2.0,
+        DOT_MIN_FILL,
+        params,
+    )?;
     // Ring of samples through the dots' centres: which angles show a dot.
     let ring: Vec<bool> = (0..RING_SAMPLES)
         .map(|k| {
@@ -386,10 +397,9 @@ fn read_marker(
         heading
     };
     let size_match = (-((ratio.ln()) / 0.6).powi(2)).exp();
-    let image_centre = camera.image_from_field(&centre).unwrap_or(ImagePoint::new(
-        blob.centroid().0,
-        blob.centroid().1,
-    ));
+    let image_centre = camera
+        .image_from_field(&centre)
+        .unwrap_or(ImagePoint::new(blob.centroid().0, blob.centroid().1));
     Ok(OverheadRobot {
         team,
         identity: MarkerIdentity::from_bits(bits),
@@ -428,8 +438,8 @@ fn best_layout_heading(ring: &[bool]) -> (f64, f64) {
         }
     }
     let heading = best.0 as f64 * step;
-    let heading = (heading + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-        - std::f64::consts::PI;
+    let heading =
+        (heading + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
     (heading, best.1 as f64 / n as f64)
 }
 

@@ -19,8 +19,8 @@ use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use super::rng::SimRng;
 use super::scene::{CameraEffects, GoalColour, Lighting, Material, Scene, Shape};
 use crate::frame::{Frame, FrameError};
-use crate::lut::ColourClass;
 use crate::geometry::{Ers7Dimensions, OverheadCamera, PinholeCamera, rotation_z};
+use crate::lut::ColourClass;
 
 /// Object identities in [`Rendered::objects`]: what each pixel shows.
 pub mod object_id {

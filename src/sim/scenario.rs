@@ -397,8 +397,8 @@ impl Scenario {
         };
         // 5 is prime to 16, so the four members of a team (k / 2 = 0..3) get distinct values.
         let value = (self.seed.wrapping_mul(7) + u64::from(k / 2) * 5 + u64::from(k % 2) * 3) % 16;
-        let identity = MarkerIdentity::new(u8::try_from(value).unwrap_or(0))
-            .unwrap_or(MarkerIdentity::MIN);
+        let identity =
+            MarkerIdentity::new(u8::try_from(value).unwrap_or(0)).unwrap_or(MarkerIdentity::MIN);
         RobotMarker::new(marker_team, identity)
     }
 

@@ -747,7 +747,9 @@ pub fn overhead_truth(
                     object_id::ROBOT + u16::try_from(r.id).unwrap_or(0).min(899),
                 )
                 .pixels,
-                marker: r.marker.map(|m| overhead_marker_truth(&m, r, camera, objects)),
+                marker: r
+                    .marker
+                    .map(|m| overhead_marker_truth(&m, r, camera, objects)),
             })
             .collect(),
     }

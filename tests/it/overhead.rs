@@ -45,10 +45,13 @@ fn projection_errors_px(a: &OverheadCamera, b: &OverheadCamera) -> Vec<f64> {
         for i in -15..=15 {
             for j in -10..=10 {
                 let p = Point::new(f64::from(i) * 20.0, f64::from(j) * 20.0, z);
-                if let (Some(u), Some(v)) = (a.image_from_field(&p), b.image_from_field(&p)) {
-                    if u.x_px > 0.0 && u.y_px > 0.0 && u.x_px < 640.0 && u.y_px < 480.0 {
-                        out.push(u.distance_to(&v));
-                    }
+                if let (Some(u), Some(v)) = (a.image_from_field(&p), b.image_from_field(&p))
+                    && u.x_px > 0.0
+                    && u.y_px > 0.0
+                    && u.x_px < 640.0
+                    && u.y_px < 480.0
+                {
+                    out.push(u.distance_to(&v));
                 }
             }
         }
@@ -71,7 +74,10 @@ fn every_robot_of_the_overhead_game_wears_a_marker_with_its_truth() {
     for r in &truth.robots {
         let m = r.marker.expect("a marker on every robot");
         assert_eq!(m.plate_height_cm, 22.5);
-        assert!(seen.insert((m.team, m.identity)), "identities differ within a team");
+        assert!(
+            seen.insert((m.team, m.identity)),
+            "identities differ within a team"
+        );
         if m.fully_visible() {
             // The team dot's colour shows at the plate's centre.
             let c = m.image.expect("in view");
@@ -79,7 +85,14 @@ fn every_robot_of_the_overhead_game_wears_a_marker_with_its_truth() {
             assert_eq!(f.labels[k], m.team.class().code(), "robot {}", r.id);
         }
     }
-    assert!(truth.robots.iter().filter(|r| r.marker.unwrap().fully_visible()).count() >= 2);
+    assert!(
+        truth
+            .robots
+            .iter()
+            .filter(|r| r.marker.unwrap().fully_visible())
+            .count()
+            >= 2
+    );
 }
 
 /// The figures on three seeds (three cameras): calibration from every visible landmark
@@ -95,13 +108,23 @@ fn calibrated_from_noisy_clicks_the_overhead_recogniser_meets_the_figures() {
         let first = sim.frame(0).unwrap();
         let truth_camera = overhead_truth(&first).camera;
         let clicks = eotn::cli::overhead::simulated_clicks(&truth_camera, &field, 1.0, seed);
-        let cal = calibrate(&clicks, &field, Some(&first.frame), &CalibrationParams::default())
-            .unwrap();
-        assert!(cal.line_samples > 100, "seed {seed}: {} line samples", cal.line_samples);
+        let cal = calibrate(
+            &clicks,
+            &field,
+            Some(&first.frame),
+            &CalibrationParams::default(),
+        )
+        .unwrap();
+        assert!(
+            cal.line_samples > 100,
+            "seed {seed}: {} line samples",
+            cal.line_samples
+        );
         let mut errors = projection_errors_px(&truth_camera, &cal.camera);
         let m = median(&mut errors);
         reprojection.push(m);
-        let mut pipeline = OverheadPipeline::new(table.clone(), cal.camera, OverheadParams::default());
+        let mut pipeline =
+            OverheadPipeline::new(table.clone(), cal.camera, OverheadParams::default());
         for index in (0..300).step_by(15) {
             let f = sim.frame(index).unwrap();
             let d = pipeline.process(&f.frame).clone();
@@ -116,9 +139,20 @@ fn calibrated_from_noisy_clicks_the_overhead_recogniser_meets_the_figures() {
     let r = OverheadEvalReport::from_frames(&frames, &[]);
     eprintln!("reprojection medians {reprojection:?} px; {r:#?}");
     assert!(reprojection.iter().all(|m| *m < 0.5), "{reprojection:?}");
-    assert!(r.ball_found as f64 >= 0.95 * r.ball_eligible as f64, "{r:?}");
-    assert!(r.ball_error_cm.p50 < 3.0 && r.ball_error_cm.p95 < 8.0, "{:?}", r.ball_error_cm);
-    assert!(r.robot_error_cm.p50 < 3.0 && r.robot_error_cm.p95 < 8.0, "{:?}", r.robot_error_cm);
+    assert!(
+        r.ball_found as f64 >= 0.95 * r.ball_eligible as f64,
+        "{r:?}"
+    );
+    assert!(
+        r.ball_error_cm.p50 < 3.0 && r.ball_error_cm.p95 < 8.0,
+        "{:?}",
+        r.ball_error_cm
+    );
+    assert!(
+        r.robot_error_cm.p50 < 3.0 && r.robot_error_cm.p95 < 8.0,
+        "{:?}",
+        r.robot_error_cm
+    );
     assert!(r.identity_rate.unwrap() >= 0.99, "{r:?}");
     assert!(r.heading_error_deg.p50 < 3.0, "{:?}", r.heading_error_deg);
     assert!(r.robots_false <= frames.len() / 20, "{r:?}");
@@ -192,18 +226,38 @@ fn the_overhead_command_line_calibrates_detects_and_evaluates() {
         .collect();
     assert_eq!(lines.len(), 3);
     let line = &lines[0];
-    let keys: Vec<&str> = line.as_object().unwrap().keys().map(String::as_str).collect();
+    let keys: Vec<&str> = line
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
     assert_eq!(keys, ["ball", "frame", "overhead_us", "robots"]);
     let robots = line["robots"].as_array().unwrap();
     assert!(!robots.is_empty());
-    let robot_keys: Vec<&str> = robots[0].as_object().unwrap().keys().map(String::as_str).collect();
-    assert_eq!(robot_keys, ["confidence", "heading_rad", "id", "team", "x_cm", "y_cm"]);
+    let robot_keys: Vec<&str> = robots[0]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(
+        robot_keys,
+        ["confidence", "heading_rad", "id", "team", "x_cm", "y_cm"]
+    );
     let team = robots[0]["team"].as_str().unwrap();
     assert!(team == "blue" || team == "yellow");
     if !line["ball"].is_null() {
-        let ball_keys: Vec<&str> =
-            line["ball"].as_object().unwrap().keys().map(String::as_str).collect();
-        assert_eq!(ball_keys, ["confidence", "image_px", "radius_px", "x_cm", "y_cm"]);
+        let ball_keys: Vec<&str> = line["ball"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        assert_eq!(
+            ball_keys,
+            ["confidence", "image_px", "radius_px", "x_cm", "y_cm"]
+        );
     }
     let out = eotn_ok(&[
         OsStr::new("eval"),
@@ -218,7 +272,10 @@ fn the_overhead_command_line_calibrates_detects_and_evaluates() {
     let overhead = &report["overhead"];
     assert_eq!(overhead["frames"], 3);
     assert!(overhead["world_models"].as_array().unwrap().len() >= 4);
-    assert!(overhead["robot_error_cm"]["p50"].as_f64().unwrap() < 5.0, "{overhead}");
+    assert!(
+        overhead["robot_error_cm"]["p50"].as_f64().unwrap() < 5.0,
+        "{overhead}"
+    );
     // The robot-camera table still reads the stream (the command is the same either way).
     eotn_ok(&[
         OsStr::new("eval"),
@@ -283,4 +340,3 @@ fn a_points_file_with_too_few_points_fails_in_one_line() {
     assert!(err.contains("at least 6"), "{err}");
     assert!(!dir.path().join("c.json").exists());
 }
-
