@@ -166,13 +166,18 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         println!("  wrong identity: {t} read as {read}");
     }
     for m in &r.world_models {
+        let vs = &m.self_error_vs_overhead_cm;
+        let vs = if vs.n == 0 {
+            "not seen overhead".to_owned()
+        } else {
+            format!("vs overhead {:.1} cm, n={}", vs.p50, vs.n)
+        };
         println!(
-            "world model robot{:<2}   self median {:.1} cm p95 {:.1} (vs overhead {:.1}), \
-             heading {:.1}°, ball median {:.1} cm",
+            "world model robot{:<2}   self median {:.1} cm p95 {:.1} ({vs}), heading {:.1}°, \
+             ball median {:.1} cm",
             m.robot_id,
             m.self_error_cm.p50,
             m.self_error_cm.p95,
-            m.self_error_vs_overhead_cm.p50,
             m.heading_error_deg.p50,
             m.ball_error_cm.p50
         );

@@ -300,7 +300,8 @@ fn find_ball(
         let Some(ground) = camera.field_from_image(centre, r_cm) else {
             continue;
         };
-        let size_match = (-((ratio.ln()) / 0.5).powi(2)).exp();
+        // A speckled ball shows half its area or less: a wide tolerance.
+        let size_match = (-(ratio.ln() / 0.8).powi(2)).exp();
         let confidence = size_match.clamp(0.0, 1.0);
         if best.is_none_or(|b| confidence > b.confidence) {
             if let Some(old) = best {
