@@ -29,6 +29,7 @@ use super::points::PointsFile;
 use crate::atomic_file::write_atomic;
 use crate::frame::Frame;
 use crate::geometry::{Camera, Field, ImagePoint, OverheadCamera, Point, PoseRecord, Transform};
+use crate::stats::median;
 
 /// Settings of the calibration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -129,8 +130,8 @@ impl Calibration {
     /// Median of the clicked points' reprojection errors, pixels.
     #[must_use]
     pub fn median_point_error_px(&self) -> f64 {
-        let mut e: Vec<f64> = self.points.iter().map(|p| p.error_px).collect();
-        median(&mut e)
+        let e: Vec<f64> = self.points.iter().map(|p| p.error_px).collect();
+        median(&e).unwrap_or(f64::NAN)
     }
 
     /// Writes the calibration atomically as JSON.
@@ -192,21 +193,6 @@ impl Calibration {
             return Err(err("the camera has a value that is not usable".into()));
         }
         Ok(file.calibration)
-    }
-}
-
-/// Median of a list (sorted in place), NaN when empty.
-#[must_use]
-pub fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        (values[n / 2 - 1] + values[n / 2]) / 2.0
     }
 }
 
@@ -287,8 +273,8 @@ pub fn calibrate(
 
 /// Keeps the line observations within three times the median distance (at least 1 px).
 fn reject_outliers(camera: &OverheadCamera, found: Vec<LineObservation>) -> Vec<LineObservation> {
-    let mut d: Vec<f64> = found.iter().map(|l| l.distance_px(camera).abs()).collect();
-    let limit = (3.0 * median(&mut d)).max(1.0);
+    let d: Vec<f64> = found.iter().map(|l| l.distance_px(camera).abs()).collect();
+    let limit = (3.0 * median(&d).unwrap_or(0.0)).max(1.0);
     found
         .into_iter()
         .filter(|l| l.distance_px(camera).abs() <= limit)

@@ -59,11 +59,6 @@ fn projection_errors_px(a: &OverheadCamera, b: &OverheadCamera) -> Vec<f64> {
     out
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 #[test]
 fn every_robot_of_the_overhead_game_wears_a_marker_with_its_truth() {
     let sim = Simulator::new(Scenario::new(ScenarioKind::OverheadGame, 6));
@@ -120,8 +115,8 @@ fn calibrated_from_noisy_clicks_the_overhead_recogniser_meets_the_figures() {
             "seed {seed}: {} line samples",
             cal.line_samples
         );
-        let mut errors = projection_errors_px(&truth_camera, &cal.camera);
-        let m = median(&mut errors);
+        let errors = projection_errors_px(&truth_camera, &cal.camera);
+        let m = eotn::stats::median(&errors).unwrap();
         reprojection.push(m);
         let mut pipeline =
             OverheadPipeline::new(table.clone(), cal.camera, OverheadParams::default());
