@@ -23,6 +23,7 @@
 //! | [`eval`] | recognition against ground truth or hand labels: rates, errors, plots |
 //! | [`streams`] | recorded MCAP streams: frames + sensors + truth, random access by index/time |
 //! | [`sources`] | frame sources (stream, files, synthetic, V4L2 camera, network), recording |
+//! | [`live`] | live robots over the Foxglove WebSocket protocol: client, frames, recording, `eotn serve` |
 //! | [`workspace`] | what the app, the CLI and the tests share: table, source, playback, edits |
 //! | [`cli`] | the `eotn` subcommands |
 //! | `app` | the desktop app (feature `gui`) |
@@ -38,6 +39,7 @@ pub mod frame;
 pub mod geometry;
 pub mod import;
 pub mod input_file;
+pub mod live;
 pub mod lut;
 pub mod overhead;
 pub mod overlay;

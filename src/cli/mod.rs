@@ -12,6 +12,7 @@ macro_rules! outln {
 }
 
 mod bench;
+mod bench_live;
 mod blobs;
 mod classify;
 pub mod detect;
@@ -28,7 +29,9 @@ mod lut_from_labels;
 pub mod open;
 pub mod overhead;
 pub mod patterns;
+mod record;
 mod render;
+mod serve;
 mod sim;
 mod sources;
 
@@ -90,6 +93,12 @@ pub enum Command {
     /// (`calibrate`), ball and robots in field coordinates (`detect`), points from a synthetic
     /// stream's truth (`sim-points`).
     Overhead(overhead::Args),
+    /// Latency and CPU of live robots on loopback: sender's write to the frame in the app state.
+    BenchLive(bench_live::Args),
+    /// A stand-in robot: play a stream at its recorded rate as a Foxglove WebSocket server.
+    Serve(serve::Args),
+    /// Record live robots (Foxglove WebSocket servers) into MCAP streams, bit-exact.
+    Record(record::Args),
     /// Open the desktop app on streams (.mcap), lookup tables (.lut) and frames (.uyvy, .png).
     Open(open::Args),
 }
@@ -116,6 +125,9 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Sources(a) => sources::run(&a),
         Command::Overhead(a) => overhead::run(&a),
         Command::Open(a) => open::run(&a),
+        Command::BenchLive(a) => bench_live::run(&a),
+        Command::Serve(a) => serve::run(&a),
+        Command::Record(a) => record::run(&a),
     }
 }
 

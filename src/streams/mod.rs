@@ -24,7 +24,7 @@ mod writer;
 use std::path::PathBuf;
 
 pub use reader::StreamReader;
-pub use writer::{Compression, StreamWriter, WriterOptions};
+pub use writer::{Compression, RawChannelSpec, StreamWriter, WriterOptions};
 
 use crate::frame::Frame;
 use crate::sensors::SensorReadings;

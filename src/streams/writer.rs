@@ -67,6 +67,34 @@ pub struct StreamWriter {
     frames_in_chunk: usize,
     frames: u32,
     buf: Vec<u8>,
+    /// Channels of [`StreamWriter::write_raw`] by topic (other than the fixed two).
+    raw_channels: HashMap<String, u16>,
+}
+
+/// A channel whose messages are recorded as they arrive ([`StreamWriter::write_raw`]): a live
+/// robot's channel as its server advertised it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RawChannelSpec {
+    /// Topic, e.g. `/camera/image`.
+    pub topic: String,
+    /// Message encoding (`protobuf`, `json`, …).
+    pub message_encoding: String,
+    /// Schema name, e.g. `foxglove.RawImage`; empty for none.
+    pub schema_name: String,
+    /// Schema encoding (`protobuf`, `jsonschema`, …).
+    pub schema_encoding: String,
+    /// Schema bytes.
+    pub schema: Vec<u8>,
+}
+
+impl RawChannelSpec {
+    /// True for the stream's image channel: `/camera/image` as protobuf `foxglove.RawImage`.
+    #[must_use]
+    pub fn is_image(&self) -> bool {
+        self.topic == IMAGE_TOPIC
+            && self.message_encoding == "protobuf"
+            && self.schema_name == "foxglove.RawImage"
+    }
 }
 
 impl std::fmt::Debug for StreamWriter {
@@ -176,6 +204,7 @@ impl StreamWriter {
             frames_in_chunk: 0,
             frames: 0,
             buf: Vec::new(),
+            raw_channels: HashMap::new(),
         })
     }
 
@@ -339,6 +368,68 @@ impl StreamWriter {
                 .map_err(self.mcap_err("cannot finish a chunk"))?;
         }
         Ok(())
+    }
+
+    /// Appends one message exactly as it arrived (a live robot's), on the channel `spec`
+    /// describes: `/camera/image` as `foxglove.RawImage` goes to the image channel and counts as
+    /// a frame, `/sensors` as JSON to the sensors channel, any other topic to a channel of its own
+    /// made on first use. The bytes are stored unchanged. A frame's chunk is closed when the next
+    /// frame's image arrives (so a frame's later messages stay with it), or by
+    /// [`StreamWriter::close_chunk`].
+    ///
+    /// # Errors
+    /// I/O errors naming the file.
+    pub fn write_raw(
+        &mut self,
+        spec: &RawChannelSpec,
+        log_time_ns: u64,
+        data: &[u8],
+    ) -> Result<(), StreamError> {
+        let is_image = spec.is_image();
+        let channel = if is_image {
+            let per_chunk = self.frames_per_chunk.unwrap_or_else(|| {
+                (TARGET_CHUNK_BYTES / data.len().max(1)).clamp(1, MAX_FRAMES_PER_CHUNK)
+            });
+            if self.frames_in_chunk >= per_chunk {
+                self.close_chunk()?;
+            }
+            self.image_channel
+        } else if spec.topic == SENSORS_TOPIC && spec.message_encoding == "json" {
+            self.sensors_channel
+        } else if let Some(&id) = self.raw_channels.get(&spec.topic) {
+            id
+        } else {
+            let schema = if spec.schema_name.is_empty() {
+                0
+            } else {
+                self.mcap
+                    .add_schema(&spec.schema_name, &spec.schema_encoding, &spec.schema)
+                    .map_err(self.mcap_err("cannot add a schema"))?
+            };
+            let id = self
+                .mcap
+                .add_channel(schema, &spec.topic, &spec.message_encoding, &BTreeMap::new())
+                .map_err(self.mcap_err("cannot add a channel"))?;
+            self.raw_channels.insert(spec.topic.clone(), id);
+            id
+        };
+        self.put(channel, log_time_ns, data)?;
+        if is_image {
+            self.frames = self.frames.saturating_add(1);
+            self.frames_in_chunk += 1;
+        }
+        Ok(())
+    }
+
+    /// Ends the current chunk and flushes it to the file: what was written survives a crash.
+    ///
+    /// # Errors
+    /// I/O errors naming the file.
+    pub fn close_chunk(&mut self) -> Result<(), StreamError> {
+        self.frames_in_chunk = 0;
+        self.mcap
+            .flush()
+            .map_err(self.mcap_err("cannot finish a chunk"))
     }
 
     /// Writes the summary (indexes, statistics), syncs the file and renames it into place.

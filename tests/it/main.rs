@@ -9,6 +9,7 @@ mod app_camera;
 mod cli;
 mod common;
 mod hardening;
+mod live;
 mod motion;
 mod overhead;
 mod patterns;

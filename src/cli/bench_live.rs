@@ -1,0 +1,262 @@
+//! `eotn bench-live`: end-to-end latency of live robots on this machine, from a sender's write to
+//! the frame in the state the app reads, and the CPU the reception costs.
+//!
+//! Starts `--robots` stand-in robots (the same Foxglove WebSocket servers as `eotn serve`) on
+//! loopback, each sending rendered frames with their sensor readings at `--fps`, connects one
+//! [`LiveRobot`] to each, and measures for `--seconds`. Latency is this machine's clock at the
+//! frame's arrival in the [`LiveRobot`] minus the log time the sender stamped when it wrote the
+//! frame. CPU is read from `/proc/self/task/*/stat`: the robots' receiving threads (socket,
+//! parsing, decoding) apart from the senders.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use serde::Serialize;
+
+use crate::live::robot::DEFAULT_KEEP_BYTES;
+use crate::live::serve::StandInRobot;
+use crate::live::{ClientOptions, LiveRobot, RobotUrl};
+use crate::sim::{Scenario, ScenarioKind, Simulator};
+use crate::streams::FrameRecord;
+
+/// Arguments of `eotn bench-live`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Robots sending at once.
+    #[arg(long, default_value_t = 4)]
+    pub robots: usize,
+    /// Frames per second each robot sends.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    /// Seconds measured.
+    #[arg(long, default_value_t = 10.0)]
+    pub seconds: f64,
+    /// End with one JSON line of the figures.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The figures (and the `--json` line).
+#[derive(Debug, Serialize)]
+pub struct LiveBenchJson {
+    /// Robots.
+    pub robots: usize,
+    /// Frames per second per robot asked for.
+    pub fps: f64,
+    /// Frame size, pixels.
+    pub width: usize,
+    /// Frame size, pixels.
+    pub height: usize,
+    /// Frames sent, all robots.
+    pub sent: usize,
+    /// Frames received, all robots.
+    pub received: usize,
+    /// Frames counted as dropped, all robots.
+    pub drops: usize,
+    /// Median latency, ms.
+    pub latency_median_ms: f64,
+    /// 99th percentile latency, ms.
+    pub latency_p99_ms: f64,
+    /// Largest latency, ms.
+    pub latency_max_ms: f64,
+    /// CPU of the receiving threads, percent of one core.
+    pub receive_cpu_percent: f64,
+    /// CPU of the whole process (senders, servers, receivers), percent of one core.
+    pub process_cpu_percent: f64,
+}
+
+/// Clock ticks per second of `/proc/…/stat` (`sysconf(_SC_CLK_TCK)`, 100 on Linux).
+const TICKS_PER_S: f64 = 100.0;
+
+/// CPU seconds (user + system) of this process's threads, split into those whose name starts
+/// with `robot ` (the receivers) and all.
+fn cpu_seconds() -> (f64, f64) {
+    let (mut robots, mut all) = (0.0, 0.0);
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return (f64::NAN, f64::NAN);
+    };
+    for task in tasks.flatten() {
+        let Ok(stat) = std::fs::read_to_string(task.path().join("stat")) else {
+            continue;
+        };
+        // `pid (comm) state …`: the name may hold spaces, so fields count from the last ')'.
+        let (Some(open), Some(close)) = (stat.find('('), stat.rfind(')')) else {
+            continue;
+        };
+        let comm = &stat[open + 1..close];
+        let fields: Vec<&str> = stat[close + 1..].split_whitespace().collect();
+        let ticks: f64 = [11, 12]
+            .iter()
+            .filter_map(|&i| fields.get(i)?.parse::<f64>().ok())
+            .sum();
+        all += ticks / TICKS_PER_S;
+        if comm.starts_with("robot ") {
+            robots += ticks / TICKS_PER_S;
+        }
+    }
+    (robots, all)
+}
+
+fn frames_to_send() -> anyhow::Result<Vec<FrameRecord>> {
+    let sim = Simulator::new(Scenario::new(ScenarioKind::WalkAndPan, 1));
+    (0..30)
+        .map(|i| {
+            let f = sim.frame(i)?;
+            let mut r = FrameRecord::new(f.time_ns, f.frame);
+            r.sensors = f.sensors;
+            Ok(r)
+        })
+        .collect()
+}
+
+#[expect(clippy::cast_precision_loss, reason = "nanosecond latencies")]
+fn percentile_ms(sorted: &[u64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        reason = "an index into the list"
+    )]
+    let at = ((sorted.len() - 1) as f64 * p).round() as usize;
+    sorted.get(at).map_or(f64::NAN, |&ns| ns as f64 / 1e6)
+}
+
+/// Runs `eotn bench-live`.
+///
+/// # Errors
+/// A server that cannot start or frames that cannot be rendered.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let frames = Arc::new(frames_to_send()?);
+    let (width, height) = frames
+        .first()
+        .map_or((0, 0), |f| (f.frame.width(), f.frame.height()));
+    let mut servers = Vec::new();
+    let mut robots = Vec::new();
+    for i in 0..args.robots {
+        let server = StandInRobot::start(&format!("bench{i}"), "127.0.0.1", 0)?;
+        let url: RobotUrl = format!("127.0.0.1:{}", server.port()).parse()?;
+        let keep = DEFAULT_KEEP_BYTES.max(frames_needed(args) * width * height * 2);
+        robots.push(LiveRobot::connect(url, ClientOptions::default(), keep, None)?);
+        servers.push(server);
+    }
+    let wait_until = Instant::now() + Duration::from_secs(10);
+    while servers.iter().any(|s| !s.has_viewer()) {
+        anyhow::ensure!(Instant::now() < wait_until, "the robots did not subscribe within 10 s");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    let cpu_before = cpu_seconds();
+    let start = Instant::now();
+    let senders: Vec<_> = servers
+        .into_iter()
+        .enumerate()
+        .map(|(i, mut server)| {
+            let (frames, stop, fps, seconds) = (Arc::clone(&frames), Arc::clone(&stop), args.fps, args.seconds);
+            std::thread::Builder::new()
+                .name(format!("sender {i}"))
+                .spawn(move || -> Result<(usize, StandInRobot), String> {
+                    let period = Duration::from_secs_f64(1.0 / fps.max(0.1));
+                    let t0 = Instant::now();
+                    let mut n = 0_usize;
+                    while t0.elapsed().as_secs_f64() < seconds && !stop.load(Ordering::Relaxed) {
+                        let due = t0 + period * u32::try_from(n).unwrap_or(u32::MAX);
+                        std::thread::sleep(due.saturating_duration_since(Instant::now()));
+                        let Some(f) = frames.get(n % frames.len().max(1)) else { break };
+                        server.send(f)?;
+                        n += 1;
+                    }
+                    Ok((n, server))
+                })
+        })
+        .collect::<Result<_, _>>()
+        .context("cannot start a sender thread")?;
+    let mut sent = 0;
+    let mut servers = Vec::new();
+    for s in senders {
+        let (n, server) = s
+            .join()
+            .map_err(|_| anyhow::anyhow!("a sender thread panicked"))?
+            .map_err(|e| anyhow::anyhow!(e))?;
+        sent += n;
+        servers.push(server);
+    }
+    // The last frames are in flight for a few milliseconds.
+    let settle = Instant::now() + Duration::from_secs(2);
+    while robots.iter().map(LiveRobot::len).sum::<usize>() < sent && Instant::now() < settle {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let wall = start.elapsed().as_secs_f64();
+    let cpu_after = cpu_seconds();
+    let report = report(args, &robots, (width, height), sent, wall, cpu_before, cpu_after);
+    drop(robots);
+    for s in servers {
+        s.stop();
+    }
+    print_report(&report, args.json)
+}
+
+fn frames_needed(args: &Args) -> usize {
+    #[expect(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a frame count")]
+    let n = (args.fps.max(0.0) * args.seconds.max(0.0)).ceil() as usize;
+    n + 30
+}
+
+fn report(
+    args: &Args,
+    robots: &[LiveRobot],
+    (width, height): (usize, usize),
+    sent: usize,
+    wall: f64,
+    cpu_before: (f64, f64),
+    cpu_after: (f64, f64),
+) -> LiveBenchJson {
+    let mut latencies = Vec::new();
+    let (mut received, mut drops) = (0, 0);
+    for r in robots {
+        received += r.len();
+        drops += r.stats().drops;
+        for i in r.first_kept()..r.len() {
+            if let Some(f) = r.frame(i) {
+                latencies.push(f.latency_ns);
+            }
+        }
+    }
+    latencies.sort_unstable();
+    LiveBenchJson {
+        robots: args.robots,
+        fps: args.fps,
+        width,
+        height,
+        sent,
+        received,
+        drops,
+        latency_median_ms: percentile_ms(&latencies, 0.5),
+        latency_p99_ms: percentile_ms(&latencies, 0.99),
+        latency_max_ms: percentile_ms(&latencies, 1.0),
+        receive_cpu_percent: 100.0 * (cpu_after.0 - cpu_before.0) / wall,
+        process_cpu_percent: 100.0 * (cpu_after.1 - cpu_before.1) / wall,
+    }
+}
+
+fn print_report(r: &LiveBenchJson, json: bool) -> anyhow::Result<()> {
+    println!(
+        "{} robots x {} fps, {}x{} frames: sent {}, received {}, dropped {}",
+        r.robots, r.fps, r.width, r.height, r.sent, r.received, r.drops
+    );
+    println!(
+        "latency write -> app state: median {:.2} ms, p99 {:.2} ms, max {:.2} ms",
+        r.latency_median_ms, r.latency_p99_ms, r.latency_max_ms
+    );
+    println!(
+        "CPU: receiving {:.1}% of a core, whole process (with senders) {:.1}%",
+        r.receive_cpu_percent, r.process_cpu_percent
+    );
+    if json {
+        println!("{}", serde_json::to_string(r)?);
+    }
+    Ok(())
+}

@@ -1,0 +1,501 @@
+//! [`LiveRobot`]: one robot's live frames, statistics and recording, filled by its
+//! [`RobotClient`] thread and read by the app or the CLI at any time.
+//!
+//! Every frame that arrives is numbered from 0 in arrival order; the newest ones are kept in
+//! memory (up to a byte budget) so a viewer can step back through them while reception goes on;
+//! a recording keeps all of them. A frame's JSON messages (sensors, world model) attach to the
+//! frame with the same log time, whether they come just before or just after its image.
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use super::client::{ClientOptions, LiveEvent, RobotClient};
+use super::protocol::AdvertisedChannel;
+use super::recorder::LiveRecorder;
+use super::{RobotUrl, unix_time_ns};
+use crate::sensors::SensorReadings;
+use crate::streams::schema::{decode_image, parse_json_lenient};
+use crate::streams::{
+    FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError,
+    StreamInfo,
+};
+
+/// Frame bytes kept in memory per robot unless told otherwise (about 2,000 ERS-7 frames).
+pub const DEFAULT_KEEP_BYTES: usize = 128 << 20;
+/// Latencies kept for the median and 99th percentile.
+const LATENCY_WINDOW: usize = 4096;
+/// Lines kept in a robot's log.
+const LOG_LINES: usize = 50;
+
+/// One frame as it arrived.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LiveFrame {
+    /// Arrival number, from 0.
+    pub index: usize,
+    /// The frame and the JSON channels that came with it; `time_ns` is the sender's log time.
+    pub record: FrameRecord,
+    /// When its image was read off the socket, nanoseconds since the Unix epoch.
+    pub received_ns: u64,
+    /// From the sender's log time to the frame in this state, nanoseconds (0 when the sender's
+    /// clock is ahead).
+    pub latency_ns: u64,
+}
+
+/// The state of a robot's connection.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Connection {
+    /// Not connected yet.
+    Connecting,
+    /// Connected; the robot's server name.
+    Connected(String),
+    /// The connection ended; retrying.
+    Disconnected {
+        /// Why.
+        reason: String,
+        /// Wait before the next attempt.
+        retry_in: Duration,
+    },
+}
+
+/// A robot's figures for the connected-robots list.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RobotStats {
+    /// Frames received.
+    pub frames: usize,
+    /// Frames lost: images that did not decode, plus gaps in the frame times longer than 1.5
+    /// frame periods (counted as the frames that would fit).
+    pub drops: usize,
+    /// Frames received in the last second.
+    pub fps: f64,
+    /// Median latency over the last frames, milliseconds.
+    pub latency_median_ms: Option<f64>,
+    /// 99th percentile latency over the last frames, milliseconds.
+    pub latency_p99_ms: Option<f64>,
+    /// Times the connection was (re)established.
+    pub connections: usize,
+    /// Frames written to the open recording, if any.
+    pub recorded: Option<usize>,
+}
+
+#[derive(Default)]
+struct Inner {
+    name: Option<String>,
+    connection: Option<Connection>,
+    frames: VecDeque<Arc<LiveFrame>>,
+    kept_bytes: usize,
+    received: usize,
+    drops: usize,
+    connections: usize,
+    arrivals: VecDeque<Instant>,
+    latencies: VecDeque<u64>,
+    period_ns: Option<f64>,
+    last_time_ns: Option<u64>,
+    pending: Vec<(Arc<AdvertisedChannel>, u64, Vec<u8>)>,
+    recorder: Option<LiveRecorder>,
+    log: VecDeque<String>,
+}
+
+/// Called after each new frame (the app passes its repaint request).
+pub type Notify = Arc<dyn Fn() + Send + Sync>;
+
+/// A connected robot: its [`RobotClient`] and the frames it delivered.
+pub struct LiveRobot {
+    url: RobotUrl,
+    shared: Arc<Mutex<Inner>>,
+    client: Option<RobotClient>,
+}
+
+impl std::fmt::Debug for LiveRobot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LiveRobot").field("url", &self.url).finish_non_exhaustive()
+    }
+}
+
+impl LiveRobot {
+    /// Connects to a robot (in the background: reconnecting until dropped). At most `keep_bytes`
+    /// of frame data stay in memory; `notify` runs after every new frame.
+    ///
+    /// # Errors
+    /// The OS's error when the connection thread cannot start.
+    pub fn connect(
+        url: RobotUrl,
+        options: ClientOptions,
+        keep_bytes: usize,
+        notify: Option<Notify>,
+    ) -> std::io::Result<Self> {
+        let shared = Arc::new(Mutex::new(Inner {
+            connection: Some(Connection::Connecting),
+            ..Inner::default()
+        }));
+        let client = RobotClient::spawn(url.clone(), options, {
+            let shared = Arc::clone(&shared);
+            move |event| {
+                let new_frame = lock(&shared).event(event, keep_bytes);
+                if new_frame && let Some(n) = &notify {
+                    n();
+                }
+            }
+        })?;
+        Ok(Self {
+            url,
+            shared,
+            client: Some(client),
+        })
+    }
+
+    /// The robot's address.
+    #[must_use]
+    pub fn url(&self) -> &RobotUrl {
+        &self.url
+    }
+
+    /// The robot's server name once it said it, else its address.
+    #[must_use]
+    pub fn name(&self) -> String {
+        lock(&self.shared)
+            .name
+            .clone()
+            .unwrap_or_else(|| self.url.to_string())
+    }
+
+    /// The connection's state.
+    #[must_use]
+    pub fn connection(&self) -> Connection {
+        lock(&self.shared)
+            .connection
+            .clone()
+            .unwrap_or(Connection::Connecting)
+    }
+
+    /// Frames received so far (the next frame's index).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        lock(&self.shared).received
+    }
+
+    /// True before the first frame.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Index of the oldest frame still in memory (`len()` when none is).
+    #[must_use]
+    pub fn first_kept(&self) -> usize {
+        let inner = lock(&self.shared);
+        inner.frames.front().map_or(inner.received, |f| f.index)
+    }
+
+    /// Frame `index` if it is still in memory.
+    #[must_use]
+    pub fn frame(&self, index: usize) -> Option<Arc<LiveFrame>> {
+        let inner = lock(&self.shared);
+        let first = inner.frames.front()?.index;
+        inner.frames.get(index.checked_sub(first)?).cloned()
+    }
+
+    /// The newest frame.
+    #[must_use]
+    pub fn latest(&self) -> Option<Arc<LiveFrame>> {
+        lock(&self.shared).frames.back().cloned()
+    }
+
+    /// The figures for the robot list.
+    #[must_use]
+    pub fn stats(&self) -> RobotStats {
+        lock(&self.shared).stats()
+    }
+
+    /// The robot's log: connections, disconnections, skipped messages, its status messages.
+    #[must_use]
+    pub fn log(&self) -> Vec<String> {
+        lock(&self.shared).log.iter().cloned().collect()
+    }
+
+    /// Starts recording every message from now on into `path` (an MCAP stream). A recording
+    /// already running is finished first.
+    ///
+    /// # Errors
+    /// [`StreamError`] when a file cannot be created or finished.
+    pub fn start_recording(&self, path: &Path) -> Result<(), StreamError> {
+        let info = StreamInfo {
+            source: "robot".to_owned(),
+            description: format!("live from {} ({})", self.name(), self.url),
+        };
+        let recorder = LiveRecorder::create(path, &info)?;
+        let old = lock(&self.shared).recorder.replace(recorder);
+        if let Some(old) = old {
+            old.finish()?;
+        }
+        Ok(())
+    }
+
+    /// Finishes the recording (indexes written, file renamed into place) and returns its path
+    /// and frame count; `None` when none was running.
+    ///
+    /// # Errors
+    /// [`StreamError`] when the file cannot be finished.
+    pub fn stop_recording(&self) -> Result<Option<(PathBuf, usize)>, StreamError> {
+        let recorder = lock(&self.shared).recorder.take();
+        recorder
+            .map(|r| {
+                let frames = r.frames();
+                r.finish().map(|p| (p, frames))
+            })
+            .transpose()
+    }
+
+    /// Closes a recording's open chunk when the robot has been quiet (call now and then).
+    pub fn tick(&self) {
+        let mut inner = lock(&self.shared);
+        if let Some(r) = inner.recorder.as_mut()
+            && let Err(e) = r.tick()
+        {
+            inner.recording_failed(&e);
+        }
+    }
+}
+
+impl Drop for LiveRobot {
+    fn drop(&mut self) {
+        if let Some(c) = self.client.take() {
+            c.stop();
+        }
+        if let Ok(Some((path, _))) = self.stop_recording() {
+            log::info!("recording finished: {}", path.display());
+        }
+    }
+}
+
+/// Locks the robot's state; a panic on another thread never makes it unreadable.
+fn lock(shared: &Mutex<Inner>) -> MutexGuard<'_, Inner> {
+    shared.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+fn percentile(sorted: &[u64], p: f64) -> Option<f64> {
+    if sorted.is_empty() {
+        return None;
+    }
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        clippy::cast_precision_loss,
+        reason = "an index into at most LATENCY_WINDOW values"
+    )]
+    let at = ((sorted.len() - 1) as f64 * p).round() as usize;
+    #[expect(clippy::cast_precision_loss, reason = "latencies well under 2^52 ns")]
+    sorted.get(at).map(|&ns| ns as f64 / 1e6)
+}
+
+impl Inner {
+    fn stats(&self) -> RobotStats {
+        let mut sorted: Vec<u64> = self.latencies.iter().copied().collect();
+        sorted.sort_unstable();
+        let now = Instant::now();
+        let recent = self
+            .arrivals
+            .iter()
+            .filter(|t| now.duration_since(**t) <= Duration::from_secs(1))
+            .count();
+        #[expect(clippy::cast_precision_loss, reason = "a count of frames in one second")]
+        let fps = recent as f64;
+        RobotStats {
+            frames: self.received,
+            drops: self.drops,
+            fps,
+            latency_median_ms: percentile(&sorted, 0.5),
+            latency_p99_ms: percentile(&sorted, 0.99),
+            connections: self.connections,
+            recorded: self.recorder.as_ref().map(LiveRecorder::frames),
+        }
+    }
+
+    fn note(&mut self, line: String) {
+        log::info!("{line}");
+        if self.log.len() >= LOG_LINES {
+            self.log.pop_front();
+        }
+        self.log.push_back(line);
+    }
+
+    fn recording_failed(&mut self, e: &StreamError) {
+        self.note(format!("recording stopped: {e}"));
+        self.recorder = None;
+    }
+
+    /// Applies one event; true when it made a new frame.
+    fn event(&mut self, event: LiveEvent, keep_bytes: usize) -> bool {
+        match event {
+            LiveEvent::Connected { server_name } => {
+                self.connections += 1;
+                let again = if self.connections > 1 { "re" } else { "" };
+                self.note(format!("{again}connected to {server_name}"));
+                self.name = Some(server_name.clone());
+                self.connection = Some(Connection::Connected(server_name));
+                self.last_time_ns = None;
+                false
+            }
+            LiveEvent::Advertised(channels) => {
+                for c in channels {
+                    if !is_image(&c) && c.encoding != "json" {
+                        self.note(format!(
+                            "channel {} ({}) is recorded, not shown",
+                            c.topic, c.encoding
+                        ));
+                    }
+                }
+                false
+            }
+            LiveEvent::Status(s) => {
+                self.note(format!("robot says {s}"));
+                false
+            }
+            LiveEvent::Disconnected { reason, retry_in } => {
+                if !matches!(&self.connection, Some(Connection::Disconnected { reason: r, .. }) if *r == reason)
+                {
+                    self.note(format!("disconnected: {reason}; reconnecting"));
+                }
+                self.connection = Some(Connection::Disconnected { reason, retry_in });
+                self.pending.clear();
+                if let Some(r) = self.recorder.as_mut()
+                    && let Err(e) = r.tick()
+                {
+                    self.recording_failed(&e);
+                }
+                false
+            }
+            LiveEvent::Message {
+                channel,
+                log_time_ns,
+                received_ns,
+                payload,
+            } => {
+                if let Some(r) = self.recorder.as_mut()
+                    && let Err(e) = r.message(&channel, log_time_ns, &payload)
+                {
+                    self.recording_failed(&e);
+                }
+                if is_image(&channel) {
+                    self.image(log_time_ns, received_ns, &payload, keep_bytes)
+                } else {
+                    if channel.encoding == "json" {
+                        self.json(channel, log_time_ns, payload);
+                    }
+                    false
+                }
+            }
+        }
+    }
+
+    fn image(&mut self, log_time_ns: u64, received_ns: u64, payload: &[u8], keep: usize) -> bool {
+        let frame = match decode_image(payload) {
+            Ok(f) => f,
+            Err(e) => {
+                self.drops += 1;
+                self.note(format!("frame skipped: {e}"));
+                return false;
+            }
+        };
+        if let (Some(last), Some(period)) = (self.last_time_ns, self.period_ns) {
+            #[expect(clippy::cast_precision_loss, reason = "nanosecond gaps")]
+            let gap = log_time_ns.saturating_sub(last) as f64;
+            if gap > 1.5 * period {
+                #[expect(
+                    clippy::cast_possible_truncation,
+                    clippy::cast_sign_loss,
+                    reason = "a small positive count"
+                )]
+                let missed = ((gap / period).round() as usize).saturating_sub(1);
+                self.drops += missed;
+            }
+        }
+        if let Some(last) = self.last_time_ns {
+            #[expect(clippy::cast_precision_loss, reason = "nanosecond gaps")]
+            let gap = log_time_ns.saturating_sub(last) as f64;
+            if gap > 0.0 {
+                // Slow average so one gap does not make the next frames look late.
+                self.period_ns = Some(self.period_ns.map_or(gap, |p| p.min(0.9 * p + 0.1 * gap)));
+            }
+        }
+        self.last_time_ns = Some(log_time_ns);
+        let mut record = FrameRecord::new(log_time_ns, frame);
+        for (channel, time, bytes) in std::mem::take(&mut self.pending) {
+            if time == log_time_ns
+                && let Some(n) = attach(&mut record, &channel, &bytes)
+            {
+                self.note(n);
+            }
+        }
+        let bytes = record.frame.data().len();
+        let latency_ns = unix_time_ns().saturating_sub(log_time_ns);
+        self.frames.push_back(Arc::new(LiveFrame {
+            index: self.received,
+            record,
+            received_ns,
+            latency_ns,
+        }));
+        self.received += 1;
+        self.kept_bytes += bytes;
+        while self.kept_bytes > keep && self.frames.len() > 1 {
+            if let Some(old) = self.frames.pop_front() {
+                self.kept_bytes -= old.record.frame.data().len();
+            }
+        }
+        if self.latencies.len() >= LATENCY_WINDOW {
+            self.latencies.pop_front();
+        }
+        self.latencies.push_back(latency_ns);
+        let now = Instant::now();
+        self.arrivals.push_back(now);
+        while self
+            .arrivals
+            .front()
+            .is_some_and(|t| now.duration_since(*t) > Duration::from_secs(1))
+        {
+            self.arrivals.pop_front();
+        }
+        true
+    }
+
+    fn json(&mut self, channel: Arc<AdvertisedChannel>, log_time_ns: u64, payload: Vec<u8>) {
+        let latest = self.frames.back_mut().filter(|f| f.record.time_ns == log_time_ns);
+        if let Some(latest) = latest {
+            let note = attach(&mut Arc::make_mut(latest).record, &channel, &payload);
+            if let Some(n) = note {
+                self.note(n);
+            }
+        } else {
+            self.pending.retain(|(_, t, _)| *t == log_time_ns);
+            if self.pending.len() < 64 {
+                self.pending.push((channel, log_time_ns, payload));
+            }
+        }
+    }
+}
+
+/// Attaches one JSON message to its frame; a note when it had to be skipped.
+fn attach(record: &mut FrameRecord, channel: &AdvertisedChannel, bytes: &[u8]) -> Option<String> {
+    let topic = channel.topic.as_str();
+    let value = match parse_json_lenient(bytes) {
+        Ok((v, _)) => v,
+        Err(e) => return Some(format!("{topic}: not JSON ({e}); skipped")),
+    };
+    match topic {
+        SENSORS_TOPIC => match serde_json::from_value::<SensorReadings>(value) {
+            Ok(s) => record.sensors = Some(s.sanitised().0),
+            Err(e) => return Some(format!("{topic}: not sensor readings ({e}); skipped")),
+        },
+        GROUND_TRUTH_TOPIC => record.ground_truth = Some(value),
+        RECOGNITION_TOPIC => record.recognition = Some(value),
+        _ => record.extra.push((topic.to_owned(), value)),
+    }
+    None
+}
+
+/// True for a camera image channel: `foxglove.RawImage` in protobuf (on `/camera/image` or,
+/// failing that, any topic).
+fn is_image(c: &AdvertisedChannel) -> bool {
+    c.encoding == "protobuf" && (c.schema_name == "foxglove.RawImage" || c.topic == IMAGE_TOPIC)
+}

@@ -1,0 +1,260 @@
+//! [`StandInRobot`]: a Foxglove WebSocket server (the SDK's own, the `foxglove` crate) that
+//! plays a stream's frames at their recorded rate, as a robot would send them: `eotn serve`.
+//!
+//! Each frame goes out as its `foxglove.RawImage` on `/camera/image`, then its sensor readings on
+//! `/sensors` and its other JSON channels, all with the same log time: the moment it is sent
+//! (this machine's clock), so a viewer can measure its latency.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use foxglove::websocket::{ChannelView, Client, ServerListener};
+use foxglove::{ChannelBuilder, Context, PartialMetadata, RawChannel, Schema, WebSocketServer};
+
+use super::unix_time_ns;
+use crate::streams::schema::{
+    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, RECOGNITION_SCHEMA_NAME, SENSORS_SCHEMA_NAME,
+    any_json_schema, encode_image, object_json_schema, raw_image_schema, sensors_json_schema,
+};
+use crate::streams::{
+    FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError,
+    StreamReader,
+};
+
+/// Why the stand-in robot could not start or play.
+#[derive(Debug, thiserror::Error)]
+pub enum ServeError {
+    /// The server could not listen (port in use, bad host).
+    #[error("cannot listen on {addr}: {detail}")]
+    Listen {
+        /// The address asked for.
+        addr: String,
+        /// What the SDK said.
+        detail: String,
+    },
+    /// A channel could not be made.
+    #[error("cannot make channel {topic}: {detail}")]
+    Channel {
+        /// The topic.
+        topic: String,
+        /// What the SDK said.
+        detail: String,
+    },
+    /// The stream could not be read.
+    #[error(transparent)]
+    Stream(#[from] StreamError),
+    /// A frame could not be encoded.
+    #[error("frame {index}: {detail}")]
+    Frame {
+        /// The frame.
+        index: usize,
+        /// What is wrong.
+        detail: String,
+    },
+}
+
+/// Sets a flag when a viewer subscribes to the image channel.
+struct ViewerFlag(Arc<AtomicBool>);
+
+impl ServerListener for ViewerFlag {
+    fn on_subscribe(&self, _client: Client, channel: ChannelView) {
+        if channel.topic() == IMAGE_TOPIC {
+            self.0.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+/// A running Foxglove WebSocket server with the stream's channels.
+pub struct StandInRobot {
+    context: Arc<Context>,
+    handle: Option<foxglove::WebSocketServerHandle>,
+    image: Arc<RawChannel>,
+    sensors: Arc<RawChannel>,
+    json: HashMap<String, Arc<RawChannel>>,
+    viewer: Arc<AtomicBool>,
+    port: u16,
+    buf: Vec<u8>,
+}
+
+impl std::fmt::Debug for StandInRobot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StandInRobot").field("port", &self.port).finish_non_exhaustive()
+    }
+}
+
+impl StandInRobot {
+    /// Starts the server on `host:port` (port 0: any free port) under the server name `name`.
+    ///
+    /// # Errors
+    /// [`ServeError::Listen`] when it cannot listen.
+    pub fn start(name: &str, host: &str, port: u16) -> Result<Self, ServeError> {
+        let context = Context::new();
+        let viewer = Arc::new(AtomicBool::new(false));
+        let channel = |topic: &str, encoding: &str, schema: Option<Schema>| {
+            ChannelBuilder::new(topic)
+                .context(&context)
+                .message_encoding(encoding)
+                .schema(schema)
+                .build_raw()
+                .map_err(|e| ServeError::Channel {
+                    topic: topic.to_owned(),
+                    detail: e.to_string(),
+                })
+        };
+        let image = channel(IMAGE_TOPIC, "protobuf", raw_image_schema())?;
+        let sensors = channel(
+            SENSORS_TOPIC,
+            "json",
+            Some(json_schema(SENSORS_SCHEMA_NAME, &sensors_json_schema())),
+        )?;
+        let handle = WebSocketServer::new()
+            .name(name)
+            .bind(host, port)
+            .context(&context)
+            .listener(Arc::new(ViewerFlag(Arc::clone(&viewer))))
+            .start_blocking()
+            .map_err(|e| ServeError::Listen {
+                addr: format!("{host}:{port}"),
+                detail: e.to_string(),
+            })?;
+        let port = handle.port();
+        Ok(Self {
+            context,
+            handle: Some(handle),
+            image,
+            sensors,
+            json: HashMap::new(),
+            viewer,
+            port,
+            buf: Vec::new(),
+        })
+    }
+
+    /// The port it listens on.
+    #[must_use]
+    pub fn port(&self) -> u16 {
+        self.port
+    }
+
+    /// True once a viewer has subscribed to the images.
+    #[must_use]
+    pub fn has_viewer(&self) -> bool {
+        self.viewer.load(Ordering::Relaxed)
+    }
+
+    /// Sends one frame now: its image, then its sensor readings and JSON channels, with this
+    /// machine's clock as their log time; returns that time, nanoseconds since the Unix epoch.
+    ///
+    /// # Errors
+    /// A message when the frame cannot be encoded or a channel made.
+    pub fn send(&mut self, record: &FrameRecord) -> Result<u64, String> {
+        encode_image(record.time_ns, &record.frame, &mut self.buf)?;
+        let meta = PartialMetadata::with_log_time(unix_time_ns());
+        let log_time = meta.log_time.unwrap_or(0);
+        self.image.log_with_meta(&self.buf, meta);
+        if let Some(s) = &record.sensors {
+            let json = serde_json::to_vec(&s.clone().sanitised().0).map_err(|e| e.to_string())?;
+            self.sensors.log_with_meta(&json, meta);
+        }
+        let fixed = [
+            (GROUND_TRUTH_TOPIC, record.ground_truth.as_ref()),
+            (RECOGNITION_TOPIC, record.recognition.as_ref()),
+        ];
+        let extra = record.extra.iter().map(|(t, v)| (t.as_str(), Some(v)));
+        for (topic, value) in fixed.into_iter().chain(extra) {
+            let Some(value) = value else { continue };
+            let json = serde_json::to_vec(value).map_err(|e| e.to_string())?;
+            self.json_channel(topic)?.log_with_meta(&json, meta);
+        }
+        Ok(log_time)
+    }
+
+    fn json_channel(&mut self, topic: &str) -> Result<&Arc<RawChannel>, String> {
+        if !self.json.contains_key(topic) {
+            let schema = match topic {
+                GROUND_TRUTH_TOPIC => json_schema(
+                    GROUND_TRUTH_SCHEMA_NAME,
+                    &object_json_schema(GROUND_TRUTH_SCHEMA_NAME, "Ground truth."),
+                ),
+                RECOGNITION_TOPIC => json_schema(
+                    RECOGNITION_SCHEMA_NAME,
+                    &object_json_schema(RECOGNITION_SCHEMA_NAME, "Recognition results."),
+                ),
+                _ => json_schema(EXTRA_SCHEMA_NAME, &any_json_schema()),
+            };
+            let channel = ChannelBuilder::new(topic)
+                .context(&self.context)
+                .message_encoding("json")
+                .schema(schema)
+                .build_raw()
+                .map_err(|e| format!("cannot make channel {topic}: {e}"))?;
+            self.json.insert(topic.to_owned(), channel);
+        }
+        self.json
+            .get(topic)
+            .ok_or_else(|| format!("channel {topic} is missing"))
+    }
+
+    /// Plays a stream at its recorded rate (again and again with `looping`) until it ends or
+    /// `stop` is set; returns the frames sent. With `wait_for_viewer` nothing is sent before a
+    /// viewer has subscribed to the images.
+    ///
+    /// # Errors
+    /// [`ServeError`] when a frame cannot be read or encoded.
+    pub fn play(
+        &mut self,
+        reader: &mut StreamReader,
+        looping: bool,
+        wait_for_viewer: bool,
+        stop: &AtomicBool,
+    ) -> Result<usize, ServeError> {
+        let stopped = || stop.load(Ordering::Relaxed);
+        while wait_for_viewer && !self.has_viewer() && !stopped() {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let mut sent = 0;
+        loop {
+            let start = Instant::now();
+            let first = reader.time_ns(0).unwrap_or(0);
+            for index in 0..reader.len() {
+                let offset = reader.time_ns(index).unwrap_or(first).saturating_sub(first);
+                let due = start + Duration::from_nanos(offset);
+                while Instant::now() < due {
+                    if stopped() {
+                        return Ok(sent);
+                    }
+                    let left = due.saturating_duration_since(Instant::now());
+                    std::thread::sleep(left.min(Duration::from_millis(20)));
+                }
+                if stopped() {
+                    return Ok(sent);
+                }
+                let record = reader.read(index)?;
+                self.send(&record)
+                    .map_err(|detail| ServeError::Frame { index, detail })?;
+                sent += 1;
+            }
+            if !looping || reader.is_empty() {
+                return Ok(sent);
+            }
+            // One frame period between the last frame and the first again.
+            let period = reader
+                .time_ns(1)
+                .map_or(33_000_000, |t| t.saturating_sub(first).max(1));
+            std::thread::sleep(Duration::from_nanos(period));
+        }
+    }
+
+    /// Stops the server, letting queued messages go out first.
+    pub fn stop(mut self) {
+        if let Some(h) = self.handle.take() {
+            h.stop().wait_blocking();
+        }
+    }
+}
+
+fn json_schema(name: &str, schema: &serde_json::Value) -> Schema {
+    Schema::new(name, "jsonschema", schema.to_string().into_bytes())
+}
