@@ -16,7 +16,7 @@ use super::protocol::AdvertisedChannel;
 use super::recorder::LiveRecorder;
 use super::{RobotUrl, unix_time_ns};
 use crate::sensors::SensorReadings;
-use crate::streams::schema::{decode_image, parse_json_lenient};
+use crate::streams::schema::{decode_image_with_time, parse_json_lenient};
 use crate::streams::{
     FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError,
     StreamInfo,
@@ -390,7 +390,7 @@ impl Inner {
     }
 
     fn image(&mut self, log_time_ns: u64, received_ns: u64, payload: &[u8], keep: usize) -> bool {
-        let frame = match decode_image(payload) {
+        let (frame, capture_ns) = match decode_image_with_time(payload) {
             Ok(f) => f,
             Err(e) => {
                 self.drops += 1;
@@ -398,9 +398,12 @@ impl Inner {
                 return false;
             }
         };
+        // Gaps are judged on the camera's capture times (regular), not on when the sender got
+        // round to writing (jittery); images without a timestamp use their log time.
+        let capture_ns = capture_ns.filter(|&t| t > 0).unwrap_or(log_time_ns);
         if let (Some(last), Some(period)) = (self.last_time_ns, self.period_ns) {
             #[expect(clippy::cast_precision_loss, reason = "nanosecond gaps")]
-            let gap = log_time_ns.saturating_sub(last) as f64;
+            let gap = capture_ns.saturating_sub(last) as f64;
             if gap > 1.5 * period {
                 #[expect(
                     clippy::cast_possible_truncation,
@@ -413,13 +416,13 @@ impl Inner {
         }
         if let Some(last) = self.last_time_ns {
             #[expect(clippy::cast_precision_loss, reason = "nanosecond gaps")]
-            let gap = log_time_ns.saturating_sub(last) as f64;
+            let gap = capture_ns.saturating_sub(last) as f64;
             if gap > 0.0 {
                 // Slow average so one gap does not make the next frames look late.
                 self.period_ns = Some(self.period_ns.map_or(gap, |p| p.min(0.9 * p + 0.1 * gap)));
             }
         }
-        self.last_time_ns = Some(log_time_ns);
+        self.last_time_ns = Some(capture_ns);
         let mut record = FrameRecord::new(log_time_ns, frame);
         for (channel, time, bytes) in std::mem::take(&mut self.pending) {
             if time == log_time_ns

@@ -172,8 +172,20 @@ pub fn encode_image(
 /// # Errors
 /// A message for undecodable protobuf, other encodings, or sizes that do not match the data.
 pub fn decode_image(bytes: &[u8]) -> Result<Frame, String> {
+    decode_image_with_time(bytes).map(|(frame, _)| frame)
+}
+
+/// [`decode_image`], also giving the image's own `timestamp` (the capture time), nanoseconds
+/// since the Unix epoch or the stream's start, when it has one.
+///
+/// # Errors
+/// As [`decode_image`].
+pub fn decode_image_with_time(bytes: &[u8]) -> Result<(Frame, Option<u64>), String> {
     let msg = foxglove::messages::RawImage::decode(bytes)
         .map_err(|e| format!("image message is not a foxglove.RawImage: {e}"))?;
+    let time_ns = msg
+        .timestamp
+        .map(|t| u64::from(t.sec()) * 1_000_000_000 + u64::from(t.nsec()));
     let (w, h) = (msg.width as usize, msg.height as usize);
     let Some(encoding) = ImageEncoding::from_name(&msg.encoding) else {
         return Err(format!(
@@ -208,7 +220,8 @@ pub fn decode_image(bytes: &[u8]) -> Result<Frame, String> {
     if encoding == ImageEncoding::Yuyv {
         swap_pairs(&mut data);
     }
-    Frame::from_uyvy(w, h, data).map_err(|e| e.to_string())
+    let frame = Frame::from_uyvy(w, h, data).map_err(|e| e.to_string())?;
+    Ok((frame, time_ns))
 }
 
 /// Parses a JSON message leniently: Python's `NaN`, `Infinity` and `-Infinity` (not JSON, but
