@@ -140,12 +140,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let server = StandInRobot::start(&format!("bench{i}"), "127.0.0.1", 0)?;
         let url: RobotUrl = format!("127.0.0.1:{}", server.port()).parse()?;
         let keep = DEFAULT_KEEP_BYTES.max(frames_needed(args) * width * height * 2);
-        robots.push(LiveRobot::connect(url, ClientOptions::default(), keep, None)?);
+        robots.push(LiveRobot::connect(
+            url,
+            ClientOptions::default(),
+            keep,
+            None,
+        )?);
         servers.push(server);
     }
     let wait_until = Instant::now() + Duration::from_secs(10);
     while servers.iter().any(|s| !s.has_viewer()) {
-        anyhow::ensure!(Instant::now() < wait_until, "the robots did not subscribe within 10 s");
+        anyhow::ensure!(
+            Instant::now() < wait_until,
+            "the robots did not subscribe within 10 s"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     let stop = Arc::new(AtomicBool::new(false));
@@ -155,7 +163,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .into_iter()
         .enumerate()
         .map(|(i, mut server)| {
-            let (frames, stop, fps, seconds) = (Arc::clone(&frames), Arc::clone(&stop), args.fps, args.seconds);
+            let (frames, stop, fps, seconds) = (
+                Arc::clone(&frames),
+                Arc::clone(&stop),
+                args.fps,
+                args.seconds,
+            );
             std::thread::Builder::new()
                 .name(format!("sender {i}"))
                 .spawn(move || -> Result<(usize, StandInRobot), String> {
@@ -165,7 +178,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     while t0.elapsed().as_secs_f64() < seconds && !stop.load(Ordering::Relaxed) {
                         let due = t0 + period * u32::try_from(n).unwrap_or(u32::MAX);
                         std::thread::sleep(due.saturating_duration_since(Instant::now()));
-                        let Some(f) = frames.get(n % frames.len().max(1)) else { break };
+                        let Some(f) = frames.get(n % frames.len().max(1)) else {
+                            break;
+                        };
                         server.send(f)?;
                         n += 1;
                     }
@@ -191,7 +206,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let wall = start.elapsed().as_secs_f64();
     let cpu_after = cpu_seconds();
-    let report = report(args, &robots, (width, height), sent, wall, cpu_before, cpu_after);
+    let report = report(
+        args,
+        &robots,
+        (width, height),
+        sent,
+        wall,
+        cpu_before,
+        cpu_after,
+    );
     drop(robots);
     for s in servers {
         s.stop();
@@ -200,7 +223,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 fn frames_needed(args: &Args) -> usize {
-    #[expect(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a frame count")]
+    #[expect(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        reason = "a frame count"
+    )]
     let n = (args.fps.max(0.0) * args.seconds.max(0.0)).ceil() as usize;
     n + 30
 }

@@ -86,12 +86,7 @@ impl Naming {
     }
 }
 
-fn on_event(
-    rec: &mut Recording,
-    naming: &Mutex<Naming>,
-    limit: Option<usize>,
-    event: LiveEvent,
-) {
+fn on_event(rec: &mut Recording, naming: &Mutex<Naming>, limit: Option<usize>, event: LiveEvent) {
     match event {
         LiveEvent::Connected { server_name } => {
             if rec.name.is_some() {
@@ -183,7 +178,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         robots.push((client, rec));
     }
     let start = Instant::now();
-    let deadline = args.seconds.map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    let deadline = args
+        .seconds
+        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
     loop {
         std::thread::sleep(Duration::from_millis(50));
         let mut all_full = args.frames.is_some();

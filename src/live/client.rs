@@ -251,10 +251,7 @@ fn session(
             {
                 let quiet = last_heard.elapsed();
                 if quiet > options.silence_timeout {
-                    return Some(format!(
-                        "nothing heard for {:.1} s",
-                        quiet.as_secs_f64()
-                    ));
+                    return Some(format!("nothing heard for {:.1} s", quiet.as_secs_f64()));
                 }
                 if quiet > options.ping_after && !pinged {
                     pinged = true;

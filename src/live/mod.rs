@@ -104,13 +104,27 @@ mod tests {
 
     #[test]
     fn robot_addresses_parse_with_and_without_scheme_and_port() {
-        let u: RobotUrl = "ws://10.0.0.3:9000".parse().unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((u.host.as_str(), u.port, u.path.as_str()), ("10.0.0.3", 9000, "/"));
+        let u: RobotUrl = "ws://10.0.0.3:9000"
+            .parse()
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            (u.host.as_str(), u.port, u.path.as_str()),
+            ("10.0.0.3", 9000, "/")
+        );
         let u: RobotUrl = "robot4".parse().unwrap_or_else(|e| panic!("{e}"));
         assert_eq!((u.host.as_str(), u.port), ("robot4", DEFAULT_PORT));
         assert_eq!(u.to_string(), "ws://robot4:8765/");
-        assert!(matches!("wss://x:1".parse::<RobotUrl>(), Err(UrlError::Tls(_))));
-        assert!(matches!("x:port".parse::<RobotUrl>(), Err(UrlError::Malformed(_))));
-        assert!(matches!("http://x:1".parse::<RobotUrl>(), Err(UrlError::Malformed(_))));
+        assert!(matches!(
+            "wss://x:1".parse::<RobotUrl>(),
+            Err(UrlError::Tls(_))
+        ));
+        assert!(matches!(
+            "x:port".parse::<RobotUrl>(),
+            Err(UrlError::Malformed(_))
+        ));
+        assert!(matches!(
+            "http://x:1".parse::<RobotUrl>(),
+            Err(UrlError::Malformed(_))
+        ));
     }
 }

@@ -313,7 +313,10 @@ mod tests {
 
     #[test]
     fn garbage_text_and_mistyped_fields_are_errors_and_unknown_ops_are_other() {
-        assert!(matches!(parse_text("not json"), Err(ProtocolError::BadJson(_))));
+        assert!(matches!(
+            parse_text("not json"),
+            Err(ProtocolError::BadJson(_))
+        ));
         assert!(matches!(
             parse_text(r#"{"op":"advertise","channels":5}"#),
             Err(ProtocolError::BadFields { .. })

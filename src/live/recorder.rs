@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use super::protocol::AdvertisedChannel;
-use crate::streams::{Compression, RawChannelSpec, StreamError, StreamInfo, StreamWriter, WriterOptions};
+use crate::streams::{
+    Compression, RawChannelSpec, StreamError, StreamInfo, StreamWriter, WriterOptions,
+};
 
 /// A chunk with messages in it is closed after this long without a new image.
 const QUIET_CLOSE: Duration = Duration::from_millis(200);
@@ -37,6 +39,7 @@ impl LiveRecorder {
             // LZ4: a live recording must keep up with several robots on one core.
             compression: Compression::Lz4,
             frames_per_chunk: Some(1),
+            ..WriterOptions::default()
         };
         Ok(Self {
             path: path.to_owned(),

@@ -109,7 +109,9 @@ pub struct LiveRobot {
 
 impl std::fmt::Debug for LiveRobot {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("LiveRobot").field("url", &self.url).finish_non_exhaustive()
+        f.debug_struct("LiveRobot")
+            .field("url", &self.url)
+            .finish_non_exhaustive()
     }
 }
 
@@ -271,7 +273,9 @@ impl Drop for LiveRobot {
 
 /// Locks the robot's state; a panic on another thread never makes it unreadable.
 fn lock(shared: &Mutex<Inner>) -> MutexGuard<'_, Inner> {
-    shared.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    shared
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 fn percentile(sorted: &[u64], p: f64) -> Option<f64> {
@@ -299,7 +303,10 @@ impl Inner {
             .iter()
             .filter(|t| now.duration_since(**t) <= Duration::from_secs(1))
             .count();
-        #[expect(clippy::cast_precision_loss, reason = "a count of frames in one second")]
+        #[expect(
+            clippy::cast_precision_loss,
+            reason = "a count of frames in one second"
+        )]
         let fps = recent as f64;
         RobotStats {
             frames: self.received,
@@ -463,7 +470,10 @@ impl Inner {
     }
 
     fn json(&mut self, channel: Arc<AdvertisedChannel>, log_time_ns: u64, payload: Vec<u8>) {
-        let latest = self.frames.back_mut().filter(|f| f.record.time_ns == log_time_ns);
+        let latest = self
+            .frames
+            .back_mut()
+            .filter(|f| f.record.time_ns == log_time_ns);
         if let Some(latest) = latest {
             let note = attach(&mut Arc::make_mut(latest).record, &channel, &payload);
             if let Some(n) = note {

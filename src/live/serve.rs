@@ -1,7 +1,8 @@
 //! [`StandInRobot`]: a Foxglove WebSocket server (the SDK's own, the `foxglove` crate) that
 //! plays a stream's frames at their recorded rate, as a robot would send them: `eotn serve`.
 //!
-//! Each frame goes out as its `foxglove.RawImage` on `/camera/image`, then its sensor readings on
+//! Each frame goes out as its `foxglove.RawImage` (encoding `yuyv`, the streams' default) on
+//! `/camera/image`, then its sensor readings on
 //! `/sensors` and its other JSON channels, all with the same log time: the moment it is sent
 //! (this machine's clock), so a viewer can measure its latency.
 
@@ -15,8 +16,9 @@ use foxglove::{ChannelBuilder, Context, PartialMetadata, RawChannel, Schema, Web
 
 use super::unix_time_ns;
 use crate::streams::schema::{
-    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, RECOGNITION_SCHEMA_NAME, SENSORS_SCHEMA_NAME,
-    any_json_schema, encode_image, object_json_schema, raw_image_schema, sensors_json_schema,
+    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, ImageEncoding, RECOGNITION_SCHEMA_NAME,
+    SENSORS_SCHEMA_NAME, any_json_schema, encode_image, object_json_schema, raw_image_schema,
+    sensors_json_schema,
 };
 use crate::streams::{
     FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError,
@@ -80,7 +82,9 @@ pub struct StandInRobot {
 
 impl std::fmt::Debug for StandInRobot {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("StandInRobot").field("port", &self.port).finish_non_exhaustive()
+        f.debug_struct("StandInRobot")
+            .field("port", &self.port)
+            .finish_non_exhaustive()
     }
 }
 
@@ -150,7 +154,12 @@ impl StandInRobot {
     /// # Errors
     /// A message when the frame cannot be encoded or a channel made.
     pub fn send(&mut self, record: &FrameRecord) -> Result<u64, String> {
-        encode_image(record.time_ns, &record.frame, &mut self.buf)?;
+        encode_image(
+            record.time_ns,
+            &record.frame,
+            ImageEncoding::default(),
+            &mut self.buf,
+        )?;
         let meta = PartialMetadata::with_log_time(unix_time_ns());
         let log_time = meta.log_time.unwrap_or(0);
         self.image.log_with_meta(&self.buf, meta);

@@ -408,7 +408,12 @@ impl StreamWriter {
             };
             let id = self
                 .mcap
-                .add_channel(schema, &spec.topic, &spec.message_encoding, &BTreeMap::new())
+                .add_channel(
+                    schema,
+                    &spec.topic,
+                    &spec.message_encoding,
+                    &BTreeMap::new(),
+                )
                 .map_err(self.mcap_err("cannot add a channel"))?;
             self.raw_channels.insert(spec.topic.clone(), id);
             id

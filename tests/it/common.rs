@@ -75,6 +75,16 @@ pub fn python_with_mcap() -> Option<PathBuf> {
     )
 }
 
+/// A python3 with the official Foxglove SDK (`foxglove-sdk`: a WebSocket server that is not ours),
+/// or `None` (with a "skipped" line) outside CI. Under `CI=true` its absence fails the test.
+pub fn python_with_foxglove() -> Option<PathBuf> {
+    python_with(
+        "import foxglove",
+        "foxglove-sdk",
+        "the Foxglove SDK server test",
+    )
+}
+
 /// The tests' Python: `$PYTHON` if set, else the project's `.venv/` that `scripts/deps.sh --test`
 /// makes from the system interpreter (with the pinned packages of `scripts/requirements-test.txt`),
 /// else `python3` from the PATH.

@@ -16,11 +16,11 @@ use eotn::frame::{Frame, Yuv};
 use eotn::live::serve::StandInRobot;
 use eotn::live::{ClientOptions, LiveRobot, RobotUrl};
 use eotn::sensors::SensorReadings;
-use eotn::streams::schema::{encode_image, raw_image_schema};
+use eotn::streams::schema::{ImageEncoding, encode_image, raw_image_schema};
 use eotn::streams::{FrameRecord, StreamReader};
 use tungstenite::Message;
 
-use crate::common::{eotn_ok, in_ci};
+use crate::common::{eotn_ok, python_with_foxglove};
 
 /// A small frame whose every byte depends on the frame number, so mix-ups show.
 fn frame(i: usize) -> Frame {
@@ -124,7 +124,8 @@ fn fake_robot_session(listener: &TcpListener) -> (tungstenite::WebSocket<TcpStre
 fn image_message(sub: u32, i: usize) -> Vec<u8> {
     let r = record(i);
     let mut payload = Vec::new();
-    encode_image(r.time_ns, &r.frame, &mut payload).unwrap();
+    // The hand-made robot sends the cameras' own order; eotn serve sends yuyv.
+    encode_image(r.time_ns, &r.frame, ImageEncoding::Uyvy, &mut payload).unwrap();
     eotn::live::protocol::encode_message_data(sub, r.time_ns, &payload)
 }
 
@@ -157,7 +158,11 @@ fn a_robot_killed_mid_frame_costs_that_frame_and_is_reconnected() {
     assert!(wait_for(5.0, || robot.len() >= 1), "no first frame");
     let out = dir.path().join("cut.mcap");
     robot.start_recording(&out).unwrap();
-    assert!(wait_for(10.0, || robot.len() >= 5), "got {} frames", robot.len());
+    assert!(
+        wait_for(10.0, || robot.len() >= 5),
+        "got {} frames",
+        robot.len()
+    );
     server.join().unwrap();
     let got: Vec<Frame> = (0..robot.len())
         .map(|i| robot.frame(i).unwrap().record.frame.clone())
@@ -165,7 +170,10 @@ fn a_robot_killed_mid_frame_costs_that_frame_and_is_reconnected() {
     let want: Vec<Frame> = [0, 1, 2, 4, 5].iter().map(|&i| frame(i)).collect();
     assert_eq!(got, want, "frame 3 alone is lost");
     let log = robot.log().join("\n");
-    assert!(log.contains("disconnected") && log.contains("reconnected"), "{log}");
+    assert!(
+        log.contains("disconnected") && log.contains("reconnected"),
+        "{log}"
+    );
     assert_eq!(robot.stats().connections, 2);
     let (path, frames) = robot.stop_recording().unwrap().unwrap();
     let mut reader = StreamReader::open(&path).unwrap();
@@ -217,10 +225,24 @@ fn garbage_and_oversized_messages_close_only_their_own_robot() {
         good.send(&record(i)).unwrap();
         std::thread::sleep(Duration::from_millis(5));
     }
-    assert!(wait_for(5.0, || ok.len() == 30), "good robot got {}", ok.len());
-    assert!(wait_for(5.0, || bad_text.log().join("\n").contains("malformed message")));
-    assert!(wait_for(5.0, || too_big.log().join("\n").contains("too large")));
-    assert_eq!(bad_text.len(), 0, "the garbage robot's later frame came after its garbage");
+    assert!(
+        wait_for(5.0, || ok.len() == 30),
+        "good robot got {}",
+        ok.len()
+    );
+    assert!(wait_for(5.0, || bad_text
+        .log()
+        .join("\n")
+        .contains("malformed message")));
+    assert!(wait_for(5.0, || too_big
+        .log()
+        .join("\n")
+        .contains("too large")));
+    assert_eq!(
+        bad_text.len(),
+        0,
+        "the garbage robot's later frame came after its garbage"
+    );
     assert_eq!(ok.stats().drops, 0);
     done.store(true, Ordering::Relaxed);
     drop(bad_text);
@@ -247,7 +269,9 @@ fn four_robots_at_30_fps_lose_no_frame_and_keep_up() {
         .iter()
         .map(|s| LiveRobot::connect(url(s.port()), fast_retry(), 256 << 20, None).unwrap())
         .collect();
-    assert!(wait_for(5.0, || servers.iter().all(StandInRobot::has_viewer)));
+    assert!(wait_for(5.0, || servers
+        .iter()
+        .all(StandInRobot::has_viewer)));
     let start = Instant::now();
     for n in 0..frames {
         let due = start + Duration::from_secs_f64(n as f64 / 30.0);
@@ -257,7 +281,13 @@ fn four_robots_at_30_fps_lose_no_frame_and_keep_up() {
         }
     }
     for r in &robots {
-        assert!(wait_for(5.0, || r.len() == frames), "{} of {frames}", r.len());
+        assert!(
+            // A frame's sensors follow its image by a moment: wait for the last one's too.
+            wait_for(5.0, || r.len() == frames
+                && r.latest().is_some_and(|f| f.record.sensors.is_some())),
+            "{} of {frames}",
+            r.len()
+        );
         let stats = r.stats();
         assert_eq!(stats.drops, 0);
         for i in 0..frames {
@@ -265,7 +295,11 @@ fn four_robots_at_30_fps_lose_no_frame_and_keep_up() {
             assert_eq!(f.record.frame, frame(i), "frame {i}");
             assert!(f.record.sensors.is_some(), "frame {i} has its sensors");
             // Falling behind would show as a growing latency; a second is far beyond any jitter.
-            assert!(f.latency_ns < 1_000_000_000, "frame {i}: {} ns", f.latency_ns);
+            assert!(
+                f.latency_ns < 1_000_000_000,
+                "frame {i}: {} ns",
+                f.latency_ns
+            );
         }
     }
     drop(robots);
@@ -359,11 +393,18 @@ fn frames_from_eotn_serve_are_recorded_bit_exact_by_eotn_record() {
         let s = source.read(i).unwrap();
         let r = recorded.read(i).unwrap();
         assert_eq!(r.frame, s.frame, "frame {i}");
-        assert_eq!(r.sensors, s.sensors.map(|x| x.sanitised().0), "frame {i} sensors");
+        assert_eq!(
+            r.sensors,
+            s.sensors.map(|x| x.sanitised().0),
+            "frame {i} sensors"
+        );
         assert_eq!(r.extra, s.extra, "frame {i} extra channels");
         let mut sent = Vec::new();
-        encode_image(s.time_ns, &s.frame, &mut sent).unwrap();
-        assert_eq!(payloads[i], sent, "frame {i}: the recorded bytes are the sent bytes");
+        encode_image(s.time_ns, &s.frame, ImageEncoding::default(), &mut sent).unwrap();
+        assert_eq!(
+            payloads[i], sent,
+            "frame {i}: the recorded bytes are the sent bytes"
+        );
     }
 }
 
@@ -377,7 +418,7 @@ fn free_port() -> u16 {
 
 #[test]
 fn a_sender_that_stops_and_comes_back_is_reconnected_and_a_killed_recorder_leaves_a_readable_file()
- {
+{
     let dir = tempfile::tempdir().unwrap();
     let stream = sim_stream(dir.path(), 10);
     let port = free_port();
@@ -405,7 +446,10 @@ fn a_sender_that_stops_and_comes_back_is_reconnected_and_a_killed_recorder_leave
     let mut source = StreamReader::open(&stream).unwrap();
     let frames: Vec<Frame> = (0..10).map(|i| source.read(i).unwrap().frame).collect();
     for i in 0..40 {
-        assert!(frames.contains(&recorded.read(i).unwrap().frame), "frame {i} is a sent frame");
+        assert!(
+            frames.contains(&recorded.read(i).unwrap().frame),
+            "frame {i} is a sent frame"
+        );
     }
 
     // The recorder killed with SIGKILL: the .partial file reads to its last chunk.
@@ -429,29 +473,6 @@ fn a_sender_that_stops_and_comes_back_is_reconnected_and_a_killed_recorder_leave
     }
 }
 
-/// A Python with the `foxglove` SDK (`scripts/requirements-test.txt`), or `None` outside CI.
-fn python_with_foxglove() -> Option<PathBuf> {
-    let candidates = [
-        std::env::var_os("PYTHON").map(PathBuf::from),
-        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python")),
-    ];
-    for python in candidates.into_iter().flatten() {
-        let ok = Command::new(&python)
-            .args(["-c", "import foxglove"])
-            .output()
-            .is_ok_and(|o| o.status.success());
-        if ok {
-            return Some(python);
-        }
-    }
-    assert!(
-        !in_ci(),
-        "python with foxglove-sdk is required under CI=true (scripts/deps.sh --test)"
-    );
-    eprintln!("SKIPPED: no python with foxglove-sdk; the SDK-server test did not run");
-    None
-}
-
 #[test]
 fn frames_from_the_python_foxglove_sdk_server_arrive_intact() {
     let Some(python) = python_with_foxglove() else {
@@ -469,7 +490,12 @@ fn frames_from_the_python_foxglove_sdk_server_arrive_intact() {
     let got_all = wait_for(20.0, || robot.len() >= 20);
     let _ = sender.kill();
     let _ = sender.wait();
-    assert!(got_all, "got {} frames; log: {:?}", robot.len(), robot.log());
+    assert!(
+        got_all,
+        "got {} frames; log: {:?}",
+        robot.len(),
+        robot.log()
+    );
     assert!(robot.name().contains("python-robot"), "{}", robot.name());
     for i in 0..20 {
         let f = robot.frame(i).unwrap();
