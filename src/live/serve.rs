@@ -164,7 +164,7 @@ impl StandInRobot {
         let log_time = meta.log_time.unwrap_or(0);
         self.image.log_with_meta(&self.buf, meta);
         if let Some(s) = &record.sensors {
-            let json = serde_json::to_vec(&s.clone().sanitised().0).map_err(|e| e.to_string())?;
+            let json = serde_json::to_vec(&s.sanitised().0).map_err(|e| e.to_string())?;
             self.sensors.log_with_meta(&json, meta);
         }
         let fixed = [

@@ -70,6 +70,10 @@ fn fast_retry() -> ClientOptions {
 /// A hand-made Foxglove server speaking the protocol byte by byte: the handshake, `serverInfo`,
 /// an image and a sensors channel; returns the socket and the image subscription id once the
 /// client subscribed.
+#[allow(
+    clippy::result_large_err,
+    reason = "tungstenite's handshake callback type"
+)]
 fn fake_robot_session(listener: &TcpListener) -> (tungstenite::WebSocket<TcpStream>, u32) {
     let (stream, _) = listener.accept().unwrap();
     stream.set_nodelay(true).unwrap();
@@ -155,7 +159,7 @@ fn a_robot_killed_mid_frame_costs_that_frame_and_is_reconnected() {
         std::thread::sleep(Duration::from_millis(500));
     });
     let robot = LiveRobot::connect(url(port), fast_retry(), 1 << 20, None).unwrap();
-    assert!(wait_for(5.0, || robot.len() >= 1), "no first frame");
+    assert!(wait_for(5.0, || !robot.is_empty()), "no first frame");
     let out = dir.path().join("cut.mcap");
     robot.start_recording(&out).unwrap();
     assert!(
@@ -389,7 +393,7 @@ fn frames_from_eotn_serve_are_recorded_bit_exact_by_eotn_record() {
     assert_eq!(recorded.len(), 12);
     let payloads = image_payloads(&out);
     assert_eq!(payloads.len(), 12);
-    for i in 0..12 {
+    for (i, payload) in payloads.iter().enumerate() {
         let s = source.read(i).unwrap();
         let r = recorded.read(i).unwrap();
         assert_eq!(r.frame, s.frame, "frame {i}");
@@ -402,7 +406,7 @@ fn frames_from_eotn_serve_are_recorded_bit_exact_by_eotn_record() {
         let mut sent = Vec::new();
         encode_image(s.time_ns, &s.frame, ImageEncoding::default(), &mut sent).unwrap();
         assert_eq!(
-            payloads[i], sent,
+            *payload, sent,
             "frame {i}: the recorded bytes are the sent bytes"
         );
     }
