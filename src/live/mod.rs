@@ -5,19 +5,22 @@
 //! [`protocol`] parses one server message (pure: bytes in, typed message or typed error out);
 //! [`client`] runs one robot's connection on its own thread with reconnection; [`robot`] turns
 //! its messages into frames with statistics and an optional bit-exact recording ([`recorder`]);
-//! [`serve`] plays a stream as a Foxglove WebSocket server (`eotn serve`, a stand-in robot).
+//! [`serve`] plays a stream as a Foxglove WebSocket server (`eotn serve`, a stand-in robot);
+//! [`source`] is a robot as a [`crate::sources::FrameSource`] for the workspace and the app.
 
 pub mod client;
 pub mod protocol;
 pub mod recorder;
 pub mod robot;
 pub mod serve;
+pub mod source;
 
 use std::fmt;
 
 pub use client::{ClientOptions, LiveEvent, RobotClient};
 pub use recorder::LiveRecorder;
 pub use robot::{LiveFrame, LiveRobot, RobotStats};
+pub use source::NetworkSource;
 
 /// WebSocket subprotocols the client offers: the SDK's (its servers accept only this one since
 /// 0.30) and the older name other servers use.

@@ -311,9 +311,11 @@ impl Workspace {
 /// network source, which lives in a module after `sources` in the data flow and is built here.
 fn open_live(spec: &SourceSpec) -> anyhow::Result<Box<dyn crate::sources::FrameSource>> {
     match spec {
-        SourceSpec::Network(address) => anyhow::bail!(
-            "{address}: network sources (robots over Foxglove WebSocket) are not built in yet"
-        ),
+        SourceSpec::Network(address) => {
+            let mut robot = crate::live::NetworkSource::new(address)?;
+            crate::sources::FrameSource::connect(&mut robot)?;
+            Ok(Box::new(robot))
+        }
         other => Ok(other.open()?),
     }
 }

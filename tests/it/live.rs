@@ -313,7 +313,7 @@ fn four_robots_at_30_fps_lose_no_frame_and_keep_up() {
 }
 
 /// A stream made by `eotn sim` in `dir`.
-fn sim_stream(dir: &Path, frames: usize) -> PathBuf {
+pub fn sim_stream(dir: &Path, frames: usize) -> PathBuf {
     let path = dir.join("walk.mcap");
     eotn_ok(&[
         OsStr::new("sim"),
@@ -328,9 +328,10 @@ fn sim_stream(dir: &Path, frames: usize) -> PathBuf {
 }
 
 /// `eotn serve` in the background; its port, read from its first line.
-struct Served {
+pub struct Served {
     child: Child,
-    port: u16,
+    /// The port it listens on.
+    pub port: u16,
 }
 
 impl Drop for Served {
@@ -340,7 +341,7 @@ impl Drop for Served {
     }
 }
 
-fn serve(stream: &Path, listen: &str, extra: &[&str]) -> Served {
+pub fn serve(stream: &Path, listen: &str, extra: &[&str]) -> Served {
     let mut child = Command::new(env!("CARGO_BIN_EXE_eotn"))
         .arg("serve")
         .arg(stream)

@@ -6,6 +6,8 @@
 mod app;
 #[cfg(feature = "gui")]
 mod app_camera;
+#[cfg(feature = "gui")]
+mod app_live;
 mod cli;
 mod common;
 mod hardening;
