@@ -111,16 +111,10 @@ fn frames_to_send() -> anyhow::Result<Vec<FrameRecord>> {
         .collect()
 }
 
-#[expect(clippy::cast_precision_loss, reason = "nanosecond latencies")]
 fn percentile_ms(sorted: &[u64], p: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
     }
-    #[expect(
-        clippy::cast_possible_truncation,
-        clippy::cast_sign_loss,
-        reason = "an index into the list"
-    )]
     let at = ((sorted.len() - 1) as f64 * p).round() as usize;
     sorted.get(at).map_or(f64::NAN, |&ns| ns as f64 / 1e6)
 }
@@ -223,11 +217,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 fn frames_needed(args: &Args) -> usize {
-    #[expect(
-        clippy::cast_possible_truncation,
-        clippy::cast_sign_loss,
-        reason = "a frame count"
-    )]
     let n = (args.fps.max(0.0) * args.seconds.max(0.0)).ceil() as usize;
     n + 30
 }

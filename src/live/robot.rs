@@ -282,14 +282,7 @@ fn percentile(sorted: &[u64], p: f64) -> Option<f64> {
     if sorted.is_empty() {
         return None;
     }
-    #[expect(
-        clippy::cast_possible_truncation,
-        clippy::cast_sign_loss,
-        clippy::cast_precision_loss,
-        reason = "an index into at most LATENCY_WINDOW values"
-    )]
     let at = ((sorted.len() - 1) as f64 * p).round() as usize;
-    #[expect(clippy::cast_precision_loss, reason = "latencies well under 2^52 ns")]
     sorted.get(at).map(|&ns| ns as f64 / 1e6)
 }
 
@@ -303,10 +296,6 @@ impl Inner {
             .iter()
             .filter(|t| now.duration_since(**t) <= Duration::from_secs(1))
             .count();
-        #[expect(
-            clippy::cast_precision_loss,
-            reason = "a count of frames in one second"
-        )]
         let fps = recent as f64;
         RobotStats {
             frames: self.received,
@@ -409,20 +398,13 @@ impl Inner {
         // round to writing (jittery); images without a timestamp use their log time.
         let capture_ns = capture_ns.filter(|&t| t > 0).unwrap_or(log_time_ns);
         if let (Some(last), Some(period)) = (self.last_time_ns, self.period_ns) {
-            #[expect(clippy::cast_precision_loss, reason = "nanosecond gaps")]
             let gap = capture_ns.saturating_sub(last) as f64;
             if gap > 1.5 * period {
-                #[expect(
-                    clippy::cast_possible_truncation,
-                    clippy::cast_sign_loss,
-                    reason = "a small positive count"
-                )]
                 let missed = ((gap / period).round() as usize).saturating_sub(1);
                 self.drops += missed;
             }
         }
         if let Some(last) = self.last_time_ns {
-            #[expect(clippy::cast_precision_loss, reason = "nanosecond gaps")]
             let gap = capture_ns.saturating_sub(last) as f64;
             if gap > 0.0 {
                 // Slow average so one gap does not make the next frames look late.
