@@ -408,6 +408,16 @@ fn lap_ns(r: &dyn RecordedSource) -> u64 {
     span + interval
 }
 
+/// The `next`-th grab of a recording played over and over: frame `next % len`, its time moved
+/// on by one [`lap_ns`] per pass, so a live replay's times keep increasing.
+fn grab_looping(r: &mut dyn RecordedSource, next: usize) -> Result<SourceFrame, SourceError> {
+    let len = r.len().max(1);
+    let (lap, index) = (next / len, next % len);
+    let mut frame = r.read(index)?;
+    frame.time_ns += lap as u64 * lap_ns(r);
+    Ok(frame)
+}
+
 /// A source the user picked (Camera ▸ Connect…, the command line): turned into a connected
 /// source by [`SourceSpec::open`], the one place each kind is built.
 #[derive(Debug, Clone, PartialEq, Eq)]

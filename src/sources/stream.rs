@@ -107,12 +107,9 @@ impl FrameSource for StreamSource {
         if !self.connected {
             return Err(SourceError::NotConnected(self.label()));
         }
-        let len = self.reader.len();
-        let (lap, index) = (self.next / len, self.next % len);
+        let next = self.next;
         self.next += 1;
-        let mut frame = self.read(index)?;
-        frame.time_ns += lap as u64 * super::lap_ns(self);
-        Ok(frame)
+        super::grab_looping(self, next)
     }
 
     fn recorded(&mut self) -> Option<&mut dyn RecordedSource> {
