@@ -389,7 +389,10 @@ pub fn fit_line(points: &[Point]) -> Option<LineFit> {
     } else {
         (sxx, syy, mx, my)
     };
-    if sii <= 0.0 {
+    // Coincident points still spread by rounding (the mean of three equal coordinates is not
+    // always that coordinate): below a spread of 1e-9 of their size they are one point.
+    let size = 1.0 + mx.abs().max(my.abs());
+    if sii <= n * (1e-9 * size).powi(2) {
         return None;
     }
     let slope = sxy / sii;
