@@ -10,6 +10,7 @@ mod app_camera;
 mod app_live;
 mod cli;
 mod common;
+mod crash_safety;
 mod hardening;
 mod live;
 mod motion;
