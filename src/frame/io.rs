@@ -65,21 +65,6 @@ pub enum FrameFileError {
     },
 }
 
-/// Where a frame came from; used in messages and JSON output.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FrameSource {
-    /// The file the frame was read from.
-    pub path: PathBuf,
-}
-
-impl FrameSource {
-    /// The file name without folders, for messages and the JSON `frame` field.
-    #[must_use]
-    pub fn name(&self) -> String {
-        display_name(&self.path)
-    }
-}
-
 /// A file's name without its folders, for messages, labels and the JSON `frame` field; the whole
 /// path when it has no file name (such as `..`).
 #[must_use]

@@ -11,8 +11,8 @@
 mod io;
 
 pub use io::{
-    FrameFileError, FrameSource, MAX_FRAME_PIXELS, display_name, infer_uyvy_size, is_image_file,
-    load_frame, load_raw_uyvy, save_rgb_png,
+    FrameFileError, MAX_FRAME_PIXELS, display_name, infer_uyvy_size, is_image_file, load_frame,
+    load_raw_uyvy, save_rgb_png,
 };
 
 use serde::{Deserialize, Serialize};
