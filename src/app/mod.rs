@@ -159,10 +159,7 @@ fn start_window(
             if opts.all_overlays {
                 app.state.settings.overlays = crate::workspace::Overlays::all_on();
             }
-            if let Some(speed) = opts.play {
-                app.state.run(Command::SetSpeed(speed.as_factor()));
-                app.state.run(Command::SetPlaying(true));
-            }
+            app.play_when_shown = opts.play.map(|speed| speed.as_factor());
             app.quit_at = opts.quit_after.map(|d| Instant::now() + d);
             Ok(Box::new(app))
         }),
@@ -273,6 +270,10 @@ pub struct EotnApp {
     show_about: bool,
     /// `--quit-after`: when to close.
     quit_at: Option<Instant>,
+    /// `--play`: the speed to start at once the first frame is on screen. Starting the clock
+    /// before it would count the window's first, slow frame (fonts, shaders, first uploads:
+    /// about 100 ms on a software renderer) as two or three dropped frames.
+    play_when_shown: Option<f32>,
 }
 
 impl EotnApp {
@@ -314,6 +315,7 @@ impl EotnApp {
             renderer: None,
             show_about: false,
             quit_at: None,
+            play_when_shown: None,
         }
     }
 
@@ -744,6 +746,16 @@ impl eframe::App for EotnApp {
         }
         // Playback and scans use wall time, capped so a stall does not skip half the stream.
         self.state.tick(dt.min(Duration::from_millis(250)));
+        // The first frame has been drawn when the second starts (dt > 0).
+        if dt > Duration::ZERO
+            && let Some(speed) = self.play_when_shown.take()
+        {
+            self.state.run(Command::SetSpeed(speed));
+            self.state.run(Command::SetPlaying(true));
+        }
+        if self.play_when_shown.is_some() {
+            ctx.request_repaint();
+        }
 
         let mut commands = Vec::new();
         let mut quit = self.keyboard(&ctx, &mut commands);
