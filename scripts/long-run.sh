@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Long runs with memory sampled (hardening): a synthetic stream of MINUTES minutes at 30 frames a
+# second (default 20: 36,000 frames, about 2.4 GB in a temporary folder, removed afterwards) read
+# end to end by `eotn detect` (the CLI) and stepped end to end through the app's state
+# (examples/long_run.rs: the headless Workspace the window draws). Prints resident memory at the
+# start, after the first tenth and at its peak for each; fails when either grows by more than
+# 16 MiB after the first tenth (the frame cache and the pipeline's buffers are bounded).
+#   scripts/long-run.sh [MINUTES]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+MINUTES=${1:-20}
+FRAMES=$((MINUTES * 60 * 30))
+cargo build --release --quiet
+cargo build --release --quiet --no-default-features --example long_run
+EOTN=target/release/eotn
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+STREAM="$WORK/long.mcap"
+echo "long-run: making $FRAMES frames ($MINUTES min at 30 fps)"
+"$EOTN" sim --scenario walk-and-pan --frames "$FRAMES" --seed 11 -o "$STREAM" >/dev/null
+ls -l "$STREAM" | awk '{printf "long-run: stream of %.1f GB\n", $5 / 1e9}'
+
+# The CLI: resident memory of `eotn detect` sampled every second from /proc.
+"$EOTN" detect "$STREAM" --lut lookup_tables/sim.lut --json >/dev/null &
+PID=$!
+: >"$WORK/cli-rss.txt"
+while kill -0 "$PID" 2>/dev/null; do
+  awk '/^VmRSS:/ {print $2 / 1024}' "/proc/$PID/status" 2>/dev/null >>"$WORK/cli-rss.txt" || true
+  sleep 1
+done
+wait "$PID"
+awk -v frames="$FRAMES" '
+  { rss[NR] = $1 }
+  END {
+    if (NR == 0) { print "long-run: detect ended before a sample"; exit 0 }
+    warm = int(NR / 10) + 1; base = rss[warm]; peak = 0
+    for (i = warm; i <= NR; i++) if (rss[i] > peak) peak = rss[i]
+    printf "long-run: detect, %d frames in about %d s: resident %.1f MiB at start, %.1f after the first tenth, peak %.1f (growth %.1f MiB)\n", frames, NR, rss[1], base, peak, peak - base
+    if (peak - base > 16) { print "long-run: detect grew by more than 16 MiB"; exit 1 }
+  }' "$WORK/cli-rss.txt"
+
+# The app's state.
+target/release/examples/long_run "$STREAM" lookup_tables/sim.lut 16 >"$WORK/app-rss.txt"
+tail -1 "$WORK/app-rss.txt"
