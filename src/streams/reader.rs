@@ -826,14 +826,42 @@ fn for_each_chunk_record(
     body: &[u8],
     mut each: impl FnMut(Record<'_>),
 ) -> Result<(), mcap::McapError> {
-    let Record::Chunk { header, data } = mcap::parse_record(op::CHUNK, body)? else {
+    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+    let Record::Chunk { header, .. } = mcap::parse_record(op::CHUNK, body)? else {
         return Err(mcap::McapError::BadIndex);
     };
     if header.uncompressed_size > MAX_CHUNK_BYTES {
         return Err(mcap::McapError::ChunkTooLarge(header.uncompressed_size));
     }
-    for record in mcap::read::ChunkReader::new(header, &data)? {
-        each(record?);
+    // The chunk is read as the one record of a file by the linear reader, whose record-length
+    // limit then holds inside the chunk too: mcap 0.26's `ChunkReader` sets none, and a damaged
+    // record length inside a chunk made it allocate exabytes (found by fuzz/mcap_stream). No
+    // record in the chunk can be longer than the chunk.
+    let limit = usize::try_from(header.uncompressed_size)
+        .unwrap_or(usize::MAX)
+        .max(body.len());
+    let mut file = Vec::with_capacity(9 + body.len());
+    file.push(op::CHUNK);
+    file.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    file.extend_from_slice(body);
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_skip_start_magic(true)
+            .with_skip_end_magic(true)
+            .with_validate_chunk_crcs(true)
+            .with_record_length_limit(limit),
+    );
+    let mut rest: &[u8] = &file;
+    while let Some(event) = reader.next_event() {
+        match event? {
+            LinearReadEvent::ReadRequest(need) => {
+                let n = need.min(rest.len());
+                reader.insert(n).copy_from_slice(&rest[..n]);
+                reader.notify_read(n);
+                rest = &rest[n..];
+            }
+            LinearReadEvent::Record { data, opcode } => each(mcap::parse_record(opcode, data)?),
+        }
     }
     Ok(())
 }

@@ -289,3 +289,24 @@ fn sim_refuses_zero_frames_and_import_a_silly_rate_in_one_short_line() {
     ]);
     assert!(err.len() < 120, "{err}");
 }
+
+#[test]
+fn a_record_length_inside_a_chunk_damaged_to_exabytes_is_skipped_not_an_abort() {
+    // Found by fuzz/mcap_stream: a sim stream with bytes changed inside a chunk so that a record
+    // in it claims 8·10^18 bytes. mcap's chunk reader allocated that much and aborted.
+    let damaged = root().join("fuzz/regressions/mcap_stream/chunk-record-length-exabytes.mcap");
+    let dir = tempfile::tempdir().unwrap();
+    let stream = dir.path().join("damaged.mcap");
+    std::fs::copy(&damaged, &stream).unwrap();
+    if let Ok(mut reader) = eotn::streams::StreamReader::open(&stream) {
+        for index in 0..reader.len() {
+            let _ = reader.read(index);
+        }
+    }
+    // The command line says so in words and exits, instead of dying of SIGABRT.
+    let out = eotn(&["info".as_ref(), stream.as_os_str()]);
+    assert!(
+        out.status.code().is_some(),
+        "eotn info was killed by a signal"
+    );
+}
