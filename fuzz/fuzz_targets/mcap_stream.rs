@@ -1,0 +1,17 @@
+//! MCAP streams: opened from a file (damaged chunks, truncation, wrong schemas) and every frame
+//! read (the first 64).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let path = std::env::temp_dir().join(format!("eotn-fuzz-{}.mcap", std::process::id()));
+    if std::fs::write(&path, data).is_err() {
+        return;
+    }
+    if let Ok(mut reader) = eotn::streams::StreamReader::open(&path) {
+        for index in 0..reader.len().min(64) {
+            let _ = reader.read(index);
+        }
+    }
+});

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Fuzzes every parser of outside data (fuzz/fuzz_targets/: the live protocol, lookup tables in
+# all seven formats, B-Human logs, parameter/label/sensor text files, MCAP streams, frame files)
+# with libFuzzer through cargo-fuzz, each for SECONDS (default 60), starting from the bundled
+# files as seeds. Prints executions and coverage per target; a crash stops the run, leaving its
+# input in fuzz/artifacts/TARGET/ (add it to fuzz/regressions/TARGET/ once fixed: CI replays
+# those). Works on the stable toolchain (no sanitizer: `-s none`; Rust's own checks still panic).
+#   scripts/fuzz.sh [SECONDS] [TARGET…]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_PER_TARGET=${1:-60}
+shift || true
+command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked --version 0.13.2
+TARGETS=("$@")
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol lookup_tables bhuman_log text_files mcap_stream frame_files)
+
+# Seeds: a real input or two of each kind, copied into a temporary corpus so fuzz/ stays clean
+# (inputs up to 1 MiB: -max_len below).
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+seed() { mkdir -p "$WORK/$1"; cp "${@:2}" "$WORK/$1/" 2>/dev/null || true; }
+seed lookup_tables lookup_tables/bhuman2009.lut
+seed mcap_stream streams/sim-goalkeeper.mcap
+seed frame_files assets/screenshot.png
+seed text_files params/*.json params/fields/*.json streams/bhuman2009.labels.json
+for t in "${TARGETS[@]}"; do
+  mkdir -p "$WORK/$t"
+  [ -d "fuzz/regressions/$t" ] && cp fuzz/regressions/"$t"/* "$WORK/$t/" 2>/dev/null || true
+done
+
+cd fuzz
+cargo fuzz build -s none
+for t in "${TARGETS[@]}"; do
+  echo "== $t: ${SECONDS_PER_TARGET} s"
+  log="$WORK/$t.log"
+  if ! cargo fuzz run -s none "$t" "$WORK/$t" -- -max_total_time="$SECONDS_PER_TARGET" \
+      -max_len=1048576 -rss_limit_mb=2048 -timeout=10 >"$log" 2>&1; then
+    grep -v "^\s*\[" "$log" | tail -40 | cut -c1-300
+    echo "fuzz: $t failed (its input is in fuzz/artifacts/$t/)" >&2
+    exit 1
+  fi
+  grep -E '^#[0-9]+\s+(DONE|pulse)' "$log" | tail -1 | sed "s/^/$t: /"
+done
