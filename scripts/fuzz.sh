@@ -12,7 +12,7 @@ SECONDS_PER_TARGET=${1:-60}
 shift || true
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked --version 0.13.2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol lookup_tables bhuman_log text_files mcap_stream frame_files)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol lookup_tables bhuman_log text_files mcap_stream frame_files field_files)
 
 # Seeds: a real input or two of each kind, copied into a temporary corpus so fuzz/ stays clean
 # (inputs up to 1 MiB: -max_len below).
@@ -22,7 +22,8 @@ seed() { mkdir -p "$WORK/$1"; cp "${@:2}" "$WORK/$1/" 2>/dev/null || true; }
 seed lookup_tables lookup_tables/bhuman2009.lut
 seed mcap_stream streams/sim-goalkeeper.mcap
 seed frame_files assets/screenshot.png
-seed text_files params/*.json params/fields/*.json streams/bhuman2009.labels.json
+seed text_files params/*.json streams/bhuman2009.labels.json
+seed field_files params/fields/*.json
 for t in "${TARGETS[@]}"; do
   mkdir -p "$WORK/$t"
   [ -d "fuzz/regressions/$t" ] && cp fuzz/regressions/"$t"/* "$WORK/$t/" 2>/dev/null || true
