@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Long runs with memory sampled (hardening): a synthetic stream of MINUTES minutes at 30 frames a
-# second (default 20: 36,000 frames, about 2.4 GB in a temporary folder, removed afterwards) read
+# second (default 20: 36,000 frames, about 1.7 GB in a temporary folder, removed afterwards) read
 # end to end by `eotn detect` (the CLI) and stepped end to end through the app's state
 # (examples/long_run.rs: the headless Workspace the window draws). Prints resident memory at the
 # start, after the first tenth and at its peak for each; fails when either grows by more than

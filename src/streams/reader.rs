@@ -840,10 +840,12 @@ fn for_each_chunk_record(
     let limit = usize::try_from(header.uncompressed_size)
         .unwrap_or(usize::MAX)
         .max(body.len());
-    let mut file = Vec::with_capacity(9 + body.len());
-    file.push(op::CHUNK);
-    file.extend_from_slice(&(body.len() as u64).to_le_bytes());
-    file.extend_from_slice(body);
+    // The record's opcode and length, then its body: fed as two pieces, so the chunk (read once
+    // per frame on demand) is not copied.
+    let mut opcode_len = [0u8; 9];
+    opcode_len[0] = op::CHUNK;
+    opcode_len[1..].copy_from_slice(&(body.len() as u64).to_le_bytes());
+    let mut pieces = [&opcode_len[..], body];
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
             .with_skip_start_magic(true)
@@ -851,14 +853,17 @@ fn for_each_chunk_record(
             .with_validate_chunk_crcs(true)
             .with_record_length_limit(limit),
     );
-    let mut rest: &[u8] = &file;
     while let Some(event) = reader.next_event() {
         match event? {
             LinearReadEvent::ReadRequest(need) => {
-                let n = need.min(rest.len());
-                reader.insert(n).copy_from_slice(&rest[..n]);
+                // The first piece with bytes left (none left: 0, which tells the reader EOF).
+                let rest = pieces.iter_mut().find(|p| !p.is_empty());
+                let n = rest.as_ref().map_or(0, |p| need.min(p.len()));
+                if let Some(rest) = rest {
+                    reader.insert(n).copy_from_slice(&rest[..n]);
+                    *rest = &rest[n..];
+                }
                 reader.notify_read(n);
-                rest = &rest[n..];
             }
             LinearReadEvent::Record { data, opcode } => each(mcap::parse_record(opcode, data)?),
         }
