@@ -10,9 +10,9 @@ cd "$(dirname "$0")/.."
 SECONDS_PER_RUN=${1:-18}
 scripts/deps.sh
 if [ "${EOTN_PROFILE:-release}" = dev ]; then
-  cargo build --quiet; EOTN=target/debug/eotn
+  cargo build --quiet; EOTN=${CARGO_TARGET_DIR:-target}/debug/eotn
 else
-  cargo build --release --quiet; EOTN=target/release/eotn
+  cargo build --release --quiet; EOTN=${CARGO_TARGET_DIR:-target}/release/eotn
 fi
 WORK=$(mktemp -d)
 n=120
@@ -29,7 +29,7 @@ for _ in $(seq 50); do [ -e "/tmp/.X11-unix/X$n" ] && break; sleep 0.1; done
 declare -A STREAM=([sample]="streams/sample.mcap lookup_tables/sample.lut"
                    [208x160]="$WORK/208x160.mcap lookup_tables/sim.lut"
                    [640x480]="$WORK/640x480.mcap lookup_tables/sim.lut")
-printf '%-8s %-8s %-6s %10s %8s %8s\n' renderer size speed "median ms" played dropped
+printf '%-8s %-8s %-6s %10s %8s %8s %6s\n' renderer size speed "median ms" played dropped late
 for renderer in gl wgpu; do
   for size in sample 208x160 640x480; do
     for speed in 1x every; do
@@ -40,8 +40,9 @@ for renderer in gl wgpu; do
       echo "$out" >> "$WORK/stats.txt"
       median=$(echo "$out" | sed -n 's/.*playing frames [0-9]* median \([0-9.]*\) ms.*/\1/p')
       played=$(echo "$out" | sed -n 's/.*played \([0-9]*\) dropped.*/\1/p')
-      dropped=$(echo "$out" | sed -n 's/.*dropped \([0-9]*\);.*/\1/p')
-      printf '%-8s %-8s %-6s %10s %8s %8s\n' "$renderer" "$size" "$speed" "${median:-?}" "${played:-?}" "${dropped:-?}"
+      dropped=$(echo "$out" | sed -n 's/.*dropped \([0-9]*\) late.*/\1/p')
+      late=$(echo "$out" | sed -n 's/.*late \([0-9]*\);.*/\1/p')
+      printf '%-8s %-8s %-6s %10s %8s %8s %6s\n' "$renderer" "$size" "$speed" "${median:-?}" "${played:-?}" "${dropped:-?}" "${late:-?}"
     done
   done
 done

@@ -717,17 +717,19 @@ impl EotnApp {
         if std::env::var_os("EOTN_STATS").is_some() {
             let t = &self.state.timings;
             eprintln!(
-                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms (our UI code {:.2} ms, eframe CPU {:.2} ms); played {} dropped {}; renderer {}",
+                "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms max {:.1} ms (our UI code {:.2} ms, eframe CPU {:.2} ms); played {} dropped {} late {}; renderer {}",
                 t.steps_ms.len(),
                 median(&t.steps_ms),
                 t.frames_ms.len(),
                 median(&t.frames_ms),
                 t.playing_frames_ms.len(),
                 median(&t.playing_frames_ms),
+                t.playing_frames_ms.iter().copied().fold(0.0, f64::max),
                 median(&t.playing_ui_ms),
                 median(&t.playing_cpu_ms),
                 t.played_frames,
                 t.dropped_frames,
+                t.late_frames,
                 self.renderer.as_ref().map_or("none", |r| r.kind.name()),
             );
         }

@@ -399,6 +399,7 @@ impl Workspace {
         if let Some(target) = self.player.tick(dt, self.settings.speed, self.index, src) {
             self.timings.played_frames += 1;
             self.timings.dropped_frames += target.saturating_sub(self.index + 1) as u64;
+            self.timings.late_frames += u64::from(self.player.last_was_late());
             self.run(Command::Seek(target));
         }
     }

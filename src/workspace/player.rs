@@ -13,6 +13,14 @@ pub trait Timeline {
     fn index_at_time(&self, time_ns: u64) -> usize;
 }
 
+/// How far behind its clock playback at a set speed may show frames (wall time) before it skips
+/// them. One slow UI frame (a scheduler hiccup on a shared machine, a stalled buffer swap) then
+/// costs no frame: the next one is shown a little late and the player catches up within a few
+/// UI frames, because the next frame is due at once while it is behind. A machine that is
+/// steadily too slow falls behind by more than this within a few frames and then skips, so `1x`
+/// still plays at the recorded rate. Three frame periods at 30 fps.
+pub const MAX_LAG: Duration = Duration::from_millis(100);
+
 /// Playback state: playing or not, and the play clock in recording time.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Player {
@@ -20,6 +28,8 @@ pub struct Player {
     /// Recording time the clock shows, nanoseconds (fractional: slow speeds add less than 1 ns
     /// in a short frame).
     clock_ns: f64,
+    /// The frame the last tick returned was shown after a later one was already due.
+    late: bool,
 }
 
 impl Player {
@@ -40,8 +50,17 @@ impl Player {
         self.playing = false;
     }
 
+    /// True when the frame the last [`Player::tick`] returned was shown late: a later frame was
+    /// already due, and the player showed this one instead of skipping it (see [`MAX_LAG`]).
+    #[must_use]
+    pub const fn last_was_late(&self) -> bool {
+        self.late
+    }
+
     /// Advances the clock by `dt` of wall time at `speed` (× recorded rate; 0 or less plays
     /// every frame) from the shown frame `index`; returns the frame to show next, if another.
+    /// When several frames are due, the next one is shown as long as it is at most [`MAX_LAG`]
+    /// behind the clock; further behind, playback skips to the frame that is due.
     /// Reaching the last frame stops playback.
     pub fn tick(
         &mut self,
@@ -54,6 +73,7 @@ impl Player {
             return None;
         }
         let len = timeline.frames();
+        self.late = false;
         let target = if speed <= 0.0 {
             index + 1
         } else {
@@ -64,7 +84,16 @@ impl Player {
                 reason = "the clock is non-negative and far below 2^64 ns"
             )]
             let clock = self.clock_ns as u64;
-            timeline.index_at_time(clock).max(index)
+            let due = timeline.index_at_time(clock).max(index);
+            let next = index + 1;
+            let max_lag_ns = MAX_LAG.as_secs_f64() * 1e9 * f64::from(speed);
+            if due > next && next < len && self.clock_ns - timeline.time_ns(next) as f64 <= max_lag_ns
+            {
+                self.late = true;
+                next
+            } else {
+                due
+            }
         };
         let target = target.min(len.saturating_sub(1));
         if target + 1 >= len {
@@ -140,8 +169,43 @@ mod tests {
         assert_eq!(
             p.tick(MS * 200, 1.0, 3, &t),
             Some(5),
-            "late frames are skipped"
+            "frames more than MAX_LAG behind the clock are skipped"
         );
+        assert!(!p.last_was_late());
+    }
+
+    #[test]
+    fn one_slow_ui_frame_shows_every_frame_late_and_then_catches_up() {
+        // At 2x the frames are 50 ms of wall time apart.
+        let t = Tenths(10);
+        let mut p = Player::default();
+        p.play_from(&t, 0);
+        // A stall of 2.5 frame periods: frames 1 and 2 are both due.
+        assert_eq!(p.tick(MS * 125, 2.0, 0, &t), Some(1), "not skipped");
+        assert!(p.last_was_late());
+        assert!(
+            about(p.next_frame_due(2.0, 1, &t), Duration::ZERO),
+            "frame 2 is due at once"
+        );
+        assert_eq!(p.tick(MS * 2, 2.0, 1, &t), Some(2));
+        assert!(!p.last_was_late(), "back on time");
+        assert!(about(p.next_frame_due(2.0, 2, &t), MS * 23));
+    }
+
+    #[test]
+    fn a_machine_steadily_too_slow_still_plays_at_the_recorded_rate() {
+        let t = Tenths(100);
+        let mut p = Player::default();
+        p.play_from(&t, 0);
+        // Every UI frame takes 2.5 frame periods: after a few late frames it skips.
+        let mut index = 0;
+        let mut shown = 0;
+        while let Some(next) = p.tick(MS * 250, 1.0, index, &t) {
+            index = next;
+            shown += 1;
+        }
+        assert_eq!(index, 99);
+        assert!(shown <= 45, "at most about one in 2.5 frames shown, saw {shown}");
     }
 
     #[test]

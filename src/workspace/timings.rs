@@ -52,6 +52,9 @@ pub struct Timings {
     pub played_frames: u64,
     /// Frames playback skipped because the next one was already due (not ready in time).
     pub dropped_frames: u64,
+    /// Frames playback showed late instead of skipping them (a later frame was already due,
+    /// but the player was less than [`super::player::MAX_LAG`] behind).
+    pub late_frames: u64,
 }
 
 pub(crate) fn push_capped(v: &mut Vec<f64>, x: f64) {
