@@ -87,7 +87,9 @@ impl Player {
             let due = timeline.index_at_time(clock).max(index);
             let next = index + 1;
             let max_lag_ns = MAX_LAG.as_secs_f64() * 1e9 * f64::from(speed);
-            if due > next && next < len && self.clock_ns - timeline.time_ns(next) as f64 <= max_lag_ns
+            if due > next
+                && next < len
+                && self.clock_ns - timeline.time_ns(next) as f64 <= max_lag_ns
             {
                 self.late = true;
                 next
@@ -205,7 +207,10 @@ mod tests {
             shown += 1;
         }
         assert_eq!(index, 99);
-        assert!(shown <= 45, "at most about one in 2.5 frames shown, saw {shown}");
+        assert!(
+            shown <= 45,
+            "at most about one in 2.5 frames shown, saw {shown}"
+        );
     }
 
     #[test]
