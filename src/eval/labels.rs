@@ -141,7 +141,44 @@ pub enum LabelsError {
         /// The file.
         path: String,
         /// What is wrong.
-        problem: String,
+        #[source]
+        problem: LabelsProblem,
+    },
+}
+
+/// What is wrong with the contents of a labels file.
+#[derive(Debug, Error)]
+pub enum LabelsProblem {
+    /// Not JSON of the labels shape.
+    #[error("{0}")]
+    Json(#[from] serde_json::Error),
+    /// Another `format`.
+    #[error("format is {found:?}, expected {LABELS_FORMAT:?}")]
+    Format {
+        /// The file's `format`.
+        found: String,
+    },
+    /// Another `version`.
+    #[error("version {found} (this eotn reads version {LABELS_VERSION})")]
+    Version {
+        /// The file's `version`.
+        found: u32,
+    },
+    /// A frame with two entries.
+    #[error("frame {frame} is labelled twice")]
+    FrameTwice {
+        /// Frame index.
+        frame: usize,
+    },
+    /// A ball label with a non-finite centre or a radius that is not positive.
+    #[error("frame {frame}: ball centre {center:?} radius {radius_px} is not a circle")]
+    NotACircle {
+        /// Frame index.
+        frame: usize,
+        /// The labelled centre, pixels.
+        center: [f64; 2],
+        /// The labelled radius, pixels.
+        radius_px: f64,
     },
 }
 
@@ -171,35 +208,34 @@ impl Labels {
     /// Parses and checks labels from JSON text.
     ///
     /// # Errors
-    /// A message saying what is wrong (see [`Self::load`]).
-    pub fn parse(text: &str) -> Result<Self, String> {
-        let labels: Self = serde_json::from_str(text).map_err(|e| e.to_string())?;
+    /// [`LabelsProblem`]: what is wrong (see [`Self::load`]).
+    pub fn parse(text: &str) -> Result<Self, LabelsProblem> {
+        let labels: Self = serde_json::from_str(text)?;
         if labels.format != LABELS_FORMAT {
-            return Err(format!(
-                "format is {:?}, expected {LABELS_FORMAT:?}",
-                labels.format
-            ));
+            return Err(LabelsProblem::Format {
+                found: labels.format,
+            });
         }
         if labels.version != LABELS_VERSION {
-            return Err(format!(
-                "version {} (this eotn reads version {LABELS_VERSION})",
-                labels.version
-            ));
+            return Err(LabelsProblem::Version {
+                found: labels.version,
+            });
         }
         let mut seen = std::collections::BTreeSet::new();
         for f in &labels.frames {
             if !seen.insert(f.frame) {
-                return Err(format!("frame {} is labelled twice", f.frame));
+                return Err(LabelsProblem::FrameTwice { frame: f.frame });
             }
             if let Some(b) = &f.ball
                 && !(b.center.iter().all(|v| v.is_finite())
                     && b.radius_px.is_finite()
                     && b.radius_px > 0.0)
             {
-                return Err(format!(
-                    "frame {}: ball centre {:?} radius {} is not a circle",
-                    f.frame, b.center, b.radius_px
-                ));
+                return Err(LabelsProblem::NotACircle {
+                    frame: f.frame,
+                    center: b.center,
+                    radius_px: b.radius_px,
+                });
             }
         }
         Ok(labels)
@@ -510,14 +546,34 @@ mod tests {
         );
         assert!(labels.frame(9).is_none());
         let twice = FILE.replace(r#"{"frame": 3}"#, r#"{"frame": 2}"#);
-        assert!(Labels::parse(&twice).unwrap_err().contains("twice"));
+        let message = |text: &str| Labels::parse(text).unwrap_err().to_string();
+        assert!(matches!(
+            Labels::parse(&twice),
+            Err(LabelsProblem::FrameTwice { frame: 2 })
+        ));
+        assert!(message(&twice).contains("twice"));
         let v2 = FILE.replace(r#""version": 1"#, r#""version": 2"#);
-        assert!(Labels::parse(&v2).unwrap_err().contains("version 2"));
+        assert!(matches!(
+            Labels::parse(&v2),
+            Err(LabelsProblem::Version { found: 2 })
+        ));
+        assert!(message(&v2).contains("version 2"));
         let other = FILE.replace("eotn.labels", "something");
-        assert!(Labels::parse(&other).unwrap_err().contains("format"));
+        assert!(matches!(
+            Labels::parse(&other),
+            Err(LabelsProblem::Format { .. })
+        ));
+        assert!(message(&other).contains("format"));
         let zero = FILE.replace(r#""radius_px": 10.0"#, r#""radius_px": 0"#);
-        assert!(Labels::parse(&zero).unwrap_err().contains("not a circle"));
-        assert!(Labels::parse("[1, 2]").is_err());
+        assert!(matches!(
+            Labels::parse(&zero),
+            Err(LabelsProblem::NotACircle { frame: 0, .. })
+        ));
+        assert!(message(&zero).contains("not a circle"));
+        assert!(matches!(
+            Labels::parse("[1, 2]"),
+            Err(LabelsProblem::Json(_))
+        ));
     }
 
     #[test]

@@ -159,7 +159,8 @@ impl StandInRobot {
             &record.frame,
             ImageEncoding::default(),
             &mut self.buf,
-        )?;
+        )
+        .map_err(|e| e.to_string())?;
         let meta = PartialMetadata::with_log_time(unix_time_ns());
         let log_time = meta.log_time.unwrap_or(0);
         self.image.log_with_meta(&self.buf, meta);

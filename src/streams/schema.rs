@@ -3,8 +3,71 @@
 
 use foxglove::{Decode, Encode};
 
-use crate::frame::{Frame, PixelLayout};
+use crate::frame::{Frame, FrameError, PixelLayout};
 use crate::sensors::SensorReadings;
+
+/// Why a frame could not become a `foxglove.RawImage`, or a message a frame.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageMessageError {
+    /// The frame cannot be made 4:2:2, or the decoded data is no frame.
+    #[error(transparent)]
+    Frame(#[from] FrameError),
+    /// The frame is too large for the message's 32-bit fields.
+    #[error("{width}×{height} is too large")]
+    TooLarge {
+        /// Width, pixels.
+        width: usize,
+        /// Height, pixels.
+        height: usize,
+    },
+    /// Protobuf encoding failed.
+    #[error("{0}")]
+    Encode(#[source] <foxglove::messages::RawImage as Encode>::Error),
+    /// The bytes are no `foxglove.RawImage`.
+    #[error("image message is not a foxglove.RawImage: {0}")]
+    NotRawImage(#[source] <foxglove::messages::RawImage as Decode>::Error),
+    /// An encoding other than the 4:2:2 orders.
+    #[error(
+        "image encoding '{encoding}' is not supported ({})",
+        ImageEncoding::NAMES
+    )]
+    Encoding {
+        /// The message's `encoding`.
+        encoding: String,
+    },
+    /// A size whose row or data length overflows.
+    #[error("image size {width}×{height} is not usable")]
+    Unusable {
+        /// Width, pixels.
+        width: usize,
+        /// Height, pixels.
+        height: usize,
+    },
+    /// A row step shorter than a row.
+    #[error("image step {step} is shorter than a {width}-pixel UYVY row ({row} bytes)")]
+    ShortStep {
+        /// The message's `step`, bytes.
+        step: usize,
+        /// Width, pixels.
+        width: usize,
+        /// A row's bytes.
+        row: usize,
+    },
+    /// Less data than the size and step need (or no rows).
+    #[error("image data has {len} bytes, a {width}×{height} frame with step {step} needs {needed}")]
+    ShortData {
+        /// Bytes of data.
+        len: usize,
+        /// Width, pixels.
+        width: usize,
+        /// Height, pixels.
+        height: usize,
+        /// Row step, bytes.
+        step: usize,
+        /// Bytes needed.
+        needed: usize,
+    },
+}
 
 /// Name of the sensor readings' JSON schema.
 pub const SENSORS_SCHEMA_NAME: &str = "eotn.SensorReadings";
@@ -125,27 +188,30 @@ fn swap_pairs(data: &mut [u8]) {
 /// frames are converted to 4:2:2 first.
 ///
 /// # Errors
-/// A message when the frame cannot become UYVY (odd width) or is too large for the message's
-/// 32-bit fields.
+/// [`ImageMessageError`] when the frame cannot become UYVY (odd width) or is too large for the
+/// message's 32-bit fields.
 pub fn encode_image(
     time_ns: u64,
     frame: &Frame,
     encoding: ImageEncoding,
     out: &mut Vec<u8>,
-) -> Result<(), String> {
+) -> Result<(), ImageMessageError> {
     let converted;
     let uyvy = if frame.layout() == PixelLayout::Uyvy {
         frame
     } else {
-        converted = frame.to_uyvy().map_err(|e| e.to_string())?;
+        converted = frame.to_uyvy()?;
         &converted
     };
-    let too_big = |_| format!("{}×{} is too large", uyvy.width(), uyvy.height());
-    let width = u32::try_from(uyvy.width()).map_err(too_big)?;
-    let height = u32::try_from(uyvy.height()).map_err(too_big)?;
-    let step = width
-        .checked_mul(2)
-        .ok_or_else(|| format!("{width}×{height} is too large"))?;
+    let too_big = ImageMessageError::TooLarge {
+        width: uyvy.width(),
+        height: uyvy.height(),
+    };
+    let (Ok(width), Ok(height)) = (u32::try_from(uyvy.width()), u32::try_from(uyvy.height()))
+    else {
+        return Err(too_big);
+    };
+    let step = width.checked_mul(2).ok_or(too_big)?;
     let sec = u32::try_from(time_ns / 1_000_000_000).unwrap_or(u32::MAX);
     let nsec = u32::try_from(time_ns % 1_000_000_000).unwrap_or(0);
     let mut data = uyvy.data().to_vec();
@@ -163,15 +229,16 @@ pub fn encode_image(
     };
     out.clear();
     out.reserve(msg.encoded_len().unwrap_or(0));
-    msg.encode(out).map_err(|e| e.to_string())
+    msg.encode(out).map_err(ImageMessageError::Encode)
 }
 
 /// Decodes a `foxglove.RawImage` into a UYVY frame (the pipeline's order). Encodings
 /// `uyvy`/`yuv422` are taken as they are, `yuyv`/`yuv422_yuy2` are reordered; row padding (`step` > 2 × width) is dropped.
 ///
 /// # Errors
-/// A message for undecodable protobuf, other encodings, or sizes that do not match the data.
-pub fn decode_image(bytes: &[u8]) -> Result<Frame, String> {
+/// [`ImageMessageError`] for undecodable protobuf, other encodings, or sizes that do not match
+/// the data.
+pub fn decode_image(bytes: &[u8]) -> Result<Frame, ImageMessageError> {
     decode_image_with_time(bytes).map(|(frame, _)| frame)
 }
 
@@ -180,38 +247,46 @@ pub fn decode_image(bytes: &[u8]) -> Result<Frame, String> {
 ///
 /// # Errors
 /// As [`decode_image`].
-pub fn decode_image_with_time(bytes: &[u8]) -> Result<(Frame, Option<u64>), String> {
-    let msg = foxglove::messages::RawImage::decode(bytes)
-        .map_err(|e| format!("image message is not a foxglove.RawImage: {e}"))?;
+pub fn decode_image_with_time(bytes: &[u8]) -> Result<(Frame, Option<u64>), ImageMessageError> {
+    let msg =
+        foxglove::messages::RawImage::decode(bytes).map_err(ImageMessageError::NotRawImage)?;
     let time_ns = msg
         .timestamp
         .map(|t| u64::from(t.sec()) * 1_000_000_000 + u64::from(t.nsec()));
     let (w, h) = (msg.width as usize, msg.height as usize);
     let Some(encoding) = ImageEncoding::from_name(&msg.encoding) else {
-        return Err(format!(
-            "image encoding '{}' is not supported ({})",
-            msg.encoding,
-            ImageEncoding::NAMES
-        ));
+        return Err(ImageMessageError::Encoding {
+            encoding: msg.encoding,
+        });
     };
-    let row = w
-        .checked_mul(2)
-        .ok_or_else(|| format!("image size {w}×{h} is not usable"))?;
+    let unusable = ImageMessageError::Unusable {
+        width: w,
+        height: h,
+    };
+    let row = w.checked_mul(2).ok_or(unusable)?;
     let step = msg.step as usize;
     if step < row {
-        return Err(format!(
-            "image step {step} is shorter than a {w}-pixel UYVY row ({row} bytes)"
-        ));
+        return Err(ImageMessageError::ShortStep {
+            step,
+            width: w,
+            row,
+        });
     }
     let needed = step
         .checked_mul(h.saturating_sub(1))
         .and_then(|n| n.checked_add(row))
-        .ok_or_else(|| format!("image size {w}×{h} is not usable"))?;
+        .ok_or(ImageMessageError::Unusable {
+            width: w,
+            height: h,
+        })?;
     if h == 0 || msg.data.len() < needed {
-        return Err(format!(
-            "image data has {} bytes, a {w}×{h} frame with step {step} needs {needed}",
-            msg.data.len()
-        ));
+        return Err(ImageMessageError::ShortData {
+            len: msg.data.len(),
+            width: w,
+            height: h,
+            step,
+            needed,
+        });
     }
     let mut data = Vec::with_capacity(row * h);
     for r in msg.data.chunks(step).take(h) {
@@ -220,7 +295,7 @@ pub fn decode_image_with_time(bytes: &[u8]) -> Result<(Frame, Option<u64>), Stri
     if encoding == ImageEncoding::Yuyv {
         swap_pairs(&mut data);
     }
-    let frame = Frame::from_uyvy(w, h, data).map_err(|e| e.to_string())?;
+    let frame = Frame::from_uyvy(w, h, data)?;
     Ok((frame, time_ns))
 }
 
@@ -228,19 +303,21 @@ pub fn decode_image_with_time(bytes: &[u8]) -> Result<(Frame, Option<u64>), Stri
 /// what `json.dumps` writes) become `null`. Returns the value and whether any were replaced.
 ///
 /// # Errors
-/// The JSON parser's message.
-pub fn parse_json_lenient(bytes: &[u8]) -> Result<(serde_json::Value, bool), String> {
+/// The JSON parser's error on the bytes as they are.
+pub fn parse_json_lenient(bytes: &[u8]) -> Result<(serde_json::Value, bool), serde_json::Error> {
     match serde_json::from_slice(bytes) {
         Ok(v) => Ok((v, false)),
         Err(first) => {
-            let text = std::str::from_utf8(bytes).map_err(|_| first.to_string())?;
+            let Ok(text) = std::str::from_utf8(bytes) else {
+                return Err(first);
+            };
             let (fixed, replaced) = replace_non_finite_tokens(text);
             if !replaced {
-                return Err(first.to_string());
+                return Err(first);
             }
             serde_json::from_str(&fixed)
                 .map(|v| (v, true))
-                .map_err(|_| first.to_string())
+                .map_err(|_| first)
         }
     }
 }

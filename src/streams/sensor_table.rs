@@ -36,12 +36,129 @@ pub struct SensorTable {
 
 /// Why a sensor table could not be read; names the file and, where it can, the line.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: {detail}")]
-pub struct SensorTableError {
-    /// The file.
-    pub path: PathBuf,
-    /// What is wrong.
-    pub detail: String,
+pub enum SensorTableError {
+    /// Reading the file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the OS said.
+        source: std::io::Error,
+    },
+    /// The contents are no sensor table.
+    #[error("{path}: {problem}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        #[source]
+        problem: SensorTableProblem,
+    },
+}
+
+/// Where in a table a row is: a CSV line (from 1, the header being line 1) or a JSON element
+/// (from 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RowPlace {
+    /// A CSV line.
+    Line(usize),
+    /// A JSON array element.
+    Element(usize),
+}
+
+impl std::fmt::Display for RowPlace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Line(n) => write!(f, "line {n}"),
+            Self::Element(i) => write!(f, "element {i}"),
+        }
+    }
+}
+
+/// What is wrong with a sensor table's contents.
+#[derive(Debug, thiserror::Error)]
+pub enum SensorTableProblem {
+    /// The CSV header row cannot be read.
+    #[error("cannot read the header row: {0}")]
+    Header(#[source] csv::Error),
+    /// A CSV column that is no reading.
+    #[error("unknown column '{name}' (known: {})", known_list())]
+    UnknownColumn {
+        /// The column's name.
+        name: String,
+    },
+    /// A CSV line that cannot be read.
+    #[error("line {line}: {source}")]
+    Record {
+        /// Line number.
+        line: usize,
+        /// What the CSV reader said.
+        source: csv::Error,
+    },
+    /// A CSV cell that is not a number.
+    #[error("line {line}, column {column}: '{cell}' is not a number")]
+    NotANumber {
+        /// Line number.
+        line: usize,
+        /// The column's name.
+        column: String,
+        /// The cell's text.
+        cell: String,
+    },
+    /// Not JSON.
+    #[error("not valid JSON: {0}")]
+    Json(#[source] serde_json::Error),
+    /// JSON that is not an array.
+    #[error("expected a JSON array of objects, one per frame")]
+    NotAnArray,
+    /// An array element that is not an object.
+    #[error("element {element} is not an object")]
+    NotAnObject {
+        /// Element index.
+        element: usize,
+    },
+    /// A JSON key that is no reading.
+    #[error("element {element}: unknown key '{name}' (known: {})", known_list())]
+    UnknownKey {
+        /// Element index.
+        element: usize,
+        /// The key.
+        name: String,
+    },
+    /// A JSON value that is neither a number nor null.
+    #[error("element {element}, key {name}: {value} is not a number or null")]
+    NotANumberOrNull {
+        /// Element index.
+        element: usize,
+        /// The key.
+        name: String,
+        /// The value, as JSON.
+        value: serde_json::Value,
+    },
+    /// A `frame` that is no frame index.
+    #[error("{at}: frame {value} is not a frame index")]
+    BadFrame {
+        /// The row.
+        at: RowPlace,
+        /// The value given.
+        value: f64,
+    },
+    /// Readings that do not fit the schema.
+    #[error("{at}: {source}")]
+    Readings {
+        /// The row.
+        at: RowPlace,
+        /// What the schema said.
+        source: serde_json::Error,
+    },
+    /// Two rows for one frame.
+    #[error("{at}: frame {frame} has more than one row")]
+    FrameTwice {
+        /// The second row.
+        at: RowPlace,
+        /// Frame index.
+        frame: usize,
+    },
 }
 
 fn known_column(name: &str) -> bool {
@@ -66,16 +183,15 @@ impl SensorTable {
     /// [`SensorTableError`] naming the file: unreadable, unknown column, a cell that is not a
     /// number, a repeated frame.
     pub fn load(path: &Path) -> Result<Self, SensorTableError> {
-        let err = |detail: String| SensorTableError {
-            path: path.to_owned(),
-            detail,
-        };
         let text = crate::input_file::read_text_bounded(
             path,
             crate::input_file::MAX_SIDE_FILE_BYTES,
             "a sensor table",
         )
-        .map_err(|e| err(e.to_string()))?;
+        .map_err(|source| SensorTableError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
         let is_json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
@@ -84,42 +200,47 @@ impl SensorTable {
         } else {
             Self::parse_csv(&text)
         };
-        table.map_err(err)
+        table.map_err(|problem| SensorTableError::Invalid {
+            path: path.to_owned(),
+            problem,
+        })
     }
 
     /// Parses CSV text (see the module docs).
     ///
     /// # Errors
-    /// A message with the line number.
-    pub fn parse_csv(text: &str) -> Result<Self, String> {
+    /// [`SensorTableProblem`] with the line number.
+    pub fn parse_csv(text: &str) -> Result<Self, SensorTableProblem> {
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .flexible(false)
             .from_reader(text.as_bytes());
         let headers: Vec<String> = reader
             .headers()
-            .map_err(|e| format!("cannot read the header row: {e}"))?
+            .map_err(SensorTableProblem::Header)?
             .iter()
             .map(str::to_owned)
             .collect();
         if let Some(bad) = headers.iter().find(|h| !known_column(h)) {
-            return Err(format!("unknown column '{bad}' (known: {})", known_list()));
+            return Err(SensorTableProblem::UnknownColumn { name: bad.clone() });
         }
         let mut table = Self::default();
         for (i, record) in reader.records().enumerate() {
             let line = i + 2;
-            let record = record.map_err(|e| format!("line {line}: {e}"))?;
+            let record = record.map_err(|source| SensorTableProblem::Record { line, source })?;
             let mut cells = Vec::new();
             for (name, cell) in headers.iter().zip(record.iter()) {
                 if cell.is_empty() {
                     continue;
                 }
-                let v: f64 = cell
-                    .parse()
-                    .map_err(|_| format!("line {line}, column {name}: '{cell}' is not a number"))?;
+                let v: f64 = cell.parse().map_err(|_| SensorTableProblem::NotANumber {
+                    line,
+                    column: name.clone(),
+                    cell: cell.to_owned(),
+                })?;
                 cells.push((name.as_str(), v));
             }
-            table.push_row(&format!("line {line}"), cells)?;
+            table.push_row(RowPlace::Line(line), cells)?;
         }
         Ok(table)
     }
@@ -127,25 +248,23 @@ impl SensorTable {
     /// Parses JSON text: an array of objects (see the module docs).
     ///
     /// # Errors
-    /// A message with the element number.
-    pub fn parse_json(text: &str) -> Result<Self, String> {
+    /// [`SensorTableProblem`] with the element number.
+    pub fn parse_json(text: &str) -> Result<Self, SensorTableProblem> {
         let value: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| format!("not valid JSON: {e}"))?;
-        let rows = value
-            .as_array()
-            .ok_or("expected a JSON array of objects, one per frame")?;
+            serde_json::from_str(text).map_err(SensorTableProblem::Json)?;
+        let rows = value.as_array().ok_or(SensorTableProblem::NotAnArray)?;
         let mut table = Self::default();
         for (i, row) in rows.iter().enumerate() {
             let obj = row
                 .as_object()
-                .ok_or_else(|| format!("element {i} is not an object"))?;
+                .ok_or(SensorTableProblem::NotAnObject { element: i })?;
             let mut cells = Vec::new();
             for (name, v) in obj {
                 if !known_column(name) {
-                    return Err(format!(
-                        "element {i}: unknown key '{name}' (known: {})",
-                        known_list()
-                    ));
+                    return Err(SensorTableProblem::UnknownKey {
+                        element: i,
+                        name: name.clone(),
+                    });
                 }
                 match v {
                     serde_json::Value::Null => {}
@@ -153,18 +272,24 @@ impl SensorTable {
                         cells.push((name.as_str(), n.as_f64().unwrap_or(f64::NAN)));
                     }
                     other => {
-                        return Err(format!(
-                            "element {i}, key {name}: {other} is not a number or null"
-                        ));
+                        return Err(SensorTableProblem::NotANumberOrNull {
+                            element: i,
+                            name: name.clone(),
+                            value: other.clone(),
+                        });
                     }
                 }
             }
-            table.push_row(&format!("element {i}"), cells)?;
+            table.push_row(RowPlace::Element(i), cells)?;
         }
         Ok(table)
     }
 
-    fn push_row(&mut self, at: &str, cells: Vec<(&str, f64)>) -> Result<(), String> {
+    fn push_row(
+        &mut self,
+        at: RowPlace,
+        cells: Vec<(&str, f64)>,
+    ) -> Result<(), SensorTableProblem> {
         let mut row = SensorRow::default();
         let mut map = serde_json::Map::new();
         for (name, v) in cells {
@@ -176,7 +301,7 @@ impl SensorTable {
             match name {
                 "frame" => {
                     if v < 0.0 || v.fract() != 0.0 || v > 1e15 {
-                        return Err(format!("{at}: frame {v} is not a frame index"));
+                        return Err(SensorTableProblem::BadFrame { at, value: v });
                     }
                     #[expect(
                         clippy::cast_possible_truncation,
@@ -193,11 +318,11 @@ impl SensorTable {
             }
         }
         row.readings = serde_json::from_value(serde_json::Value::Object(map))
-            .map_err(|e| format!("{at}: {e}"))?;
+            .map_err(|source| SensorTableProblem::Readings { at, source })?;
         if let Some(f) = row.frame
             && self.by_frame.insert(f, self.rows.len()).is_some()
         {
-            return Err(format!("{at}: frame {f} has more than one row"));
+            return Err(SensorTableProblem::FrameTwice { at, frame: f });
         }
         self.rows.push(row);
         Ok(())
@@ -264,12 +389,40 @@ mod tests {
     #[test]
     fn csv_errors_name_the_problem() {
         let e = SensorTable::parse_csv("head_pan,ir_far_cm\n1,2\n").unwrap_err();
-        assert!(e.contains("unknown column 'head_pan'"), "{e}");
+        assert!(
+            matches!(&e, SensorTableProblem::UnknownColumn { name } if name == "head_pan"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("unknown column 'head_pan'"), "{e}");
         let e = SensorTable::parse_csv("head_pan_rad\nabc\n").unwrap_err();
-        assert!(e.contains("line 2") && e.contains("abc"), "{e}");
+        assert!(
+            matches!(&e, SensorTableProblem::NotANumber { line: 2, cell, .. } if cell == "abc"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("line 2"), "{e}");
         let e = SensorTable::parse_csv("frame,head_pan_rad\n1,0\n1,0\n").unwrap_err();
-        assert!(e.contains("more than one row"), "{e}");
-        assert!(SensorTable::parse_csv("frame\n-1\n").is_err());
+        assert!(
+            matches!(
+                e,
+                SensorTableProblem::FrameTwice {
+                    at: RowPlace::Line(3),
+                    frame: 1
+                }
+            ),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .contains("line 3: frame 1 has more than one row"),
+            "{e}"
+        );
+        assert!(matches!(
+            SensorTable::parse_csv("frame\n-1\n"),
+            Err(SensorTableProblem::BadFrame {
+                at: RowPlace::Line(2),
+                ..
+            })
+        ));
     }
 
     #[test]
@@ -280,8 +433,22 @@ mod tests {
         .unwrap();
         assert_eq!(t.for_frame(1).unwrap().readings.pan_pwm, Some(-0.2));
         assert!(t.for_frame(0).is_none(), "frame numbers given: by number");
-        assert!(SensorTable::parse_json(r#"{"a": 1}"#).is_err());
-        assert!(SensorTable::parse_json(r#"[{"typo": 1}]"#).is_err());
-        assert!(SensorTable::parse_json(r#"[{"ir_far_cm": "far"}]"#).is_err());
+        assert!(matches!(
+            SensorTable::parse_json(r#"{"a": 1}"#),
+            Err(SensorTableProblem::NotAnArray)
+        ));
+        assert!(matches!(
+            SensorTable::parse_json(r#"[{"typo": 1}]"#),
+            Err(SensorTableProblem::UnknownKey { element: 0, .. })
+        ));
+        let e = SensorTable::parse_json(r#"[{}, {"ir_far_cm": "far"}]"#).unwrap_err();
+        assert!(
+            matches!(e, SensorTableProblem::NotANumberOrNull { element: 1, .. }),
+            "{e}"
+        );
+        assert!(
+            e.to_string().contains(r#"element 1, key ir_far_cm: "far""#),
+            "{e}"
+        );
     }
 }

@@ -328,7 +328,7 @@ impl StreamWriter {
             self.image_encoding,
             &mut image,
         )
-        .map_err(bad)?;
+        .map_err(|e| bad(e.to_string()))?;
         let written = self.put(self.image_channel, record.time_ns, &image);
         self.buf = image;
         written?;

@@ -13,7 +13,9 @@
 //! first class of the set in B-Human's order (orange first: the ball matters most). Neither real
 //! table uses such cells.
 
-use super::{Channel, Converted, SourceFormat, SourceGrid, build, lookup};
+use thiserror::Error;
+
+use super::{Channel, Converted, SourceFormat, SourceGrid, TableError, build, lookup};
 use crate::lut::ColourClass;
 
 /// Cells in a B-Human table (64³).
@@ -59,50 +61,85 @@ pub fn class_of(value: u8) -> Option<(String, ColourClass)> {
     Some((names.join("+"), class))
 }
 
+/// What is wrong with a `.c64` run-length stream; byte offsets count from the file's start.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum RleError {
+    /// The stream ends where a run length should be.
+    #[error("truncated at byte {at}: no run length (the stream ends with a run length of 0)")]
+    NoRunLength {
+        /// Where the run length should start.
+        at: usize,
+    },
+    /// A run length below zero.
+    #[error("negative run length {run} at byte {at}")]
+    NegativeRun {
+        /// The run length read.
+        run: i32,
+        /// Where it starts.
+        at: usize,
+    },
+    /// A run length with no class byte after it.
+    #[error("truncated at byte {at}: a run has no class byte")]
+    NoClassByte {
+        /// Where the class byte should be.
+        at: usize,
+    },
+    /// The runs overflow the table.
+    #[error("runs fill more than 64³ = {CELLS} cells (at byte {at})")]
+    TooManyCells {
+        /// Where the overflowing run starts.
+        at: usize,
+    },
+    /// The runs end before the table is full.
+    #[error("runs fill {cells} cells; a B-Human table has 64³ = {CELLS}")]
+    TooFewCells {
+        /// Cells filled.
+        cells: usize,
+    },
+    /// Bytes follow the end marker.
+    #[error("{extra} bytes after the end marker at byte {at}")]
+    TrailingBytes {
+        /// Bytes after the marker.
+        extra: usize,
+        /// Where the marker starts.
+        at: usize,
+    },
+}
+
 /// Expands the run-length stream to its 262,144 cells.
 ///
 /// # Errors
-/// A message for a truncated stream, a negative run, runs past 64³ cells, or too few cells.
-pub fn decode_rle(bytes: &[u8]) -> Result<Vec<u8>, String> {
+/// [`RleError`]: a truncated stream, a negative run, runs past 64³ cells, or too few cells.
+pub fn decode_rle(bytes: &[u8]) -> Result<Vec<u8>, RleError> {
     let mut cells = Vec::with_capacity(CELLS);
     let mut pos = 0usize;
     loop {
         let Some(len_bytes) = bytes.get(pos..pos + 4) else {
-            return Err(format!(
-                "truncated at byte {pos}: no run length (the stream ends with a run length of 0)"
-            ));
+            return Err(RleError::NoRunLength { at: pos });
         };
         let run = i32::from_le_bytes([len_bytes[0], len_bytes[1], len_bytes[2], len_bytes[3]]);
         pos += 4;
         if run == 0 {
             break;
         }
-        let run = usize::try_from(run)
-            .map_err(|_| format!("negative run length {run} at byte {}", pos - 4))?;
+        let run = usize::try_from(run).map_err(|_| RleError::NegativeRun { run, at: pos - 4 })?;
         let Some(&class) = bytes.get(pos) else {
-            return Err(format!("truncated at byte {pos}: a run has no class byte"));
+            return Err(RleError::NoClassByte { at: pos });
         };
         pos += 1;
         if cells.len() + run > CELLS {
-            return Err(format!(
-                "runs fill more than 64³ = {CELLS} cells (at byte {})",
-                pos - 5
-            ));
+            return Err(RleError::TooManyCells { at: pos - 5 });
         }
         cells.resize(cells.len() + run, class);
     }
     if cells.len() != CELLS {
-        return Err(format!(
-            "runs fill {} cells; a B-Human table has 64³ = {CELLS}",
-            cells.len()
-        ));
+        return Err(RleError::TooFewCells { cells: cells.len() });
     }
     if pos != bytes.len() {
-        return Err(format!(
-            "{} bytes after the end marker at byte {}",
-            bytes.len() - pos,
-            pos - 4
-        ));
+        return Err(RleError::TrailingBytes {
+            extra: bytes.len() - pos,
+            at: pos - 4,
+        });
     }
     Ok(cells)
 }
@@ -110,8 +147,8 @@ pub fn decode_rle(bytes: &[u8]) -> Result<Vec<u8>, String> {
 /// Converts the bytes of a `.c64` file.
 ///
 /// # Errors
-/// A message when the run-length stream is malformed ([`decode_rle`]).
-pub fn convert(bytes: &[u8]) -> Result<Converted, String> {
+/// [`TableError::Rle`] when the run-length stream is malformed ([`decode_rle`]).
+pub fn convert(bytes: &[u8]) -> Result<Converted, TableError> {
     let grid = SourceGrid {
         bits: [6, 6, 6],
         axes: [Channel::Y, Channel::U, Channel::V],
@@ -155,26 +192,30 @@ mod tests {
 
     #[test]
     fn malformed_streams_say_what_is_wrong() {
-        assert!(
-            decode_rle(&rle(&[(10, 1)]))
-                .unwrap_err()
-                .contains("fill 10 cells")
+        let short = decode_rle(&rle(&[(10, 1)])).unwrap_err();
+        assert_eq!(short, RleError::TooFewCells { cells: 10 });
+        assert!(short.to_string().contains("fill 10 cells"), "{short}");
+        assert_eq!(
+            decode_rle(&rle(&[(CELLS as i32 + 1, 1)])).unwrap_err(),
+            RleError::TooManyCells { at: 0 }
         );
-        assert!(
-            decode_rle(&rle(&[(CELLS as i32 + 1, 1)]))
-                .unwrap_err()
-                .contains("more than")
-        );
-        assert!(
-            decode_rle(&rle(&[(-3, 1)]))
-                .unwrap_err()
-                .contains("negative")
-        );
+        let negative = decode_rle(&rle(&[(-3, 1)])).unwrap_err();
+        assert_eq!(negative, RleError::NegativeRun { run: -3, at: 0 });
+        assert!(negative.to_string().contains("negative"), "{negative}");
         let full = rle(&[(CELLS as i32, 1)]);
-        assert!(decode_rle(&full[..7]).unwrap_err().contains("truncated"));
+        assert_eq!(
+            decode_rle(&full[..7]).unwrap_err(),
+            RleError::NoRunLength { at: 5 }
+        );
+        assert_eq!(
+            decode_rle(&full[..4]).unwrap_err(),
+            RleError::NoClassByte { at: 4 }
+        );
         let mut extra = full.clone();
         extra.push(9);
-        assert!(decode_rle(&extra).unwrap_err().contains("after the end"));
+        let trailing = decode_rle(&extra).unwrap_err();
+        assert_eq!(trailing, RleError::TrailingBytes { extra: 1, at: 5 });
+        assert!(trailing.to_string().contains("after the end"), "{trailing}");
         assert_eq!(decode_rle(&full).unwrap().len(), CELLS);
     }
 

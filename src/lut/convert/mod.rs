@@ -156,8 +156,64 @@ pub enum ConvertError {
         /// The format it was read as.
         format: SourceFormat,
         /// What is wrong.
-        problem: String,
+        #[source]
+        problem: TableError,
     },
+}
+
+/// What is wrong with a foreign table's contents (the file is named by [`ConvertError`]).
+#[derive(Debug, Error)]
+pub enum TableError {
+    /// A fixed-size format of the wrong length.
+    #[error("{len} bytes; a {table} is {expected}")]
+    WrongLength {
+        /// Bytes read.
+        len: usize,
+        /// The kind of file ("NUbots 2013 .lut").
+        table: &'static str,
+        /// Its length in words ("2,097,152 (128³)").
+        expected: &'static str,
+    },
+    /// A grid whose cell count does not match its bits per axis.
+    #[error(
+        "{cells} cells where a {}×{}×{} grid needs {want}",
+        1u32 << .bits[0], 1u32 << .bits[1], 1u32 << .bits[2]
+    )]
+    GridCells {
+        /// Cells held.
+        cells: usize,
+        /// Bits per file axis.
+        bits: [u8; 3],
+        /// Cells the bits need.
+        want: usize,
+    },
+    /// An axis with fewer than 1 or more than 8 bits.
+    #[error("{bits:?} bits per axis; each must be 1..=8")]
+    GridBits {
+        /// Bits per file axis.
+        bits: [u8; 3],
+    },
+    /// Our table could not be made from the converted cells.
+    #[error(transparent)]
+    Table(#[from] super::LutError),
+    /// B-Human's run-length stream is malformed.
+    #[error(transparent)]
+    Rle(#[from] bhuman::RleError),
+    /// The ssl-vision settings hold no usable `LUT Data`.
+    #[error(transparent)]
+    Ssl(#[from] ssl::SslError),
+    /// The Tekkotsu `.tm` is malformed.
+    #[error(transparent)]
+    Threshold(#[from] tekkotsu::ThresholdMapError),
+    /// The Tekkotsu `.col` file is malformed.
+    #[error(transparent)]
+    Colours(#[from] tekkotsu::ColError),
+    /// A Tekkotsu `.tm` with no `.col` file to name its classes.
+    #[error("no .col file names its classes: give one with --col FILE.col")]
+    NoColFile,
+    /// A Tekkotsu `.tm` given as bytes alone, without its `.col`.
+    #[error("a Tekkotsu .tm needs its .col file (use convert_file or tekkotsu::convert)")]
+    NeedsColFile,
 }
 
 /// One of the source's values, what it was called there, the class it became, and how many
@@ -211,18 +267,16 @@ pub(crate) struct SourceGrid {
 
 impl SourceGrid {
     /// Checks the cell count against the bits.
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), TableError> {
         let want = 1usize << self.bits.iter().map(|&b| u32::from(b)).sum::<u32>();
         if self.cells.len() == want {
             Ok(())
         } else {
-            Err(format!(
-                "{} cells where a {}×{}×{} grid needs {want}",
-                self.cells.len(),
-                1u32 << self.bits[0],
-                1u32 << self.bits[1],
-                1u32 << self.bits[2]
-            ))
+            Err(TableError::GridCells {
+                cells: self.cells.len(),
+                bits: self.bits,
+                want,
+            })
         }
     }
 
@@ -242,11 +296,11 @@ pub(crate) fn build(
     format: SourceFormat,
     grid: &SourceGrid,
     map: &dyn Fn(u8) -> Option<(String, ColourClass)>,
-) -> Result<Converted, String> {
-    grid.check()?;
+) -> Result<Converted, TableError> {
     if grid.bits.iter().any(|&b| !(1..=8).contains(&b)) {
-        return Err(format!("{:?} bits per axis; each must be 1..=8", grid.bits));
+        return Err(TableError::GridBits { bits: grid.bits });
     }
+    grid.check()?;
     let source_bits = grid.channel_bits();
     let out_bits = source_bits.iter().copied().max().unwrap_or(6).max(6);
     let mut counts = [0usize; 256];
@@ -288,7 +342,7 @@ pub(crate) fn build(
             source_bits[0], source_bits[1], source_bits[2]
         ));
     }
-    let mut table = LookupTable::new(out_bits).map_err(|e| e.to_string())?;
+    let mut table = LookupTable::new(out_bits)?;
     let n = table.side();
     // For each file axis, which output coordinate feeds it and by how much it shifts.
     let shift = grid.bits.map(|b| out_bits - b);
@@ -303,7 +357,7 @@ pub(crate) fn build(
             }
         }
     }
-    table = LookupTable::from_bytes(cells).map_err(|e| e.to_string())?;
+    table = LookupTable::from_bytes(cells)?;
     Ok(Converted {
         format,
         table,
@@ -340,7 +394,7 @@ pub fn convert_file(
             len: bytes.len(),
         })?,
     };
-    let invalid = |problem: String| ConvertError::Invalid {
+    let invalid = |problem: TableError| ConvertError::Invalid {
         path: path.to_owned(),
         format,
         problem,
@@ -349,9 +403,7 @@ pub fn convert_file(
         SourceFormat::TekkotsuTm => {
             let col_path = match col {
                 Some(c) => c.to_owned(),
-                None => tekkotsu::find_col(path).ok_or_else(|| {
-                    invalid("no .col file names its classes: give one with --col FILE.col".into())
-                })?,
+                None => tekkotsu::find_col(path).ok_or_else(|| invalid(TableError::NoColFile))?,
             };
             let col_text = crate::input_file::read_text_bounded(
                 &col_path,
@@ -366,7 +418,7 @@ pub fn convert_file(
                 tekkotsu::parse_col(&col_text).map_err(|problem| ConvertError::Invalid {
                     path: col_path.clone(),
                     format,
-                    problem,
+                    problem: problem.into(),
                 })?;
             tekkotsu::convert(&bytes, &classes).map_err(invalid)
         }
@@ -378,17 +430,15 @@ pub fn convert_file(
 /// [`tekkotsu::convert`]).
 ///
 /// # Errors
-/// A message saying what is wrong with the contents.
-pub fn convert_bytes(format: SourceFormat, bytes: &[u8]) -> Result<Converted, String> {
+/// [`TableError`]: what is wrong with the contents.
+pub fn convert_bytes(format: SourceFormat, bytes: &[u8]) -> Result<Converted, TableError> {
     match format {
         SourceFormat::RunswiftCal => runswift::convert(bytes),
         SourceFormat::NubotsLut => nubots::convert(bytes),
         SourceFormat::BhumanC64 => bhuman::convert(bytes),
         SourceFormat::UpennRaw => upenn::convert(bytes),
         SourceFormat::SslXml => ssl::convert(bytes),
-        SourceFormat::TekkotsuTm => {
-            Err("a Tekkotsu .tm needs its .col file (use convert_file or tekkotsu::convert)".into())
-        }
+        SourceFormat::TekkotsuTm => Err(TableError::NeedsColFile),
     }
 }
 
@@ -463,7 +513,18 @@ mod tests {
             cells: vec![0; 1000],
         };
         let e = build(SourceFormat::UpennRaw, &grid, &|_| None).unwrap_err();
-        assert!(e.contains("1000") && e.contains("262144"), "{e}");
+        assert!(
+            matches!(
+                e,
+                TableError::GridCells {
+                    cells: 1000,
+                    want: 262_144,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("64×64×64"), "{e}");
     }
 
     #[test]

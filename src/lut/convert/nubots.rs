@@ -8,7 +8,7 @@
 //! single blue (goals before 2012, team markers after) becomes sky blue, and its shadow blue our
 //! shadow blue (sky or dark blue); the soft oranges map one to one.
 
-use super::{Channel, Converted, SourceFormat, SourceGrid, build, lookup};
+use super::{Channel, Converted, SourceFormat, SourceGrid, TableError, build, lookup};
 use crate::lut::ColourClass;
 
 /// NUbots value → name → our class.
@@ -35,13 +35,14 @@ pub fn class_of(value: u8) -> Option<(String, ColourClass)> {
 /// Converts the bytes of a NUbots `.lut`.
 ///
 /// # Errors
-/// A message when the size is not 128³ bytes.
-pub fn convert(bytes: &[u8]) -> Result<Converted, String> {
+/// [`TableError::WrongLength`] when the size is not 128³ bytes.
+pub fn convert(bytes: &[u8]) -> Result<Converted, TableError> {
     if bytes.len() != 1 << 21 {
-        return Err(format!(
-            "{} bytes; a NUbots 2013 .lut is 2,097,152 (128³)",
-            bytes.len()
-        ));
+        return Err(TableError::WrongLength {
+            len: bytes.len(),
+            table: "NUbots 2013 .lut",
+            expected: "2,097,152 (128³)",
+        });
     }
     let grid = SourceGrid {
         bits: [7, 7, 7],

@@ -13,7 +13,7 @@
 //! "maybe" as a weaker vote for the same colour, and our basic classes have no weaker form).
 //! The real file holds no maybe cells.
 
-use super::{Channel, Converted, SourceFormat, SourceGrid, build, lookup};
+use super::{Channel, Converted, SourceFormat, SourceGrid, TableError, build, lookup};
 use crate::lut::ColourClass;
 
 /// rUNSWift's "no colour" value.
@@ -54,13 +54,14 @@ pub fn class_of(value: u8) -> Option<(String, ColourClass)> {
 /// Converts the bytes of a `.cal` file.
 ///
 /// # Errors
-/// A message when the size is not 128³ bytes.
-pub fn convert(bytes: &[u8]) -> Result<Converted, String> {
+/// [`TableError::WrongLength`] when the size is not 128³ bytes.
+pub fn convert(bytes: &[u8]) -> Result<Converted, TableError> {
     if bytes.len() != 1 << 21 {
-        return Err(format!(
-            "{} bytes; a rUNSWift .cal is 2,097,152 (128³)",
-            bytes.len()
-        ));
+        return Err(TableError::WrongLength {
+            len: bytes.len(),
+            table: "rUNSWift .cal",
+            expected: "2,097,152 (128³)",
+        });
     }
     let grid = SourceGrid {
         bits: [7, 7, 7],
@@ -94,6 +95,8 @@ mod tests {
         );
         assert!(c.source_classes.iter().any(|s| s.name == "maybe robot red"));
         assert!(c.notes.is_empty(), "{:?}", c.notes);
-        assert!(convert(&[0; 10]).unwrap_err().contains("2,097,152"));
+        let e = convert(&[0; 10]).unwrap_err();
+        assert!(matches!(e, TableError::WrongLength { len: 10, .. }), "{e}");
+        assert!(e.to_string().contains("2,097,152"), "{e}");
     }
 }

@@ -14,7 +14,9 @@
 
 use base64::Engine;
 
-use super::{Channel, Converted, SourceFormat, SourceGrid, build, lookup};
+use thiserror::Error;
+
+use super::{Channel, Converted, SourceFormat, SourceGrid, TableError, build, lookup};
 use crate::lut::ColourClass;
 
 /// ssl-vision channel → name → our class.
@@ -40,43 +42,62 @@ pub fn class_of(value: u8) -> Option<(String, ColourClass)> {
     lookup(MAPPING, value)
 }
 
+/// What is wrong with an ssl-vision settings file as a table.
+#[derive(Debug, Error)]
+pub enum SslError {
+    /// The file is not UTF-8.
+    #[error("not UTF-8 text: {0}")]
+    NotText(#[from] std::str::Utf8Error),
+    /// No `LUT Data` variable.
+    #[error("no <Var name=\"LUT Data\"> element")]
+    NoLutData,
+    /// The variable's opening tag does not end.
+    #[error("the LUT Data element is not closed")]
+    UnclosedElement,
+    /// The variable does not end.
+    #[error("no </Var> after the LUT Data")]
+    NoEndTag,
+    /// The blob is not base64.
+    #[error("LUT Data is not base64: {0}")]
+    NotBase64(#[from] base64::DecodeError),
+    /// The blob is shorter than a table.
+    #[error("LUT Data holds {len} bytes; a 4/6/6-bit table needs {TABLE_BYTES}")]
+    ShortBlob {
+        /// Bytes decoded.
+        len: usize,
+    },
+}
+
 /// The decoded `LUT Data` blob of an ssl-vision settings file.
 ///
 /// # Errors
-/// A message when the variable is missing, unterminated or not base64.
-pub fn lut_blob(text: &str) -> Result<Vec<u8>, String> {
-    let start = text
-        .find(r#"name="LUT Data""#)
-        .ok_or("no <Var name=\"LUT Data\"> element")?;
+/// [`SslError`] when the variable is missing, unterminated or not base64.
+pub fn lut_blob(text: &str) -> Result<Vec<u8>, SslError> {
+    let start = text.find(r#"name="LUT Data""#).ok_or(SslError::NoLutData)?;
     let open = text[start..]
         .find('>')
         .map(|i| start + i + 1)
-        .ok_or("the LUT Data element is not closed")?;
+        .ok_or(SslError::UnclosedElement)?;
     let close = text[open..]
         .find("</Var>")
         .map(|i| open + i)
-        .ok_or("no </Var> after the LUT Data")?;
+        .ok_or(SslError::NoEndTag)?;
     let b64: String = text[open..close]
         .chars()
         .filter(|c| !c.is_ascii_whitespace())
         .collect();
-    base64::engine::general_purpose::STANDARD
-        .decode(b64)
-        .map_err(|e| format!("LUT Data is not base64: {e}"))
+    Ok(base64::engine::general_purpose::STANDARD.decode(b64)?)
 }
 
 /// Converts the bytes of an ssl-vision XML settings file.
 ///
 /// # Errors
-/// A message when the file is not UTF-8, has no LUT blob, or the blob is too short.
-pub fn convert(bytes: &[u8]) -> Result<Converted, String> {
-    let text = std::str::from_utf8(bytes).map_err(|e| format!("not UTF-8 text: {e}"))?;
+/// [`TableError::Ssl`] when the file is not UTF-8, has no LUT blob, or the blob is too short.
+pub fn convert(bytes: &[u8]) -> Result<Converted, TableError> {
+    let text = std::str::from_utf8(bytes).map_err(SslError::from)?;
     let blob = lut_blob(text)?;
     if blob.len() < TABLE_BYTES {
-        return Err(format!(
-            "LUT Data holds {} bytes; a 4/6/6-bit table needs {TABLE_BYTES}",
-            blob.len()
-        ));
+        return Err(SslError::ShortBlob { len: blob.len() }.into());
     }
     let rest_used = blob[TABLE_BYTES..].iter().filter(|&&b| b != 0).count();
     let grid = SourceGrid {
@@ -132,13 +153,29 @@ mod tests {
 
     #[test]
     fn missing_or_short_blobs_are_errors() {
+        let none = convert(b"<VarXML></VarXML>").unwrap_err();
         assert!(
-            convert(b"<VarXML></VarXML>")
-                .unwrap_err()
-                .contains("LUT Data")
+            matches!(none, TableError::Ssl(SslError::NoLutData)),
+            "{none}"
         );
-        assert!(convert(&xml(&[0; 100])).unwrap_err().contains("100 bytes"));
+        assert!(none.to_string().contains("LUT Data"), "{none}");
+        let short = convert(&xml(&[0; 100])).unwrap_err();
+        assert!(
+            matches!(short, TableError::Ssl(SslError::ShortBlob { len: 100 })),
+            "{short}"
+        );
+        assert!(short.to_string().contains("100 bytes"), "{short}");
         let bad = b"<Var name=\"LUT Data\" type=\"blob\">@@@@</Var>";
-        assert!(convert(bad).unwrap_err().contains("base64"));
+        let bad = convert(bad).unwrap_err();
+        assert!(
+            matches!(bad, TableError::Ssl(SslError::NotBase64(_))),
+            "{bad}"
+        );
+        assert!(bad.to_string().contains("base64"), "{bad}");
+        let unclosed = convert(b"<Var name=\"LUT Data\"").unwrap_err();
+        assert!(
+            matches!(unclosed, TableError::Ssl(SslError::UnclosedElement)),
+            "{unclosed}"
+        );
     }
 }

@@ -16,8 +16,87 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Channel, Converted, SourceFormat, SourceGrid, build};
+use thiserror::Error;
+
+use super::{Channel, Converted, SourceFormat, SourceGrid, TableError, build};
 use crate::lut::ColourClass;
+
+/// What is wrong with a `.col` file.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ColError {
+    /// One line is malformed.
+    #[error("line {line}: {problem}: '{text}'")]
+    Line {
+        /// Line number, from 1.
+        line: usize,
+        /// What is wrong with it.
+        problem: ColLineProblem,
+        /// The line, trimmed.
+        text: String,
+    },
+    /// No line names a colour.
+    #[error("no colours in the .col file")]
+    NoColours,
+}
+
+/// What is wrong with one line of a `.col` file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+pub enum ColLineProblem {
+    /// The line does not start with a number 0..=255.
+    #[error("no colour index (0..=255) first")]
+    NoIndex,
+    /// The line has no name in double quotes.
+    #[error("no quoted colour name")]
+    NoName,
+    /// An earlier line has the same index.
+    #[error("index given twice")]
+    RepeatedIndex,
+}
+
+/// What is wrong with a `.tm` threshold map.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ThresholdMapError {
+    /// Fewer than three header lines in the first 256 bytes.
+    #[error("no complete three-line header (TMAP, colour space, sizes)")]
+    NoHeader,
+    /// The first line is not `TMAP`.
+    #[error("header starts '{first}', not TMAP")]
+    NotTmap {
+        /// The first line.
+        first: String,
+    },
+    /// The colour space is not YUV.
+    #[error("colour space '{space}' is not YUV")]
+    NotYuv {
+        /// The second line.
+        space: String,
+    },
+    /// The sizes line is not three numbers.
+    #[error("sizes line '{line}' is not three numbers")]
+    BadSizes {
+        /// The third line.
+        line: String,
+    },
+    /// An axis size that is no power of two in 2..=256.
+    #[error("axis size {size} is not a power of two from 2 to 256")]
+    BadAxisSize {
+        /// Cells along the axis.
+        size: u32,
+    },
+    /// Fewer cells after the header than the sizes need.
+    #[error(
+        "{len} bytes of cells after the header; {}×{}×{} needs {need}",
+        1u32 << .bits[0], 1u32 << .bits[1], 1u32 << .bits[2]
+    )]
+    ShortCells {
+        /// Bytes after the header.
+        len: usize,
+        /// Bits per axis (Y, U, V).
+        bits: [u8; 3],
+        /// Cells the sizes need.
+        need: usize,
+    },
+}
 
 /// One line of a `.col` file.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -69,27 +148,31 @@ pub fn class_for_name(name: &str) -> Option<ColourClass> {
 /// Parses a `.col` file.
 ///
 /// # Errors
-/// A message naming the line that has no index or no quoted name, or repeats an index.
-pub fn parse_col(text: &str) -> Result<Vec<ColEntry>, String> {
+/// [`ColError`] naming the line that has no index or no quoted name, or repeats an index.
+pub fn parse_col(text: &str) -> Result<Vec<ColEntry>, ColError> {
     let mut out: Vec<ColEntry> = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let bad = |what: &str| format!("line {}: {what}: '{line}'", n + 1);
+        let bad = |problem| ColError::Line {
+            line: n + 1,
+            problem,
+            text: line.to_owned(),
+        };
         let index: u8 = line
             .split_whitespace()
             .next()
             .and_then(|t| t.parse().ok())
-            .ok_or_else(|| bad("no colour index (0..=255) first"))?;
+            .ok_or_else(|| bad(ColLineProblem::NoIndex))?;
         let mut quoted = line.split('"');
         let name = match (quoted.next(), quoted.next()) {
             (Some(_), Some(name)) if line.matches('"').count() >= 2 => name.to_owned(),
-            _ => return Err(bad("no quoted colour name")),
+            _ => return Err(bad(ColLineProblem::NoName)),
         };
         if out.iter().any(|e| e.index == index) {
-            return Err(bad("index given twice"));
+            return Err(bad(ColLineProblem::RepeatedIndex));
         }
         out.push(ColEntry {
             index,
@@ -98,7 +181,7 @@ pub fn parse_col(text: &str) -> Result<Vec<ColEntry>, String> {
         });
     }
     if out.is_empty() {
-        return Err("no colours in the .col file".into());
+        return Err(ColError::NoColours);
     }
     Ok(out)
 }
@@ -125,7 +208,7 @@ pub fn find_col(tm: &Path) -> Option<PathBuf> {
 }
 
 /// Parses the `.tm` header; returns cells per axis (Y, U, V) as bits and the data offset.
-fn parse_header(bytes: &[u8]) -> Result<([u8; 3], usize), String> {
+fn parse_header(bytes: &[u8]) -> Result<([u8; 3], usize), ThresholdMapError> {
     let mut lines = Vec::new();
     let mut start = 0;
     for (i, &b) in bytes.iter().enumerate().take(256) {
@@ -138,26 +221,33 @@ fn parse_header(bytes: &[u8]) -> Result<([u8; 3], usize), String> {
         }
     }
     if lines.len() < 3 {
-        return Err("no complete three-line header (TMAP, colour space, sizes)".into());
+        return Err(ThresholdMapError::NoHeader);
     }
     if lines[0] != "TMAP" {
-        return Err(format!("header starts '{}', not TMAP", lines[0]));
+        return Err(ThresholdMapError::NotTmap {
+            first: lines[0].clone(),
+        });
     }
     if !lines[1].starts_with("YUV") {
-        return Err(format!("colour space '{}' is not YUV", lines[1]));
+        return Err(ThresholdMapError::NotYuv {
+            space: lines[1].clone(),
+        });
     }
+    let bad_sizes = || ThresholdMapError::BadSizes {
+        line: lines[2].clone(),
+    };
     let sizes: Vec<u32> = lines[2]
         .split_whitespace()
         .map(str::parse)
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("sizes line '{}' is not three numbers", lines[2]))?;
+        .map_err(|_| bad_sizes())?;
     let [y, u, v] = sizes[..] else {
-        return Err(format!("sizes line '{}' is not three numbers", lines[2]));
+        return Err(bad_sizes());
     };
-    let bits = |s: u32| {
-        (s.is_power_of_two() && (2..=256).contains(&s))
-            .then(|| u8::try_from(s.trailing_zeros()).unwrap_or(8))
-            .ok_or_else(|| format!("axis size {s} is not a power of two from 2 to 256"))
+    let bits = |size: u32| {
+        (size.is_power_of_two() && (2..=256).contains(&size))
+            .then(|| u8::try_from(size.trailing_zeros()).unwrap_or(8))
+            .ok_or(ThresholdMapError::BadAxisSize { size })
     };
     Ok(([bits(y)?, bits(u)?, bits(v)?], start))
 }
@@ -165,19 +255,18 @@ fn parse_header(bytes: &[u8]) -> Result<([u8; 3], usize), String> {
 /// Converts a `.tm` file's bytes with the classes of its `.col` file.
 ///
 /// # Errors
-/// A message for a bad header or too few cells.
-pub fn convert(bytes: &[u8], col: &[ColEntry]) -> Result<Converted, String> {
+/// [`TableError::Threshold`] for a bad header or too few cells.
+pub fn convert(bytes: &[u8], col: &[ColEntry]) -> Result<Converted, TableError> {
     let (bits, offset) = parse_header(bytes)?;
     let need = 1usize << bits.iter().map(|&b| u32::from(b)).sum::<u32>();
     let data = &bytes[offset..];
     if data.len() < need {
-        return Err(format!(
-            "{} bytes of cells after the header; {}×{}×{} needs {need}",
-            data.len(),
-            1u32 << bits[0],
-            1u32 << bits[1],
-            1u32 << bits[2]
-        ));
+        return Err(ThresholdMapError::ShortCells {
+            len: data.len(),
+            bits,
+            need,
+        }
+        .into());
     }
     let grid = SourceGrid {
         bits,
@@ -251,24 +340,56 @@ mod tests {
     #[test]
     fn bad_inputs_say_what_is_wrong() {
         let col = parse_col(COL).unwrap();
+        let threshold = |bytes: &[u8]| match convert(bytes, &col) {
+            Err(TableError::Threshold(e)) => e,
+            other => panic!("expected a threshold-map error, got {other:?}"),
+        };
+        let short = threshold(b"TMAP\nYUV'8\n16 64 64\n\0\0");
+        assert!(matches!(
+            short,
+            ThresholdMapError::ShortCells {
+                len: 2,
+                need: 65536,
+                ..
+            }
+        ));
         assert!(
-            convert(b"TMAP\nYUV'8\n16 64 64\n\0\0", &col)
-                .unwrap_err()
-                .contains("needs 65536")
+            short.to_string().contains("16×64×64 needs 65536"),
+            "{short}"
         );
-        assert!(
-            convert(b"TMAX\nYUV'8\n16 64 64\n", &col)
-                .unwrap_err()
-                .contains("TMAP")
+        let not_tmap = threshold(b"TMAX\nYUV'8\n16 64 64\n");
+        assert!(not_tmap.to_string().contains("TMAP"), "{not_tmap}");
+        assert_eq!(
+            threshold(b"TMAP\nYUV'8\n16 60 64\n"),
+            ThresholdMapError::BadAxisSize { size: 60 }
         );
-        assert!(
-            convert(b"TMAP\nYUV'8\n16 60 64\n", &col)
-                .unwrap_err()
-                .contains("power of two")
+        assert_eq!(threshold(b"TMAP\nYUV"), ThresholdMapError::NoHeader);
+        assert_eq!(
+            threshold(b"TMAP\nRGB\n16 64 64\n"),
+            ThresholdMapError::NotYuv {
+                space: "RGB".into()
+            }
         );
-        assert!(convert(b"TMAP\nYUV", &col).unwrap_err().contains("header"));
-        assert!(parse_col("x (1 2 3) \"a\"").unwrap_err().contains("line 1"));
-        assert!(parse_col("1 (1 2 3) a").unwrap_err().contains("quoted"));
-        assert!(parse_col("# nothing\n").is_err());
+        let no_index = parse_col("x (1 2 3) \"a\"").unwrap_err();
+        assert!(matches!(
+            no_index,
+            ColError::Line {
+                line: 1,
+                problem: ColLineProblem::NoIndex,
+                ..
+            }
+        ));
+        assert!(no_index.to_string().contains("line 1"), "{no_index}");
+        let unquoted = parse_col("1 (1 2 3) a").unwrap_err();
+        assert!(unquoted.to_string().contains("quoted"), "{unquoted}");
+        assert!(matches!(
+            parse_col("1 \"a\"\n1 \"b\"").unwrap_err(),
+            ColError::Line {
+                line: 2,
+                problem: ColLineProblem::RepeatedIndex,
+                ..
+            }
+        ));
+        assert_eq!(parse_col("# nothing\n"), Err(ColError::NoColours));
     }
 }

@@ -16,7 +16,7 @@
 //! Cells with several bits: ball+yellow → yellow-orange (when the ball is orange), yellow+field →
 //! shadow yellow, otherwise the lowest bit set (UPenn's own order, ball first).
 
-use super::{Channel, Converted, SourceFormat, SourceGrid, build};
+use super::{Channel, Converted, SourceFormat, SourceGrid, TableError, build};
 use crate::lut::ColourClass;
 
 /// UPenn bit → name → our class (bit 1 is decided per table; see the module docs).
@@ -81,13 +81,14 @@ fn ball_class(cells: &[u8]) -> (ColourClass, Option<f64>) {
 /// Converts the bytes of a `.raw` file.
 ///
 /// # Errors
-/// A message when the size is not 64³ bytes.
-pub fn convert(bytes: &[u8]) -> Result<Converted, String> {
+/// [`TableError::WrongLength`] when the size is not 64³ bytes.
+pub fn convert(bytes: &[u8]) -> Result<Converted, TableError> {
     if bytes.len() != 1 << 18 {
-        return Err(format!(
-            "{} bytes; a UPennalizers .raw is 262,144 (64³)",
-            bytes.len()
-        ));
+        return Err(TableError::WrongLength {
+            len: bytes.len(),
+            table: "UPennalizers .raw",
+            expected: "262,144 (64³)",
+        });
     }
     let (ball, mean_cr) = ball_class(bytes);
     let grid = SourceGrid {

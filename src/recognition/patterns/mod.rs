@@ -43,7 +43,7 @@ use super::draw::{Primitive, owner};
 
 pub use learning::{LearnParams, LearnReport, LearnView, Triangulation, triangulate};
 use learning::{median, theil_sen};
-pub use places::PlacesError;
+pub use places::{PlacesError, PlacesProblem};
 pub use signatures::{FieldRay, GroundRay, PatternObservation, observe};
 
 /// The two most common class codes of each of the nine regions, row by row (top-left first,

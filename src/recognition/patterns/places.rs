@@ -46,7 +46,68 @@ pub enum PlacesError {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        problem: String,
+        #[source]
+        problem: PlacesProblem,
+    },
+}
+
+/// What makes a places file of the right shape unusable.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PlacesProblem {
+    /// Another `format`.
+    #[error("format is {found:?}, not {PLACES_FORMAT:?}")]
+    Format {
+        /// The file's `format`.
+        found: String,
+    },
+    /// Another `version`.
+    #[error("places version {found} (this eotn reads version {PLACES_VERSION})")]
+    Version {
+        /// The file's `version`.
+        found: u32,
+    },
+    /// Two objects with one id.
+    #[error("object id {id} appears twice")]
+    IdTwice {
+        /// The id.
+        id: usize,
+    },
+    /// A position that is not finite.
+    #[error("object {id}: position is not a number")]
+    Position {
+        /// The object's id.
+        id: usize,
+    },
+    /// A height that is not finite.
+    #[error("object {id}: height is not a number")]
+    Height {
+        /// The object's id.
+        id: usize,
+    },
+    /// An object without patterns.
+    #[error("object {id}: no patterns")]
+    NoPatterns {
+        /// The object's id.
+        id: usize,
+    },
+    /// A pattern cell that is no class code.
+    #[error("object {id}: {code} is not a class code")]
+    ClassCode {
+        /// The object's id.
+        id: usize,
+        /// The cell's value.
+        code: u8,
+    },
+    /// A size relation whose distances do not shrink with size.
+    #[error(
+        "size relation distance = {multiplier_cm_px} / size + {offset_cm} is not a relation \
+         (the multiplier must be a positive number)"
+    )]
+    Relation {
+        /// Its multiplier, cm × px.
+        multiplier_cm_px: f64,
+        /// Its offset, cm.
+        offset_cm: f64,
     },
 }
 
@@ -96,33 +157,31 @@ impl PatternMemory {
         Ok(memory)
     }
 
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), PlacesProblem> {
         if self.format != PLACES_FORMAT {
-            return Err(format!(
-                "format is {:?}, not {PLACES_FORMAT:?}",
-                self.format
-            ));
+            return Err(PlacesProblem::Format {
+                found: self.format.clone(),
+            });
         }
         if self.version != PLACES_VERSION {
-            return Err(format!(
-                "places version {} (this eotn reads version {PLACES_VERSION})",
-                self.version
-            ));
+            return Err(PlacesProblem::Version {
+                found: self.version,
+            });
         }
         let mut ids: Vec<usize> = self.objects.iter().map(|o| o.id).collect();
         ids.sort_unstable();
         if let Some(w) = ids.windows(2).find(|w| w[0] == w[1]) {
-            return Err(format!("object id {} appears twice", w[0]));
+            return Err(PlacesProblem::IdTwice { id: w[0] });
         }
         for o in &self.objects {
             if !o.field_cm.iter().all(|v| v.is_finite()) {
-                return Err(format!("object {}: position is not a number", o.id));
+                return Err(PlacesProblem::Position { id: o.id });
             }
             if o.height_cm.is_some_and(|h| !h.is_finite()) {
-                return Err(format!("object {}: height is not a number", o.id));
+                return Err(PlacesProblem::Height { id: o.id });
             }
             if o.patterns.is_empty() {
-                return Err(format!("object {}: no patterns", o.id));
+                return Err(PlacesProblem::NoPatterns { id: o.id });
             }
             for p in &o.patterns {
                 if let Some(c) =
@@ -130,7 +189,7 @@ impl PatternMemory {
                         .flatten()
                         .find(|&&c| ColourClass::from_code(c).is_none())
                 {
-                    return Err(format!("object {}: {c} is not a class code", o.id));
+                    return Err(PlacesProblem::ClassCode { id: o.id, code: *c });
                 }
             }
         }
@@ -139,11 +198,10 @@ impl PatternMemory {
                 && r.multiplier_cm_px > 0.0
                 && r.offset_cm.is_finite())
         {
-            return Err(format!(
-                "size relation distance = {} / size + {} is not a relation (the multiplier \
-                 must be a positive number)",
-                r.multiplier_cm_px, r.offset_cm
-            ));
+            return Err(PlacesProblem::Relation {
+                multiplier_cm_px: r.multiplier_cm_px,
+                offset_cm: r.offset_cm,
+            });
         }
         Ok(())
     }
