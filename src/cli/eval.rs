@@ -472,9 +472,51 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The human-readable summary: the ball, the skew study, goals, the frames that went wrong,
+/// the comparison, what was written, the pink markers.
 fn print_summary(o: &EvalOutput) {
     let r = &o.report;
     println!("frames                 {}", r.frames);
+    print_ball_summary(r);
+    if let Some(s) = &o.skew {
+        print_skew_summary(s);
+    }
+    print_goal_summary(r);
+    print_frame_lists(r);
+    if let Some(c) = &o.compare {
+        println!(
+            "compared: ball {}/{}, false {}, goals {}/{}; {} frame(s) differ",
+            c.ball_found,
+            c.ball_eligible,
+            c.ball_false,
+            c.goals_found,
+            c.goals_eligible,
+            o.differences.len()
+        );
+        for d in o.differences.iter().take(50) {
+            println!("  {}#{}: {}", d.stream, d.frame, d.what);
+        }
+    }
+    if let Some((m, off)) = o.goal_calibration {
+        println!("goal distance          = {m:.1} / height_px + {off:.1} cm (written)");
+    }
+    if !o.plots.is_empty() {
+        println!("plots                  {} written", o.plots.len());
+    }
+    if let Some(p) = &o.patterns {
+        print_pattern_summary(p);
+    }
+    if !o.skipped.is_empty() {
+        println!(
+            "skipped {} frame(s), first: {}",
+            o.skipped.len(),
+            o.skipped[0]
+        );
+    }
+}
+
+/// The ball's lines of the summary.
+fn print_ball_summary(r: &EvalReport) {
     println!(
         "ball found             {}/{} = {}   false {} = {} of frames",
         r.ball_found,
@@ -502,30 +544,36 @@ fn print_summary(o: &EvalOutput) {
         "ball bearing error     median {:.2}° p90 {:.2}°; radius error median {:.2} px",
         r.ball_bearing_error_deg.p50, r.ball_bearing_error_deg.p90, r.ball_radius_error_px.p50
     );
-    if let Some(s) = &o.skew {
-        println!(
-            "skew correction        {} fast-panning frames, {} with a ball on the true one in both runs",
-            s.frames, s.compared
-        );
-        for (name, e) in [
-            ("all balls", &s.all),
-            ("seen from one side", &s.one_sided),
-            ("whole outline", &s.whole),
-        ] {
-            if e.radius_with_px.n == 0 {
-                continue;
-            }
-            println!(
-                "  {name:<20} radius error median {:.2} px with, {:.2} without; centre {:.2} \
-                 px with, {:.2} without (n={})",
-                e.radius_with_px.p50,
-                e.radius_without_px.p50,
-                e.centre_with_px.p50,
-                e.centre_without_px.p50,
-                e.radius_with_px.n
-            );
+}
+
+/// The skew study's lines of the summary.
+fn print_skew_summary(s: &SkewReport) {
+    println!(
+        "skew correction        {} fast-panning frames, {} with a ball on the true one in both runs",
+        s.frames, s.compared
+    );
+    for (name, e) in [
+        ("all balls", &s.all),
+        ("seen from one side", &s.one_sided),
+        ("whole outline", &s.whole),
+    ] {
+        if e.radius_with_px.n == 0 {
+            continue;
         }
+        println!(
+            "  {name:<20} radius error median {:.2} px with, {:.2} without; centre {:.2} \
+             px with, {:.2} without (n={})",
+            e.radius_with_px.p50,
+            e.radius_without_px.p50,
+            e.centre_with_px.p50,
+            e.centre_without_px.p50,
+            e.radius_with_px.n
+        );
     }
+}
+
+/// The goals', posts' and gaps' lines of the summary.
+fn print_goal_summary(r: &EvalReport) {
     println!(
         "goals found            {}/{} = {}   false {}; distance error median {:.1}%",
         r.goals_found,
@@ -546,6 +594,10 @@ fn print_summary(o: &EvalOutput) {
         pct(r.gaps_within_3px),
         r.gap_error_px.n
     );
+}
+
+/// The frames where the ball or a goal was missed or false.
+fn print_frame_lists(r: &EvalReport) {
     if !r.ball_misses.is_empty() {
         println!("ball missed in frames  {:?}", r.ball_misses);
     }
@@ -558,64 +610,39 @@ fn print_summary(o: &EvalOutput) {
     if !r.goal_false_frames.is_empty() {
         println!("false goal in frames   {:?}", r.goal_false_frames);
     }
-    if let Some(c) = &o.compare {
-        println!(
-            "compared: ball {}/{}, false {}, goals {}/{}; {} frame(s) differ",
-            c.ball_found,
-            c.ball_eligible,
-            c.ball_false,
-            c.goals_found,
-            c.goals_eligible,
-            o.differences.len()
-        );
-        for d in o.differences.iter().take(50) {
-            println!("  {}#{}: {}", d.stream, d.frame, d.what);
-        }
+}
+
+/// The pink markers' lines of the summary.
+fn print_pattern_summary(p: &crate::eval::patterns::PatternEvalReport) {
+    println!(
+        "pink markers           {}/{} identified correctly = {}, wrongly {}, not at all {}; \
+         false identifications {}",
+        p.correct,
+        p.eligible,
+        pct(p.correct_rate),
+        p.wrong,
+        p.missed,
+        p.false_identifications
+    );
+    println!(
+        "marker distance error  median {:.1}% p90 {:.1}% p95 {:.1}% (n={}); signed median {}",
+        p.distance_error.p50 * 100.0,
+        p.distance_error.p90 * 100.0,
+        p.distance_error.p95 * 100.0,
+        p.distance_error.n,
+        p.distance_bias_cm
+            .map_or_else(|| "-".to_owned(), |b| format!("{b:+.1} cm"))
+    );
+    let lost: Vec<usize> = p
+        .places
+        .iter()
+        .filter(|(_, m)| m.is_none())
+        .map(|(id, _)| *id)
+        .collect();
+    if !lost.is_empty() {
+        println!("places near no marker  {lost:?}");
     }
-    if let Some((m, off)) = o.goal_calibration {
-        println!("goal distance          = {m:.1} / height_px + {off:.1} cm (written)");
-    }
-    if !o.plots.is_empty() {
-        println!("plots                  {} written", o.plots.len());
-    }
-    if let Some(p) = &o.patterns {
-        println!(
-            "pink markers           {}/{} identified correctly = {}, wrongly {}, not at all {}; \
-             false identifications {}",
-            p.correct,
-            p.eligible,
-            pct(p.correct_rate),
-            p.wrong,
-            p.missed,
-            p.false_identifications
-        );
-        println!(
-            "marker distance error  median {:.1}% p90 {:.1}% p95 {:.1}% (n={}); signed median {}",
-            p.distance_error.p50 * 100.0,
-            p.distance_error.p90 * 100.0,
-            p.distance_error.p95 * 100.0,
-            p.distance_error.n,
-            p.distance_bias_cm
-                .map_or_else(|| "-".to_owned(), |b| format!("{b:+.1} cm"))
-        );
-        let lost: Vec<usize> = p
-            .places
-            .iter()
-            .filter(|(_, m)| m.is_none())
-            .map(|(id, _)| *id)
-            .collect();
-        if !lost.is_empty() {
-            println!("places near no marker  {lost:?}");
-        }
-        if !p.wrong_frames.is_empty() {
-            println!("wrong place in frames  {:?}", p.wrong_frames);
-        }
-    }
-    if !o.skipped.is_empty() {
-        println!(
-            "skipped {} frame(s), first: {}",
-            o.skipped.len(),
-            o.skipped[0]
-        );
+    if !p.wrong_frames.is_empty() {
+        println!("wrong place in frames  {:?}", p.wrong_frames);
     }
 }

@@ -98,26 +98,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     let table = match &args.sensors {
-        Some(p) => {
-            let t = SensorTable::load(p)?;
-            for w in t.warnings() {
-                log::warn!("{}: {w}", p.display());
-            }
-            let unmatched = t
-                .rows()
-                .iter()
-                .enumerate()
-                .filter(|(i, r)| r.frame.unwrap_or(*i) >= paths.len())
-                .count();
-            if unmatched > 0 {
-                log::warn!(
-                    "{}: {unmatched} rows name frames beyond the {} given; ignored",
-                    p.display(),
-                    paths.len()
-                );
-            }
-            Some(t)
-        }
+        Some(p) => Some(load_sensor_table(p, paths.len())?),
         None => None,
     };
     let options = writer_options(args);
@@ -131,16 +112,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for (i, path) in paths.iter().enumerate() {
         let frame = load_frame_arg(path, args.size)?;
         let row = table.as_ref().and_then(|t| t.for_frame(i));
-        let time_ns = match row.and_then(|r| r.time_s) {
-            Some(t) => seconds_to_ns(t).with_context(|| {
-                format!(
-                    "{}: time_s {t} of frame {i} is not a time",
-                    args.sensors.as_deref().unwrap_or(path).display()
-                )
-            })?,
-            None => seconds_to_ns(frame_seconds(i, args.fps))
-                .with_context(|| format!("frame {i} at {:.3} fps is too late", args.fps))?,
-        };
+        let time_ns = frame_time_ns(i, row, path, args)?;
         if let Some((before, _)) = previous.as_ref()
             && time_ns < *before
         {
@@ -172,6 +144,47 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// Loads the sensor table, warning about its own warnings and about rows that name frames
+/// beyond the `frames` given.
+fn load_sensor_table(path: &std::path::Path, frames: usize) -> anyhow::Result<SensorTable> {
+    let t = SensorTable::load(path)?;
+    for w in t.warnings() {
+        log::warn!("{}: {w}", path.display());
+    }
+    let unmatched = t
+        .rows()
+        .iter()
+        .enumerate()
+        .filter(|(i, r)| r.frame.unwrap_or(*i) >= frames)
+        .count();
+    if unmatched > 0 {
+        log::warn!(
+            "{}: {unmatched} rows name frames beyond the {frames} given; ignored",
+            path.display(),
+        );
+    }
+    Ok(t)
+}
+
+/// Frame `i`'s time, nanoseconds: its row's `time_s`, else `i` frames at `--fps`.
+fn frame_time_ns(
+    i: usize,
+    row: Option<&crate::streams::sensor_table::SensorRow>,
+    path: &std::path::Path,
+    args: &Args,
+) -> anyhow::Result<u64> {
+    Ok(match row.and_then(|r| r.time_s) {
+        Some(t) => seconds_to_ns(t).with_context(|| {
+            format!(
+                "{}: time_s {t} of frame {i} is not a time",
+                args.sensors.as_deref().unwrap_or(path).display()
+            )
+        })?,
+        None => seconds_to_ns(frame_seconds(i, args.fps))
+            .with_context(|| format!("frame {i} at {:.3} fps is too late", args.fps))?,
+    })
 }
 
 /// `eotn import OLD.mcap -o NEW.mcap`: the stream rewritten in today's layout and the chosen

@@ -91,46 +91,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         min_pixels: args.min_pixels,
         min_purity: args.min_purity,
     };
-    let mut builder = TableBuilder::new(args.bits)?;
-    let mut held_back: Vec<(String, Frame, Vec<u8>)> = Vec::new();
-    let mut index = 0_u64;
-    let mut take = |name: String, frame: Frame, labels: Vec<u8>| -> anyhow::Result<()> {
-        index += 1;
-        if index.is_multiple_of(args.holdout_every) {
-            held_back.push((name, frame, labels));
-        } else {
-            builder
-                .add_frame(&frame, &labels)
-                .with_context(|| format!("{name}: labels"))?;
-        }
-        Ok(())
+    let mut training = Training {
+        builder: TableBuilder::new(args.bits)?,
+        held_back: Vec::new(),
+        taken: 0,
+        holdout_every: args.holdout_every,
     };
-    let paths = if args.frames.is_empty() {
-        Vec::new()
-    } else {
-        expand_frame_paths(&args.frames)?
-    };
-    refuse_overwriting(&args.output, &paths)?;
-    for path in &paths {
-        let frame = load_frame_arg(path, args.size)?;
-        let labels = load_mask(path, &frame)?;
-        take(path.display().to_string(), frame, labels)?;
-    }
-    for name in &args.scenarios {
-        let kind =
-            ScenarioKind::from_name(name).with_context(|| format!("unknown scenario {name:?}"))?;
-        let sim = Simulator::new(Scenario::new(kind, args.seed));
-        let bar = progress(
-            usize::try_from(args.frames_per_scenario).unwrap_or(usize::MAX),
-            name,
-        );
-        for k in 0..args.frames_per_scenario {
-            let f = sim.frame(k)?;
-            take(format!("{name}#{k}"), f.frame, f.labels)?;
-            bar.inc(1);
-        }
-        bar.finish_and_clear();
-    }
+    gather_labelled_frames(args, &mut training)?;
+    let Training {
+        builder, held_back, ..
+    } = training;
     anyhow::ensure!(
         builder.pixel_count() > 0,
         "no labelled frames to build from (give frames with .cls masks, or --sim SCENARIO)"
@@ -145,6 +115,68 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .add_frame(frame, labels, &table)
             .with_context(|| format!("{name}: labels"))?;
     }
+    print_report(args, &builder, held_back.len(), &accuracy);
+    Ok(())
+}
+
+/// Labelled frames as they come: every `holdout_every`-th is held back to score the table, the
+/// others go into it.
+struct Training {
+    builder: TableBuilder,
+    held_back: Vec<(String, Frame, Vec<u8>)>,
+    /// Frames taken so far.
+    taken: u64,
+    holdout_every: u64,
+}
+
+impl Training {
+    fn take(&mut self, name: String, frame: Frame, labels: Vec<u8>) -> anyhow::Result<()> {
+        self.taken += 1;
+        if self.taken.is_multiple_of(self.holdout_every) {
+            self.held_back.push((name, frame, labels));
+        } else {
+            self.builder
+                .add_frame(&frame, &labels)
+                .with_context(|| format!("{name}: labels"))?;
+        }
+        Ok(())
+    }
+}
+
+/// The frames with their `.cls` masks, then `--frames-per-scenario` frames of each scenario
+/// with the simulator's labels.
+fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Result<()> {
+    let paths = if args.frames.is_empty() {
+        Vec::new()
+    } else {
+        expand_frame_paths(&args.frames)?
+    };
+    refuse_overwriting(&args.output, &paths)?;
+    for path in &paths {
+        let frame = load_frame_arg(path, args.size)?;
+        let labels = load_mask(path, &frame)?;
+        training.take(path.display().to_string(), frame, labels)?;
+    }
+    for name in &args.scenarios {
+        let kind =
+            ScenarioKind::from_name(name).with_context(|| format!("unknown scenario {name:?}"))?;
+        let sim = Simulator::new(Scenario::new(kind, args.seed));
+        let bar = progress(
+            usize::try_from(args.frames_per_scenario).unwrap_or(usize::MAX),
+            name,
+        );
+        for k in 0..args.frames_per_scenario {
+            let f = sim.frame(k)?;
+            training.take(format!("{name}#{k}"), f.frame, f.labels)?;
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
+    }
+    Ok(())
+}
+
+/// The table written and its scores on the held-back frames, as text or `--json`.
+fn print_report(args: &Args, builder: &TableBuilder, held_back: usize, accuracy: &Accuracy) {
     let recalls: Vec<(String, f64)> = ColourClass::ALL
         .iter()
         .filter_map(|&c| {
@@ -165,7 +197,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 "bits": args.bits,
                 "training_pixels": builder.pixel_count(),
                 "cells_seen": builder.cells_seen(),
-                "held_back_frames": held_back.len(),
+                "held_back_frames": held_back,
                 "colour_accuracy": accuracy.colour_accuracy(),
                 "false_colour_rate": accuracy.false_colour_rate(),
                 "recall": per_class,
@@ -180,8 +212,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             builder.cells_seen()
         );
         outln!(
-            "held back {} frames: colour accuracy {:.2}%, false colour on unlabelled pixels {:.2}%",
-            held_back.len(),
+            "held back {held_back} frames: colour accuracy {:.2}%, false colour on unlabelled pixels {:.2}%",
             100.0 * accuracy.colour_accuracy(),
             100.0 * accuracy.false_colour_rate()
         );
@@ -189,5 +220,4 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             outln!("  {name:<12} {:.2}%", 100.0 * r);
         }
     }
-    Ok(())
 }

@@ -222,7 +222,7 @@ pub struct LearnOutput {
 /// A frame's robot pose from a stream record: the `/robot_pose` channel, else the ground
 /// truth's `robot_pose`.
 fn recorded_pose(
-    (truth, extra): &(Option<serde_json::Value>, Vec<(String, serde_json::Value)>),
+    (truth, extra): &RecordedChannels,
     sources: &mut PoseSources,
 ) -> Option<RobotPose> {
     if let Some(p) = extra
@@ -274,16 +274,6 @@ pub fn learn(args: &LearnArgs) -> anyhow::Result<LearnOutput> {
             paths.len()
         );
     }
-    let typed_for = |p: &Path| -> Option<RobotPose> {
-        match args.pose.as_slice() {
-            [] => None,
-            [one] => Some(*one),
-            many => paths
-                .iter()
-                .position(|q| q == p)
-                .and_then(|i| many.get(i).copied()),
-        }
-    };
     let mut pipeline = Pipeline::new(
         lut,
         PipelineParams {
@@ -297,23 +287,7 @@ pub fn learn(args: &LearnArgs) -> anyhow::Result<LearnOutput> {
     let bar = progress(inputs.len(), "learn");
     for (i, item) in inputs.items().iter().enumerate() {
         bar.inc(1);
-        let (frame, recorded_sensors, recorded) = match item {
-            FrameInput::File(p) => (load_frame_arg(p, args.input.size)?, None, None),
-            FrameInput::Stream { path, index } => {
-                if reader.as_ref().is_none_or(|r| r.path() != path) {
-                    reader = Some(StreamReader::open(path)?);
-                }
-                let Some(r) = reader.as_mut() else {
-                    bail!("{}: stream not open", path.display());
-                };
-                let record = r.read(*index)?;
-                (
-                    record.frame,
-                    record.sensors,
-                    Some((record.ground_truth, record.extra)),
-                )
-            }
-        };
+        let (frame, recorded_sensors, recorded) = read_input(item, &mut reader, args.input.size)?;
         let path = match item {
             FrameInput::File(p) | FrameInput::Stream { path: p, .. } => p,
         };
@@ -323,7 +297,7 @@ pub fn learn(args: &LearnArgs) -> anyhow::Result<LearnOutput> {
                 sources.table += 1;
             }
             p
-        } else if let Some(p) = typed_for(path) {
+        } else if let Some(p) = typed_pose(&args.pose, &paths, path) {
             sources.typed += 1;
             Some(p)
         } else {
@@ -359,6 +333,51 @@ pub fn learn(args: &LearnArgs) -> anyhow::Result<LearnOutput> {
         places: memory,
         output: args.output.clone(),
     })
+}
+
+/// What a stream recorded beside a frame: its ground truth and extra channels.
+type RecordedChannels = (Option<serde_json::Value>, Vec<(String, serde_json::Value)>);
+
+/// One input's frame, with the sensor readings and channels its stream recorded (none for a
+/// frame file); `reader` keeps the last stream open.
+fn read_input(
+    item: &FrameInput,
+    reader: &mut Option<StreamReader>,
+    size: Option<(usize, usize)>,
+) -> anyhow::Result<(
+    crate::frame::Frame,
+    Option<crate::sensors::SensorReadings>,
+    Option<RecordedChannels>,
+)> {
+    Ok(match item {
+        FrameInput::File(p) => (load_frame_arg(p, size)?, None, None),
+        FrameInput::Stream { path, index } => {
+            if reader.as_ref().is_none_or(|r| r.path() != path) {
+                *reader = Some(StreamReader::open(path)?);
+            }
+            let Some(r) = reader.as_mut() else {
+                bail!("{}: stream not open", path.display());
+            };
+            let record = r.read(*index)?;
+            (
+                record.frame,
+                record.sensors,
+                Some((record.ground_truth, record.extra)),
+            )
+        }
+    })
+}
+
+/// The `--pose` typed for input `path`: the only one, or the one at its place among `paths`.
+fn typed_pose(poses: &[RobotPose], paths: &[PathBuf], path: &Path) -> Option<RobotPose> {
+    match poses {
+        [] => None,
+        [one] => Some(*one),
+        many => paths
+            .iter()
+            .position(|q| q == path)
+            .and_then(|i| many.get(i).copied()),
+    }
 }
 
 /// Runs `eotn patterns`.

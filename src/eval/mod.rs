@@ -15,8 +15,9 @@ use serde::{Deserialize, Serialize};
 use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::Recognition;
+use crate::recognition::goals::Post;
 use crate::sim::scene::GoalColour;
-use crate::sim::truth::{GoalGap, RobotViewTruth};
+use crate::sim::truth::{GoalGap, GoalTruth, RobotViewTruth};
 
 /// When an object counts as "should have been found", and when a detection matches.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -167,6 +168,26 @@ pub fn evaluate_frame(
         frame,
         ..FrameEval::default()
     };
+    score_ball(&mut e, r, t, p);
+    for tg in &t.goals {
+        score_goal(&mut e, r, tg, width, height, p);
+    }
+    let in_view: Vec<ColourClass> = t
+        .goals
+        .iter()
+        .filter(|g| g.visible_pixels > 0)
+        .map(|g| goal_class(g.colour))
+        .collect();
+    e.goals_false = r
+        .goals
+        .goals()
+        .filter(|g| !in_view.contains(&g.colour))
+        .count();
+    e
+}
+
+/// The ball: eligible, reported, matched (then its distance, bearing and radius errors), false.
+fn score_ball(e: &mut FrameEval, r: &Recognition, t: &RobotViewTruth, p: &EvalParams) {
     let reported = r.ball.ball.as_ref();
     e.ball_reported = reported.is_some();
     let truth = t.ball.as_ref().filter(|b| b.visible_pixels > 0);
@@ -203,94 +224,92 @@ pub fn evaluate_frame(
         }
     }
     e.ball_false = e.ball_reported && !e.ball_near;
+}
 
-    for tg in &t.goals {
-        let class = goal_class(tg.colour);
-        let mouth = mouth_fraction_in_image(tg, width, height);
-        let eligible = mouth >= p.goal_min_mouth_fraction && tg.visible_pixels >= p.goal_min_pixels;
-        let found = r.goals.goals().find(|g| g.colour == class);
-        if eligible {
-            e.goals_eligible += 1;
-            e.goal_detections
-                .push((tg.relative.camera_distance_cm, found.is_some()));
-        }
-        let Some(g) = found else { continue };
-        if eligible {
-            e.goals_found += 1;
-        }
-        if !g.cut_off.top && !g.cut_off.bottom && !g.distance_from_ir {
-            let d = tg.relative.camera_distance_cm;
-            e.goal_distance_errors
-                .push((g.camera.distance_cm - d).abs() / d);
-            e.goal_distances_cm.push(GoalDistance {
-                true_cm: d,
-                measured_cm: g.camera.distance_cm,
-                height_px: g.height_px,
-                sky_blue: class == ColourClass::SkyBlue,
-            });
-        }
-        for post in &g.posts {
-            // The true post nearest this one, scored only when both its ends are in the
-            // image (a post whose partner runs out of the image is not compared with the
-            // goal's other post instead).
-            let inside = |q: &ImagePoint| {
-                q.x_px >= 0.0 && q.x_px <= width && q.y_px >= 0.0 && q.y_px <= height
-            };
-            let best = tg
-                .posts
-                .iter()
-                .filter_map(|tp| Some((tp.image_base?, tp.image_top?)))
-                .map(|(base, top)| {
-                    // The truth projects at the reference row's time: compare the post moved
-                    // there (the line through its skew-corrected ends).
-                    let (a, b) = (post.reference_top, post.reference_bottom);
-                    let at = |y: f64| {
-                        if (b.1 - a.1).abs() > 1e-9 {
-                            a.0 + (b.0 - a.0) * (y - a.1) / (b.1 - a.1)
-                        } else {
-                            a.0
-                        }
-                    };
-                    let error = (at(base.y_px) - base.x_px)
-                        .abs()
-                        .max((at(top.y_px) - top.x_px).abs());
-                    (error, inside(&base) && inside(&top))
-                })
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .filter(|(_, scored)| *scored)
-                .map_or(f64::INFINITY, |(error, _)| error);
-            if best.is_finite() {
-                e.post_errors_px.push(best);
-            }
-        }
-        if let (Some(gap), Some(largest)) = (&g.gap, &tg.largest_gap) {
-            // Scored against the largest open stretch, or against the second when that is as
-            // wide within the tie tolerance and nearer (either is "the largest").
-            let error = |t: &GoalGap| {
-                let left = (gap.left.0 - t.from_x_px as f64).abs();
-                let right = (gap.right.0 - (t.to_x_px as f64 + 1.0)).abs();
-                left.max(right)
-            };
-            let width = |t: &GoalGap| (t.to_x_px - t.from_x_px) as f64;
-            let tied = tg
-                .second_gap
-                .filter(|s| width(s) + p.gap_tie_px >= width(largest))
-                .map_or(f64::INFINITY, |s| error(&s));
-            e.gap_errors_px.push(error(largest).min(tied));
+/// One true goal: eligible and found, and the found goal's distance, post and gap errors.
+fn score_goal(
+    e: &mut FrameEval,
+    r: &Recognition,
+    tg: &GoalTruth,
+    width: f64,
+    height: f64,
+    p: &EvalParams,
+) {
+    let class = goal_class(tg.colour);
+    let mouth = mouth_fraction_in_image(tg, width, height);
+    let eligible = mouth >= p.goal_min_mouth_fraction && tg.visible_pixels >= p.goal_min_pixels;
+    let found = r.goals.goals().find(|g| g.colour == class);
+    if eligible {
+        e.goals_eligible += 1;
+        e.goal_detections
+            .push((tg.relative.camera_distance_cm, found.is_some()));
+    }
+    let Some(g) = found else { return };
+    if eligible {
+        e.goals_found += 1;
+    }
+    if !g.cut_off.top && !g.cut_off.bottom && !g.distance_from_ir {
+        let d = tg.relative.camera_distance_cm;
+        e.goal_distance_errors
+            .push((g.camera.distance_cm - d).abs() / d);
+        e.goal_distances_cm.push(GoalDistance {
+            true_cm: d,
+            measured_cm: g.camera.distance_cm,
+            height_px: g.height_px,
+            sky_blue: class == ColourClass::SkyBlue,
+        });
+    }
+    for post in &g.posts {
+        let best = post_error_px(post, tg, width, height);
+        if best.is_finite() {
+            e.post_errors_px.push(best);
         }
     }
-    let in_view: Vec<ColourClass> = t
-        .goals
+    if let (Some(gap), Some(largest)) = (&g.gap, &tg.largest_gap) {
+        // Scored against the largest open stretch, or against the second when that is as
+        // wide within the tie tolerance and nearer (either is "the largest").
+        let error = |t: &GoalGap| {
+            let left = (gap.left.0 - t.from_x_px as f64).abs();
+            let right = (gap.right.0 - (t.to_x_px as f64 + 1.0)).abs();
+            left.max(right)
+        };
+        let width = |t: &GoalGap| (t.to_x_px - t.from_x_px) as f64;
+        let tied = tg
+            .second_gap
+            .filter(|s| width(s) + p.gap_tie_px >= width(largest))
+            .map_or(f64::INFINITY, |s| error(&s));
+        e.gap_errors_px.push(error(largest).min(tied));
+    }
+}
+
+/// A found post's error against the true post nearest it, pixels: infinite when that post is
+/// not scored because one of its ends is outside the image (a post whose partner runs out of
+/// the image is not compared with the goal's other post instead).
+fn post_error_px(post: &Post, tg: &GoalTruth, width: f64, height: f64) -> f64 {
+    let inside =
+        |q: &ImagePoint| q.x_px >= 0.0 && q.x_px <= width && q.y_px >= 0.0 && q.y_px <= height;
+    tg.posts
         .iter()
-        .filter(|g| g.visible_pixels > 0)
-        .map(|g| goal_class(g.colour))
-        .collect();
-    e.goals_false = r
-        .goals
-        .goals()
-        .filter(|g| !in_view.contains(&g.colour))
-        .count();
-    e
+        .filter_map(|tp| Some((tp.image_base?, tp.image_top?)))
+        .map(|(base, top)| {
+            // The truth projects at the reference row's time: compare the post moved there
+            // (the line through its skew-corrected ends).
+            let (a, b) = (post.reference_top, post.reference_bottom);
+            let at = |y: f64| {
+                if (b.1 - a.1).abs() > 1e-9 {
+                    a.0 + (b.0 - a.0) * (y - a.1) / (b.1 - a.1)
+                } else {
+                    a.0
+                }
+            };
+            let error = (at(base.y_px) - base.x_px)
+                .abs()
+                .max((at(top.y_px) - top.x_px).abs());
+            (error, inside(&base) && inside(&top))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .filter(|(_, scored)| *scored)
+        .map_or(f64::INFINITY, |(error, _)| error)
 }
 
 /// 50th, 90th and 95th percentiles and the count of a sample.

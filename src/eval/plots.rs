@@ -423,109 +423,7 @@ fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3
 pub fn write_eval_plots(dir: &Path, frames: &[FrameEval]) -> io::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)
         .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
-    let mut ball_uncut = Vec::new();
-    let mut ball_cut = Vec::new();
-    let mut ball_rates = Vec::new();
-    let mut goal_yellow = Vec::new();
-    let mut goal_blue = Vec::new();
-    let mut goal_rates = Vec::new();
-    let mut posts = Vec::new();
-    for f in frames {
-        if let Some((t, m)) = f.ball_distances_cm {
-            if f.ball_cut {
-                ball_cut.push((t, m));
-            } else {
-                ball_uncut.push((t, m));
-            }
-        }
-        if let Some(t) = f.ball_true_distance_cm.filter(|_| f.ball_eligible) {
-            ball_rates.push((t, f.ball_correct));
-        }
-        for g in &f.goal_distances_cm {
-            if g.sky_blue {
-                goal_blue.push((g.true_cm, g.measured_cm));
-            } else {
-                goal_yellow.push((g.true_cm, g.measured_cm));
-            }
-        }
-        goal_rates.extend(f.goal_detections.iter().copied());
-        posts.extend(f.post_errors_px.iter().copied());
-    }
-    let signed = |pts: &[(f64, f64)]| -> Vec<f64> {
-        pts.iter()
-            .filter(|p| p.0 > 0.0)
-            .map(|p| 100.0 * (p.1 - p.0) / p.0)
-            .collect()
-    };
-    let ball_all: Vec<(f64, f64)> = ball_uncut.iter().chain(&ball_cut).copied().collect();
-    let goal_all: Vec<(f64, f64)> = goal_yellow.iter().chain(&goal_blue).copied().collect();
-    let charts = [
-        (
-            "ball_distance.png",
-            distance_chart(
-                "ball: measured against true distance",
-                &[
-                    ("whole ball", BALL, ball_uncut.clone()),
-                    ("cut off by the image edge", BALL_CUT, ball_cut.clone()),
-                ],
-            ),
-        ),
-        (
-            "goal_distance.png",
-            distance_chart(
-                "goals (uncut): measured against true distance",
-                &[
-                    ("yellow goal", YELLOW, goal_yellow.clone()),
-                    ("sky-blue goal", SKY_BLUE, goal_blue.clone()),
-                ],
-            ),
-        ),
-        (
-            "ball_distance_error.png",
-            histogram_chart(
-                "ball distance error",
-                "(measured - true) / true (%)",
-                &signed(&ball_all),
-                BALL,
-            ),
-        ),
-        (
-            "goal_distance_error.png",
-            histogram_chart(
-                "goal distance error",
-                "(measured - true) / true (%)",
-                &signed(&goal_all),
-                YELLOW,
-            ),
-        ),
-        (
-            "ball_detection.png",
-            rate_chart(
-                "ball found, per distance band (eligible frames)",
-                &ball_rates,
-                50.0,
-                BALL,
-            ),
-        ),
-        (
-            "goal_detection.png",
-            rate_chart(
-                "goals found, per distance band (eligible goals)",
-                &goal_rates,
-                100.0,
-                YELLOW,
-            ),
-        ),
-        (
-            "post_error.png",
-            histogram_chart(
-                "post position error (worst of top and foot)",
-                "error (px)",
-                &posts,
-                SKY_BLUE,
-            ),
-        ),
-    ];
+    let charts = EvalSeries::from_frames(frames).charts();
     let mut written = Vec::new();
     for (name, chart) in &charts {
         let path = dir.join(name);
@@ -533,6 +431,142 @@ pub fn write_eval_plots(dir: &Path, frames: &[FrameEval]) -> io::Result<Vec<Path
         written.push(path);
     }
     Ok(written)
+}
+
+/// The series the evaluation's charts draw, gathered from its frames.
+#[derive(Default)]
+struct EvalSeries {
+    /// (true, measured) distance of each matched ball not cut by the image edge, cm.
+    ball_uncut: Vec<(f64, f64)>,
+    /// ... and of each cut one, cm.
+    ball_cut: Vec<(f64, f64)>,
+    /// (true distance cm, found) of each eligible ball.
+    ball_rates: Vec<(f64, bool)>,
+    /// (true, measured) distance of each uncut yellow goal, cm.
+    goal_yellow: Vec<(f64, f64)>,
+    /// ... and of each sky-blue one, cm.
+    goal_blue: Vec<(f64, f64)>,
+    /// (true distance cm, found) of each eligible goal.
+    goal_rates: Vec<(f64, bool)>,
+    /// Post position errors, pixels.
+    posts: Vec<f64>,
+}
+
+impl EvalSeries {
+    fn from_frames(frames: &[FrameEval]) -> Self {
+        let mut s = Self::default();
+        for f in frames {
+            if let Some((t, m)) = f.ball_distances_cm {
+                if f.ball_cut {
+                    s.ball_cut.push((t, m));
+                } else {
+                    s.ball_uncut.push((t, m));
+                }
+            }
+            if let Some(t) = f.ball_true_distance_cm.filter(|_| f.ball_eligible) {
+                s.ball_rates.push((t, f.ball_correct));
+            }
+            for g in &f.goal_distances_cm {
+                if g.sky_blue {
+                    s.goal_blue.push((g.true_cm, g.measured_cm));
+                } else {
+                    s.goal_yellow.push((g.true_cm, g.measured_cm));
+                }
+            }
+            s.goal_rates.extend(f.goal_detections.iter().copied());
+            s.posts.extend(f.post_errors_px.iter().copied());
+        }
+        s
+    }
+
+    /// Each chart with its file name.
+    fn charts(&self) -> [(&'static str, Chart); 7] {
+        let signed = |pts: &[(f64, f64)]| -> Vec<f64> {
+            pts.iter()
+                .filter(|p| p.0 > 0.0)
+                .map(|p| 100.0 * (p.1 - p.0) / p.0)
+                .collect()
+        };
+        let ball_all: Vec<(f64, f64)> = self
+            .ball_uncut
+            .iter()
+            .chain(&self.ball_cut)
+            .copied()
+            .collect();
+        let goal_all: Vec<(f64, f64)> = self
+            .goal_yellow
+            .iter()
+            .chain(&self.goal_blue)
+            .copied()
+            .collect();
+        [
+            (
+                "ball_distance.png",
+                distance_chart(
+                    "ball: measured against true distance",
+                    &[
+                        ("whole ball", BALL, self.ball_uncut.clone()),
+                        ("cut off by the image edge", BALL_CUT, self.ball_cut.clone()),
+                    ],
+                ),
+            ),
+            (
+                "goal_distance.png",
+                distance_chart(
+                    "goals (uncut): measured against true distance",
+                    &[
+                        ("yellow goal", YELLOW, self.goal_yellow.clone()),
+                        ("sky-blue goal", SKY_BLUE, self.goal_blue.clone()),
+                    ],
+                ),
+            ),
+            (
+                "ball_distance_error.png",
+                histogram_chart(
+                    "ball distance error",
+                    "(measured - true) / true (%)",
+                    &signed(&ball_all),
+                    BALL,
+                ),
+            ),
+            (
+                "goal_distance_error.png",
+                histogram_chart(
+                    "goal distance error",
+                    "(measured - true) / true (%)",
+                    &signed(&goal_all),
+                    YELLOW,
+                ),
+            ),
+            (
+                "ball_detection.png",
+                rate_chart(
+                    "ball found, per distance band (eligible frames)",
+                    &self.ball_rates,
+                    50.0,
+                    BALL,
+                ),
+            ),
+            (
+                "goal_detection.png",
+                rate_chart(
+                    "goals found, per distance band (eligible goals)",
+                    &self.goal_rates,
+                    100.0,
+                    YELLOW,
+                ),
+            ),
+            (
+                "post_error.png",
+                histogram_chart(
+                    "post position error (worst of top and foot)",
+                    "error (px)",
+                    &self.posts,
+                    SKY_BLUE,
+                ),
+            ),
+        ]
+    }
 }
 
 /// Draws a size → distance calibration: the samples (height px, true distance cm), the fitted

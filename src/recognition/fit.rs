@@ -199,24 +199,54 @@ pub fn fit_sheared_circle(
         return None;
     }
     let start = fit_circle(points)?;
-    let s: Vec<f64> = rows.iter().map(|r| r - reference_row).collect();
-    // Parameters: cx, cy, r, a (shear_x), b (shear_y).
-    let mut q = [start.center_x, start.center_y, start.radius, 0.0, 0.0];
-    let cost = |q: &[f64; 5]| -> f64 {
-        points
+    let problem = ShearedCircle {
+        points,
+        lines_after_reference: rows.iter().map(|r| r - reference_row).collect(),
+        vertical_shear,
+    };
+    let (q, cost) = problem.refine([start.center_x, start.center_y, start.radius, 0.0, 0.0]);
+    if !(q.iter().all(|v| v.is_finite()) && q[2] > 0.0) {
+        return None;
+    }
+    Some(problem.result(&q, cost))
+}
+
+/// The sheared-circle least-squares problem of [`fit_sheared_circle`]. Its parameters `q` are
+/// the centre x and y, the radius (pixels) and the horizontal and vertical shear (pixels per
+/// line).
+struct ShearedCircle<'a> {
+    points: &'a [Point],
+    /// Per point, lines read after the reference row (negative: before).
+    lines_after_reference: Vec<f64>,
+    /// Fit the vertical shear too (else it is held at zero).
+    vertical_shear: bool,
+}
+
+impl ShearedCircle<'_> {
+    /// A point moved back to the reference row's time, relative to the centre.
+    fn unsheared(q: &[f64; 5], p: Point, s: f64) -> (f64, f64) {
+        (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1])
+    }
+
+    /// Sum of squared geometric distances to the circle, pixels².
+    fn cost(&self, q: &[f64; 5]) -> f64 {
+        self.points
             .iter()
-            .zip(&s)
+            .zip(&self.lines_after_reference)
             .map(|(p, s)| {
-                let (ux, uy) = (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1]);
+                let (ux, uy) = Self::unsheared(q, *p, *s);
                 ((ux * ux + uy * uy).sqrt() - q[2]).powi(2)
             })
             .sum()
-    };
-    let normal = |q: &[f64; 5]| -> (Matrix5, Vector5) {
+    }
+
+    /// The normal equations JᵀJ and Jᵀr at `q`; without the vertical shear its equation
+    /// becomes "step = 0".
+    fn normal(&self, q: &[f64; 5]) -> (Matrix5, Vector5) {
         let mut jtj = Matrix5::zeros();
         let mut jtr = Vector5::zeros();
-        for (p, s) in points.iter().zip(&s) {
-            let (ux, uy) = (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1]);
+        for (p, s) in self.points.iter().zip(&self.lines_after_reference) {
+            let (ux, uy) = Self::unsheared(q, *p, *s);
             let d = (ux * ux + uy * uy).sqrt();
             if d < 1e-12 {
                 continue;
@@ -226,8 +256,7 @@ pub fn fit_sheared_circle(
             jtr += j * (d - q[2]);
             jtj += j * j.transpose();
         }
-        if !vertical_shear {
-            // Hold the vertical shear: its equation becomes "step = 0".
+        if !self.vertical_shear {
             let keep = jtj[(2, 2)].max(1.0);
             jtj.row_mut(4).fill(0.0);
             jtj.column_mut(4).fill(0.0);
@@ -235,75 +264,73 @@ pub fn fit_sheared_circle(
             jtr[4] = 0.0;
         }
         (jtj, jtr)
-    };
-    let mut current = cost(&q);
-    let mut lambda = 1e-3;
-    for _ in 0..60 {
-        let (jtj, jtr) = normal(&q);
-        let mut damped = jtj;
-        for k in 0..5 {
-            damped[(k, k)] += lambda * jtj[(k, k)].max(1e-9);
-        }
-        let Some(step) = solve5(damped, &jtr) else {
-            break;
-        };
-        let mut next = q;
-        for (v, d) in next.iter_mut().zip(step.iter()) {
-            *v -= *d;
-        }
-        let c = cost(&next);
-        if c.is_finite() && c <= current {
-            let small = step.iter().all(|d| d.abs() < 1e-10);
-            q = next;
-            current = c;
-            lambda = (lambda * 0.3).max(1e-9);
-            if small {
-                break;
+    }
+
+    /// Damped Gauss–Newton (Levenberg–Marquardt) from `q`: the parameters and their cost.
+    fn refine(&self, mut q: [f64; 5]) -> ([f64; 5], f64) {
+        let mut current = self.cost(&q);
+        let mut lambda = 1e-3;
+        for _ in 0..60 {
+            let (jtj, jtr) = self.normal(&q);
+            let mut damped = jtj;
+            for k in 0..5 {
+                damped[(k, k)] += lambda * jtj[(k, k)].max(1e-9);
             }
-        } else {
-            lambda *= 10.0;
-            if lambda > 1e8 {
+            let Some(step) = solve5(damped, &jtr) else {
                 break;
+            };
+            let mut next = q;
+            for (v, d) in next.iter_mut().zip(step.iter()) {
+                *v -= *d;
             }
+            let c = self.cost(&next);
+            if c.is_finite() && c <= current {
+                let small = step.iter().all(|d| d.abs() < 1e-10);
+                q = next;
+                current = c;
+                lambda = (lambda * 0.3).max(1e-9);
+                if small {
+                    break;
+                }
+            } else {
+                lambda *= 10.0;
+                if lambda > 1e8 {
+                    break;
+                }
+            }
+        }
+        (q, current)
+    }
+
+    /// The fit at the converged `q` (of cost `cost`), with the shears' standard errors.
+    fn result(&self, q: &[f64; 5], cost: f64) -> ShearedCircleFit {
+        let n = self.points.len() as f64;
+        let (jtj, _) = self.normal(q);
+        let dof = (n - 5.0).max(1.0);
+        let sigma2 = cost / dof;
+        // Standard errors from the diagonal of (JᵀJ)⁻¹ σ²; a singular matrix (shear
+        // undetermined) gives infinite errors.
+        let inv_diag =
+            |k: usize| solve5(jtj, &Vector5::ith(k, 1.0)).map_or(f64::INFINITY, |x| x[k].abs());
+        let var = self.cost(q) / n;
+        ShearedCircleFit {
+            circle: CircleFit {
+                center_x: q[0],
+                center_y: q[1],
+                radius: q[2],
+                residual_sd: var.sqrt(),
+                points: self.points.len(),
+            },
+            shear_x: q[3],
+            shear_y: q[4],
+            shear_x_sd: (sigma2 * inv_diag(3)).sqrt(),
+            shear_y_sd: if self.vertical_shear {
+                (sigma2 * inv_diag(4)).sqrt()
+            } else {
+                0.0
+            },
         }
     }
-    if !(q.iter().all(|v| v.is_finite()) && q[2] > 0.0) {
-        return None;
-    }
-    let n = points.len() as f64;
-    let (jtj, _) = normal(&q);
-    let dof = (n - 5.0).max(1.0);
-    let sigma2 = current / dof;
-    // Standard errors from the diagonal of (JᵀJ)⁻¹ σ²; a singular matrix (shear undetermined)
-    // gives infinite errors.
-    let inv_diag =
-        |k: usize| solve5(jtj, &Vector5::ith(k, 1.0)).map_or(f64::INFINITY, |x| x[k].abs());
-    let var = points
-        .iter()
-        .zip(&s)
-        .map(|(p, s)| {
-            let (ux, uy) = (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1]);
-            ((ux * ux + uy * uy).sqrt() - q[2]).powi(2)
-        })
-        .sum::<f64>()
-        / n;
-    Some(ShearedCircleFit {
-        circle: CircleFit {
-            center_x: q[0],
-            center_y: q[1],
-            radius: q[2],
-            residual_sd: var.sqrt(),
-            points: points.len(),
-        },
-        shear_x: q[3],
-        shear_y: q[4],
-        shear_x_sd: (sigma2 * inv_diag(3)).sqrt(),
-        shear_y_sd: if vertical_shear {
-            (sigma2 * inv_diag(4)).sqrt()
-        } else {
-            0.0
-        },
-    })
 }
 
 type Matrix5 = SMatrix<f64, 5, 5>;

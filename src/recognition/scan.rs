@@ -209,7 +209,6 @@ pub fn edge_points_with_mixed(
     is_mixed: impl Fn(u8) -> bool,
     mode: MixedEdge,
 ) -> Vec<Point> {
-    let run = i64::from(run.max(1));
     let (w, h) = (img.width() as i64, img.height() as i64);
     let (minx, miny, maxx, maxy) = (
         i64::from(minx),
@@ -219,58 +218,15 @@ pub fn edge_points_with_mixed(
     );
     let margin = i64::from(margin);
     let mut points = Vec::new();
-    let is_obj = |x: i64, y: i64| img.get_signed(x, y).is_some_and(&is_object);
-    // Scans from `start` by `dir` until an object pixel; returns the boundary coordinate.
-    let scan = |fixed: i64, start: i64, end: i64, dir: i64, horizontal: bool| -> Option<f64> {
-        let start = if horizontal {
-            start.clamp(0, w - 1)
-        } else {
-            start.clamp(0, h - 1)
-        };
-        let at = |t: i64| {
-            if horizontal {
-                is_obj(t, fixed)
-            } else {
-                is_obj(fixed, t)
-            }
-        };
-        if (0..run).all(|k| at(start + k * dir)) {
-            return None;
-        }
-        let mixed_at = |t: i64| {
-            let code = if horizontal {
-                img.get_signed(t, fixed)
-            } else {
-                img.get_signed(fixed, t)
-            };
-            code.is_some_and(&is_mixed)
-        };
-        let mut t = start;
-        while (dir > 0 && t <= end) || (dir < 0 && t >= end) {
-            if (0..run).all(|k| at(t + k * dir)) {
-                // The pixel before the run: another chroma pair when the run starts at a pair's
-                // first pixel (scanning right) or ends at a pair's second (scanning left).
-                let before = t - dir;
-                let other_pair = before.div_euclid(2) != t.div_euclid(2);
-                let allowed = match mode {
-                    MixedEdge::Never => false,
-                    MixedEdge::ChromaPairs => !horizontal || other_pair,
-                    MixedEdge::Always => true,
-                };
-                let out = if allowed && mixed_at(before) {
-                    1.0
-                } else {
-                    0.0
-                };
-                return Some(if dir > 0 {
-                    t as f64 - out
-                } else {
-                    t as f64 + 1.0 + out
-                });
-            }
-            t += dir;
-        }
-        None
+    let scanner = EdgeScanner {
+        img,
+        run: i64::from(run.max(1)),
+        is_object,
+        is_mixed,
+        mode,
+    };
+    let scan = |fixed: i64, start: i64, end: i64, dir: i64, horizontal: bool| {
+        scanner.scan(fixed, start, end, dir, horizontal)
     };
     use EdgeScanPattern as P;
     let rows = matches!(pattern, P::LeftToRight | P::RightToLeft | P::SidesToCentre);
@@ -306,6 +262,71 @@ pub fn edge_points_with_mixed(
     // Points on the image border are where the object is cut, not its outline.
     points.retain(|p| p.0 > 0.0 && p.0 < w as f64 && p.1 > 0.0 && p.1 < h as f64);
     points
+}
+
+/// One scan line of [`edge_points_with_mixed`]: its image, settings and class tests.
+struct EdgeScanner<'a, O, M> {
+    img: &'a ClassifiedImage,
+    /// Object pixels in a row that make an edge (at least 1).
+    run: i64,
+    is_object: O,
+    is_mixed: M,
+    mode: MixedEdge,
+}
+
+impl<O: Fn(u8) -> bool, M: Fn(u8) -> bool> EdgeScanner<'_, O, M> {
+    /// The class code at `t` along the line (a row at y = `fixed` when `horizontal`, else a
+    /// column at x = `fixed`).
+    fn code(&self, fixed: i64, t: i64, horizontal: bool) -> Option<u8> {
+        if horizontal {
+            self.img.get_signed(t, fixed)
+        } else {
+            self.img.get_signed(fixed, t)
+        }
+    }
+
+    /// Scans from `start` (clamped into the image) by `dir` up to `end` until `run` object
+    /// pixels in a row; returns the boundary coordinate, one pixel farther out when the pixel
+    /// before the run is mixed and `mode` allows it. `None` when the line starts inside the
+    /// object or meets none.
+    fn scan(&self, fixed: i64, start: i64, end: i64, dir: i64, horizontal: bool) -> Option<f64> {
+        let (w, h) = (self.img.width() as i64, self.img.height() as i64);
+        let start = if horizontal {
+            start.clamp(0, w - 1)
+        } else {
+            start.clamp(0, h - 1)
+        };
+        let at = |t: i64| self.code(fixed, t, horizontal).is_some_and(&self.is_object);
+        if (0..self.run).all(|k| at(start + k * dir)) {
+            return None;
+        }
+        let mut t = start;
+        while (dir > 0 && t <= end) || (dir < 0 && t >= end) {
+            if (0..self.run).all(|k| at(t + k * dir)) {
+                // The pixel before the run: another chroma pair when the run starts at a pair's
+                // first pixel (scanning right) or ends at a pair's second (scanning left).
+                let before = t - dir;
+                let other_pair = before.div_euclid(2) != t.div_euclid(2);
+                let allowed = match self.mode {
+                    MixedEdge::Never => false,
+                    MixedEdge::ChromaPairs => !horizontal || other_pair,
+                    MixedEdge::Always => true,
+                };
+                let mixed = || {
+                    self.code(fixed, before, horizontal)
+                        .is_some_and(&self.is_mixed)
+                };
+                let out = if allowed && mixed() { 1.0 } else { 0.0 };
+                return Some(if dir > 0 {
+                    t as f64 - out
+                } else {
+                    t as f64 + 1.0 + out
+                });
+            }
+            t += dir;
+        }
+        None
+    }
 }
 
 /// Removes a rolling shutter's horizontal shear: row `y` was read `y − reference_row` lines after

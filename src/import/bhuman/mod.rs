@@ -78,6 +78,18 @@ use thiserror::Error;
 use crate::frame::Frame;
 use crate::sensors::SensorReadings;
 
+mod jpeg;
+mod records;
+#[cfg(test)]
+mod tests;
+
+pub use jpeg::{JpegImageError, decode_macropixels, macropixels_to_uyvy};
+use records::{
+    camera_matrix_json, head_at_image_times, image_coordinate_system_json, parse_joints,
+    parse_sensors, raw_json,
+};
+pub use records::{map_sensors, parse_camera_matrix};
+
 /// Message ids of B-Human 2009 (`MessageIDs.h`) that this reader uses.
 pub mod ids {
     /// A compressed camera image.
@@ -162,7 +174,28 @@ pub enum BhumanError {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        problem: String,
+        #[source]
+        problem: LogError,
+    },
+}
+
+/// Why a log's contents are unusable as a whole.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum LogError {
+    /// Fewer bytes than the 8-byte header.
+    #[error("{len} bytes is too short for a log header")]
+    TooShort {
+        /// The log's length, bytes.
+        len: usize,
+    },
+    /// The header is followed by no complete message.
+    #[error("no complete message after the header")]
+    NoMessage,
+    /// No image in the log could be decoded.
+    #[error("no decodable camera image in the log ({})", .warnings.join("; "))]
+    NoImage {
+        /// What was skipped, and why.
+        warnings: Vec<String>,
     },
 }
 
@@ -270,10 +303,9 @@ pub fn read_log(path: &Path) -> Result<BhumanLog, BhumanError> {
     if log.frames.is_empty() {
         return Err(BhumanError::Invalid {
             path: path.to_owned(),
-            problem: format!(
-                "no decodable camera image in the log ({})",
-                log.warnings.join("; ")
-            ),
+            problem: LogError::NoImage {
+                warnings: log.warnings,
+            },
         });
     }
     Ok(log)
@@ -286,10 +318,10 @@ struct Message<'a> {
 }
 
 /// Splits the log into messages; a cut-off tail becomes a warning.
-fn messages<'a>(bytes: &'a [u8], warnings: &mut Vec<String>) -> Result<Vec<Message<'a>>, String> {
+fn messages<'a>(bytes: &'a [u8], warnings: &mut Vec<String>) -> Result<Vec<Message<'a>>, LogError> {
     let header = bytes
         .get(..8)
-        .ok_or_else(|| format!("{} bytes is too short for a log header", bytes.len()))?;
+        .ok_or(LogError::TooShort { len: bytes.len() })?;
     let used = u32::from_le_bytes([header[0], header[1], header[2], header[3]]) as usize;
     let count = u32::from_le_bytes([header[4], header[5], header[6], header[7]]) as usize;
     if used + 8 != bytes.len() {
@@ -320,7 +352,7 @@ fn messages<'a>(bytes: &'a [u8], warnings: &mut Vec<String>) -> Result<Vec<Messa
         pos += 4 + size;
     }
     if out.is_empty() {
-        return Err("no complete message after the header".into());
+        return Err(LogError::NoMessage);
     }
     if out.len() != count {
         warnings.push(format!(
@@ -331,594 +363,145 @@ fn messages<'a>(bytes: &'a [u8], warnings: &mut Vec<String>) -> Result<Vec<Messa
     Ok(out)
 }
 
-fn le_u32(b: &[u8], at: usize) -> Option<u32> {
-    b.get(at..at + 4)
-        .map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
-}
-
-fn parse_joints(p: &[u8]) -> Option<JointRecord> {
-    if p.len() != 22 * 8 + 4 {
-        return None;
-    }
-    let mut angles = [0.0; 22];
-    for (i, a) in angles.iter_mut().enumerate() {
-        let s = p.get(i * 8..i * 8 + 8)?;
-        *a = f64::from_le_bytes(s.try_into().ok()?);
-    }
-    Some(JointRecord {
-        angles,
-        time_ms: le_u32(p, 176)?,
-    })
-}
-
-fn parse_sensors(p: &[u8]) -> Option<SensorRecord> {
-    if p.len() != 18 * 4 + 22 * 2 + 22 + 4 + 4 {
-        return None;
-    }
-    let mut data = [0.0f32; 18];
-    for (i, d) in data.iter_mut().enumerate() {
-        *d = f32::from_bits(le_u32(p, i * 4)?);
-    }
-    let mut currents = [0i16; 22];
-    for (i, c) in currents.iter_mut().enumerate() {
-        let s = p.get(72 + i * 2..74 + i * 2)?;
-        *c = i16::from_le_bytes([s[0], s[1]]);
-    }
-    let mut temperatures = [0u8; 22];
-    temperatures.copy_from_slice(p.get(116..138)?);
-    Some(SensorRecord {
-        data,
-        currents,
-        temperatures,
-        us_mode: i32::from_le_bytes(p.get(138..142)?.try_into().ok()?),
-        time_ms: le_u32(p, 142)?,
-    })
-}
-
-fn le_f64(b: &[u8], at: usize) -> Option<f64> {
-    Some(f64::from_le_bytes(b.get(at..at + 8)?.try_into().ok()?))
-}
-
-/// A CameraMatrix payload: 12 `f64` (rotation column by column, translation in mm) and
-/// `isValid` (the first byte after them; B-Human writes it as 4 bytes).
-#[must_use]
-pub fn parse_camera_matrix(p: &[u8]) -> Option<CameraMatrixRecord> {
-    if p.len() != 97 && p.len() != 100 {
-        return None;
-    }
-    let v = |i: usize| le_f64(p, i * 8);
-    let column = |c: usize| Some([v(3 * c)?, v(3 * c + 1)?, v(3 * c + 2)?]);
-    Some(CameraMatrixRecord {
-        rotation_columns: [column(0)?, column(1)?, column(2)?],
-        translation_mm: [v(9)?, v(10)?, v(11)?],
-        is_valid: *p.get(96)? != 0,
-    })
-}
-
-/// An ImageCoordinateSystem payload (160 bytes) as JSON: the offset to the previous image
-/// (rad, about z and y), the read-out factors a and b, and the camera info.
-fn image_coordinate_system_json(p: &[u8]) -> Option<serde_json::Value> {
-    if p.len() != 160 {
-        return None;
-    }
-    let f = |at: usize| le_f64(p, at);
-    let i = |at: usize| Some(i32::from_le_bytes(p.get(at..at + 4)?.try_into().ok()?));
-    Some(serde_json::json!({
-        "horizon_origin_px": [f(64)?, f(72)?],
-        "horizon_direction": [f(0)?, f(8)?],
-        "offset_rad": [f(80)?, f(88)?],
-        "a": f(96)?,
-        "b": f(104)?,
-        "resolution": [i(112)?, i(116)?],
-        "opening_angle_width_rad": f(120)?,
-        "opening_angle_height_rad": f(128)?,
-        "focal_length_px": f(136)?,
-        "optical_center_px": [f(144)?, f(152)?],
-    }))
-}
-
-fn camera_matrix_json(m: &CameraMatrixRecord) -> serde_json::Value {
-    serde_json::json!({
-        "rotation_columns": m.rotation_columns,
-        "translation_mm": m.translation_mm,
-        "is_valid": m.is_valid,
-    })
-}
-
-/// Decodes a JPEGImage payload's JPEG to B-Human's macropixels: `width × height` entries of
-/// `[Y0, Cb, Y1, Cr]` (zune-jpeg's CMYK output as it comes; see the module docs).
-///
-/// # Errors
-/// A message when the JPEG does not decode or is not 4-component at the given size.
-pub fn decode_macropixels(
-    jpeg: &[u8],
-    width: usize,
-    height: usize,
-) -> Result<Vec<[u8; 4]>, String> {
-    use zune_core::colorspace::ColorSpace;
-    use zune_core::options::DecoderOptions;
-    let options = DecoderOptions::default().jpeg_set_out_colorspace(ColorSpace::CMYK);
-    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(std::io::Cursor::new(jpeg), options);
-    decoder
-        .decode_headers()
-        .map_err(|e| format!("JPEG header: {e:?}"))?;
-    let info = decoder.info().ok_or("JPEG header gave no image size")?;
-    if (usize::from(info.width), usize::from(info.height)) != (width, height) {
-        return Err(format!(
-            "JPEG is {}×{}, the message says {width}×{height}",
-            info.width, info.height
-        ));
-    }
-    if decoder.input_colorspace() != Some(ColorSpace::CMYK) {
-        return Err(format!(
-            "JPEG colour space {:?}, expected 4 untransformed components",
-            decoder.input_colorspace()
-        ));
-    }
-    let mut out = vec![0u8; width * height * 4];
-    decoder
-        .decode_into(&mut out)
-        .map_err(|e| format!("JPEG data: {e:?}"))?;
-    Ok(out
-        .chunks_exact(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect())
-}
-
-/// Macropixels (`[Y0, Cb, Y1, Cr]`, `width` per row) → a UYVY frame of the same width: pixel
-/// *x* takes the mean luma of macropixel *x*; each pair shares the mean chroma of its two.
-///
-/// # Errors
-/// A message when the width is odd or the count does not match.
-pub fn macropixels_to_uyvy(mp: &[[u8; 4]], width: usize, height: usize) -> Result<Frame, String> {
-    if !width.is_multiple_of(2) || mp.len() != width * height {
-        return Err(format!(
-            "{} macropixels for {width}×{height} (the width must be even)",
-            mp.len()
-        ));
-    }
-    let mean =
-        |a: u8, b: u8| u8::try_from((u16::from(a) + u16::from(b)).div_ceil(2)).unwrap_or(u8::MAX);
-    let mut data = Vec::with_capacity(width * height * 2);
-    for pair in mp.chunks_exact(2) {
-        let (a, b) = (pair[0], pair[1]);
-        data.extend_from_slice(&[
-            mean(a[1], b[1]),
-            mean(a[0], a[2]),
-            mean(a[3], b[3]),
-            mean(b[0], b[2]),
-        ]);
-    }
-    Frame::from_uyvy(width, height, data).map_err(|e| e.to_string())
-}
-
-/// A reading B-Human marks as missing (1000 off, 2000 ignore) or non-finite → `None`.
-fn reading(v: f64) -> Option<f64> {
-    (v.is_finite() && v != 1000.0 && v != 2000.0).then_some(v)
-}
-
-/// Our sensor schema from B-Human's records (see the module docs for each mapping).
-#[must_use]
-pub fn map_sensors(joints: Option<&JointRecord>, sensors: Option<&SensorRecord>) -> SensorReadings {
-    let mut r = SensorReadings::default();
-    if let Some(j) = joints {
-        r.head_pan_rad = reading(j.angles[0]);
-        r.head_tilt_rad = reading(j.angles[1]);
-    }
-    if let Some(s) = sensors {
-        let d = |i: usize| reading(f64::from(s.data[i]));
-        r.accel_x_mps2 = d(3).map(|a| -a * G_MPS2);
-        r.accel_y_mps2 = d(4).map(|a| -a * G_MPS2);
-        r.accel_z_mps2 = d(5).map(|a| -a * G_MPS2);
-        r.battery_percent = d(6).filter(|b| (0.0..=1.0).contains(b)).map(|b| b * 100.0);
-        r.body_roll_rad = d(16);
-        r.body_pitch_rad = d(17);
-    }
-    r
-}
-
-fn raw_json(joints: Option<&JointRecord>, sensors: Option<&SensorRecord>) -> serde_json::Value {
-    let mut v = serde_json::Map::new();
-    if let Some(j) = joints {
-        let angles: serde_json::Map<String, serde_json::Value> = JOINT_NAMES
-            .iter()
-            .zip(j.angles)
-            .map(|(n, a)| ((*n).to_owned(), a.into()))
-            .collect();
-        v.insert("joint_time_ms".into(), j.time_ms.into());
-        v.insert("joint_angles_rad".into(), angles.into());
-    }
-    if let Some(s) = sensors {
-        let data: serde_json::Map<String, serde_json::Value> = SENSOR_NAMES
-            .iter()
-            .zip(s.data)
-            .map(|(n, d)| ((*n).to_owned(), f64::from(d).into()))
-            .collect();
-        v.insert("sensor_time_ms".into(), s.time_ms.into());
-        v.insert("sensors".into(), data.into());
-        v.insert("motor_currents".into(), s.currents.to_vec().into());
-        v.insert(
-            "motor_temperatures_c".into(),
-            s.temperatures.to_vec().into(),
-        );
-        v.insert("us_mode".into(), s.us_mode.into());
-    }
-    v.into()
-}
-
 /// Parses a whole log held in memory.
 ///
 /// # Errors
-/// A message when the header is missing or no message is complete; lesser damage (a cut-off
+/// [`LogError`] when the header is missing or no message is complete; lesser damage (a cut-off
 /// tail, a bad image, a malformed record) becomes a warning and the rest is kept.
-pub fn parse_log(bytes: &[u8]) -> Result<BhumanLog, String> {
-    let mut log = BhumanLog::default();
-    let msgs = messages(bytes, &mut log.warnings)?;
-    let mut joints: Option<JointRecord> = None;
-    let mut all_joints: Vec<JointRecord> = Vec::new();
-    let mut sensors: Option<SensorRecord> = None;
-    // The frame whose image was logged in the current process cycle (since the last
-    // ProcessBegin): the cycle's camera matrix and coordinate system belong to it.
-    let mut cycle_frame: Option<usize> = None;
-    for (index, m) in msgs.iter().enumerate() {
-        *log.message_counts.entry(m.id).or_default() += 1;
+pub fn parse_log(bytes: &[u8]) -> Result<BhumanLog, LogError> {
+    let mut reader = LogReader::default();
+    for (index, m) in messages(bytes, &mut reader.log.warnings)?
+        .iter()
+        .enumerate()
+    {
+        reader.message(index, m);
+    }
+    let LogReader {
+        mut log,
+        mut all_joints,
+        ..
+    } = reader;
+    head_at_image_times(&mut log.frames, &mut all_joints);
+    Ok(log)
+}
+
+/// The log read so far and the latest records, as the messages are read in order.
+#[derive(Default)]
+struct LogReader {
+    log: BhumanLog,
+    /// The latest JointData.
+    joints: Option<JointRecord>,
+    /// Every JointData, for the head angles at the image times.
+    all_joints: Vec<JointRecord>,
+    /// The latest SensorData.
+    sensors: Option<SensorRecord>,
+    /// The frame whose image was logged in the current process cycle (since the last
+    /// ProcessBegin): the cycle's camera matrix and coordinate system belong to it.
+    cycle_frame: Option<usize>,
+}
+
+impl LogReader {
+    /// Takes one message (number `index`) into the log.
+    fn message(&mut self, index: usize, m: &Message<'_>) {
+        *self.log.message_counts.entry(m.id).or_default() += 1;
         match m.id {
-            ids::PROCESS_BEGIN => cycle_frame = None,
-            ids::CAMERA_MATRIX => {
-                let frame = cycle_frame.and_then(|i| log.frames.get_mut(i));
-                match (parse_camera_matrix(m.payload), frame) {
-                    (Some(matrix), Some(frame)) if frame.camera_matrix.is_none() => {
-                        let pose = matrix.field_from_camera();
-                        if pose.is_none() {
-                            log.warnings.push(format!(
-                                "message {index}: CameraMatrix is not a rotation and a \
-                                 translation; kept raw only"
-                            ));
-                        }
-                        if let Some(pose) = pose.filter(|_| matrix.is_valid) {
-                            crate::geometry::write_camera_pose(&pose, &mut frame.sensors);
-                        }
-                        if let Some(obj) = frame.raw.as_object_mut() {
-                            obj.insert("camera_matrix".into(), camera_matrix_json(&matrix));
-                        }
-                        frame.camera_matrix = Some(matrix);
-                    }
-                    (None, _) => log.warnings.push(format!(
-                        "message {index}: CameraMatrix of {} bytes, expected 100; skipped",
-                        m.payload.len()
-                    )),
-                    (Some(_), _) => log.warnings.push(format!(
-                        "message {index}: CameraMatrix without an image of its own in its \
-                         cycle; skipped"
-                    )),
-                }
-            }
-            ids::IMAGE_COORDINATE_SYSTEM => {
-                let json = image_coordinate_system_json(m.payload);
-                let frame = cycle_frame.and_then(|i| log.frames.get_mut(i));
-                match (json, frame) {
-                    (Some(v), Some(frame)) => {
-                        if let Some(obj) = frame.raw.as_object_mut() {
-                            obj.insert("image_coordinate_system".into(), v);
-                        }
-                    }
-                    (None, _) => log.warnings.push(format!(
-                        "message {index}: ImageCoordinateSystem of {} bytes, expected 160; \
-                         skipped",
-                        m.payload.len()
-                    )),
-                    (Some(_), None) => log.warnings.push(format!(
-                        "message {index}: ImageCoordinateSystem without an image in its cycle; \
-                         skipped"
-                    )),
-                }
-            }
+            ids::PROCESS_BEGIN => self.cycle_frame = None,
+            ids::CAMERA_MATRIX => self.camera_matrix(index, m.payload),
+            ids::IMAGE_COORDINATE_SYSTEM => self.image_coordinate_system(index, m.payload),
             ids::JOINT_DATA => match parse_joints(m.payload) {
                 Some(j) => {
-                    all_joints.push(j.clone());
-                    joints = Some(j);
+                    self.all_joints.push(j.clone());
+                    self.joints = Some(j);
                 }
-                None => log.warnings.push(format!(
+                None => self.log.warnings.push(format!(
                     "message {index}: JointData of {} bytes, expected 180; skipped",
                     m.payload.len()
                 )),
             },
             ids::SENSOR_DATA => match parse_sensors(m.payload) {
-                Some(s) => sensors = Some(s),
-                None => log.warnings.push(format!(
+                Some(s) => self.sensors = Some(s),
+                None => self.log.warnings.push(format!(
                     "message {index}: SensorData of {} bytes, expected 146; skipped",
                     m.payload.len()
                 )),
             },
-            ids::JPEG_IMAGE => match image(m.payload) {
-                Ok((time_ms, frame)) => {
-                    let s = map_sensors(joints.as_ref(), sensors.as_ref());
-                    let mut raw = raw_json(joints.as_ref(), sensors.as_ref());
-                    if let Some(obj) = raw.as_object_mut() {
-                        obj.insert("image_time_ms".into(), time_ms.into());
-                    }
-                    cycle_frame = Some(log.frames.len());
-                    log.frames.push(BhumanFrame {
-                        time_ms,
-                        frame,
-                        sensors: s,
-                        camera_matrix: None,
-                        raw,
-                    });
-                }
-                Err(problem) => log
-                    .warnings
-                    .push(format!("message {index}: JPEGImage skipped: {problem}")),
-            },
+            ids::JPEG_IMAGE => self.jpeg_image(index, m.payload),
             _ => {}
         }
     }
-    head_at_image_times(&mut log.frames, &mut all_joints);
-    Ok(log)
-}
 
-/// Head pan and tilt (B-Human's `headPan`, `headTilt`) at time `t_ms`, interpolated between the
-/// joint records around it (`joints` sorted by time), and the two records' times; the nearest
-/// record's angles outside their span. `None` without a usable record.
-fn head_at(joints: &[JointRecord], t_ms: u32) -> Option<((f64, f64), [u32; 2])> {
-    let usable: Vec<&JointRecord> = joints
-        .iter()
-        .filter(|j| reading(j.angles[0]).is_some() && reading(j.angles[1]).is_some())
-        .collect();
-    let after = usable.partition_point(|j| j.time_ms <= t_ms);
-    let (a, b) = match (
-        after.checked_sub(1).and_then(|i| usable.get(i)),
-        usable.get(after),
-    ) {
-        (Some(a), Some(b)) => (*a, *b),
-        (Some(a), None) => (*a, *a),
-        (None, Some(b)) => (*b, *b),
-        (None, None) => return None,
-    };
-    let span = f64::from(b.time_ms.saturating_sub(a.time_ms));
-    let f = if span > 0.0 {
-        (f64::from(t_ms.saturating_sub(a.time_ms)) / span).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let lerp = |i: usize| a.angles[i] + f * (b.angles[i] - a.angles[i]);
-    Some(((lerp(0), lerp(1)), [a.time_ms, b.time_ms]))
-}
-
-/// Sets each frame's head pan and tilt to their values at its image's time, interpolated
-/// between the joint records logged around it (the log keeps about 8 of them per second, taken
-/// up to ±180 ms from its images, so the last one before an image may be far from it, or even
-/// the same record as the previous image's), and the previous frame's as the previous values,
-/// with the time between the images as the interval.
-fn head_at_image_times(frames: &mut [BhumanFrame], joints: &mut [JointRecord]) {
-    joints.sort_by_key(|j| j.time_ms);
-    let mut previous: Option<(u32, SensorReadings)> = None;
-    for f in frames.iter_mut() {
-        if let Some(((pan, tilt), [ta, tb])) = head_at(joints, f.time_ms) {
-            f.sensors.head_pan_rad = Some(pan);
-            f.sensors.head_tilt_rad = Some(tilt);
-            if let Some(obj) = f.raw.as_object_mut() {
-                obj.insert("head_interpolated_between_ms".into(), vec![ta, tb].into());
+    /// A CameraMatrix: the pose of the cycle's image (its camera pose when valid).
+    fn camera_matrix(&mut self, index: usize, payload: &[u8]) {
+        let frame = self.cycle_frame.and_then(|i| self.log.frames.get_mut(i));
+        match (parse_camera_matrix(payload), frame) {
+            (Some(matrix), Some(frame)) if frame.camera_matrix.is_none() => {
+                let pose = matrix.field_from_camera();
+                if pose.is_none() {
+                    self.log.warnings.push(format!(
+                        "message {index}: CameraMatrix is not a rotation and a translation; \
+                         kept raw only"
+                    ));
+                }
+                if let Some(pose) = pose.filter(|_| matrix.is_valid) {
+                    crate::geometry::write_camera_pose(&pose, &mut frame.sensors);
+                }
+                if let Some(obj) = frame.raw.as_object_mut() {
+                    obj.insert("camera_matrix".into(), camera_matrix_json(&matrix));
+                }
+                frame.camera_matrix = Some(matrix);
             }
+            (None, _) => self.log.warnings.push(format!(
+                "message {index}: CameraMatrix of {} bytes, expected 100; skipped",
+                payload.len()
+            )),
+            (Some(_), _) => self.log.warnings.push(format!(
+                "message {index}: CameraMatrix without an image of its own in its cycle; skipped"
+            )),
         }
-        if let Some((t0, prev)) = &previous {
-            f.sensors.previous_head_pan_rad = prev.head_pan_rad;
-            f.sensors.previous_head_tilt_rad = prev.head_tilt_rad;
-            f.sensors.frame_interval_s =
-                (f.time_ms > *t0).then(|| f64::from(f.time_ms - t0) / 1000.0);
+    }
+
+    /// An ImageCoordinateSystem: kept raw with the cycle's image.
+    fn image_coordinate_system(&mut self, index: usize, payload: &[u8]) {
+        let json = image_coordinate_system_json(payload);
+        let frame = self.cycle_frame.and_then(|i| self.log.frames.get_mut(i));
+        match (json, frame) {
+            (Some(v), Some(frame)) => {
+                if let Some(obj) = frame.raw.as_object_mut() {
+                    obj.insert("image_coordinate_system".into(), v);
+                }
+            }
+            (None, _) => self.log.warnings.push(format!(
+                "message {index}: ImageCoordinateSystem of {} bytes, expected 160; skipped",
+                payload.len()
+            )),
+            (Some(_), None) => self.log.warnings.push(format!(
+                "message {index}: ImageCoordinateSystem without an image in its cycle; skipped"
+            )),
         }
-        previous = Some((f.time_ms, f.sensors));
-    }
-}
-
-/// Decodes a JPEGImage payload to its time and frame.
-fn image(p: &[u8]) -> Result<(u32, Frame), String> {
-    let field = |at: usize| le_u32(p, at).ok_or("payload shorter than its 16-byte header");
-    let (w, h, time_ms, len) = (field(0)?, field(4)?, field(8)?, field(12)? as usize);
-    let (w, h) = (w as usize, h as usize);
-    if !(2..=4096).contains(&w) || !(1..=4096).contains(&h) {
-        return Err(format!("image size {w}×{h} is not plausible"));
-    }
-    let jpeg = p
-        .get(16..16 + len)
-        .ok_or_else(|| format!("JPEG of {len} bytes, the payload has {}", p.len() - 16))?;
-    let mp = decode_macropixels(jpeg, w, h)?;
-    Ok((time_ms, macropixels_to_uyvy(&mp, w, h)?))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn macropixels_become_uyvy_with_mean_luma_and_shared_chroma() {
-        let mp = [[10, 100, 20, 200], [30, 110, 41, 210]];
-        let f = macropixels_to_uyvy(&mp, 2, 1).unwrap();
-        assert_eq!(f.data(), &[105, 15, 205, 36]);
-        assert!(macropixels_to_uyvy(&mp, 3, 1).is_err());
     }
 
-    #[test]
-    fn sensors_map_with_signs_units_and_missing_values() {
-        let mut angles = [0.0; 22];
-        angles[0] = 0.3;
-        angles[1] = 0.4;
-        let j = JointRecord { angles, time_ms: 5 };
-        let mut data = [0.0f32; 18];
-        data[5] = -1.0;
-        data[6] = 0.5;
-        data[16] = 1000.0;
-        data[17] = 0.1;
-        let s = SensorRecord {
-            data,
-            currents: [0; 22],
-            temperatures: [0; 22],
-            us_mode: 0,
-            time_ms: 5,
-        };
-        let r = map_sensors(Some(&j), Some(&s));
-        assert_eq!(r.head_pan_rad, Some(0.3));
-        assert_eq!(r.head_tilt_rad, Some(0.4));
-        assert!((r.accel_z_mps2.unwrap() - G_MPS2).abs() < 1e-9);
-        assert_eq!(r.battery_percent, Some(50.0));
-        assert_eq!(r.body_roll_rad, None);
-        assert!((r.body_pitch_rad.unwrap() - 0.1).abs() < 1e-6);
-        assert_eq!(r.neck_tilt_rad, None);
-        assert_eq!(map_sensors(None, None), SensorReadings::default());
-    }
-
-    #[test]
-    fn damaged_logs_are_errors_or_warnings() {
-        assert!(parse_log(&[1, 2, 3]).unwrap_err().contains("too short"));
-        // Header + one complete JointData + a cut-off message.
-        let mut b = Vec::new();
-        b.extend_from_slice(&0u32.to_le_bytes());
-        b.extend_from_slice(&2u32.to_le_bytes());
-        b.extend_from_slice(&[ids::JOINT_DATA, 180, 0, 0]);
-        b.extend_from_slice(&[0u8; 180]);
-        b.extend_from_slice(&[ids::JPEG_IMAGE, 100, 0, 0, 1, 2]);
-        let log = parse_log(&b).unwrap();
-        assert!(log.frames.is_empty());
-        assert_eq!(log.message_counts.get(&ids::JOINT_DATA), Some(&1));
-        assert!(
-            log.warnings.iter().any(|w| w.contains("cut off")),
-            "{:?}",
-            log.warnings
-        );
-        // A JPEGImage whose JPEG is garbage is skipped with a warning.
-        let mut b = Vec::new();
-        b.extend_from_slice(&0u32.to_le_bytes());
-        b.extend_from_slice(&1u32.to_le_bytes());
-        let mut p = Vec::new();
-        for v in [320u32, 240, 7, 4] {
-            p.extend_from_slice(&v.to_le_bytes());
+    /// A JPEGImage: a new frame with the latest joint and sensor readings.
+    fn jpeg_image(&mut self, index: usize, payload: &[u8]) {
+        match jpeg::image(payload) {
+            Ok((time_ms, frame)) => {
+                let sensors = map_sensors(self.joints.as_ref(), self.sensors.as_ref());
+                let mut raw = raw_json(self.joints.as_ref(), self.sensors.as_ref());
+                if let Some(obj) = raw.as_object_mut() {
+                    obj.insert("image_time_ms".into(), time_ms.into());
+                }
+                self.cycle_frame = Some(self.log.frames.len());
+                self.log.frames.push(BhumanFrame {
+                    time_ms,
+                    frame,
+                    sensors,
+                    camera_matrix: None,
+                    raw,
+                });
+            }
+            Err(problem) => self
+                .log
+                .warnings
+                .push(format!("message {index}: JPEGImage skipped: {problem}")),
         }
-        p.extend_from_slice(&[0xff, 0xd8, 0, 0]);
-        b.extend_from_slice(&[ids::JPEG_IMAGE, p.len() as u8, 0, 0]);
-        b.extend_from_slice(&p);
-        let log = parse_log(&b).unwrap();
-        assert!(log.frames.is_empty());
-        assert!(
-            log.warnings.iter().any(|w| w.contains("JPEGImage skipped")),
-            "{:?}",
-            log.warnings
-        );
-    }
-
-    fn camera_matrix_payload(columns: [[f64; 3]; 3], t: [f64; 3], valid: bool) -> Vec<u8> {
-        let mut p = Vec::new();
-        for v in columns.iter().flatten().chain(t.iter()) {
-            p.extend_from_slice(&v.to_le_bytes());
-        }
-        p.extend_from_slice(&u32::from(valid).to_le_bytes());
-        p
-    }
-
-    #[test]
-    fn camera_matrix_parses_column_by_column_into_a_pose_in_centimetres() {
-        // Looking 13° down, 48.5 cm up, 5.6 cm ahead of the feet (frame 0 of the log).
-        let (s, c) = 13.0_f64.to_radians().sin_cos();
-        let columns = [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]];
-        let p = camera_matrix_payload(columns, [56.0, 4.0, 485.0], true);
-        assert_eq!(p.len(), 100);
-        let m = parse_camera_matrix(&p).expect("parses");
-        assert!(m.is_valid);
-        assert_eq!(m.rotation_columns, columns);
-        let pose = m.field_from_camera().expect("a rotation");
-        let o = pose.origin();
-        assert!((o.z() - 48.5).abs() < 1e-9 && (o.x() - 5.6).abs() < 1e-9);
-        let axis = pose * crate::geometry::Vector::<crate::geometry::Camera>::new(1.0, 0.0, 0.0);
-        assert!((axis.coords.z + s).abs() < 1e-9, "{axis:?}");
-        let mut r = SensorReadings::default();
-        crate::geometry::write_camera_pose(&pose, &mut r);
-        assert!((r.camera_pitch_rad.expect("pitch") - 13.0_f64.to_radians()).abs() < 1e-9);
-        assert!(r.camera_yaw_rad.expect("yaw").abs() < 1e-9);
-        assert!(
-            !parse_camera_matrix(&camera_matrix_payload(columns, [0.0; 3], false))
-                .expect("parses")
-                .is_valid
-        );
-        // Wrong sizes and non-rotations are refused.
-        assert!(parse_camera_matrix(&p[..96]).is_none());
-        let skewed = [[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let bad = parse_camera_matrix(&camera_matrix_payload(skewed, [0.0; 3], true));
-        assert!(bad.expect("parses").field_from_camera().is_none());
-        let nan = [[f64::NAN, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let bad = parse_camera_matrix(&camera_matrix_payload(nan, [0.0; 3], true));
-        assert!(bad.expect("parses").field_from_camera().is_none());
-    }
-
-    #[test]
-    fn a_camera_matrix_outside_an_image_cycle_is_a_warning() {
-        let columns = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let p = camera_matrix_payload(columns, [0.0, 0.0, 480.0], true);
-        let mut b = Vec::new();
-        b.extend_from_slice(&0u32.to_le_bytes());
-        b.extend_from_slice(&3u32.to_le_bytes());
-        b.extend_from_slice(&[ids::PROCESS_BEGIN, 1, 0, 0, 0]);
-        b.extend_from_slice(&[ids::CAMERA_MATRIX, p.len() as u8, 0, 0]);
-        b.extend_from_slice(&p);
-        b.extend_from_slice(&[ids::CAMERA_MATRIX, 3, 0, 0, 1, 2, 3]);
-        let log = parse_log(&b).expect("parses");
-        assert!(
-            log.warnings
-                .iter()
-                .any(|w| w.contains("without an image of its own")),
-            "{:?}",
-            log.warnings
-        );
-        assert!(
-            log.warnings.iter().any(|w| w.contains("expected 100")),
-            "{:?}",
-            log.warnings
-        );
-    }
-
-    #[test]
-    fn head_angles_are_interpolated_at_the_image_time() {
-        let record = |time_ms: u32, pan: f64, tilt: f64| {
-            let mut angles = [0.0; 22];
-            angles[0] = pan;
-            angles[1] = tilt;
-            JointRecord { angles, time_ms }
-        };
-        let mut joints = vec![
-            record(300, 0.4, -0.2),
-            record(100, 0.0, 0.0),
-            record(200, 1000.0, 1000.0),
-        ];
-        joints.sort_by_key(|j| j.time_ms);
-        // The record marked "off" (1000) is passed over: 250 ms lies three quarters of the way
-        // from 100 to 300 ms.
-        let ((pan, tilt), span) = head_at(&joints, 250).expect("records");
-        assert_eq!(span, [100, 300]);
-        assert!(
-            (pan - 0.3).abs() < 1e-12 && (tilt + 0.15).abs() < 1e-12,
-            "{pan} {tilt}"
-        );
-        // Outside the records' span: the nearest one.
-        assert_eq!(head_at(&joints, 50).map(|h| h.0), Some((0.0, 0.0)));
-        assert_eq!(head_at(&joints, 900).map(|h| h.0), Some((0.4, -0.2)));
-        assert_eq!(head_at(&[], 100), None);
-        // Frames get those values, the previous frame's as previous, the image interval.
-        let frame = |time_ms: u32| BhumanFrame {
-            time_ms,
-            frame: Frame::from_uyvy(2, 1, vec![128, 16, 128, 16]).expect("frame"),
-            sensors: SensorReadings::default(),
-            camera_matrix: None,
-            raw: serde_json::json!({}),
-        };
-        let mut frames = vec![frame(150), frame(250)];
-        head_at_image_times(&mut frames, &mut joints);
-        let s = frames[1].sensors;
-        assert_eq!(s.previous_head_pan_rad, frames[0].sensors.head_pan_rad);
-        assert!((s.frame_interval_s.expect("interval") - 0.1).abs() < 1e-12);
-        assert!((s.head_pan_rad.expect("pan") - 0.3).abs() < 1e-12);
-        assert!((frames[0].sensors.head_pan_rad.expect("pan") - 0.1).abs() < 1e-12);
-        assert_eq!(frames[0].sensors.frame_interval_s, None);
-        assert_eq!(
-            frames[1].raw["head_interpolated_between_ms"],
-            serde_json::json!([100, 300])
-        );
     }
 }

@@ -226,9 +226,7 @@ fn placement_tests(
     distance: f64,
     body: Option<&Relative>,
 ) {
-    let (cut, e_all, height_px, bottom_mid) =
-        (shape.cut, shape.e_all, shape.height_px, shape.bottom_mid);
-    let angle = ctx.horizon_angle();
+    let cut = shape.cut;
     // A sliver cut off on three or four sides that does not fill the image shows too
     // little of itself to be identified.
     let cut_sides = [cut.left, cut.right, cut.top, cut.bottom]
@@ -241,6 +239,21 @@ fn placement_tests(
         [0.0, p.max_cut_sides],
         TestWeight::new(0.0, p.cut_sides_penalty),
     );
+    ground_tests(confidence, img, ctx, p, shape);
+    distance_tests(confidence, ctx, p, shape, distance, body);
+}
+
+/// Green (or a white line) in a band below the candidate, and in a thinner band at its foot.
+fn ground_tests(
+    confidence: &mut Confidence,
+    img: &ClassifiedImage,
+    ctx: &ViewContext,
+    p: &GoalParams,
+    shape: &LevelShape,
+) {
+    let (cut, e_all, height_px, bottom_mid) =
+        (shape.cut, shape.e_all, shape.height_px, shape.bottom_mid);
+    let angle = ctx.horizon_angle();
     let half_w = (e_all[2] - e_all[0]) / 2.0;
     let band = (height_px * 0.3).max(2.0);
     let below = scan_rotated_rect(
@@ -276,6 +289,19 @@ fn placement_tests(
         ),
         _ => confidence.skipped(TestName::GroundAtFoot, p.ground_at_foot),
     }
+}
+
+/// The foot's height above the ground at `distance` (cm), the real width, the size distance
+/// against the foot's ground distance, and the elevation.
+fn distance_tests(
+    confidence: &mut Confidence,
+    ctx: &ViewContext,
+    p: &GoalParams,
+    shape: &LevelShape,
+    distance: f64,
+    body: Option<&Relative>,
+) {
+    let (cut, e_all, bottom_mid) = (shape.cut, shape.e_all, shape.bottom_mid);
     if cut.bottom {
         confidence.skipped(TestName::BottomHeightCm, p.bottom_height_cm);
     } else {

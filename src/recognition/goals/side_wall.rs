@@ -3,7 +3,7 @@
 
 use crate::classify::ClassifiedImage;
 use crate::lut::ColourClass;
-use crate::recognition::fit::{Point, fit_line};
+use crate::recognition::fit::{LineFit, Point, fit_line};
 
 /// How much higher (sample rows) the foot of a side wall seen from outside must be at the
 /// outline, and just beyond the wall's front corner, than at the corner. One row is the
@@ -89,102 +89,198 @@ pub(super) fn front_corner(
     (centre, angle): (Point, f64),
 ) -> Option<SideWall> {
     let line = fit_line(outline).filter(|f| f.steep)?;
-    let edge_x = |y: f64| line.at(y).0;
-    // Level frame → image: `rotate_about` by −angle with its sine and cosine taken once.
-    let (sin, cos) = (-angle).sin_cos();
-    let code_at = |x: f64, y: f64| {
-        let (dx, dy) = (x - centre.0, y - centre.1);
-        let q = (
-            centre.0 + cos * dx - sin * dy,
-            centre.1 + sin * dx + cos * dy,
-        );
-        img.get_at(q.0, q.1)
-    };
-    let goal_at = |x: f64, y: f64| code_at(x, y).is_some_and(is_goal);
-    let ground = |c: Option<u8>| {
-        c.is_some_and(|c| c == ColourClass::Green.code() || c == ColourClass::White.code())
-    };
     let height = e[3] - e[1];
     if !(height.is_finite() && height > 0.0 && e[2] > e[0]) {
         return None;
     }
-    let rows = (height / 2.0).ceil() as usize;
+    // Level frame → image: `rotate_about` by −angle with its sine and cosine taken once.
+    let (sin, cos) = (-angle).sin_cos();
+    let side = SideColumns {
+        img,
+        is_goal,
+        line,
+        dir,
+        centre,
+        sin,
+        cos,
+        extent: e,
+        rows: (height / 2.0).ceil() as usize,
+    };
     let columns = (e[2] - e[0]).floor() as usize;
     // The corner lies in the near half of the goal (anywhere across it when the other side is
     // cut off) and no farther inside than the goal is tall: a side wall shows at most its
     // depth, and the 2005 goals' walls are as deep as they are tall (30 cm).
     let search = if far_side_cut { columns } else { columns / 2 }.min(height.ceil() as usize);
-    // Sample row i counted from below the extent's bottom (feet) and from above its top (tops).
-    let foot_y = |i: usize| e[3] + 0.5 - i as f64;
-    let top_y = |i: usize| e[1] - 0.5 + i as f64;
-    let column_x = |k: usize, y: f64| edge_x(y) + dir * (k as f64 + 0.5);
-    let foot_of = |k: usize| (0..rows).find(|&i| goal_at(column_x(k, foot_y(i)), foot_y(i)));
     // Seen from in front, the outline's foot is the lowest already (most goals): done.
-    if (0..2).filter_map(foot_of).max()? < FOOT_STEP_ROWS {
+    if (0..2).filter_map(|k| side.foot_of(k)).max()? < FOOT_STEP_ROWS {
         return None;
     }
     // Per column: the sample row of its lowest goal sample (smaller = farther out); the tops
     // are looked at only once the feet show a corner.
-    let feet: Vec<Option<usize>> = (0..columns.min(search + 4)).map(foot_of).collect();
-    let foot = |k: usize| feet.get(k).copied().flatten();
-    // The lowest foot: its first column from the outline and the end of its plateau.
-    let (k0, lowest) = (0..search)
-        .filter_map(|k| foot(k).map(|f| (k, f)))
-        .min_by_key(|&(k, f)| (f, k))?;
-    let foot_at_edge = (0..2).filter_map(foot).max()?;
-    if k0 < MIN_WALL_COLUMNS
-        || (0..k0).any(|k| foot(k).is_none())
-        || foot_at_edge < lowest + FOOT_STEP_ROWS
-    {
+    let feet: Vec<Option<usize>> = (0..columns.min(search + 4))
+        .map(|k| side.foot_of(k))
+        .collect();
+    let slope = FootSlope::find(&feet, search)?;
+    if !side.back_wall_beyond(&feet, slope) || !side.carpet_under(&feet, slope.k0) {
         return None;
     }
-    let k1 = plateau_end(&foot, k0, lowest);
-    // Beyond the corner the foot jumps up (after at most one column between) and stays up: the
-    // back wall's bottom. On a goal seen from in front the feet go on down towards a nearer
-    // post instead. Outside the image nothing is known.
-    let yf = foot_y(lowest);
-    let up = |k: usize, step: usize| {
-        k < feet.len()
-            && code_at(column_x(k, yf), yf).is_some()
-            && foot(k).is_none_or(|f| f >= lowest + step)
-    };
-    let jumps = up(k1 + 1, 1)
-        && up(k1 + 2, 1)
-        && (up(k1 + 1, FOOT_STEP_ROWS) || up(k1 + 2, FOOT_STEP_ROWS));
-    if !jumps || !(1..=3).any(|d| ground(code_at(column_x(k1 + d, yf), yf))) {
-        return None;
+    let foot_corner = side.crossing(slope.k1, side.foot_y(slope.lowest));
+    let top = side.top_corner(feet.len(), slope, foot_corner)?;
+    Some(SideWall {
+        foot: foot_corner,
+        top,
+    })
+}
+
+/// One side of a goal in the level frame, sampled in columns parallel to its outline, one
+/// pixel apart, and in rows counted from below the extent's bottom (feet) or from above its top
+/// (tops).
+struct SideColumns<'a, G: Fn(u8) -> bool> {
+    img: &'a ClassifiedImage,
+    is_goal: &'a G,
+    /// The outline's line, level frame.
+    line: LineFit,
+    /// +1 for the left side (inward is +x), −1 for the right.
+    dir: f64,
+    /// The level frame's centre in the image, pixels.
+    centre: Point,
+    /// Sine and cosine of the level frame → image rotation.
+    sin: f64,
+    cos: f64,
+    /// The goal's extent, level frame: min x, min y, max x, max y, pixels.
+    extent: [f64; 4],
+    /// Sample rows searched for a foot or a top: half the extent's height.
+    rows: usize,
+}
+
+impl<G: Fn(u8) -> bool> SideColumns<'_, G> {
+    /// The outline's x at level row `y`.
+    fn edge_x(&self, y: f64) -> f64 {
+        self.line.at(y).0
     }
-    // Carpet under the slanting foot, in at least half of those columns (the first row under
-    // it is often a mixed pixel): not a robot standing in front of the post.
-    let carpet_under = (0..k0)
-        .filter(|&k| {
-            foot(k).is_some_and(|f| {
-                (1..=2).any(|d| {
-                    let y = foot_y(f) + d as f64;
-                    ground(code_at(column_x(k, y), y))
+
+    /// The class code at a level-frame point (`None` outside the image).
+    fn code_at(&self, x: f64, y: f64) -> Option<u8> {
+        let (dx, dy) = (x - self.centre.0, y - self.centre.1);
+        let q = (
+            self.centre.0 + self.cos * dx - self.sin * dy,
+            self.centre.1 + self.sin * dx + self.cos * dy,
+        );
+        self.img.get_at(q.0, q.1)
+    }
+
+    fn goal_at(&self, x: f64, y: f64) -> bool {
+        self.code_at(x, y).is_some_and(self.is_goal)
+    }
+
+    /// Carpet: green or a white line.
+    fn ground_at(&self, x: f64, y: f64) -> bool {
+        self.code_at(x, y)
+            .is_some_and(|c| c == ColourClass::Green.code() || c == ColourClass::White.code())
+    }
+
+    /// Level y of foot sample row `i`.
+    fn foot_y(&self, i: usize) -> f64 {
+        self.extent[3] + 0.5 - i as f64
+    }
+
+    /// Level y of top sample row `i`.
+    fn top_y(&self, i: usize) -> f64 {
+        self.extent[1] - 0.5 + i as f64
+    }
+
+    /// Level x of column `k` at row `y`.
+    fn column_x(&self, k: usize, y: f64) -> f64 {
+        self.edge_x(y) + self.dir * (k as f64 + 0.5)
+    }
+
+    /// Column `k`'s lowest goal sample, as a foot sample row.
+    fn foot_of(&self, k: usize) -> Option<usize> {
+        (0..self.rows).find(|&i| self.goal_at(self.column_x(k, self.foot_y(i)), self.foot_y(i)))
+    }
+
+    /// Column `k`'s highest goal sample, as a top sample row.
+    fn top_of(&self, k: usize) -> Option<usize> {
+        (0..self.rows).find(|&i| self.goal_at(self.column_x(k, self.top_y(i)), self.top_y(i)))
+    }
+
+    /// Beyond the corner the foot jumps up (after at most one column between) and stays up:
+    /// the back wall's bottom, with carpet under it. On a goal seen from in front the feet go
+    /// on down towards a nearer post instead. Outside the image nothing is known.
+    fn back_wall_beyond(&self, feet: &[Option<usize>], slope: FootSlope) -> bool {
+        let FootSlope { lowest, k1, .. } = slope;
+        let foot = |k: usize| feet.get(k).copied().flatten();
+        let yf = self.foot_y(lowest);
+        let up = |k: usize, step: usize| {
+            k < feet.len()
+                && self.code_at(self.column_x(k, yf), yf).is_some()
+                && foot(k).is_none_or(|f| f >= lowest + step)
+        };
+        let jumps = up(k1 + 1, 1)
+            && up(k1 + 2, 1)
+            && (up(k1 + 1, FOOT_STEP_ROWS) || up(k1 + 2, FOOT_STEP_ROWS));
+        jumps && (1..=3).any(|d| self.ground_at(self.column_x(k1 + d, yf), yf))
+    }
+
+    /// Carpet under the slanting foot, in at least half of the `k0` columns before the lowest
+    /// foot (the first row under it is often a mixed pixel): not a robot standing in front of
+    /// the post.
+    fn carpet_under(&self, feet: &[Option<usize>], k0: usize) -> bool {
+        let carpet_under = (0..k0)
+            .filter(|&k| {
+                feet.get(k).copied().flatten().is_some_and(|f| {
+                    (1..=2).any(|d| {
+                        let y = self.foot_y(f) + d as f64;
+                        self.ground_at(self.column_x(k, y), y)
+                    })
                 })
             })
-        })
-        .count();
-    if carpet_under * 2 < k0 {
-        return None;
+            .count();
+        carpet_under * 2 >= k0
     }
-    // The corner is nearer, so its top is no lower than the outline's; it rises less than the
-    // foot descends when the camera is below the goal's top, and a row of it is noise.
-    let tops: Vec<Option<usize>> = (0..feet.len())
-        .map(|k| (0..rows).find(|&i| goal_at(column_x(k, top_y(i)), top_y(i))))
-        .collect();
-    let top = |k: usize| tops.get(k).copied().flatten();
-    let top_at_edge = (0..2).filter_map(top).min()?;
-    let highest = (0..=k1).filter_map(top).min()?;
-    if (k0..=k1).filter_map(top).min()? > top_at_edge + 1 {
-        return None;
+
+    /// The corner on the top's side, checked against the foot's corner: `None` (no side wall)
+    /// when the tops rise more than a row towards the corner; `Some(None)` when the top shows
+    /// no clear corner. The corner is nearer, so its top is no lower than the outline's; it
+    /// rises less than the foot descends when the camera is below the goal's top, and a row of
+    /// it is noise.
+    fn top_corner(
+        &self,
+        columns: usize,
+        slope: FootSlope,
+        foot_corner: WallCorner,
+    ) -> Option<Option<WallCorner>> {
+        let FootSlope { k0, k1, .. } = slope;
+        let tops: Vec<Option<usize>> = (0..columns).map(|k| self.top_of(k)).collect();
+        let top = |k: usize| tops.get(k).copied().flatten();
+        let top_at_edge = (0..2).filter_map(top).min()?;
+        let highest = (0..=k1).filter_map(top).min()?;
+        if (k0..=k1).filter_map(top).min()? > top_at_edge + 1 {
+            return None;
+        }
+        // The end of the highest top's plateau, the top lower in the next two columns (the
+        // back wall's, farther away).
+        let yf = foot_corner.at.1;
+        Some((0..=k1).find(|&k| top(k) == Some(highest)).and_then(|k| {
+            let end = plateau_end(&top, k, highest);
+            let lower = |k: usize| k < tops.len() && top(k).is_none_or(|t| t > highest);
+            let yt = self.top_y(highest);
+            let corner = self.crossing(end, yt);
+            (lower(end + 1)
+                && lower(end + 2)
+                && self.code_at(self.column_x(end + 1, yt), yt).is_some()
+                && (corner.offset - foot_corner.offset).abs() <= SideWall::MAX_LEAN * (yf - yt))
+                .then_some(corner)
+        }))
     }
-    let crossing = |k: usize, y: f64| {
-        let (mut inside, mut outside) = (column_x(k, y), column_x(k + 1, y));
+
+    /// Where row `y` leaves the goal colour between columns `k` and `k + 1`, to 1/64 px by
+    /// bisection.
+    fn crossing(&self, k: usize, y: f64) -> WallCorner {
+        let (mut inside, mut outside) = (self.column_x(k, y), self.column_x(k + 1, y));
         for _ in 0..6 {
             let m = (inside + outside) / 2.0;
-            if goal_at(m, y) {
+            if self.goal_at(m, y) {
                 inside = m;
             } else {
                 outside = m;
@@ -193,27 +289,42 @@ pub(super) fn front_corner(
         let x = (inside + outside) / 2.0;
         WallCorner {
             at: (x, y),
-            offset: dir * (x - edge_x(y)),
+            offset: self.dir * (x - self.edge_x(y)),
         }
-    };
-    let foot_corner = crossing(k1, yf);
-    // The top's corner: the end of the highest top's plateau, the top lower in the next two
-    // columns (the back wall's, farther away).
-    let top_corner = (0..=k1).find(|&k| top(k) == Some(highest)).and_then(|k| {
-        let end = plateau_end(&top, k, highest);
-        let lower = |k: usize| k < tops.len() && top(k).is_none_or(|t| t > highest);
-        let yt = top_y(highest);
-        let corner = crossing(end, yt);
-        (lower(end + 1)
-            && lower(end + 2)
-            && code_at(column_x(end + 1, yt), yt).is_some()
-            && (corner.offset - foot_corner.offset).abs() <= SideWall::MAX_LEAN * (yf - yt))
-            .then_some(corner)
-    });
-    Some(SideWall {
-        foot: foot_corner,
-        top: top_corner,
-    })
+    }
+}
+
+/// The slanting foot of a side wall: its lowest foot (sample row `lowest`) from column `k0`
+/// (the first, counted from the outline) to `k1` (the end of its plateau).
+#[derive(Debug, Clone, Copy)]
+struct FootSlope {
+    k0: usize,
+    k1: usize,
+    lowest: usize,
+}
+
+impl FootSlope {
+    /// The lowest foot among the first `search` columns, when it is at least
+    /// [`MIN_WALL_COLUMNS`] inside, every column before it has a foot, and the foot at the
+    /// outline is [`FOOT_STEP_ROWS`] higher.
+    fn find(feet: &[Option<usize>], search: usize) -> Option<Self> {
+        let foot = |k: usize| feet.get(k).copied().flatten();
+        let (k0, lowest) = (0..search)
+            .filter_map(|k| foot(k).map(|f| (k, f)))
+            .min_by_key(|&(k, f)| (f, k))?;
+        let foot_at_edge = (0..2).filter_map(foot).max()?;
+        if k0 < MIN_WALL_COLUMNS
+            || (0..k0).any(|k| foot(k).is_none())
+            || foot_at_edge < lowest + FOOT_STEP_ROWS
+        {
+            return None;
+        }
+        Some(Self {
+            k0,
+            k1: plateau_end(&foot, k0, lowest),
+            lowest,
+        })
+    }
 }
 
 /// The last column of a plateau of `value` starting at column `from` in a profile: a single

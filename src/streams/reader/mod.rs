@@ -15,6 +15,10 @@ use super::{
     RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
 };
 use crate::sensors::SensorReadings;
+use chunk::decode_chunk_messages;
+
+mod chunk;
+mod recovery;
 
 /// The MCAP magic bytes at both ends of a file.
 const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
@@ -636,124 +640,6 @@ impl StreamReader {
         }
     }
 
-    /// Recovery: walks the data section record by record, decompressing each chunk once, and
-    /// stops at the first record that is cut off or damaged.
-    fn scan(&mut self, table: &mut ChannelTable) -> Result<(), StreamError> {
-        let mut offset = 8u64;
-        let mut loose_messages = 0u64;
-        let mut complete = false;
-        loop {
-            let remaining = self.file_len.saturating_sub(offset);
-            if remaining == 0 {
-                break;
-            }
-            if remaining < 9 {
-                self.warn(format!(
-                    "the file ends inside a record header at offset {offset}"
-                ));
-                break;
-            }
-            let head = self.read_exact_at(offset, 9)?;
-            let opcode = head[0];
-            let len = u64::from_le_bytes(head[1..9].try_into().unwrap_or([0xff; 8]));
-            if opcode == op::DATA_END || opcode == op::FOOTER {
-                complete = true;
-                break;
-            }
-            if len > remaining - 9 {
-                self.warn(format!(
-                    "record at offset {offset} (opcode {opcode:#04x}) needs {len} bytes but the file ends after {}: it was cut off; frames up to the last complete chunk are kept",
-                    remaining - 9
-                ));
-                break;
-            }
-            let body_at = offset + 9;
-            let next = body_at + len;
-            match opcode {
-                op::CHUNK => {
-                    if len > MAX_CHUNK_BYTES {
-                        self.warn(format!(
-                            "chunk at offset {offset} is implausibly large ({len} bytes); stopping"
-                        ));
-                        break;
-                    }
-                    let body = self.read_exact_at(body_at, len)?;
-                    let mut records = Vec::new();
-                    if let Err(e) = decode_chunk(&body, |r| records.push(r)) {
-                        self.warn(format!(
-                            "chunk at offset {offset} is damaged ({e}); frames up to the previous chunk are kept"
-                        ));
-                        break;
-                    }
-                    let chunk = u32::try_from(self.chunks.len())
-                        .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
-                    let mut nth = 0u32;
-                    for r in records {
-                        match r {
-                            ChunkItem::Schema(id, name) => {
-                                table.schema_names.insert(id, name);
-                            }
-                            ChunkItem::Channel(c) => add_channel(table, &c),
-                            ChunkItem::Message(channel, log_time) => {
-                                if Some(channel) == table.image {
-                                    self.frames.push(FrameLoc {
-                                        time_ns: log_time,
-                                        chunk,
-                                        nth,
-                                    });
-                                    nth = nth.saturating_add(1);
-                                }
-                            }
-                        }
-                    }
-                    self.chunks.push(ChunkLoc {
-                        offset,
-                        length: len + 9,
-                    });
-                }
-                op::SCHEMA | op::CHANNEL | op::METADATA => {
-                    if len > MAX_INDEX_BYTES {
-                        self.warn(format!(
-                            "record at offset {offset} is implausibly large; stopping"
-                        ));
-                        break;
-                    }
-                    let body = self.read_exact_at(body_at, len)?;
-                    match mcap::parse_record(opcode, &body) {
-                        Ok(Record::Schema { header, .. }) => {
-                            table.schema_names.insert(header.id, header.name);
-                        }
-                        Ok(Record::Channel(c)) => add_channel(table, &c),
-                        Ok(Record::Metadata(_)) => self.take_metadata(opcode, &body),
-                        _ => {
-                            self.warn(format!("record at offset {offset} is malformed; stopping"));
-                            break;
-                        }
-                    }
-                }
-                op::MESSAGE => loose_messages += 1,
-                _ => {}
-            }
-            offset = next;
-        }
-        if self.info == StreamInfo::default() {
-            self.no_metadata();
-        }
-        if loose_messages > 0 {
-            self.warn(format!(
-                "{loose_messages} messages outside chunks were skipped (only chunked streams are read)"
-            ));
-        }
-        if !complete {
-            self.warn(format!(
-                "recovered {} frames from {} complete chunks",
-                self.frames.len(),
-                self.chunks.len()
-            ));
-        }
-        Ok(())
-    }
-
     /// Reads and decompresses chunk `chunk` into its messages.
     fn load_chunk(&mut self, chunk: u32) -> Result<Vec<Msg>, StreamError> {
         let loc = *self
@@ -784,91 +670,6 @@ fn topic_of(role: &Role) -> &str {
         Role::Extra(t) => t,
         Role::Ignored => "an ignored channel",
     }
-}
-
-fn add_channel(table: &mut ChannelTable, c: &mcap::records::Channel) {
-    let schema = table.schema_names.get(&c.schema_id).cloned();
-    table.add(c.id, &c.topic, &c.message_encoding, schema.as_deref());
-}
-
-/// What the recovery scan needs from a chunk's records.
-enum ChunkItem {
-    Schema(u16, String),
-    Channel(mcap::records::Channel),
-    Message(u16, u64),
-}
-
-/// Parses a chunk record's body and calls `each` for its schemas, channels and messages.
-fn decode_chunk(body: &[u8], mut each: impl FnMut(ChunkItem)) -> Result<(), mcap::McapError> {
-    for_each_chunk_record(body, |r| match r {
-        Record::Schema { header, .. } => each(ChunkItem::Schema(header.id, header.name)),
-        Record::Channel(c) => each(ChunkItem::Channel(c)),
-        Record::Message { header, .. } => {
-            each(ChunkItem::Message(header.channel_id, header.log_time));
-        }
-        _ => {}
-    })
-}
-
-/// Parses a chunk record's body into its messages.
-fn decode_chunk_messages(body: &[u8], out: &mut Vec<Msg>) -> Result<(), mcap::McapError> {
-    for_each_chunk_record(body, |r| {
-        if let Record::Message { header, data } = r {
-            out.push(Msg {
-                channel: header.channel_id,
-                data: data.into_owned(),
-            });
-        }
-    })
-}
-
-fn for_each_chunk_record(
-    body: &[u8],
-    mut each: impl FnMut(Record<'_>),
-) -> Result<(), mcap::McapError> {
-    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
-    let Record::Chunk { header, .. } = mcap::parse_record(op::CHUNK, body)? else {
-        return Err(mcap::McapError::BadIndex);
-    };
-    if header.uncompressed_size > MAX_CHUNK_BYTES {
-        return Err(mcap::McapError::ChunkTooLarge(header.uncompressed_size));
-    }
-    // The chunk is read as the one record of a file by the linear reader, whose record-length
-    // limit then holds inside the chunk too: mcap 0.26's `ChunkReader` sets none, and a damaged
-    // record length inside a chunk made it allocate exabytes (found by fuzz/mcap_stream). No
-    // record in the chunk can be longer than the chunk.
-    let limit = usize::try_from(header.uncompressed_size)
-        .unwrap_or(usize::MAX)
-        .max(body.len());
-    // The record's opcode and length, then its body: fed as two pieces, so the chunk (read once
-    // per frame on demand) is not copied.
-    let mut opcode_len = [0u8; 9];
-    opcode_len[0] = op::CHUNK;
-    opcode_len[1..].copy_from_slice(&(body.len() as u64).to_le_bytes());
-    let mut pieces = [&opcode_len[..], body];
-    let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_skip_start_magic(true)
-            .with_skip_end_magic(true)
-            .with_validate_chunk_crcs(true)
-            .with_record_length_limit(limit),
-    );
-    while let Some(event) = reader.next_event() {
-        match event? {
-            LinearReadEvent::ReadRequest(need) => {
-                // The first piece with bytes left (none left: 0, which tells the reader EOF).
-                let rest = pieces.iter_mut().find(|p| !p.is_empty());
-                let n = rest.as_ref().map_or(0, |p| need.min(p.len()));
-                if let Some(rest) = rest {
-                    reader.insert(n).copy_from_slice(&rest[..n]);
-                    *rest = &rest[n..];
-                }
-                reader.notify_read(n);
-            }
-            LinearReadEvent::Record { data, opcode } => each(mcap::parse_record(opcode, data)?),
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]
