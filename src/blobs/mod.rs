@@ -19,6 +19,7 @@ mod avx2;
 use serde::{Deserialize, Serialize};
 
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
 use crate::lut::ColourClass;
 
 /// Which neighbours join a blob.
@@ -107,6 +108,12 @@ pub struct Blob {
 }
 
 impl Blob {
+    /// Its bounding box, inclusive pixels.
+    #[must_use]
+    pub const fn bounds(&self) -> PixelBox {
+        PixelBox::new(self.minx, self.miny, self.maxx, self.maxy)
+    }
+
     /// Box width, pixels.
     #[must_use]
     pub const fn width(&self) -> u32 {

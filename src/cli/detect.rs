@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use super::inputs::{InputArgs, parse_connectivity, progress};
 use crate::blobs::Connectivity;
+use crate::frame::PixelBox;
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::{GoalCandidate, Recognition, Relative};
@@ -162,8 +163,8 @@ pub struct GoalJson {
 pub struct BeaconJson {
     /// E.g. `pink over yellow`.
     pub kind: String,
-    /// Box, inclusive pixels `[minx, miny, maxx, maxy]`.
-    pub bounds: [u32; 4],
+    /// Box, inclusive pixels (`[minx, miny, maxx, maxy]` in JSON).
+    pub bounds: PixelBox,
     /// Where it is.
     #[serde(flatten)]
     pub placement: PlacementJson,
@@ -185,8 +186,8 @@ pub struct PlaceJson {
 /// A pink marker's coloured pattern in `--json` output.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct PatternJson {
-    /// The pink blob's box, inclusive pixels `[minx, miny, maxx, maxy]`.
-    pub bounds: [u32; 4],
+    /// The pink blob's box, inclusive pixels (`[minx, miny, maxx, maxy]` in JSON).
+    pub bounds: PixelBox,
     /// The two most common class codes of each of the nine regions, row by row (0: nothing).
     pub signature: [[u8; 2]; 9],
     /// The pink blob's size (mean column height), pixels.
@@ -277,10 +278,10 @@ fn sides(cut: crate::recognition::scan::CutOff) -> Vec<&'static str> {
 fn goal_json(g: &GoalCandidate) -> GoalJson {
     GoalJson {
         colour: g.colour.name(),
-        minx: g.bounds[0],
-        miny: g.bounds[1],
-        maxx: g.bounds[2],
-        maxy: g.bounds[3],
+        minx: g.bounds.min_x,
+        miny: g.bounds.min_y,
+        maxx: g.bounds.max_x,
+        maxy: g.bounds.max_y,
         placement: PlacementJson::new(&g.camera, g.body.as_ref()),
         distance_is_max: g.distance_is_max,
         cut_off: sides(g.cut_off),

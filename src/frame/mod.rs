@@ -9,11 +9,13 @@
 //! ([`yuv_to_rgb`]); loading PNG/JPEG goes the other way with [`rgb_to_yuv`].
 
 mod io;
+mod pixel_box;
 
 pub use io::{
     FrameFileError, MAX_FRAME_PIXELS, display_name, infer_uyvy_size, is_image_file, load_frame,
     load_raw_uyvy, save_rgb_png,
 };
+pub use pixel_box::PixelBox;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

@@ -9,6 +9,7 @@ use super::context::{Relative, ViewContext};
 use super::draw::Primitive;
 use super::fit::rotate_about;
 use crate::blobs::{Blob, BlobSet};
+use crate::frame::PixelBox;
 use crate::lut::ColourClass;
 
 /// Settings of beacon recognition.
@@ -80,7 +81,7 @@ pub struct Beacon {
     /// Which beacon.
     pub kind: BeaconKind,
     /// Both bands' box, inclusive pixels.
-    pub bounds: [u32; 4],
+    pub bounds: PixelBox,
     /// Top or bottom touches the image edge.
     pub cut_off: bool,
     /// Camera-relative distance, bearing, elevation of the centre.
@@ -171,7 +172,7 @@ pub fn recognise_beacons(blobs: &BlobSet, ctx: &ViewContext, p: &BeaconParams) -
                 };
                 let beacon = Beacon {
                     kind,
-                    bounds: [all.minx, all.miny, all.maxx, all.maxy],
+                    bounds: all.bounds(),
                     cut_off,
                     camera: ctx.camera_relative(c, distance),
                     body: ctx.body_relative(c, distance),
@@ -204,12 +205,12 @@ pub fn beacon_primitives(beacons: &[Beacon]) -> Vec<Primitive> {
         out.push(Primitive::Box {
             owner: owner.clone(),
             colour: ColourClass::Pink.code(),
-            bounds: b.bounds,
+            bounds: b.bounds.to_array(),
         });
         if b.accepted {
             out.push(Primitive::Label {
                 owner,
-                at: (f64::from(b.bounds[0]), f64::from(b.bounds[1]) - 2.0),
+                at: (f64::from(b.bounds.min_x), f64::from(b.bounds.min_y) - 2.0),
                 text: format!("{} {:.0} cm", b.kind.name(), b.camera.distance_cm),
             });
         }

@@ -147,7 +147,7 @@ pub fn recognise(
     memory: Option<&patterns::PatternMemory>,
 ) -> Recognition {
     let beacons = beacons::recognise_beacons(blobs, ctx, &params.beacons);
-    let beacon_boxes: Vec<[u32; 4]> = beacons
+    let beacon_boxes: Vec<crate::frame::PixelBox> = beacons
         .iter()
         .filter(|b| b.accepted)
         .map(|b| b.bounds)

@@ -194,7 +194,7 @@ fn the_shipped_table_classifies_the_markers() {
                 (b.min_y + b.max_y) as u32 / 2,
             );
             let Some(c) = r.recognition.patterns.iter().find(|c| {
-                let [x0, y0, x1, y1] = c.observation.bounds;
+                let [x0, y0, x1, y1] = c.observation.bounds.to_array();
                 (x0..=x1).contains(&cx) && (y0..=y1).contains(&cy)
             }) else {
                 continue;

@@ -8,13 +8,6 @@ use crate::recognition::context::ViewContext;
 use crate::recognition::fit::{Point, rotate_about};
 use crate::recognition::scan::CutOff;
 
-pub(super) fn near(a: &Blob, b: &Blob, gap: u32) -> bool {
-    a.minx <= b.maxx + gap + 1
-        && b.minx <= a.maxx + gap + 1
-        && a.miny <= b.maxy + gap + 1
-        && b.miny <= a.maxy + gap + 1
-}
-
 /// A candidate while it is being built: the joined blob and its basic-colour part.
 #[derive(Debug, Clone)]
 pub(super) struct Group {
@@ -99,7 +92,7 @@ pub(super) fn build_groups(
             members: vec![b.number],
         };
         for (i, s) in soft.iter().enumerate() {
-            if !used[i] && near(&g.all, s, p.join_px) {
+            if !used[i] && g.all.bounds().is_near(&s.bounds(), p.join_px) {
                 g.all = g.all.merged_with(s);
                 g.members.push(s.number);
                 used[i] = true;
@@ -128,7 +121,7 @@ pub(super) fn build_groups(
                 );
                 let tol = p.split_tolerance * (ea[3] - ea[1]).max(eb[3] - eb[1]);
                 let split = (ea[1] - eb[1]).abs() <= tol && (ea[3] - eb[3]).abs() <= tol;
-                if near(a, b, p.join_px) || lined_up && split {
+                if a.bounds().is_near(&b.bounds(), p.join_px) || lined_up && split {
                     let other = groups.swap_remove(j);
                     let g = &mut groups[i];
                     g.all = g.all.merged_with(&other.all);
@@ -146,14 +139,6 @@ pub(super) fn build_groups(
     groups.retain(|g| g.all.pixels >= p.min_candidate_pixels);
     groups.sort_by_key(|g| std::cmp::Reverse(g.all.pixels));
     groups
-}
-
-/// Share of box `a` covered by box `b` (inclusive pixel boxes).
-pub(super) fn overlap_fraction(a: [u32; 4], b: [u32; 4]) -> f64 {
-    let w = (a[2].min(b[2]) + 1).saturating_sub(a[0].max(b[0]));
-    let h = (a[3].min(b[3]) + 1).saturating_sub(a[1].max(b[1]));
-    let area = f64::from(a[2] - a[0] + 1) * f64::from(a[3] - a[1] + 1);
-    f64::from(w) * f64::from(h) / area
 }
 
 /// Cut-off detection: the level box's 8 points (corners and side midpoints), rotated back into

@@ -52,9 +52,9 @@ pub(super) fn examine(
     let confidence = goal_tests(img, g, ctx, p, &shape, distance, body.as_ref());
     GoalCandidate {
         colour,
-        bounds: [g.all.minx, g.all.miny, g.all.maxx, g.all.maxy],
+        bounds: g.all.bounds(),
         pixels: g.all.pixels,
-        basic_bounds: [g.basic.minx, g.basic.miny, g.basic.maxx, g.basic.maxy],
+        basic_bounds: g.basic.bounds(),
         blobs: g.members.clone(),
         cut_off: cut,
         height_px,

@@ -27,6 +27,7 @@ use super::fit::{LineFit, Point};
 use super::scan::CutOff;
 use crate::blobs::BlobSet;
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
 use crate::lut::ColourClass;
 
 // The stages' items, for each other (each stage file reads them through `use super::*`).
@@ -348,12 +349,12 @@ impl std::fmt::Display for PostRejection {
 pub struct GoalCandidate {
     /// Yellow or sky blue.
     pub colour: ColourClass,
-    /// `[minx, miny, maxx, maxy]`, inclusive pixels.
-    pub bounds: [u32; 4],
+    /// Bounds, inclusive pixels.
+    pub bounds: PixelBox,
     /// Pixels of goal colours.
     pub pixels: u32,
     /// Bounds of the basic goal-colour part.
-    pub basic_bounds: [u32; 4],
+    pub basic_bounds: PixelBox,
     /// Numbers of the blobs that make it up.
     pub blobs: Vec<u32>,
     /// Sides cut off by the image edge.
@@ -413,7 +414,7 @@ pub fn recognise_goals(
     blobs: &BlobSet,
     ctx: &ViewContext,
     p: &GoalParams,
-    beacons: &[[u32; 4]],
+    beacons: &[PixelBox],
 ) -> GoalResult {
     let mut result = GoalResult::default();
     for colour in [ColourClass::Yellow, ColourClass::SkyBlue] {
@@ -423,7 +424,7 @@ pub fn recognise_goals(
             // A beacon's yellow or sky-blue band is not a goal.
             let overlap = beacons
                 .iter()
-                .map(|b| overlap_fraction(cand.bounds, *b))
+                .map(|b| cand.bounds.overlap_fraction(b))
                 .fold(0.0, f64::max);
             if overlap > 0.0 {
                 cand.confidence.range_test(
@@ -445,8 +446,7 @@ pub fn recognise_goals(
                 find_posts(img, &mut cand, colour, ctx, p);
             }
             let e = cand.level_extent;
-            let area = f64::from(cand.bounds[2] - cand.bounds[0] + 1)
-                * f64::from(cand.bounds[3] - cand.bounds[1] + 1);
+            let area = cand.bounds.area_px();
             let fills = area >= p.fills_image_fraction * img.width() as f64 * img.height() as f64;
             let sides_in_view = !(cand.cut_off.left && cand.cut_off.right);
             if hopeless || fills || !sides_in_view || e[3] - e[1] < p.post_test_min_height_px {
@@ -482,7 +482,7 @@ impl GoalResult {
             out.push(Primitive::Box {
                 owner: owner.clone(),
                 colour: c.colour.code(),
-                bounds: c.bounds,
+                bounds: c.bounds.to_array(),
             });
             if !c.post_points.is_empty() {
                 out.push(Primitive::ScanPoints {
@@ -517,7 +517,7 @@ impl GoalResult {
             if c.accepted {
                 out.push(Primitive::Label {
                     owner,
-                    at: (f64::from(c.bounds[0]), f64::from(c.bounds[1]) - 2.0),
+                    at: (f64::from(c.bounds.min_x), f64::from(c.bounds.min_y) - 2.0),
                     text: format!(
                         "{} goal {}{:.0} cm {:+.0}°",
                         c.colour.name(),

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::{PatternParams, Signature};
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
 use crate::geometry::{ImagePoint, RobotPose};
 use crate::lut::ColourClass;
 use crate::recognition::context::ViewContext;
@@ -64,7 +65,7 @@ pub struct PatternObservation {
     /// Camera elevation of the blob's centre, radians, positive up.
     pub elevation_rad: f64,
     /// The pink blob's box, inclusive pixels `[minx, miny, maxx, maxy]`.
-    pub bounds: [u32; 4],
+    pub bounds: PixelBox,
     /// The pink blob's pixels.
     pub pixels: u32,
     /// Of the nine regions, how many lie wholly inside the image.
@@ -85,7 +86,7 @@ impl PatternObservation {
     /// measured worse: the pink blob's rim is often lost, so its box is narrower already.)
     #[must_use]
     pub fn region_bounds(&self, k: usize) -> [i64; 4] {
-        let [x0, y0, x1, y1] = self.bounds.map(i64::from);
+        let [x0, y0, x1, y1] = self.bounds.to_array().map(i64::from);
         let (w, h) = (x1 - x0 + 1, y1 - y0 + 1);
         let shear = if self.shear_px_per_row.is_finite() {
             self.shear_px_per_row
@@ -100,7 +101,7 @@ impl PatternObservation {
     /// The blob's box centre, image pixels.
     #[must_use]
     pub fn centre(&self) -> (f64, f64) {
-        let [x0, y0, x1, y1] = self.bounds.map(f64::from);
+        let [x0, y0, x1, y1] = self.bounds.to_array().map(f64::from);
         ((x0 + x1 + 1.0) / 2.0, (y0 + y1 + 1.0) / 2.0)
     }
 }
@@ -114,32 +115,21 @@ pub(super) const ASSUMED_DISTANCE_CM: f64 = 200.0;
 pub(super) const REGION_SAMPLES: i64 = 128;
 
 /// Signatures of the pink markers in a classified frame, leaving out pink blobs inside any of
-/// the boxes `except` (inclusive `[minx, miny, maxx, maxy]`: accepted beacons, whose bands are
-/// theirs).
+/// the boxes `except` (accepted beacons, whose bands are theirs).
 #[must_use]
 pub fn observe(
     img: &ClassifiedImage,
     blobs: &BlobSet,
     ctx: &ViewContext,
     params: &PatternParams,
-    except: &[[u32; 4]],
+    except: &[PixelBox],
 ) -> Vec<PatternObservation> {
     blobs
         .of_class(ColourClass::Pink)
         .filter(|b| b.pixels >= params.min_pixels)
-        .filter(|b| {
-            let own = [b.minx, b.miny, b.maxx, b.maxy];
-            !except.iter().any(|e| inside(own, *e))
-        })
+        .filter(|b| !except.iter().any(|e| b.bounds().is_within(e)))
         .map(|b| observe_blob(img, b, ctx))
         .collect()
-}
-
-/// Whether the inclusive box `a` lies within the inclusive box `b` (both `[minx, miny, maxx,
-/// maxy]`).
-#[must_use]
-pub fn inside(a: [u32; 4], b: [u32; 4]) -> bool {
-    a[0] >= b[0] && a[1] >= b[1] && a[2] <= b[2] && a[3] <= b[3]
 }
 
 /// The two most common class codes in the inclusive box `[x0, y0, x1, y1]` (clipped to the
@@ -224,7 +214,7 @@ pub(super) fn observe_blob(
         size_px: column_height(img, b),
         bearing_rad: 0.0,
         elevation_rad: 0.0,
-        bounds: [b.minx, b.miny, b.maxx, b.maxy],
+        bounds: b.bounds(),
         pixels: b.pixels,
         regions_in_image: 0,
         ray: None,
