@@ -53,8 +53,8 @@ pub struct ErrorSample {
 /// See the module documentation.
 #[derive(Debug, Clone, Default)]
 pub struct FieldModel {
-    trails: BTreeMap<RobotKey, VecDeque<[f64; 2]>>,
-    ball_trail: VecDeque<[f64; 2]>,
+    trails: BTreeMap<RobotKey, VecDeque<(usize, [f64; 2])>>,
+    ball_trail: VecDeque<(usize, [f64; 2])>,
     last_index: Option<usize>,
     world_models: Vec<WorldModelView>,
     errors: BTreeMap<usize, ErrorSample>,
@@ -72,23 +72,23 @@ impl FieldModel {
         extra: &[(String, serde_json::Value)],
     ) {
         // Trails follow playback: a jump (seek, step back) starts them again; the same frame
-        // processed again (a new table or calibration) leaves them.
+        // processed again (a new table or calibration) replaces its own points.
         let again = self.last_index == Some(index);
         if !again && self.last_index.is_none_or(|i| index != i + 1) {
             self.trails.clear();
             self.ball_trail.clear();
         }
         self.last_index = Some(index);
-        if let Some(d) = detections.filter(|_| !again) {
+        if let Some(d) = detections {
             for r in &d.robots {
                 let key = RobotKey {
                     team: r.team,
                     identity: r.identity,
                 };
-                push_trail(self.trails.entry(key).or_default(), r.field_cm);
+                push_trail(self.trails.entry(key).or_default(), index, r.field_cm);
             }
             if let Some(b) = &d.ball {
-                push_trail(&mut self.ball_trail, b.field_cm);
+                push_trail(&mut self.ball_trail, index, b.field_cm);
             }
         }
         self.world_models = extra
@@ -113,15 +113,15 @@ impl FieldModel {
         }
     }
 
-    /// Each robot's trail, oldest first (field cm).
+    /// Each robot's trail, oldest first: (frame index, field position in cm).
     #[must_use]
-    pub const fn trails(&self) -> &BTreeMap<RobotKey, VecDeque<[f64; 2]>> {
+    pub const fn trails(&self) -> &BTreeMap<RobotKey, VecDeque<(usize, [f64; 2])>> {
         &self.trails
     }
 
-    /// The ball's trail, oldest first (field cm).
+    /// The ball's trail, oldest first: (frame index, field position in cm).
     #[must_use]
-    pub const fn ball_trail(&self) -> &VecDeque<[f64; 2]> {
+    pub const fn ball_trail(&self) -> &VecDeque<(usize, [f64; 2])> {
         &self.ball_trail
     }
 
@@ -137,8 +137,11 @@ impl FieldModel {
     }
 }
 
-fn push_trail(trail: &mut VecDeque<[f64; 2]>, p: [f64; 2]) {
-    trail.push_back(p);
+fn push_trail(trail: &mut VecDeque<(usize, [f64; 2])>, index: usize, p: [f64; 2]) {
+    if trail.back().is_some_and(|(i, _)| *i == index) {
+        trail.pop_back();
+    }
+    trail.push_back((index, p));
     while trail.len() > TRAIL_FRAMES {
         trail.pop_front();
     }
@@ -264,7 +267,21 @@ mod tests {
         }
         let trail = m.trails().values().next().expect("one robot");
         assert_eq!(trail.len(), TRAIL_FRAMES);
-        assert_eq!(trail.back(), Some(&[(TRAIL_FRAMES + 4) as f64, 0.0]));
+        assert_eq!(
+            trail.back(),
+            Some(&(TRAIL_FRAMES + 4, [(TRAIL_FRAMES + 4) as f64, 0.0]))
+        );
+        // The same frame again replaces its point.
+        m.observe(
+            TRAIL_FRAMES + 4,
+            0,
+            Some(&detections([-1.0, 0.0], [0.0, 0.0])),
+            None,
+            &[],
+        );
+        let trail = m.trails().values().next().expect("one robot");
+        assert_eq!(trail.len(), TRAIL_FRAMES);
+        assert_eq!(trail.back(), Some(&(TRAIL_FRAMES + 4, [-1.0, 0.0])));
         assert_eq!(m.ball_trail().len(), TRAIL_FRAMES);
         m.observe(3, 0, Some(&detections([0.0, 0.0], [0.0, 0.0])), None, &[]);
         assert_eq!(m.trails().values().next().map(VecDeque::len), Some(1));
