@@ -343,6 +343,10 @@ fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         ui.label("No frame open.");
         return;
     }
+    if state.overhead().active() {
+        overhead_results_ui(ui, state, commands);
+        return;
+    }
     let list = candidates(state.recognition(), state.places());
     if list.is_empty() {
         ui.label(
@@ -507,4 +511,54 @@ fn pattern_regions_ui(ui: &mut Ui, owner: &str, p: &PatternInfo) {
                 }
             }
         });
+}
+
+/// An overhead frame's results: the ball and each robot with field position, heading and
+/// confidence, and the candidates turned down with their reasons; clicking a robot selects it
+/// in every view.
+fn overhead_results_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    use crate::workspace::{OverheadCommand, RobotKey};
+    let overhead = state.overhead();
+    let Some(d) = overhead.detections() else {
+        ui.label(overhead.calibration_status());
+        return;
+    };
+    match &d.ball {
+        Some(b) => ui.label(format!(
+            "ball at ({:.1}, {:.1}) cm, image ({:.1}, {:.1}) px, radius {:.1} px, confidence {:.2}",
+            b.field_cm[0], b.field_cm[1], b.image.x_px, b.image.y_px, b.radius_px, b.confidence
+        )),
+        None => ui.label("no ball"),
+    };
+    let selected = overhead.selected();
+    egui::Grid::new("overhead-robots")
+        .striped(true)
+        .show(ui, |ui| {
+            for h in ["robot", "field (cm)", "heading (°)", "confidence"] {
+                ui.strong(h);
+            }
+            ui.end_row();
+            for r in &d.robots {
+                let key = RobotKey {
+                    team: r.team,
+                    identity: r.identity,
+                };
+                let mine = selected == Some(key);
+                if ui.selectable_label(mine, key.to_string()).clicked() {
+                    let next = if mine { None } else { Some(key) };
+                    commands.push(Command::Overhead(OverheadCommand::SelectRobot(next)));
+                }
+                ui.monospace(format!("{:7.1} {:7.1}", r.field_cm[0], r.field_cm[1]));
+                ui.monospace(format!("{:6.1}", r.heading_rad.to_degrees()));
+                ui.monospace(format!("{:.2}", r.confidence));
+                ui.end_row();
+            }
+        });
+    if !d.rejected.is_empty() {
+        ui.collapsing(format!("{} rejected candidates", d.rejected.len()), |ui| {
+            for c in &d.rejected {
+                ui.label(format!("{:?} at {:?}: {:?}", c.colour, c.bounds, c.reason));
+            }
+        });
+    }
 }

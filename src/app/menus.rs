@@ -1,4 +1,4 @@
-//! The menu bar: File, Classification, View, Stream, Camera, Windows, Help. Menus rather than buttons
+//! The menu bar: File, Classification, View, Stream, Camera, Overhead, Windows, Help. Menus rather than buttons
 //! leave the screen to the images; every item sends a [`Command`] or toggles a window.
 
 use std::path::PathBuf;
@@ -81,6 +81,9 @@ pub fn menu_bar_ui(
         ui.menu_button("Stream", |ui| stream_menu_ui(ui, state, commands));
         ui.menu_button("Camera", |ui| {
             super::camera_menu::camera_menu_ui(ui, state, commands);
+        });
+        ui.menu_button("Overhead", |ui| {
+            super::overhead_menu::overhead_menu_ui(ui, state, commands);
         });
         ui.menu_button("Windows", |ui| windows_menu_ui(ui, state, commands));
         ui.menu_button("Help", |ui| {

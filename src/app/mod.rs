@@ -13,14 +13,22 @@
 //! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
 //! | `menus.rs` | File, Classification, View, Stream, Camera, Windows, Help |
 //! | `camera_menu.rs` | the Camera menu and its dialogs: connect, settings, grab, record |
+//! | `overhead_overlays.rs` | the overhead camera's overlays: field lines, ball, robot markers, picked points |
+//! | `overhead_menu.rs` | the Overhead menu: calibration files, view options, windows |
+//! | `calibration_window.rs` | pick landmarks by name, solve, each point's reprojection error |
+//! | `field_view.rs` | the top-down field: ball, robots, trails, world models and their errors |
 //! | `renderer.rs` | wgpu on a GPU, OpenGL on a software rasteriser: the choice before the window opens |
 //!
 //! Only this folder names egui/eframe (`scripts/check.sh` checks it).
 
+pub mod calibration_window;
 pub mod camera_menu;
 pub mod classify_panel;
+pub mod field_view;
 pub mod inspector;
 pub mod menus;
+pub mod overhead_menu;
+pub mod overhead_overlays;
 pub mod overlays;
 pub mod renderer;
 pub mod sensors_dialog;
@@ -213,12 +221,12 @@ pub struct ViewImages {
 pub fn view_images(state: &Workspace, palette: &[Color32; 256]) -> Option<ViewImages> {
     let frame = state.frame()?;
     let size = [frame.width(), frame.height()];
-    let raw = ColorImage::from_rgb(size, state.rgb());
+    // The undistorted view of an overhead frame, when chosen, else the frame as it is.
+    let raw = ColorImage::from_rgb(size, &state.view_rgb());
     let classified = ColorImage::new(
         size,
         state
-            .classified()
-            .codes()
+            .view_codes()
             .iter()
             .map(|&c| palette[usize::from(c)])
             .collect(),
@@ -254,6 +262,8 @@ pub struct EotnApp {
     menu_input: menus::MenuInput,
     /// What the Camera dialogs are editing.
     pub camera: camera_menu::CameraDialogs,
+    /// The file names typed in the overhead calibration window.
+    pub overhead: calibration_window::OverheadPaths,
     uv_plane: uv_plane::UvPlane,
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
@@ -302,6 +312,7 @@ impl EotnApp {
             textures: None,
             menu_input: menus::MenuInput::default(),
             camera: camera_menu::CameraDialogs::default(),
+            overhead: calibration_window::OverheadPaths::default(),
             uv_plane: uv_plane::UvPlane::default(),
             hovered: None,
             last_view: None,
@@ -800,6 +811,13 @@ impl eframe::App for EotnApp {
         self.uv_plane.window(&ctx, &self.state, &mut commands);
         classify_panel::try_edit_window(&ctx, &self.state, &mut commands);
         inspector::inspector_window(&ctx, &self.state, &mut commands);
+        calibration_window::calibration_window(
+            &ctx,
+            &self.state,
+            &mut self.overhead,
+            &mut commands,
+        );
+        field_view::field_view_window(&ctx, &self.state, &mut commands);
         self.warnings_window(&ctx);
         self.about_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);

@@ -150,6 +150,8 @@ pub fn paint_view(
         painter.image(tex.preview, img, uv, Color32::WHITE);
     }
     let boxes = match kind {
+        // Boxes are in the camera's pixels: the undistorted view does not show them.
+        _ if state.undistorted_view() => Vec::new(),
         ViewKind::Objects => Vec::new(),
         ViewKind::Blobs => state.drawn_blobs(),
         _ if with_overlays && o.blob_boxes => state.drawn_blobs(),
@@ -191,9 +193,13 @@ pub fn paint_view(
             state.selected_object(),
         );
     }
-    if with_overlays && let Some((x, y)) = state.selection().and_then(|s| s.pixel) {
+    if with_overlays
+        && !state.undistorted_view()
+        && let Some((x, y)) = state.selection().and_then(|s| s.pixel)
+    {
         sample_marker(&painter, xf, x, y);
     }
+    super::overhead_overlays::paint_overhead(&painter, xf, kind, state, with_overlays);
 }
 
 /// A blob's box on screen (pixel edges inclusive).

@@ -5,7 +5,8 @@
 use egui::{Align2, Color32, PointerButton, Sense, Ui, vec2};
 
 use super::overlays::{FrameTextures, ImageTransform, corner_text, paint_view};
-use crate::workspace::{Command, PixelInfo, ViewKind, Workspace};
+use crate::geometry::ImagePoint;
+use crate::workspace::{Command, OverheadCommand, PixelInfo, ViewKind, Workspace};
 
 /// Screen points the mouse wheel must move for the zoom to double.
 const WHEEL_POINTS_PER_DOUBLING: f32 = 240.0;
@@ -50,7 +51,10 @@ pub fn main_view_ui(
         transform: Some(xf),
     };
     if let Some(pos) = response.hover_pos() {
-        out.hovered = xf.pixel_at(pos).and_then(|(x, y)| state.pixel_info(x, y));
+        out.hovered = xf
+            .pixel_at(pos)
+            .and_then(|_| camera_pixel(state, xf.to_image(pos)))
+            .and_then(|(x, y)| state.pixel_info(x, y));
         let (scroll, zoom_delta) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
         let factor = if (zoom_delta - 1.0).abs() > f32::EPSILON {
             zoom_delta
@@ -75,9 +79,10 @@ pub fn main_view_ui(
     if response.double_clicked_by(PointerButton::Primary) {
         commands.push(Command::ResetView);
     } else if response.clicked_by(PointerButton::Primary)
-        && let Some((x, y)) = response.interact_pointer_pos().and_then(|p| xf.pixel_at(p))
+        && let Some(pos) = response.interact_pointer_pos()
+        && xf.pixel_at(pos).is_some()
     {
-        commands.push(Command::Sample { x, y });
+        commands.push(click_command(state, xf.to_image(pos)));
     }
     if response.clicked_by(PointerButton::Secondary) && state.selection().is_some() {
         commands.push(Command::Commit);
@@ -88,6 +93,30 @@ pub fn main_view_ui(
     };
     corner_text(&painter, rect, Align2::RIGHT_TOP, zoom_text);
     out
+}
+
+/// The camera's pixel a view point (image pixels of the view) shows: the same, or through the
+/// lens model in the undistorted view.
+fn camera_pixel(state: &Workspace, p: egui::Pos2) -> Option<(usize, usize)> {
+    let q = state.camera_point_of_view(ImagePoint::new(f64::from(p.x), f64::from(p.y)));
+    let (w, h) = state.image_size();
+    (q.x_px >= 0.0 && q.y_px >= 0.0 && q.x_px < w as f64 && q.y_px < h as f64)
+        .then_some((q.x_px as usize, q.y_px as usize))
+}
+
+/// What a left click at view point `p` does: picks the chosen landmark there while picking
+/// calibration points (sub-pixel, in the camera's image), else samples the pixel for hand
+/// classification.
+fn click_command(state: &Workspace, p: egui::Pos2) -> Command {
+    if state.overhead().active() && state.overhead().landmark().is_some() {
+        let q = state.camera_point_of_view(ImagePoint::new(f64::from(p.x), f64::from(p.y)));
+        return Command::Overhead(OverheadCommand::PickPoint {
+            x_px: q.x_px,
+            y_px: q.y_px,
+        });
+    }
+    let (x, y) = camera_pixel(state, p).unwrap_or((p.x as usize, p.y as usize));
+    Command::Sample { x, y }
 }
 
 /// The thumbnails of the other views in a row; clicking one enlarges it.

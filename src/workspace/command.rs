@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use crate::sources::{SourceSettings, SourceSpec};
 
-use super::settings::{Overlays, ViewKind};
+use super::overhead::RobotKey;
+use super::settings::{OverheadView, Overlays, ViewKind};
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
 
@@ -112,6 +113,42 @@ pub enum Command {
     /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
     /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
     SelectObject(Option<String>),
+    /// The overhead camera: calibration, picked points, robot selection, view options.
+    Overhead(OverheadCommand),
+}
+
+/// What the UI can ask of the overhead camera's side (`workspace/overhead.rs`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum OverheadCommand {
+    /// Use this calibration file (`eotn overhead calibrate` writes them).
+    OpenCalibration(PathBuf),
+    /// Save the calibration in use (opened or solved here) as this file.
+    SaveCalibration(PathBuf),
+    /// Forget the opened or solved calibration: the stream's own camera, if any, is used.
+    CloseCalibration,
+    /// Use this field description (landmarks, lines; `params/fields/`).
+    OpenField(PathBuf),
+    /// Open a points file (`*.points.json`) to go on picking or to calibrate from.
+    OpenPoints(PathBuf),
+    /// Save the picked points as a points file.
+    SavePoints(PathBuf),
+    /// The landmark (by its name in the field description) the next image click picks.
+    ChooseLandmark(Option<String>),
+    /// Pick the chosen landmark at this point of the camera's image (pixels, not undistorted).
+    PickPoint {
+        /// Column, pixels (pixel centres at +0.5).
+        x_px: f64,
+        /// Row, pixels.
+        y_px: f64,
+    },
+    /// Undo the latest pick.
+    UndoPick,
+    /// Solve the camera from the picked points, refined along the frame's field lines.
+    Calibrate,
+    /// Select a robot in every view (`None` clears).
+    SelectRobot(Option<RobotKey>),
+    /// Overhead view options.
+    SetView(OverheadView),
 }
 
 /// The app's extra windows.
@@ -131,11 +168,22 @@ pub enum Window {
     SourceSettings,
     /// Camera ▸ Start recording…: name the stream.
     Record,
+    /// The overhead camera's field view: ball, robots, world models.
+    FieldView,
+    /// Overhead calibration: pick landmarks, solve, reprojection errors.
+    Calibration,
 }
 
 impl Window {
     /// Every window, for the Windows menu.
-    pub const ALL: [Self; 4] = [Self::Sensors, Self::UvPlane, Self::TryEdit, Self::Inspector];
+    pub const ALL: [Self; 6] = [
+        Self::Sensors,
+        Self::UvPlane,
+        Self::TryEdit,
+        Self::Inspector,
+        Self::FieldView,
+        Self::Calibration,
+    ];
 
     /// Its title.
     #[must_use]
@@ -148,6 +196,8 @@ impl Window {
             Self::Connect => "Connect a source",
             Self::SourceSettings => "Source settings",
             Self::Record => "Record into a stream",
+            Self::FieldView => "Field view",
+            Self::Calibration => "Overhead calibration",
         }
     }
 }

@@ -53,6 +53,7 @@ impl Workspace {
         self.player.stop();
         self.try_edit = None;
         self.current = None;
+        self.reset_overhead_for_source();
         if let Err(e) = self.seek(0) {
             self.source = old;
             self.use_table_of(old_kind);
@@ -76,6 +77,9 @@ impl Workspace {
                 self.warn(format!("{label}: {w}"));
             }
             self.status = format!("opened {label}: {n} frames");
+            if self.overhead.active() {
+                self.status = format!("{}; {}", self.status, self.overhead.calibration_status());
+            }
         }
         Ok(())
     }
@@ -99,6 +103,10 @@ impl Workspace {
     /// Runs every stage on `loaded` with its sensor readings (recognition needs the camera
     /// pose for heights and the horizon) and refreshes what is derived from the results.
     pub(super) fn run_pipeline(&mut self, loaded: &SourceFrame) -> crate::pipeline::StageTimings {
+        if self.camera_kind() == crate::sources::CameraKind::Overhead {
+            return self.run_overhead(loaded);
+        }
+        self.overhead_inactive();
         let r = self
             .pipeline
             .process(&loaded.frame, loaded.sensors.as_ref());

@@ -84,6 +84,7 @@ impl Workspace {
         self.try_edit = None;
         self.current = None;
         self.index = 0;
+        self.reset_overhead_for_source();
         let info = streamer.info().clone();
         self.use_table_of(info.camera);
         self.sensor_series = super::SensorSeries::default();

@@ -19,12 +19,16 @@
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
 //! | `timings.rs` | step and frame-time measurements |
+//! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
+//! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time |
 
 mod command;
 mod compose;
+pub mod field_model;
 mod frames;
 pub mod journal;
 mod live;
+pub mod overhead;
 pub mod player;
 mod settings;
 pub mod source;
@@ -37,13 +41,14 @@ use std::time::Duration;
 
 use anyhow::Context as _;
 
-pub use command::{Command, Window};
+pub use command::{Command, OverheadCommand, Window};
 pub use compose::{PrimitiveFilter, box_colour};
 pub use live::Live;
+pub use overhead::{CalibrationSource, Overhead, RobotKey};
 pub use player::Player;
 pub use settings::{
-    MAX_RECENT, MAX_WARNINGS, Overlays, SPEEDS, Settings, ViewKind, ViewTransform, ZOOM_PRESETS,
-    ZOOM_RANGE,
+    MAX_RECENT, MAX_WARNINGS, OverheadView, Overlays, SPEEDS, Settings, ViewKind, ViewTransform,
+    ZOOM_PRESETS, ZOOM_RANGE,
 };
 pub use source::Source;
 pub use table::TableSlot;
@@ -140,6 +145,8 @@ pub struct Workspace {
     table_kind: CameraKind,
     /// The other camera's table.
     other_table: TableSlot,
+    /// The overhead camera's pipeline, calibration, picked points and selection.
+    overhead: overhead::Overhead,
 }
 
 impl Default for Workspace {
@@ -194,6 +201,7 @@ impl Workspace {
             recorder: None,
             table_kind: CameraKind::Robot,
             other_table: TableSlot::empty(bits),
+            overhead: overhead::Overhead::default(),
         }
     }
 
@@ -324,6 +332,7 @@ impl Workspace {
                 }
                 self.selected_object = owner;
             }
+            Command::Overhead(c) => self.apply_overhead(c)?,
         }
         Ok(())
     }
@@ -528,19 +537,19 @@ impl Workspace {
     /// The classified shown frame.
     #[must_use]
     pub fn classified(&self) -> &ClassifiedImage {
-        self.pipeline.result().classified
+        self.shown_classified()
     }
 
     /// The shown frame's blobs.
     #[must_use]
     pub fn blobs(&self) -> &BlobSet {
-        self.pipeline.result().blobs
+        self.shown_blobs()
     }
 
     /// What recognition made of the shown frame: every candidate with its evidence.
     #[must_use]
     pub fn recognition(&self) -> &Recognition {
-        self.pipeline.result().recognition
+        self.shown_recognition()
     }
 
     /// The shown frame's drawing primitives (image pixels), computed once per frame.
@@ -658,6 +667,8 @@ impl Workspace {
             Window::Connect => self.settings.show_connect,
             Window::SourceSettings => self.settings.show_source_settings,
             Window::Record => self.settings.show_record,
+            Window::FieldView => self.settings.show_field_view,
+            Window::Calibration => self.settings.show_calibration,
         }
     }
 
@@ -670,6 +681,8 @@ impl Workspace {
             Window::Connect => &mut self.settings.show_connect,
             Window::SourceSettings => &mut self.settings.show_source_settings,
             Window::Record => &mut self.settings.show_record,
+            Window::FieldView => &mut self.settings.show_field_view,
+            Window::Calibration => &mut self.settings.show_calibration,
         }
     }
 

@@ -153,6 +153,28 @@ impl ViewTransform {
     }
 }
 
+/// View options of the overhead camera's image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OverheadView {
+    /// The field lines projected through the calibration in use.
+    pub field_lines: bool,
+    /// The image as a pinhole camera would see it (the lens's bending removed).
+    pub undistorted: bool,
+    /// Each picked calibration point with its reprojection error.
+    pub points: bool,
+}
+
+impl Default for OverheadView {
+    fn default() -> Self {
+        Self {
+            field_lines: true,
+            undistorted: false,
+            points: true,
+        }
+    }
+}
+
 /// Settings that persist between runs (eframe storage).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -199,6 +221,12 @@ pub struct Settings {
     pub show_timings: bool,
     /// The object inspector window open.
     pub show_inspector: bool,
+    /// The overhead field view open.
+    pub show_field_view: bool,
+    /// The overhead calibration window open.
+    pub show_calibration: bool,
+    /// Overhead view options.
+    pub overhead: OverheadView,
     /// The Connect dialog open (not kept between runs, like the other Camera dialogs).
     #[serde(skip)]
     pub show_connect: bool,
@@ -234,6 +262,9 @@ impl Default for Settings {
             show_try_edit: false,
             show_timings: true,
             show_inspector: false,
+            show_field_view: false,
+            show_calibration: false,
+            overhead: OverheadView::default(),
             show_connect: false,
             show_source_settings: false,
             show_record: false,

@@ -8,6 +8,8 @@ mod app;
 mod app_camera;
 #[cfg(feature = "gui")]
 mod app_live;
+#[cfg(feature = "gui")]
+mod app_overhead;
 mod cli;
 mod common;
 mod crash_safety;

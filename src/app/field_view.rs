@@ -1,0 +1,327 @@
+//! The field view: a top-down drawing of the field description's lines with the ball and each
+//! robot where the overhead camera puts them (position, heading, team colour, identity) and
+//! short trails; each robot's own world-model estimate of itself and of the ball drawn beside
+//! that overhead truth with the error of each, and a plot of the errors over the frames seen.
+//! Clicking a robot selects it in every view. It draws the workspace's field model only.
+
+use egui::{Color32, Context, FontId, Pos2, Rect, Sense, Stroke, Ui, vec2};
+use egui_plot::{Legend, Line, Plot, VLine};
+
+use super::overhead_overlays::team_colour;
+use crate::overhead::FieldDescription;
+use crate::workspace::{Command, OverheadCommand, RobotKey, Window, Workspace};
+
+/// Margin round the field's lines, centimetres.
+const MARGIN_CM: f32 = 30.0;
+/// A robot's drawn radius, centimetres (the marker plate's).
+const ROBOT_RADIUS_CM: f32 = 15.0;
+/// Screen distance within which a click selects a robot, points.
+const CLICK_RADIUS_PT: f32 = 14.0;
+/// Colour of a robot's own world-model estimates.
+const WORLD_MODEL_COLOUR: Color32 = Color32::from_rgb(230, 230, 230);
+/// Colour of the ball.
+const BALL_COLOUR: Color32 = Color32::from_rgb(255, 150, 30);
+
+/// The window, when open.
+pub fn field_view_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
+    if !state.window_open(Window::FieldView) {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new(Window::FieldView.name())
+        .open(&mut open)
+        .default_size([560.0, 560.0])
+        .default_pos([120.0, 80.0])
+        .show(ctx, |ui| field_view_ui(ui, state, commands));
+    if !open {
+        commands.push(Command::ShowWindow(Window::FieldView, false));
+    }
+}
+
+/// Field cm ↔ screen points for the drawing: x right, y up.
+#[derive(Debug, Clone, Copy)]
+pub struct FieldTransform {
+    rect: Rect,
+    centre_cm: [f32; 2],
+    scale: f32,
+}
+
+impl FieldTransform {
+    /// Fits the field's lines and landmarks (with a margin) into `rect`.
+    #[must_use]
+    pub fn fit(rect: Rect, field: &FieldDescription) -> Self {
+        let mut lo = [f32::MAX; 2];
+        let mut hi = [f32::MIN; 2];
+        let points = field
+            .lines
+            .iter()
+            .flat_map(|l| [l.from_cm, l.to_cm])
+            .chain(field.landmarks.iter().map(|l| l.field_cm));
+        for p in points {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k] as f32);
+                hi[k] = hi[k].max(p[k] as f32);
+            }
+        }
+        if lo[0] > hi[0] {
+            lo = [-300.0, -200.0];
+            hi = [300.0, 200.0];
+        }
+        let (w, h) = (
+            hi[0] - lo[0] + 2.0 * MARGIN_CM,
+            hi[1] - lo[1] + 2.0 * MARGIN_CM,
+        );
+        Self {
+            rect,
+            centre_cm: [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0],
+            scale: (rect.width() / w).min(rect.height() / h).max(1e-3),
+        }
+    }
+
+    /// A field point (cm) on screen.
+    #[must_use]
+    pub fn to_screen(&self, p: [f64; 2]) -> Pos2 {
+        self.rect.center()
+            + vec2(
+                (p[0] as f32 - self.centre_cm[0]) * self.scale,
+                -(p[1] as f32 - self.centre_cm[1]) * self.scale,
+            )
+    }
+
+    /// Screen points per centimetre.
+    #[must_use]
+    pub const fn scale(&self) -> f32 {
+        self.scale
+    }
+}
+
+/// The window's contents: the drawing, then the table and the plot of world-model errors.
+pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    let overhead = state.overhead();
+    if !overhead.active() {
+        ui.label(
+            "Not an overhead frame: open an overhead stream (e.g. streams/sim-overhead-game.mcap).",
+        );
+        return;
+    }
+    if overhead.detections().is_none() {
+        ui.label(overhead.calibration_status());
+    }
+    let models = overhead.field_model.world_models();
+    let plot_height = if models.is_empty() { 0.0 } else { 200.0 };
+    let size = vec2(
+        ui.available_width(),
+        (ui.available_height() - plot_height).max(220.0),
+    );
+    let (rect, response) = ui.allocate_exact_size(size, Sense::click());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "field drawing"));
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 2.0, Color32::from_rgb(20, 90, 40));
+    let xf = FieldTransform::fit(rect, overhead.field());
+    paint_field(&painter, &xf, overhead.field());
+    let robots = paint_objects(&painter, &xf, state);
+    if response.clicked()
+        && let Some(pos) = response.interact_pointer_pos()
+    {
+        let hit = robots
+            .iter()
+            .map(|(k, p)| (p.distance(pos), *k))
+            .filter(|(d, _)| *d <= CLICK_RADIUS_PT.max(ROBOT_RADIUS_CM * xf.scale()))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, k)| k);
+        commands.push(Command::Overhead(OverheadCommand::SelectRobot(hit)));
+    }
+    if !models.is_empty() {
+        errors_ui(ui, state);
+    }
+}
+
+fn paint_field(painter: &egui::Painter, xf: &FieldTransform, field: &FieldDescription) {
+    let stroke = Stroke::new(1.5, Color32::from_gray(235));
+    for l in &field.lines {
+        painter.line_segment([xf.to_screen(l.from_cm), xf.to_screen(l.to_cm)], stroke);
+    }
+    for a in &field.arcs {
+        let n = 48;
+        let pts: Vec<Pos2> = (0..=n)
+            .map(|k| {
+                let t = a.from_rad + (a.to_rad - a.from_rad) * f64::from(k) / f64::from(n);
+                xf.to_screen([
+                    a.centre_cm[0] + a.radius_cm * t.cos(),
+                    a.centre_cm[1] + a.radius_cm * t.sin(),
+                ])
+            })
+            .collect();
+        painter.add(egui::Shape::line(pts, stroke));
+    }
+}
+
+/// Draws trails, ball, robots and world models; returns each robot's screen position (for
+/// clicks).
+fn paint_objects(
+    painter: &egui::Painter,
+    xf: &FieldTransform,
+    state: &Workspace,
+) -> Vec<(RobotKey, Pos2)> {
+    let overhead = state.overhead();
+    let model = &overhead.field_model;
+    let selected = overhead.selected();
+    let trail = |pts: Vec<Pos2>, colour: Color32| {
+        painter.add(egui::Shape::line(
+            pts,
+            Stroke::new(1.0, colour.gamma_multiply(0.6)),
+        ));
+    };
+    trail(
+        model
+            .ball_trail()
+            .iter()
+            .map(|(_, p)| xf.to_screen(*p))
+            .collect(),
+        BALL_COLOUR,
+    );
+    for (k, t) in model.trails() {
+        trail(
+            t.iter().map(|(_, p)| xf.to_screen(*p)).collect(),
+            team_colour(k.team),
+        );
+    }
+    let mut out = Vec::new();
+    let radius = (ROBOT_RADIUS_CM * xf.scale()).max(4.0);
+    if let Some(d) = overhead.detections() {
+        for r in &d.robots {
+            let key = RobotKey {
+                team: r.team,
+                identity: r.identity,
+            };
+            let c = xf.to_screen(r.field_cm);
+            let colour = team_colour(r.team);
+            let width = if selected == Some(key) { 3.0 } else { 1.0 };
+            painter.circle_filled(c, radius, colour.gamma_multiply(0.8));
+            painter.circle_stroke(c, radius, Stroke::new(width, Color32::WHITE));
+            let dir = vec2(r.heading_rad.cos() as f32, -(r.heading_rad.sin() as f32));
+            painter.line_segment(
+                [c, c + dir * radius * 1.8],
+                Stroke::new(2.0, Color32::BLACK),
+            );
+            painter.text(
+                c,
+                egui::Align2::CENTER_CENTER,
+                r.identity.value().to_string(),
+                FontId::proportional(11.0),
+                Color32::BLACK,
+            );
+            out.push((key, c));
+        }
+        if let Some(b) = &d.ball {
+            painter.circle_filled(
+                xf.to_screen(b.field_cm),
+                (4.25 * xf.scale()).max(3.0),
+                BALL_COLOUR,
+            );
+        }
+    }
+    for m in model.world_models() {
+        let own = xf.to_screen([m.own[0], m.own[1]]);
+        let stroke = Stroke::new(1.0, WORLD_MODEL_COLOUR);
+        painter.circle_stroke(own, radius * 0.7, stroke);
+        let dir = vec2(m.own[2].cos() as f32, -(m.own[2].sin() as f32));
+        painter.line_segment([own, own + dir * radius * 1.4], stroke);
+        if let Some(k) = m.key
+            && let Some((_, c)) = out.iter().find(|(key, _)| *key == k)
+        {
+            painter.extend(egui::Shape::dashed_line(&[own, *c], stroke, 4.0, 3.0));
+        }
+        let text = format!(
+            "robot{}{}",
+            m.robot_id,
+            m.self_error_cm
+                .map(|e| format!(" {e:.0} cm"))
+                .unwrap_or_default()
+        );
+        painter.text(
+            own + vec2(radius, radius),
+            egui::Align2::LEFT_TOP,
+            text,
+            FontId::proportional(10.0),
+            WORLD_MODEL_COLOUR,
+        );
+        if let Some(b) = m.ball {
+            painter.circle_stroke(
+                xf.to_screen(b),
+                (4.25 * xf.scale()).max(3.0),
+                Stroke::new(1.0, BALL_COLOUR),
+            );
+        }
+    }
+    out
+}
+
+/// Each world model's errors on this frame, and over the frames seen so far.
+fn errors_ui(ui: &mut Ui, state: &Workspace) {
+    let model = &state.overhead().field_model;
+    let cm = |e: Option<f64>| e.map_or_else(|| "–".to_owned(), |e| format!("{e:.1}"));
+    egui::Grid::new("world-model-errors")
+        .striped(true)
+        .show(ui, |ui| {
+            for h in [
+                "world model",
+                "robot",
+                "self (cm)",
+                "heading (°)",
+                "ball (cm)",
+            ] {
+                ui.strong(h);
+            }
+            ui.end_row();
+            for m in model.world_models() {
+                ui.label(format!("robot{}", m.robot_id));
+                ui.label(
+                    m.key
+                        .map_or_else(|| "not seen".to_owned(), |k| format!("marker {k}")),
+                );
+                ui.monospace(cm(m.self_error_cm));
+                ui.monospace(cm(m.heading_error_deg));
+                ui.monospace(cm(m.ball_error_cm));
+                ui.end_row();
+            }
+        });
+    let now_s = state.current().map_or(0.0, |c| c.time_ns as f64 / 1e9);
+    let ids: Vec<u32> = model.world_models().iter().map(|m| m.robot_id).collect();
+    Plot::new("world-model-error-plot")
+        .height(140.0)
+        .legend(Legend::default())
+        .y_axis_label("error (cm)")
+        .show(ui, |p| {
+            for id in ids {
+                for (what, pick) in [("self", 0usize), ("ball", 1)] {
+                    let points: Vec<[f64; 2]> = model
+                        .error_samples()
+                        .filter_map(|s| {
+                            let (_, own, ball) = s.errors.iter().find(|e| e.0 == id)?;
+                            let e = if pick == 0 { *own } else { *ball };
+                            e.map(|e| [s.time_s, e])
+                        })
+                        .collect();
+                    p.line(Line::new(format!("robot{id} {what}"), points));
+                }
+            }
+            p.vline(VLine::new("current frame", now_s).color(Color32::WHITE));
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui::pos2;
+
+    #[test]
+    fn the_field_fits_its_rectangle_with_x_right_and_y_up() {
+        let rect = Rect::from_min_size(pos2(0.0, 0.0), vec2(600.0, 400.0));
+        let xf = FieldTransform::fit(rect, &FieldDescription::four_legged_2005());
+        let c = xf.to_screen([0.0, 0.0]);
+        assert!((c - rect.center()).length() < 1.0);
+        assert!(xf.to_screen([100.0, 0.0]).x > c.x);
+        assert!(xf.to_screen([0.0, 100.0]).y < c.y);
+    }
+}

@@ -1,0 +1,289 @@
+//! The field view's model, headless: where the overhead camera puts the ball and each robot
+//! (with short trails), each robot's own world-model estimate of itself and of the ball beside
+//! that overhead truth, the error of each, and the errors over the frames seen so far (for the
+//! plot). The app's field view (`app/field_view.rs`) only draws this.
+//!
+//! A world model (`/world_model/robotN`) names its robot by number; the overhead camera knows
+//! robots by team colour and marker identity. A synthetic frame's truth says which marker robot
+//! N wears; without truth a world model goes with the nearest detected robot within
+//! [`MATCH_RADIUS_CM`] of its own estimate.
+
+use std::collections::{BTreeMap, VecDeque};
+
+use super::overhead::RobotKey;
+use crate::eval::overhead::WorldModel;
+use crate::overhead::OverheadDetections;
+use crate::sim::truth::OverheadTruth;
+
+/// Positions a trail keeps (frames).
+pub const TRAIL_FRAMES: usize = 30;
+
+/// Farthest a world model's self estimate may be from a detected robot to be matched with it
+/// when the frame carries no truth, centimetres.
+pub const MATCH_RADIUS_CM: f64 = 100.0;
+
+/// One robot's world model on the shown frame, beside the overhead truth.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WorldModelView {
+    /// The robot's number (`/world_model/robotN`).
+    pub robot_id: u32,
+    /// The overhead robot it is compared with, if found.
+    pub key: Option<RobotKey>,
+    /// Its own estimate of itself: field x, y (cm) and heading (rad).
+    pub own: [f64; 3],
+    /// Its estimate of the ball, field x, y (cm).
+    pub ball: Option<[f64; 2]>,
+    /// Distance of its self estimate from the overhead robot, cm.
+    pub self_error_cm: Option<f64>,
+    /// Its heading error against the overhead robot's, degrees (absolute).
+    pub heading_error_deg: Option<f64>,
+    /// Distance of its ball estimate from the overhead ball, cm.
+    pub ball_error_cm: Option<f64>,
+}
+
+/// Errors of every world model at one frame, for the plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorSample {
+    /// Frame time, seconds since the first frame.
+    pub time_s: f64,
+    /// Per robot number: self error and ball error, cm.
+    pub errors: Vec<(u32, Option<f64>, Option<f64>)>,
+}
+
+/// See the module documentation.
+#[derive(Debug, Clone, Default)]
+pub struct FieldModel {
+    trails: BTreeMap<RobotKey, VecDeque<(usize, [f64; 2])>>,
+    ball_trail: VecDeque<(usize, [f64; 2])>,
+    last_index: Option<usize>,
+    world_models: Vec<WorldModelView>,
+    errors: BTreeMap<usize, ErrorSample>,
+}
+
+impl FieldModel {
+    /// Takes in the shown frame: `index` in the source, its time, what the overhead camera
+    /// found, the frame's truth if any and its extra channels (the world models).
+    pub fn observe(
+        &mut self,
+        index: usize,
+        time_ns: u64,
+        detections: Option<&OverheadDetections>,
+        truth: Option<&OverheadTruth>,
+        extra: &[(String, serde_json::Value)],
+    ) {
+        // Trails follow playback: a jump (seek, step back) starts them again; the same frame
+        // processed again (a new table or calibration) replaces its own points.
+        let again = self.last_index == Some(index);
+        if !again && self.last_index.is_none_or(|i| index != i + 1) {
+            self.trails.clear();
+            self.ball_trail.clear();
+        }
+        self.last_index = Some(index);
+        if let Some(d) = detections {
+            for r in &d.robots {
+                let key = RobotKey {
+                    team: r.team,
+                    identity: r.identity,
+                };
+                push_trail(self.trails.entry(key).or_default(), index, r.field_cm);
+            }
+            if let Some(b) = &d.ball {
+                push_trail(&mut self.ball_trail, index, b.field_cm);
+            }
+        }
+        self.world_models = extra
+            .iter()
+            .filter(|(topic, _)| topic.starts_with("/world_model/"))
+            .filter_map(|(_, v)| serde_json::from_value::<WorldModel>(v.clone()).ok())
+            .map(|m| compare(&m, detections, truth))
+            .collect();
+        self.world_models.sort_by_key(|m| m.robot_id);
+        if !self.world_models.is_empty() {
+            self.errors.insert(
+                index,
+                ErrorSample {
+                    time_s: time_ns as f64 / 1e9,
+                    errors: self
+                        .world_models
+                        .iter()
+                        .map(|m| (m.robot_id, m.self_error_cm, m.ball_error_cm))
+                        .collect(),
+                },
+            );
+        }
+    }
+
+    /// Each robot's trail, oldest first: (frame index, field position in cm).
+    #[must_use]
+    pub const fn trails(&self) -> &BTreeMap<RobotKey, VecDeque<(usize, [f64; 2])>> {
+        &self.trails
+    }
+
+    /// The ball's trail, oldest first: (frame index, field position in cm).
+    #[must_use]
+    pub const fn ball_trail(&self) -> &VecDeque<(usize, [f64; 2])> {
+        &self.ball_trail
+    }
+
+    /// The shown frame's world models, by robot number.
+    #[must_use]
+    pub fn world_models(&self) -> &[WorldModelView] {
+        &self.world_models
+    }
+
+    /// The world-model errors of every frame seen so far, in frame order.
+    pub fn error_samples(&self) -> impl Iterator<Item = &ErrorSample> {
+        self.errors.values()
+    }
+}
+
+fn push_trail(trail: &mut VecDeque<(usize, [f64; 2])>, index: usize, p: [f64; 2]) {
+    if trail.back().is_some_and(|(i, _)| *i == index) {
+        trail.pop_back();
+    }
+    trail.push_back((index, p));
+    while trail.len() > TRAIL_FRAMES {
+        trail.pop_front();
+    }
+}
+
+/// Which overhead robot a world model is about, and its errors against it.
+fn compare(
+    m: &WorldModel,
+    detections: Option<&OverheadDetections>,
+    truth: Option<&OverheadTruth>,
+) -> WorldModelView {
+    let own = [m.own.x_cm, m.own.y_cm];
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let key = match truth {
+        Some(t) => t
+            .robots
+            .iter()
+            .find(|r| r.id == m.robot_id)
+            .and_then(|r| r.marker)
+            .map(|k| RobotKey {
+                team: k.team,
+                identity: k.identity,
+            }),
+        None => detections.and_then(|d| {
+            d.robots
+                .iter()
+                .map(|r| (dist(r.field_cm, own), r))
+                .filter(|(e, _)| *e <= MATCH_RADIUS_CM)
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, r)| RobotKey {
+                    team: r.team,
+                    identity: r.identity,
+                })
+        }),
+    };
+    let seen = key.and_then(|k| {
+        detections?
+            .robots
+            .iter()
+            .find(|r| r.team == k.team && r.identity == k.identity)
+    });
+    let ball = m.ball.map(|b| [b.x_cm, b.y_cm]);
+    let overhead_ball = detections.and_then(|d| d.ball.as_ref()).map(|b| b.field_cm);
+    WorldModelView {
+        robot_id: m.robot_id,
+        key,
+        own: [m.own.x_cm, m.own.y_cm, m.own.heading_rad],
+        ball,
+        self_error_cm: seen.map(|r| dist(r.field_cm, own)),
+        heading_error_deg: seen.map(|r| {
+            let d = (m.own.heading_rad - r.heading_rad).rem_euclid(std::f64::consts::TAU);
+            d.min(std::f64::consts::TAU - d).to_degrees()
+        }),
+        ball_error_cm: ball.zip(overhead_ball).map(|(a, b)| dist(a, b)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{ImagePoint, MarkerIdentity, MarkerTeam};
+    use crate::overhead::recognise::{OverheadBall, OverheadRobot};
+
+    fn detections(robot_at: [f64; 2], ball_at: [f64; 2]) -> OverheadDetections {
+        let p = ImagePoint::new(0.0, 0.0);
+        OverheadDetections {
+            ball: Some(OverheadBall {
+                field_cm: ball_at,
+                image: p,
+                radius_px: 4.0,
+                confidence: 1.0,
+            }),
+            robots: vec![OverheadRobot {
+                team: MarkerTeam::Blue,
+                identity: MarkerIdentity::new(5).expect("identity"),
+                field_cm: robot_at,
+                heading_rad: 0.0,
+                image: p,
+                dots: [p; 4],
+                confidence: 1.0,
+            }],
+            rejected: Vec::new(),
+        }
+    }
+
+    fn world_model(id: u32, x: f64, heading: f64, ball_x: f64) -> (String, serde_json::Value) {
+        (
+            format!("/world_model/robot{id}"),
+            serde_json::json!({"robot_id": id, "self": {"x_cm": x, "y_cm": 0.0,
+                "heading_rad": heading}, "ball": {"x_cm": ball_x, "y_cm": 0.0}}),
+        )
+    }
+
+    #[test]
+    fn a_world_model_is_compared_with_the_nearest_robot_without_truth() {
+        let mut m = FieldModel::default();
+        let d = detections([100.0, 0.0], [0.0, 0.0]);
+        m.observe(0, 0, Some(&d), None, &[world_model(3, 130.0, 0.5, 40.0)]);
+        let w = &m.world_models()[0];
+        assert_eq!(w.key.map(|k| k.identity.value()), Some(5));
+        assert!((w.self_error_cm.expect("matched") - 30.0).abs() < 1e-9);
+        assert!((w.heading_error_deg.expect("matched") - 0.5f64.to_degrees()).abs() < 1e-9);
+        assert!((w.ball_error_cm.expect("ball") - 40.0).abs() < 1e-9);
+        // Too far from every robot: no match, no self error; the ball error stays.
+        m.observe(
+            1,
+            40_000_000,
+            Some(&d),
+            None,
+            &[world_model(3, 400.0, 0.0, 10.0)],
+        );
+        let w = &m.world_models()[0];
+        assert_eq!((w.key, w.self_error_cm), (None, None));
+        assert_eq!(m.error_samples().count(), 2);
+    }
+
+    #[test]
+    fn trails_grow_with_playback_stay_short_and_restart_on_a_jump() {
+        let mut m = FieldModel::default();
+        for i in 0..TRAIL_FRAMES + 5 {
+            let d = detections([i as f64, 0.0], [0.0, i as f64]);
+            m.observe(i, 0, Some(&d), None, &[]);
+        }
+        let trail = m.trails().values().next().expect("one robot");
+        assert_eq!(trail.len(), TRAIL_FRAMES);
+        assert_eq!(
+            trail.back(),
+            Some(&(TRAIL_FRAMES + 4, [(TRAIL_FRAMES + 4) as f64, 0.0]))
+        );
+        // The same frame again replaces its point.
+        m.observe(
+            TRAIL_FRAMES + 4,
+            0,
+            Some(&detections([-1.0, 0.0], [0.0, 0.0])),
+            None,
+            &[],
+        );
+        let trail = m.trails().values().next().expect("one robot");
+        assert_eq!(trail.len(), TRAIL_FRAMES);
+        assert_eq!(trail.back(), Some(&(TRAIL_FRAMES + 4, [-1.0, 0.0])));
+        assert_eq!(m.ball_trail().len(), TRAIL_FRAMES);
+        m.observe(3, 0, Some(&detections([0.0, 0.0], [0.0, 0.0])), None, &[]);
+        assert_eq!(m.trails().values().next().map(VecDeque::len), Some(1));
+    }
+}

@@ -1,0 +1,647 @@
+//! The overhead camera's side of the workspace: frames of an overhead source go through the
+//! [`OverheadPipeline`] (classification, blobs, ball and robot markers in field coordinates)
+//! instead of the robot-camera [`crate::pipeline::Pipeline`], with the calibration in use; the
+//! calibration tools (open, save, pick landmarks, solve) and the one robot selection.
+//!
+//! The calibration in use is, in this order: one the user opened or solved in the app (a user's
+//! choice beats a default; Overhead ▸ Close calibration goes back), the stream's own camera (a
+//! synthetic stream's `/ground_truth` carries the camera that made it), or none — then the
+//! frame is classified and its blobs found, but nothing is placed on the field, and the status
+//! line says so.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+
+use super::Workspace;
+use super::command::OverheadCommand;
+use super::field_model::FieldModel;
+use crate::geometry::{ImagePoint, MarkerIdentity, MarkerTeam, OverheadCamera};
+use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
+use crate::overhead::{
+    CalibrationPoint, FieldDescription, OverheadDetections, OverheadParams, OverheadPipeline,
+    PointsFile,
+};
+use crate::recognition::Recognition;
+use crate::sources::SourceFrame;
+
+/// Fewest picked points the solver is asked to work with (pose, focal, centre, k1, k2).
+pub const MIN_CALIBRATION_POINTS: usize = 6;
+
+/// One robot as the overhead camera identifies it: team colour and marker identity. The one
+/// robot selection of the workspace (field view, image overlays) is one of these.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct RobotKey {
+    /// Team dot colour.
+    pub team: MarkerTeam,
+    /// Marker identity, 0–15.
+    pub identity: MarkerIdentity,
+}
+
+impl Ord for RobotKey {
+    /// Blue team first, then by identity (listings, trails).
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        let rank = |k: &Self| (k.team == MarkerTeam::Yellow, k.identity);
+        rank(self).cmp(&rank(other))
+    }
+}
+
+impl PartialOrd for RobotKey {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl std::fmt::Display for RobotKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {}", self.team.name(), self.identity.value())
+    }
+}
+
+/// Where the camera in use comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CalibrationSource {
+    /// Opened from a file or solved in the app.
+    User,
+    /// The stream's own camera (a synthetic stream's truth).
+    Stream,
+}
+
+/// One picked point's change, for undo: the point's name and what it replaced.
+#[derive(Debug, Clone, PartialEq)]
+struct PickEdit {
+    name: String,
+    replaced: Option<CalibrationPoint>,
+}
+
+/// The overhead state; see the module documentation.
+#[derive(Debug)]
+pub struct Overhead {
+    pipeline: OverheadPipeline,
+    /// The shown frame went through the overhead pipeline.
+    active: bool,
+    detections: Option<OverheadDetections>,
+    user_calibration: Option<Calibration>,
+    calibration_path: Option<PathBuf>,
+    stream_camera: Option<OverheadCamera>,
+    field: FieldDescription,
+    field_path: Option<PathBuf>,
+    points: PointsFile,
+    points_path: Option<PathBuf>,
+    picks: Vec<PickEdit>,
+    landmark: Option<String>,
+    selected: Option<RobotKey>,
+    synced_table: Option<u64>,
+    /// The undistorted view's pixel map and the camera and size it was made for.
+    view_map: Option<(OverheadCamera, (usize, usize), Vec<Option<u32>>)>,
+    empty_recognition: Recognition,
+    /// The field view's model: trails, world models, errors over time.
+    pub field_model: FieldModel,
+}
+
+impl Default for Overhead {
+    fn default() -> Self {
+        let field = FieldDescription::four_legged_2005();
+        Self {
+            pipeline: OverheadPipeline::new(
+                crate::lut::LookupTable::new(6).unwrap_or_else(|_| super::seven_bit_table()),
+                OverheadCamera::above_field_2005(),
+                params_for(&field),
+            ),
+            active: false,
+            detections: None,
+            user_calibration: None,
+            calibration_path: None,
+            stream_camera: None,
+            field,
+            field_path: None,
+            points: PointsFile::new(0, 0),
+            points_path: None,
+            picks: Vec::new(),
+            landmark: None,
+            selected: None,
+            synced_table: None,
+            view_map: None,
+            empty_recognition: Recognition::default(),
+            field_model: FieldModel::default(),
+        }
+    }
+}
+
+/// The recogniser's settings for a field (ball radius, plate height).
+fn params_for(field: &FieldDescription) -> OverheadParams {
+    OverheadParams {
+        ball_radius_cm: field.ball_radius_cm,
+        plate_height_cm: field.plate_height_cm,
+        ..OverheadParams::default()
+    }
+}
+
+impl Overhead {
+    /// True when the shown frame went through the overhead pipeline.
+    #[must_use]
+    pub const fn active(&self) -> bool {
+        self.active
+    }
+
+    /// The shown frame's ball and robots in field coordinates; `None` for a robot-camera frame
+    /// or when no calibration is set.
+    #[must_use]
+    pub const fn detections(&self) -> Option<&OverheadDetections> {
+        self.detections.as_ref()
+    }
+
+    /// The camera in use and where it comes from.
+    #[must_use]
+    pub fn camera(&self) -> Option<(&OverheadCamera, CalibrationSource)> {
+        self.user_calibration
+            .as_ref()
+            .map(|c| (&c.camera, CalibrationSource::User))
+            .or_else(|| {
+                self.stream_camera
+                    .as_ref()
+                    .map(|c| (c, CalibrationSource::Stream))
+            })
+    }
+
+    /// The calibration opened or solved in the app (with each point's reprojection error).
+    #[must_use]
+    pub const fn calibration(&self) -> Option<&Calibration> {
+        self.user_calibration.as_ref()
+    }
+
+    /// The calibration's file, if it was opened or saved.
+    #[must_use]
+    pub fn calibration_path(&self) -> Option<&Path> {
+        self.calibration_path.as_deref()
+    }
+
+    /// The field description (landmarks by name, lines).
+    #[must_use]
+    pub const fn field(&self) -> &FieldDescription {
+        &self.field
+    }
+
+    /// The picked points.
+    #[must_use]
+    pub const fn points(&self) -> &PointsFile {
+        &self.points
+    }
+
+    /// The points file, if it was opened or saved.
+    #[must_use]
+    pub fn points_path(&self) -> Option<&Path> {
+        self.points_path.as_deref()
+    }
+
+    /// The landmark the next click in the image picks, if one is chosen.
+    #[must_use]
+    pub fn landmark(&self) -> Option<&str> {
+        self.landmark.as_deref()
+    }
+
+    /// How many picks can be undone.
+    #[must_use]
+    pub fn picks_to_undo(&self) -> usize {
+        self.picks.len()
+    }
+
+    /// The selected robot (field view, overlays).
+    #[must_use]
+    pub const fn selected(&self) -> Option<RobotKey> {
+        self.selected
+    }
+
+    /// The stage timings of the last overhead frame.
+    #[must_use]
+    pub fn timings(&self) -> crate::overhead::pipeline::OverheadTimings {
+        self.pipeline.timings()
+    }
+
+    /// One line on the calibration in use, for the status line.
+    #[must_use]
+    pub fn calibration_status(&self) -> String {
+        match self.camera() {
+            None => "overhead: no calibration set (Overhead > Open calibration…, or pick points and Calibrate): nothing is placed on the field".to_owned(),
+            Some((_, CalibrationSource::Stream)) => "overhead: the stream's own camera".to_owned(),
+            Some((_, CalibrationSource::User)) => {
+                let name = self
+                    .calibration_path
+                    .as_deref()
+                    .map_or_else(|| "solved in the app".to_owned(), crate::frame::display_name);
+                let median = self
+                    .user_calibration
+                    .as_ref()
+                    .map_or(f64::NAN, Calibration::median_point_error_px);
+                format!("overhead: calibration {name} (median point error {median:.2} px)")
+            }
+        }
+    }
+}
+
+impl Workspace {
+    /// The overhead camera's state: detections, calibration, picked points, selection.
+    #[must_use]
+    pub const fn overhead(&self) -> &Overhead {
+        &self.overhead
+    }
+
+    /// The shown frame's overhead detections (ball and robots in field coordinates), when it
+    /// is an overhead frame with a calibration in use.
+    #[must_use]
+    pub const fn overhead_detections(&self) -> Option<&OverheadDetections> {
+        self.overhead.detections()
+    }
+
+    /// Recognition results for the views: the robot pipeline's, or none for an overhead frame.
+    pub(super) fn shown_recognition(&self) -> &Recognition {
+        if self.overhead.active {
+            &self.overhead.empty_recognition
+        } else {
+            self.pipeline.result().recognition
+        }
+    }
+
+    /// Classified image of the shown frame, from whichever pipeline ran.
+    pub(super) fn shown_classified(&self) -> &crate::classify::ClassifiedImage {
+        if self.overhead.active {
+            self.overhead.pipeline.classified()
+        } else {
+            self.pipeline.result().classified
+        }
+    }
+
+    /// Blobs of the shown frame, from whichever pipeline ran.
+    pub(super) fn shown_blobs(&self) -> &crate::blobs::BlobSet {
+        if self.overhead.active {
+            self.overhead.pipeline.blobs()
+        } else {
+            self.pipeline.result().blobs
+        }
+    }
+
+    /// Runs the overhead pipeline on an overhead frame with the table in use and the
+    /// calibration in use; returns the stage timings in the robot pipeline's shape.
+    pub(super) fn run_overhead(&mut self, loaded: &SourceFrame) -> crate::pipeline::StageTimings {
+        if self.overhead.synced_table != Some(self.table_generation) {
+            self.overhead.pipeline.set_lut(self.pipeline.lut().clone());
+            self.overhead.synced_table = Some(self.table_generation);
+        }
+        self.overhead.stream_camera = stream_camera(loaded);
+        let camera = self.overhead.camera().map(|(c, _)| *c);
+        if let Some(c) = camera {
+            self.overhead.pipeline.set_camera(c);
+        }
+        self.overhead.pipeline.process(&loaded.frame);
+        self.overhead.active = true;
+        if (self.overhead.points.width, self.overhead.points.height) == (0, 0) {
+            self.overhead.points = PointsFile::new(loaded.frame.width(), loaded.frame.height());
+        }
+        self.overhead.detections = camera.map(|_| self.overhead.pipeline.detections().clone());
+        self.refresh_view_map((loaded.frame.width(), loaded.frame.height()));
+        self.primitives.clear();
+        self.accepted_owners.clear();
+        self.selected_object = None;
+        self.frame_counts = self.overhead.pipeline.classified().histogram();
+        let truth = truth_of(loaded);
+        let index = self.index_of_frame(loaded);
+        self.overhead.field_model.observe(
+            index,
+            loaded.time_ns,
+            self.overhead.detections.as_ref(),
+            truth.as_ref(),
+            &loaded.extra,
+        );
+        let t = self.overhead.pipeline.timings();
+        crate::pipeline::StageTimings {
+            classify: t.classify,
+            blobs: t.blobs,
+            recognition: t.recognition,
+        }
+    }
+
+    /// The index a frame is shown at (live frames count on; recorded ones by their index).
+    fn index_of_frame(&self, loaded: &SourceFrame) -> usize {
+        self.source
+            .as_ref()
+            .map_or(self.index, |s| s.index_at_time(loaded.time_ns))
+    }
+
+    /// Applies an overhead command.
+    pub(super) fn apply_overhead(&mut self, command: OverheadCommand) -> anyhow::Result<()> {
+        match command {
+            OverheadCommand::OpenCalibration(p) => {
+                let cal = Calibration::load(&p)?;
+                self.status = format!(
+                    "opened calibration {}: {} points, median error {:.2} px",
+                    p.display(),
+                    cal.points.len(),
+                    cal.median_point_error_px()
+                );
+                self.overhead.user_calibration = Some(cal);
+                self.overhead.calibration_path = Some(p);
+                self.reprocess();
+            }
+            OverheadCommand::SaveCalibration(p) => {
+                let cal = self
+                    .overhead
+                    .user_calibration
+                    .as_ref()
+                    .context("no calibration to save: open one or Calibrate first")?;
+                cal.save(&p)?;
+                self.overhead.calibration_path = Some(p.clone());
+                self.status = format!("saved calibration {}", p.display());
+            }
+            OverheadCommand::CloseCalibration => {
+                self.overhead.user_calibration = None;
+                self.overhead.calibration_path = None;
+                self.reprocess();
+                self.status = self.overhead.calibration_status();
+            }
+            OverheadCommand::OpenField(p) => {
+                let field = FieldDescription::load(&p)?;
+                self.overhead.pipeline = OverheadPipeline::new(
+                    self.pipeline.lut().clone(),
+                    *self.overhead.pipeline.camera(),
+                    params_for(&field),
+                );
+                self.overhead.synced_table = Some(self.table_generation);
+                self.status = format!(
+                    "field {}: {} landmarks, {} lines",
+                    field.name,
+                    field.landmarks.len(),
+                    field.lines.len()
+                );
+                self.overhead.field = field;
+                self.overhead.field_path = Some(p);
+                self.overhead.landmark = None;
+                self.reprocess();
+            }
+            OverheadCommand::OpenPoints(p) => {
+                let points = PointsFile::load(&p)?;
+                self.status = format!("opened {} points from {}", points.points.len(), p.display());
+                self.overhead.points = points;
+                self.overhead.points_path = Some(p);
+                self.overhead.picks.clear();
+            }
+            OverheadCommand::SavePoints(p) => {
+                anyhow::ensure!(
+                    !self.overhead.points.points.is_empty(),
+                    "no points picked yet: choose a landmark and click it in the image"
+                );
+                self.overhead.points.save(&p)?;
+                self.status = format!(
+                    "saved {} points as {}",
+                    self.overhead.points.points.len(),
+                    p.display()
+                );
+                self.overhead.points_path = Some(p);
+            }
+            OverheadCommand::ChooseLandmark(name) => self.choose_landmark(name)?,
+            OverheadCommand::PickPoint { x_px, y_px } => self.pick_point(x_px, y_px)?,
+            OverheadCommand::UndoPick => self.undo_pick()?,
+            OverheadCommand::Calibrate => self.calibrate_from_points()?,
+            OverheadCommand::SelectRobot(key) => {
+                self.overhead.selected = key;
+                if let Some(k) = key {
+                    self.status = format!("selected robot {k}");
+                }
+            }
+            OverheadCommand::SetView(v) => {
+                self.settings.overhead = v;
+                self.refresh_view_map(self.image_size());
+                self.frame_generation += 1;
+            }
+        }
+        Ok(())
+    }
+
+    fn choose_landmark(&mut self, name: Option<String>) -> anyhow::Result<()> {
+        if let Some(n) = &name {
+            anyhow::ensure!(
+                self.overhead.field.landmark(n).is_some(),
+                "no landmark {n:?} in the field {}",
+                self.overhead.field.name
+            );
+            self.status = format!("click {n} in the image");
+        }
+        self.overhead.landmark = name;
+        Ok(())
+    }
+
+    fn pick_point(&mut self, x_px: f64, y_px: f64) -> anyhow::Result<()> {
+        let name = self
+            .overhead
+            .landmark
+            .clone()
+            .context("choose a landmark first (Calibration window)")?;
+        let (w, h) = self.image_size();
+        anyhow::ensure!(w > 0, "no frame to pick on");
+        anyhow::ensure!(
+            x_px.is_finite()
+                && y_px.is_finite()
+                && (0.0..w as f64).contains(&x_px)
+                && (0.0..h as f64).contains(&y_px),
+            "({x_px:.1}, {y_px:.1}) is outside the {w}×{h} frame"
+        );
+        let l = self
+            .overhead
+            .field
+            .landmark(&name)
+            .with_context(|| format!("no landmark {name:?}"))?
+            .clone();
+        if (self.overhead.points.width, self.overhead.points.height) != (w, h) {
+            anyhow::ensure!(
+                self.overhead.points.points.is_empty(),
+                "the picked points are for a {}×{} frame, this one is {w}×{h}",
+                self.overhead.points.width,
+                self.overhead.points.height
+            );
+            self.overhead.points = PointsFile::new(w, h);
+        }
+        let replaced = self
+            .overhead
+            .points
+            .points
+            .iter()
+            .find(|p| p.name == name)
+            .cloned();
+        self.overhead.points.set(CalibrationPoint {
+            name: name.clone(),
+            field_cm: l.field_cm,
+            height_cm: l.height_cm,
+            image_px: [x_px, y_px],
+        });
+        self.overhead.picks.push(PickEdit {
+            name: name.clone(),
+            replaced,
+        });
+        // The next landmark not yet picked, so clicking round the field needs no menu.
+        let picked = |n: &str| self.overhead.points.points.iter().any(|p| p.name == n);
+        let next = self
+            .overhead
+            .field
+            .landmarks
+            .iter()
+            .map(|l| l.name.clone())
+            .find(|n| !picked(n));
+        self.status = format!(
+            "{name} at ({x_px:.1}, {y_px:.1}) px; {} points{}",
+            self.overhead.points.points.len(),
+            next.as_ref()
+                .map(|n| format!("; next: {n}"))
+                .unwrap_or_default()
+        );
+        self.overhead.landmark = next;
+        Ok(())
+    }
+
+    fn undo_pick(&mut self) -> anyhow::Result<()> {
+        let edit = self
+            .overhead
+            .picks
+            .pop()
+            .context("no picked point to undo")?;
+        self.overhead.points.remove(&edit.name);
+        if let Some(old) = edit.replaced {
+            self.overhead.points.set(old);
+        }
+        self.overhead.landmark = Some(edit.name.clone());
+        self.status = format!("undid the pick of {}", edit.name);
+        Ok(())
+    }
+
+    fn calibrate_from_points(&mut self) -> anyhow::Result<()> {
+        let n = self.overhead.points.points.len();
+        anyhow::ensure!(
+            n >= MIN_CALIBRATION_POINTS,
+            "{n} points picked: calibration needs at least {MIN_CALIBRATION_POINTS}"
+        );
+        let frame = self.frame().cloned();
+        let frame = frame.filter(|f| {
+            (f.width(), f.height()) == (self.overhead.points.width, self.overhead.points.height)
+        });
+        let cal = calibrate(
+            &self.overhead.points,
+            &self.overhead.field,
+            frame.as_ref(),
+            &CalibrationParams::default(),
+        )?;
+        self.status = format!(
+            "calibrated from {n} points: median error {:.2} px{}",
+            cal.median_point_error_px(),
+            cal.line_rms_px
+                .map(|r| format!(", lines {r:.2} px rms over {} samples", cal.line_samples))
+                .unwrap_or_default()
+        );
+        self.overhead.user_calibration = Some(cal);
+        self.overhead.calibration_path = None;
+        self.reprocess();
+        Ok(())
+    }
+
+    /// Makes or drops the undistorted view's pixel map for the shown frame and camera.
+    pub(super) fn refresh_view_map(&mut self, size: (usize, usize)) {
+        let wanted = self.settings.overhead.undistorted && self.overhead.active;
+        let camera = self.overhead.camera().map(|(c, _)| *c);
+        match (wanted, camera) {
+            (true, Some(c)) => {
+                let fresh = self
+                    .overhead
+                    .view_map
+                    .as_ref()
+                    .is_some_and(|(mc, ms, _)| *mc == c && *ms == size);
+                if !fresh {
+                    let map = crate::overhead::undistort::source_pixel_map(&c, size.0, size.1);
+                    self.overhead.view_map = Some((c, size, map));
+                }
+            }
+            _ => self.overhead.view_map = None,
+        }
+    }
+
+    /// True when the views show the undistorted image.
+    #[must_use]
+    pub const fn undistorted_view(&self) -> bool {
+        self.overhead.view_map.is_some()
+    }
+
+    /// The shown frame as packed RGB as the views show it (undistorted when chosen).
+    #[must_use]
+    pub fn view_rgb(&self) -> std::borrow::Cow<'_, [u8]> {
+        let Some((_, _, map)) = &self.overhead.view_map else {
+            return std::borrow::Cow::Borrowed(self.rgb());
+        };
+        let rgb = self.rgb();
+        let mut out = vec![0u8; map.len() * 3];
+        for (o, k) in out.chunks_exact_mut(3).zip(map) {
+            if let Some(src) = k.and_then(|k| rgb.get(k as usize * 3..k as usize * 3 + 3)) {
+                o.copy_from_slice(src);
+            }
+        }
+        std::borrow::Cow::Owned(out)
+    }
+
+    /// One class code per pixel as the views show it (undistorted when chosen).
+    #[must_use]
+    pub fn view_codes(&self) -> std::borrow::Cow<'_, [u8]> {
+        let codes = self.classified().codes();
+        let Some((_, _, map)) = &self.overhead.view_map else {
+            return std::borrow::Cow::Borrowed(codes);
+        };
+        std::borrow::Cow::Owned(
+            map.iter()
+                .map(|k| k.and_then(|k| codes.get(k as usize).copied()).unwrap_or(0))
+                .collect(),
+        )
+    }
+
+    /// The camera's image point a view point (pixels) shows: itself, or through the lens
+    /// model in the undistorted view. Clicks are turned into camera pixels with this.
+    #[must_use]
+    pub fn camera_point_of_view(&self, p: ImagePoint) -> ImagePoint {
+        match &self.overhead.view_map {
+            Some((c, size, _)) => crate::overhead::undistort::distorted_point(p, c, *size),
+            None => p,
+        }
+    }
+
+    /// Marks the shown frame as a robot-camera frame (the robot pipeline ran on it).
+    pub(super) fn overhead_inactive(&mut self) {
+        self.overhead.active = false;
+        self.overhead.detections = None;
+        self.overhead.view_map = None;
+    }
+
+    /// Forgets the per-stream overhead state when another source is opened.
+    pub(super) fn reset_overhead_for_source(&mut self) {
+        self.overhead.active = false;
+        self.overhead.detections = None;
+        self.overhead.stream_camera = None;
+        self.overhead.field_model = FieldModel::default();
+    }
+
+    /// Where an image point (pixels of the camera's image) is drawn in the views: itself, or
+    /// its place in the undistorted view when that is shown.
+    #[must_use]
+    pub fn overhead_view_point(&self, p: ImagePoint) -> Option<ImagePoint> {
+        match &self.overhead.view_map {
+            Some((c, size, _)) => crate::overhead::undistort::undistorted_point(p, c, *size),
+            None => Some(p),
+        }
+    }
+}
+
+/// The camera a frame's own truth names, if it is a synthetic overhead frame.
+fn stream_camera(loaded: &SourceFrame) -> Option<OverheadCamera> {
+    truth_of(loaded).map(|t| t.camera)
+}
+
+/// The overhead truth a synthetic frame carries, if any.
+pub(super) fn truth_of(loaded: &SourceFrame) -> Option<crate::sim::truth::OverheadTruth> {
+    let value = loaded.channel(crate::streams::GROUND_TRUTH_TOPIC)?;
+    match serde_json::from_value::<crate::sim::truth::GroundTruth>(value.clone()) {
+        Ok(crate::sim::truth::GroundTruth::Overhead(t)) => Some(t),
+        _ => None,
+    }
+}
