@@ -47,12 +47,16 @@ pub enum OverheadCommand {
 #[derive(Debug, clap::Args)]
 pub struct MarkerArgs {
     /// Team dot colour: `blue` or `yellow`.
-    #[arg(long)]
-    pub team: String,
+    #[arg(long, required_unless_present = "all", conflicts_with = "all")]
+    pub team: Option<String>,
     /// Identity, 0–15.
+    #[arg(long, required_unless_present = "all", conflicts_with = "all")]
+    pub id: Option<u8>,
+    /// Write every marker (both teams, identities 0–15) into the folder `-o` names, as
+    /// `TEAM-NN.svg` (the set shipped in `assets/markers/`).
     #[arg(long)]
-    pub id: u8,
-    /// Output SVG.
+    pub all: bool,
+    /// Output SVG (with `--all`, the folder).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -149,9 +153,15 @@ pub fn load_field(path: Option<&Path>) -> anyhow::Result<FieldDescription> {
 }
 
 fn run_marker(a: &MarkerArgs) -> anyhow::Result<()> {
-    let team = MarkerTeam::from_name(&a.team)
-        .with_context(|| format!("team {:?}: must be blue or yellow", a.team))?;
-    let id = MarkerIdentity::new(a.id).with_context(|| format!("id {}: must be 0-15", a.id))?;
+    if a.all {
+        return write_all_markers(&a.output);
+    }
+    let (Some(name), Some(value)) = (a.team.as_deref(), a.id) else {
+        bail!("--team and --id name the marker (or --all writes every one)");
+    };
+    let team = MarkerTeam::from_name(name)
+        .with_context(|| format!("team {name:?}: must be blue or yellow"))?;
+    let id = MarkerIdentity::new(value).with_context(|| format!("id {value}: must be 0-15"))?;
     crate::atomic_file::write_atomic(&a.output, marker_svg(team, id).as_bytes())
         .with_context(|| format!("{}: cannot write", a.output.display()))?;
     eprintln!(
@@ -159,6 +169,27 @@ fn run_marker(a: &MarkerArgs) -> anyhow::Result<()> {
         a.output.display(),
         team.name()
     );
+    Ok(())
+}
+
+/// The file name of a marker in a `--all` folder: `blue-05.svg`.
+#[must_use]
+pub fn marker_file_name(team: MarkerTeam, id: MarkerIdentity) -> String {
+    format!("{}-{:02}.svg", team.name(), id.value())
+}
+
+/// Writes all 32 markers into `dir` (made if missing).
+fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot make", dir.display()))?;
+    for team in [MarkerTeam::Blue, MarkerTeam::Yellow] {
+        for value in 0..16 {
+            let id = MarkerIdentity::new(value).context("identity in 0..16")?;
+            let path = dir.join(marker_file_name(team, id));
+            crate::atomic_file::write_atomic(&path, marker_svg(team, id).as_bytes())
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
+    eprintln!("{}: 32 markers (blue and yellow, 0-15)", dir.display());
     Ok(())
 }
 
