@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Serialize;
 
-use super::inputs::{FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress};
+use super::inputs::{
+    FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress, refuse_overwriting,
+};
 use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
 use crate::overhead::OverheadPipeline;
 use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
@@ -194,6 +196,16 @@ fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
 }
 
 fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
+    let png = a.output.with_extension("lines.png");
+    let inputs: Vec<PathBuf> = [Some(&a.points), a.image.as_ref(), a.field.as_ref()]
+        .into_iter()
+        .flatten()
+        .cloned()
+        .collect();
+    refuse_overwriting(&a.output, &inputs)?;
+    if a.image.is_some() {
+        refuse_overwriting(&png, &inputs)?;
+    }
     let field = load_field(a.field.as_deref())?;
     let points = PointsFile::load(&a.points)?;
     let frame = a
@@ -225,7 +237,6 @@ fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
     cal.save(&a.output)?;
     print_calibration(&cal);
     if let Some(f) = &frame {
-        let png = a.output.with_extension("lines.png");
         write_lines_png(&png, f, &field, &cal.camera)?;
         println!("field lines over the image: {}", png.display());
     }
@@ -470,6 +481,7 @@ fn run_sim_points(a: &SimPointsArgs) -> anyhow::Result<()> {
     if !(a.noise_px.is_finite() && a.noise_px >= 0.0) {
         bail!("--noise-px must be a non-negative number");
     }
+    refuse_overwriting(&a.output, std::slice::from_ref(&a.stream))?;
     let field = load_field(a.field.as_deref())?;
     let camera = stream_truth_camera(&a.stream)?;
     let file = simulated_clicks(&camera, &field, a.noise_px, a.seed);

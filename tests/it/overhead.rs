@@ -408,4 +408,19 @@ fn a_points_file_with_too_few_points_fails_in_one_line() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("at least 6"), "{err}");
     assert!(!dir.path().join("c.json").exists());
+    // Writing the calibration over its own points file is refused, the file kept.
+    let before = std::fs::read(&points).unwrap();
+    let out = crate::common::eotn(&[
+        OsStr::new("overhead"),
+        OsStr::new("calibrate"),
+        OsStr::new("--points"),
+        points.as_os_str(),
+        OsStr::new("-o"),
+        points.as_os_str(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("would replace the input"), "{err}");
+    assert_eq!(std::fs::read(&points).unwrap(), before);
 }
