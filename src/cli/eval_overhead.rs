@@ -166,21 +166,33 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         println!("  wrong identity: {t} read as {read}");
     }
     for m in &r.world_models {
-        let vs = &m.self_error_vs_overhead_cm;
-        let vs = if vs.n == 0 {
-            "not seen overhead".to_owned()
-        } else {
-            format!("vs overhead {:.1} cm, n={}", vs.p50, vs.n)
-        };
         println!(
-            "world model robot{:<2}   self median {:.1} cm p95 {:.1} ({vs}), heading {:.1}°, \
-             ball median {:.1} cm",
+            "world model robot{:<2}   vs truth: self median {:.1} cm p95 {:.1}, heading {:.1}°, \
+             ball {:.1} cm",
             m.robot_id,
             m.self_error_cm.p50,
             m.self_error_cm.p95,
             m.heading_error_deg.p50,
             m.ball_error_cm.p50
         );
+        let vs = &m.self_error_vs_overhead_cm;
+        if vs.n == 0 {
+            println!("                       vs overhead: not seen overhead");
+        } else {
+            println!(
+                "                       vs overhead: self median {:.1} cm p95 {:.1} (n={}), \
+                 heading {:.1}°, ball {}",
+                vs.p50,
+                vs.p95,
+                vs.n,
+                m.heading_error_vs_overhead_deg.p50,
+                if m.ball_error_vs_overhead_cm.n == 0 {
+                    "not seen".to_owned()
+                } else {
+                    format!("{:.1} cm", m.ball_error_vs_overhead_cm.p50)
+                }
+            );
+        }
     }
     if !skipped.is_empty() {
         println!(

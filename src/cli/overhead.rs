@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Serialize;
 
-use super::inputs::{FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress};
+use super::inputs::{
+    FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress, refuse_overwriting,
+};
 use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
 use crate::overhead::OverheadPipeline;
 use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
@@ -47,12 +49,16 @@ pub enum OverheadCommand {
 #[derive(Debug, clap::Args)]
 pub struct MarkerArgs {
     /// Team dot colour: `blue` or `yellow`.
-    #[arg(long)]
-    pub team: String,
+    #[arg(long, required_unless_present = "all", conflicts_with = "all")]
+    pub team: Option<String>,
     /// Identity, 0–15.
+    #[arg(long, required_unless_present = "all", conflicts_with = "all")]
+    pub id: Option<u8>,
+    /// Write every marker (both teams, identities 0–15) into the folder `-o` names, as
+    /// `TEAM-NN.svg` (the set shipped in `assets/markers/`).
     #[arg(long)]
-    pub id: u8,
-    /// Output SVG.
+    pub all: bool,
+    /// Output SVG (with `--all`, the folder).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -149,9 +155,15 @@ pub fn load_field(path: Option<&Path>) -> anyhow::Result<FieldDescription> {
 }
 
 fn run_marker(a: &MarkerArgs) -> anyhow::Result<()> {
-    let team = MarkerTeam::from_name(&a.team)
-        .with_context(|| format!("team {:?}: must be blue or yellow", a.team))?;
-    let id = MarkerIdentity::new(a.id).with_context(|| format!("id {}: must be 0-15", a.id))?;
+    if a.all {
+        return write_all_markers(&a.output);
+    }
+    let (Some(name), Some(value)) = (a.team.as_deref(), a.id) else {
+        bail!("--team and --id name the marker (or --all writes every one)");
+    };
+    let team = MarkerTeam::from_name(name)
+        .with_context(|| format!("team {name:?}: must be blue or yellow"))?;
+    let id = MarkerIdentity::new(value).with_context(|| format!("id {value}: must be 0-15"))?;
     crate::atomic_file::write_atomic(&a.output, marker_svg(team, id).as_bytes())
         .with_context(|| format!("{}: cannot write", a.output.display()))?;
     eprintln!(
@@ -162,7 +174,38 @@ fn run_marker(a: &MarkerArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The file name of a marker in a `--all` folder: `blue-05.svg`.
+#[must_use]
+pub fn marker_file_name(team: MarkerTeam, id: MarkerIdentity) -> String {
+    format!("{}-{:02}.svg", team.name(), id.value())
+}
+
+/// Writes all 32 markers into `dir` (made if missing).
+fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot make", dir.display()))?;
+    for team in [MarkerTeam::Blue, MarkerTeam::Yellow] {
+        for value in 0..16 {
+            let id = MarkerIdentity::new(value).context("identity in 0..16")?;
+            let path = dir.join(marker_file_name(team, id));
+            crate::atomic_file::write_atomic(&path, marker_svg(team, id).as_bytes())
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
+    eprintln!("{}: 32 markers (blue and yellow, 0-15)", dir.display());
+    Ok(())
+}
+
 fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
+    let png = a.output.with_extension("lines.png");
+    let inputs: Vec<PathBuf> = [Some(&a.points), a.image.as_ref(), a.field.as_ref()]
+        .into_iter()
+        .flatten()
+        .cloned()
+        .collect();
+    refuse_overwriting(&a.output, &inputs)?;
+    if a.image.is_some() {
+        refuse_overwriting(&png, &inputs)?;
+    }
     let field = load_field(a.field.as_deref())?;
     let points = PointsFile::load(&a.points)?;
     let frame = a
@@ -194,7 +237,6 @@ fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
     cal.save(&a.output)?;
     print_calibration(&cal);
     if let Some(f) = &frame {
-        let png = a.output.with_extension("lines.png");
         write_lines_png(&png, f, &field, &cal.camera)?;
         println!("field lines over the image: {}", png.display());
     }
@@ -439,6 +481,7 @@ fn run_sim_points(a: &SimPointsArgs) -> anyhow::Result<()> {
     if !(a.noise_px.is_finite() && a.noise_px >= 0.0) {
         bail!("--noise-px must be a non-negative number");
     }
+    refuse_overwriting(&a.output, std::slice::from_ref(&a.stream))?;
     let field = load_field(a.field.as_deref())?;
     let camera = stream_truth_camera(&a.stream)?;
     let file = simulated_clicks(&camera, &field, a.noise_px, a.seed);

@@ -146,6 +146,11 @@ pub struct WorldModelFrameEval {
     /// Its own position estimate's error against the overhead detection of its marker,
     /// centimetres (what the debugger shows when there is no truth).
     pub self_error_vs_overhead_cm: Option<f64>,
+    /// Its own heading estimate's error against the overhead detection of its marker,
+    /// degrees (absolute).
+    pub heading_error_vs_overhead_deg: Option<f64>,
+    /// Its ball estimate's error against the ball the overhead camera found, centimetres.
+    pub ball_error_vs_overhead_cm: Option<f64>,
 }
 
 /// A robot's world model as the simulator writes it on `/world_model/robotN`.
@@ -210,6 +215,15 @@ pub fn evaluate_world_model(
             _ => None,
         },
         self_error_vs_overhead_cm: overhead.map(|d| dist(own, d.field_cm)),
+        heading_error_vs_overhead_deg: overhead.map(|d| {
+            angle_diff(model.own.heading_rad, d.heading_rad)
+                .abs()
+                .to_degrees()
+        }),
+        ball_error_vs_overhead_cm: match (&model.ball, detections.and_then(|d| d.ball.as_ref())) {
+            (Some(b), Some(seen)) => Some(dist([b.x_cm, b.y_cm], seen.field_cm)),
+            _ => None,
+        },
     })
 }
 
@@ -226,6 +240,10 @@ pub struct WorldModelReport {
     pub ball_error_cm: Percentiles,
     /// Self position error against the overhead detection, centimetres.
     pub self_error_vs_overhead_cm: Percentiles,
+    /// Heading error against the overhead detection, degrees.
+    pub heading_error_vs_overhead_deg: Percentiles,
+    /// Ball error against the ball the overhead camera found, centimetres.
+    pub ball_error_vs_overhead_cm: Percentiles,
 }
 
 /// The whole overhead evaluation.
@@ -297,6 +315,8 @@ impl OverheadEvalReport {
                     heading_error_deg: of(|m| m.heading_error_deg),
                     ball_error_cm: of(|m| m.ball_error_cm),
                     self_error_vs_overhead_cm: of(|m| m.self_error_vs_overhead_cm),
+                    heading_error_vs_overhead_deg: of(|m| m.heading_error_vs_overhead_deg),
+                    ball_error_vs_overhead_cm: of(|m| m.ball_error_vs_overhead_cm),
                 }
             })
             .collect();
@@ -413,7 +433,7 @@ mod tests {
             "ball": {"x_cm": 10.0, "y_cm": 0.0, "sd_cm": 25.0}
         }))
         .expect("the simulator's shape");
-        let d = OverheadDetections {
+        let mut d = OverheadDetections {
             robots: vec![detected(2, 100.0, 0.5)],
             ..OverheadDetections::default()
         };
@@ -421,6 +441,18 @@ mod tests {
         assert!((e.self_error_cm.expect("error") - 5.0).abs() < 1e-9);
         assert!((e.ball_error_cm.expect("error") - 10.0).abs() < 1e-9);
         assert!((e.self_error_vs_overhead_cm.expect("error") - 5.0).abs() < 1e-9);
+        let heading = e.heading_error_vs_overhead_deg.expect("seen overhead");
+        assert!((heading - 0.1f64.to_degrees()).abs() < 1e-9, "{heading}");
+        // No ball overhead: nothing to compare; a ball 6-8-10 away from the model's.
+        assert_eq!(e.ball_error_vs_overhead_cm, None);
+        d.ball = Some(OverheadBall {
+            field_cm: [16.0, 8.0],
+            image: ImagePoint::default(),
+            radius_px: 5.0,
+            confidence: 1.0,
+        });
+        let e = evaluate_world_model(&model, &truth(), Some(&d)).expect("robot 2 is there");
+        assert!((e.ball_error_vs_overhead_cm.expect("error") - 10.0).abs() < 1e-9);
         assert!(
             evaluate_world_model(
                 &WorldModel {

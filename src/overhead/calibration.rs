@@ -13,7 +13,10 @@
 //!
 //! The start comes from a closed-form 2-D similarity between the ground points and the image
 //! (scale, turn and mirror of a camera looking straight down), so no guess of the camera's
-//! turn is needed.
+//! turn is needed. A pinhole (principal point at the image centre, no distortion) is fitted
+//! first, then all eleven parameters, with weak priors holding the principal point near the
+//! image centre and k1, k2 near 0 where the clicks alone cannot place them (a half field seen
+//! by a wide lens: the real SSL 2008 frame ran off to a folded lens without them).
 
 use std::path::Path;
 
@@ -46,6 +49,12 @@ pub struct CalibrationParams {
     pub height_prior_fraction: f64,
     /// Line samples about this far apart along the lines, centimetres.
     pub line_step_cm: f64,
+    /// Standard deviation of the weak prior pulling the principal point towards the image
+    /// centre, as a fraction of the image width (0.05: ±32 px at 640). Clicks on half a field
+    /// leave it loosely determined; the lines, when found, outweigh it.
+    pub principal_point_prior_fraction: f64,
+    /// Standard deviation of the weak prior pulling k1 and k2 towards 0.
+    pub distortion_prior_sd: f64,
 }
 
 impl Default for CalibrationParams {
@@ -56,6 +65,8 @@ impl Default for CalibrationParams {
             line_rounds: 3,
             height_prior_fraction: 0.15,
             line_step_cm: 6.0,
+            principal_point_prior_fraction: 0.05,
+            distortion_prior_sd: 0.3,
         }
     }
 }
@@ -222,11 +233,23 @@ pub fn calibrate(
         });
     }
     let start = starting_camera(points.width, points.height, &targets, field)?;
-    let height_prior = HeightPrior {
+    let prior = Priors {
         height_cm: field.camera_height_guess_cm,
-        sd_cm: params.height_prior_fraction * field.camera_height_guess_cm,
+        height_sd_cm: params.height_prior_fraction * field.camera_height_guess_cm,
+        centre: start.centre,
+        centre_sd_px: params.principal_point_prior_fraction * points.width as f64,
+        distortion_sd: params.distortion_prior_sd,
     };
-    let mut camera = solve(start, &targets, &[], height_prior)?;
+    // First a pinhole with its principal point at the image centre (pose and focal length
+    // only), then everything from there: eleven free parameters from a straight-down start can
+    // run off to a folded lens on clicks over half a field.
+    let pinhole = Priors {
+        centre_sd_px: 1e-3,
+        distortion_sd: 1e-6,
+        ..prior
+    };
+    let camera = solve(start, &targets, &[], pinhole)?;
+    let mut camera = solve(camera, &targets, &[], prior)?;
     let mut lines: Vec<LineObservation> = Vec::new();
     if let (Some(frame), true) = (image, params.refine_lines) {
         let samples = field.line_samples(params.line_step_cm);
@@ -238,7 +261,7 @@ pub fn calibrate(
             if lines.len() < 10 {
                 break;
             }
-            camera = solve(camera, &targets, &lines, height_prior)?;
+            camera = solve(camera, &targets, &lines, prior)?;
         }
         lines = reject_outliers(&camera, lines);
     }
@@ -287,10 +310,20 @@ struct Target {
     image: ImagePoint,
 }
 
+/// Weak priors that keep the problem well posed (each a residual of one "pixel" per standard
+/// deviation).
 #[derive(Debug, Clone, Copy)]
-struct HeightPrior {
+struct Priors {
+    /// The field description's guess of the camera height, centimetres.
     height_cm: f64,
-    sd_cm: f64,
+    /// Its standard deviation, centimetres.
+    height_sd_cm: f64,
+    /// Where the principal point is expected (the image centre), pixels.
+    centre: ImagePoint,
+    /// Its standard deviation, pixels.
+    centre_sd_px: f64,
+    /// Standard deviation of k1 and k2 about 0.
+    distortion_sd: f64,
 }
 
 /// A camera looking straight down from the similarity that best maps the ground points to the
@@ -362,7 +395,7 @@ struct Problem<'a> {
     base_rotation: UnitQuaternion<f64>,
     targets: &'a [Target],
     lines: &'a [LineObservation],
-    prior: HeightPrior,
+    prior: Priors,
     params: [f64; PARAMS],
 }
 
@@ -393,9 +426,10 @@ impl Problem<'_> {
     }
 
     fn residuals_at(&self, p: &[f64; PARAMS]) -> Vec<f64> {
+        let len = 2 * self.targets.len() + self.lines.len() + 5;
         let (camera, field_from_camera) = self.model(p);
         let camera_from_field = field_from_camera.inverse();
-        let mut r = Vec::with_capacity(2 * self.targets.len() + self.lines.len() + 1);
+        let mut r = Vec::with_capacity(len);
         for t in self.targets {
             match camera.image_from_camera(&(camera_from_field * t.field)) {
                 Some(q) => {
@@ -409,8 +443,13 @@ impl Problem<'_> {
             let d = l.distance_px_with(&camera, &camera_from_field);
             r.push(if d.is_finite() { d } else { UNSEEN_PX });
         }
-        // The height prior in pixel-like units: one "pixel" per standard deviation.
-        r.push((p[2] - self.prior.height_cm) / self.prior.sd_cm.max(1e-6));
+        // The priors in pixel-like units: one "pixel" per standard deviation.
+        let q = &self.prior;
+        r.push((p[2] - q.height_cm) / q.height_sd_cm.max(1e-6));
+        r.push((p[7] - q.centre.x_px) / q.centre_sd_px.max(1e-9));
+        r.push((p[8] - q.centre.y_px) / q.centre_sd_px.max(1e-9));
+        r.push(p[9] / q.distortion_sd.max(1e-12));
+        r.push(p[10] / q.distortion_sd.max(1e-12));
         r
     }
 }
@@ -477,11 +516,30 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 }
 
+/// The same camera with a positive focal length: a negative one (which the solver can step
+/// into, as it did on the real SSL 2008 frame) turns the image half round about the principal
+/// point, which is the camera turned half round about its optical axis. The radial lens
+/// model is the same either way, so every projection is unchanged.
+fn with_positive_focal(camera: OverheadCamera) -> OverheadCamera {
+    if camera.focal_px >= 0.0 {
+        return camera;
+    }
+    let t = camera.field_from_camera();
+    let half_turn = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI);
+    let turned: Transform<Field, Camera> =
+        Transform::new(t.origin().coords.coords, t.rotation() * half_turn);
+    OverheadCamera {
+        focal_px: -camera.focal_px,
+        pose: PoseRecord::from_transform(&turned),
+        ..camera
+    }
+}
+
 fn solve(
     start: OverheadCamera,
     targets: &[Target],
     lines: &[LineObservation],
-    prior: HeightPrior,
+    prior: Priors,
 ) -> Result<OverheadCamera, CalibrationError> {
     let problem = Problem {
         base: start,
@@ -494,11 +552,14 @@ fn solve(
     let (problem, report) = LevenbergMarquardt::new()
         .with_patience(200)
         .minimize(problem);
-    let camera = problem.camera(&problem.params);
+    let camera = with_positive_focal(problem.camera(&problem.params));
     let finite = problem.params.iter().all(|v| v.is_finite());
     if !finite || !report.objective_function.is_finite() || camera.focal_px <= 0.0 {
         return Err(CalibrationError::NoFit {
-            reason: format!("{:?}", report.termination),
+            reason: format!(
+                "{:?}, focal {:.1} px, objective {:.3e}",
+                report.termination, camera.focal_px, report.objective_function
+            ),
         });
     }
     Ok(camera)
@@ -533,6 +594,23 @@ mod tests {
             }
         }
         file
+    }
+
+    #[test]
+    fn a_negative_focal_length_is_the_camera_turned_half_round() {
+        let mut flipped = OverheadCamera::above_field_2005();
+        flipped.focal_px = -flipped.focal_px;
+        let fixed = with_positive_focal(flipped);
+        assert!(fixed.focal_px > 0.0);
+        for p in [
+            Point::new(0.0, 0.0, 0.0),
+            Point::new(120.0, -80.0, 0.0),
+            Point::new(-200.0, 90.0, 22.5),
+        ] {
+            let a = flipped.image_from_field(&p).expect("in front");
+            let b = fixed.image_from_field(&p).expect("in front");
+            assert!(a.distance_to(&b) < 1e-6, "{a:?} {b:?}");
+        }
     }
 
     #[test]

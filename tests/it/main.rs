@@ -25,6 +25,7 @@ mod recognition;
 mod sim;
 mod sim_table;
 mod snapshots;
+mod ssl2008;
 mod streams;
 mod viewers;
 #[cfg(feature = "gui")]

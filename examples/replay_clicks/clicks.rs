@@ -1,0 +1,65 @@
+//! A hand classification written down as the clicks that made it: per class, the sensitivity
+//! (± table cells on Y, U, V) and the pixels clicked. Replayed through the app's own commands
+//! (`SetClass`, `SetSensitivity`, `Sample`, `Commit`), exactly as a user clicking those pixels in
+//! the window would make the table. Shared by `examples/replay_clicks` and the tests.
+
+use std::path::Path;
+
+use anyhow::Context;
+use eotn::lut::{ColourClass, Sensitivity};
+use eotn::workspace::{Command, Workspace};
+use serde::Deserialize;
+
+/// A clicks file (`*.clicks.json`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Clicks {
+    /// Bits per channel of the new table (6, 7 or 8).
+    pub bits: u8,
+    /// One entry per class and sensitivity, in the order they were clicked.
+    pub clicks: Vec<ClickGroup>,
+}
+
+/// Pixels clicked with one class and one sensitivity.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClickGroup {
+    /// Class name as the app shows it (`"sky blue"`).
+    pub class: String,
+    /// ± table cells on Y, U, V.
+    pub sensitivity: [u8; 3],
+    /// The clicked pixels `[x, y]`.
+    pub pixels: Vec<[usize; 2]>,
+}
+
+impl Clicks {
+    /// Reads a clicks file.
+    pub fn load(path: &Path) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+        serde_json::from_str(&text).with_context(|| format!("{}", path.display()))
+    }
+
+    /// Number of clicks.
+    pub fn len(&self) -> usize {
+        self.clicks.iter().map(|g| g.pixels.len()).sum()
+    }
+
+    /// Starts a new table in `ws` (whose frame must be open) and clicks every pixel: left
+    /// click (`Sample`) then right click (`Commit`), as in the window.
+    pub fn replay(&self, ws: &mut Workspace) -> anyhow::Result<()> {
+        ws.apply(Command::NewTable(self.bits))?;
+        for g in &self.clicks {
+            let class = ColourClass::parse(&g.class)
+                .with_context(|| format!("unknown class {:?}", g.class))?;
+            let [y, u, v] = g.sensitivity;
+            ws.apply(Command::SetClass(class))?;
+            ws.apply(Command::SetSensitivity(Sensitivity { y, u, v }))?;
+            for &[x, y] in &g.pixels {
+                ws.apply(Command::Sample { x, y })?;
+                ws.apply(Command::Commit)
+                    .with_context(|| format!("{} at ({x}, {y})", g.class))?;
+            }
+        }
+        Ok(())
+    }
+}
