@@ -23,6 +23,7 @@ pub mod inspector;
 pub mod menus;
 pub mod overlays;
 pub mod renderer;
+pub mod robots_panel;
 pub mod sensors_dialog;
 pub mod uv_plane;
 pub mod views;
@@ -254,6 +255,8 @@ pub struct EotnApp {
     menu_input: menus::MenuInput,
     /// What the Camera dialogs are editing.
     pub camera: camera_menu::CameraDialogs,
+    /// What the robots window is editing.
+    pub robots: robots_panel::RobotsPanel,
     uv_plane: uv_plane::UvPlane,
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
@@ -302,6 +305,7 @@ impl EotnApp {
             textures: None,
             menu_input: menus::MenuInput::default(),
             camera: camera_menu::CameraDialogs::default(),
+            robots: robots_panel::RobotsPanel::default(),
             uv_plane: uv_plane::UvPlane::default(),
             hovered: None,
             last_view: None,
@@ -465,6 +469,7 @@ impl EotnApp {
         let len = src.len();
         let index = self.state.index();
         ui.horizontal(|ui| {
+            robots_panel::live_controls_ui(ui, &self.state, commands);
             if ui.button("Previous").on_hover_text("Left arrow").clicked() {
                 commands.push(Command::Step(-1));
             }
@@ -802,6 +807,7 @@ impl eframe::App for EotnApp {
         self.about_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
         camera_menu::camera_windows(&ctx, &self.state, &mut self.camera, &mut commands);
+        robots_panel::robots_window(&ctx, &self.state, &mut self.robots, &mut commands);
         if let Some(at) = self.quit_at {
             if now >= at {
                 // Unsaved table edits still get the question: a timer never discards work.

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use crate::sources::{SourceSettings, SourceSpec};
 
+use super::robots::RobotId;
 use super::settings::{Overlays, ViewKind};
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
@@ -112,6 +113,22 @@ pub enum Command {
     /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
     /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
     SelectObject(Option<String>),
+    /// Connect a robot at `HOST:PORT` (or `ws://HOST:PORT`) beside those connected already
+    /// (Camera ▸ Connect to robot…); shown when no robot is.
+    ConnectRobot(String),
+    /// Show this robot in the views, following its newest frame; the others keep receiving.
+    ShowRobot(RobotId),
+    /// Disconnect this robot, finishing its recording.
+    DisconnectRobot(RobotId),
+    /// Record this robot, bit-exact, into this MCAP stream.
+    RecordRobot(RobotId, PathBuf),
+    /// Record every robot not recording yet into this folder, one file per robot.
+    RecordAllRobots(PathBuf),
+    /// Finish this robot's recording.
+    StopRecordingRobot(RobotId),
+    /// Follow the shown robot's newest frame (true) or hold the view where it is (false);
+    /// reception and recording go on either way.
+    SetFollowLive(bool),
 }
 
 /// The app's extra windows.
@@ -131,11 +148,19 @@ pub enum Window {
     SourceSettings,
     /// Camera ▸ Start recording…: name the stream.
     Record,
+    /// Camera ▸ Connect to robot…: the robots list.
+    Robots,
 }
 
 impl Window {
     /// Every window, for the Windows menu.
-    pub const ALL: [Self; 4] = [Self::Sensors, Self::UvPlane, Self::TryEdit, Self::Inspector];
+    pub const ALL: [Self; 5] = [
+        Self::Sensors,
+        Self::UvPlane,
+        Self::TryEdit,
+        Self::Inspector,
+        Self::Robots,
+    ];
 
     /// Its title.
     #[must_use]
@@ -148,6 +173,7 @@ impl Window {
             Self::Connect => "Connect a source",
             Self::SourceSettings => "Source settings",
             Self::Record => "Record into a stream",
+            Self::Robots => "Robots",
         }
     }
 }

@@ -14,6 +14,7 @@
 //! | `frames.rs` | opening sources, showing a frame, the sensor-series scan |
 //! | `player.rs` | [`Player`]: playback clock, `tick`, `next_frame_due` |
 //! | `live.rs` | [`Live`]: a connected live source streaming on its thread; recording |
+//! | `robots.rs` | robots over the network, several at once: the list, the shown one, following live, recording each |
 //! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
@@ -26,6 +27,7 @@ mod frames;
 pub mod journal;
 mod live;
 pub mod player;
+mod robots;
 mod settings;
 pub mod source;
 mod table;
@@ -41,6 +43,7 @@ pub use command::{Command, Window};
 pub use compose::{PrimitiveFilter, box_colour};
 pub use live::Live;
 pub use player::Player;
+pub use robots::{RobotId, RobotRow};
 pub use settings::{
     MAX_RECENT, MAX_WARNINGS, Overlays, SPEEDS, Settings, ViewKind, ViewTransform, ZOOM_PRESETS,
     ZOOM_RANGE,
@@ -134,6 +137,8 @@ pub struct Workspace {
     accepted_owners: Vec<String>,
     selected_object: Option<String>,
     live: Option<Live>,
+    /// Robots over the network, one of them perhaps shown.
+    robots: robots::Robots,
     /// Recording a recorded source's shown frames (a live source records on its thread).
     recorder: Option<Recorder>,
     /// Which camera's table the pipeline holds.
@@ -191,6 +196,7 @@ impl Workspace {
             accepted_owners: Vec::new(),
             selected_object: None,
             live: None,
+            robots: robots::Robots::default(),
             recorder: None,
             table_kind: CameraKind::Robot,
             other_table: TableSlot::empty(bits),
@@ -251,9 +257,18 @@ impl Workspace {
             }
             Command::SaveTableAs(p) => self.save_table(&p)?,
             Command::RebuildFromJournal => self.rebuild_from_journal()?,
-            Command::Step(delta) => self.step(delta)?,
-            Command::Seek(i) => self.seek(i)?,
-            Command::SetPlaying(p) => self.set_playing(p)?,
+            Command::Step(delta) => {
+                self.leave_live();
+                self.step(delta)?;
+            }
+            Command::Seek(i) => {
+                self.leave_live();
+                self.seek(i)?;
+            }
+            Command::SetPlaying(p) => {
+                self.leave_live();
+                self.set_playing(p)?;
+            }
             Command::SetSpeed(s) => {
                 self.settings.speed = if s.is_finite() { s.max(0.0) } else { 1.0 }
             }
@@ -315,6 +330,15 @@ impl Workspace {
             Command::SetStreaming(on) => self.set_streaming(on)?,
             Command::StartRecording(p) => self.start_recording(&p)?,
             Command::StopRecording => self.stop_recording()?,
+            Command::ConnectRobot(address) => {
+                self.connect_robot(&address)?;
+            }
+            Command::ShowRobot(id) => self.show_robot(id)?,
+            Command::DisconnectRobot(id) => self.disconnect_robot(id)?,
+            Command::RecordRobot(id, path) => self.record_robot(id, &path)?,
+            Command::RecordAllRobots(folder) => self.record_all_robots(&folder)?,
+            Command::StopRecordingRobot(id) => self.stop_recording_robot(id)?,
+            Command::SetFollowLive(on) => self.set_follow_live(on)?,
             Command::SelectObject(owner) => {
                 if let Some(o) = &owner {
                     anyhow::ensure!(
@@ -387,6 +411,7 @@ impl Workspace {
     /// Advances playback and background scans by `dt` of wall time. Called once per UI frame.
     pub fn tick(&mut self, dt: Duration) {
         self.poll_live();
+        self.poll_robots();
         self.scan_sensor_series();
         if let (Some(t), Some(src)) = (self.try_edit.as_mut(), self.source.as_mut()) {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
@@ -417,9 +442,15 @@ impl Workspace {
                 .unwrap_or(30.0);
             return Some(Duration::from_secs_f64(0.5 / rate.min(240.0)));
         }
-        let src = self.source.as_ref()?;
-        self.player
-            .next_frame_due(self.settings.speed, self.index, src)
+        let robots = self.robots_poll_due();
+        let player = self.source.as_ref().and_then(|src| {
+            self.player
+                .next_frame_due(self.settings.speed, self.index, src)
+        });
+        match (robots, player) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     /// Which camera the shown frames come from (robot when nothing is open): it chooses the
@@ -657,6 +688,7 @@ impl Workspace {
             Window::Connect => self.settings.show_connect,
             Window::SourceSettings => self.settings.show_source_settings,
             Window::Record => self.settings.show_record,
+            Window::Robots => self.settings.show_robots,
         }
     }
 
@@ -669,6 +701,7 @@ impl Workspace {
             Window::Connect => &mut self.settings.show_connect,
             Window::SourceSettings => &mut self.settings.show_source_settings,
             Window::Record => &mut self.settings.show_record,
+            Window::Robots => &mut self.settings.show_robots,
         }
     }
 

@@ -93,6 +93,13 @@ impl Source {
         self.len() == 0
     }
 
+    /// The first frame that can be read (0 except for a live robot's, whose oldest frames may
+    /// have left memory).
+    #[must_use]
+    pub fn first_index(&self) -> usize {
+        self.inner.first_index()
+    }
+
     /// Time of frame `index`, nanoseconds since the first frame.
     #[must_use]
     pub fn time_ns(&self, index: usize) -> u64 {
@@ -116,6 +123,11 @@ impl Source {
     /// # Errors
     /// Index out of range; the file's read error, naming it.
     pub fn read(&mut self, index: usize) -> Result<SourceFrame, SourceError> {
+        if self.info.kind == SourceKind::Network {
+            // A robot's frames are in memory already, and the newest one may still gain the
+            // sensor readings that follow its image: never serve it from a stale copy.
+            return self.inner.read(index);
+        }
         if let Some(pos) = self.cache.iter().position(|(i, _)| *i == index)
             && let Some(entry) = self.cache.remove(pos)
         {
