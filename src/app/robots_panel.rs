@@ -184,11 +184,8 @@ pub fn live_controls_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
     if ui.add(button).on_hover_text(hover).clicked() {
         commands.push(Command::SetFollowLive(!live));
     }
-    if !live && let Some(src) = state.source() {
-        ui.weak(format!(
-            "held at frame {} of {} (reception and recording go on)",
-            state.index(),
-            src.len()
-        ));
+    if !live {
+        ui.weak("held")
+            .on_hover_text("reception and recording go on; Live shows the newest frame");
     }
 }

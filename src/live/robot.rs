@@ -200,6 +200,12 @@ impl RobotFrames {
         lock(&self.shared).frames.back().cloned()
     }
 
+    /// The figures for the robot list.
+    #[must_use]
+    pub fn stats(&self) -> RobotStats {
+        lock(&self.shared).stats()
+    }
+
     /// When frame `index` arrived, nanoseconds after the first frame (the last frame's time
     /// past the end; 0 before any frame).
     #[must_use]

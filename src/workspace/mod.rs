@@ -242,6 +242,13 @@ impl Workspace {
     /// File problems (naming the file), nothing to commit or save, and the like; the state is
     /// unchanged by a failed command.
     pub fn apply(&mut self, command: Command) -> anyhow::Result<()> {
+        if matches!(
+            command,
+            Command::Step(_) | Command::Seek(_) | Command::SetPlaying(_)
+        ) {
+            // Moving through a shown robot's frames holds the view (reception goes on).
+            self.leave_live();
+        }
         match command {
             Command::Open(paths) => self.open(paths)?,
             Command::OpenTable(p) => self.open_table(&p)?,
@@ -257,18 +264,9 @@ impl Workspace {
             }
             Command::SaveTableAs(p) => self.save_table(&p)?,
             Command::RebuildFromJournal => self.rebuild_from_journal()?,
-            Command::Step(delta) => {
-                self.leave_live();
-                self.step(delta)?;
-            }
-            Command::Seek(i) => {
-                self.leave_live();
-                self.seek(i)?;
-            }
-            Command::SetPlaying(p) => {
-                self.leave_live();
-                self.set_playing(p)?;
-            }
+            Command::Step(delta) => self.step(delta)?,
+            Command::Seek(i) => self.seek(i)?,
+            Command::SetPlaying(p) => self.set_playing(p)?,
             Command::SetSpeed(s) => {
                 self.settings.speed = if s.is_finite() { s.max(0.0) } else { 1.0 }
             }
@@ -330,15 +328,13 @@ impl Workspace {
             Command::SetStreaming(on) => self.set_streaming(on)?,
             Command::StartRecording(p) => self.start_recording(&p)?,
             Command::StopRecording => self.stop_recording()?,
-            Command::ConnectRobot(address) => {
-                self.connect_robot(&address)?;
-            }
-            Command::ShowRobot(id) => self.show_robot(id)?,
-            Command::DisconnectRobot(id) => self.disconnect_robot(id)?,
-            Command::RecordRobot(id, path) => self.record_robot(id, &path)?,
-            Command::RecordAllRobots(folder) => self.record_all_robots(&folder)?,
-            Command::StopRecordingRobot(id) => self.stop_recording_robot(id)?,
-            Command::SetFollowLive(on) => self.set_follow_live(on)?,
+            c @ (Command::ConnectRobot(_)
+            | Command::ShowRobot(_)
+            | Command::DisconnectRobot(_)
+            | Command::RecordRobot(..)
+            | Command::RecordAllRobots(_)
+            | Command::StopRecordingRobot(_)
+            | Command::SetFollowLive(_)) => self.apply_robot_command(c)?,
             Command::SelectObject(owner) => {
                 if let Some(o) = &owner {
                     anyhow::ensure!(

@@ -11,8 +11,8 @@ use std::time::Duration;
 
 use anyhow::Context as _;
 
-use super::Workspace;
 use super::source::Source;
+use super::{Command, Workspace};
 use crate::live::recorder::file_stem;
 use crate::live::robot::DEFAULT_KEEP_BYTES;
 use crate::live::{ClientOptions, Connection, LiveRobot, RobotStats, RobotUrl};
@@ -99,6 +99,20 @@ fn same_state(a: &Connection, b: &Connection) -> bool {
 }
 
 impl Workspace {
+    /// Applies one of the robot commands (the others are refused).
+    pub(super) fn apply_robot_command(&mut self, command: Command) -> anyhow::Result<()> {
+        match command {
+            Command::ConnectRobot(address) => self.connect_robot(&address).map(drop),
+            Command::ShowRobot(id) => self.show_robot(id),
+            Command::DisconnectRobot(id) => self.disconnect_robot(id),
+            Command::RecordRobot(id, path) => self.record_robot(id, &path),
+            Command::RecordAllRobots(folder) => self.record_all_robots(&folder),
+            Command::StopRecordingRobot(id) => self.stop_recording_robot(id),
+            Command::SetFollowLive(on) => self.set_follow_live(on),
+            other => anyhow::bail!("not a robot command: {other:?}"),
+        }
+    }
+
     /// Connects a robot at `address` (`HOST:PORT` or `ws://HOST:PORT`) beside those already
     /// connected; it is shown when no robot is. Connecting goes on in the background.
     pub(super) fn connect_robot(&mut self, address: &str) -> anyhow::Result<RobotId> {
@@ -236,7 +250,12 @@ impl Workspace {
     pub fn robot_recording_path(&self, id: RobotId, folder: &Path) -> PathBuf {
         let stem = self.robots.entry(id).map_or_else(
             |_| id.0.to_string(),
-            |e| file_stem(&e.robot.name(), e.robot.url()),
+            |e| {
+                // Until a robot names itself its name is its address: HOST_PORT then.
+                let name = e.robot.name();
+                let named = name != e.robot.url().to_string();
+                file_stem(if named { &name } else { "" }, e.robot.url())
+            },
         );
         let mut path = folder.join(format!("{stem}.mcap"));
         let mut n = 2;
@@ -289,6 +308,7 @@ impl Workspace {
     /// recordings' chunks, and shows the shown robot's newest frame when following it.
     pub(super) fn poll_robots(&mut self) {
         let mut notes = Vec::new();
+        let mut shown_changed = false;
         for e in &mut self.robots.entries {
             e.robot.tick();
             let name = e.robot.name();
@@ -304,6 +324,7 @@ impl Workspace {
                     _ => (false, format!("{name}: {now}")),
                 });
                 e.reported = now;
+                shown_changed |= self.robots.shown == Some(e.id);
             }
             let recording = e.robot.recording_path();
             if e.recording.is_some() && recording.is_none() {
@@ -311,6 +332,10 @@ impl Workspace {
                 notes.push((true, format!("{name}: {why}")));
             }
             e.recording = recording;
+        }
+        if shown_changed && let Some(src) = self.source.as_mut() {
+            // Its label (title, status) carries the name it gave on connecting.
+            src.refresh_info();
         }
         for (warning, note) in notes {
             if warning {
@@ -320,6 +345,12 @@ impl Workspace {
         }
         if self.robots.follow_live {
             self.follow_newest();
+        }
+        if self.robots.shown.is_some()
+            && let Some(src) = &self.source
+        {
+            // The sensor dialog's plots grow with the frames that arrive.
+            self.sensor_series.total = src.len();
         }
     }
 

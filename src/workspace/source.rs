@@ -63,6 +63,11 @@ impl Source {
         &self.info
     }
 
+    /// Asks the source again what it is (a robot names itself once connected).
+    pub fn refresh_info(&mut self) {
+        self.info = self.inner.info();
+    }
+
     /// The files this source was opened from (for "reopen at start" and recent files).
     #[must_use]
     pub fn paths(&self) -> Vec<PathBuf> {

@@ -260,7 +260,8 @@ fn garbage_and_oversized_messages_close_only_their_own_robot() {
 
 #[test]
 fn four_robots_at_30_fps_lose_no_frame_and_keep_up() {
-    // A full minute with EOTN_LIVE_SECONDS=60 (scripts/live-soak.sh); a short run in the suite.
+    // Longer with EOTN_LIVE_SECONDS (scripts/live-soak.sh runs the workspace's version of this
+    // test, tests/it/robots.rs, for a minute); a short run in the suite.
     let seconds: f64 = std::env::var("EOTN_LIVE_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())

@@ -13,7 +13,7 @@ use eotn::live::serve::StandInRobot;
 use eotn::live::{Connection, unix_time_ns};
 use eotn::streams::StreamReader;
 use eotn::streams::schema::{ImageEncoding, encode_image};
-use eotn::workspace::{Command, RobotId, RobotRow, Workspace};
+use eotn::workspace::{Command, RobotId, RobotRow, Window, Workspace};
 use tungstenite::Message;
 
 use crate::live::{fake_robot_session, frame, image_message, image_payloads, record};
@@ -93,6 +93,7 @@ fn two_robots_are_recorded_bit_exact_one_file_each_and_a_dropped_robot_leaves_a_
         .robots()
         .iter()
         .all(|r| is_connected(&r.connection))));
+    assert!(w.title().ends_with("robot alpha"), "{}", w.title());
     assert!(tick_until(&mut w, 5.0, |_| alpha.has_viewer() && bravo.has_viewer()));
     let folder = dir.path().join("rec");
     w.apply(Command::RecordAllRobots(folder.clone())).unwrap();
@@ -184,6 +185,17 @@ fn stepping_back_holds_the_view_while_frames_arrive_and_are_recorded_and_live_re
     send_ticking(&mut w, &mut robot, 20..25);
     assert!(tick_until(&mut w, 5.0, |w| w.index() == 24));
     assert_eq!(w.frame(), Some(&frame(24)));
+    // The sensor dialog's plots cover every frame that has arrived, with its readings.
+    w.apply(Command::ShowWindow(Window::Sensors, true)).unwrap();
+    assert!(tick_until(&mut w, 5.0, |w| w.sensor_series.points.len() == 25));
+    let pans: Vec<Option<f64>> = w
+        .sensor_series
+        .points
+        .iter()
+        .map(|(_, r)| r.as_ref().and_then(|r| r.head_pan_rad))
+        .collect();
+    assert_eq!(pans[24], Some(0.24));
+    assert!(pans.iter().all(Option::is_some));
     w.apply(Command::StopRecording).unwrap();
     assert_eq!(w.recording(), None);
     assert_recorded_bit_exact(&out, &(0..25).collect::<Vec<_>>());
@@ -348,10 +360,11 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
         );
         let view = w.robot_frames(*id).unwrap();
         for i in 0..frames {
-            assert_eq!(
-                view.frame(i).unwrap().record.frame,
-                frame(i),
-                "robot {k} frame {i}"
+            let f = view.frame(i).unwrap();
+            assert_eq!(f.record.frame, frame(i), "robot {k} frame {i}");
+            assert!(
+                f.record.sensors.is_some(),
+                "robot {k} frame {i} has its sensors"
             );
         }
     }
