@@ -289,6 +289,10 @@ impl EotnApp {
             .and_then(|s| eframe::get_value::<Settings>(s, SETTINGS_KEY))
             .unwrap_or_default();
         let mut app = Self::with_state(Workspace::new(settings));
+        // A shown robot's new frame repaints at once (no waiting for the next look).
+        let ctx = cc.egui_ctx.clone();
+        app.state
+            .set_wake(std::sync::Arc::new(move || ctx.request_repaint()));
         if paths.is_empty() {
             app.state.reopen_last();
         } else {

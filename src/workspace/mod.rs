@@ -43,7 +43,7 @@ pub use command::{Command, Window};
 pub use compose::{PrimitiveFilter, box_colour};
 pub use live::Live;
 pub use player::Player;
-pub use robots::{RobotId, RobotRow};
+pub use robots::{RobotId, RobotRow, Wake};
 pub use settings::{
     MAX_RECENT, MAX_WARNINGS, Overlays, SPEEDS, Settings, ViewKind, ViewTransform, ZOOM_PRESETS,
     ZOOM_RANGE,

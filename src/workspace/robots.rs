@@ -7,6 +7,8 @@
 
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use anyhow::Context as _;
@@ -22,6 +24,23 @@ use crate::sources::CameraKind;
 const FOLLOW_POLL: Duration = Duration::from_millis(16);
 /// How often the robots' figures are refreshed when no robot is followed live.
 const STATS_POLL: Duration = Duration::from_millis(250);
+
+/// Wakes the UI (the app passes its repaint request), from a robot's thread.
+pub type Wake = Arc<dyn Fn() + Send + Sync>;
+
+/// The UI's wake, set once by the app; robots connected before it is set wake nothing.
+#[derive(Default, Clone)]
+struct WakeSlot(Arc<OnceLock<Wake>>);
+
+impl fmt::Debug for WakeSlot {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(if self.0.get().is_some() {
+            "WakeSlot(set)"
+        } else {
+            "WakeSlot(unset)"
+        })
+    }
+}
 
 /// A connected robot's identity in this workspace (its place in the robots list never moves).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -61,6 +80,8 @@ struct Entry {
     reported: Connection,
     /// The recording last seen running (to report one the robot's thread had to stop).
     recording: Option<PathBuf>,
+    /// True while shown: only the shown robot's new frames wake the UI.
+    shown: Arc<AtomicBool>,
 }
 
 /// The connected robots; see the module documentation.
@@ -70,13 +91,21 @@ pub struct Robots {
     shown: Option<RobotId>,
     follow_live: bool,
     next_id: u32,
+    wake: WakeSlot,
 }
 
 impl Robots {
     /// Forgets which robot is shown (another source took the views); they all keep receiving.
     pub(super) fn unshow(&mut self) {
-        self.shown = None;
+        self.set_shown(None);
         self.follow_live = false;
+    }
+
+    fn set_shown(&mut self, id: Option<RobotId>) {
+        self.shown = id;
+        for e in &self.entries {
+            e.shown.store(Some(e.id) == id, Ordering::Relaxed);
+        }
     }
 
     fn entry(&self, id: RobotId) -> anyhow::Result<&Entry> {
@@ -121,11 +150,22 @@ impl Workspace {
             !self.robots.entries.iter().any(|e| *e.robot.url() == url),
             "{url} is connected already"
         );
+        let shown = Arc::new(AtomicBool::new(false));
+        let wake: crate::live::robot::Notify = {
+            let (shown, slot) = (Arc::clone(&shown), self.robots.wake.clone());
+            Arc::new(move || {
+                if shown.load(Ordering::Relaxed)
+                    && let Some(wake) = slot.0.get()
+                {
+                    wake();
+                }
+            })
+        };
         let robot = LiveRobot::connect(
             url.clone(),
             ClientOptions::default(),
             DEFAULT_KEEP_BYTES,
-            None,
+            Some(wake),
         )
         .with_context(|| format!("cannot start the connection to {url}"))?;
         let id = RobotId(self.robots.next_id);
@@ -135,6 +175,7 @@ impl Workspace {
             robot,
             reported: Connection::Connecting,
             recording: None,
+            shown,
         });
         self.status = format!("connecting to {url}");
         if self.robots.shown.is_none() {
@@ -149,7 +190,7 @@ impl Workspace {
         self.disconnect_live();
         self.stop_recording_recorded();
         self.source = Some(Source::new(Box::new(view)));
-        self.robots.shown = Some(id);
+        self.robots.set_shown(Some(id));
         self.robots.follow_live = true;
         self.use_table_of(CameraKind::Robot);
         self.player.stop();
@@ -394,6 +435,12 @@ impl Workspace {
         self.source
             .as_ref()
             .map_or_else(String::new, super::Source::label)
+    }
+
+    /// Lets a shown robot's new frame wake the UI at once (the app passes its repaint request),
+    /// rather than wait for the next look. Set once; later calls are ignored.
+    pub fn set_wake(&mut self, wake: Wake) {
+        let _ = self.robots.wake.0.set(wake);
     }
 
     // ---- reading ----

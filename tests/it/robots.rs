@@ -86,6 +86,13 @@ fn two_robots_are_recorded_bit_exact_one_file_each_and_a_dropped_robot_leaves_a_
     let mut alpha = StandInRobot::start("alpha", "127.0.0.1", 0).unwrap();
     let mut bravo = StandInRobot::start("bravo", "127.0.0.1", 0).unwrap();
     let mut w = Workspace::default();
+    let wakes = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    w.set_wake(Arc::new({
+        let wakes = Arc::clone(&wakes);
+        move || {
+            wakes.fetch_add(1, Ordering::Relaxed);
+        }
+    }));
     let a = connect(&mut w, alpha.port());
     let b = connect(&mut w, bravo.port());
     assert_eq!(w.shown_robot(), Some(a), "the first robot is shown");
@@ -115,6 +122,8 @@ fn two_robots_are_recorded_bit_exact_one_file_each_and_a_dropped_robot_leaves_a_
         && w.current().is_some_and(|c| c.sensors.is_some())));
     assert_eq!(w.frame(), Some(&frame(19)));
     assert_eq!(row(&w, b).stats.frames, 20);
+    // Only the shown robot's frames woke the UI (bravo's 20 did not).
+    assert_eq!(wakes.load(Ordering::Relaxed), 20);
 
     // Alpha goes away: its connection closes (said in the list and the status line), its
     // recording stays open and readable, and finishes into a valid file.
