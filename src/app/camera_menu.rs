@@ -71,6 +71,13 @@ pub fn camera_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command
     item(
         commands,
         ui,
+        true,
+        "Connect to robot…",
+        vec![Command::ShowWindow(Window::Robots, true)],
+    );
+    item(
+        commands,
+        ui,
         connected.is_some(),
         "Disconnect",
         vec![Command::Disconnect],

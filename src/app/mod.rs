@@ -31,6 +31,7 @@ pub mod overhead_menu;
 pub mod overhead_overlays;
 pub mod overlays;
 pub mod renderer;
+pub mod robots_panel;
 pub mod sensors_dialog;
 pub mod uv_plane;
 pub mod views;
@@ -264,6 +265,8 @@ pub struct EotnApp {
     pub camera: camera_menu::CameraDialogs,
     /// The file names typed in the overhead calibration window.
     pub overhead: calibration_window::OverheadPaths,
+    /// What the robots window is editing.
+    pub robots: robots_panel::RobotsPanel,
     uv_plane: uv_plane::UvPlane,
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
@@ -296,6 +299,10 @@ impl EotnApp {
             .and_then(|s| eframe::get_value::<Settings>(s, SETTINGS_KEY))
             .unwrap_or_default();
         let mut app = Self::with_state(Workspace::new(settings));
+        // A shown robot's new frame repaints at once (no waiting for the next look).
+        let ctx = cc.egui_ctx.clone();
+        app.state
+            .set_wake(std::sync::Arc::new(move || ctx.request_repaint()));
         if paths.is_empty() {
             app.state.reopen_last();
         } else {
@@ -313,6 +320,7 @@ impl EotnApp {
             menu_input: menus::MenuInput::default(),
             camera: camera_menu::CameraDialogs::default(),
             overhead: calibration_window::OverheadPaths::default(),
+            robots: robots_panel::RobotsPanel::default(),
             uv_plane: uv_plane::UvPlane::default(),
             hovered: None,
             last_view: None,
@@ -476,6 +484,7 @@ impl EotnApp {
         let len = src.len();
         let index = self.state.index();
         ui.horizontal(|ui| {
+            robots_panel::live_controls_ui(ui, &self.state, commands);
             if ui.button("Previous").on_hover_text("Left arrow").clicked() {
                 commands.push(Command::Step(-1));
             }
@@ -822,6 +831,7 @@ impl eframe::App for EotnApp {
         self.about_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
         camera_menu::camera_windows(&ctx, &self.state, &mut self.camera, &mut commands);
+        robots_panel::robots_window(&ctx, &self.state, &mut self.robots, &mut commands);
         if let Some(at) = self.quit_at {
             if now >= at {
                 // Unsaved table edits still get the question: a timer never discards work.

@@ -7,6 +7,12 @@
 //! frame's arrival in the [`LiveRobot`] minus the log time the sender stamped when it wrote the
 //! frame. CPU is read from `/proc/self/task/*/stat`: the robots' receiving threads (socket,
 //! parsing, decoding) apart from the senders.
+//!
+//! With `--app` the robots are connected through the app's [`Workspace`] instead (Camera ▸
+//! Connect to robot…, each recorded with Record all into a temporary folder), ticked as the window
+//! is: woken by the shown robot's new frame, else about 60 times a second; it adds the latency to
+//! the frame shown (the pipeline run on it) and the CPU of the whole app state, pipeline and
+//! recording included.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -15,11 +21,16 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use serde::Serialize;
 
+use crate::live::RobotFrames;
 use crate::live::robot::DEFAULT_KEEP_BYTES;
 use crate::live::serve::StandInRobot;
 use crate::live::{ClientOptions, LiveRobot, RobotUrl};
 use crate::sim::{Scenario, ScenarioKind, Simulator};
 use crate::streams::FrameRecord;
+use crate::workspace::{Command, Workspace};
+
+/// How often `--app` ticks the workspace, as the window does while following a robot.
+const APP_TICK: Duration = Duration::from_millis(16);
 
 /// Arguments of `eotn bench-live`.
 #[derive(Debug, clap::Args)]
@@ -33,6 +44,9 @@ pub struct Args {
     /// Seconds measured.
     #[arg(long, default_value_t = 10.0)]
     pub seconds: f64,
+    /// Connect through the app's workspace (ticked as the window does), recording every robot.
+    #[arg(long)]
+    pub app: bool,
     /// End with one JSON line of the figures.
     #[arg(long)]
     pub json: bool,
@@ -65,6 +79,12 @@ pub struct LiveBenchJson {
     pub receive_cpu_percent: f64,
     /// CPU of the whole process (senders, servers, receivers), percent of one core.
     pub process_cpu_percent: f64,
+    /// `--app`: frames shown (the shown robot's that the view followed).
+    pub shown: Option<usize>,
+    /// `--app`: median latency from the sender's write to the frame shown, ms.
+    pub shown_median_ms: Option<f64>,
+    /// `--app`: 99th percentile of the same, ms.
+    pub shown_p99_ms: Option<f64>,
 }
 
 /// Clock ticks per second of `/proc/…/stat` (`sysconf(_SC_CLK_TCK)`, 100 on Linux).
@@ -130,18 +150,34 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .map_or((0, 0), |f| (f.frame.width(), f.frame.height()));
     let mut servers = Vec::new();
     let mut robots = Vec::new();
+    let mut app = args.app.then(Workspace::default);
     for i in 0..args.robots {
         let server = StandInRobot::start(&format!("bench{i}"), "127.0.0.1", 0)?;
         let url: RobotUrl = format!("127.0.0.1:{}", server.port()).parse()?;
-        let keep = DEFAULT_KEEP_BYTES.max(frames_needed(args) * width * height * 2);
-        robots.push(LiveRobot::connect(
-            url,
-            ClientOptions::default(),
-            keep,
-            None,
-        )?);
+        if let Some(w) = app.as_mut() {
+            w.apply(Command::ConnectRobot(url.to_string()))?;
+        } else {
+            let keep = DEFAULT_KEEP_BYTES.max(frames_needed(args) * width * height * 2);
+            robots.push(LiveRobot::connect(
+                url,
+                ClientOptions::default(),
+                keep,
+                None,
+            )?);
+        }
         servers.push(server);
     }
+    let folder = std::env::temp_dir().join(format!("eotn-bench-live-{}", std::process::id()));
+    let views: Vec<RobotFrames> = match app.as_mut() {
+        Some(w) => {
+            w.apply(Command::RecordAllRobots(folder.clone()))?;
+            w.robots()
+                .iter()
+                .filter_map(|r| w.robot_frames(r.id))
+                .collect()
+        }
+        None => robots.iter().map(LiveRobot::frames_view).collect(),
+    };
     let wait_until = Instant::now() + Duration::from_secs(10);
     while servers.iter().any(|s| !s.has_viewer()) {
         anyhow::ensure!(
@@ -183,6 +219,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         })
         .collect::<Result<_, _>>()
         .context("cannot start a sender thread")?;
+    let shown = app
+        .as_mut()
+        .map(|w| follow_in_app(w, &senders, views.first()));
     let mut sent = 0;
     let mut servers = Vec::new();
     for s in senders {
@@ -195,25 +234,63 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     // The last frames are in flight for a few milliseconds.
     let settle = Instant::now() + Duration::from_secs(2);
-    while robots.iter().map(LiveRobot::len).sum::<usize>() < sent && Instant::now() < settle {
+    while views.iter().map(RobotFrames::len).sum::<usize>() < sent && Instant::now() < settle {
         std::thread::sleep(Duration::from_millis(5));
     }
     let wall = start.elapsed().as_secs_f64();
     let cpu_after = cpu_seconds();
-    let report = report(
+    let mut report = report(
         args,
-        &robots,
+        &views,
         (width, height),
         sent,
         wall,
         cpu_before,
         cpu_after,
     );
+    if let Some(mut shown) = shown {
+        shown.sort_unstable();
+        report.shown = Some(shown.len());
+        report.shown_median_ms = Some(percentile_ms(&shown, 0.5));
+        report.shown_p99_ms = Some(percentile_ms(&shown, 0.99));
+    }
     drop(robots);
+    drop(app);
+    // The recordings were only there to cost what they cost.
+    let _ = std::fs::remove_dir_all(&folder);
     for s in servers {
         s.stop();
     }
     print_report(&report, args.json)
+}
+
+/// Ticks the workspace as the window does (when the shown robot's new frame wakes it, else every
+/// [`APP_TICK`]) until every sender is done; the latency of each frame shown (sender's write to
+/// the frame in the views), nanoseconds.
+fn follow_in_app<T>(
+    w: &mut Workspace,
+    senders: &[std::thread::JoinHandle<T>],
+    shown: Option<&RobotFrames>,
+) -> Vec<u64> {
+    // The shown robot's new frames wake the loop as they repaint the window.
+    let (wake, woken) = std::sync::mpsc::sync_channel::<()>(1);
+    w.set_wake(Arc::new(move || {
+        let _ = wake.try_send(());
+    }));
+    let mut latencies = Vec::new();
+    let mut last = None;
+    while senders.iter().any(|s| !s.is_finished()) {
+        let _ = woken.recv_timeout(APP_TICK);
+        w.tick(APP_TICK);
+        let index = w.index();
+        if w.frame().is_some() && last != Some(index) {
+            last = Some(index);
+            if let Some(f) = shown.and_then(|v| v.frame(index)) {
+                latencies.push(crate::live::unix_time_ns().saturating_sub(f.record.time_ns));
+            }
+        }
+    }
+    latencies
 }
 
 fn frames_needed(args: &Args) -> usize {
@@ -223,7 +300,7 @@ fn frames_needed(args: &Args) -> usize {
 
 fn report(
     args: &Args,
-    robots: &[LiveRobot],
+    robots: &[RobotFrames],
     (width, height): (usize, usize),
     sent: usize,
     wall: f64,
@@ -255,6 +332,9 @@ fn report(
         latency_max_ms: percentile_ms(&latencies, 1.0),
         receive_cpu_percent: 100.0 * (cpu_after.0 - cpu_before.0) / wall,
         process_cpu_percent: 100.0 * (cpu_after.1 - cpu_before.1) / wall,
+        shown: None,
+        shown_median_ms: None,
+        shown_p99_ms: None,
     }
 }
 
@@ -267,9 +347,20 @@ fn print_report(r: &LiveBenchJson, json: bool) -> anyhow::Result<()> {
         "latency write -> app state: median {:.2} ms, p99 {:.2} ms, max {:.2} ms",
         r.latency_median_ms, r.latency_p99_ms, r.latency_max_ms
     );
+    if let (Some(n), Some(m), Some(p)) = (r.shown, r.shown_median_ms, r.shown_p99_ms) {
+        println!(
+            "latency write -> frame shown in the app's workspace ({n} frames): median {m:.2} ms, p99 {p:.2} ms"
+        );
+    }
     println!(
-        "CPU: receiving {:.1}% of a core, whole process (with senders) {:.1}%",
-        r.receive_cpu_percent, r.process_cpu_percent
+        "CPU: receiving {:.1}% of a core, whole process (with senders{}) {:.1}%",
+        r.receive_cpu_percent,
+        if r.shown.is_some() {
+            ", the workspace's pipeline and recording"
+        } else {
+            ""
+        },
+        r.process_cpu_percent
     );
     if json {
         println!("{}", serde_json::to_string(r)?);

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 
+use crate::live::recorder::file_stem;
 use crate::live::{ClientOptions, LiveEvent, LiveRecorder, RobotClient, RobotUrl};
 use crate::streams::{IMAGE_TOPIC, StreamInfo};
 
@@ -48,26 +49,6 @@ struct Naming {
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
-}
-
-/// A file name from a server name: letters, digits, `-`, `_`, `.` kept, the rest `_`.
-fn file_stem(name: &str, url: &RobotUrl) -> String {
-    let stem: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    let stem = stem.trim_matches('.');
-    if stem.is_empty() {
-        format!("{}_{}", url.host, url.port)
-    } else {
-        stem.to_owned()
-    }
 }
 
 impl Naming {

@@ -19,7 +19,7 @@ use std::fmt;
 
 pub use client::{ClientOptions, LiveEvent, RobotClient};
 pub use recorder::LiveRecorder;
-pub use robot::{LiveFrame, LiveRobot, RobotStats};
+pub use robot::{Connection, LiveFrame, LiveRobot, RobotFrames, RobotStats};
 pub use source::NetworkSource;
 
 /// WebSocket subprotocols the client offers: the SDK's (its servers accept only this one since

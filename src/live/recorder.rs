@@ -9,6 +9,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use super::RobotUrl;
 use super::protocol::AdvertisedChannel;
 use crate::streams::{
     Compression, RawChannelSpec, StreamError, StreamInfo, StreamWriter, WriterOptions,
@@ -113,5 +114,27 @@ impl LiveRecorder {
     pub fn finish(self) -> Result<PathBuf, StreamError> {
         self.writer.finish()?;
         Ok(self.path)
+    }
+}
+
+/// A recording's file name (without `.mcap`) from a robot's server name: letters, digits, `-`,
+/// `_`, `.` kept, the rest `_`; the address when nothing is left.
+#[must_use]
+pub fn file_stem(name: &str, url: &RobotUrl) -> String {
+    let stem: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let stem = stem.trim_matches('.');
+    if stem.is_empty() {
+        format!("{}_{}", url.host, url.port)
+    } else {
+        stem.to_owned()
     }
 }

@@ -59,6 +59,20 @@ pub enum Connection {
     },
 }
 
+impl std::fmt::Display for Connection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Connecting => write!(f, "connecting…"),
+            Self::Connected(_) => write!(f, "connected"),
+            Self::Disconnected { reason, retry_in } => write!(
+                f,
+                "closed: {reason}; reconnecting in {:.1} s",
+                retry_in.as_secs_f64()
+            ),
+        }
+    }
+}
+
 /// A robot's figures for the connected-robots list.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RobotStats {
@@ -94,6 +108,11 @@ struct Inner {
     pending: Vec<(Arc<AdvertisedChannel>, u64, Vec<u8>)>,
     recorder: Option<LiveRecorder>,
     log: VecDeque<String>,
+    /// When the first frame arrived (the origin of the arrival times).
+    first_arrival: Option<Instant>,
+    /// Every frame's arrival, nanoseconds after the first frame's, by index (8 bytes a frame,
+    /// kept for frames no longer in memory too, so the timeline's times never change).
+    arrival_offsets_ns: Vec<u64>,
 }
 
 /// Called after each new frame (the app passes its repaint request).
@@ -106,49 +125,27 @@ pub struct LiveRobot {
     client: Option<RobotClient>,
 }
 
-impl std::fmt::Debug for LiveRobot {
+/// A read-only handle on a robot's frames (cheap to clone): what a viewer steps through while
+/// the robot's thread goes on adding frames. It reads the same state as its [`LiveRobot`] and
+/// stays readable (frozen) after the robot is dropped.
+#[derive(Clone)]
+pub struct RobotFrames {
+    url: RobotUrl,
+    shared: Arc<Mutex<Inner>>,
+}
+
+impl std::fmt::Debug for RobotFrames {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("LiveRobot")
+        f.debug_struct("RobotFrames")
             .field("url", &self.url)
             .finish_non_exhaustive()
     }
 }
 
-impl LiveRobot {
-    /// Connects to a robot (in the background: reconnecting until dropped). At most `keep_bytes`
-    /// of frame data stay in memory; `notify` runs after every new frame.
-    ///
-    /// # Errors
-    /// The OS's error when the connection thread cannot start.
-    pub fn connect(
-        url: RobotUrl,
-        options: ClientOptions,
-        keep_bytes: usize,
-        notify: Option<Notify>,
-    ) -> std::io::Result<Self> {
-        let shared = Arc::new(Mutex::new(Inner {
-            connection: Some(Connection::Connecting),
-            ..Inner::default()
-        }));
-        let client = RobotClient::spawn(url.clone(), options, {
-            let shared = Arc::clone(&shared);
-            move |event| {
-                let new_frame = lock(&shared).event(event, keep_bytes);
-                if new_frame && let Some(n) = &notify {
-                    n();
-                }
-            }
-        })?;
-        Ok(Self {
-            url,
-            shared,
-            client: Some(client),
-        })
-    }
-
+impl RobotFrames {
     /// The robot's address.
     #[must_use]
-    pub fn url(&self) -> &RobotUrl {
+    pub const fn url(&self) -> &RobotUrl {
         &self.url
     }
 
@@ -201,6 +198,142 @@ impl LiveRobot {
     #[must_use]
     pub fn latest(&self) -> Option<Arc<LiveFrame>> {
         lock(&self.shared).frames.back().cloned()
+    }
+
+    /// The figures for the robot list.
+    #[must_use]
+    pub fn stats(&self) -> RobotStats {
+        lock(&self.shared).stats()
+    }
+
+    /// When frame `index` arrived, nanoseconds after the first frame (the last frame's time
+    /// past the end; 0 before any frame).
+    #[must_use]
+    pub fn arrival_ns(&self, index: usize) -> u64 {
+        let inner = lock(&self.shared);
+        let times = &inner.arrival_offsets_ns;
+        times
+            .get(index)
+            .or_else(|| times.last())
+            .copied()
+            .unwrap_or(0)
+    }
+
+    /// The last frame that arrived at or before `offset_ns` after the first one (0 when none).
+    #[must_use]
+    pub fn index_at_arrival(&self, offset_ns: u64) -> usize {
+        let inner = lock(&self.shared);
+        inner
+            .arrival_offsets_ns
+            .partition_point(|&t| t <= offset_ns)
+            .saturating_sub(1)
+    }
+}
+
+impl std::fmt::Debug for LiveRobot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LiveRobot")
+            .field("url", &self.url)
+            .finish_non_exhaustive()
+    }
+}
+
+impl LiveRobot {
+    /// Connects to a robot (in the background: reconnecting until dropped). At most `keep_bytes`
+    /// of frame data stay in memory; `notify` runs after every new frame.
+    ///
+    /// # Errors
+    /// The OS's error when the connection thread cannot start.
+    pub fn connect(
+        url: RobotUrl,
+        options: ClientOptions,
+        keep_bytes: usize,
+        notify: Option<Notify>,
+    ) -> std::io::Result<Self> {
+        let shared = Arc::new(Mutex::new(Inner {
+            connection: Some(Connection::Connecting),
+            ..Inner::default()
+        }));
+        let client = RobotClient::spawn(url.clone(), options, {
+            let shared = Arc::clone(&shared);
+            move |event| {
+                let new_frame = lock(&shared).event(event, keep_bytes);
+                if new_frame && let Some(n) = &notify {
+                    n();
+                }
+            }
+        })?;
+        Ok(Self {
+            url,
+            shared,
+            client: Some(client),
+        })
+    }
+
+    /// The robot's address.
+    #[must_use]
+    pub fn url(&self) -> &RobotUrl {
+        &self.url
+    }
+
+    /// The robot's server name once it said it, else its address.
+    #[must_use]
+    pub fn name(&self) -> String {
+        self.frames_view().name()
+    }
+
+    /// The connection's state.
+    #[must_use]
+    pub fn connection(&self) -> Connection {
+        self.frames_view().connection()
+    }
+
+    /// Frames received so far (the next frame's index).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        lock(&self.shared).received
+    }
+
+    /// True before the first frame.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Index of the oldest frame still in memory (`len()` when none is).
+    #[must_use]
+    pub fn first_kept(&self) -> usize {
+        self.frames_view().first_kept()
+    }
+
+    /// Frame `index` if it is still in memory.
+    #[must_use]
+    pub fn frame(&self, index: usize) -> Option<Arc<LiveFrame>> {
+        self.frames_view().frame(index)
+    }
+
+    /// The newest frame.
+    #[must_use]
+    pub fn latest(&self) -> Option<Arc<LiveFrame>> {
+        lock(&self.shared).frames.back().cloned()
+    }
+
+    /// A handle on the frames for a viewer to step through while reception goes on.
+    #[must_use]
+    pub fn frames_view(&self) -> RobotFrames {
+        RobotFrames {
+            url: self.url.clone(),
+            shared: Arc::clone(&self.shared),
+        }
+    }
+
+    /// Where the running recording goes, if one runs.
+    #[must_use]
+    pub fn recording_path(&self) -> Option<PathBuf> {
+        lock(&self.shared)
+            .recorder
+            .as_ref()
+            .map(|r| r.path().to_owned())
     }
 
     /// The figures for the robot list.
@@ -432,6 +565,9 @@ impl Inner {
         }
         self.latencies.push_back(latency_ns);
         let now = Instant::now();
+        let first = *self.first_arrival.get_or_insert(now);
+        let offset = u64::try_from(now.duration_since(first).as_nanos()).unwrap_or(u64::MAX);
+        self.arrival_offsets_ns.push(offset);
         self.arrivals.push_back(now);
         while self
             .arrivals

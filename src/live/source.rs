@@ -5,13 +5,20 @@
 //! the connection (and reconnection) goes on in the background. [`FrameSource::grab`] hands out
 //! the newest frame not handed out yet, waiting up to [`GRAB_WAIT`] for one; every frame stays in
 //! the [`LiveRobot`]'s own history whether it was grabbed or not.
+//!
+//! [`RobotFrames`] is also a [`RecordedSource`]: the frames that have arrived so far, by arrival
+//! index and arrival time, growing while the robot sends. The app shows a robot through it, so
+//! stepping back, seeking and playing through what has arrived use the same timeline as a
+//! recording while reception and recording go on. Frames older than the robot's byte budget
+//! are no longer in memory: [`RecordedSource::first_index`] says where the kept ones start.
 
 use std::time::{Duration, Instant};
 
-use super::robot::{Connection, DEFAULT_KEEP_BYTES};
-use super::{ClientOptions, LiveRobot, RobotUrl};
+use super::robot::{Connection, DEFAULT_KEEP_BYTES, LiveFrame};
+use super::{ClientOptions, LiveRobot, RobotFrames, RobotUrl};
 use crate::sources::{
-    CameraKind, FrameSource, SourceError, SourceFrame, SourceInfo, SourceKind, SourceSettings,
+    CameraKind, FrameSource, RecordedSource, SourceError, SourceFrame, SourceInfo, SourceKind,
+    SourceSettings,
 };
 
 /// Longest a grab waits for a new frame.
@@ -137,6 +144,92 @@ impl FrameSource for NetworkSource {
                 return Err(SourceError::Device { label, detail });
             }
             std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+}
+
+/// A frame as the workspace shows it: its time is its arrival after the robot's first frame
+/// (the timeline's time), its sensors and JSON channels as they came.
+fn source_frame(live: &LiveFrame, time_ns: u64) -> SourceFrame {
+    let r = &live.record;
+    let mut frame = SourceFrame::new(time_ns, r.frame.clone());
+    frame.sensors = r.sensors;
+    frame.extra.clone_from(&r.extra);
+    frame
+}
+
+impl FrameSource for RobotFrames {
+    fn info(&self) -> SourceInfo {
+        SourceInfo {
+            kind: SourceKind::Network,
+            label: format!("robot {}", self.name()),
+            camera: CameraKind::Robot,
+            paths: Vec::new(),
+            stream_source: "robot".to_owned(),
+        }
+    }
+
+    /// The robot's own thread connects; a view has nothing to open.
+    fn connect(&mut self) -> Result<(), SourceError> {
+        Ok(())
+    }
+
+    fn disconnect(&mut self) {}
+
+    fn is_connected(&self) -> bool {
+        matches!(self.connection(), Connection::Connected(_))
+    }
+
+    fn settings(&self) -> SourceSettings {
+        SourceSettings::default()
+    }
+
+    /// The newest frame.
+    fn grab(&mut self) -> Result<SourceFrame, SourceError> {
+        let latest = self
+            .latest()
+            .ok_or_else(|| SourceError::Empty(format!("robot {}: no frame yet", self.name())))?;
+        Ok(source_frame(&latest, self.arrival_ns(latest.index)))
+    }
+
+    fn recorded(&mut self) -> Option<&mut dyn RecordedSource> {
+        Some(self)
+    }
+}
+
+impl RecordedSource for RobotFrames {
+    fn len(&self) -> usize {
+        RobotFrames::len(self)
+    }
+
+    fn first_index(&self) -> usize {
+        self.first_kept()
+    }
+
+    fn time_ns(&self, index: usize) -> u64 {
+        self.arrival_ns(index)
+    }
+
+    fn index_at_time(&self, time_ns: u64) -> usize {
+        self.index_at_arrival(time_ns)
+    }
+
+    fn read(&mut self, index: usize) -> Result<SourceFrame, SourceError> {
+        let label = format!("robot {}", self.name());
+        match self.frame(index) {
+            Some(f) => Ok(source_frame(&f, self.arrival_ns(index))),
+            None if index < self.first_kept() => Err(SourceError::Unsupported {
+                label,
+                detail: format!(
+                    "frame {index} is no longer in memory (the byte budget keeps frames {} on)",
+                    self.first_kept()
+                ),
+            }),
+            None => Err(SourceError::NoSuchFrame {
+                label,
+                index,
+                len: RobotFrames::len(self),
+            }),
         }
     }
 }

@@ -377,6 +377,12 @@ pub trait RecordedSource: FrameSource {
         self.len() == 0
     }
 
+    /// The first frame that can be read: 0, except for a live robot whose oldest frames have
+    /// left memory (frames `first_index()..len()` are readable).
+    fn first_index(&self) -> usize {
+        0
+    }
+
     /// Time of frame `index`, nanoseconds since the first frame.
     fn time_ns(&self, index: usize) -> u64;
 

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use crate::sources::{SourceSettings, SourceSpec};
 
 use super::overhead::RobotKey;
+use super::robots::RobotId;
 use super::settings::{OverheadView, Overlays, ViewKind};
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
@@ -113,6 +114,22 @@ pub enum Command {
     /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
     /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
     SelectObject(Option<String>),
+    /// Connect a robot at `HOST:PORT` (or `ws://HOST:PORT`) beside those connected already
+    /// (Camera ▸ Connect to robot…); shown when no robot is.
+    ConnectRobot(String),
+    /// Show this robot in the views, following its newest frame; the others keep receiving.
+    ShowRobot(RobotId),
+    /// Disconnect this robot, finishing its recording.
+    DisconnectRobot(RobotId),
+    /// Record this robot, bit-exact, into this MCAP stream.
+    RecordRobot(RobotId, PathBuf),
+    /// Record every robot not recording yet into this folder, one file per robot.
+    RecordAllRobots(PathBuf),
+    /// Finish this robot's recording.
+    StopRecordingRobot(RobotId),
+    /// Follow the shown robot's newest frame (true) or hold the view where it is (false);
+    /// reception and recording go on either way.
+    SetFollowLive(bool),
     /// The overhead camera: calibration, picked points, robot selection, view options.
     Overhead(OverheadCommand),
 }
@@ -172,17 +189,20 @@ pub enum Window {
     FieldView,
     /// Overhead calibration: pick landmarks, solve, reprojection errors.
     Calibration,
+    /// Camera ▸ Connect to robot…: the robots list.
+    Robots,
 }
 
 impl Window {
     /// Every window, for the Windows menu.
-    pub const ALL: [Self; 6] = [
+    pub const ALL: [Self; 7] = [
         Self::Sensors,
         Self::UvPlane,
         Self::TryEdit,
         Self::Inspector,
         Self::FieldView,
         Self::Calibration,
+        Self::Robots,
     ];
 
     /// Its title.
@@ -198,6 +218,7 @@ impl Window {
             Self::Record => "Record into a stream",
             Self::FieldView => "Field view",
             Self::Calibration => "Overhead calibration",
+            Self::Robots => "Robots",
         }
     }
 }

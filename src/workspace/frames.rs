@@ -60,6 +60,7 @@ impl Workspace {
             return Err(e);
         }
         self.live = None;
+        self.robots.unshow();
         if let Some(src) = &self.source {
             self.settings.last_source = src
                 .paths()
@@ -152,7 +153,9 @@ impl Workspace {
 
     pub(super) fn seek(&mut self, index: usize) -> anyhow::Result<()> {
         let src = self.source.as_mut().context("no stream or frames open")?;
-        let index = index.min(src.len().saturating_sub(1));
+        let index = index
+            .min(src.len().saturating_sub(1))
+            .max(src.first_index());
         let t0 = Instant::now();
         let loaded = src.read(index)?;
         let t1 = Instant::now();

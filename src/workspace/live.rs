@@ -61,6 +61,11 @@ impl Workspace {
     /// Connects `spec`: a recorded source is opened for stepping and playback, a live one starts
     /// streaming on its own thread. What was connected before is disconnected.
     pub(super) fn connect(&mut self, spec: &SourceSpec) -> anyhow::Result<()> {
+        if let SourceSpec::Network(address) = spec {
+            // One way to connect a robot: into the robots list, shown at once.
+            let id = self.connect_robot(address)?;
+            return self.show_robot(id);
+        }
         if spec.is_recorded() {
             let source = Source::new(spec.open_recorded()?);
             self.disconnect_live();
@@ -80,6 +85,7 @@ impl Workspace {
         self.disconnect_live();
         self.stop_recording_recorded();
         self.source = None;
+        self.robots.unshow();
         self.player.stop();
         self.try_edit = None;
         self.current = None;
@@ -100,6 +106,9 @@ impl Workspace {
 
     /// Disconnects the live source or closes the recorded one, finishing a recording.
     pub(super) fn disconnect(&mut self) -> anyhow::Result<()> {
+        if let Some(id) = self.shown_robot() {
+            return self.disconnect_robot(id);
+        }
         if let Some(label) = self.disconnect_live() {
             self.status = format!("disconnected {label}");
             return Ok(());
@@ -115,7 +124,7 @@ impl Workspace {
     }
 
     /// Stops the live source's thread (finishing its recording); its label, if one was live.
-    fn disconnect_live(&mut self) -> Option<String> {
+    pub(super) fn disconnect_live(&mut self) -> Option<String> {
         let live = self.live.take()?;
         let label = live.info().label.clone();
         let mut streamer = live.streamer;
@@ -168,6 +177,10 @@ impl Workspace {
             "{}: a recording is an MCAP stream: name it NAME.mcap",
             path.display()
         );
+        if let Some(id) = self.shown_robot() {
+            // A robot records every message as it came, with its own recorder.
+            return self.record_robot(id, path);
+        }
         let info = self
             .connected_info()
             .context("nothing connected to record")?;
@@ -193,6 +206,9 @@ impl Workspace {
 
     /// Finishes the recording.
     pub(super) fn stop_recording(&mut self) -> anyhow::Result<()> {
+        if let Some(id) = self.shown_robot() {
+            return self.stop_recording_robot(id);
+        }
         if let Some(live) = self.live.as_mut()
             && live.streamer.recording().is_some()
         {
@@ -206,7 +222,7 @@ impl Workspace {
         Ok(())
     }
 
-    fn stop_recording_recorded(&mut self) {
+    pub(super) fn stop_recording_recorded(&mut self) {
         if let Some(r) = self.recorder.take() {
             let path = r.path().to_owned();
             match r.finish() {
@@ -305,6 +321,7 @@ impl Workspace {
             .as_ref()
             .and_then(|l| l.streamer.recording().map(Path::to_owned))
             .or_else(|| self.recorder.as_ref().map(|r| r.path().to_owned()))
+            .or_else(|| self.shown_robot_recording())
     }
 }
 

@@ -14,6 +14,7 @@
 //! | `frames.rs` | opening sources, showing a frame, the sensor-series scan |
 //! | `player.rs` | [`Player`]: playback clock, `tick`, `next_frame_due` |
 //! | `live.rs` | [`Live`]: a connected live source streaming on its thread; recording |
+//! | `robots.rs` | robots over the network, several at once: the list, the shown one, following live, recording each |
 //! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
@@ -30,6 +31,7 @@ pub mod journal;
 mod live;
 pub mod overhead;
 pub mod player;
+mod robots;
 mod settings;
 pub mod source;
 mod table;
@@ -46,6 +48,7 @@ pub use compose::{PrimitiveFilter, box_colour};
 pub use live::Live;
 pub use overhead::{CalibrationSource, Overhead, RobotKey};
 pub use player::Player;
+pub use robots::{RobotId, RobotRow, Wake};
 pub use settings::{
     MAX_RECENT, MAX_WARNINGS, OverheadView, Overlays, SPEEDS, Settings, ViewKind, ViewTransform,
     ZOOM_PRESETS, ZOOM_RANGE,
@@ -139,6 +142,8 @@ pub struct Workspace {
     accepted_owners: Vec<String>,
     selected_object: Option<String>,
     live: Option<Live>,
+    /// Robots over the network, one of them perhaps shown.
+    robots: robots::Robots,
     /// Recording a recorded source's shown frames (a live source records on its thread).
     recorder: Option<Recorder>,
     /// Which camera's table the pipeline holds.
@@ -198,6 +203,7 @@ impl Workspace {
             accepted_owners: Vec::new(),
             selected_object: None,
             live: None,
+            robots: robots::Robots::default(),
             recorder: None,
             table_kind: CameraKind::Robot,
             other_table: TableSlot::empty(bits),
@@ -244,6 +250,13 @@ impl Workspace {
     /// File problems (naming the file), nothing to commit or save, and the like; the state is
     /// unchanged by a failed command.
     pub fn apply(&mut self, command: Command) -> anyhow::Result<()> {
+        if matches!(
+            command,
+            Command::Step(_) | Command::Seek(_) | Command::SetPlaying(_)
+        ) {
+            // Moving through a shown robot's frames holds the view (reception goes on).
+            self.leave_live();
+        }
         match command {
             Command::Open(paths) => self.open(paths)?,
             Command::OpenTable(p) => self.open_table(&p)?,
@@ -323,6 +336,13 @@ impl Workspace {
             Command::SetStreaming(on) => self.set_streaming(on)?,
             Command::StartRecording(p) => self.start_recording(&p)?,
             Command::StopRecording => self.stop_recording()?,
+            c @ (Command::ConnectRobot(_)
+            | Command::ShowRobot(_)
+            | Command::DisconnectRobot(_)
+            | Command::RecordRobot(..)
+            | Command::RecordAllRobots(_)
+            | Command::StopRecordingRobot(_)
+            | Command::SetFollowLive(_)) => self.apply_robot_command(c)?,
             Command::SelectObject(owner) => {
                 if let Some(o) = &owner {
                     anyhow::ensure!(
@@ -396,6 +416,7 @@ impl Workspace {
     /// Advances playback and background scans by `dt` of wall time. Called once per UI frame.
     pub fn tick(&mut self, dt: Duration) {
         self.poll_live();
+        self.poll_robots();
         self.scan_sensor_series();
         if let (Some(t), Some(src)) = (self.try_edit.as_mut(), self.source.as_mut()) {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
@@ -427,9 +448,15 @@ impl Workspace {
                 .unwrap_or(30.0);
             return Some(Duration::from_secs_f64(0.5 / rate.min(240.0)));
         }
-        let src = self.source.as_ref()?;
-        self.player
-            .next_frame_due(self.settings.speed, self.index, src)
+        let robots = self.robots_poll_due();
+        let player = self.source.as_ref().and_then(|src| {
+            self.player
+                .next_frame_due(self.settings.speed, self.index, src)
+        });
+        match (robots, player) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     /// Which camera the shown frames come from (robot when nothing is open): it chooses the
@@ -669,6 +696,7 @@ impl Workspace {
             Window::Record => self.settings.show_record,
             Window::FieldView => self.settings.show_field_view,
             Window::Calibration => self.settings.show_calibration,
+            Window::Robots => self.settings.show_robots,
         }
     }
 
@@ -683,6 +711,7 @@ impl Workspace {
             Window::Record => &mut self.settings.show_record,
             Window::FieldView => &mut self.settings.show_field_view,
             Window::Calibration => &mut self.settings.show_calibration,
+            Window::Robots => &mut self.settings.show_robots,
         }
     }
 

@@ -236,6 +236,9 @@ pub struct Settings {
     /// The "Start recording" dialog open.
     #[serde(skip)]
     pub show_record: bool,
+    /// The robots window (Camera ▸ Connect to robot…) open.
+    #[serde(skip)]
+    pub show_robots: bool,
 }
 
 impl Default for Settings {
@@ -268,6 +271,7 @@ impl Default for Settings {
             show_connect: false,
             show_source_settings: false,
             show_record: false,
+            show_robots: false,
         }
     }
 }

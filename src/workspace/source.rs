@@ -63,6 +63,11 @@ impl Source {
         &self.info
     }
 
+    /// Asks the source again what it is (a robot names itself once connected).
+    pub fn refresh_info(&mut self) {
+        self.info = self.inner.info();
+    }
+
     /// The files this source was opened from (for "reopen at start" and recent files).
     #[must_use]
     pub fn paths(&self) -> Vec<PathBuf> {
@@ -93,6 +98,13 @@ impl Source {
         self.len() == 0
     }
 
+    /// The first frame that can be read (0 except for a live robot's, whose oldest frames may
+    /// have left memory).
+    #[must_use]
+    pub fn first_index(&self) -> usize {
+        self.inner.first_index()
+    }
+
     /// Time of frame `index`, nanoseconds since the first frame.
     #[must_use]
     pub fn time_ns(&self, index: usize) -> u64 {
@@ -116,6 +128,11 @@ impl Source {
     /// # Errors
     /// Index out of range; the file's read error, naming it.
     pub fn read(&mut self, index: usize) -> Result<SourceFrame, SourceError> {
+        if self.info.kind == SourceKind::Network {
+            // A robot's frames are in memory already, and the newest one may still gain the
+            // sensor readings that follow its image: never serve it from a stale copy.
+            return self.inner.read(index);
+        }
         if let Some(pos) = self.cache.iter().position(|(i, _)| *i == index)
             && let Some(entry) = self.cache.remove(pos)
         {

@@ -1,5 +1,7 @@
 //! The app watching a robot: Camera ▸ Connect… ▸ network to an `eotn serve` stand-in robot,
 //! driven headlessly with egui_kittest; its frames arrive in the app state with their sensors.
+//! Camera ▸ Connect to robot…: two robots at once in the robots window, clicking one shows it,
+//! the Live switch holds the view while frames keep arriving, Record all writes one file each.
 
 use std::time::{Duration, Instant};
 
@@ -36,9 +38,10 @@ fn camera_connect_to_a_robot_served_by_eotn_serve_shows_its_frames() {
     h.run();
     h.get_by_label("Connect").click();
     h.run();
-    let frames = |a: &EotnApp| a.state.live().map_or(0, |l| l.frames());
+    // Connect… ▸ network puts the robot into the robots list, shown at once.
+    let frames = |a: &EotnApp| a.state.robots().first().map_or(0, |r| r.stats.frames);
     let start = Instant::now();
-    while frames(h.state()) < 5 {
+    while frames(h.state()) < 5 || h.state().state.frame().is_none() {
         assert!(
             start.elapsed() < Duration::from_secs(30),
             "{:?}",
@@ -51,10 +54,118 @@ fn camera_connect_to_a_robot_served_by_eotn_serve_shows_its_frames() {
     assert_eq!(info.kind, SourceKind::Network);
     assert!(info.label.starts_with("robot "), "{}", info.label);
     assert_eq!(h.state().state.camera_kind(), CameraKind::Robot);
-    assert!(h.state().state.frame().is_some());
+    assert!(h.state().state.shown_robot().is_some());
     h.get_by_label("Camera").click();
     h.run();
     h.get_by_label("Disconnect").click();
     h.run();
-    assert!(h.state().state.live().is_none());
+    assert!(h.state().state.robots().is_empty());
+    assert!(h.state().state.connected_info().is_none());
+}
+
+/// Runs the app until `done` holds, at most 30 s.
+fn run_until(h: &mut Harness<'static, EotnApp>, done: impl Fn(&EotnApp) -> bool) {
+    let start = Instant::now();
+    while !done(h.state()) {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "{:?}",
+            h.state().state.warnings()
+        );
+        h.run_steps(4);
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+fn robot_frames(a: &EotnApp, name: &str) -> usize {
+    a.state
+        .robots()
+        .iter()
+        .find(|r| r.name == name)
+        .map_or(0, |r| r.stats.frames)
+}
+
+#[test]
+fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let stream = sim_stream(dir.path(), 10);
+    let alpha = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "alpha"]);
+    let bravo = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "bravo"]);
+    let mut h: Harness<'static, EotnApp> = Harness::builder()
+        .with_size(Vec2::new(1280.0, 800.0))
+        .build_eframe(|cc| EotnApp::new(cc, Vec::new()));
+    h.run_steps(4);
+    h.get_by_label("Camera").click();
+    h.run_steps(4);
+    h.get_by_label("Connect to robot…").click();
+    h.run_steps(4);
+    assert!(h.state().state.window_open(Window::Robots));
+    for port in [alpha.port, bravo.port] {
+        h.state_mut().robots.address.clear();
+        h.run_steps(4);
+        let field = h.get_by_label("address");
+        field.focus();
+        field.type_text(&format!("127.0.0.1:{port}"));
+        h.run_steps(4);
+        h.get_by_label("Connect robot").click();
+        h.run_steps(4);
+    }
+    run_until(&mut h, |a| {
+        robot_frames(a, "alpha") >= 3 && robot_frames(a, "bravo") >= 3
+    });
+    let rows = h.state().state.robots();
+    assert_eq!(rows.len(), 2);
+    assert!(rows[0].shown && !rows[1].shown, "the first robot is shown");
+    assert!(h.state().state.frame().is_some());
+    // The list shows each robot's state and figures.
+    assert!(h.query_all_by_label("connected").count() >= 2);
+
+    h.get_by_label("bravo").click();
+    h.run_steps(4);
+    assert_eq!(h.state().state.shown_robot(), Some(rows[1].id));
+    assert!(
+        h.state().state.title().contains("robot bravo"),
+        "{}",
+        h.state().state.title()
+    );
+    // Alpha, not shown, keeps receiving.
+    let before = robot_frames(h.state(), "alpha");
+    run_until(&mut h, |a| robot_frames(a, "alpha") > before + 2);
+
+    // The Live switch holds the view; frames keep arriving; Live again shows the newest.
+    run_until(&mut h, |a| a.state.frame().is_some());
+    // (The switch is in the timeline and in the robots window.)
+    h.get_all_by_label("Live").next().unwrap().click();
+    h.run_steps(4);
+    assert!(!h.state().state.following_live());
+    let held = h.state().state.index();
+    let received = robot_frames(h.state(), "bravo");
+    run_until(&mut h, |a| robot_frames(a, "bravo") > received + 2);
+    assert_eq!(h.state().state.index(), held, "the view is held");
+    h.get_all_by_label("Live").next().unwrap().click();
+    h.run_steps(4);
+    assert!(h.state().state.following_live());
+    assert!(h.state().state.index() > held);
+
+    // Record all: one file per robot, named after it.
+    let folder = dir.path().join("rec");
+    h.state_mut().robots.folder = folder.display().to_string();
+    h.run_steps(4);
+    h.get_by_label("Record all").click();
+    h.run_steps(4);
+    run_until(&mut h, |a| {
+        a.state
+            .robots()
+            .iter()
+            .all(|r| r.stats.recorded.is_some_and(|n| n >= 2))
+    });
+    for _ in 0..2 {
+        h.get_all_by_label("Disconnect").next().unwrap().click();
+        h.run_steps(4);
+    }
+    assert!(h.state().state.robots().is_empty());
+    for name in ["alpha", "bravo"] {
+        let r = eotn::streams::StreamReader::open(&folder.join(format!("{name}.mcap"))).unwrap();
+        assert!(r.len() >= 2, "{name}: {} frames", r.len());
+    }
 }

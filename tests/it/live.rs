@@ -23,7 +23,7 @@ use tungstenite::Message;
 use crate::common::{eotn_ok, python_with_foxglove};
 
 /// A small frame whose every byte depends on the frame number, so mix-ups show.
-fn frame(i: usize) -> Frame {
+pub fn frame(i: usize) -> Frame {
     Frame::uyvy_from_fn(32, 24, |x, y| {
         Yuv::new(
             ((x * 7 + y * 3 + i * 11) % 220 + 16) as u8,
@@ -34,7 +34,7 @@ fn frame(i: usize) -> Frame {
     .unwrap()
 }
 
-fn record(i: usize) -> FrameRecord {
+pub fn record(i: usize) -> FrameRecord {
     let mut r = FrameRecord::new(1_000_000 + i as u64 * 33_333_333, frame(i));
     r.sensors = Some(SensorReadings {
         head_pan_rad: Some(0.01 * i as f64),
@@ -44,7 +44,7 @@ fn record(i: usize) -> FrameRecord {
 }
 
 /// Waits up to `secs` for `done`; false when it never came.
-fn wait_for(secs: f64, mut done: impl FnMut() -> bool) -> bool {
+pub fn wait_for(secs: f64, mut done: impl FnMut() -> bool) -> bool {
     let until = Instant::now() + Duration::from_secs_f64(secs);
     while Instant::now() < until {
         if done() {
@@ -74,7 +74,7 @@ fn fast_retry() -> ClientOptions {
     clippy::result_large_err,
     reason = "tungstenite's handshake callback type"
 )]
-fn fake_robot_session(listener: &TcpListener) -> (tungstenite::WebSocket<TcpStream>, u32) {
+pub fn fake_robot_session(listener: &TcpListener) -> (tungstenite::WebSocket<TcpStream>, u32) {
     let (stream, _) = listener.accept().unwrap();
     stream.set_nodelay(true).unwrap();
     let mut ws = tungstenite::accept_hdr(
@@ -125,7 +125,7 @@ fn fake_robot_session(listener: &TcpListener) -> (tungstenite::WebSocket<TcpStre
     }
 }
 
-fn image_message(sub: u32, i: usize) -> Vec<u8> {
+pub fn image_message(sub: u32, i: usize) -> Vec<u8> {
     let r = record(i);
     let mut payload = Vec::new();
     // The hand-made robot sends the cameras' own order; eotn serve sends yuyv.
@@ -260,7 +260,8 @@ fn garbage_and_oversized_messages_close_only_their_own_robot() {
 
 #[test]
 fn four_robots_at_30_fps_lose_no_frame_and_keep_up() {
-    // A full minute with EOTN_LIVE_SECONDS=60 (scripts/live-soak.sh); a short run in the suite.
+    // Longer with EOTN_LIVE_SECONDS (scripts/live-soak.sh runs the workspace's version of this
+    // test, tests/it/robots.rs, for a minute); a short run in the suite.
     let seconds: f64 = std::env::var("EOTN_LIVE_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -364,7 +365,7 @@ pub fn serve(stream: &Path, listen: &str, extra: &[&str]) -> Served {
 }
 
 /// Every image message's bytes in an MCAP file, in order, read with the `mcap` crate alone.
-fn image_payloads(path: &Path) -> Vec<Vec<u8>> {
+pub fn image_payloads(path: &Path) -> Vec<Vec<u8>> {
     let bytes = std::fs::read(path).unwrap();
     mcap::MessageStream::new(&bytes)
         .unwrap()
@@ -413,7 +414,7 @@ fn frames_from_eotn_serve_are_recorded_bit_exact_by_eotn_record() {
     }
 }
 
-fn free_port() -> u16 {
+pub fn free_port() -> u16 {
     TcpListener::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()

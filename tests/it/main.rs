@@ -22,6 +22,7 @@ mod peer;
 mod properties;
 mod real_data;
 mod recognition;
+mod robots;
 mod sim;
 mod sim_table;
 mod snapshots;

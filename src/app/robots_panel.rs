@@ -1,0 +1,191 @@
+//! The robots window (Camera ▸ Connect to robot…): connect robots by address, several at once,
+//! and a list of them — name, connection state (with why a connection closed), frame rate,
+//! drops, latency, recording — where clicking a robot shows it. Every action is a [`Command`].
+//! [`live_controls_ui`] is the timeline's Live switch while a robot is shown.
+
+use std::path::PathBuf;
+
+use egui::{Context, RichText, Ui};
+
+use crate::live::Connection;
+use crate::workspace::{Command, RobotRow, Window, Workspace};
+
+/// What the robots window is editing.
+#[derive(Debug)]
+pub struct RobotsPanel {
+    /// The robot address typed (`HOST:PORT` or `ws://HOST:PORT`).
+    pub address: String,
+    /// The folder recordings go into, one file per robot named after it.
+    pub folder: String,
+}
+
+impl Default for RobotsPanel {
+    fn default() -> Self {
+        Self {
+            address: "127.0.0.1:8765".to_owned(),
+            folder: "recordings".to_owned(),
+        }
+    }
+}
+
+/// Shows the robots window while it is open; closing it sends [`Command::ShowWindow`].
+pub fn robots_window(
+    ctx: &Context,
+    state: &Workspace,
+    panel: &mut RobotsPanel,
+    commands: &mut Vec<Command>,
+) {
+    if !state.window_open(Window::Robots) {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new(Window::Robots.name())
+        .open(&mut open)
+        .default_pos([300.0, 90.0])
+        .show(ctx, |ui| robots_ui(ui, state, panel, commands));
+    if !open {
+        commands.push(Command::ShowWindow(Window::Robots, false));
+    }
+}
+
+/// The window's contents: the address field, the robots list, recording into a folder.
+pub fn robots_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    panel: &mut RobotsPanel,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal(|ui| {
+        let label = ui.label("address");
+        ui.add(
+            egui::TextEdit::singleline(&mut panel.address)
+                .hint_text("HOST:PORT")
+                .desired_width(220.0),
+        )
+        .labelled_by(label.id);
+        let address = panel.address.trim();
+        if ui
+            .add_enabled(!address.is_empty(), egui::Button::new("Connect robot"))
+            .on_hover_text("connect beside the robots connected already")
+            .clicked()
+        {
+            commands.push(Command::ConnectRobot(address.to_owned()));
+        }
+    });
+    ui.separator();
+    let rows = state.robots();
+    if rows.is_empty() {
+        ui.weak("No robot connected. A team is four or five: connect each by its address.");
+        return;
+    }
+    egui::Grid::new("robots")
+        .striped(true)
+        .num_columns(7)
+        .show(ui, |ui| {
+            for heading in ["robot", "state", "fps", "drops", "latency", "recording", ""] {
+                ui.strong(heading);
+            }
+            ui.end_row();
+            for row in &rows {
+                robot_row_ui(ui, state, panel, row, commands);
+                ui.end_row();
+            }
+        });
+    ui.separator();
+    ui.horizontal(|ui| {
+        let label = ui.label("record into folder");
+        ui.add(egui::TextEdit::singleline(&mut panel.folder).desired_width(220.0))
+            .labelled_by(label.id);
+        let folder = panel.folder.trim();
+        if ui
+            .add_enabled(!folder.is_empty(), egui::Button::new("Record all"))
+            .on_hover_text("every robot not recording yet, one file each, bit-exact")
+            .clicked()
+        {
+            commands.push(Command::RecordAllRobots(PathBuf::from(folder)));
+        }
+    });
+    live_controls_ui(ui, state, commands);
+}
+
+fn robot_row_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    panel: &RobotsPanel,
+    row: &RobotRow,
+    commands: &mut Vec<Command>,
+) {
+    let id = row.id;
+    if ui
+        .selectable_label(row.shown, &row.name)
+        .on_hover_text(format!("{}: click to show it", row.url))
+        .clicked()
+        && !row.shown
+    {
+        commands.push(Command::ShowRobot(id));
+    }
+    let text = row.connection.to_string();
+    let state_label = match &row.connection {
+        Connection::Connected(_) => ui.label(text),
+        Connection::Connecting => ui.weak(text),
+        Connection::Disconnected { .. } => ui.colored_label(ui.visuals().warn_fg_color, text),
+    };
+    state_label.on_hover_text(state.robot_log(id).join("\n"));
+    let s = &row.stats;
+    ui.monospace(format!("{:.0}", s.fps));
+    ui.monospace(s.drops.to_string());
+    ui.monospace(match (s.latency_median_ms, s.latency_p99_ms) {
+        (Some(m), Some(p)) => format!("{m:.1} / {p:.1} ms"),
+        _ => "-".to_owned(),
+    })
+    .on_hover_text("median / 99th percentile, sender's write to the frame here");
+    match &row.recording {
+        Some(path) => {
+            ui.horizontal(|ui| {
+                ui.label(RichText::new(format!("rec {}", s.recorded.unwrap_or(0))).strong())
+                    .on_hover_text(path.display().to_string());
+                if ui.small_button("Stop").clicked() {
+                    commands.push(Command::StopRecordingRobot(id));
+                }
+            });
+        }
+        None => {
+            let folder = PathBuf::from(panel.folder.trim());
+            if ui
+                .small_button("Record")
+                .on_hover_text("into the folder below, named after the robot")
+                .clicked()
+            {
+                commands.push(Command::RecordRobot(
+                    id,
+                    state.robot_recording_path(id, &folder),
+                ));
+            }
+        }
+    }
+    if ui.small_button("Disconnect").clicked() {
+        commands.push(Command::DisconnectRobot(id));
+    }
+}
+
+/// While a robot is shown: the Live switch (follow its newest frame, or hold the view to step
+/// back through what has arrived) and where the view is.
+pub fn live_controls_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    if state.shown_robot().is_none() {
+        return;
+    }
+    let live = state.following_live();
+    let button = egui::Button::new("Live").selected(live);
+    let hover = if live {
+        "showing each frame as it arrives: click to hold the view"
+    } else {
+        "back to the newest frame"
+    };
+    if ui.add(button).on_hover_text(hover).clicked() {
+        commands.push(Command::SetFollowLive(!live));
+    }
+    if !live {
+        ui.weak("held")
+            .on_hover_text("reception and recording go on; Live shows the newest frame");
+    }
+}
