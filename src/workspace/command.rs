@@ -112,6 +112,29 @@ pub enum Command {
     /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
     /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
     SelectObject(Option<String>),
+    /// Count the colours the table leaves unclassified over frames `first..=last` (clamped to
+    /// the source), a few frames per UI frame: the coverage hints.
+    FindUnclassified {
+        /// First frame.
+        first: usize,
+        /// Last frame (inclusive).
+        last: usize,
+    },
+    /// Select these table cells (by index), as clicking a coverage hint: the preview, nothing
+    /// written until a Commit.
+    SelectCells(Vec<usize>),
+    /// Run the pipeline over the whole source for its events (ball found or lost, goal
+    /// appears, warnings), a few frames per UI frame.
+    FindEvents,
+    /// Bookmark the shown frame with a note (replacing one there), saved beside the stream.
+    AddBookmark(String),
+    /// Remove the bookmark at this frame.
+    RemoveBookmark(usize),
+    /// Go to the next (or previous) mark: an event or a bookmark.
+    JumpToMark {
+        /// Next when true, previous when false.
+        forward: bool,
+    },
 }
 
 /// The app's extra windows.
@@ -131,11 +154,22 @@ pub enum Window {
     SourceSettings,
     /// Camera ▸ Start recording…: name the stream.
     Record,
+    /// The colours the table leaves unclassified (coverage hints).
+    Coverage,
+    /// Events and bookmarks on the timeline.
+    Bookmarks,
 }
 
 impl Window {
     /// Every window, for the Windows menu.
-    pub const ALL: [Self; 4] = [Self::Sensors, Self::UvPlane, Self::TryEdit, Self::Inspector];
+    pub const ALL: [Self; 6] = [
+        Self::Sensors,
+        Self::UvPlane,
+        Self::TryEdit,
+        Self::Inspector,
+        Self::Coverage,
+        Self::Bookmarks,
+    ];
 
     /// Its title.
     #[must_use]
@@ -148,6 +182,8 @@ impl Window {
             Self::Connect => "Connect a source",
             Self::SourceSettings => "Source settings",
             Self::Record => "Record into a stream",
+            Self::Coverage => "Unclassified colours",
+            Self::Bookmarks => "Events and bookmarks",
         }
     }
 }

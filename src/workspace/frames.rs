@@ -59,6 +59,7 @@ impl Workspace {
             return Err(e);
         }
         self.live = None;
+        self.load_bookmarks();
         if let Some(src) = &self.source {
             self.settings.last_source = src
                 .paths()

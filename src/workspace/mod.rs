@@ -17,12 +17,17 @@
 //! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
+//! | `coverage.rs`, `cell_origin.rs`, `bookmarks.rs`, `hints.rs` | what is unclassified, who set a cell, events and bookmarks |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
 //! | `timings.rs` | step and frame-time measurements |
 
+pub mod bookmarks;
+pub mod cell_origin;
 mod command;
 mod compose;
+pub mod coverage;
 mod frames;
+mod hints;
 pub mod journal;
 mod live;
 pub mod player;
@@ -140,6 +145,8 @@ pub struct Workspace {
     table_kind: CameraKind,
     /// The other camera's table.
     other_table: TableSlot,
+    /// Coverage hints, events and bookmarks.
+    hints: hints::Hints,
 }
 
 impl Default for Workspace {
@@ -194,6 +201,7 @@ impl Workspace {
             recorder: None,
             table_kind: CameraKind::Robot,
             other_table: TableSlot::empty(bits),
+            hints: hints::Hints::default(),
         }
     }
 
@@ -324,6 +332,12 @@ impl Workspace {
                 }
                 self.selected_object = owner;
             }
+            c @ (Command::FindUnclassified { .. }
+            | Command::SelectCells(_)
+            | Command::FindEvents
+            | Command::AddBookmark(_)
+            | Command::RemoveBookmark(_)
+            | Command::JumpToMark { .. }) => self.apply_hints(c)?,
         }
         Ok(())
     }
@@ -392,6 +406,7 @@ impl Workspace {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
             t.scan(src, self.pipeline.lut(), conn, min, SCAN_BUDGET);
         }
+        self.tick_hints();
         let Some(src) = self.source.as_ref() else {
             self.player.stop();
             return;
@@ -657,6 +672,8 @@ impl Workspace {
             Window::Connect => self.settings.show_connect,
             Window::SourceSettings => self.settings.show_source_settings,
             Window::Record => self.settings.show_record,
+            Window::Coverage => self.settings.show_coverage,
+            Window::Bookmarks => self.settings.show_bookmarks,
         }
     }
 
@@ -669,6 +686,8 @@ impl Workspace {
             Window::Connect => &mut self.settings.show_connect,
             Window::SourceSettings => &mut self.settings.show_source_settings,
             Window::Record => &mut self.settings.show_record,
+            Window::Coverage => &mut self.settings.show_coverage,
+            Window::Bookmarks => &mut self.settings.show_bookmarks,
         }
     }
 

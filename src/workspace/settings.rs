@@ -208,6 +208,10 @@ pub struct Settings {
     /// The "Start recording" dialog open.
     #[serde(skip)]
     pub show_record: bool,
+    /// The unclassified-colours (coverage hints) window open.
+    pub show_coverage: bool,
+    /// The events-and-bookmarks window open.
+    pub show_bookmarks: bool,
 }
 
 impl Default for Settings {
@@ -237,6 +241,8 @@ impl Default for Settings {
             show_connect: false,
             show_source_settings: false,
             show_record: false,
+            show_coverage: false,
+            show_bookmarks: false,
         }
     }
 }
