@@ -211,7 +211,7 @@ impl Default for BallParams {
             green_below: [0.25, 1.0],
             green_below_bonus: 1.0,
             field_below_without_pose: [0.5, 1.0],
-            field_below_without_pose_weight: TestWeight::new(0.0, 4.0),
+            field_below_without_pose_weight: TestWeight::new(0.0, 2.5),
             aspect: [0.6, 1.67],
             aspect_weight: TestWeight::new(0.5, 1.5),
             orange_fraction: [0.3, 1.0],
