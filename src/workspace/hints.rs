@@ -169,7 +169,7 @@ impl Workspace {
                     .map(|r| Event {
                         frame: r.index,
                         kind: EventKind::TryEditChange,
-                        detail: format!("blobs {} → {}", r.blobs_before, r.blobs_after),
+                        detail: format!("blobs {} -> {}", r.blobs_before, r.blobs_after),
                     }),
             );
         }

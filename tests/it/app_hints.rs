@@ -130,7 +130,7 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     assert_eq!(pixels, vec![300]);
 
     // Why is the ball orange? The hint's edit. Why is a pink pixel unclassified? As loaded.
-    let origin = state(&h).pixel_origin(65, 45).unwrap();
+    let origin = state(&h).pixel_origin(75, 45).unwrap();
     let CellOrigin::Edit(e) = origin else {
         panic!("the commit set the ball's cell: {origin:?}");
     };
