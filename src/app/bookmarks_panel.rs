@@ -50,7 +50,7 @@ pub fn bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
             commands.push(Command::JumpToMark { forward: true });
         }
     });
-    let id = egui::Id::new("bookmark_note");
+    let id = egui::Id::unique("bookmark_note");
     let mut note: String = ui.data(|d| d.get_temp(id)).unwrap_or_default();
     ui.horizontal(|ui| {
         let label = ui.label("note");

@@ -34,7 +34,7 @@ pub fn coverage_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) 
         return;
     };
     let last_frame = src.len().saturating_sub(1);
-    let id = egui::Id::new("coverage_range");
+    let id = egui::Id::unique("coverage_range");
     let mut range: [usize; 2] = ui.data(|d| d.get_temp(id)).unwrap_or([0, last_frame]);
     ui.horizontal(|ui| {
         ui.label("frames");
