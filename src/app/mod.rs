@@ -11,6 +11,8 @@
 //! | `inspector.rs` | every recognition candidate with its confidence breakdown; selection |
 //! | `sensors_dialog.rs` | every sensor reading with units, plots over the stream |
 //! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
+//! | `coverage_panel.rs` | the colours the table leaves unclassified, ranked; select to commit |
+//! | `bookmarks_panel.rs` | the pipeline's events and the user's bookmarks; timeline marks |
 //! | `menus.rs` | File, Classification, View, Stream, Camera, Windows, Help |
 //! | `camera_menu.rs` | the Camera menu and its dialogs: connect, settings, grab, record |
 //! | `overhead_overlays.rs` | the overhead camera's overlays: field lines, ball, robot markers, picked points |
@@ -21,9 +23,11 @@
 //!
 //! Only this folder names egui/eframe (`scripts/check.sh` checks it).
 
+pub mod bookmarks_panel;
 pub mod calibration_window;
 pub mod camera_menu;
 pub mod classify_panel;
+pub mod coverage_panel;
 pub mod field_view;
 pub mod inspector;
 pub mod menus;
@@ -460,6 +464,11 @@ impl EotnApp {
                         commands.push(Command::Step(delta * n as i64));
                     }
                 }
+                for (key, forward) in [(Key::ArrowRight, true), (Key::ArrowLeft, false)] {
+                    if i.consume_key(Modifiers::COMMAND, key) {
+                        commands.push(Command::JumpToMark { forward });
+                    }
+                }
                 if i.consume_key(Modifiers::NONE, Key::Home) {
                     commands.push(Command::Seek(0));
                 }
@@ -536,6 +545,7 @@ impl EotnApp {
             if slider.changed() {
                 commands.push(Command::Seek(j));
             }
+            bookmarks_panel::timeline_marks(ui.painter(), slider.rect, &self.state, len);
         });
     }
 
@@ -595,7 +605,18 @@ impl EotnApp {
                 ui.colored_label(colour, format!("this frame: {w}"));
             }
         }
-        ui.horizontal(|ui| views::pixel_readout_ui(ui, self.hovered.as_ref()));
+        ui.horizontal(|ui| {
+            views::pixel_readout_ui(ui, self.hovered.as_ref());
+            // Why this pixel has its class: the edit that last set its cell.
+            if let Some(o) = self
+                .hovered
+                .as_ref()
+                .and_then(|h| self.state.pixel_origin(h.x, h.y))
+            {
+                ui.separator();
+                ui.monospace(o.to_string());
+            }
+        });
     }
 
     fn warnings_window(&mut self, ctx: &egui::Context) {
@@ -827,6 +848,8 @@ impl eframe::App for EotnApp {
             &mut commands,
         );
         field_view::field_view_window(&ctx, &self.state, &mut commands);
+        coverage_panel::coverage_window(&ctx, &self.state, &mut commands);
+        bookmarks_panel::bookmarks_window(&ctx, &self.state, &mut commands);
         self.warnings_window(&ctx);
         self.about_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
@@ -858,6 +881,7 @@ impl eframe::App for EotnApp {
             ctx.request_repaint_after(due);
         }
         let busy = self.state.try_edit().is_some_and(|t| !t.done())
+            || self.state.hints_busy()
             || (self.state.settings.show_sensors
                 && self.state.sensor_series.points.len() < self.state.sensor_series.total);
         self.state.record_ui_time(now.elapsed(), cpu);

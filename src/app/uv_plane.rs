@@ -78,6 +78,7 @@ impl UvPlane {
                 Color32::WHITE,
             );
         }
+        super::coverage_panel::uv_plane_marks(ui.painter(), rect, state);
         let cell = side / n as f32;
         // Selected cells on this layer: outline their bounding box.
         if let Some(Selection::Box(b)) = state.resolved_selection()

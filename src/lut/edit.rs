@@ -94,6 +94,16 @@ pub enum Selection {
 }
 
 impl Region {
+    /// True when the region holds the cell at `index` of `lut` (without resolving a whole
+    /// selection: cheap enough to ask per hovered pixel).
+    #[must_use]
+    pub fn contains_index(&self, lut: &LookupTable, index: usize) -> bool {
+        match self {
+            Self::AroundSample { .. } => self.select(lut).contains_index(lut, index),
+            Self::Cells { indices } => indices.contains(&index),
+        }
+    }
+
     /// Resolves the region for a table of this resolution.
     #[must_use]
     pub fn select(&self, lut: &LookupTable) -> Selection {
@@ -175,6 +185,21 @@ pub struct EditRecord {
     /// When the edit was made, milliseconds since the Unix epoch (0 when unknown).
     #[serde(default)]
     pub time_unix_ms: u64,
+    /// The frame and pixel the sample was taken from, when the edit came from one (absent in
+    /// journals written before 2026-12-03 and for cells picked in the U–V plane).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampled_at: Option<SampleAt>,
+}
+
+/// Where an edit's sample pixel was: which frame of the open source, which pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SampleAt {
+    /// Frame index in the source.
+    pub frame: usize,
+    /// Column, pixels.
+    pub x: usize,
+    /// Row, pixels.
+    pub y: usize,
 }
 
 impl EditRecord {
@@ -185,6 +210,7 @@ impl EditRecord {
             class,
             region,
             time_unix_ms: now_unix_ms(),
+            sampled_at: None,
         }
     }
 }
@@ -444,6 +470,11 @@ mod tests {
                 indices: vec![5, 9, usize::MAX],
             },
             time_unix_ms: 42,
+            sampled_at: Some(SampleAt {
+                frame: 3,
+                x: 10,
+                y: 20,
+            }),
         };
         let json = serde_json::to_string(&record).unwrap();
         let back: EditRecord = serde_json::from_str(&json).unwrap();

@@ -14,7 +14,7 @@ pub mod edit;
 pub mod learn;
 
 pub use classes::{CLASS_COUNT, ClassKind, ColourClass, code_display_rgb};
-pub use edit::{AppliedEdit, CellBox, EditHistory, EditRecord, Region, Sensitivity};
+pub use edit::{AppliedEdit, CellBox, EditHistory, EditRecord, Region, SampleAt, Sensitivity};
 
 use std::path::{Path, PathBuf};
 

@@ -44,6 +44,8 @@ pub enum TestName {
     HeightCm,
     /// Ball and goals: share of green below (a bonus only for the ball).
     GreenBelow,
+    /// Ball without a camera pose: share of field colours (green, white) right at its foot.
+    FieldBelow,
     /// Goal: pixels of the basic goal colour.
     Pixels,
     /// Goal: real width from the box width at its distance, centimetres.
@@ -94,6 +96,7 @@ impl TestName {
             Self::Roundness => "roundness",
             Self::HeightCm => "height_cm",
             Self::GreenBelow => "green_below",
+            Self::FieldBelow => "field_below",
             Self::Pixels => "pixels",
             Self::ApparentWidthCm => "apparent_width_cm",
             Self::BottomHeightCm => "bottom_height_cm",

@@ -166,6 +166,29 @@ pub enum OverheadCommand {
     SelectRobot(Option<RobotKey>),
     /// Overhead view options.
     SetView(OverheadView),
+    /// Count the colours the table leaves unclassified over frames `first..=last` (clamped to
+    /// the source), a few frames per UI frame: the coverage hints.
+    FindUnclassified {
+        /// First frame.
+        first: usize,
+        /// Last frame (inclusive).
+        last: usize,
+    },
+    /// Select these table cells (by index), as clicking a coverage hint: the preview, nothing
+    /// written until a Commit.
+    SelectCells(Vec<usize>),
+    /// Run the pipeline over the whole source for its events (ball found or lost, goal
+    /// appears, warnings), a few frames per UI frame.
+    FindEvents,
+    /// Bookmark the shown frame with a note (replacing one there), saved beside the stream.
+    AddBookmark(String),
+    /// Remove the bookmark at this frame.
+    RemoveBookmark(usize),
+    /// Go to the next (or previous) mark: an event or a bookmark.
+    JumpToMark {
+        /// Next when true, previous when false.
+        forward: bool,
+    },
 }
 
 /// The app's extra windows.
@@ -191,11 +214,15 @@ pub enum Window {
     Calibration,
     /// Camera ▸ Connect to robot…: the robots list.
     Robots,
+    /// The colours the table leaves unclassified (coverage hints).
+    Coverage,
+    /// Events and bookmarks on the timeline.
+    Bookmarks,
 }
 
 impl Window {
     /// Every window, for the Windows menu.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 9] = [
         Self::Sensors,
         Self::UvPlane,
         Self::TryEdit,
@@ -203,6 +230,8 @@ impl Window {
         Self::FieldView,
         Self::Calibration,
         Self::Robots,
+        Self::Coverage,
+        Self::Bookmarks,
     ];
 
     /// Its title.
@@ -219,6 +248,8 @@ impl Window {
             Self::FieldView => "Field view",
             Self::Calibration => "Overhead calibration",
             Self::Robots => "Robots",
+            Self::Coverage => "Unclassified colours",
+            Self::Bookmarks => "Events and bookmarks",
         }
     }
 }

@@ -61,6 +61,7 @@ impl Workspace {
         }
         self.live = None;
         self.robots.unshow();
+        self.load_bookmarks();
         if let Some(src) = &self.source {
             self.settings.last_source = src
                 .paths()

@@ -18,15 +18,20 @@
 //! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
+//! | `coverage.rs`, `cell_origin.rs`, `bookmarks.rs`, `hints.rs` | what is unclassified, who set a cell, events and bookmarks |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
 //! | `timings.rs` | step and frame-time measurements |
 //! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
 //! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time |
 
+pub mod bookmarks;
+pub mod cell_origin;
 mod command;
 mod compose;
+pub mod coverage;
 pub mod field_model;
 mod frames;
+mod hints;
 pub mod journal;
 mod live;
 pub mod overhead;
@@ -152,6 +157,8 @@ pub struct Workspace {
     other_table: TableSlot,
     /// The overhead camera's pipeline, calibration, picked points and selection.
     overhead: overhead::Overhead,
+    /// Coverage hints, events and bookmarks.
+    hints: hints::Hints,
 }
 
 impl Default for Workspace {
@@ -208,6 +215,7 @@ impl Workspace {
             table_kind: CameraKind::Robot,
             other_table: TableSlot::empty(bits),
             overhead: overhead::Overhead::default(),
+            hints: hints::Hints::default(),
         }
     }
 
@@ -353,6 +361,12 @@ impl Workspace {
                 self.selected_object = owner;
             }
             Command::Overhead(c) => self.apply_overhead(c)?,
+            c @ (Command::FindUnclassified { .. }
+            | Command::SelectCells(_)
+            | Command::FindEvents
+            | Command::AddBookmark(_)
+            | Command::RemoveBookmark(_)
+            | Command::JumpToMark { .. }) => self.apply_hints(c)?,
         }
         Ok(())
     }
@@ -422,6 +436,7 @@ impl Workspace {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
             t.scan(src, self.pipeline.lut(), conn, min, SCAN_BUDGET);
         }
+        self.tick_hints();
         let Some(src) = self.source.as_ref() else {
             self.player.stop();
             return;
@@ -697,6 +712,8 @@ impl Workspace {
             Window::FieldView => self.settings.show_field_view,
             Window::Calibration => self.settings.show_calibration,
             Window::Robots => self.settings.show_robots,
+            Window::Coverage => self.settings.show_coverage,
+            Window::Bookmarks => self.settings.show_bookmarks,
         }
     }
 
@@ -712,6 +729,8 @@ impl Workspace {
             Window::FieldView => &mut self.settings.show_field_view,
             Window::Calibration => &mut self.settings.show_calibration,
             Window::Robots => &mut self.settings.show_robots,
+            Window::Coverage => &mut self.settings.show_coverage,
+            Window::Bookmarks => &mut self.settings.show_bookmarks,
         }
     }
 

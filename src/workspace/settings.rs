@@ -239,6 +239,10 @@ pub struct Settings {
     /// The robots window (Camera ▸ Connect to robot…) open.
     #[serde(skip)]
     pub show_robots: bool,
+    /// The unclassified-colours (coverage hints) window open.
+    pub show_coverage: bool,
+    /// The events-and-bookmarks window open.
+    pub show_bookmarks: bool,
 }
 
 impl Default for Settings {
@@ -272,6 +276,8 @@ impl Default for Settings {
             show_source_settings: false,
             show_record: false,
             show_robots: false,
+            show_coverage: false,
+            show_bookmarks: false,
         }
     }
 }

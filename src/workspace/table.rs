@@ -98,7 +98,12 @@ impl Workspace {
             .selection
             .clone()
             .context("nothing selected: left-click a pixel first")?;
-        let record = EditRecord::now(self.settings.class, sel.region);
+        let mut record = EditRecord::now(self.settings.class, sel.region);
+        record.sampled_at = sel.pixel.map(|(x, y)| crate::lut::SampleAt {
+            frame: self.index,
+            x,
+            y,
+        });
         // The journal must start from the table before its first edit.
         if let Some(path) = self.table_path.clone()
             && !journal::journal_path(&path).exists()

@@ -7,6 +7,8 @@ mod app;
 #[cfg(feature = "gui")]
 mod app_camera;
 #[cfg(feature = "gui")]
+mod app_hints;
+#[cfg(feature = "gui")]
 mod app_live;
 #[cfg(feature = "gui")]
 mod app_overhead;
@@ -31,3 +33,4 @@ mod streams;
 mod viewers;
 #[cfg(feature = "gui")]
 mod window;
+mod without_readings;

@@ -107,7 +107,7 @@ proptest! {
                 sample: Yuv::new(*y, *u, *v),
                 sensitivity: Sensitivity::uniform(*reach),
             };
-            history.commit(&mut lut, EditRecord { class, region, time_unix_ms: 0 });
+            history.commit(&mut lut, EditRecord { class, region, time_unix_ms: 0, sampled_at: None });
         }
         let edited = lut.clone();
         while history.undo(&mut lut).is_some() {}

@@ -160,7 +160,8 @@ fn place_tests(
     } else {
         params.height_cm
     };
-    match ctx.height_above_ground(center, m.distance) {
+    let height = ctx.height_above_ground(center, m.distance);
+    match height {
         Some(z) => confidence.range_test(TestName::HeightCm, z, height_range, params.height_weight),
         None => confidence.skipped(TestName::HeightCm, height_range),
     }
@@ -188,7 +189,52 @@ fn place_tests(
         ),
         None => confidence.skipped(TestName::GreenBelow, params.green_below),
     }
+    if height.is_none() {
+        // No pose, so no height: an orange thing off the field (in the audience, on a table, a
+        // chair on the floor) would pass every other test. A ball lies on the field, so field
+        // colour (carpet, its shadow on the carpet, or a line) lies right at its foot; at the
+        // foot of an off-field thing lie furniture or the floor, even where the carpet shows a
+        // little lower in the image.
+        match field_at_foot(img, m.group) {
+            Some(field) => confidence.range_test(
+                TestName::FieldBelow,
+                field,
+                params.field_below_without_pose,
+                params.field_below_without_pose_weight,
+            ),
+            None => confidence.skipped(TestName::FieldBelow, params.field_below_without_pose),
+        }
+    }
     below_scan.area
+}
+
+/// Share of field colours in a band three rows high just below the box, a few pixels down
+/// (past the rim pixels whose UYVY pair mixes the ball's chroma with the carpet's) and across
+/// the middle three fifths of its width (pixels inside the image only); `None` when the band
+/// lies wholly outside (a ball cut by the bottom edge). White counts only beside some green
+/// (at least a tenth of the band): a line crossing under a ball has carpet beside it, while
+/// the white base of a beacon or a robot's shell standing off the field has none.
+fn field_at_foot(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
+    let (minx, maxx) = (i64::from(b.minx), i64::from(b.maxx));
+    let (miny, maxy) = (i64::from(b.miny), i64::from(b.maxy));
+    let inset = (maxx - minx + 1) / 5;
+    let gap = ((maxy - miny + 1) / 16).clamp(1, 3);
+    let (mut n, mut green, mut white) = (0u32, 0u32, 0u32);
+    for y in maxy + 1 + gap..=maxy + 3 + gap {
+        for x in minx + inset..=maxx - inset {
+            if let Some(c) = img.get_signed(x, y) {
+                n += 1;
+                green += u32::from(c == ColourClass::Green.code());
+                white += u32::from(c == ColourClass::White.code());
+            }
+        }
+    }
+    let field = if green * 10 >= n {
+        green + white
+    } else {
+        green
+    };
+    (n > 0).then(|| f64::from(field) / f64::from(n))
 }
 
 /// Share of unclassified pixels on the ring one pixel outside the box (pixels inside the image

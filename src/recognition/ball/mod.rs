@@ -63,6 +63,14 @@ pub struct BallParams {
     pub green_below: [f64; 2],
     /// Bonus for green below (never a penalty: a ball on a line or against a robot is still a ball).
     pub green_below_bonus: f64,
+    /// Without a camera pose (frames without sensor readings: no height test), the share of
+    /// field colours (green or white) that a ball needs right at its foot (a band just below
+    /// its box): a ball lies on the field, while an orange thing off the field — in the
+    /// audience, on a table, a chair on the floor — has furniture or floor at its foot. With a
+    /// pose the height test rejects such things and this test is not applied.
+    pub field_below_without_pose: [f64; 2],
+    /// Weight of the field-below test (applied only without a pose).
+    pub field_below_without_pose_weight: TestWeight,
     /// Accepted box width / height for an uncut candidate.
     pub aspect: [f64; 2],
     /// Weight of the roundness test.
@@ -202,6 +210,8 @@ impl Default for BallParams {
             height_pose_slack_rad: 0.0,
             green_below: [0.25, 1.0],
             green_below_bonus: 1.0,
+            field_below_without_pose: [0.5, 1.0],
+            field_below_without_pose_weight: TestWeight::new(0.0, 2.5),
             aspect: [0.6, 1.67],
             aspect_weight: TestWeight::new(0.5, 1.5),
             orange_fraction: [0.3, 1.0],

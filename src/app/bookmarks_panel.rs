@@ -1,0 +1,175 @@
+//! "Where did something happen?": the pipeline's events (ball found or lost, goal appears,
+//! warnings, the frames a try-edit changes) and the user's bookmarks with notes, as lists with
+//! next/previous jumps, and as marks on the timeline.
+
+use egui::{Color32, Context, Painter, Rect, Stroke, Ui, pos2};
+
+use crate::workspace::bookmarks::EventKind;
+use crate::workspace::{Command, Window, Workspace};
+
+/// Colour of the user's bookmarks on the timeline.
+const BOOKMARK_COLOUR: Color32 = Color32::from_rgb(80, 170, 255);
+
+/// Shows the window while it is open; closing it sends [`Command::ShowWindow`].
+pub fn bookmarks_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
+    if !state.window_open(Window::Bookmarks) {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new(Window::Bookmarks.name())
+        .open(&mut open)
+        .default_width(320.0)
+        .default_pos([900.0, 380.0])
+        .show(ctx, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| bookmarks_ui(ui, state, commands));
+        });
+    if !open {
+        commands.push(Command::ShowWindow(Window::Bookmarks, false));
+    }
+}
+
+/// Jumps, the note field, the user's bookmarks and the events.
+pub fn bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    if state.source().is_none() {
+        ui.label("Open a stream or frames first.");
+        return;
+    }
+    ui.horizontal(|ui| {
+        if ui
+            .button("Previous mark")
+            .on_hover_text("Ctrl+Left: the previous event or bookmark")
+            .clicked()
+        {
+            commands.push(Command::JumpToMark { forward: false });
+        }
+        if ui
+            .button("Next mark")
+            .on_hover_text("Ctrl+Right: the next event or bookmark")
+            .clicked()
+        {
+            commands.push(Command::JumpToMark { forward: true });
+        }
+    });
+    let id = egui::Id::unique("bookmark_note");
+    let mut note: String = ui.data(|d| d.get_temp(id)).unwrap_or_default();
+    ui.horizontal(|ui| {
+        let label = ui.label("note");
+        ui.add(egui::TextEdit::singleline(&mut note).desired_width(160.0))
+            .labelled_by(label.id);
+        if ui
+            .button("Bookmark this frame")
+            .on_hover_text("saved beside the stream as STREAM.bookmarks.json")
+            .clicked()
+        {
+            commands.push(Command::AddBookmark(std::mem::take(&mut note)));
+        }
+    });
+    ui.data_mut(|d| d.insert_temp(id, note));
+    user_bookmarks_ui(ui, state, commands);
+    ui.separator();
+    events_ui(ui, state, commands);
+}
+
+fn user_bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    let marks = state.bookmarks();
+    if marks.is_empty() {
+        ui.weak("No bookmarks.");
+        return;
+    }
+    egui::Grid::new("user_bookmarks")
+        .striped(true)
+        .show(ui, |ui| {
+            for b in marks {
+                if ui
+                    .selectable_label(b.frame == state.index(), format!("frame {}", b.frame))
+                    .clicked()
+                {
+                    commands.push(Command::Seek(b.frame));
+                }
+                ui.label(&b.note);
+                if ui
+                    .small_button("Remove")
+                    .on_hover_text(format!("remove the bookmark at frame {}", b.frame))
+                    .clicked()
+                {
+                    commands.push(Command::RemoveBookmark(b.frame));
+                }
+                ui.end_row();
+            }
+        });
+}
+
+fn events_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        if ui
+            .button("Find events")
+            .on_hover_text("run the pipeline over every frame: ball found or lost, goals, warnings")
+            .clicked()
+        {
+            commands.push(Command::FindEvents);
+        }
+        if let Some(scan) = state.event_scan().filter(|s| !s.done()) {
+            ui.add(
+                egui::ProgressBar::new(scan.next as f32 / scan.total.max(1) as f32)
+                    .text(format!("{} / {}", scan.next, scan.total)),
+            );
+        }
+    });
+    let events = state.events();
+    if events.is_empty() {
+        ui.weak("No events (Find events; a pending try-edit adds the frames it changes).");
+        return;
+    }
+    egui::Grid::new("events").striped(true).show(ui, |ui| {
+        for e in &events {
+            if ui
+                .selectable_label(e.frame == state.index(), format!("frame {}", e.frame))
+                .clicked()
+            {
+                commands.push(Command::Seek(e.frame));
+            }
+            ui.colored_label(event_colour(e.kind), e.kind.describe());
+            ui.label(&e.detail);
+            ui.end_row();
+        }
+    });
+}
+
+/// The colour of an event's mark: the ball's orange, the goal's colour, warnings red.
+fn event_colour(kind: EventKind) -> Color32 {
+    let rgb = match kind {
+        EventKind::BallFound => [255, 140, 0],
+        EventKind::BallLost => [150, 90, 40],
+        EventKind::GoalAppears(c) => c.display_rgb(),
+        EventKind::Warning => [230, 50, 50],
+        EventKind::TryEditChange => [255, 0, 255],
+    };
+    Color32::from_rgb(rgb[0], rgb[1], rgb[2])
+}
+
+/// Marks on the timeline slider (`rect`, frames `0..len`): events as short ticks below its
+/// middle, bookmarks as taller blue ticks.
+pub fn timeline_marks(painter: &Painter, rect: Rect, state: &Workspace, len: usize) {
+    if len < 2 {
+        return;
+    }
+    // The slider's handle travels between its ends less its radius.
+    let inset = rect.height() / 2.0;
+    let x_of = |frame: usize| {
+        rect.left() + inset + (rect.width() - 2.0 * inset) * frame as f32 / (len - 1) as f32
+    };
+    for e in state.events() {
+        let x = x_of(e.frame);
+        painter.line_segment(
+            [pos2(x, rect.center().y), pos2(x, rect.bottom())],
+            Stroke::new(2.0, event_colour(e.kind)),
+        );
+    }
+    for b in state.bookmarks() {
+        let x = x_of(b.frame);
+        painter.line_segment(
+            [pos2(x, rect.top()), pos2(x, rect.bottom())],
+            Stroke::new(2.0, BOOKMARK_COLOUR),
+        );
+    }
+}

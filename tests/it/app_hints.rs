@@ -1,0 +1,246 @@
+//! The hand-classifier's three questions in the app, driven with egui_kittest through the same
+//! `Workspace`/`Command` path as the window: what is still unclassified (coverage hints), why a
+//! pixel has its class (the edit that set its cell), where something happened (events and
+//! bookmarks on the timeline).
+
+use std::path::{Path, PathBuf};
+
+use egui::{Event, Key, Modifiers, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable as _;
+use eotn::app::EotnApp;
+use eotn::frame::{Frame, Yuv};
+use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
+use eotn::workspace::bookmarks::{EventKind, bookmarks_path};
+use eotn::workspace::cell_origin::CellOrigin;
+use eotn::workspace::{Command, Window, Workspace};
+
+const GREEN: Yuv = Yuv::new(100, 110, 100);
+const ORANGE: Yuv = Yuv::new(120, 80, 190);
+const PINK: Yuv = Yuv::new(170, 150, 200);
+
+/// 208×160 green; an orange 20×20 ball on frames 1 and 2 (not 0); a pink 10×10 patch on all.
+fn scene(n: usize) -> Frame {
+    Frame::uyvy_from_fn(208, 160, |x, y| {
+        let bx = 60 + 10 * n;
+        if n > 0 && (bx..bx + 20).contains(&x) && (40..60).contains(&y) {
+            ORANGE
+        } else if (150..160).contains(&x) && (100..110).contains(&y) {
+            PINK
+        } else {
+            GREEN
+        }
+    })
+    .unwrap()
+}
+
+/// Three frame files and a 7-bit table with only green classified.
+fn fixture(dir: &Path) -> Vec<PathBuf> {
+    let mut paths = Vec::new();
+    for n in 0..3 {
+        let p = dir.join(format!("f{n}.uyvy"));
+        std::fs::write(&p, scene(n).data()).unwrap();
+        paths.push(p);
+    }
+    let mut lut = LookupTable::new(7).unwrap();
+    lut.apply(EditRecord::now(
+        ColourClass::Green,
+        Region::AroundSample {
+            sample: GREEN,
+            sensitivity: Sensitivity::uniform(2),
+        },
+    ));
+    let table = dir.join("field.lut");
+    lut.save(&table).unwrap();
+    paths.push(table);
+    paths
+}
+
+fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
+    Harness::builder()
+        .with_size(Vec2::new(1200.0, 800.0))
+        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
+}
+
+fn state<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
+    &h.state().state
+}
+
+fn pixel_pos(h: &Harness<'_, EotnApp>, x: usize, y: usize) -> Pos2 {
+    h.state()
+        .last_view
+        .expect("the view was drawn")
+        .pixel_centre(x, y)
+}
+
+/// Runs UI frames until `done` (at most 200).
+fn run_until(h: &mut Harness<'_, EotnApp>, done: impl Fn(&Workspace) -> bool) {
+    for _ in 0..200 {
+        if done(state(h)) {
+            return;
+        }
+        h.run();
+    }
+    panic!("a scan did not finish");
+}
+
+#[test]
+fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(fixture(dir.path()));
+    h.run();
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Coverage, true));
+    h.run();
+    h.get_by_label("Find unclassified").click();
+    h.run();
+    run_until(&mut h, |s| s.coverage().is_some_and(|c| c.done()));
+    h.run();
+    let scan = state(&h).coverage().unwrap();
+    // Orange: 2 frames × 400 pixels; pink: 3 × 100. Green is classified.
+    let pixels: Vec<u64> = scan.hints().iter().map(|x| x.pixels).collect();
+    assert_eq!(pixels, vec![800, 300], "{:?}", scan.hints());
+    assert_eq!(scan.unclassified_pixels(), 1100);
+    let orange_cells = scan.hints()[0].cells.clone();
+    assert_eq!(orange_cells, vec![state(&h).lut().index(ORANGE)]);
+
+    // Clicking the first hint selects its cells and previews its pixels in the image.
+    h.state_mut().state.run(Command::Seek(1));
+    h.run();
+    h.get_by_label("hint 1").click();
+    h.run();
+    let previewed = state(&h).preview_mask().iter().filter(|&&m| m).count();
+    assert_eq!(previewed, 400, "the ball's pixels are previewed");
+    h.state_mut()
+        .state
+        .run(Command::SetClass(ColourClass::Orange));
+    h.get_by_label("Commit").click();
+    h.run();
+    assert_eq!(state(&h).lut().class_of(ORANGE), ColourClass::Orange);
+    // The hints re-rank at once: orange is classified now, pink is left.
+    h.run();
+    let pixels: Vec<u64> = state(&h)
+        .coverage()
+        .unwrap()
+        .hints()
+        .iter()
+        .map(|x| x.pixels)
+        .collect();
+    assert_eq!(pixels, vec![300]);
+
+    // Why is the ball orange? The hint's edit. Why is a pink pixel unclassified? As loaded.
+    let origin = state(&h).pixel_origin(75, 45).unwrap();
+    let CellOrigin::Edit(e) = origin else {
+        panic!("the commit set the ball's cell: {origin:?}");
+    };
+    assert_eq!(
+        (e.number, e.class, e.picked_cells),
+        (1, ColourClass::Orange, Some(1))
+    );
+    assert_eq!(state(&h).pixel_origin(155, 105), Some(CellOrigin::AsLoaded));
+    // A sampled commit records its frame and pixel, shown when hovering.
+    h.state_mut().state.run(Command::Sample { x: 155, y: 105 });
+    h.state_mut()
+        .state
+        .run(Command::SetClass(ColourClass::Pink));
+    h.state_mut().state.run(Command::Commit);
+    h.run();
+    let pos = pixel_pos(&h, 155, 105);
+    h.event(Event::PointerMoved(pos));
+    h.run();
+    h.get_by_label_contains("edit 2: pink from frame 1 pixel (155, 105)");
+}
+
+#[test]
+fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream() {
+    let dir = tempfile::tempdir().unwrap();
+    let paths = fixture(dir.path());
+    let mut lut = LookupTable::load(&paths[3]).unwrap();
+    lut.apply(EditRecord::now(
+        ColourClass::Orange,
+        Region::AroundSample {
+            sample: ORANGE,
+            sensitivity: Sensitivity::uniform(1),
+        },
+    ));
+    lut.save(&paths[3]).unwrap();
+    let mut h = harness(paths.clone());
+    h.run();
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Bookmarks, true));
+    h.run();
+    // A bookmark with a note on frame 2, saved beside the first frame file.
+    h.state_mut().state.run(Command::Seek(2));
+    h.run();
+    let field = h.get_by_label("note");
+    field.focus();
+    field.type_text("ball near the line");
+    h.run();
+    h.get_by_label("Bookmark this frame").click();
+    h.run();
+    let file = bookmarks_path(&paths[0]);
+    let text = std::fs::read_to_string(&file).expect("saved");
+    assert!(
+        text.contains("ball near the line") && text.contains("\"frame\": 2"),
+        "{text}"
+    );
+
+    // Ctrl+→ from frame 0 jumps to the bookmark (a plain step would go to 1).
+    h.state_mut().state.run(Command::Seek(0));
+    h.run();
+    h.key_press_modifiers(Modifiers::COMMAND, Key::ArrowRight);
+    h.run();
+    assert_eq!(state(&h).index(), 2);
+
+    h.get_by_label("Find events").click();
+    h.run();
+    run_until(&mut h, |s| s.event_scan().is_some_and(|e| e.done()));
+    let kinds: Vec<(usize, EventKind)> = state(&h)
+        .events()
+        .iter()
+        .map(|e| (e.frame, e.kind))
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![(1, EventKind::BallFound)],
+        "the ball appears at frame 1"
+    );
+
+    // Jumps: from 0 the next mark is the event at 1, then the bookmark at 2; and back.
+    h.state_mut().state.run(Command::Seek(0));
+    h.run();
+    h.get_by_label("Next mark").click();
+    h.run();
+    assert_eq!(state(&h).index(), 1);
+    h.get_by_label("Next mark").click();
+    h.run();
+    assert_eq!(state(&h).index(), 2);
+    h.get_by_label("Previous mark").click();
+    h.run();
+    assert_eq!(state(&h).index(), 1);
+
+    // Reopening finds the bookmark; removing it saves the file again.
+    drop(h);
+    let mut h = harness(paths);
+    h.run();
+    assert_eq!(state(&h).bookmarks().len(), 1);
+    assert_eq!(state(&h).bookmarks()[0].note, "ball near the line");
+    h.state_mut().state.run(Command::RemoveBookmark(2));
+    h.run();
+    assert!(state(&h).bookmarks().is_empty());
+    assert!(!std::fs::read_to_string(&file).unwrap().contains("line"));
+    // A damaged bookmarks file is a warning, not a failure to open.
+    std::fs::write(&file, "not json").unwrap();
+    let mut s = Workspace::default();
+    s.run(Command::Open(vec![file.with_file_name("f0.uyvy")]));
+    assert!(s.source().is_some());
+    assert!(
+        s.warnings()
+            .iter()
+            .any(|w| w.contains("not a bookmarks file")),
+        "{:?}",
+        s.warnings()
+    );
+}
