@@ -6,7 +6,7 @@
 //! [`candidates`] turns a [`Recognition`] into plain rows (tested without a window);
 //! [`inspector_window`] draws them.
 
-use egui::{Color32, Context, RichText, Ui};
+use egui::{Color32, RichText, Ui};
 
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
@@ -14,7 +14,7 @@ use crate::recognition::draw::owner;
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::scan::CutOff;
 use crate::recognition::{Recognition, Relative};
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::{Command, Workspace};
 
 /// One candidate as the inspector lists it.
 #[derive(Debug, Clone, PartialEq)]
@@ -321,24 +321,8 @@ fn verdict_colour(accepted: bool) -> Color32 {
     }
 }
 
-/// Shows the inspector while it is open; selecting pushes [`Command::SelectObject`].
-pub fn inspector_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-    if !state.window_open(Window::Inspector) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::Inspector.name())
-        .open(&mut open)
-        .default_width(600.0)
-        // Low and to the right: the interesting part of a robot's image is usually its middle.
-        .default_pos([640.0, 330.0])
-        .show(ctx, |ui| inspector_ui(ui, state, commands));
-    if !open {
-        commands.push(Command::ShowWindow(Window::Inspector, false));
-    }
-}
-
-fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+/// The inspector's contents: every candidate of the shown frame with its confidence breakdown.
+pub fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     if state.frame().is_none() {
         ui.label("No frame open.");
         return;

@@ -4,12 +4,11 @@
 //! the matching pixels in the image (selection works both ways).
 
 use egui::{
-    Color32, ColorImage, Context, Rect, Sense, Stroke, StrokeKind, TextureHandle, TextureOptions,
-    pos2, vec2,
+    Color32, ColorImage, Rect, Sense, Stroke, StrokeKind, TextureHandle, TextureOptions, pos2, vec2,
 };
 
 use crate::lut::edit::Selection;
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::{Command, Workspace};
 
 /// The U–V plane texture, rebuilt when the table, frame or Y changes.
 #[derive(Default)]
@@ -19,23 +18,8 @@ pub struct UvPlane {
 }
 
 impl UvPlane {
-    /// Shows the window while it is open; closing it sends [`Command::ShowWindow`].
-    pub fn window(&mut self, ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-        if !state.window_open(Window::UvPlane) {
-            return;
-        }
-        let mut open = true;
-        egui::Window::new(Window::UvPlane.name())
-            .open(&mut open)
-            .default_width(300.0)
-            .default_pos([960.0, 60.0])
-            .show(ctx, |ui| self.ui(ui, state, commands));
-        if !open {
-            commands.push(Command::ShowWindow(Window::UvPlane, false));
-        }
-    }
-
-    fn ui(&mut self, ui: &mut egui::Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    /// The U–V plane's contents.
+    pub fn ui(&mut self, ui: &mut egui::Ui, state: &Workspace, commands: &mut Vec<Command>) {
         let lut = state.lut();
         let n = lut.side();
         let shift = lut.shift();

@@ -17,6 +17,7 @@
 //! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
+//! | `params.rs` | recognition parameters: open, tune, reset, save, the set a stream names, [`params::TryParams`] |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
 //! | `timings.rs` | step and frame-time measurements |
 
@@ -25,6 +26,7 @@ mod compose;
 mod frames;
 pub mod journal;
 mod live;
+pub mod params;
 pub mod player;
 mod settings;
 pub mod source;
@@ -40,6 +42,7 @@ use anyhow::Context as _;
 pub use command::{Command, Window};
 pub use compose::{PrimitiveFilter, box_colour};
 pub use live::Live;
+pub use params::{ParamsOffer, ParamsSlot, TryParams, TryParamsRow};
 pub use player::Player;
 pub use settings::{
     MAX_RECENT, MAX_WARNINGS, Overlays, SPEEDS, Settings, ViewKind, ViewTransform, ZOOM_PRESETS,
@@ -140,6 +143,11 @@ pub struct Workspace {
     table_kind: CameraKind,
     /// The other camera's table.
     other_table: TableSlot,
+    /// The recognition parameters' file, the loaded values, the stream's offer.
+    params: ParamsSlot,
+    /// Edits in the undo history when the table was last opened or saved (`None` when that
+    /// state can no longer be reached by undoing).
+    saved_undo_len: Option<usize>,
 }
 
 impl Default for Workspace {
@@ -194,6 +202,8 @@ impl Workspace {
             recorder: None,
             table_kind: CameraKind::Robot,
             other_table: TableSlot::empty(bits),
+            params: ParamsSlot::default(),
+            saved_undo_len: Some(0),
         }
     }
 
@@ -210,6 +220,9 @@ impl Workspace {
         }
         if let Some(p) = self.settings.last_places.clone() {
             self.run(Command::OpenPlaces(p));
+        }
+        if let Some(p) = self.settings.last_params.clone() {
+            self.run(Command::OpenParams(p));
         }
         let src = self.settings.last_source.clone();
         let index = self.settings.last_index;
@@ -241,6 +254,22 @@ impl Workspace {
             Command::OpenTable(p) => self.open_table(&p)?,
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),
+            Command::OpenParams(p) => self.open_params(&p)?,
+            Command::UseOfferedParams => {
+                let p = self
+                    .params
+                    .offer
+                    .as_ref()
+                    .and_then(|o| o.path.clone())
+                    .context("the stream names no parameter set that was found")?;
+                self.open_params(&p)?;
+            }
+            Command::DefaultParams => self.default_params(),
+            Command::SetParamValue { pointer, value } => self.set_param_value(&pointer, value)?,
+            Command::ResetParamValue(pointer) => self.reset_param_value(&pointer)?,
+            Command::ResetParams => self.reset_params(),
+            Command::SaveParams(p) => self.save_params(&p)?,
+            Command::TryParamsOnStream => self.try_params_on_stream()?,
             Command::NewTable(bits) => self.new_table(bits)?,
             Command::SaveTable => {
                 let path = self
@@ -251,6 +280,7 @@ impl Workspace {
             }
             Command::SaveTableAs(p) => self.save_table(&p)?,
             Command::RebuildFromJournal => self.rebuild_from_journal()?,
+            Command::DiscardUnsaved => self.discard_unsaved()?,
             Command::Step(delta) => self.step(delta)?,
             Command::Seek(i) => self.seek(i)?,
             Command::SetPlaying(p) => self.set_playing(p)?,
@@ -288,6 +318,10 @@ impl Workspace {
                 self.pipeline.set_params(params);
                 self.reprocess();
             }
+            Command::SetBlobFilter { min_pixels, hidden } => {
+                self.settings.min_blob_pixels = min_pixels;
+                self.settings.hidden_blob_classes = hidden;
+            }
             Command::SetZoom(z) => {
                 self.settings.transform.zoom = z.filter(|z| z.is_finite()).map(clamp_zoom);
             }
@@ -306,7 +340,13 @@ impl Workspace {
             }
             Command::TryEditOnStream => self.try_edit_on_stream()?,
             Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
-            Command::ShowWindow(w, open) => *self.window_flag(w) = open,
+            Command::ShowWindow(w, open) => {
+                *self.window_flag(w) = open;
+                if w == Window::Inspector && !open {
+                    // Its highlight belongs to it: closed, every object is drawn alike again.
+                    self.selected_object = None;
+                }
+            }
             Command::ShowTimings(on) => self.settings.show_timings = on,
             Command::Connect(spec) => self.connect(&spec)?,
             Command::Disconnect => self.disconnect()?,
@@ -392,6 +432,7 @@ impl Workspace {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
             t.scan(src, self.pipeline.lut(), conn, min, SCAN_BUDGET);
         }
+        self.scan_try_params(SCAN_BUDGET);
         let Some(src) = self.source.as_ref() else {
             self.player.stop();
             return;
@@ -565,9 +606,10 @@ impl Workspace {
     #[must_use]
     pub fn drawn_blobs(&self) -> Vec<Blob> {
         let min = self.settings.min_blob_pixels;
+        let hidden = &self.settings.hidden_blob_classes;
         self.blobs()
             .active()
-            .filter(|b| b.pixels >= min)
+            .filter(|b| b.pixels >= min && !hidden.iter().any(|c| c.code() == b.colour))
             .copied()
             .collect()
     }
@@ -657,6 +699,7 @@ impl Workspace {
             Window::Connect => self.settings.show_connect,
             Window::SourceSettings => self.settings.show_source_settings,
             Window::Record => self.settings.show_record,
+            Window::Parameters => self.settings.show_params,
         }
     }
 
@@ -669,6 +712,7 @@ impl Workspace {
             Window::Connect => &mut self.settings.show_connect,
             Window::SourceSettings => &mut self.settings.show_source_settings,
             Window::Record => &mut self.settings.show_record,
+            Window::Parameters => &mut self.settings.show_params,
         }
     }
 

@@ -7,6 +7,8 @@ mod app;
 #[cfg(feature = "gui")]
 mod app_camera;
 #[cfg(feature = "gui")]
+mod app_daily;
+#[cfg(feature = "gui")]
 mod app_live;
 mod cli;
 mod common;
