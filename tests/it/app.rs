@@ -672,7 +672,7 @@ fn nan_sensor_readings_of_a_side_file_show_as_warnings() {
         "{w}"
     );
     assert!(h.query_by_label_contains("this frame:").is_some());
-    assert!(h.query_by_label("1 warnings").is_some());
+    assert!(h.query_by_label("1 warning").is_some());
     // The next frame has no problems: the frame line goes, the list keeps the warning.
     h.key_press(Key::ArrowRight);
     h.run();
