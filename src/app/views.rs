@@ -5,7 +5,7 @@
 use egui::{Align2, Color32, PointerButton, Sense, Ui, vec2};
 
 use super::overlays::{FrameTextures, ImageTransform, corner_text, paint_view};
-use crate::workspace::{Command, PixelInfo, ViewKind, Workspace};
+use crate::workspace::{Command, PendingSelection, PixelInfo, ViewKind, Workspace};
 
 /// Screen points the mouse wheel must move for the zoom to double.
 const WHEEL_POINTS_PER_DOUBLING: f32 = 240.0;
@@ -72,11 +72,21 @@ pub fn main_view_ui(
             commands.push(Command::Pan([d.x, d.y]));
         }
     }
+    // A click samples at once; when it turns out to be the first of a double-click (fit), the
+    // selection from before it is put back, so fitting never changes the selection.
+    let before_click = egui::Id::unique("eotn-selection-before-click");
     if response.double_clicked_by(PointerButton::Primary) {
         commands.push(Command::ResetView);
+        if let Some(before) =
+            ui.data_mut(|d| d.remove_temp::<Option<PendingSelection>>(before_click))
+        {
+            commands.push(Command::RestoreSelection(before));
+        }
     } else if response.clicked_by(PointerButton::Primary)
         && let Some((x, y)) = response.interact_pointer_pos().and_then(|p| xf.pixel_at(p))
     {
+        let before = state.selection().cloned();
+        ui.data_mut(|d| d.insert_temp(before_click, before));
         commands.push(Command::Sample { x, y });
     }
     if response.clicked_by(PointerButton::Secondary) && state.selection().is_some() {

@@ -85,6 +85,8 @@ pub enum Command {
     SampleCell([usize; 3]),
     /// Drop the pending selection.
     ClearSelection,
+    /// Put back a pending selection as it was (the first click of a double-click sampled).
+    RestoreSelection(Option<super::PendingSelection>),
     /// Write the pending selection into the table with the current class.
     Commit,
     /// Undo the latest edit.

@@ -298,6 +298,10 @@ impl Workspace {
                 self.selection = None;
                 self.refresh_preview();
             }
+            Command::RestoreSelection(s) => {
+                self.selection = s;
+                self.refresh_preview();
+            }
             Command::Commit => self.commit()?,
             Command::Undo => self.undo()?,
             Command::Redo => self.redo()?,
