@@ -609,45 +609,6 @@ fn quit_without_saving_keeps_the_undo_history_and_warns_of_no_crash() {
 }
 
 #[test]
-fn double_click_fits_without_sampling() {
-    let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut h = harness(vec![frames[0].clone(), table]);
-    h.run();
-    h.state_mut().state.run(Command::SetZoom(Some(4.0)));
-    h.run();
-    let pos = h.state().last_view.unwrap().pixel_centre(100, 80);
-    h.event(egui::Event::PointerMoved(pos));
-    // Two clicks, one UI frame each, as a person's double-click arrives.
-    for _ in 0..2 {
-        for pressed in [true, false] {
-            h.event(egui::Event::PointerButton {
-                pos,
-                button: egui::PointerButton::Primary,
-                pressed,
-                modifiers: egui::Modifiers::NONE,
-            });
-        }
-        h.step();
-    }
-    h.run();
-    assert_eq!(ws(&h).settings.transform.zoom, None, "fitted");
-    assert!(ws(&h).selection().is_none(), "and nothing sampled");
-    // A single click still samples.
-    let pos = h.state().last_view.unwrap().pixel_centre(100, 80);
-    for pressed in [true, false] {
-        h.event(egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: egui::Modifiers::NONE,
-        });
-    }
-    h.run();
-    assert!(ws(&h).selection().is_some());
-}
-
-#[test]
 fn sample_frame_3_ball_in_the_middle_is_not_cut_off() {
     let mut s = Workspace::default();
     s.apply(Command::Open(vec![
