@@ -10,24 +10,6 @@ use crate::workspace::{Command, Window, Workspace};
 /// Colour of the user's bookmarks on the timeline.
 const BOOKMARK_COLOUR: Color32 = Color32::from_rgb(80, 170, 255);
 
-/// Shows the window while it is open; closing it sends [`Command::ShowWindow`].
-pub fn bookmarks_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-    if !state.window_open(Window::Bookmarks) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::Bookmarks.name())
-        .open(&mut open)
-        .default_width(320.0)
-        .default_pos([900.0, 380.0])
-        .show(ctx, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| bookmarks_ui(ui, state, commands));
-        });
-    if !open {
-        commands.push(Command::ShowWindow(Window::Bookmarks, false));
-    }
-}
-
 /// Jumps, the note field, the user's bookmarks and the events.
 pub fn bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     if state.source().is_none() {

@@ -22,27 +22,6 @@ pub struct OverheadPaths {
     pub field: String,
 }
 
-/// The window, when open.
-pub fn calibration_window(
-    ctx: &Context,
-    state: &Workspace,
-    paths: &mut OverheadPaths,
-    commands: &mut Vec<Command>,
-) {
-    if !state.window_open(Window::Calibration) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::Calibration.name())
-        .open(&mut open)
-        .default_width(460.0)
-        .default_pos([700.0, 80.0])
-        .show(ctx, |ui| calibration_ui(ui, state, paths, commands));
-    if !open {
-        commands.push(Command::ShowWindow(Window::Calibration, false));
-    }
-}
-
 /// The window's contents.
 pub fn calibration_ui(
     ui: &mut Ui,

@@ -1,10 +1,10 @@
 //! Hand classification: the class picker, the sensitivity sliders, the pending selection with
 //! commit, undo and redo, and the whole-stream check of a pending edit.
 
-use egui::{Color32, Context, RichText, Sense, Ui, vec2};
+use egui::{Color32, RichText, Sense, Ui, vec2};
 
 use crate::lut::{ColourClass, Sensitivity};
-use crate::workspace::{Command, TryEdit, Window, Workspace};
+use crate::workspace::{Command, TryEdit, Workspace};
 
 /// A colour swatch the size of a line of text.
 pub fn swatch(ui: &mut Ui, rgb: [u8; 3]) {
@@ -25,6 +25,12 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
     let counts = state.table_counts();
     let frame_counts = state.frame_counts();
     egui::Grid::new("classes").num_columns(3).show(ui, |ui| {
+        ui.label(RichText::new("class").small().weak());
+        ui.label(RichText::new("table cells").small().weak())
+            .on_hover_text("cells of the lookup table set to the class");
+        ui.label(RichText::new("frame pixels").small().weak())
+            .on_hover_text("pixels of the shown frame of the class");
+        ui.end_row();
         for class in ColourClass::ALL {
             ui.horizontal(|ui| {
                 swatch(ui, class.display_rgb());
@@ -70,13 +76,20 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
     match (state.selection(), state.resolved_selection()) {
         (Some(sel), Some(resolved)) => {
             let cells = resolved.indices(state.lut()).count();
-            let pixels = state.preview_mask().iter().filter(|&&m| m).count();
+            let (selected, changing) = state.selection_pixel_counts();
             if let Some((x, y)) = sel.pixel {
                 ui.label(format!("sample ({x}, {y})"));
             } else {
                 ui.label("sample from the U–V plane");
             }
-            ui.label(format!("{cells} cells, {pixels} pixels in this frame"));
+            ui.label(format!(
+                "{cells} cells; {changing} pixels of this frame change class"
+            ))
+            .on_hover_text(format!(
+                "{selected} pixels selected, {} of them already {} (Try edit counts the {changing})",
+                selected - changing,
+                state.settings.class.name()
+            ));
             ui.horizontal(|ui| {
                 if ui
                     .button("Commit")
@@ -123,24 +136,58 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
     });
 }
 
-/// The results of "Try on whole stream"; clicking a row shows that frame.
-/// Shown while the window is open and a check exists; it borrows the check (its edited table is
-/// megabytes: no copy per UI frame). Closing it sends [`Command::ShowWindow`].
-pub fn try_edit_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-    if !state.window_open(Window::TryEdit) {
-        return;
+/// The Try edit window's contents: the frames the pending table edit would change and the
+/// frames whose recognition a parameter change alters; before any run, what to do to start one.
+/// Clicking a row shows that frame.
+pub fn try_edit_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    let has_stream = state.source().is_some_and(|s| s.len() > 1);
+    ui.strong("Table edit");
+    match state.try_edit() {
+        Some(t) => try_edit_ui(ui, t, state.index(), commands),
+        None => {
+            ui.weak(try_edit_hint(state, has_stream));
+            if ui
+                .add_enabled(
+                    state.selection().is_some() && has_stream,
+                    egui::Button::new("Try the selection on the whole stream"),
+                )
+                .clicked()
+            {
+                commands.push(Command::TryEditOnStream);
+            }
+        }
     }
-    let Some(t) = state.try_edit() else {
-        return;
-    };
-    let mut open = true;
-    egui::Window::new(Window::TryEdit.name())
-        .open(&mut open)
-        .default_width(360.0)
-        .default_pos([900.0, 420.0])
-        .show(ctx, |ui| try_edit_ui(ui, t, state.index(), commands));
-    if !open {
-        commands.push(Command::ShowWindow(Window::TryEdit, false));
+    ui.separator();
+    ui.strong("Parameter change");
+    match &state.params_slot().try_run {
+        Some(t) => super::params_panel::try_params_ui(ui, t, state.index(), commands),
+        None => {
+            ui.weak(if state.params_modified() {
+                "Parameters tuned: try them to list the frames whose recognition changes."
+            } else {
+                "No parameter tuned: change one in the Parameters window, then try it here."
+            });
+            if ui
+                .add_enabled(
+                    state.params_modified() && has_stream,
+                    egui::Button::new("Try the tuned parameters on the whole stream"),
+                )
+                .clicked()
+            {
+                commands.push(Command::TryParamsOnStream);
+            }
+        }
+    }
+}
+
+/// What to do before a table edit can be tried.
+fn try_edit_hint(state: &Workspace, has_stream: bool) -> &'static str {
+    if !has_stream {
+        "No check yet: open a stream of more than one frame."
+    } else if state.selection().is_none() {
+        "No check yet: left-click a pixel to select its colours, then try the selection."
+    } else {
+        "No check yet: the pending selection can be tried."
     }
 }
 
@@ -165,29 +212,28 @@ fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Comm
             String::new()
         }
     ));
+    ui.label(
+        RichText::new("frame · pixels changed · blobs before -> after")
+            .small()
+            .weak(),
+    );
     egui::ScrollArea::vertical()
+        .id_salt("try_rows")
         .max_height(300.0)
         .show(ui, |ui| {
-            egui::Grid::new("try_rows").striped(true).show(ui, |ui| {
-                ui.strong("frame");
-                ui.strong("pixels");
-                ui.strong("blobs");
-                ui.end_row();
-                for r in &t.rows {
-                    if ui
-                        .selectable_label(r.index == current, format!("{}", r.index))
-                        .clicked()
-                    {
-                        commands.push(Command::Seek(r.index));
-                    }
-                    ui.label(format!("{}", r.changed_pixels));
-                    let delta = r.blobs_after as i64 - r.blobs_before as i64;
-                    ui.label(format!(
-                        "{} -> {} ({delta:+})",
-                        r.blobs_before, r.blobs_after
-                    ));
-                    ui.end_row();
+            for r in &t.rows {
+                let delta = r.blobs_after as i64 - r.blobs_before as i64;
+                let text = format!(
+                    "frame {:>5}   {:>6} px   blobs {} -> {} ({delta:+})",
+                    r.index, r.changed_pixels, r.blobs_before, r.blobs_after
+                );
+                // The whole row is one button: anywhere on it shows the frame.
+                let row =
+                    egui::Button::selectable(r.index == current, RichText::new(text).monospace())
+                        .min_size(vec2(ui.available_width(), 0.0));
+                if ui.add(row).clicked() {
+                    commands.push(Command::Seek(r.index));
                 }
-            });
+            }
         });
 }

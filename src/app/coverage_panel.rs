@@ -9,24 +9,6 @@ use crate::frame::yuv_to_rgb;
 use crate::lut::Region;
 use crate::workspace::{Command, Window, Workspace};
 
-/// Shows the window while it is open; closing it sends [`Command::ShowWindow`].
-pub fn coverage_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-    if !state.window_open(Window::Coverage) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::Coverage.name())
-        .open(&mut open)
-        .default_width(320.0)
-        .default_pos([900.0, 120.0])
-        .show(ctx, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| coverage_ui(ui, state, commands));
-        });
-    if !open {
-        commands.push(Command::ShowWindow(Window::Coverage, false));
-    }
-}
-
 /// The range, the scan's progress and the hints.
 pub fn coverage_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let Some(src) = state.source() else {

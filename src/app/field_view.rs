@@ -22,22 +22,6 @@ const WORLD_MODEL_COLOUR: Color32 = Color32::from_rgb(230, 230, 230);
 /// Colour of the ball.
 const BALL_COLOUR: Color32 = Color32::from_rgb(255, 150, 30);
 
-/// The window, when open.
-pub fn field_view_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-    if !state.window_open(Window::FieldView) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::FieldView.name())
-        .open(&mut open)
-        .default_size([560.0, 560.0])
-        .default_pos([120.0, 80.0])
-        .show(ctx, |ui| field_view_ui(ui, state, commands));
-    if !open {
-        commands.push(Command::ShowWindow(Window::FieldView, false));
-    }
-}
-
 /// Field cm ↔ screen points for the drawing: x right, y up.
 #[derive(Debug, Clone, Copy)]
 pub struct FieldTransform {

@@ -6,7 +6,7 @@
 //! [`candidates`] turns a [`Recognition`] into plain rows (tested without a window);
 //! [`inspector_window`] draws them.
 
-use egui::{Color32, Context, RichText, Ui};
+use egui::{Color32, RichText, Ui};
 
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
@@ -14,7 +14,7 @@ use crate::recognition::draw::owner;
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::scan::CutOff;
 use crate::recognition::{Recognition, Relative};
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::{Command, Workspace};
 
 /// One candidate as the inspector lists it.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,7 +35,8 @@ pub struct CandidateInfo {
     pub body: Option<Relative>,
     /// The distance is only an upper bound (the object is cut off at top or bottom).
     pub distance_is_max: bool,
-    /// Sides cut off by the image edge: `left`, `right`, `top`, `bottom`.
+    /// Sides not seen, each with why: `left (image edge)`, `top (hidden)` (robot colours
+    /// against it), …
     pub cut_sides: Vec<&'static str>,
     /// Further evidence: circle fit refused, posts without a line, pixel counts.
     pub notes: Vec<String>,
@@ -164,15 +165,30 @@ fn pattern_candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<Ca
         .collect()
 }
 
-fn sides(cut: CutOff) -> Vec<&'static str> {
+/// The sides not seen, each saying why: at the image's edge ("cut off"), or inside the image
+/// with robot colours against it ("hidden"; a ball in the middle of the image is never cut off).
+fn sides(cut: CutOff, bounds: [u32; 4], image_size: (usize, usize)) -> Vec<&'static str> {
+    let [minx, miny, maxx, maxy] = bounds.map(|v| v as usize);
+    let (w, h) = image_size;
     [
-        (cut.left, "left"),
-        (cut.right, "right"),
-        (cut.top, "top"),
-        (cut.bottom, "bottom"),
+        (cut.left, minx == 0, "left (image edge)", "left (hidden)"),
+        (
+            cut.right,
+            maxx + 1 >= w,
+            "right (image edge)",
+            "right (hidden)",
+        ),
+        (cut.top, miny == 0, "top (image edge)", "top (hidden)"),
+        (
+            cut.bottom,
+            maxy + 1 >= h,
+            "bottom (image edge)",
+            "bottom (hidden)",
+        ),
     ]
     .into_iter()
-    .filter_map(|(on, name)| on.then_some(name))
+    .filter(|(on, ..)| *on)
+    .map(|(_, edge, at_edge, hidden)| if edge { at_edge } else { hidden })
     .collect()
 }
 
@@ -202,9 +218,14 @@ fn reason(c: &Confidence, accepted: bool) -> String {
 }
 
 /// Every candidate of `r`: balls, goals, beacons, pink markers, in that order (`places`: the
-/// open places file pink markers were identified against).
+/// open places file pink markers were identified against; `image_size`: the frame's, pixels,
+/// which tells sides cut off at the image edge from hidden ones).
 #[must_use]
-pub fn candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<CandidateInfo> {
+pub fn candidates(
+    r: &Recognition,
+    places: Option<&PatternMemory>,
+    image_size: (usize, usize),
+) -> Vec<CandidateInfo> {
     let mut out = Vec::new();
     for (i, c) in r.ball.candidates.iter().enumerate() {
         let mut notes = vec![format!(
@@ -242,7 +263,7 @@ pub fn candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<Candid
             camera,
             body,
             distance_is_max: false,
-            cut_sides: sides(c.cut_off),
+            cut_sides: sides(c.cut_off, c.bounds, image_size),
             notes,
             pattern: None,
         });
@@ -281,7 +302,7 @@ pub fn candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<Candid
             camera: g.camera,
             body: g.body,
             distance_is_max: g.distance_is_max,
-            cut_sides: sides(g.cut_off),
+            cut_sides: sides(g.cut_off, g.bounds, image_size),
             notes,
             pattern: None,
         });
@@ -321,24 +342,8 @@ fn verdict_colour(accepted: bool) -> Color32 {
     }
 }
 
-/// Shows the inspector while it is open; selecting pushes [`Command::SelectObject`].
-pub fn inspector_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-    if !state.window_open(Window::Inspector) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::Inspector.name())
-        .open(&mut open)
-        .default_width(600.0)
-        // Low and to the right: the interesting part of a robot's image is usually its middle.
-        .default_pos([640.0, 330.0])
-        .show(ctx, |ui| inspector_ui(ui, state, commands));
-    if !open {
-        commands.push(Command::ShowWindow(Window::Inspector, false));
-    }
-}
-
-fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+/// The inspector's contents: every candidate of the shown frame with its confidence breakdown.
+pub fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     if state.frame().is_none() {
         ui.label("No frame open.");
         return;
@@ -347,7 +352,7 @@ fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         overhead_results_ui(ui, state, commands);
         return;
     }
-    let list = candidates(state.recognition(), state.places());
+    let list = candidates(state.recognition(), state.places(), state.image_size());
     if list.is_empty() {
         ui.label(
             "No candidates in this frame: no ball, goal, beacon or pink marker colour large \
@@ -431,7 +436,7 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
         flags.push("distance is a maximum".to_owned());
     }
     if !c.cut_sides.is_empty() {
-        flags.push(format!("cut off: {}", c.cut_sides.join(", ")));
+        flags.push(format!("not seen: {}", c.cut_sides.join(", ")));
     }
     if !flags.is_empty() {
         ui.label(format!("flags: {}", flags.join("; ")));

@@ -5,9 +5,12 @@ use std::path::PathBuf;
 
 use egui::Ui;
 
+use super::file_dialog::FileAction;
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
-use crate::workspace::{Command, Overlays, SPEEDS, ViewKind, Window, Workspace, ZOOM_PRESETS};
+use crate::workspace::{
+    Command, Overlays, SPEEDS, ViewKind, Window, Workspace, ZOOM_PRESETS, ZOOM_RANGE,
+};
 
 /// What the menus ask of the app besides commands.
 #[derive(Debug, Default, Clone, PartialEq, Eq)]
@@ -18,13 +21,15 @@ pub struct MenuOutput {
     pub about: bool,
 }
 
-/// Path typed into File ▸ Open path (dialogs are not always available, e.g. under Xvfb).
+/// Path typed into File ▸ Open path, and the file dialog a menu asked for.
 #[derive(Debug, Default)]
 pub struct MenuInput {
     /// The "Open path" window is shown.
     pub open: bool,
     /// The text of the path field.
     pub path: String,
+    /// A file dialog to open (what for, and the file name to suggest for a save).
+    pub dialog: Option<(FileAction, Option<String>)>,
 }
 
 /// The "Open path" window: a text field, because native dialogs are not always available.
@@ -41,7 +46,9 @@ pub fn open_path_window(ctx: &egui::Context, input: &mut MenuInput, commands: &m
         .show(ctx, |ui| {
             let edit = ui.add(
                 egui::TextEdit::singleline(&mut input.path)
-                    .hint_text("/path/to/stream.mcap, table.lut, places.json or frames")
+                    .hint_text(
+                        "/path/to/stream.mcap, table.lut, params.json, places.json or frames",
+                    )
                     .desired_width(420.0),
             );
             edit.request_focus();
@@ -52,14 +59,6 @@ pub fn open_path_window(ctx: &egui::Context, input: &mut MenuInput, commands: &m
             }
         });
     input.open = open && !done;
-}
-
-fn pick_open(title: &str, filters: &[(&str, &[&str])]) -> Option<Vec<PathBuf>> {
-    let mut d = rfd::FileDialog::new().set_title(title);
-    for (name, ext) in filters {
-        d = d.add_filter(*name, ext);
-    }
-    d.pick_files()
 }
 
 /// The menu bar.
@@ -75,7 +74,7 @@ pub fn menu_bar_ui(
             file_menu_ui(ui, state, input, commands, &mut out)
         });
         ui.menu_button("Classification", |ui| {
-            classification_menu_ui(ui, state, commands)
+            classification_menu_ui(ui, state, input, commands)
         });
         ui.menu_button("View", |ui| view_menu_ui(ui, state, commands));
         ui.menu_button("Stream", |ui| stream_menu_ui(ui, state, commands));
@@ -104,24 +103,11 @@ fn file_menu_ui(
     out: &mut MenuOutput,
 ) {
     if ui.button("Open stream or frames…").clicked() {
-        if let Some(p) = pick_open(
-            "Open a stream or frames",
-            &[(
-                "Streams and frames",
-                &["mcap", "uyvy", "yuv", "raw", "png", "jpg", "jpeg"],
-            )],
-        ) {
-            commands.push(Command::Open(p));
-        }
+        input.dialog = Some((FileAction::Open, None));
         ui.close();
     }
     if ui.button("Open table…").clicked() {
-        if let Some(p) = pick_open(
-            "Open a lookup table",
-            &[("Lookup tables", &["lut", "cal", "raw"])],
-        ) {
-            commands.extend(p.into_iter().map(Command::OpenTable));
-        }
+        input.dialog = Some((FileAction::OpenTable, None));
         ui.close();
     }
     if ui
@@ -155,29 +141,18 @@ fn file_menu_ui(
         ui.close();
     }
     if ui.button("Save table as…").clicked() {
-        if let Some(p) = rfd::FileDialog::new()
-            .set_title("Save the lookup table")
-            .add_filter("Lookup tables", &["lut"])
-            .save_file()
-        {
-            commands.push(Command::SaveTableAs(p));
-        }
+        input.dialog = Some((FileAction::SaveTableAs, Some("table.lut".to_owned())));
         ui.close();
     }
+    ui.separator();
+    params_menu_items_ui(ui, state, input, commands);
     ui.separator();
     let has_frame = state.frame().is_some();
     if ui
         .add_enabled(has_frame, egui::Button::new("Export view as PNG…"))
         .clicked()
     {
-        if let Some(p) = rfd::FileDialog::new()
-            .set_title("Export the view")
-            .add_filter("PNG", &["png"])
-            .set_file_name(default_export_name(state))
-            .save_file()
-        {
-            commands.push(Command::ExportView(p));
-        }
+        input.dialog = Some((FileAction::ExportView, Some(default_export_name(state))));
         ui.close();
     }
     if ui
@@ -215,6 +190,56 @@ fn file_menu_ui(
     }
 }
 
+/// File ▸ Open parameters…, the stream's set, the defaults, Save parameters as….
+fn params_menu_items_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    input: &mut MenuInput,
+    commands: &mut Vec<Command>,
+) {
+    if ui
+        .button("Open parameters…")
+        .on_hover_text("recognition parameters (params/spl2009.json: the 2009 SPL field)")
+        .clicked()
+    {
+        input.dialog = Some((FileAction::OpenParams, None));
+        ui.close();
+    }
+    if let Some(o) = &state.params_slot().offer {
+        let label = format!("Use the stream's parameters ({})", o.name);
+        let hover = o.path.as_ref().map_or_else(
+            || format!("params/{}.json was not found near the stream", o.name),
+            |p| p.display().to_string(),
+        );
+        if ui
+            .add_enabled(o.path.is_some(), egui::Button::new(label))
+            .on_hover_text(hover)
+            .on_disabled_hover_text(format!(
+                "params/{}.json was not found near the stream: Open parameters…",
+                o.name
+            ))
+            .clicked()
+        {
+            commands.push(Command::UseOfferedParams);
+            ui.close();
+        }
+    }
+    if ui
+        .add_enabled(
+            state.params_slot().path.is_some() || state.params_modified(),
+            egui::Button::new("Default parameters"),
+        )
+        .clicked()
+    {
+        commands.push(Command::DefaultParams);
+        ui.close();
+    }
+    if ui.button("Save parameters as…").clicked() {
+        input.dialog = Some((FileAction::SaveParams, Some("params.json".to_owned())));
+        ui.close();
+    }
+}
+
 /// `eotn-view-FRAME-VIEW.png`.
 #[must_use]
 pub fn default_export_name(state: &Workspace) -> String {
@@ -225,7 +250,12 @@ pub fn default_export_name(state: &Workspace) -> String {
     )
 }
 
-fn classification_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+fn classification_menu_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    input: &mut MenuInput,
+    commands: &mut Vec<Command>,
+) {
     ui.menu_button(format!("Class: {}", state.settings.class.name()), |ui| {
         for class in ColourClass::ALL {
             if ui
@@ -301,9 +331,7 @@ fn classification_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Com
         )
         .clicked()
     {
-        if let Some(p) = pick_open("Open a places file", &[("Places", &["json"])]) {
-            commands.extend(p.into_iter().map(Command::OpenPlaces));
-        }
+        input.dialog = Some((FileAction::OpenPlaces, None));
         ui.close();
     }
     let places = state.places_path().map_or_else(
@@ -354,7 +382,10 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 ui.close();
             }
         }
+        ui.separator();
+        zoom_value_ui(ui, state, commands);
     });
+    ui.menu_button("Blob boxes", |ui| blob_filter_ui(ui, state, commands));
     ui.menu_button("Overlays", |ui| overlays_menu_ui(ui, state, commands));
     let mut inspector = state.window_open(Window::Inspector);
     if ui.checkbox(&mut inspector, "Object inspector").changed() {
@@ -373,6 +404,66 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         if ui.selectable_label(c == conn, name).clicked() {
             commands.push(Command::SetConnectivity(conn));
         }
+    }
+}
+
+/// A typed zoom value in percent (Enter or leaving the field applies it).
+pub fn zoom_value_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    let mut percent = state.settings.transform.zoom.map_or(100.0, |z| z * 100.0);
+    let before = percent;
+    ui.horizontal(|ui| {
+        let l = ui.label("Zoom");
+        let r = ui
+            .add(
+                egui::DragValue::new(&mut percent)
+                    .range(ZOOM_RANGE.0 * 100.0..=ZOOM_RANGE.1 * 100.0)
+                    .suffix(" %")
+                    .max_decimals(1),
+            )
+            .labelled_by(l.id)
+            .on_hover_text("type a zoom in percent");
+        if r.changed() && (percent - before).abs() > f32::EPSILON {
+            commands.push(Command::SetZoom(Some(percent / 100.0)));
+        }
+    });
+}
+
+/// View ▸ Blob boxes: the smallest blob drawn and the classes drawn.
+fn blob_filter_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    let mut min = state.settings.min_blob_pixels;
+    let mut hidden = state.settings.hidden_blob_classes.clone();
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        let l = ui.label("Smallest blob");
+        changed |= ui
+            .add(
+                egui::DragValue::new(&mut min)
+                    .range(1..=100_000)
+                    .suffix(" px"),
+            )
+            .labelled_by(l.id)
+            .changed();
+    });
+    ui.separator();
+    for class in ColourClass::ALL.into_iter().skip(1) {
+        let mut shown = !hidden.contains(&class);
+        if ui
+            .checkbox(&mut shown, format!("{} blobs", class.name()))
+            .changed()
+        {
+            changed = true;
+            if shown {
+                hidden.retain(|c| *c != class);
+            } else {
+                hidden.push(class);
+            }
+        }
+    }
+    if changed {
+        commands.push(Command::SetBlobFilter {
+            min_pixels: min,
+            hidden,
+        });
     }
 }
 
@@ -416,6 +507,7 @@ fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         ("Back 10 frames", Command::Step(-10), "PgUp"),
         ("Forward 10 frames", Command::Step(10), "PgDn"),
         ("First frame", Command::Seek(0), "Home"),
+        ("Last frame", Command::Seek(usize::MAX), "End"),
     ] {
         if ui
             .add_enabled(open, egui::Button::new(label).shortcut_text(key))

@@ -13,6 +13,10 @@
 //! | `uv_plane.rs` | the table's U–V plane with the frame's histogram, selection both ways |
 //! | `coverage_panel.rs` | the colours the table leaves unclassified, ranked; select to commit |
 //! | `bookmarks_panel.rs` | the pipeline's events and the user's bookmarks; timeline marks |
+//! | `robots_panel.rs` | Camera ▸ Connect to robot…: the robots list, the Live switch |
+//! | `params_panel.rs` | the recognition parameters: tune each value, reset, save, try on the stream |
+//! | `dock.rs` | the image and the windows docked beside it as tabs (`egui_tiles`) |
+//! | `file_dialog.rs` | in-app file dialogs (`egui_file`): no desktop portal needed |
 //! | `menus.rs` | File, Classification, View, Stream, Camera, Windows, Help |
 //! | `camera_menu.rs` | the Camera menu and its dialogs: connect, settings, grab, record |
 //! | `overhead_overlays.rs` | the overhead camera's overlays: field lines, ball, robot markers, picked points |
@@ -28,12 +32,15 @@ pub mod calibration_window;
 pub mod camera_menu;
 pub mod classify_panel;
 pub mod coverage_panel;
+pub mod dock;
 pub mod field_view;
+pub mod file_dialog;
 pub mod inspector;
 pub mod menus;
 pub mod overhead_menu;
 pub mod overhead_overlays;
 pub mod overlays;
+pub mod params_panel;
 pub mod renderer;
 pub mod robots_panel;
 pub mod sensors_dialog;
@@ -253,11 +260,30 @@ pub fn preview_image(state: &Workspace, size: [usize; 2]) -> ColorImage {
     // Unselected pixels are dimmed, so the highlight shows even where the class colour is
     // the colour of the pixels themselves (orange on an orange ball).
     let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
+    // A dark class colour (black, dark blue) would vanish on the dimmed dark pixels: those
+    // classes are previewed in a light colour instead.
+    let colour = visible_preview_colour(colour);
     ColorImage::new(
         size,
         mask.iter().map(|&m| if m { colour } else { dim }).collect(),
     )
 }
+
+/// The highlight colour of a previewed class: its own colour, or a light magenta for classes
+/// too dark to show over dimmed pixels (black's near-black, dark blue).
+#[must_use]
+pub fn visible_preview_colour(class_colour: Color32) -> Color32 {
+    let [r, g, b, a] = class_colour.to_array();
+    let luma = 0.299 * f32::from(r) + 0.587 * f32::from(g) + 0.114 * f32::from(b);
+    if a > 0 && luma < PREVIEW_MIN_LUMA {
+        Color32::from_rgb(255, 96, 255)
+    } else {
+        class_colour
+    }
+}
+
+/// Class colours darker than this (0..255 luma) get a light preview colour.
+const PREVIEW_MIN_LUMA: f32 = 100.0;
 
 /// The eframe application: the state plus the runtime resources of the window.
 pub struct EotnApp {
@@ -272,6 +298,10 @@ pub struct EotnApp {
     /// What the robots window is editing.
     pub robots: robots_panel::RobotsPanel,
     uv_plane: uv_plane::UvPlane,
+    /// The image and the docked windows.
+    pub dock: dock::Dock,
+    /// The in-app file dialog.
+    pub file_dialogs: file_dialog::FileDialogs,
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
     pub last_view: Option<ImageTransform>,
@@ -326,6 +356,8 @@ impl EotnApp {
             overhead: calibration_window::OverheadPaths::default(),
             robots: robots_panel::RobotsPanel::default(),
             uv_plane: uv_plane::UvPlane::default(),
+            dock: dock::Dock::default(),
+            file_dialogs: file_dialog::FileDialogs::default(),
             hovered: None,
             last_view: None,
             confirm_close: false,
@@ -340,6 +372,19 @@ impl EotnApp {
             quit_at: None,
             play_when_shown: None,
         }
+    }
+
+    /// Where a file dialog starts: the folder of the file it concerns, else the current one.
+    fn dialog_folder(&self, action: file_dialog::FileAction) -> Option<PathBuf> {
+        use file_dialog::FileAction as A;
+        let file = match action {
+            A::OpenTable | A::SaveTableAs => self.state.table_path().map(std::path::Path::to_owned),
+            A::OpenParams | A::SaveParams => self.state.params_slot().path.clone(),
+            A::OpenPlaces => self.state.places_path().map(std::path::Path::to_owned),
+            A::Open | A::ExportView => self.state.settings.last_source.first().cloned(),
+        };
+        file.and_then(|f| f.parent().map(std::path::Path::to_owned))
+            .filter(|d| !d.as_os_str().is_empty())
     }
 
     /// The pixel the pointer was over in the last frame.
@@ -416,6 +461,7 @@ impl EotnApp {
         if ctx.egui_wants_keyboard_input() {
             return quit;
         }
+        let menu_open = egui::Popup::is_any_open(ctx);
         ctx.input_mut(|i| {
             let cmd = |k| KeyboardShortcut::new(Modifiers::COMMAND, k);
             if i.consume_shortcut(&KeyboardShortcut::new(
@@ -479,7 +525,8 @@ impl EotnApp {
                     commands.push(Command::SetPlaying(!self.state.playing()));
                 }
             }
-            if i.consume_key(Modifiers::NONE, Key::Escape) {
+            // Escape closes an open menu first; only then does it drop the selection.
+            if !menu_open && i.consume_key(Modifiers::NONE, Key::Escape) {
                 commands.push(Command::ClearSelection);
             }
         });
@@ -552,10 +599,10 @@ impl EotnApp {
     fn status_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             let n = self.state.warnings().len();
-            let label = if n == 0 {
-                "no warnings".to_owned()
-            } else {
-                format!("{n} warnings")
+            let label = match n {
+                0 => "no warnings".to_owned(),
+                1 => "1 warning".to_owned(),
+                _ => format!("{n} warnings"),
             };
             let button = egui::Button::new(label).selected(self.show_warnings);
             if ui.add_enabled(n > 0, button).clicked() {
@@ -728,6 +775,9 @@ impl EotnApp {
                 self.confirm_close = false;
             }
             Some(2) => {
+                // The edits are undone in the journal too: the next start finds the table as
+                // saved, with its undo history, and no sign of a crash.
+                commands.push(Command::DiscardUnsaved);
                 self.allow_close = true;
                 self.confirm_close = false;
                 ctx.send_viewport_cmd(egui::ViewportCommand::Close);
@@ -829,32 +879,33 @@ impl eframe::App for EotnApp {
                     classify_panel::classify_panel_ui(ui, &self.state, &mut commands);
                 });
             });
+        self.dock.sync(&self.state);
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
             .show(ui, |ui| {
-                let out = views::main_view_ui(ui, &self.state, tex.as_ref(), &mut commands);
+                let mut behavior = dock::DockBehavior {
+                    state: &self.state,
+                    tex: tex.as_ref(),
+                    uv_plane: &mut self.uv_plane,
+                    overhead_paths: &mut self.overhead,
+                    robots: &mut self.robots,
+                    commands: &mut commands,
+                    dialog: &mut self.menu_input.dialog,
+                    view: views::MainViewOutput::default(),
+                };
+                let out = self.dock.ui(ui, &mut behavior);
                 self.hovered = out.hovered;
                 self.last_view = out.transform;
             });
-
-        sensors_dialog::sensors_window(&ctx, &self.state, &mut commands);
-        self.uv_plane.window(&ctx, &self.state, &mut commands);
-        classify_panel::try_edit_window(&ctx, &self.state, &mut commands);
-        inspector::inspector_window(&ctx, &self.state, &mut commands);
-        calibration_window::calibration_window(
-            &ctx,
-            &self.state,
-            &mut self.overhead,
-            &mut commands,
-        );
-        field_view::field_view_window(&ctx, &self.state, &mut commands);
-        coverage_panel::coverage_window(&ctx, &self.state, &mut commands);
-        bookmarks_panel::bookmarks_window(&ctx, &self.state, &mut commands);
+        if let Some((action, name)) = self.menu_input.dialog.take() {
+            let folder = self.dialog_folder(action);
+            self.file_dialogs.open(action, folder.as_deref(), name);
+        }
+        self.file_dialogs.show(&ctx, &mut commands);
         self.warnings_window(&ctx);
         self.about_window(&ctx);
         menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
         camera_menu::camera_windows(&ctx, &self.state, &mut self.camera, &mut commands);
-        robots_panel::robots_window(&ctx, &self.state, &mut self.robots, &mut commands);
         if let Some(at) = self.quit_at {
             if now >= at {
                 // Unsaved table edits still get the question: a timer never discards work.
@@ -882,6 +933,12 @@ impl eframe::App for EotnApp {
         }
         let busy = self.state.try_edit().is_some_and(|t| !t.done())
             || self.state.hints_busy()
+            || self
+                .state
+                .params_slot()
+                .try_run
+                .as_ref()
+                .is_some_and(|t| !t.done())
             || (self.state.settings.show_sensors
                 && self.state.sensor_series.points.len() < self.state.sensor_series.total);
         self.state.record_ui_time(now.elapsed(), cpu);

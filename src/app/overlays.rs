@@ -228,10 +228,17 @@ pub fn blob_label(painter: &Painter, xf: &ImageTransform, b: &Blob, placed: &mut
     let [r, g, bl] = box_colour(b.colour);
     let colour = Color32::from_rgb(r, g, bl);
     let text = format!("{} {}×{}", b.class().name(), b.width(), b.height());
-    // Below the box: above it go recognition's object labels.
-    let pos = blob_rect(xf, b).left_bottom() + vec2(0.0, 3.0);
+    // Below the box: above it go recognition's object labels. A box at the bottom of the view
+    // gets its label above it instead, and a box partly outside the view its label at the edge.
+    let rect = blob_rect(xf, b);
     let galley = painter.layout_no_wrap(text, FontId::proportional(11.0), colour);
-    let bg = Rect::from_min_size(pos, galley.size()).expand(1.0);
+    let view = painter.clip_rect();
+    let mut bg =
+        Rect::from_min_size(rect.left_bottom() + vec2(0.0, 3.0), galley.size()).expand(1.0);
+    if bg.max.y > view.max.y {
+        bg = bg.translate(vec2(0.0, -(rect.height() + bg.height() + 6.0)));
+    }
+    let bg = keep_inside(bg, view);
     if placed.iter().any(|p| p.intersects(bg)) {
         return;
     }
@@ -346,17 +353,23 @@ pub fn paint_primitives(
                 let bg =
                     Rect::from_min_size(anchor - vec2(0.0, galley.size().y + 2.0), galley.size())
                         .expand(2.0);
-                // Kept inside the view: a ball at the top edge still shows its distance.
-                let view = painter.clip_rect();
-                let dx = (view.max.x - bg.max.x).min(0.0) + (view.min.x - bg.min.x).max(0.0);
-                let dy = (view.max.y - bg.max.y).min(0.0) + (view.min.y - bg.min.y).max(0.0);
-                let bg = bg.translate(vec2(dx, dy));
+                // Kept inside the view: a ball at the top edge, or outside the view when
+                // zoomed in, still shows its distance at the edge nearest to it.
+                let bg = keep_inside(bg, painter.clip_rect());
                 let bg_alpha = if dim { 60 } else { 180 };
                 painter.rect_filled(bg, 3.0, Color32::from_black_alpha(bg_alpha));
                 painter.galley(bg.min + vec2(2.0, 2.0), galley, colour);
             }
         }
     }
+}
+
+/// `bg` moved the least distance that puts it inside `view` (pinned to the nearest edge).
+#[must_use]
+pub fn keep_inside(bg: Rect, view: Rect) -> Rect {
+    let dx = (view.max.x - bg.max.x).min(0.0) + (view.min.x - bg.min.x).max(0.0);
+    let dy = (view.max.y - bg.max.y).min(0.0) + (view.min.y - bg.min.y).max(0.0);
+    bg.translate(vec2(dx, dy))
 }
 
 /// A cross on the sampled pixel.

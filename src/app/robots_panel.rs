@@ -28,26 +28,6 @@ impl Default for RobotsPanel {
     }
 }
 
-/// Shows the robots window while it is open; closing it sends [`Command::ShowWindow`].
-pub fn robots_window(
-    ctx: &Context,
-    state: &Workspace,
-    panel: &mut RobotsPanel,
-    commands: &mut Vec<Command>,
-) {
-    if !state.window_open(Window::Robots) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::Robots.name())
-        .open(&mut open)
-        .default_pos([300.0, 90.0])
-        .show(ctx, |ui| robots_ui(ui, state, panel, commands));
-    if !open {
-        commands.push(Command::ShowWindow(Window::Robots, false));
-    }
-}
-
 /// The window's contents: the address field, the robots list, recording into a folder.
 pub fn robots_ui(
     ui: &mut Ui,

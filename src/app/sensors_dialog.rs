@@ -2,29 +2,15 @@
 //! and plots of head pan, pan velocity and the pan motor's PWM over the stream with a cursor at
 //! the current frame.
 
-use egui::{Color32, Context, Id};
+use egui::{Color32, Id};
 use egui_plot::{Legend, Line, Plot, VLine};
 
 use crate::sensors::SensorReadings;
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::Workspace;
 
-/// Shows the dialog while it is open; closing it sends [`Command::ShowWindow`].
-pub fn sensors_window(ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-    if !state.window_open(Window::Sensors) {
-        return;
-    }
-    let mut open = true;
-    egui::Window::new(Window::Sensors.name())
-        .open(&mut open)
-        .default_width(420.0)
-        .default_pos([700.0, 80.0])
-        .show(ctx, |ui| sensors_ui(ui, state));
-    if !open {
-        commands.push(Command::ShowWindow(Window::Sensors, false));
-    }
-}
-
-fn sensors_ui(ui: &mut egui::Ui, state: &Workspace) {
+/// The Sensors window's contents: every reading of the shown frame with units, plots over
+/// the stream.
+pub fn sensors_ui(ui: &mut egui::Ui, state: &Workspace) {
     let Some(current) = state.current() else {
         ui.label("No frame open.");
         return;

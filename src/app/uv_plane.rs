@@ -4,12 +4,11 @@
 //! the matching pixels in the image (selection works both ways).
 
 use egui::{
-    Color32, ColorImage, Context, Rect, Sense, Stroke, StrokeKind, TextureHandle, TextureOptions,
-    pos2, vec2,
+    Color32, ColorImage, Rect, Sense, Stroke, StrokeKind, TextureHandle, TextureOptions, pos2, vec2,
 };
 
 use crate::lut::edit::Selection;
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::{Command, Workspace};
 
 /// The U–V plane texture, rebuilt when the table, frame or Y changes.
 #[derive(Default)]
@@ -19,23 +18,8 @@ pub struct UvPlane {
 }
 
 impl UvPlane {
-    /// Shows the window while it is open; closing it sends [`Command::ShowWindow`].
-    pub fn window(&mut self, ctx: &Context, state: &Workspace, commands: &mut Vec<Command>) {
-        if !state.window_open(Window::UvPlane) {
-            return;
-        }
-        let mut open = true;
-        egui::Window::new(Window::UvPlane.name())
-            .open(&mut open)
-            .default_width(300.0)
-            .default_pos([960.0, 60.0])
-            .show(ctx, |ui| self.ui(ui, state, commands));
-        if !open {
-            commands.push(Command::ShowWindow(Window::UvPlane, false));
-        }
-    }
-
-    fn ui(&mut self, ui: &mut egui::Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    /// The U–V plane's contents.
+    pub fn ui(&mut self, ui: &mut egui::Ui, state: &Workspace, commands: &mut Vec<Command>) {
         let lut = state.lut();
         let n = lut.side();
         let shift = lut.shift();
@@ -67,8 +51,12 @@ impl UvPlane {
             }
             self.key = key;
         }
-        let side = ui.available_width().clamp(128.0, 512.0);
-        let (rect, response) = ui.allocate_exact_size(vec2(side, side), Sense::click());
+        let side = (ui.available_width() - AXIS_MARGIN).clamp(128.0, 512.0);
+        let (outer, response) =
+            ui.allocate_exact_size(vec2(side + AXIS_MARGIN, side + AXIS_MARGIN), Sense::click());
+        let rect =
+            Rect::from_min_size(outer.min + vec2(AXIS_MARGIN, AXIS_MARGIN), vec2(side, side));
+        axis_ticks(ui, rect);
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "U–V plane"));
         if let Some(t) = &self.texture {
             ui.painter().image(
@@ -96,6 +84,9 @@ impl UvPlane {
             );
         }
         let to_cell = |p: egui::Pos2| {
+            if !rect.contains(p) {
+                return None;
+            }
             let u = ((p.y - rect.min.y) / cell) as usize;
             let v = ((p.x - rect.min.x) / cell) as usize;
             (u < n && v < n).then_some((u, v))
@@ -151,4 +142,45 @@ impl UvPlane {
         }
         ColorImage::new([n, n], pixels)
     }
+}
+
+/// Room left of and above the plane for its axes, screen points.
+const AXIS_MARGIN: f32 = 26.0;
+
+/// Ticks and values (0, 64, 128, 192, 255) along the V axis (across, above the plane) and the
+/// U axis (down, left of it).
+fn axis_ticks(ui: &egui::Ui, plane: Rect) {
+    let painter = ui.painter();
+    let colour = ui.visuals().weak_text_color();
+    let font = egui::FontId::monospace(9.0);
+    let stroke = Stroke::new(1.0, colour);
+    for value in [0u16, 64, 128, 192, 255] {
+        let t = (f32::from(value) + 0.5) / 256.0;
+        let x = plane.min.x + t * plane.width();
+        let y = plane.min.y + t * plane.height();
+        painter.line_segment([pos2(x, plane.min.y - 4.0), pos2(x, plane.min.y)], stroke);
+        painter.text(
+            pos2(x, plane.min.y - 5.0),
+            egui::Align2::CENTER_BOTTOM,
+            value.to_string(),
+            font.clone(),
+            colour,
+        );
+        painter.line_segment([pos2(plane.min.x - 4.0, y), pos2(plane.min.x, y)], stroke);
+        painter.text(
+            pos2(plane.min.x - 5.0, y),
+            egui::Align2::RIGHT_CENTER,
+            value.to_string(),
+            font.clone(),
+            colour,
+        );
+    }
+    let corner = plane.min - vec2(AXIS_MARGIN, AXIS_MARGIN);
+    painter.text(
+        corner,
+        egui::Align2::LEFT_TOP,
+        "U / V",
+        egui::FontId::proportional(9.0),
+        colour,
+    );
 }

@@ -6,7 +6,9 @@ use egui::{Align2, Color32, PointerButton, Sense, Ui, vec2};
 
 use super::overlays::{FrameTextures, ImageTransform, corner_text, paint_view};
 use crate::geometry::ImagePoint;
-use crate::workspace::{Command, OverheadCommand, PixelInfo, ViewKind, Workspace};
+use crate::workspace::{
+    Command, OverheadCommand, PendingSelection, PixelInfo, ViewKind, Workspace,
+};
 
 /// Screen points the mouse wheel must move for the zoom to double.
 const WHEEL_POINTS_PER_DOUBLING: f32 = 240.0;
@@ -76,12 +78,22 @@ pub fn main_view_ui(
             commands.push(Command::Pan([d.x, d.y]));
         }
     }
+    // A click samples at once; when it turns out to be the first of a double-click (fit), the
+    // selection from before it is put back, so fitting never changes the selection.
+    let before_click = egui::Id::unique("eotn-selection-before-click");
     if response.double_clicked_by(PointerButton::Primary) {
         commands.push(Command::ResetView);
+        if let Some(before) =
+            ui.data_mut(|d| d.remove_temp::<Option<PendingSelection>>(before_click))
+        {
+            commands.push(Command::RestoreSelection(before));
+        }
     } else if response.clicked_by(PointerButton::Primary)
         && let Some(pos) = response.interact_pointer_pos()
         && xf.pixel_at(pos).is_some()
     {
+        let before = state.selection().cloned();
+        ui.data_mut(|d| d.insert_temp(before_click, before));
         commands.push(click_command(state, xf.to_image(pos)));
     }
     if response.clicked_by(PointerButton::Secondary) && state.selection().is_some() {

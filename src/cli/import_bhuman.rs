@@ -32,6 +32,9 @@ pub fn run(log_path: &Path, output: &Path, options: WriterOptions) -> anyhow::Re
         ),
     };
     let mut writer = StreamWriter::create_with(output, &info, options)?;
+    if let Some(set) = crate::streams::param_set_of_source(&info.source) {
+        writer.name_param_set(set)?;
+    }
     let t0 = log.frames.first().map_or(0, |f| f.time_ms);
     for (i, f) in log.frames.iter().enumerate() {
         let time_ns = u64::from(f.time_ms.saturating_sub(t0)) * 1_000_000;

@@ -42,6 +42,18 @@ pub const RECOGNITION_TOPIC: &str = "/recognition";
 pub const ANNOTATIONS_TOPIC: &str = "/camera/annotations";
 /// Name of the MCAP metadata record that holds the [`StreamInfo`].
 pub const METADATA_NAME: &str = "eotn.stream";
+/// Name of the MCAP metadata record naming the recognition parameter set a stream is meant for
+/// (key `params`, e.g. `spl2009` for `params/spl2009.json`).
+pub const PARAMS_METADATA_NAME: &str = "eotn.recognition";
+
+/// The parameter set streams of this source kind need when they do not name one: B-Human 2009
+/// streams (the SPL field through a Nao camera) need `spl2009`; every other kind runs on the
+/// defaults.
+#[must_use]
+pub fn param_set_of_source(source: &str) -> Option<&'static str> {
+    (source == "bhuman2009").then_some("spl2009")
+}
+
 /// Version of the stream layout written by this crate (metadata key `format_version`).
 pub const FORMAT_VERSION: &str = "1";
 

@@ -15,7 +15,7 @@ use super::schema::{
 };
 use super::{
     ANNOTATIONS_TOPIC, FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME,
-    RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
+    PARAMS_METADATA_NAME, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
 };
 
 /// How chunks are compressed.
@@ -291,6 +291,26 @@ impl StreamWriter {
         self.mcap
             .write_to_known_channel(&header, data)
             .map_err(self.mcap_err("cannot write a message"))
+    }
+
+    /// Names the recognition parameter set the stream is meant for (`"spl2009"` reads
+    /// `params/spl2009.json`): a [`PARAMS_METADATA_NAME`] metadata record the app offers.
+    ///
+    /// # Errors
+    /// I/O errors naming the file.
+    pub fn name_param_set(&mut self, name: &str) -> Result<(), StreamError> {
+        let metadata = mcap::records::Metadata {
+            name: PARAMS_METADATA_NAME.to_owned(),
+            metadata: BTreeMap::from([("params".to_owned(), name.to_owned())]),
+        };
+        let path = self.partial.clone();
+        self.mcap
+            .write_metadata(&metadata)
+            .map_err(|source| StreamError::Mcap {
+                path,
+                context: "cannot write the parameter set's metadata".to_owned(),
+                source,
+            })
     }
 
     /// Appends one frame with its data. Non-finite sensor values are written as `null`.

@@ -13,12 +13,36 @@ use crate::lut::{ColourClass, Sensitivity};
 /// Everything the UI can ask for.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
-    /// Open files by kind: `.mcap` streams, frame files (as one sequence), anything else as a table.
+    /// Open files by kind: `.mcap` streams, frame files (as one sequence), `.json` recognition
+    /// parameters or places (told by content), anything else as a table. Each file opens or
+    /// fails on its own.
     Open(Vec<PathBuf>),
     /// Open a lookup table.
     OpenTable(PathBuf),
     /// Open a places file (`eotn patterns learn`): pink markers are identified as its places.
     OpenPlaces(PathBuf),
+    /// Open a recognition parameters file (`params/spl2009.json`): the frame is re-run with it.
+    OpenParams(PathBuf),
+    /// Use the parameter set the open stream names (the file found for it).
+    UseOfferedParams,
+    /// Back to the built-in default parameters.
+    DefaultParams,
+    /// Set one recognition parameter: `pointer` is a JSON pointer into the parameters
+    /// (`/ball/diameter_cm`, `/ball/height_cm/0`), checked as a parameters file is.
+    SetParamValue {
+        /// Where the value is.
+        pointer: String,
+        /// The new value.
+        value: serde_json::Value,
+    },
+    /// Reset one parameter (JSON pointer) to its value in the file opened or saved last.
+    ResetParamValue(String),
+    /// Reset every parameter to the file opened or saved last.
+    ResetParams,
+    /// Save the parameters (what differs from the defaults) as a parameters file.
+    SaveParams(PathBuf),
+    /// Start the whole-stream check of the tuned parameters against the opened ones.
+    TryParamsOnStream,
     /// Forget the places file: pink markers keep their signatures, unidentified.
     ClosePlaces,
     /// A new empty table with the given bits per channel.
@@ -27,6 +51,10 @@ pub enum Command {
     SaveTable,
     /// Save the table under a new name (it becomes the table's path).
     SaveTableAs(PathBuf),
+    /// Drop the table's unsaved edits (Quit without saving): they are undone, and the undoing
+    /// journalled, so the journal replays to the saved table and the next start keeps the undo
+    /// history (the dropped edits can be redone) instead of warning of a crash.
+    DiscardUnsaved,
     /// Replace the table by replaying its journal.
     RebuildFromJournal,
     /// Move by this many frames.
@@ -59,6 +87,8 @@ pub enum Command {
     SampleCell([usize; 3]),
     /// Drop the pending selection.
     ClearSelection,
+    /// Put back a pending selection as it was (the first click of a double-click sampled).
+    RestoreSelection(Option<super::PendingSelection>),
     /// Write the pending selection into the table with the current class.
     Commit,
     /// Undo the latest edit.
@@ -71,6 +101,13 @@ pub enum Command {
     SetOverlays(Overlays),
     /// Blob connectivity.
     SetConnectivity(Connectivity),
+    /// Which blobs get boxes and labels: at least `min_pixels` pixels, not of a `hidden` class.
+    SetBlobFilter {
+        /// Smallest blob drawn, pixels.
+        min_pixels: u32,
+        /// Classes whose blobs are not drawn.
+        hidden: Vec<ColourClass>,
+    },
     /// Zoom to a value (screen points per pixel), keeping the centre; `None` fits.
     SetZoom(Option<f32>),
     /// Zoom by `factor` keeping the image point `about` (pixels) where it is on screen.
@@ -218,11 +255,13 @@ pub enum Window {
     Coverage,
     /// Events and bookmarks on the timeline.
     Bookmarks,
+    /// The recognition parameters: tune, reset, save.
+    Parameters,
 }
 
 impl Window {
     /// Every window, for the Windows menu.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::Sensors,
         Self::UvPlane,
         Self::TryEdit,
@@ -232,6 +271,7 @@ impl Window {
         Self::Robots,
         Self::Coverage,
         Self::Bookmarks,
+        Self::Parameters,
     ];
 
     /// Its title.
@@ -250,6 +290,7 @@ impl Window {
             Self::Robots => "Robots",
             Self::Coverage => "Unclassified colours",
             Self::Bookmarks => "Events and bookmarks",
+            Self::Parameters => "Parameters",
         }
     }
 }

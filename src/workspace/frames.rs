@@ -12,37 +12,86 @@ use super::{SCAN_BUDGET, SensorSeries, Workspace};
 use crate::sources::SourceFrame;
 
 impl Workspace {
+    /// Opens each file by its kind; each opens or fails on its own (a bad table does not stop
+    /// the stream beside it). Every failure is a warning naming its file; the error returned
+    /// lists them all.
     pub(super) fn open(&mut self, paths: Vec<PathBuf>) -> anyhow::Result<()> {
         anyhow::ensure!(!paths.is_empty(), "nothing to open");
         let mut frames = Vec::new();
-        let mut stream = None;
+        let mut streams = Vec::new();
+        let mut failures = Vec::new();
         for p in paths {
             let ext = p
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default();
-            if ext == "mcap" {
-                stream = Some(p);
+            let partial_stream = p.to_string_lossy().ends_with(".mcap.partial");
+            let opened = if ext == "mcap" || partial_stream {
+                streams.push(p);
+                Ok(())
             } else if ext == "json" {
-                self.open_places(&p)?;
+                self.open_json(&p)
             } else if crate::sources::is_frame_file(&p) || p.is_dir() {
                 frames.push(p);
+                Ok(())
             } else {
-                self.open_table(&p)?;
+                self.open_table(&p)
+            };
+            if let Err(e) = opened {
+                failures.push(format!("{e:#}"));
             }
         }
-        if let Some(s) = stream {
-            let source = Source::stream(&s)?;
-            self.remember_recent(&s);
-            self.set_source(source)?;
+        // One source is shown: the last stream given, else the frames as one sequence.
+        if let Some(s) = streams.pop() {
+            for skipped in &streams {
+                failures.push(format!(
+                    "{}: not opened (one stream at a time; {} is shown)",
+                    skipped.display(),
+                    s.display()
+                ));
+            }
+            match Source::stream(&s) {
+                Ok(source) => {
+                    self.remember_recent(&s);
+                    match self.set_source(source) {
+                        Ok(()) => self.offer_param_set(&s),
+                        Err(e) => failures.push(format!("{e:#}")),
+                    }
+                }
+                Err(e) => failures.push(format!("{e:#}")),
+            }
         } else if !frames.is_empty() {
-            let files = crate::sources::expand_frame_paths(&frames)?;
-            for f in &frames {
-                self.remember_recent(f);
+            let opened = crate::sources::expand_frame_paths(&frames)
+                .and_then(|files| Source::files(files).map_err(Into::into))
+                .and_then(|source| self.set_source(source));
+            match opened {
+                Ok(()) => {
+                    for f in &frames {
+                        self.remember_recent(f);
+                    }
+                }
+                Err(e) => failures.push(format!("{e:#}")),
             }
-            self.set_source(Source::files(files)?)?;
         }
-        Ok(())
+        match failures.len() {
+            0 => Ok(()),
+            1 => Err(anyhow::anyhow!(failures.remove(0))),
+            _ => {
+                let last = failures.pop().unwrap_or_default();
+                for f in failures {
+                    self.warn(f);
+                }
+                Err(anyhow::anyhow!(last))
+            }
+        }
+    }
+
+    /// A `.json` given to Open: recognition parameters or a places file, told by content.
+    fn open_json(&mut self, path: &std::path::Path) -> anyhow::Result<()> {
+        match super::params::json_kind(path)? {
+            super::params::JsonKind::Params => self.open_params(path),
+            super::params::JsonKind::Places => self.open_places(path),
+        }
     }
 
     pub(super) fn set_source(&mut self, source: Source) -> anyhow::Result<()> {

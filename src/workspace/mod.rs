@@ -19,6 +19,7 @@
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
 //! | `coverage.rs`, `cell_origin.rs`, `bookmarks.rs`, `hints.rs` | what is unclassified, who set a cell, events and bookmarks |
+//! | `params.rs` | recognition parameters: open, tune, reset, save, the set a stream names, [`params::TryParams`] |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
 //! | `timings.rs` | step and frame-time measurements |
 //! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
@@ -35,6 +36,7 @@ mod hints;
 pub mod journal;
 mod live;
 pub mod overhead;
+pub mod params;
 pub mod player;
 mod robots;
 mod settings;
@@ -52,6 +54,7 @@ pub use command::{Command, OverheadCommand, Window};
 pub use compose::{PrimitiveFilter, box_colour};
 pub use live::Live;
 pub use overhead::{CalibrationSource, Overhead, RobotKey};
+pub use params::{ParamsOffer, ParamsSlot, TryParams, TryParamsRow};
 pub use player::Player;
 pub use robots::{RobotId, RobotRow, Wake};
 pub use settings::{
@@ -159,6 +162,11 @@ pub struct Workspace {
     overhead: overhead::Overhead,
     /// Coverage hints, events and bookmarks.
     hints: hints::Hints,
+    /// The recognition parameters' file, the loaded values, the stream's offer.
+    params: ParamsSlot,
+    /// Edits in the undo history when the table was last opened or saved (`None` when that
+    /// state can no longer be reached by undoing).
+    saved_undo_len: Option<usize>,
 }
 
 impl Default for Workspace {
@@ -216,6 +224,8 @@ impl Workspace {
             other_table: TableSlot::empty(bits),
             overhead: overhead::Overhead::default(),
             hints: hints::Hints::default(),
+            params: ParamsSlot::default(),
+            saved_undo_len: Some(0),
         }
     }
 
@@ -232,6 +242,9 @@ impl Workspace {
         }
         if let Some(p) = self.settings.last_places.clone() {
             self.run(Command::OpenPlaces(p));
+        }
+        if let Some(p) = self.settings.last_params.clone() {
+            self.run(Command::OpenParams(p));
         }
         let src = self.settings.last_source.clone();
         let index = self.settings.last_index;
@@ -270,6 +283,22 @@ impl Workspace {
             Command::OpenTable(p) => self.open_table(&p)?,
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),
+            Command::OpenParams(p) => self.open_params(&p)?,
+            Command::UseOfferedParams => {
+                let p = self
+                    .params
+                    .offer
+                    .as_ref()
+                    .and_then(|o| o.path.clone())
+                    .context("the stream names no parameter set that was found")?;
+                self.open_params(&p)?;
+            }
+            Command::DefaultParams => self.default_params(),
+            Command::SetParamValue { pointer, value } => self.set_param_value(&pointer, value)?,
+            Command::ResetParamValue(pointer) => self.reset_param_value(&pointer)?,
+            Command::ResetParams => self.reset_params(),
+            Command::SaveParams(p) => self.save_params(&p)?,
+            Command::TryParamsOnStream => self.try_params_on_stream()?,
             Command::NewTable(bits) => self.new_table(bits)?,
             Command::SaveTable => {
                 let path = self
@@ -280,6 +309,7 @@ impl Workspace {
             }
             Command::SaveTableAs(p) => self.save_table(&p)?,
             Command::RebuildFromJournal => self.rebuild_from_journal()?,
+            Command::DiscardUnsaved => self.discard_unsaved()?,
             Command::Step(delta) => self.step(delta)?,
             Command::Seek(i) => self.seek(i)?,
             Command::SetPlaying(p) => self.set_playing(p)?,
@@ -295,6 +325,10 @@ impl Workspace {
             Command::SampleCell(cell) => self.sample_cell(cell)?,
             Command::ClearSelection => {
                 self.selection = None;
+                self.refresh_preview();
+            }
+            Command::RestoreSelection(s) => {
+                self.selection = s;
                 self.refresh_preview();
             }
             Command::Commit => self.commit()?,
@@ -317,6 +351,10 @@ impl Workspace {
                 self.pipeline.set_params(params);
                 self.reprocess();
             }
+            Command::SetBlobFilter { min_pixels, hidden } => {
+                self.settings.min_blob_pixels = min_pixels;
+                self.settings.hidden_blob_classes = hidden;
+            }
             Command::SetZoom(z) => {
                 self.settings.transform.zoom = z.filter(|z| z.is_finite()).map(clamp_zoom);
             }
@@ -335,7 +373,13 @@ impl Workspace {
             }
             Command::TryEditOnStream => self.try_edit_on_stream()?,
             Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
-            Command::ShowWindow(w, open) => *self.window_flag(w) = open,
+            Command::ShowWindow(w, open) => {
+                *self.window_flag(w) = open;
+                if w == Window::Inspector && !open {
+                    // Its highlight belongs to it: closed, every object is drawn alike again.
+                    self.selected_object = None;
+                }
+            }
             Command::ShowTimings(on) => self.settings.show_timings = on,
             Command::Connect(spec) => self.connect(&spec)?,
             Command::Disconnect => self.disconnect()?,
@@ -437,6 +481,7 @@ impl Workspace {
             t.scan(src, self.pipeline.lut(), conn, min, SCAN_BUDGET);
         }
         self.tick_hints();
+        self.scan_try_params(SCAN_BUDGET);
         let Some(src) = self.source.as_ref() else {
             self.player.stop();
             return;
@@ -617,9 +662,10 @@ impl Workspace {
     #[must_use]
     pub fn drawn_blobs(&self) -> Vec<Blob> {
         let min = self.settings.min_blob_pixels;
+        let hidden = &self.settings.hidden_blob_classes;
         self.blobs()
             .active()
-            .filter(|b| b.pixels >= min)
+            .filter(|b| b.pixels >= min && !hidden.iter().any(|c| c.code() == b.colour))
             .copied()
             .collect()
     }
@@ -714,6 +760,7 @@ impl Workspace {
             Window::Robots => self.settings.show_robots,
             Window::Coverage => self.settings.show_coverage,
             Window::Bookmarks => self.settings.show_bookmarks,
+            Window::Parameters => self.settings.show_params,
         }
     }
 
@@ -731,6 +778,7 @@ impl Workspace {
             Window::Robots => &mut self.settings.show_robots,
             Window::Coverage => &mut self.settings.show_coverage,
             Window::Bookmarks => &mut self.settings.show_bookmarks,
+            Window::Parameters => &mut self.settings.show_params,
         }
     }
 

@@ -187,6 +187,8 @@ pub struct Settings {
     pub last_overhead_table: Option<PathBuf>,
     /// The places file (learnt coloured patterns) to reopen at start.
     pub last_places: Option<PathBuf>,
+    /// The recognition parameters file to reopen at start (`None`: the defaults).
+    pub last_params: Option<PathBuf>,
     /// The stream or frame files to reopen at start.
     pub last_source: Vec<PathBuf>,
     /// The frame that was shown.
@@ -207,6 +209,9 @@ pub struct Settings {
     pub connectivity: Connectivity,
     /// Blobs smaller than this many pixels get no box or label.
     pub min_blob_pixels: u32,
+    /// Classes whose blobs get no box or label (green and white by default: the carpet and
+    /// the lines make dozens of boxes that hide the objects).
+    pub hidden_blob_classes: Vec<ColourClass>,
     /// Bits of a new table.
     pub new_table_bits: u8,
     /// Sensor dialog open.
@@ -227,6 +232,8 @@ pub struct Settings {
     pub show_calibration: bool,
     /// Overhead view options.
     pub overhead: OverheadView,
+    /// The Parameters window open.
+    pub show_params: bool,
     /// The Connect dialog open (not kept between runs, like the other Camera dialogs).
     #[serde(skip)]
     pub show_connect: bool,
@@ -252,6 +259,7 @@ impl Default for Settings {
             last_table: None,
             last_overhead_table: None,
             last_places: None,
+            last_params: None,
             last_source: Vec::new(),
             last_index: 0,
             class: ColourClass::Orange,
@@ -262,6 +270,7 @@ impl Default for Settings {
             speed: 1.0,
             connectivity: Connectivity::default(),
             min_blob_pixels: 10,
+            hidden_blob_classes: vec![ColourClass::Green, ColourClass::White],
             new_table_bits: 7,
             show_sensors: false,
             show_uv_plane: false,
@@ -272,6 +281,7 @@ impl Default for Settings {
             show_field_view: false,
             show_calibration: false,
             overhead: OverheadView::default(),
+            show_params: false,
             show_connect: false,
             show_source_settings: false,
             show_record: false,

@@ -23,10 +23,11 @@ impl Workspace {
                 Ok(r) if &r.table == self.pipeline.lut() => {
                     let n = r.history.undo_len();
                     self.history = r.history;
+                    self.saved_undo_len = Some(n);
                     self.status = format!("opened table {}; journal: {n} edits can be undone", path.display());
                 }
                 Ok(r) => self.warn(format!(
-                    "{}: the table differs from its journal's replay ({} edits; unsaved edits before a crash?): Classification > Rebuild from journal recovers them",
+                    "{}: the table differs from its journal's replay ({} edits; unsaved edits before a crash?): Classification > Rebuild table from journal recovers them",
                     path.display(),
                     r.commits
                 )),
@@ -64,6 +65,7 @@ impl Workspace {
         self.table_path = path;
         self.history.clear();
         self.dirty = false;
+        self.saved_undo_len = Some(0);
         self.table_changed();
     }
 
@@ -80,6 +82,7 @@ impl Workspace {
         self.remember_table(path);
         self.remember_recent(path);
         self.dirty = false;
+        self.saved_undo_len = Some(self.history.undo_len());
         self.status = format!("saved {}", path.display());
         Ok(())
     }
@@ -110,6 +113,13 @@ impl Workspace {
             && let Err(e) = journal::append(&path, self.pipeline.lut(), &[])
         {
             self.warn(format!("{e:#}"));
+        }
+        if self
+            .saved_undo_len
+            .is_some_and(|saved| self.history.undo_len() < saved)
+        {
+            // The saved state was undone and is now replaced: no undo leads back to it.
+            self.saved_undo_len = None;
         }
         let changed = self.history.commit(self.pipeline.lut_mut(), record.clone());
         self.journal(&JournalEntry::Commit { record });
@@ -142,6 +152,7 @@ impl Workspace {
         self.table_generation += 1;
         self.table_counts = self.pipeline.lut().class_counts();
         self.try_edit = None;
+        self.params.try_run = None;
         self.reprocess();
     }
 
@@ -169,9 +180,30 @@ impl Workspace {
         }
         self.pipeline.set_lut(r.table);
         self.history = r.history;
+        self.saved_undo_len = None;
         self.dirty = true;
         self.table_changed();
         self.status = format!("rebuilt from the journal: {} edits replayed", r.commits);
+        Ok(())
+    }
+
+    /// See [`super::Command::DiscardUnsaved`]. Where undoing cannot reach the saved table (it
+    /// was undone and then replaced by new edits) the journal is left as it is.
+    pub(super) fn discard_unsaved(&mut self) -> anyhow::Result<()> {
+        if !self.dirty {
+            return Ok(());
+        }
+        let saved = self
+            .saved_undo_len
+            .context("the saved table cannot be reached by undoing: the journal keeps the edits")?;
+        while self.history.undo_len() > saved {
+            self.undo()?;
+        }
+        while self.history.undo_len() < saved && self.history.redo_len() > 0 {
+            self.redo()?;
+        }
+        self.dirty = false;
+        self.status = "unsaved edits dropped (they can be redone)".to_owned();
         Ok(())
     }
 
@@ -235,6 +267,25 @@ impl Workspace {
         Ok(())
     }
 
+    /// Pixels of the shown frame the pending selection selects, and of those the ones whose
+    /// class a commit would change (the others already have the class): the second is what
+    /// Try edit counts for this frame.
+    #[must_use]
+    pub fn selection_pixel_counts(&self) -> (usize, usize) {
+        let code = self.settings.class.code();
+        let codes = self.pipeline.result().classified.codes();
+        if codes.len() != self.preview_mask.len() {
+            return (0, 0);
+        }
+        self.preview_mask
+            .iter()
+            .zip(codes)
+            .filter(|(m, _)| **m)
+            .fold((0, 0), |(sel, chg), (_, &c)| {
+                (sel + 1, chg + usize::from(c != code))
+            })
+    }
+
     pub(super) fn sample_cell(&mut self, cell: [usize; 3]) -> anyhow::Result<()> {
         let lut = self.pipeline.lut();
         anyhow::ensure!(
@@ -266,6 +317,7 @@ pub struct TableSlot {
     pub(super) path: Option<PathBuf>,
     pub(super) history: crate::lut::EditHistory,
     pub(super) dirty: bool,
+    pub(super) saved_undo_len: Option<usize>,
 }
 
 impl TableSlot {
@@ -276,6 +328,7 @@ impl TableSlot {
             path: None,
             history: crate::lut::EditHistory::default(),
             dirty: false,
+            saved_undo_len: Some(0),
         }
     }
 
@@ -303,6 +356,7 @@ impl Workspace {
         std::mem::swap(&mut self.table_path, &mut o.path);
         std::mem::swap(&mut self.history, &mut o.history);
         std::mem::swap(&mut self.dirty, &mut o.dirty);
+        std::mem::swap(&mut self.saved_undo_len, &mut o.saved_undo_len);
         self.table_kind = kind;
         self.selection = None;
         self.table_changed();

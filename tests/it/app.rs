@@ -588,7 +588,12 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         .state
         .run(Command::ShowWindow(Window::Inspector, true));
     h.run();
-    let n = eotn::app::inspector::candidates(state(&h).recognition(), state(&h).places()).len();
+    let n = eotn::app::inspector::candidates(
+        state(&h).recognition(),
+        state(&h).places(),
+        state(&h).image_size(),
+    )
+    .len();
     assert!(n >= 2, "ball and goal candidates, got {n}");
     assert_eq!(
         h.query_all_by_label_contains("accepted ").count()
@@ -613,11 +618,15 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         "selected: thicker {circles:?}"
     );
     // Selecting another candidate dims the ball.
-    let goal = eotn::app::inspector::candidates(state(&h).recognition(), state(&h).places())
-        .into_iter()
-        .map(|c| c.owner)
-        .find(|o| *o != ball_owner)
-        .expect("another candidate in frame 0");
+    let goal = eotn::app::inspector::candidates(
+        state(&h).recognition(),
+        state(&h).places(),
+        state(&h).image_size(),
+    )
+    .into_iter()
+    .map(|c| c.owner)
+    .find(|o| *o != ball_owner)
+    .expect("another candidate in frame 0");
     h.state_mut()
         .state
         .run(Command::SelectObject(Some(goal.clone())));
@@ -672,7 +681,7 @@ fn nan_sensor_readings_of_a_side_file_show_as_warnings() {
         "{w}"
     );
     assert!(h.query_by_label_contains("this frame:").is_some());
-    assert!(h.query_by_label("1 warnings").is_some());
+    assert!(h.query_by_label("1 warning").is_some());
     // The next frame has no problems: the frame line goes, the list keeps the warning.
     h.key_press(Key::ArrowRight);
     h.run();

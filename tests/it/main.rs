@@ -6,6 +6,7 @@
 mod app;
 #[cfg(feature = "gui")]
 mod app_camera;
+mod app_daily;
 #[cfg(feature = "gui")]
 mod app_hints;
 #[cfg(feature = "gui")]

@@ -12,7 +12,8 @@ use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 use super::schema::{decode_image, parse_json_lenient};
 use super::{
     ANNOTATIONS_TOPIC, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME,
-    RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
+    PARAMS_METADATA_NAME, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
+    param_set_of_source,
 };
 use crate::sensors::SensorReadings;
 use chunk::decode_chunk_messages;
@@ -79,6 +80,8 @@ pub struct StreamReader {
     file: BufReader<File>,
     file_len: u64,
     info: StreamInfo,
+    /// The recognition parameter set the stream names (`eotn.recognition` metadata).
+    param_set: Option<String>,
     roles: HashMap<u16, Role>,
     chunks: Vec<ChunkLoc>,
     frames: Vec<FrameLoc>,
@@ -174,6 +177,7 @@ impl StreamReader {
             file: BufReader::with_capacity(64 << 10, file),
             file_len,
             info: StreamInfo::default(),
+            param_set: None,
             roles: HashMap::new(),
             chunks: Vec::new(),
             frames: Vec::new(),
@@ -237,6 +241,17 @@ impl StreamReader {
     #[must_use]
     pub fn info(&self) -> &StreamInfo {
         &self.info
+    }
+
+    /// The recognition parameter set the stream is meant for (`"spl2009"`): its
+    /// [`PARAMS_METADATA_NAME`] metadata record, else the set known for its source kind
+    /// ([`param_set_of_source`]: B-Human streams imported before the record existed); `None`
+    /// for the built-in defaults.
+    #[must_use]
+    pub fn param_set(&self) -> Option<&str> {
+        self.param_set
+            .as_deref()
+            .or_else(|| param_set_of_source(&self.info.source))
     }
 
     /// The file this reader reads.
@@ -524,7 +539,7 @@ impl StreamReader {
         table: &mut ChannelTable,
     ) -> Result<bool, StreamError> {
         for index in &summary.metadata_indexes {
-            if index.name != METADATA_NAME {
+            if index.name != METADATA_NAME && index.name != PARAMS_METADATA_NAME {
                 continue;
             }
             if index.length > MAX_INDEX_BYTES
@@ -634,6 +649,9 @@ impl StreamReader {
                     source: get("source"),
                     description: get("description"),
                 };
+            }
+            Ok(Record::Metadata(m)) if m.name == PARAMS_METADATA_NAME => {
+                self.param_set = m.metadata.get("params").filter(|s| !s.is_empty()).cloned();
             }
             Ok(Record::Metadata(_)) => {}
             _ => self.warn("a metadata record is malformed; ignored".to_owned()),

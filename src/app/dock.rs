@@ -1,0 +1,230 @@
+//! The dock: the enlarged image and, beside it, the windows of the Windows menu as tabs
+//! (`egui_tiles`: drag a tab to split, drag the gap to resize). Nothing covers the image, and
+//! every docked window scrolls, so at 1280×800 the whole of each can be reached.
+//!
+//! Generic over the windows: a window is a [`Window`] variant in [`Window::ALL`] plus a
+//! `fn …_ui(ui: &mut egui::Ui, …)` drawing its contents, called from [`DockBehavior::window_ui`].
+//! Windows open and close only through [`Command::ShowWindow`]: [`Dock::sync`] adds a tab for a
+//! window opened elsewhere (menu, shortcut, command) and removes one closed; closing a tab sends
+//! the command.
+
+use egui::Ui;
+use egui_tiles::{Container, SimplificationOptions, Tile, TileId, Tiles, Tree, UiResponse};
+
+use super::overlays::FrameTextures;
+use super::views::{self, MainViewOutput};
+use crate::workspace::{Command, Window, Workspace};
+
+/// Share of the width the image gets beside the docked windows (they get 1).
+const IMAGE_SHARE: f32 = 1.8;
+
+/// What a tile shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pane {
+    /// The enlarged view.
+    Image,
+    /// A window of the Windows menu.
+    Window(Window),
+}
+
+/// The layout of the image and the docked windows (kept while the app runs).
+pub struct Dock {
+    tree: Tree<Pane>,
+}
+
+impl Default for Dock {
+    fn default() -> Self {
+        let mut tiles = Tiles::default();
+        let image = tiles.insert_pane(Pane::Image);
+        let root = tiles.insert_horizontal_tile(vec![image]);
+        Self {
+            tree: Tree::new(egui::Id::unique("eotn-dock"), root, tiles),
+        }
+    }
+}
+
+impl std::fmt::Debug for Dock {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Dock")
+            .field("docked", &self.docked())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Dock {
+    /// The windows that have a tab, in tile order.
+    #[must_use]
+    pub fn docked(&self) -> Vec<Window> {
+        let mut out: Vec<Window> = self
+            .tree
+            .tiles
+            .tiles()
+            .filter_map(|t| match t {
+                Tile::Pane(Pane::Window(w)) => Some(*w),
+                _ => None,
+            })
+            .collect();
+        out.sort_by_key(|w| Window::ALL.iter().position(|a| a == w));
+        out
+    }
+
+    /// Gives every open window a tab and removes the tabs of closed ones.
+    pub fn sync(&mut self, state: &Workspace) {
+        for w in Window::ALL {
+            let tile = self.tree.tiles.find_pane(&Pane::Window(w));
+            match (state.window_open(w), tile) {
+                (true, None) => self.add(w),
+                (false, Some(id)) => {
+                    self.tree.remove_recursively(id);
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// A tab for `w` beside the other docked windows (a new column right of the image when
+    /// there are none), made the active one.
+    fn add(&mut self, w: Window) {
+        let pane = self.tree.tiles.insert_pane(Pane::Window(w));
+        let tiles = &self.tree.tiles;
+        let tabs = tiles.tile_ids().find(|id| match tiles.get(*id) {
+            Some(Tile::Container(Container::Tabs(t))) => t
+                .children
+                .iter()
+                .any(|c| matches!(tiles.get_pane(c), Some(Pane::Window(_)))),
+            _ => false,
+        });
+        if let Some(id) = tabs
+            && let Some(Tile::Container(Container::Tabs(t))) = self.tree.tiles.get_mut(id)
+        {
+            t.add_child(pane);
+            t.set_active(pane);
+            return;
+        }
+        let tabs = self.tree.tiles.insert_tab_tile(vec![pane]);
+        let root = self.tree.root;
+        if let Some(root) = root
+            && let Some(Tile::Container(Container::Linear(l))) = self.tree.tiles.get_mut(root)
+            && l.dir == egui_tiles::LinearDir::Horizontal
+        {
+            l.add_child(tabs);
+            for child in l.children.clone() {
+                let share = if child == tabs { 1.0 } else { IMAGE_SHARE };
+                l.shares.set_share(child, share);
+            }
+            return;
+        }
+        let mut children: Vec<TileId> = root.into_iter().collect();
+        children.push(tabs);
+        let mut linear = egui_tiles::Linear::new(egui_tiles::LinearDir::Horizontal, children);
+        if let Some(r) = root {
+            linear.shares.set_share(r, IMAGE_SHARE);
+        }
+        linear.shares.set_share(tabs, 1.0);
+        self.tree.root = Some(self.tree.tiles.insert_container(linear));
+    }
+
+    /// Draws the dock into `ui` (the central panel); returns what the image view reported.
+    pub fn ui(&mut self, ui: &mut Ui, behavior: &mut DockBehavior<'_>) -> MainViewOutput {
+        self.tree.ui(behavior, ui);
+        behavior.view
+    }
+}
+
+/// What the dock's panes draw from, for one frame.
+pub struct DockBehavior<'a> {
+    /// The workspace.
+    pub state: &'a Workspace,
+    /// The frame's textures.
+    pub tex: Option<&'a FrameTextures>,
+    /// The U–V plane's cached image.
+    pub uv_plane: &'a mut super::uv_plane::UvPlane,
+    /// The file names typed in the overhead calibration window.
+    pub overhead_paths: &'a mut super::calibration_window::OverheadPaths,
+    /// What the robots window is editing.
+    pub robots: &'a mut super::robots_panel::RobotsPanel,
+    /// Where the panes' commands go.
+    pub commands: &'a mut Vec<Command>,
+    /// A file dialog a pane asks for.
+    pub dialog: &'a mut Option<(super::file_dialog::FileAction, Option<String>)>,
+    /// What the image view reported.
+    pub view: MainViewOutput,
+}
+
+impl DockBehavior<'_> {
+    /// The contents of window `w`: one `…_ui` function per window (add a window here).
+    fn window_ui(&mut self, ui: &mut Ui, w: Window) {
+        let (state, commands) = (self.state, &mut *self.commands);
+        match w {
+            Window::Sensors => super::sensors_dialog::sensors_ui(ui, state),
+            Window::UvPlane => self.uv_plane.ui(ui, state, commands),
+            Window::TryEdit => super::classify_panel::try_edit_panel_ui(ui, state, commands),
+            Window::Inspector => super::inspector::inspector_ui(ui, state, commands),
+            Window::Parameters => {
+                super::params_panel::params_panel_ui(ui, state, commands, self.dialog);
+            }
+            Window::FieldView => super::field_view::field_view_ui(ui, state, commands),
+            Window::Calibration => {
+                super::calibration_window::calibration_ui(ui, state, self.overhead_paths, commands);
+            }
+            Window::Robots => super::robots_panel::robots_ui(ui, state, self.robots, commands),
+            Window::Coverage => super::coverage_panel::coverage_ui(ui, state, commands),
+            Window::Bookmarks => super::bookmarks_panel::bookmarks_ui(ui, state, commands),
+            Window::Connect | Window::SourceSettings | Window::Record => {
+                ui.weak("a Camera dialog");
+            }
+        }
+    }
+}
+
+impl egui_tiles::Behavior<Pane> for DockBehavior<'_> {
+    fn pane_ui(&mut self, ui: &mut Ui, _tile_id: TileId, pane: &mut Pane) -> UiResponse {
+        match *pane {
+            Pane::Image => {
+                self.view = views::main_view_ui(ui, self.state, self.tex, self.commands);
+            }
+            Pane::Window(w) => {
+                egui::Frame::new().inner_margin(6.0).show(ui, |ui| {
+                    egui::ScrollArea::both()
+                        .id_salt(("dock-scroll", w.name()))
+                        .auto_shrink([false, false])
+                        .show(ui, |ui| self.window_ui(ui, w));
+                });
+            }
+        }
+        UiResponse::None
+    }
+
+    fn tab_title_for_pane(&mut self, pane: &Pane) -> egui::WidgetText {
+        match pane {
+            Pane::Image => "Image".into(),
+            Pane::Window(w) => w.name().into(),
+        }
+    }
+
+    fn is_tab_closable(&self, tiles: &Tiles<Pane>, tile_id: TileId) -> bool {
+        matches!(tiles.get_pane(&tile_id), Some(Pane::Window(_)))
+    }
+
+    fn on_tab_close(&mut self, tiles: &mut Tiles<Pane>, tile_id: TileId) -> bool {
+        if let Some(Pane::Window(w)) = tiles.get_pane(&tile_id) {
+            self.commands.push(Command::ShowWindow(*w, false));
+        }
+        // The tab goes when the command has closed the window (`Dock::sync`).
+        false
+    }
+
+    fn simplification_options(&self) -> SimplificationOptions {
+        SimplificationOptions {
+            // A single docked window keeps its tab: its title and close button.
+            prune_single_child_tabs: false,
+            prune_single_child_containers: false,
+            all_panes_must_have_tabs: false,
+            ..SimplificationOptions::default()
+        }
+    }
+
+    fn min_size(&self) -> f32 {
+        120.0
+    }
+}

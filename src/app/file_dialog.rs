@@ -1,0 +1,145 @@
+//! File dialogs drawn by the app itself (`egui_file`), so File ▸ Open… and Save as… work
+//! everywhere: native dialogs need a desktop portal that bare X servers, Xvfb and many tiling
+//! desktops lack (they returned nothing, silently). File ▸ Open path… stays for typing a path.
+
+use std::path::{Path, PathBuf};
+
+use egui_file::{FileDialog, State};
+
+use crate::workspace::Command;
+
+/// What a dialog is for; it decides the title, the filter and the command sent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileAction {
+    /// A stream, frames or anything Open takes.
+    Open,
+    /// A lookup table.
+    OpenTable,
+    /// Recognition parameters.
+    OpenParams,
+    /// A places file.
+    OpenPlaces,
+    /// Save the table under a new name.
+    SaveTableAs,
+    /// Save the recognition parameters.
+    SaveParams,
+    /// Export the enlarged view as PNG.
+    ExportView,
+}
+
+impl FileAction {
+    /// The dialog's title.
+    #[must_use]
+    pub const fn title(self) -> &'static str {
+        match self {
+            Self::Open => "Open a stream, frames, a table or parameters",
+            Self::OpenTable => "Open a lookup table",
+            Self::OpenParams => "Open recognition parameters",
+            Self::OpenPlaces => "Open a places file",
+            Self::SaveTableAs => "Save the lookup table as",
+            Self::SaveParams => "Save the recognition parameters as",
+            Self::ExportView => "Export the view as PNG",
+        }
+    }
+
+    /// File name endings shown (folders always are); empty shows every file.
+    #[must_use]
+    pub const fn extensions(self) -> &'static [&'static str] {
+        match self {
+            Self::Open => &[],
+            Self::OpenTable | Self::SaveTableAs => &["lut", "cal", "raw", "tm", "col"],
+            Self::OpenParams | Self::OpenPlaces | Self::SaveParams => &["json"],
+            Self::ExportView => &["png"],
+        }
+    }
+
+    const fn saves(self) -> bool {
+        matches!(
+            self,
+            Self::SaveTableAs | Self::SaveParams | Self::ExportView
+        )
+    }
+
+    /// The command for the chosen path.
+    #[must_use]
+    pub fn command(self, path: PathBuf) -> Command {
+        match self {
+            Self::Open => Command::Open(vec![path]),
+            Self::OpenTable => Command::OpenTable(path),
+            Self::OpenParams => Command::OpenParams(path),
+            Self::OpenPlaces => Command::OpenPlaces(path),
+            Self::SaveTableAs => Command::SaveTableAs(path),
+            Self::SaveParams => Command::SaveParams(path),
+            Self::ExportView => Command::ExportView(path),
+        }
+    }
+}
+
+/// The dialog shown, if any.
+#[derive(Default)]
+pub struct FileDialogs {
+    shown: Option<(FileAction, FileDialog)>,
+}
+
+impl std::fmt::Debug for FileDialogs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FileDialogs")
+            .field("shown", &self.shown.as_ref().map(|(a, _)| *a))
+            .finish()
+    }
+}
+
+impl FileDialogs {
+    /// Which dialog is shown.
+    #[must_use]
+    pub fn shown(&self) -> Option<FileAction> {
+        self.shown.as_ref().map(|(a, _)| *a)
+    }
+
+    /// Opens the dialog for `action` in `folder` (the current folder when `None`), with
+    /// `file_name` filled in for a save.
+    pub fn open(&mut self, action: FileAction, folder: Option<&Path>, file_name: Option<String>) {
+        let mut d = if action.saves() {
+            FileDialog::save_file()
+        } else {
+            FileDialog::open_file()
+        };
+        d = d
+            .title(action.title())
+            .show_rename(false)
+            .show_new_folder(action.saves());
+        if let Some(f) = folder.filter(|f| f.is_dir()) {
+            d = d.initial_path(f);
+        }
+        if let Some(name) = file_name {
+            d = d.default_filename(name);
+        }
+        let exts = action.extensions();
+        if !exts.is_empty() {
+            d = d.show_files_filter(Box::new(move |p: &Path| {
+                p.extension()
+                    .and_then(|e| e.to_str())
+                    .is_some_and(|e| exts.iter().any(|x| x.eq_ignore_ascii_case(e)))
+            }));
+        }
+        d.open();
+        self.shown = Some((action, d));
+    }
+
+    /// Draws the shown dialog; a chosen file becomes its command.
+    pub fn show(&mut self, ctx: &egui::Context, commands: &mut Vec<Command>) {
+        let Some((action, dialog)) = self.shown.as_mut() else {
+            return;
+        };
+        match dialog.show(ctx).state() {
+            State::Open => {}
+            State::Selected => {
+                if let Some(p) = dialog.path() {
+                    commands.push(action.command(p.to_owned()));
+                }
+                self.shown = None;
+            }
+            State::Closed | State::Cancelled => self.shown = None,
+        }
+    }
+}
