@@ -1,9 +1,10 @@
 //! Robots over the network (Camera ▸ Connect to robot…): several connected at once, each on its
 //! own thread, each receiving — and recording, bit-exact, into a file of its own — whether it
 //! is shown or not. One robot is shown: its frames are the workspace's [`Source`] (the robot's
-//! [`RobotFrames`], a timeline that grows as frames arrive), so its sensor readings, recognition,
-//! stepping back and playback work as for a recording. Following live, the newest frame is shown
-//! as it arrives; stepping, seeking, playing or pausing holds the view while reception goes on.
+//! [`crate::live::RobotFrames`], a timeline that grows as frames arrive), so its sensor
+//! readings, recognition, stepping back and playback work as for a recording. Following live,
+//! the newest frame is shown as it arrives (its arrival wakes the UI); stepping, seeking, playing
+//! or pausing holds the view while reception and recording go on.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
