@@ -2,10 +2,10 @@
 //! warnings, the frames a try-edit changes) and the user's bookmarks with notes, as lists with
 //! next/previous jumps, and as marks on the timeline.
 
-use egui::{Color32, Context, Painter, Rect, Stroke, Ui, pos2};
+use egui::{Color32, Painter, Rect, Stroke, Ui, pos2};
 
 use crate::workspace::bookmarks::EventKind;
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::{Command, Workspace};
 
 /// Colour of the user's bookmarks on the timeline.
 const BOOKMARK_COLOUR: Color32 = Color32::from_rgb(80, 170, 255);

@@ -5,10 +5,10 @@
 
 use std::path::PathBuf;
 
-use egui::{Context, Ui};
+use egui::Ui;
 
 use crate::workspace::{
-    Command, OverheadCommand, OverheadView, Window, Workspace, overhead::MIN_CALIBRATION_POINTS,
+    Command, OverheadCommand, OverheadView, Workspace, overhead::MIN_CALIBRATION_POINTS,
 };
 
 /// The file names typed in the window.

@@ -3,11 +3,11 @@
 //! on the U–V plane. Clicking a hint selects its cells (the image previews its pixels; Commit
 //! classifies them) and shows its Y layer in the U–V plane.
 
-use egui::{Color32, Context, Painter, Rect, Stroke, Ui, pos2, vec2};
+use egui::{Color32, Painter, Rect, Stroke, Ui, pos2, vec2};
 
 use crate::frame::yuv_to_rgb;
 use crate::lut::Region;
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::{Command, Workspace};
 
 /// The range, the scan's progress and the hints.
 pub fn coverage_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {

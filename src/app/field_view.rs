@@ -4,12 +4,12 @@
 //! that overhead truth with the error of each, and a plot of the errors over the frames seen.
 //! Clicking a robot selects it in every view. It draws the workspace's field model only.
 
-use egui::{Color32, Context, FontId, Pos2, Rect, Sense, Stroke, Ui, vec2};
+use egui::{Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, vec2};
 use egui_plot::{Legend, Line, Plot, VLine};
 
 use super::overhead_overlays::team_colour;
 use crate::overhead::FieldDescription;
-use crate::workspace::{Command, OverheadCommand, RobotKey, Window, Workspace};
+use crate::workspace::{Command, OverheadCommand, RobotKey, Workspace};
 
 /// Margin round the field's lines, centimetres.
 const MARGIN_CM: f32 = 30.0;

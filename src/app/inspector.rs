@@ -8,6 +8,7 @@
 
 use egui::{Color32, RichText, Ui};
 
+use crate::frame::PixelBox;
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
 use crate::recognition::draw::owner;
@@ -167,8 +168,8 @@ fn pattern_candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<Ca
 
 /// The sides not seen, each saying why: at the image's edge ("cut off"), or inside the image
 /// with robot colours against it ("hidden"; a ball in the middle of the image is never cut off).
-fn sides(cut: CutOff, bounds: [u32; 4], image_size: (usize, usize)) -> Vec<&'static str> {
-    let [minx, miny, maxx, maxy] = bounds.map(|v| v as usize);
+fn sides(cut: CutOff, bounds: PixelBox, image_size: (usize, usize)) -> Vec<&'static str> {
+    let [minx, miny, maxx, maxy] = bounds.to_array().map(|v| v as usize);
     let (w, h) = image_size;
     [
         (cut.left, minx == 0, "left (image edge)", "left (hidden)"),
@@ -263,7 +264,7 @@ pub fn candidates(
             camera,
             body,
             distance_is_max: false,
-            cut_sides: sides(c.cut_off, c.bounds, image_size),
+            cut_sides: sides(c.cut_off, c.bounds.into(), image_size),
             notes,
             pattern: None,
         });

@@ -5,10 +5,10 @@
 
 use std::path::PathBuf;
 
-use egui::{Context, RichText, Ui};
+use egui::{RichText, Ui};
 
 use crate::live::Connection;
-use crate::workspace::{Command, RobotRow, Window, Workspace};
+use crate::workspace::{Command, RobotRow, Workspace};
 
 /// What the robots window is editing.
 #[derive(Debug)]

@@ -167,6 +167,29 @@ pub enum Command {
     /// Follow the shown robot's newest frame (true) or hold the view where it is (false);
     /// reception and recording go on either way.
     SetFollowLive(bool),
+    /// Count the colours the table leaves unclassified over frames `first..=last` (clamped to
+    /// the source), a few frames per UI frame: the coverage hints.
+    FindUnclassified {
+        /// First frame.
+        first: usize,
+        /// Last frame (inclusive).
+        last: usize,
+    },
+    /// Select these table cells (by index), as clicking a coverage hint: the preview, nothing
+    /// written until a Commit.
+    SelectCells(Vec<usize>),
+    /// Run the pipeline over the whole source for its events (ball found or lost, goal
+    /// appears, warnings), a few frames per UI frame.
+    FindEvents,
+    /// Bookmark the shown frame with a note (replacing one there), saved beside the stream.
+    AddBookmark(String),
+    /// Remove the bookmark at this frame.
+    RemoveBookmark(usize),
+    /// Go to the next (or previous) mark: an event or a bookmark.
+    JumpToMark {
+        /// Next when true, previous when false.
+        forward: bool,
+    },
     /// The overhead camera: calibration, picked points, robot selection, view options.
     Overhead(OverheadCommand),
 }
@@ -203,29 +226,6 @@ pub enum OverheadCommand {
     SelectRobot(Option<RobotKey>),
     /// Overhead view options.
     SetView(OverheadView),
-    /// Count the colours the table leaves unclassified over frames `first..=last` (clamped to
-    /// the source), a few frames per UI frame: the coverage hints.
-    FindUnclassified {
-        /// First frame.
-        first: usize,
-        /// Last frame (inclusive).
-        last: usize,
-    },
-    /// Select these table cells (by index), as clicking a coverage hint: the preview, nothing
-    /// written until a Commit.
-    SelectCells(Vec<usize>),
-    /// Run the pipeline over the whole source for its events (ball found or lost, goal
-    /// appears, warnings), a few frames per UI frame.
-    FindEvents,
-    /// Bookmark the shown frame with a note (replacing one there), saved beside the stream.
-    AddBookmark(String),
-    /// Remove the bookmark at this frame.
-    RemoveBookmark(usize),
-    /// Go to the next (or previous) mark: an event or a bookmark.
-    JumpToMark {
-        /// Next when true, previous when false.
-        forward: bool,
-    },
 }
 
 /// The app's extra windows.
