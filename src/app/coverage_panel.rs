@@ -124,7 +124,9 @@ pub fn uv_plane_marks(painter: &Painter, rect: Rect, state: &Workspace) {
                 (f32::from(h.mean.u >> shift) + 0.5) * cell,
             );
         let on_layer = h.mean.y >> shift == layer;
-        let colour = Color32::from_rgb(255, 230, 0);
+        // White on a black ring: visible over every class colour and the dark empty cells.
+        let colour = Color32::WHITE;
+        painter.circle_stroke(at, 6.0, Stroke::new(3.0, Color32::BLACK));
         if on_layer {
             painter.circle_filled(at, 5.0, colour);
         } else {
