@@ -3,7 +3,7 @@
 //! every docked window scrolls, so at 1280×800 the whole of each can be reached.
 //!
 //! Generic over the windows: a window is a [`Window`] variant in [`Window::ALL`] plus a
-//! `fn …_ui(ui: &mut egui::Ui, …)` drawing its contents, called from [`DockBehavior::window_ui`].
+//! `fn …_ui(ui: &mut egui::Ui, …)` drawing its contents, called from `DockBehavior::window_ui`.
 //! Windows open and close only through [`Command::ShowWindow`]: [`Dock::sync`] adds a tab for a
 //! window opened elsewhere (menu, shortcut, command) and removes one closed; closing a tab sends
 //! the command.

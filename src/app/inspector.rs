@@ -4,7 +4,7 @@
 //! flags. Selecting a candidate highlights its overlays in every view and dims the others.
 //!
 //! [`candidates`] turns a [`Recognition`] into plain rows (tested without a window);
-//! [`inspector_window`] draws them.
+//! [`inspector_ui`] draws them (docked beside the image, `dock.rs`).
 
 use egui::{Color32, RichText, Ui};
 

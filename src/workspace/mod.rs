@@ -283,22 +283,14 @@ impl Workspace {
             Command::OpenTable(p) => self.open_table(&p)?,
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),
-            Command::OpenParams(p) => self.open_params(&p)?,
-            Command::UseOfferedParams => {
-                let p = self
-                    .params
-                    .offer
-                    .as_ref()
-                    .and_then(|o| o.path.clone())
-                    .context("the stream names no parameter set that was found")?;
-                self.open_params(&p)?;
-            }
-            Command::DefaultParams => self.default_params(),
-            Command::SetParamValue { pointer, value } => self.set_param_value(&pointer, value)?,
-            Command::ResetParamValue(pointer) => self.reset_param_value(&pointer)?,
-            Command::ResetParams => self.reset_params(),
-            Command::SaveParams(p) => self.save_params(&p)?,
-            Command::TryParamsOnStream => self.try_params_on_stream()?,
+            c @ (Command::OpenParams(_)
+            | Command::UseOfferedParams
+            | Command::DefaultParams
+            | Command::SetParamValue { .. }
+            | Command::ResetParamValue(_)
+            | Command::ResetParams
+            | Command::SaveParams(_)
+            | Command::TryParamsOnStream) => self.apply_params(c)?,
             Command::NewTable(bits) => self.new_table(bits)?,
             Command::SaveTable => {
                 let path = self

@@ -271,6 +271,31 @@ impl Workspace {
         self.params.loaded != *self.recognition_params()
     }
 
+    /// Applies the parameter commands (the rest of [`Workspace::apply`]).
+    pub(super) fn apply_params(&mut self, command: super::Command) -> anyhow::Result<()> {
+        use super::Command as C;
+        match command {
+            C::OpenParams(p) => self.open_params(&p)?,
+            C::UseOfferedParams => {
+                let p = self
+                    .params
+                    .offer
+                    .as_ref()
+                    .and_then(|o| o.path.clone())
+                    .context("the stream names no parameter set that was found")?;
+                self.open_params(&p)?;
+            }
+            C::DefaultParams => self.default_params(),
+            C::SetParamValue { pointer, value } => self.set_param_value(&pointer, value)?,
+            C::ResetParamValue(pointer) => self.reset_param_value(&pointer)?,
+            C::ResetParams => self.reset_params(),
+            C::SaveParams(p) => self.save_params(&p)?,
+            C::TryParamsOnStream => self.try_params_on_stream()?,
+            _ => anyhow::bail!("not a parameter command"),
+        }
+        Ok(())
+    }
+
     pub(super) fn open_params(&mut self, path: &Path) -> anyhow::Result<()> {
         let p = params_file::load(path)?;
         self.set_recognition_params(p);

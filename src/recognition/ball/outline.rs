@@ -203,55 +203,21 @@ fn cut_off(
     );
     let rows = |x: i64| (miny..=maxy).map(|y| (x, y)).collect::<Vec<_>>();
     let columns = |y: i64| (minx..=maxx).map(|x| (x, y)).collect::<Vec<_>>();
-    // Robot colours half the ball's size further out too (or beyond the image there): a thin
-    // white field line along the ball does not hide it, a robot does. Without this a ball in
-    // the middle of the sample stream's frame 3, just under a line, read "cut off: top".
-    let still_bordered = |samples: &[(i64, i64)]| {
-        let inside = samples
-            .iter()
-            .filter(|&&(x, y)| img.get_signed(x, y).is_some())
-            .count();
-        inside < 3 || bordered(samples)
-    };
-    let (depth_x, depth_y) = ((maxx - minx + 1) / 2, (maxy - miny + 1) / 2);
     // `own`: the box's own first or last line; `outside`: the line just beyond it (none at the
-    // image border); `far`: the line half the ball's size beyond it.
-    let side =
-        |at_border: bool, own: Vec<(i64, i64)>, outside: Vec<(i64, i64)>, far: Vec<(i64, i64)>| {
-            if at_border {
-                chord(&own, border_share)
-            } else {
-                let small = (own.len() as f64) < 2.0 * hidden_min_radius_px;
-                bordered(&outside)
-                    && still_bordered(&far)
-                    && chord(&own, if small { 0.0 } else { hidden_share })
-            }
-        };
+    // image border).
+    let side = |at_border: bool, own: Vec<(i64, i64)>, outside: Vec<(i64, i64)>| {
+        if at_border {
+            chord(&own, border_share)
+        } else {
+            let small = (own.len() as f64) < 2.0 * hidden_min_radius_px;
+            bordered(&outside) && chord(&own, if small { 0.0 } else { hidden_share })
+        }
+    };
     CutOff {
-        left: side(
-            b.minx == 0,
-            rows(minx),
-            rows(minx - 1),
-            rows(minx - 1 - depth_x),
-        ),
-        right: side(
-            b.maxx + 1 >= w,
-            rows(maxx),
-            rows(maxx + 1),
-            rows(maxx + 1 + depth_x),
-        ),
-        top: side(
-            b.miny == 0,
-            columns(miny),
-            columns(miny - 1),
-            columns(miny - 1 - depth_y),
-        ),
-        bottom: side(
-            b.maxy + 1 >= h,
-            columns(maxy),
-            columns(maxy + 1),
-            columns(maxy + 1 + depth_y),
-        ),
+        left: side(b.minx == 0, rows(minx), rows(minx - 1)),
+        right: side(b.maxx + 1 >= w, rows(maxx), rows(maxx + 1)),
+        top: side(b.miny == 0, columns(miny), columns(miny - 1)),
+        bottom: side(b.maxy + 1 >= h, columns(maxy), columns(maxy + 1)),
     }
 }
 
