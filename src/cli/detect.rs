@@ -439,6 +439,15 @@ pub fn readings_for<'a>(
 /// Unreadable or malformed inputs, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let (lut, mut inputs) = args.input.open()?;
+    if let Some(p) = inputs.overhead_streams().first() {
+        anyhow::bail!(
+            "{}: an overhead camera's stream (it looks down at the field); `eotn detect` runs the \
+             robot camera's recogniser: use `eotn overhead detect {} --lut TABLE --calibration \
+             CAL.json`",
+            p.display(),
+            p.display()
+        );
+    }
 
     let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
     let params = PipelineParams {

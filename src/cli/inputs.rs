@@ -144,6 +144,9 @@ pub struct FrameInputs {
     items: Vec<FrameInput>,
     stream: Option<StreamSource>,
     skipped: SkippedFrames,
+    /// The streams among the inputs whose camera looks down at the field (their source kind
+    /// says so): the robot camera's recogniser means nothing on them.
+    overhead_streams: Vec<PathBuf>,
 }
 
 /// Runs of consecutive stream frames skipped as unreadable, warned about once per run (when the
@@ -192,9 +195,15 @@ impl FrameInputs {
     /// without frames (each naming the file).
     pub fn open(paths: &[PathBuf], range: Option<Range<usize>>) -> anyhow::Result<Self> {
         let mut items = Vec::new();
+        let mut overhead_streams = Vec::new();
         for p in expand_frame_paths(paths)? {
             if is_stream_file(&p) {
                 let stream = StreamSource::open(&p)?;
+                if crate::sources::FrameSource::info(&stream).camera
+                    == crate::sources::CameraKind::Overhead
+                {
+                    overhead_streams.push(p.clone());
+                }
                 for w in stream.warnings() {
                     log::warn!("{}: {w}", p.display());
                 }
@@ -221,7 +230,14 @@ impl FrameInputs {
             items,
             stream: None,
             skipped: SkippedFrames::default(),
+            overhead_streams,
         })
+    }
+
+    /// The streams among the inputs recorded by an overhead camera.
+    #[must_use]
+    pub fn overhead_streams(&self) -> &[PathBuf] {
+        &self.overhead_streams
     }
 
     /// Number of frames.

@@ -150,7 +150,6 @@ fn detect_on_the_bundled_simulated_streams_is_unchanged() {
         "fast-pans",
         "orange-clutter",
         "beacon-tour",
-        "overhead-game",
     ] {
         let lines = detect_lines(
             &format!("streams/sim-{scenario}.mcap"),
@@ -159,6 +158,25 @@ fn detect_on_the_bundled_simulated_streams_is_unchanged() {
         );
         insta::assert_snapshot!(format!("detect_sim_{scenario}"), summary(&lines));
     }
+}
+
+#[test]
+fn detect_refuses_an_overhead_stream_and_names_the_overhead_command() {
+    // The robot camera's recogniser on a top-down image reads the robots' marker dots as
+    // beacons and the ball as 6 m away; the overhead stream has its own (tests/it/overhead.rs).
+    let stream = repo_file("streams/sim-overhead-game.mcap");
+    let lut = repo_file("lookup_tables/sim.lut");
+    let out = crate::common::eotn(&[
+        std::ffi::OsStr::new("detect"),
+        stream.as_os_str(),
+        std::ffi::OsStr::new("--lut"),
+        lut.as_os_str(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("overhead camera's stream"), "{err}");
+    assert!(err.contains("eotn overhead detect"), "{err}");
+    assert!(out.stdout.is_empty(), "no detections printed");
 }
 
 #[test]
