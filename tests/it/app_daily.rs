@@ -641,3 +641,21 @@ fn sample_frame_3_ball_in_the_middle_is_not_called_cut_off() {
     );
     assert!(!ball_row.cut_sides.is_empty());
 }
+
+#[test]
+fn file_open_table_shows_the_in_app_dialog() {
+    use eotn::app::file_dialog::FileAction;
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut h = harness(vec![frames[0].clone(), table]);
+    h.run();
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Open table…").click();
+    h.run();
+    assert_eq!(h.state().file_dialogs.shown(), Some(FileAction::OpenTable));
+    assert!(h.query_by_label_contains("Cancel").is_some());
+    h.get_by_label("Cancel").click();
+    h.run();
+    assert_eq!(h.state().file_dialogs.shown(), None);
+}
