@@ -19,6 +19,9 @@ impl Workspace {
         anyhow::ensure!(!paths.is_empty(), "nothing to open");
         let mut frames = Vec::new();
         let mut streams = Vec::new();
+        // Tables open after the source: each camera kind has its own table, so a table given
+        // beside an overhead stream belongs in the overhead slot, whatever the order.
+        let mut tables = Vec::new();
         let mut failures = Vec::new();
         for p in paths {
             let ext = p
@@ -35,7 +38,8 @@ impl Workspace {
                 frames.push(p);
                 Ok(())
             } else {
-                self.open_table(&p)
+                tables.push(p);
+                Ok(())
             };
             if let Err(e) = opened {
                 failures.push(format!("{e:#}"));
@@ -71,6 +75,11 @@ impl Workspace {
                     }
                 }
                 Err(e) => failures.push(format!("{e:#}")),
+            }
+        }
+        for t in tables {
+            if let Err(e) = self.open_table(&t) {
+                failures.push(format!("{e:#}"));
             }
         }
         match failures.len() {
@@ -252,5 +261,35 @@ impl Workspace {
             let r = src.read_uncached(i).ok().and_then(|f| f.sensors);
             self.sensor_series.points.push((t, r));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use super::super::{Command, Workspace};
+    use crate::sources::CameraKind;
+
+    fn repo(relative: &str) -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
+    }
+
+    #[test]
+    fn a_table_given_before_an_overhead_stream_goes_into_the_overhead_slot() {
+        let mut w = Workspace::default();
+        let table = repo("lookup_tables/sim.lut");
+        w.apply(Command::Open(vec![
+            table.clone(),
+            repo("streams/sim-overhead-game.mcap"),
+        ]))
+        .unwrap();
+        assert_eq!(w.camera_kind(), CameraKind::Overhead);
+        assert_eq!(w.table_path(), Some(table.as_path()));
+        let counts = w.lut().class_counts();
+        assert!(
+            counts[1..].iter().sum::<usize>() > 0,
+            "the overhead view classifies with the table given"
+        );
     }
 }
