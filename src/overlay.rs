@@ -135,7 +135,56 @@ impl Canvas {
         self.line((x0, y1 - e), (x0, y0), c);
     }
 
-    /// Draws every primitive (labels are left to the app, which has fonts).
+    /// A label anchored at `at` (source-image pixels): its text in an 8×8 bitmap font on a dark
+    /// backing just above the anchor, as the app draws it, moved the least distance that keeps
+    /// it inside the picture (a ball at the top or bottom edge still shows its distance).
+    /// Characters the font lacks are drawn as `?`.
+    pub fn label(&mut self, at: (f64, f64), text: &str, c: [u8; 3]) {
+        use font8x8::UnicodeFonts as _;
+        const GLYPH: i64 = 8;
+        const PAD: i64 = 2;
+        if !(at.0.is_finite() && at.1.is_finite()) || text.is_empty() {
+            return;
+        }
+        let glyphs: Vec<[u8; 8]> = text
+            .chars()
+            .take(64)
+            .map(|ch| {
+                font8x8::BASIC_FONTS
+                    .get(ch)
+                    .or_else(|| font8x8::LATIN_FONTS.get(ch))
+                    .or_else(|| font8x8::BASIC_FONTS.get('?'))
+                    .unwrap_or([0; 8])
+            })
+            .collect();
+        let (w, h) = (self.width as i64, self.height as i64);
+        let box_w = glyphs.len() as i64 * GLYPH + 2 * PAD;
+        let box_h = GLYPH + 2 * PAD;
+        let s = self.scale as f64;
+        let (ax, ay) = ((at.0 * s).floor() as i64, (at.1 * s).floor() as i64);
+        let x0 = ax.min(w - box_w).max(0);
+        let y0 = (ay - box_h - 2).min(h - box_h).max(0);
+        for y in y0..(y0 + box_h).min(h) {
+            for x in x0..(x0 + box_w).min(w) {
+                let i = (y as usize * self.width + x as usize) * 3;
+                for v in &mut self.rgb[i..i + 3] {
+                    *v /= 4;
+                }
+            }
+        }
+        for (k, rows) in glyphs.iter().enumerate() {
+            let gx = x0 + PAD + k as i64 * GLYPH;
+            for (row, bits) in rows.iter().enumerate() {
+                for col in 0..8 {
+                    if bits & (1 << col) != 0 {
+                        self.put(gx + col, y0 + PAD + row as i64, c);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Draws every primitive, labels in a bitmap font.
     pub fn draw(&mut self, primitives: &[Primitive]) {
         for p in primitives {
             match p {
@@ -185,7 +234,7 @@ impl Canvas {
                         self.line((a.0, b.1), a, c);
                     }
                 }
-                Primitive::Label { .. } => {}
+                Primitive::Label { at, text, .. } => self.label(*at, text, primitive_rgb(p)),
             }
         }
     }
@@ -235,6 +284,60 @@ pub fn pattern_region_rgb(code: u8) -> [u8; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn label(at: (f64, f64), text: &str) -> Primitive {
+        Primitive::Label {
+            owner: "ball#0".into(),
+            at,
+            text: text.into(),
+        }
+    }
+
+    /// The bounding box of the label's white text pixels, output pixels.
+    fn white_text(c: &Canvas) -> Option<[usize; 4]> {
+        let mut b: Option<[usize; 4]> = None;
+        for (i, p) in c.rgb.chunks(3).enumerate() {
+            if p == [255, 255, 255] {
+                let (x, y) = (i % c.width, i / c.width);
+                b = Some(b.map_or([x, y, x, y], |[a, b_, c_, d]| {
+                    [a.min(x), b_.min(y), c_.max(x), d.max(y)]
+                }));
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn a_label_is_drawn_above_its_anchor_on_a_dark_backing() {
+        let grey = vec![200u8; 100 * 60 * 3];
+        let mut c = Canvas::from_rgb(100, 60, &grey, 1).expect("canvas");
+        c.draw(&[label((20.0, 40.0), "ball 123 cm")]);
+        let [x0, y0, x1, y1] = white_text(&c).expect("text drawn");
+        assert!(x0 >= 20 && x1 < 20 + 11 * 8 + 4, "{x0}..{x1}");
+        assert!(y1 < 40 && y0 > 40 - 16, "above the anchor: {y0}..{y1}");
+        assert_eq!(
+            &c.rgb[(38 * 100 + 95) * 3..(38 * 100 + 95) * 3 + 3],
+            &[200; 3]
+        );
+        assert!(
+            c.rgb.chunks(3).any(|p| p == [50, 50, 50]),
+            "the backing darkens the image"
+        );
+    }
+
+    #[test]
+    fn a_label_at_an_edge_is_kept_inside_the_picture() {
+        for at in [(95.0, 2.0), (-30.0, 59.0), (f64::MAX, f64::MAX)] {
+            let mut c = Canvas::from_rgb(100, 60, &[0u8; 100 * 60 * 3], 1).expect("canvas");
+            c.draw(&[label(at, "goal 452 cm")]);
+            let [x0, y0, x1, y1] = white_text(&c).expect("text drawn");
+            assert!(x1 - x0 > 60, "whole text visible at {at:?}: {x0}..{x1}");
+            assert!(y1 - y0 >= 5 && y1 < 60, "{at:?}: {y0}..{y1}");
+        }
+        let mut c = Canvas::from_rgb(10, 10, &[0u8; 300], 1).expect("canvas");
+        c.draw(&[label((f64::NAN, 1.0), "x"), label((1.0, 1.0), "")]);
+        assert!(white_text(&c).is_none(), "nothing drawn for NaN or no text");
+    }
 
     #[test]
     fn draws_boxes_lines_and_circles_inside_the_canvas_only() {

@@ -22,6 +22,7 @@ impl Workspace {
         // Tables open after the source: each camera kind has its own table, so a table given
         // beside an overhead stream belongs in the overhead slot, whatever the order.
         let mut tables = Vec::new();
+        let mut offer = None;
         let mut failures = Vec::new();
         for p in paths {
             let ext = p
@@ -58,7 +59,7 @@ impl Workspace {
                 Ok(source) => {
                     self.remember_recent(&s);
                     match self.set_source(source) {
-                        Ok(()) => self.offer_param_set(&s),
+                        Ok(()) => offer = Some(s),
                         Err(e) => failures.push(format!("{e:#}")),
                     }
                 }
@@ -81,6 +82,10 @@ impl Workspace {
             if let Err(e) = self.open_table(&t) {
                 failures.push(format!("{e:#}"));
             }
+        }
+        // Last, so the status line ends with the stream's parameter set on offer.
+        if let Some(s) = offer {
+            self.offer_param_set(&s);
         }
         match failures.len() {
             0 => Ok(()),
