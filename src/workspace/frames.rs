@@ -16,6 +16,7 @@ impl Workspace {
         anyhow::ensure!(!paths.is_empty(), "nothing to open");
         let mut frames = Vec::new();
         let mut stream = None;
+        let mut tables = Vec::new();
         for p in paths {
             let ext = p
                 .extension()
@@ -28,9 +29,29 @@ impl Workspace {
             } else if crate::sources::is_frame_file(&p) || p.is_dir() {
                 frames.push(p);
             } else {
-                self.open_table(&p)?;
+                tables.push(p);
             }
         }
+        // Tables after the source: a table named with an overhead stream is the overhead
+        // camera's, which is only in use once that stream is open.
+        let opens_source = stream.is_some() || !frames.is_empty();
+        self.open_source_of(stream, frames)?;
+        let source_status = self.status.clone();
+        for t in tables {
+            self.open_table(&t)?;
+        }
+        if opens_source {
+            // What was opened is said by the source's line (frames, calibration in use).
+            self.status = source_status;
+        }
+        Ok(())
+    }
+
+    fn open_source_of(
+        &mut self,
+        stream: Option<PathBuf>,
+        frames: Vec<PathBuf>,
+    ) -> anyhow::Result<()> {
         if let Some(s) = stream {
             let source = Source::stream(&s)?;
             self.remember_recent(&s);
