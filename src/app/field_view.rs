@@ -95,7 +95,7 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
     let plot_height = if models.is_empty() { 0.0 } else { 200.0 };
     let size = vec2(
         ui.available_width(),
-        (ui.available_height() - plot_height).max(220.0),
+        (ui.available_height() - plot_height).clamp(220.0, 360.0),
     );
     let (rect, response) = ui.allocate_exact_size(size, Sense::click());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "field drawing"));

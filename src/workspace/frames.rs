@@ -78,10 +78,16 @@ impl Workspace {
                 Err(e) => failures.push(format!("{e:#}")),
             }
         }
+        let opened_source = offer.is_some() || !frames.is_empty();
+        let source_status = self.status.clone();
         for t in tables {
             if let Err(e) = self.open_table(&t) {
                 failures.push(format!("{e:#}"));
             }
+        }
+        if opened_source {
+            // What was opened is said by the source's line (frames, calibration in use).
+            self.status = source_status;
         }
         // Last, so the status line ends with the stream's parameter set on offer.
         if let Some(s) = offer {

@@ -58,6 +58,15 @@ impl std::fmt::Display for RobotKey {
     }
 }
 
+/// The undistorted view's pixel map and the camera and frame size it was made for.
+#[derive(Debug, Clone)]
+struct ViewMap {
+    camera: OverheadCamera,
+    size: (usize, usize),
+    /// Per view pixel, the camera pixel it shows (`undistort::source_pixel_map`).
+    map: Vec<Option<u32>>,
+}
+
 /// Where the camera in use comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CalibrationSource {
@@ -92,8 +101,8 @@ pub struct Overhead {
     landmark: Option<String>,
     selected: Option<RobotKey>,
     synced_table: Option<u64>,
-    /// The undistorted view's pixel map and the camera and size it was made for.
-    view_map: Option<(OverheadCamera, (usize, usize), Vec<Option<u32>>)>,
+    /// The undistorted view's pixel map, when that view is shown.
+    view_map: Option<ViewMap>,
     empty_recognition: Recognition,
     /// The field view's model: trails, world models, errors over time.
     pub field_model: FieldModel,
@@ -550,10 +559,14 @@ impl Workspace {
                     .overhead
                     .view_map
                     .as_ref()
-                    .is_some_and(|(mc, ms, _)| *mc == c && *ms == size);
+                    .is_some_and(|m| m.camera == c && m.size == size);
                 if !fresh {
                     let map = crate::overhead::undistort::source_pixel_map(&c, size.0, size.1);
-                    self.overhead.view_map = Some((c, size, map));
+                    self.overhead.view_map = Some(ViewMap {
+                        camera: c,
+                        size,
+                        map,
+                    });
                 }
             }
             _ => self.overhead.view_map = None,
@@ -569,7 +582,7 @@ impl Workspace {
     /// The shown frame as packed RGB as the views show it (undistorted when chosen).
     #[must_use]
     pub fn view_rgb(&self) -> std::borrow::Cow<'_, [u8]> {
-        let Some((_, _, map)) = &self.overhead.view_map else {
+        let Some(ViewMap { map, .. }) = &self.overhead.view_map else {
             return std::borrow::Cow::Borrowed(self.rgb());
         };
         let rgb = self.rgb();
@@ -586,7 +599,7 @@ impl Workspace {
     #[must_use]
     pub fn view_codes(&self) -> std::borrow::Cow<'_, [u8]> {
         let codes = self.classified().codes();
-        let Some((_, _, map)) = &self.overhead.view_map else {
+        let Some(ViewMap { map, .. }) = &self.overhead.view_map else {
             return std::borrow::Cow::Borrowed(codes);
         };
         std::borrow::Cow::Owned(
@@ -601,7 +614,7 @@ impl Workspace {
     #[must_use]
     pub fn camera_point_of_view(&self, p: ImagePoint) -> ImagePoint {
         match &self.overhead.view_map {
-            Some((c, size, _)) => crate::overhead::undistort::distorted_point(p, c, *size),
+            Some(m) => crate::overhead::undistort::distorted_point(p, &m.camera, m.size),
             None => p,
         }
     }
@@ -626,7 +639,7 @@ impl Workspace {
     #[must_use]
     pub fn overhead_view_point(&self, p: ImagePoint) -> Option<ImagePoint> {
         match &self.overhead.view_map {
-            Some((c, size, _)) => crate::overhead::undistort::undistorted_point(p, c, *size),
+            Some(m) => crate::overhead::undistort::undistorted_point(p, &m.camera, m.size),
             None => Some(p),
         }
     }

@@ -126,6 +126,24 @@ fn an_overhead_stream_runs_the_overhead_recogniser_with_the_streams_own_camera()
 }
 
 #[test]
+fn a_table_opened_with_an_overhead_stream_is_the_overhead_cameras() {
+    let (stream, table) = fixture();
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![table.clone(), stream.clone()]))
+        .unwrap();
+    assert_eq!(w.table_kind(), CameraKind::Overhead);
+    assert_eq!(w.table_path(), Some(table.as_path()));
+    assert!(
+        w.other_table().path().is_none(),
+        "the robot table is untouched"
+    );
+    assert!(
+        w.overhead_detections()
+            .is_some_and(|d| !d.robots.is_empty())
+    );
+}
+
+#[test]
 fn a_robot_stream_keeps_the_robot_recogniser() {
     let mut w = Workspace::default();
     w.apply(Command::Open(vec![repo_file(
