@@ -115,6 +115,9 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     h.state_mut()
         .state
         .run(Command::SetClass(ColourClass::Orange));
+    // The class panel scrolls: bring its Commit button into view first, as a user would.
+    h.get_by_label("Commit").scroll_to_me();
+    h.run();
     h.get_by_label("Commit").click();
     h.run();
     assert_eq!(state(&h).lut().class_of(ORANGE), ColourClass::Orange);
