@@ -654,14 +654,16 @@ impl EotnApp {
         }
         ui.horizontal(|ui| {
             views::pixel_readout_ui(ui, self.hovered.as_ref());
-            // Why this pixel has its class: the edit that last set its cell.
+            // Why this pixel has its class: the edit that last set its cell. A text mark, not
+            // `ui.separator()`: a separator is a styled widget, and one appearing (the pointer
+            // entering the image, a live frame under a still pointer) makes egui repaint twice
+            // more to style it.
             if let Some(o) = self
                 .hovered
                 .as_ref()
                 .and_then(|h| self.state.pixel_origin(h.x, h.y))
             {
-                ui.separator();
-                ui.monospace(o.to_string());
+                ui.monospace(format!("| {o}"));
             }
         });
     }
