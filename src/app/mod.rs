@@ -654,10 +654,8 @@ impl EotnApp {
         }
         ui.horizontal(|ui| {
             views::pixel_readout_ui(ui, self.hovered.as_ref());
-            // Why this pixel has its class: the edit that last set its cell. A text mark, not
-            // `ui.separator()`: a separator is a styled widget, and one appearing (the pointer
-            // entering the image, a live frame under a still pointer) makes egui repaint twice
-            // more to style it.
+            // Why this pixel has its class: the edit that last set its cell. A "|", not a
+            // separator: a styled widget appearing costs egui two more repaints.
             if let Some(o) = self
                 .hovered
                 .as_ref()
