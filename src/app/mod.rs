@@ -654,14 +654,14 @@ impl EotnApp {
         }
         ui.horizontal(|ui| {
             views::pixel_readout_ui(ui, self.hovered.as_ref());
-            // Why this pixel has its class: the edit that last set its cell.
+            // Why this pixel has its class: the edit that last set its cell. A "|", not a
+            // separator: a styled widget appearing costs egui two more repaints.
             if let Some(o) = self
                 .hovered
                 .as_ref()
                 .and_then(|h| self.state.pixel_origin(h.x, h.y))
             {
-                ui.separator();
-                ui.monospace(o.to_string());
+                ui.monospace(format!("| {o}"));
             }
         });
     }

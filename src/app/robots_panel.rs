@@ -28,14 +28,16 @@ impl Default for RobotsPanel {
     }
 }
 
-/// The window's contents: the address field, the robots list, recording into a folder.
+/// The window's contents: the address field, recording into a folder, the robots list. The
+/// fields come first and wrap, so in a narrow dock tab their buttons stay in view (the list,
+/// wider, scrolls: laid out after it, they would take its width and be cut off).
 pub fn robots_ui(
     ui: &mut Ui,
     state: &Workspace,
     panel: &mut RobotsPanel,
     commands: &mut Vec<Command>,
 ) {
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         let label = ui.label("address");
         ui.add(
             egui::TextEdit::singleline(&mut panel.address)
@@ -50,6 +52,22 @@ pub fn robots_ui(
             .clicked()
         {
             commands.push(Command::ConnectRobot(address.to_owned()));
+        }
+    });
+    ui.horizontal_wrapped(|ui| {
+        let label = ui.label("record into folder");
+        ui.add(egui::TextEdit::singleline(&mut panel.folder).desired_width(220.0))
+            .labelled_by(label.id);
+        let folder = panel.folder.trim();
+        if ui
+            .add_enabled(
+                !folder.is_empty() && !state.robots().is_empty(),
+                egui::Button::new("Record all"),
+            )
+            .on_hover_text("every robot not recording yet, one file each, bit-exact")
+            .clicked()
+        {
+            commands.push(Command::RecordAllRobots(PathBuf::from(folder)));
         }
     });
     ui.separator();
@@ -72,19 +90,6 @@ pub fn robots_ui(
             }
         });
     ui.separator();
-    ui.horizontal(|ui| {
-        let label = ui.label("record into folder");
-        ui.add(egui::TextEdit::singleline(&mut panel.folder).desired_width(220.0))
-            .labelled_by(label.id);
-        let folder = panel.folder.trim();
-        if ui
-            .add_enabled(!folder.is_empty(), egui::Button::new("Record all"))
-            .on_hover_text("every robot not recording yet, one file each, bit-exact")
-            .clicked()
-        {
-            commands.push(Command::RecordAllRobots(PathBuf::from(folder)));
-        }
-    });
     live_controls_ui(ui, state, commands);
 }
 

@@ -160,6 +160,12 @@ fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows
             .all(|r| r.stats.recorded.is_some_and(|n| n >= 2))
     });
     for _ in 0..2 {
+        // The list is wider than its dock tab: bring the button into view, as a user scrolls.
+        h.get_all_by_label("Disconnect")
+            .next()
+            .unwrap()
+            .scroll_to_me();
+        h.run_steps(4);
         h.get_all_by_label("Disconnect").next().unwrap().click();
         h.run_steps(4);
     }
