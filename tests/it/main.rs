@@ -6,6 +6,7 @@
 mod app;
 #[cfg(feature = "gui")]
 mod app_camera;
+#[cfg(feature = "gui")]
 mod app_daily;
 #[cfg(feature = "gui")]
 mod app_hints;
