@@ -48,7 +48,8 @@ fn path_row(
     buttons: &[(&str, bool)],
 ) -> Option<usize> {
     let mut clicked = None;
-    ui.horizontal(|ui| {
+    // Wrapped: the docked window may be narrower than a row.
+    ui.horizontal_wrapped(|ui| {
         let name = ui.label(label);
         ui.add(
             egui::TextEdit::singleline(text)
@@ -151,7 +152,8 @@ fn picking_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let overhead = state.overhead();
     let picked = |n: &str| overhead.points().points.iter().any(|p| p.name == n);
     let chosen = overhead.landmark().map(str::to_owned);
-    ui.horizontal(|ui| {
+    // Wrapped: in the narrow dock column Undo pick and Calibrate go below the landmark.
+    ui.horizontal_wrapped(|ui| {
         egui::ComboBox::from_label("pick landmark")
             .selected_text(chosen.clone().unwrap_or_else(|| "(not picking)".to_owned()))
             .width(200.0)

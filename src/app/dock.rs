@@ -1,6 +1,8 @@
-//! The dock: the enlarged image and, beside it, the windows of the Windows menu as tabs
-//! (`egui_tiles`: drag a tab to split, drag the gap to resize). Nothing covers the image, and
-//! every docked window scrolls, so at 1280×800 the whole of each can be reached.
+//! The dock: the enlarged image and, beside it, the windows of the Windows menu in a column
+//! (`egui_tiles`: drag a tab to split or move, drag the gap to resize). Windows opened are
+//! stacked top to bottom so they are seen together, up to [`MAX_STACKED`]; more become tabs of
+//! the bottom group. Nothing covers the image, and every docked window scrolls, so at 1280×800
+//! the whole of each can be reached.
 //!
 //! Generic over the windows: a window is a [`Window`] variant in [`Window::ALL`] plus a
 //! `fn …_ui(ui: &mut egui::Ui, …)` drawing its contents, called from `DockBehavior::window_ui`.
@@ -17,6 +19,10 @@ use crate::workspace::{Command, Window, Workspace};
 
 /// Share of the width the image gets beside the docked windows (they get 1).
 const IMAGE_SHARE: f32 = 1.8;
+
+/// How many groups of docked windows are stacked in the column beside the image before more
+/// windows become tabs of the last group.
+pub const MAX_STACKED: usize = 3;
 
 /// What a tile shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -68,6 +74,22 @@ impl Dock {
         out
     }
 
+    /// The docked windows whose contents are drawn (the active tab of each group), in
+    /// [`Window::ALL`] order.
+    #[must_use]
+    pub fn shown(&self) -> Vec<Window> {
+        let active = self.tree.active_tiles();
+        let mut out: Vec<Window> = active
+            .iter()
+            .filter_map(|id| match self.tree.tiles.get_pane(id) {
+                Some(Pane::Window(w)) => Some(*w),
+                _ => None,
+            })
+            .collect();
+        out.sort_by_key(|w| Window::ALL.iter().position(|a| a == w));
+        out
+    }
+
     /// Gives every open window a tab and removes the tabs of closed ones.
     pub fn sync(&mut self, state: &Workspace) {
         for w in Window::ALL {
@@ -82,19 +104,35 @@ impl Dock {
         }
     }
 
-    /// A tab for `w` beside the other docked windows (a new column right of the image when
-    /// there are none), made the active one.
+    /// Docks `w` right of the image: below the windows already docked, in a column of at
+    /// most [`MAX_STACKED`] groups so that windows opened together are seen together (the field
+    /// view and the inspector highlight the same robot); beyond that, as the active tab of the
+    /// column's last group. The first window makes the column.
     fn add(&mut self, w: Window) {
         let pane = self.tree.tiles.insert_pane(Pane::Window(w));
-        let tiles = &self.tree.tiles;
-        let tabs = tiles.tile_ids().find(|id| match tiles.get(*id) {
-            Some(Tile::Container(Container::Tabs(t))) => t
-                .children
-                .iter()
-                .any(|c| matches!(tiles.get_pane(c), Some(Pane::Window(_)))),
-            _ => false,
-        });
-        if let Some(id) = tabs
+        if let Some(column) = self.window_column() {
+            let last_tabs = match self.tree.tiles.get(column) {
+                Some(Tile::Container(Container::Linear(l))) if l.children.len() >= MAX_STACKED => {
+                    l.children.last().copied()
+                }
+                _ => None,
+            };
+            if let Some(id) = last_tabs
+                && let Some(Tile::Container(Container::Tabs(t))) = self.tree.tiles.get_mut(id)
+            {
+                t.add_child(pane);
+                t.set_active(pane);
+                return;
+            }
+            let tabs = self.tree.tiles.insert_tab_tile(vec![pane]);
+            if let Some(Tile::Container(Container::Linear(l))) = self.tree.tiles.get_mut(column) {
+                l.add_child(tabs);
+                return;
+            }
+        }
+        // No column (none docked yet, or the user dragged the windows elsewhere): a group that
+        // already holds windows takes the tab, else a new column right of the image.
+        if let Some(id) = self.window_tabs()
             && let Some(Tile::Container(Container::Tabs(t))) = self.tree.tiles.get_mut(id)
         {
             t.add_child(pane);
@@ -102,25 +140,68 @@ impl Dock {
             return;
         }
         let tabs = self.tree.tiles.insert_tab_tile(vec![pane]);
+        let column = self.tree.tiles.insert_vertical_tile(vec![tabs]);
+        self.add_beside_image(column);
+    }
+
+    /// Whether tile `id` is a tab group holding a docked window.
+    fn holds_windows(&self, id: TileId) -> bool {
+        let tiles = &self.tree.tiles;
+        match tiles.get(id) {
+            Some(Tile::Container(Container::Tabs(t))) => t
+                .children
+                .iter()
+                .any(|c| matches!(tiles.get_pane(c), Some(Pane::Window(_)))),
+            _ => false,
+        }
+    }
+
+    /// The vertical column of tab groups the docked windows are stacked in.
+    fn window_column(&self) -> Option<TileId> {
+        let tiles = &self.tree.tiles;
+        tiles.tile_ids().find(|id| match tiles.get(*id) {
+            Some(Tile::Container(Container::Linear(l))) => {
+                l.dir == egui_tiles::LinearDir::Vertical
+                    && l.children.iter().all(|c| {
+                        tiles
+                            .get(*c)
+                            .is_some_and(|t| matches!(t, Tile::Container(Container::Tabs(_))))
+                    })
+                    && l.children.iter().any(|c| self.holds_windows(*c))
+            }
+            _ => false,
+        })
+    }
+
+    /// A tab group holding docked windows, wherever it is.
+    fn window_tabs(&self) -> Option<TileId> {
+        self.tree
+            .tiles
+            .tile_ids()
+            .find(|id| self.holds_windows(*id))
+    }
+
+    /// Puts `column` right of the image, the image keeping [`IMAGE_SHARE`] of the width.
+    fn add_beside_image(&mut self, column: TileId) {
         let root = self.tree.root;
         if let Some(root) = root
             && let Some(Tile::Container(Container::Linear(l))) = self.tree.tiles.get_mut(root)
             && l.dir == egui_tiles::LinearDir::Horizontal
         {
-            l.add_child(tabs);
+            l.add_child(column);
             for child in l.children.clone() {
-                let share = if child == tabs { 1.0 } else { IMAGE_SHARE };
+                let share = if child == column { 1.0 } else { IMAGE_SHARE };
                 l.shares.set_share(child, share);
             }
             return;
         }
         let mut children: Vec<TileId> = root.into_iter().collect();
-        children.push(tabs);
+        children.push(column);
         let mut linear = egui_tiles::Linear::new(egui_tiles::LinearDir::Horizontal, children);
         if let Some(r) = root {
             linear.shares.set_share(r, IMAGE_SHARE);
         }
-        linear.shares.set_share(tabs, 1.0);
+        linear.shares.set_share(column, 1.0);
         self.tree.root = Some(self.tree.tiles.insert_container(linear));
     }
 

@@ -15,7 +15,7 @@
 //! | `bookmarks_panel.rs` | the pipeline's events and the user's bookmarks; timeline marks |
 //! | `robots_panel.rs` | Camera ▸ Connect to robot…: the robots list, the Live switch |
 //! | `params_panel.rs` | the recognition parameters: tune each value, reset, save, try on the stream |
-//! | `dock.rs` | the image and the windows docked beside it as tabs (`egui_tiles`) |
+//! | `dock.rs` | the image and the windows docked beside it, stacked, then as tabs (`egui_tiles`) |
 //! | `file_dialog.rs` | in-app file dialogs (`egui_file`): no desktop portal needed |
 //! | `menus.rs` | File, Classification, View, Stream, Camera, Windows, Help |
 //! | `camera_menu.rs` | the Camera menu and its dialogs: connect, settings, grab, record |

@@ -429,6 +429,37 @@ fn ws<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
 }
 
 #[test]
+fn windows_opened_one_after_another_are_stacked_and_seen_together() {
+    let (stream, table, params) = bhuman();
+    let mut h = harness(vec![stream, table, params]);
+    h.run_steps(2);
+    let stacked = [Window::Sensors, Window::UvPlane, Window::Inspector];
+    for w in stacked {
+        h.state_mut().state.run(Command::ShowWindow(w, true));
+        // Steps, not run: the stream's recognition may still be repainting.
+        h.run_steps(2);
+    }
+    assert_eq!(h.state().dock.shown(), stacked.to_vec());
+    // A fourth becomes the active tab of the bottom group: the first two stay in view.
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Parameters, true));
+    h.run_steps(2);
+    assert_eq!(h.state().dock.docked().len(), 4);
+    assert_eq!(
+        h.state().dock.shown(),
+        vec![Window::Sensors, Window::UvPlane, Window::Parameters]
+    );
+    // Closing it shows the window behind its tab again.
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Parameters, false));
+    h.run_steps(2);
+    h.run_steps(2);
+    assert_eq!(h.state().dock.shown(), stacked.to_vec());
+}
+
+#[test]
 fn windows_dock_beside_the_image_and_the_parameters_window_works() {
     let (stream, table, params) = bhuman();
     let mut h = harness(vec![stream, table, params]);
@@ -447,7 +478,8 @@ fn windows_dock_beside_the_image_and_the_parameters_window_works() {
         view.width() < full.width() - 200.0,
         "the image makes room: {full:?} -> {view:?}"
     );
-    // The docked tab is the Parameters window, active as the last opened.
+    // The three are stacked in the column, all drawn; Parameters is the bottom one.
+    assert_eq!(h.state().dock.shown(), h.state().dock.docked());
     assert!(
         h.query_by_label_contains("Parameters: spl2009.json")
             .is_some()

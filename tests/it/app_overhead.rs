@@ -455,7 +455,7 @@ fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
             .image();
         assert!(got.distance_to(p) < 1.5, "{name}: {got:?} vs {p:?}");
     }
-    // The window opens over the image's right side, where some landmarks are.
+    // The window docks beside the image; its buttons fit the column (no sideways scrolling).
     h.state_mut()
         .state
         .run(Command::ShowWindow(Window::Calibration, true));
@@ -466,7 +466,13 @@ fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
         h.state().state.overhead().points().points.len(),
         clicks.len() - 1
     );
-    h.get_by_label("Calibrate").click();
+    let calibrate = h.get_by_label("Calibrate");
+    assert!(
+        calibrate.rect().max.x <= 1200.0,
+        "Calibrate is on screen: {:?}",
+        calibrate.rect()
+    );
+    calibrate.click();
     h.run();
     h.run();
     let cal = h
