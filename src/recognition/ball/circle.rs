@@ -225,6 +225,38 @@ fn circle_holds_blob(f: &CircleFit, b: &Blob, cut: CutOff, shift: Point) -> bool
         && (!cut.bottom || f.center_y + f.radius >= maxy - reach)
 }
 
+/// The hidden sides the fitted circle confirms: a side bordered by robot colours (not the image
+/// border) stays hidden only when the circle reaches more than `min_overhang_px` beyond the
+/// blob's box there. A round side that merely lies against a white field line or a robot is
+/// whole: the circle fitted to the other sides ends at the box (sample stream, frame 3: a ball
+/// under a field line read "cut off: top" with the circle's top 0.4 px inside its box).
+/// `shift` moves the box as the skew removal moved its centre.
+#[must_use]
+pub fn confirmed_cut(
+    f: &CircleFit,
+    b: &Blob,
+    cut: CutOff,
+    shift: Point,
+    image_size: (u32, u32),
+    min_overhang_px: f64,
+) -> CutOff {
+    let (minx, miny) = (f64::from(b.minx) + shift.0, f64::from(b.miny) + shift.1);
+    let (maxx, maxy) = (
+        f64::from(b.maxx + 1) + shift.0,
+        f64::from(b.maxy + 1) + shift.1,
+    );
+    let (w, h) = image_size;
+    let keep = |hidden: bool, at_border: bool, overhang: f64| {
+        hidden && (at_border || overhang > min_overhang_px)
+    };
+    CutOff {
+        left: keep(cut.left, b.minx == 0, minx - (f.center_x - f.radius)),
+        right: keep(cut.right, b.maxx + 1 >= w, f.center_x + f.radius - maxx),
+        top: keep(cut.top, b.miny == 0, miny - (f.center_y - f.radius)),
+        bottom: keep(cut.bottom, b.maxy + 1 >= h, f.center_y + f.radius - maxy),
+    }
+}
+
 /// Whether a moving-circle fit may replace the plain circle: both shears determined, and a
 /// radius within a quarter of the plain fit's (a wild fit on noisy points is not a ball).
 fn ellipse_usable(e: &ShearedCircleFit, plain: Option<&CircleFit>, params: &BallParams) -> bool {

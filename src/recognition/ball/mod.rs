@@ -116,6 +116,10 @@ pub struct BallParams {
     /// side's share (1/√r ≥ 0.29) cannot be told from a slightly hidden one's, and holes in a
     /// small ball's classified rim shorten the chord, so every bordered side counts as hidden.
     pub hidden_chord_min_radius_px: f64,
+    /// A hidden side stays hidden after the circle fit only when the circle reaches more than
+    /// this beyond the blob there, pixels (else the ball is whole on that side: it lies against
+    /// a white line or a robot without being covered).
+    pub hidden_min_overhang_px: f64,
     /// Outline points farther than this many residual SDs from the first circle are dropped
     /// and the circle refitted (see [`super::fit::fit_circle_trimmed`]).
     pub fit_trim_sd: f64,
@@ -226,6 +230,7 @@ impl Default for BallParams {
             border_cut_min_share: 0.25,
             hidden_min_chord_share: 0.35,
             hidden_chord_min_radius_px: 20.0,
+            hidden_min_overhang_px: 1.5,
             fit_trim_sd: 2.5,
             fit_trim_min_px: 1.0,
             fit_trim_max_share: 0.2,
@@ -363,8 +368,18 @@ pub fn recognise_ball(
 ) -> BallResult {
     let mut result = BallResult::default();
     for (group, orange_pixels) in outline::candidate_groups(blobs, params) {
-        let outline = outline::Outline::scan(img, &group, ctx, params);
+        let mut outline = outline::Outline::scan(img, &group, ctx, params);
         let circle = circle::CircleStage::fit(&outline, &group, ctx, params);
+        if let Some(fit) = circle.fit.as_ref().filter(|_| circle.used()) {
+            outline.cut = circle::confirmed_cut(
+                fit,
+                &group,
+                outline.cut,
+                outline.box_shift,
+                (img.width() as u32, img.height() as u32),
+                params.hidden_min_overhang_px,
+            );
+        }
         let (center, radius) = circle.center_and_radius(&outline, ctx, params);
         let distance = distance::ball_distance(ctx, &outline, &circle, center, radius, params);
         let camera = ctx.camera_relative(center, distance);

@@ -300,6 +300,7 @@ fn a_large_ball_on_a_white_line_is_round_not_hidden() {
     // ball, which is not what this part is about.)
     let old = BallParams {
         hidden_min_chord_share: 0.0,
+        hidden_min_overhang_px: f64::NEG_INFINITY,
         field_below_without_pose_weight: TestWeight::new(0.0, 0.0),
         ..BallParams::default()
     };
@@ -309,6 +310,43 @@ fn a_large_ball_on_a_white_line_is_round_not_hidden() {
     let blobs = BlobSet::from_image(&img, Connectivity::Eight);
     let res = recognise_ball(&img, &blobs, &ctx, &old);
     assert!(res.ball.expect("ball").cut_off.any());
+}
+
+#[test]
+fn a_small_ball_under_a_field_line_is_whole_but_one_under_a_leg_is_hidden() {
+    let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+        320,
+        240,
+        45.0_f64.to_radians(),
+    ));
+    // A 12-px ball whose top touches a white field line running behind it (the sample
+    // stream's frame 3): the line borders the top, but the ball is round there.
+    let (cx, cy, r) = (160.0, 120.0, 12.0);
+    let img = big_scene(cx, cy, r, |_, y| (cy - r - 4.0..cy - r + 1.0).contains(&y));
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let ball = res.ball.expect("ball");
+    assert!(!ball.cut_off.any(), "{:?}", ball.cut_off);
+    // The same ball with a white leg over its top third: the circle fitted to the rest reaches
+    // four pixels beyond the blob, the top is hidden.
+    let img = big_scene(cx, cy, r, |_, _| false);
+    let mut codes = img.codes().to_vec();
+    for (i, c) in codes.iter_mut().enumerate() {
+        let (x, y) = ((i % 320) as f64 + 0.5, (i / 320) as f64 + 0.5);
+        if y < cy - r + 4.0 && (x - cx).abs() < 30.0 && y > cy - 40.0 {
+            *c = ColourClass::White.code();
+        }
+    }
+    let img = ClassifiedImage::from_codes(320, 240, codes).expect("size");
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let ball = res.ball.expect("ball");
+    assert!(
+        ball.cut_off.top && !ball.cut_off.bottom && !ball.cut_off.left && !ball.cut_off.right,
+        "{:?}",
+        ball.cut_off
+    );
+    assert!((ball.radius_px - r).abs() < 1.5, "{}", ball.radius_px);
 }
 
 #[test]
