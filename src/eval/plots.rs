@@ -126,7 +126,7 @@ impl Chart {
         c.text_scaled(
             title,
             (WIDTH as f64 - title_width) / 2.0,
-            14.0,
+            10.0,
             title_scale,
             BLACK,
         );

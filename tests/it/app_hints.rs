@@ -4,19 +4,21 @@
 //! bookmarks on the timeline).
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
-use egui::{Event, Key, Modifiers, Pos2, Vec2};
-use egui_kittest::Harness;
+use egui::{Event, Key, Modifiers};
 use egui_kittest::kittest::Queryable as _;
-use eotn::app::EotnApp;
 use eotn::frame::{Frame, Yuv};
 use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
 use eotn::workspace::bookmarks::{EventKind, bookmarks_path};
 use eotn::workspace::cell_origin::CellOrigin;
 use eotn::workspace::{Command, Window, Workspace};
 
-const GREEN: Yuv = Yuv::new(100, 110, 100);
-const ORANGE: Yuv = Yuv::new(120, 80, 190);
+use crate::harness::{GREEN, ORANGE, harness, pixel_pos, run_until, workspace};
+
+/// How long a background scan may take.
+const WITHIN: Duration = Duration::from_secs(60);
+
 const PINK: Yuv = Yuv::new(170, 150, 200);
 
 /// 208×160 green; an orange 20×20 ball on frames 1 and 2 (not 0); a pink 10×10 patch on all.
@@ -56,34 +58,6 @@ fn fixture(dir: &Path) -> Vec<PathBuf> {
     paths
 }
 
-fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
-    Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
-}
-
-fn state<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
-    &h.state().state
-}
-
-fn pixel_pos(h: &Harness<'_, EotnApp>, x: usize, y: usize) -> Pos2 {
-    h.state()
-        .last_view
-        .expect("the view was drawn")
-        .pixel_centre(x, y)
-}
-
-/// Runs UI frames until `done` (at most 200).
-fn run_until(h: &mut Harness<'_, EotnApp>, done: impl Fn(&Workspace) -> bool) {
-    for _ in 0..200 {
-        if done(state(h)) {
-            return;
-        }
-        h.run();
-    }
-    panic!("a scan did not finish");
-}
-
 #[test]
 fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit() {
     let dir = tempfile::tempdir().unwrap();
@@ -95,22 +69,24 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     h.run();
     h.get_by_label("Find unclassified").click();
     h.run();
-    run_until(&mut h, |s| s.coverage().is_some_and(|c| c.done()));
+    run_until(&mut h, WITHIN, |a| {
+        a.state.coverage().is_some_and(|c| c.done())
+    });
     h.run();
-    let scan = state(&h).coverage().unwrap();
+    let scan = workspace(&h).coverage().unwrap();
     // Orange: 2 frames × 400 pixels; pink: 3 × 100. Green is classified.
     let pixels: Vec<u64> = scan.hints().iter().map(|x| x.pixels).collect();
     assert_eq!(pixels, vec![800, 300], "{:?}", scan.hints());
     assert_eq!(scan.unclassified_pixels(), 1100);
     let orange_cells = scan.hints()[0].cells.clone();
-    assert_eq!(orange_cells, vec![state(&h).lut().index(ORANGE)]);
+    assert_eq!(orange_cells, vec![workspace(&h).lut().index(ORANGE)]);
 
     // Clicking the first hint selects its cells and previews its pixels in the image.
     h.state_mut().state.run(Command::Seek(1));
     h.run();
     h.get_by_label("hint 1").click();
     h.run();
-    let previewed = state(&h).preview_mask().iter().filter(|&&m| m).count();
+    let previewed = workspace(&h).preview_mask().iter().filter(|&&m| m).count();
     assert_eq!(previewed, 400, "the ball's pixels are previewed");
     h.state_mut()
         .state
@@ -120,10 +96,10 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     h.run();
     h.get_by_label("Commit").click();
     h.run();
-    assert_eq!(state(&h).lut().class_of(ORANGE), ColourClass::Orange);
+    assert_eq!(workspace(&h).lut().class_of(ORANGE), ColourClass::Orange);
     // The hints re-rank at once: orange is classified now, pink is left.
     h.run();
-    let pixels: Vec<u64> = state(&h)
+    let pixels: Vec<u64> = workspace(&h)
         .coverage()
         .unwrap()
         .hints()
@@ -133,7 +109,7 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     assert_eq!(pixels, vec![300]);
 
     // Why is the ball orange? The hint's edit. Why is a pink pixel unclassified? As loaded.
-    let origin = state(&h).pixel_origin(75, 45).unwrap();
+    let origin = workspace(&h).pixel_origin(75, 45).unwrap();
     let CellOrigin::Edit(e) = origin else {
         panic!("the commit set the ball's cell: {origin:?}");
     };
@@ -141,7 +117,10 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
         (e.number, e.class, e.picked_cells),
         (1, ColourClass::Orange, Some(1))
     );
-    assert_eq!(state(&h).pixel_origin(155, 105), Some(CellOrigin::AsLoaded));
+    assert_eq!(
+        workspace(&h).pixel_origin(155, 105),
+        Some(CellOrigin::AsLoaded)
+    );
     // A sampled commit records its frame and pixel, shown when hovering.
     h.state_mut().state.run(Command::Sample { x: 155, y: 105 });
     h.state_mut()
@@ -195,12 +174,14 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     h.run();
     h.key_press_modifiers(Modifiers::COMMAND, Key::ArrowRight);
     h.run();
-    assert_eq!(state(&h).index(), 2);
+    assert_eq!(workspace(&h).index(), 2);
 
     h.get_by_label("Find events").click();
     h.run();
-    run_until(&mut h, |s| s.event_scan().is_some_and(|e| e.done()));
-    let kinds: Vec<(usize, EventKind)> = state(&h)
+    run_until(&mut h, WITHIN, |a| {
+        a.state.event_scan().is_some_and(|e| e.done())
+    });
+    let kinds: Vec<(usize, EventKind)> = workspace(&h)
         .events()
         .iter()
         .map(|e| (e.frame, e.kind))
@@ -216,23 +197,23 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     h.run();
     h.get_by_label("Next mark").click();
     h.run();
-    assert_eq!(state(&h).index(), 1);
+    assert_eq!(workspace(&h).index(), 1);
     h.get_by_label("Next mark").click();
     h.run();
-    assert_eq!(state(&h).index(), 2);
+    assert_eq!(workspace(&h).index(), 2);
     h.get_by_label("Previous mark").click();
     h.run();
-    assert_eq!(state(&h).index(), 1);
+    assert_eq!(workspace(&h).index(), 1);
 
     // Reopening finds the bookmark; removing it saves the file again.
     drop(h);
     let mut h = harness(paths);
     h.run();
-    assert_eq!(state(&h).bookmarks().len(), 1);
-    assert_eq!(state(&h).bookmarks()[0].note, "ball near the line");
+    assert_eq!(workspace(&h).bookmarks().len(), 1);
+    assert_eq!(workspace(&h).bookmarks()[0].note, "ball near the line");
     h.state_mut().state.run(Command::RemoveBookmark(2));
     h.run();
-    assert!(state(&h).bookmarks().is_empty());
+    assert!(workspace(&h).bookmarks().is_empty());
     assert!(!std::fs::read_to_string(&file).unwrap().contains("line"));
     // A damaged bookmarks file is a warning, not a failure to open.
     std::fs::write(&file, "not json").unwrap();
