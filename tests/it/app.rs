@@ -11,9 +11,10 @@ use eotn::lut::{ColourClass, Sensitivity};
 use eotn::workspace::journal;
 use eotn::workspace::{Command, ViewKind, Window, Workspace};
 
-use crate::common::{repo_file, write_stream};
+use crate::common::repo_file;
 use crate::harness::{
-    ORANGE, click_at, close_window, fixture, harness, pixel_pos, scene, snapshot_harness, workspace,
+    ORANGE, click_at, close_window, fixture, harness, pixel_pos, scene, snapshot_harness,
+    workspace, write_stream,
 };
 
 #[test]

@@ -21,8 +21,8 @@ use eotn::workspace::{
     CalibrationSource, Command, OverheadCommand, RobotKey, ViewKind, Window, Workspace,
 };
 
-use crate::common::{repo_file, sim_stream, write_stream};
-use crate::harness::{click_at, harness_with};
+use crate::common::{repo_file, sim_stream};
+use crate::harness::{click_at, harness_with, write_stream};
 
 /// An overhead-game stream of 4 frames rendered once for every test (markers, truth, world
 /// models), and a table learnt from its own labels.

@@ -146,22 +146,3 @@ pub fn sim_stream(dir: &Path, scenario: &str, frames: usize, seed: Option<u64>) 
     eotn_ok(&args);
     out
 }
-
-/// Writes `records` into a new stream at `path` recorded from `source` (`"robot"`,
-/// `"sim:pattern-tour"`, …, which tells the camera kind); returns the path.
-pub fn write_stream(
-    path: &Path,
-    source: &str,
-    records: impl IntoIterator<Item = eotn::streams::FrameRecord>,
-) -> PathBuf {
-    let info = eotn::streams::StreamInfo {
-        source: source.to_owned(),
-        description: "test stream".to_owned(),
-    };
-    let mut w = eotn::streams::StreamWriter::create(path, &info).unwrap();
-    for r in records {
-        w.write(&r).unwrap();
-    }
-    w.finish().unwrap();
-    path.to_owned()
-}

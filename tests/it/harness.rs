@@ -1,7 +1,7 @@
 //! Helpers shared by the app tests (egui_kittest drives the real app through the same
 //! `Workspace`/`Command` path as the window): one way to build the harness, read its workspace,
-//! find and click a pixel of the enlarged view, run frames until something holds; and the small
-//! synthetic field the table tests classify.
+//! find and click a pixel of the enlarged view, close the window, run frames until something
+//! holds; the small synthetic field the table tests classify, and streams written from records.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -162,4 +162,23 @@ fn wait_until(
         step(h);
         std::thread::sleep(Duration::from_millis(10));
     }
+}
+
+/// Writes `records` into a new stream at `path` recorded from `source` (`"robot"`,
+/// `"sim:pattern-tour"`, …, which tells the camera kind); returns the path.
+pub fn write_stream(
+    path: &Path,
+    source: &str,
+    records: impl IntoIterator<Item = eotn::streams::FrameRecord>,
+) -> PathBuf {
+    let info = eotn::streams::StreamInfo {
+        source: source.to_owned(),
+        description: "test stream".to_owned(),
+    };
+    let mut w = eotn::streams::StreamWriter::create(path, &info).unwrap();
+    for r in records {
+        w.write(&r).unwrap();
+    }
+    w.finish().unwrap();
+    path.to_owned()
 }
