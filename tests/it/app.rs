@@ -13,8 +13,8 @@ use eotn::workspace::{Command, ViewKind, Window, Workspace};
 
 use crate::common::repo_file;
 use crate::harness::{
-    ORANGE, click_at, close_window, fixture, harness, pixel_pos, scene, snapshot_harness,
-    workspace, write_stream,
+    ORANGE, click_at, close_window, fixture, fixture_files, harness, opened_fixture, pixel_pos,
+    scene, show_window, snapshot_harness, workspace, write_stream,
 };
 
 #[test]
@@ -246,11 +246,7 @@ fn bad_files_are_reported_not_fatal() {
 #[test]
 fn try_edit_lists_the_frames_that_would_change() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut s = Workspace::default();
-    let mut paths = frames;
-    paths.push(table);
-    s.apply(Command::Open(paths)).unwrap();
+    let mut s = opened_fixture(dir.path());
     // Selecting green as white would change every frame's field.
     s.apply(Command::SetClass(ColourClass::White)).unwrap();
     s.apply(Command::Sample { x: 150, y: 120 }).unwrap();
@@ -273,9 +269,7 @@ fn try_edit_lists_the_frames_that_would_change() {
 #[test]
 fn every_window_and_menu_opens() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut paths = frames;
-    paths.push(table);
+    let paths = fixture_files(dir.path());
     let mut h = harness(paths);
     h.run();
     for w in Window::ALL {
@@ -329,11 +323,7 @@ fn closing_with_unsaved_changes_asks_first() {
 #[test]
 fn snapshot_with_overlays() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut s = Workspace::default();
-    let mut paths = frames;
-    paths.push(table);
-    s.apply(Command::Open(paths)).unwrap();
+    let mut s = opened_fixture(dir.path());
     let mut o = s.settings.overlays;
     o.classified = true;
     o.opacity = 0.6;
@@ -393,10 +383,7 @@ fn stream_steps_plays_and_plots_sensors() {
     }
     assert!(workspace(&h).source().unwrap().cached() <= eotn::workspace::source::CACHE_FRAMES);
     // The sensor dialog reads the whole series in the background.
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Sensors, true));
-    h.run();
+    show_window(&mut h, Window::Sensors);
     let st = &mut h.state_mut().state;
     for _ in 0..100 {
         st.tick(std::time::Duration::from_millis(16));
@@ -499,10 +486,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
 
     // The inspector lists every candidate; selecting the ball shows its breakdown and
     // highlights its overlays.
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Inspector, true));
-    h.run();
+    show_window(&mut h, Window::Inspector);
     let n = eotn::app::inspector::candidates(
         workspace(&h).recognition(),
         workspace(&h).places(),
@@ -762,10 +746,7 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     h.run();
     assert_eq!(workspace(&h).places_path(), Some(places.as_path()));
     h.state_mut().state.run(Command::Seek(index));
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Inspector, true));
-    h.run();
+    show_window(&mut h, Window::Inspector);
     let s = workspace(&h);
     let (k, c) = s
         .recognition()

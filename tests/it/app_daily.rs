@@ -18,7 +18,10 @@ use eotn::workspace::params::{JsonKind, json_kind};
 use eotn::workspace::{Command, Window, Workspace};
 
 use crate::common::repo_file;
-use crate::harness::{GREEN, close_window, fixture, harness_sized, workspace};
+use crate::harness::{
+    GREEN, close_window, fixture, fixture_files, harness_sized, opened_fixture, show_window,
+    workspace,
+};
 
 /// The app in a 1280 × 800 window (the docked windows need the width).
 fn wide_harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
@@ -310,11 +313,7 @@ fn each_file_opens_or_fails_on_its_own() {
 #[test]
 fn selection_and_try_edit_count_the_same_pixels() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut s = Workspace::default();
-    let mut paths = frames;
-    paths.push(table);
-    s.apply(Command::Open(paths)).unwrap();
+    let mut s = opened_fixture(dir.path());
     // Green over the ball with a reach that takes in every colour of the frame: the field is
     // selected too, but it is green already.
     s.apply(Command::SetClass(ColourClass::Green)).unwrap();
@@ -464,15 +463,10 @@ fn windows_dock_beside_the_image_and_the_parameters_window_works() {
 #[test]
 fn try_edit_window_says_what_to_do_before_a_run_and_rows_click_whole() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut paths = frames;
-    paths.push(table);
+    let paths = fixture_files(dir.path());
     let mut h = wide_harness(paths);
     h.run();
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::TryEdit, true));
-    h.run();
+    show_window(&mut h, Window::TryEdit);
     assert!(h.query_by_label_contains("No check yet").is_some());
     h.state_mut()
         .state
@@ -515,9 +509,7 @@ fn closing_the_inspector_clears_its_highlight() {
 #[test]
 fn small_things_last_frame_escape_one_warning() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut paths = frames;
-    paths.push(table);
+    let paths = fixture_files(dir.path());
     let mut h = wide_harness(paths);
     h.run();
     // Stream ▸ Last frame.

@@ -14,7 +14,7 @@ use eotn::workspace::bookmarks::{EventKind, bookmarks_path};
 use eotn::workspace::cell_origin::CellOrigin;
 use eotn::workspace::{Command, Window, Workspace};
 
-use crate::harness::{GREEN, ORANGE, harness, pixel_pos, run_until, workspace};
+use crate::harness::{GREEN, ORANGE, harness, pixel_pos, run_until, show_window, workspace};
 
 /// How long a background scan may take.
 const WITHIN: Duration = Duration::from_secs(60);
@@ -63,10 +63,7 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(fixture(dir.path()));
     h.run();
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Coverage, true));
-    h.run();
+    show_window(&mut h, Window::Coverage);
     h.get_by_label("Find unclassified").click();
     h.run();
     run_until(&mut h, WITHIN, |a| {
@@ -149,10 +146,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     lut.save(&paths[3]).unwrap();
     let mut h = harness(paths.clone());
     h.run();
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Bookmarks, true));
-    h.run();
+    show_window(&mut h, Window::Bookmarks);
     // A bookmark with a note on frame 2, saved beside the first frame file.
     h.state_mut().state.run(Command::Seek(2));
     h.run();

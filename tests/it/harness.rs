@@ -11,7 +11,7 @@ use egui_kittest::Harness;
 use eotn::app::EotnApp;
 use eotn::frame::{Frame, Yuv};
 use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
-use eotn::workspace::Workspace;
+use eotn::workspace::{Command, Window, Workspace};
 
 /// The field's green.
 pub const GREEN: Yuv = Yuv::new(100, 110, 100);
@@ -61,6 +61,20 @@ pub fn fixture(dir: &Path) -> (Vec<PathBuf>, PathBuf) {
     let table = dir.join("field.lut");
     lut.save(&table).unwrap();
     (frames, table)
+}
+
+/// The files of [`fixture`] as the command line gives them: the frames, then the table.
+pub fn fixture_files(dir: &Path) -> Vec<PathBuf> {
+    let (mut paths, table) = fixture(dir);
+    paths.push(table);
+    paths
+}
+
+/// A workspace (no window) with the files of [`fixture`] open.
+pub fn opened_fixture(dir: &Path) -> Workspace {
+    let mut w = Workspace::default();
+    w.apply(Command::Open(fixture_files(dir))).unwrap();
+    w
 }
 
 /// The app in a [`WINDOW`]-sized window, opening `paths` as the command line would.
@@ -115,6 +129,12 @@ pub fn click_at(h: &Harness<'_, EotnApp>, pos: Pos2, button: PointerButton) {
             modifiers: Modifiers::NONE,
         });
     }
+}
+
+/// Opens `window` through the command the Windows menu sends, and runs the UI until it settles.
+pub fn show_window(h: &mut Harness<'_, EotnApp>, window: Window) {
+    h.state_mut().state.run(Command::ShowWindow(window, true));
+    h.run();
 }
 
 /// Asks the window to close, as its close button does (the app may ask first).
