@@ -13,8 +13,8 @@ use eotn::workspace::{Command, ViewKind, Window, Workspace};
 
 use crate::common::repo_file;
 use crate::harness::{
-    ORANGE, click_at, close_window, fixture, fixture_files, harness, opened_fixture, pixel_pos,
-    scene, show_window, snapshot_harness, workspace, write_stream,
+    ORANGE, click_at, click_label, close_window, fixture, fixture_files, harness, opened_fixture,
+    pixel_pos, scene, show_window, snapshot_harness, workspace, write_stream,
 };
 
 #[test]
@@ -37,8 +37,7 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     h.key_press(Key::ArrowRight);
     h.run();
     assert_eq!(workspace(&h).index(), 1);
-    h.get_by_label("Next").click();
-    h.run();
+    click_label(&mut h, "Next");
     assert_eq!(workspace(&h).index(), 2);
     h.key_press(Key::ArrowRight);
     h.run();
@@ -48,11 +47,9 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     assert_eq!(workspace(&h).index(), 0);
 
     // Thumbnails swap with the enlarged view.
-    h.get_by_label("Classified").click();
-    h.run();
+    click_label(&mut h, "Classified");
     assert_eq!(workspace(&h).settings.main_view, ViewKind::Classified);
-    h.get_by_label("Raw").click();
-    h.run();
+    click_label(&mut h, "Raw");
     assert_eq!(workspace(&h).settings.main_view, ViewKind::Raw);
 
     // Overlays switch.
@@ -284,8 +281,7 @@ fn every_window_and_menu_opens() {
         h.root()
     );
     for menu in ["File", "Classification", "View", "Stream", "Windows"] {
-        h.get_by_label(menu).click();
-        h.run();
+        click_label(&mut h, menu);
     }
     // Clicking the U–V plane selects around a cell and previews matching pixels.
     h.state_mut().state.run(Command::ClearSelection);
@@ -315,8 +311,7 @@ fn closing_with_unsaved_changes_asks_first() {
     h.run();
     assert!(h.state().confirming_close());
     assert!(h.query_by_label("Quit without saving").is_some());
-    h.get_by_label("Cancel").click();
-    h.run();
+    click_label(&mut h, "Cancel");
     assert!(!h.state().confirming_close());
 }
 
@@ -457,12 +452,9 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     assert!(!drawn_circles(&h).is_empty());
 
     // View > Overlays > Circle fits switches the circles off everywhere but the objects view.
-    h.get_by_label("View").click();
-    h.run();
-    h.get_by_label("Overlays").click();
-    h.run();
-    h.get_by_label("Circle fits").click();
-    h.run();
+    click_label(&mut h, "View");
+    click_label(&mut h, "Overlays");
+    click_label(&mut h, "Circle fits");
     assert!(!workspace(&h).settings.overlays.circles);
     h.key_press(Key::Escape);
     h.state_mut().state.run(Command::SetMainView(ViewKind::Raw));
@@ -820,7 +812,6 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
             .iter()
             .any(|p| p.ends_with("places.json"))
     );
-    h.get_by_label("Classification").click();
-    h.run();
+    click_label(&mut h, "Classification");
     assert!(h.query_by_label("Open places…").is_some());
 }

@@ -9,7 +9,7 @@ use eotn::app::EotnApp;
 use eotn::sources::{CameraKind, FrameSource as _, RecordedSource as _, StreamSource};
 use eotn::workspace::Window;
 
-use crate::harness::{harness, run_until};
+use crate::harness::{click_label, harness, run_until};
 
 /// How long a connected source may take to deliver what a step waits for.
 const WITHIN: Duration = Duration::from_secs(60);
@@ -19,16 +19,12 @@ fn camera_menu_connects_a_scenario_records_it_and_disconnects() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(Vec::new());
     h.run();
-    h.get_by_label("Camera").click();
-    h.run();
+    click_label(&mut h, "Camera");
     assert!(h.query_by_label("nothing connected").is_some());
-    h.get_by_label("Connect…").click();
-    h.run();
+    click_label(&mut h, "Connect…");
     assert!(h.state().state.window_open(Window::Connect));
-    h.get_by_label("synthetic").click();
-    h.run();
-    h.get_by_label("Connect").click();
-    h.run();
+    click_label(&mut h, "synthetic");
+    click_label(&mut h, "Connect");
     assert!(
         !h.state().state.window_open(Window::Connect),
         "connecting closes the dialog"
@@ -39,42 +35,34 @@ fn camera_menu_connects_a_scenario_records_it_and_disconnects() {
     assert!(h.state().state.frame().is_some());
 
     // Settings… shows what the source delivers.
-    h.get_by_label("Camera").click();
-    h.run();
-    h.get_by_label("Settings…").click();
-    h.run();
+    click_label(&mut h, "Camera");
+    click_label(&mut h, "Settings…");
     assert!(h.state().state.window_open(Window::SourceSettings));
     assert!(h.query_by_label("208×160").is_some(), "{:#?}", h.root());
 
     // Start recording… asks for the file; a typed path works (no file dialog needed).
     let out = dir.path().join("camera.mcap");
-    h.get_by_label("Camera").click();
-    h.run();
-    h.get_by_label("Start recording…").click();
-    h.run();
+    click_label(&mut h, "Camera");
+    click_label(&mut h, "Start recording…");
     h.state_mut().camera.record_path.clear();
     h.run();
     let field = h.get_by_label("file");
     field.focus();
     field.type_text(&out.display().to_string());
     h.run();
-    h.get_by_label("Start recording").click();
-    h.run();
+    click_label(&mut h, "Start recording");
     assert_eq!(h.state().state.recording(), Some(out.clone()));
     let at = live(h.state());
     run_until(&mut h, WITHIN, |a| live(a) >= at + 3);
-    h.get_by_label("Camera").click();
-    h.run();
+    click_label(&mut h, "Camera");
     h.get_by_label("Stop recording").click();
     run_until(&mut h, WITHIN, |_| out.exists());
     let back = StreamSource::open(&out).unwrap();
     assert!(back.len() >= 2, "{} frames recorded", back.len());
     assert_eq!(back.info().stream_source, "sim:walk-and-pan");
 
-    h.get_by_label("Camera").click();
-    h.run();
-    h.get_by_label("Disconnect").click();
-    h.run();
+    click_label(&mut h, "Camera");
+    click_label(&mut h, "Disconnect");
     assert!(h.state().state.live().is_none());
 }
 
@@ -93,19 +81,16 @@ fn camera_connect_dialog_lists_no_camera_in_one_line_and_opens_a_typed_stream() 
         .state
         .run(eotn::workspace::Command::ShowWindow(Window::Connect, true));
     h.run();
-    h.get_by_label("camera").click();
-    h.run();
+    click_label(&mut h, "camera");
     if eotn::sources::available().cameras.is_empty() {
         assert!(h.query_by_label_contains("no camera found").is_some());
     }
-    h.get_by_label("stream").click();
-    h.run();
+    click_label(&mut h, "stream");
     let field = h.get_by_label("stream file");
     field.focus();
     field.type_text(&stream.display().to_string());
     h.run();
-    h.get_by_label("Connect").click();
-    h.run();
+    click_label(&mut h, "Connect");
     let s = &h.state().state;
     assert_eq!(s.source().map(|s| s.len()), Some(2), "{:?}", s.warnings());
     assert_eq!(s.camera_kind(), CameraKind::Overhead);

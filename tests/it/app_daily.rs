@@ -19,8 +19,8 @@ use eotn::workspace::{Command, Window, Workspace};
 
 use crate::common::repo_file;
 use crate::harness::{
-    GREEN, close_window, fixture, fixture_files, harness_sized, opened_fixture, show_window,
-    workspace,
+    GREEN, click_label, close_window, fixture, fixture_files, harness_sized, opened_fixture,
+    show_window, workspace,
 };
 
 /// The app in a 1280 × 800 window (the docked windows need the width).
@@ -440,8 +440,7 @@ fn windows_dock_beside_the_image_and_the_parameters_window_works() {
         h.query_by_label_contains("Parameters: spl2009.json")
             .is_some()
     );
-    h.get_by_label("Defaults").click();
-    h.run();
+    click_label(&mut h, "Defaults");
     assert!(workspace(&h).params_slot().path.is_none());
     assert_eq!(
         *workspace(&h).recognition_params(),
@@ -513,15 +512,13 @@ fn small_things_last_frame_escape_one_warning() {
     let mut h = wide_harness(paths);
     h.run();
     // Stream ▸ Last frame.
-    h.get_by_label("Stream").click();
-    h.run();
+    click_label(&mut h, "Stream");
     h.get_by_label_contains("Last frame").click();
     h.run();
     assert_eq!(workspace(&h).index(), 2);
     // Escape closes an open menu (and keeps the selection while it does).
     h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
-    h.get_by_label("File").click();
-    h.run();
+    click_label(&mut h, "File");
     assert!(h.query_by_label("Open parameters…").is_some());
     h.key_press(Key::Escape);
     h.run();
@@ -568,8 +565,7 @@ fn quit_without_saving_keeps_the_undo_history_and_warns_of_no_crash() {
     assert!(workspace(&h).dirty());
     close_window(&mut h);
     h.run();
-    h.get_by_label("Quit without saving").click();
-    h.run();
+    click_label(&mut h, "Quit without saving");
     assert!(!workspace(&h).dirty());
     assert_eq!(
         std::fs::read(&table).unwrap(),
@@ -633,13 +629,10 @@ fn file_open_table_shows_the_in_app_dialog() {
         .with_accessibility_check(false)
         .build_eframe(move |cc| EotnApp::new(cc, paths.clone()));
     h.run();
-    h.get_by_label("File").click();
-    h.run();
-    h.get_by_label("Open table…").click();
-    h.run();
+    click_label(&mut h, "File");
+    click_label(&mut h, "Open table…");
     assert_eq!(h.state().file_dialogs.shown(), Some(FileAction::OpenTable));
     assert!(h.query_by_label_contains("Cancel").is_some());
-    h.get_by_label("Cancel").click();
-    h.run();
+    click_label(&mut h, "Cancel");
     assert_eq!(h.state().file_dialogs.shown(), None);
 }

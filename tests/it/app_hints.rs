@@ -14,7 +14,9 @@ use eotn::workspace::bookmarks::{EventKind, bookmarks_path};
 use eotn::workspace::cell_origin::CellOrigin;
 use eotn::workspace::{Command, Window, Workspace};
 
-use crate::harness::{GREEN, ORANGE, harness, pixel_pos, run_until, show_window, workspace};
+use crate::harness::{
+    GREEN, ORANGE, click_label, harness, pixel_pos, run_until, show_window, workspace,
+};
 
 /// How long a background scan may take.
 const WITHIN: Duration = Duration::from_secs(60);
@@ -64,8 +66,7 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     let mut h = harness(fixture(dir.path()));
     h.run();
     show_window(&mut h, Window::Coverage);
-    h.get_by_label("Find unclassified").click();
-    h.run();
+    click_label(&mut h, "Find unclassified");
     run_until(&mut h, WITHIN, |a| {
         a.state.coverage().is_some_and(|c| c.done())
     });
@@ -81,8 +82,7 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     // Clicking the first hint selects its cells and previews its pixels in the image.
     h.state_mut().state.run(Command::Seek(1));
     h.run();
-    h.get_by_label("hint 1").click();
-    h.run();
+    click_label(&mut h, "hint 1");
     let previewed = workspace(&h).preview_mask().iter().filter(|&&m| m).count();
     assert_eq!(previewed, 400, "the ball's pixels are previewed");
     h.state_mut()
@@ -91,8 +91,7 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     // The class panel scrolls: bring its Commit button into view first, as a user would.
     h.get_by_label("Commit").scroll_to_me();
     h.run();
-    h.get_by_label("Commit").click();
-    h.run();
+    click_label(&mut h, "Commit");
     assert_eq!(workspace(&h).lut().class_of(ORANGE), ColourClass::Orange);
     // The hints re-rank at once: orange is classified now, pink is left.
     h.run();
@@ -154,8 +153,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     field.focus();
     field.type_text("ball near the line");
     h.run();
-    h.get_by_label("Bookmark this frame").click();
-    h.run();
+    click_label(&mut h, "Bookmark this frame");
     let file = bookmarks_path(&paths[0]);
     let text = std::fs::read_to_string(&file).expect("saved");
     assert!(
@@ -170,8 +168,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     h.run();
     assert_eq!(workspace(&h).index(), 2);
 
-    h.get_by_label("Find events").click();
-    h.run();
+    click_label(&mut h, "Find events");
     run_until(&mut h, WITHIN, |a| {
         a.state.event_scan().is_some_and(|e| e.done())
     });
@@ -189,14 +186,11 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     // Jumps: from 0 the next mark is the event at 1, then the bookmark at 2; and back.
     h.state_mut().state.run(Command::Seek(0));
     h.run();
-    h.get_by_label("Next mark").click();
-    h.run();
+    click_label(&mut h, "Next mark");
     assert_eq!(workspace(&h).index(), 1);
-    h.get_by_label("Next mark").click();
-    h.run();
+    click_label(&mut h, "Next mark");
     assert_eq!(workspace(&h).index(), 2);
-    h.get_by_label("Previous mark").click();
-    h.run();
+    click_label(&mut h, "Previous mark");
     assert_eq!(workspace(&h).index(), 1);
 
     // Reopening finds the bookmark; removing it saves the file again.

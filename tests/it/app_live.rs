@@ -12,7 +12,7 @@ use eotn::sources::{CameraKind, SourceKind};
 use eotn::workspace::Window;
 
 use crate::common::sim_stream;
-use crate::harness::{harness, harness_sized, run_steps_until, run_until};
+use crate::harness::{click_label, harness, harness_sized, run_steps_until, run_until};
 use crate::live::serve;
 
 /// How long a robot may take to deliver what a step waits for.
@@ -25,21 +25,17 @@ fn camera_connect_to_a_robot_served_by_eotn_serve_shows_its_frames() {
     let served = serve(&stream, "127.0.0.1:0", &["--loop"]);
     let mut h = harness(Vec::new());
     h.run();
-    h.get_by_label("Camera").click();
-    h.run();
-    h.get_by_label("Connect…").click();
-    h.run();
+    click_label(&mut h, "Camera");
+    click_label(&mut h, "Connect…");
     assert!(h.state().state.window_open(Window::Connect));
-    h.get_by_label("network").click();
-    h.run();
+    click_label(&mut h, "network");
     h.state_mut().camera.address.clear();
     h.run();
     let field = h.get_by_label("address");
     field.focus();
     field.type_text(&format!("ws://127.0.0.1:{}", served.port));
     h.run();
-    h.get_by_label("Connect").click();
-    h.run();
+    click_label(&mut h, "Connect");
     // Connect… ▸ network puts the robot into the robots list, shown at once.
     let frames = |a: &EotnApp| a.state.robots().first().map_or(0, |r| r.stats.frames);
     run_until(&mut h, WITHIN, |a| {
@@ -50,10 +46,8 @@ fn camera_connect_to_a_robot_served_by_eotn_serve_shows_its_frames() {
     assert!(info.label.starts_with("robot "), "{}", info.label);
     assert_eq!(h.state().state.camera_kind(), CameraKind::Robot);
     assert!(h.state().state.shown_robot().is_some());
-    h.get_by_label("Camera").click();
-    h.run();
-    h.get_by_label("Disconnect").click();
-    h.run();
+    click_label(&mut h, "Camera");
+    click_label(&mut h, "Disconnect");
     assert!(h.state().state.robots().is_empty());
     assert!(h.state().state.connected_info().is_none());
 }

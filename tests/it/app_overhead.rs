@@ -22,7 +22,7 @@ use eotn::workspace::{
 };
 
 use crate::common::{repo_file, sim_stream};
-use crate::harness::{click_at, harness_with, show_window, write_stream};
+use crate::harness::{click_at, click_label, harness_with, show_window, write_stream};
 
 /// An overhead-game stream of 4 frames rendered once for every test (markers, truth, world
 /// models), and a table learnt from its own labels.
@@ -421,8 +421,7 @@ fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
     }
     // The window docks beside the image; its buttons fit the column (no sideways scrolling).
     show_window(&mut h, Window::Calibration);
-    h.get_by_label("Undo pick").click();
-    h.run();
+    click_label(&mut h, "Undo pick");
     assert_eq!(
         h.state().state.overhead().points().points.len(),
         clicks.len() - 1

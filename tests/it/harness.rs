@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 
 use egui::{Event, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable as _;
 use eotn::app::EotnApp;
 use eotn::frame::{Frame, Yuv};
 use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
@@ -129,6 +130,13 @@ pub fn click_at(h: &Harness<'_, EotnApp>, pos: Pos2, button: PointerButton) {
             modifiers: Modifiers::NONE,
         });
     }
+}
+
+/// Clicks the widget labelled `label` (which must be there, once) and runs the UI until it
+/// settles.
+pub fn click_label(h: &mut Harness<'_, EotnApp>, label: &str) {
+    h.get_by_label(label).click();
+    h.run();
 }
 
 /// Opens `window` through the command the Windows menu sends, and runs the UI until it settles.
