@@ -135,31 +135,20 @@ impl Canvas {
         self.line((x0, y1 - e), (x0, y0), c);
     }
 
-    /// A label anchored at `at` (source-image pixels): its text in an 8×8 bitmap font on a dark
-    /// backing just above the anchor, as the app draws it, moved the least distance that keeps
-    /// it inside the picture (a ball at the top or bottom edge still shows its distance).
-    /// Characters the font lacks are drawn as `?`.
+    /// A label anchored at `at` (source-image pixels): its text (up to 64 characters) in the
+    /// bitmap font on a dark backing just above the anchor, as the app draws it, moved the least
+    /// distance that keeps it inside the picture (a ball at the top or bottom edge still shows
+    /// its distance).
     pub fn label(&mut self, at: (f64, f64), text: &str, c: [u8; 3]) {
-        use font8x8::UnicodeFonts as _;
-        const GLYPH: i64 = 8;
         const PAD: i64 = 2;
         if !(at.0.is_finite() && at.1.is_finite()) || text.is_empty() {
             return;
         }
-        let glyphs: Vec<[u8; 8]> = text
-            .chars()
-            .take(64)
-            .map(|ch| {
-                font8x8::BASIC_FONTS
-                    .get(ch)
-                    .or_else(|| font8x8::LATIN_FONTS.get(ch))
-                    .or_else(|| font8x8::BASIC_FONTS.get('?'))
-                    .unwrap_or([0; 8])
-            })
-            .collect();
+        let shown: String = text.chars().take(64).collect();
+        let (text_w, text_h) = text_size_px(&shown, 1);
         let (w, h) = (self.width as i64, self.height as i64);
-        let box_w = glyphs.len() as i64 * GLYPH + 2 * PAD;
-        let box_h = GLYPH + 2 * PAD;
+        let box_w = text_w as i64 + 2 * PAD;
+        let box_h = text_h as i64 + 2 * PAD;
         let s = self.scale as f64;
         let (ax, ay) = ((at.0 * s).floor() as i64, (at.1 * s).floor() as i64);
         let x0 = ax.min(w - box_w).max(0);
@@ -172,12 +161,29 @@ impl Canvas {
                 }
             }
         }
-        for (k, rows) in glyphs.iter().enumerate() {
-            let gx = x0 + PAD + k as i64 * GLYPH;
-            for (row, bits) in rows.iter().enumerate() {
-                for col in 0..8 {
-                    if bits & (1 << col) != 0 {
-                        self.put(gx + col, y0 + PAD + row as i64, c);
+        self.text((x0 + PAD, y0 + PAD), &shown, 1, c);
+    }
+
+    /// Writes `text` in the bitmap font (`font8x8`), each font pixel a `scale` × `scale` block
+    /// (0 counts as 1), the first character cell's top-left corner at `top_left` output pixels;
+    /// only the glyphs' own pixels are set, and those outside the canvas are left out. The one
+    /// text routine of the overlays' labels and the evaluation charts.
+    pub fn text(&mut self, top_left: (i64, i64), text: &str, scale: usize, c: [u8; 3]) {
+        let scale = scale.max(1) as i64;
+        let cell = FONT_CELL_PX as i64 * scale;
+        for (k, ch) in text.chars().enumerate() {
+            let cell_x = top_left.0.saturating_add((k as i64).saturating_mul(cell));
+            if cell_x >= self.width as i64 {
+                break;
+            }
+            for (row, bits) in glyph(ch).iter().enumerate() {
+                let y = top_left.1.saturating_add(row as i64 * scale);
+                for col in (0..8).filter(|col| bits & (1 << col) != 0) {
+                    let x = cell_x + col * scale;
+                    for dy in 0..scale {
+                        for dx in 0..scale {
+                            self.put(x.saturating_add(dx), y.saturating_add(dy), c);
+                        }
                     }
                 }
             }
@@ -238,6 +244,28 @@ impl Canvas {
             }
         }
     }
+}
+
+/// Side of a character cell of the bitmap font, font pixels: text is this many pixels high and
+/// this many wide per character at scale 1.
+pub const FONT_CELL_PX: usize = 8;
+
+/// Width and height of `text` written by [`Canvas::text`] at `scale`, output pixels.
+#[must_use]
+pub fn text_size_px(text: &str, scale: usize) -> (usize, usize) {
+    let cell = FONT_CELL_PX * scale.max(1);
+    (text.chars().count() * cell, cell)
+}
+
+/// The 8×8 bitmap of `ch` (rows top to bottom, bit 0 the leftmost column): Basic Latin and
+/// Latin-1 from `font8x8`, `?` for anything else.
+fn glyph(ch: char) -> [u8; 8] {
+    use font8x8::UnicodeFonts as _;
+    font8x8::BASIC_FONTS
+        .get(ch)
+        .or_else(|| font8x8::LATIN_FONTS.get(ch))
+        .or_else(|| font8x8::BASIC_FONTS.get('?'))
+        .unwrap_or([0; 8])
 }
 
 /// The one palette of the overlays: the colour a primitive is drawn in by `eotn render`, the app
@@ -335,6 +363,60 @@ mod tests {
         let mut c = Canvas::from_rgb(10, 10, &[0u8; 300], 1).expect("canvas");
         c.draw(&[label((f64::NAN, 1.0), "x"), label((1.0, 1.0), "")]);
         assert!(white_text(&c).is_none(), "nothing drawn for NaN or no text");
+    }
+
+    #[test]
+    fn text_sets_exactly_the_glyph_pixels_at_its_scale() {
+        let (w, h) = (40, 24);
+        let mut c = Canvas::from_rgb(w, h, &vec![0u8; w * h * 3], 1).expect("canvas");
+        c.text((3, 2), "L-", 2, [255, 255, 255]);
+        let lit = |x: usize, y: usize| c.rgb[(y * w + x) * 3] == 255;
+        let glyphs = [glyph('L'), glyph('-')];
+        let mut count = 0;
+        for y in 0..h {
+            for x in 0..w {
+                let (fx, fy) = (x as i64 - 3, y as i64 - 2);
+                let expected = (0..32).contains(&fx)
+                    && (0..16).contains(&fy)
+                    && glyphs[(fx / 16) as usize][(fy / 2) as usize] & (1 << (fx % 16 / 2)) != 0;
+                assert_eq!(lit(x, y), expected, "pixel ({x}, {y})");
+                count += usize::from(expected);
+            }
+        }
+        // font8x8's L: a stroke in columns 1-2 and a foot along row 6; its dash: row 3, columns
+        // 0-5 (each font pixel 2 × 2 here).
+        assert!(lit(5, 6) && lit(7, 11) && !lit(3, 6), "the L's stroke");
+        assert!(lit(3, 14) && lit(16, 15), "the L's foot");
+        assert!(
+            lit(19, 8) && lit(30, 9) && !lit(31, 8) && !lit(19, 10),
+            "the dash"
+        );
+        assert!(count >= 4 * 10, "{count} pixels");
+        assert_eq!(text_size_px("L-", 2), (32, 16));
+    }
+
+    #[test]
+    fn text_past_an_edge_is_clipped_not_wrapped() {
+        let (w, h) = (40, 20);
+        let white = |c: &Canvas| -> Vec<(usize, usize)> {
+            (0..w * h)
+                .filter(|i| c.rgb[i * 3] == 255)
+                .map(|i| (i % w, i / w))
+                .collect()
+        };
+        let mut c = Canvas::from_rgb(w, h, &vec![0u8; w * h * 3], 1).expect("canvas");
+        c.text((35, 15), "WWW", 1, [255, 255, 255]);
+        let set = white(&c);
+        assert!(!set.is_empty(), "the visible part is drawn");
+        assert!(
+            set.iter().all(|&(x, y)| x >= 35 && y >= 15),
+            "nothing wraps to the left or top: {set:?}"
+        );
+        let mut c = Canvas::from_rgb(w, h, &vec![0u8; w * h * 3], 1).expect("canvas");
+        c.text((-6, -4), "WW", 1, [255, 255, 255]);
+        assert!(white(&c).iter().all(|&(x, y)| x < 10 && y < 4));
+        c.text((i64::MAX, i64::MIN), "far away", 3, [255, 255, 255]);
+        c.text((i64::MIN, i64::MAX), "far away", 3, [255, 255, 255]);
     }
 
     #[test]

@@ -194,20 +194,20 @@ fn try_edit_hint(state: &Workspace, has_stream: bool) -> &'static str {
 fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         super::classify_panel::swatch(ui, t.class.display_rgb());
-        ui.label(format!("{} over {} frames", t.class.name(), t.total));
+        ui.label(format!("{} over {} frames", t.class.name(), t.stream.total));
     });
     if !t.done() {
         ui.add(
-            egui::ProgressBar::new(t.next as f32 / t.total.max(1) as f32)
-                .text(format!("{} / {}", t.next, t.total)),
+            egui::ProgressBar::new(t.stream.next as f32 / t.stream.total.max(1) as f32)
+                .text(format!("{} / {}", t.stream.next, t.stream.total)),
         );
     }
-    let changed: usize = t.rows.iter().map(|r| r.changed_pixels).sum();
+    let changed: usize = t.stream.rows.iter().map(|r| r.changed_pixels).sum();
     ui.label(format!(
         "{} frames change, {changed} pixels in all{}",
-        t.rows.len(),
-        if t.errors > 0 {
-            format!("; {} frames unreadable", t.errors)
+        t.stream.rows.len(),
+        if t.stream.errors > 0 {
+            format!("; {} frames unreadable", t.stream.errors)
         } else {
             String::new()
         }
@@ -221,7 +221,7 @@ fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Comm
         .id_salt("try_rows")
         .max_height(300.0)
         .show(ui, |ui| {
-            for r in &t.rows {
+            for r in &t.stream.rows {
                 let delta = r.blobs_after as i64 - r.blobs_before as i64;
                 let text = format!(
                     "frame {:>5}   {:>6} px   blobs {} -> {} ({delta:+})",

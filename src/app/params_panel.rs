@@ -247,16 +247,16 @@ pub fn try_params_ui(ui: &mut Ui, t: &TryParams, current: usize, commands: &mut 
     }
     if !t.done() {
         ui.add(
-            egui::ProgressBar::new(t.next as f32 / t.total.max(1) as f32)
-                .text(format!("{} / {}", t.next, t.total)),
+            egui::ProgressBar::new(t.stream.next as f32 / t.stream.total.max(1) as f32)
+                .text(format!("{} / {}", t.stream.next, t.stream.total)),
         );
     }
     ui.label(format!(
         "{} of {} frames recognise differently{}",
-        t.rows.len(),
-        t.next,
-        if t.errors > 0 {
-            format!("; {} frames unreadable", t.errors)
+        t.stream.rows.len(),
+        t.stream.next,
+        if t.stream.errors > 0 {
+            format!("; {} frames unreadable", t.stream.errors)
         } else {
             String::new()
         }
@@ -265,7 +265,7 @@ pub fn try_params_ui(ui: &mut Ui, t: &TryParams, current: usize, commands: &mut 
         .id_salt("try_params_rows")
         .max_height(300.0)
         .show(ui, |ui| {
-            for r in &t.rows {
+            for r in &t.stream.rows {
                 let text = format!("frame {:>5}   {}  ->  {}", r.index, r.before, r.after);
                 let row =
                     egui::Button::selectable(r.index == current, RichText::new(text).monospace())

@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use crate::live::RobotFrames;
 use crate::live::robot::DEFAULT_KEEP_BYTES;
-use crate::live::serve::StandInRobot;
+use crate::live::serve::{SendError, StandInRobot};
 use crate::live::{ClientOptions, LiveRobot, RobotUrl};
 use crate::sim::{Scenario, ScenarioKind, Simulator};
 use crate::streams::FrameRecord;
@@ -201,7 +201,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             );
             std::thread::Builder::new()
                 .name(format!("sender {i}"))
-                .spawn(move || -> Result<(usize, StandInRobot), String> {
+                .spawn(move || -> Result<(usize, StandInRobot), SendError> {
                     let period = Duration::from_secs_f64(1.0 / fps.max(0.1));
                     let t0 = Instant::now();
                     let mut n = 0_usize;
@@ -227,8 +227,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for s in senders {
         let (n, server) = s
             .join()
-            .map_err(|_| anyhow::anyhow!("a sender thread panicked"))?
-            .map_err(|e| anyhow::anyhow!(e))?;
+            .map_err(|_| anyhow::anyhow!("a sender thread panicked"))??;
         sent += n;
         servers.push(server);
     }

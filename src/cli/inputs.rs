@@ -4,7 +4,7 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use anyhow::bail;
+use anyhow::{Context as _, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 
 pub use crate::sources::{RAW_EXTENSIONS, expand_frame_paths, is_frame_file};
@@ -21,20 +21,20 @@ use crate::streams::is_stream_file;
 ///
 /// # Errors
 /// A message saying what is wrong with the text.
-pub fn parse_size(text: &str) -> Result<(usize, usize), String> {
+pub fn parse_size(text: &str) -> anyhow::Result<(usize, usize)> {
     let (w, h) = text
         .split_once(['x', 'X', '×'])
-        .ok_or_else(|| format!("'{text}' is not WxH (e.g. 208x160)"))?;
+        .with_context(|| format!("'{text}' is not WxH (e.g. 208x160)"))?;
     let w: usize = w
         .trim()
         .parse()
-        .map_err(|_| format!("bad width in '{text}'"))?;
+        .with_context(|| format!("bad width in '{text}'"))?;
     let h: usize = h
         .trim()
         .parse()
-        .map_err(|_| format!("bad height in '{text}'"))?;
+        .with_context(|| format!("bad height in '{text}'"))?;
     if w == 0 || h == 0 {
-        return Err(format!("'{text}': width and height must be positive"));
+        bail!("'{text}': width and height must be positive");
     }
     Ok((w, h))
 }
@@ -43,20 +43,20 @@ pub fn parse_size(text: &str) -> Result<(usize, usize), String> {
 ///
 /// # Errors
 /// A message for anything else.
-pub fn parse_connectivity(text: &str) -> Result<Connectivity, String> {
+pub fn parse_connectivity(text: &str) -> anyhow::Result<Connectivity> {
     text.trim()
         .parse::<u8>()
         .ok()
         .and_then(Connectivity::from_neighbours)
-        .ok_or_else(|| format!("connectivity must be 4 or 8, not '{text}'"))
+        .with_context(|| format!("connectivity must be 4 or 8, not '{text}'"))
 }
 
 /// Parses a frame range: `A..B` (B excluded), `A..=B`, `A..`, `..B`, or a single index `A`.
 ///
 /// # Errors
 /// A message for anything else.
-pub fn parse_frame_range(text: &str) -> Result<Range<usize>, String> {
-    let bad = || format!("'{text}' is not a frame range (A..B, A..=B, A.., ..B or A)");
+pub fn parse_frame_range(text: &str) -> anyhow::Result<Range<usize>> {
+    let bad = || anyhow!("'{text}' is not a frame range (A..B, A..=B, A.., ..B or A)");
     let num = |s: &str| s.trim().parse::<usize>().map_err(|_| bad());
     let Some((a, b)) = text.split_once("..") else {
         let a = num(text)?;
@@ -455,11 +455,13 @@ mod tests {
 
     #[test]
     fn sizes_parse_and_reject_nonsense() {
-        assert_eq!(parse_size("208x160"), Ok((208, 160)));
-        assert_eq!(parse_size("640X480"), Ok((640, 480)));
+        assert_eq!(parse_size("208x160").ok(), Some((208, 160)));
+        assert_eq!(parse_size("640X480").ok(), Some((640, 480)));
         assert!(parse_size("208").is_err());
-        assert!(parse_size("0x5").is_err());
-        assert!(parse_size("axb").is_err());
+        let zero = parse_size("0x5").expect_err("zero width").to_string();
+        assert!(zero.contains("must be positive"), "{zero}");
+        let text = parse_size("axb").expect_err("letters").to_string();
+        assert_eq!(text, "bad width in 'axb'");
     }
 
     #[test]
@@ -476,11 +478,11 @@ mod tests {
 
     #[test]
     fn frame_ranges_parse() {
-        assert_eq!(parse_frame_range("2..5"), Ok(2..5));
-        assert_eq!(parse_frame_range("2..=5"), Ok(2..6));
-        assert_eq!(parse_frame_range("..3"), Ok(0..3));
-        assert_eq!(parse_frame_range("7.."), Ok(7..usize::MAX));
-        assert_eq!(parse_frame_range("4"), Ok(4..5));
+        assert_eq!(parse_frame_range("2..5").ok(), Some(2..5));
+        assert_eq!(parse_frame_range("2..=5").ok(), Some(2..6));
+        assert_eq!(parse_frame_range("..3").ok(), Some(0..3));
+        assert_eq!(parse_frame_range("7..").ok(), Some(7..usize::MAX));
+        assert_eq!(parse_frame_range("4").ok(), Some(4..5));
         assert!(parse_frame_range("5..2").is_err());
         assert!(parse_frame_range("a..b").is_err());
     }

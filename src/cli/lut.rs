@@ -47,13 +47,13 @@ pub struct ConvertArgs {
 #[derive(Debug, Clone, Copy)]
 pub struct FormatChoice(pub Option<SourceFormat>);
 
-fn parse_format(text: &str) -> Result<FormatChoice, String> {
+fn parse_format(text: &str) -> anyhow::Result<FormatChoice> {
     if text == "auto" {
         return Ok(FormatChoice(None));
     }
     SourceFormat::parse(text)
         .map(|f| FormatChoice(Some(f)))
-        .ok_or_else(|| {
+        .with_context(|| {
             let names: Vec<&str> = SourceFormat::ALL.iter().map(|f| f.name()).collect();
             format!("'{text}' is not a format: auto, {}", names.join(", "))
         })

@@ -97,17 +97,15 @@ pub struct ShowArgs {
 ///
 /// # Errors
 /// A message for anything but three finite numbers.
-pub fn parse_pose(text: &str) -> Result<RobotPose, String> {
+pub fn parse_pose(text: &str) -> anyhow::Result<RobotPose> {
     let v: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("'{text}' is not X_CM,Y_CM,HEADING_RAD"))?;
+        .with_context(|| format!("'{text}' is not X_CM,Y_CM,HEADING_RAD"))?;
     match v.as_slice() {
         [x, y, h] if v.iter().all(|a| a.is_finite()) => Ok(RobotPose::new(*x, *y, *h)),
-        _ => Err(format!(
-            "'{text}' is not three numbers X_CM,Y_CM,HEADING_RAD"
-        )),
+        _ => bail!("'{text}' is not three numbers X_CM,Y_CM,HEADING_RAD"),
     }
 }
 
@@ -499,8 +497,8 @@ mod tests {
     #[test]
     fn poses_parse_from_text_and_tables() {
         assert_eq!(
-            parse_pose("10, -20.5, 1.57"),
-            Ok(RobotPose::new(10.0, -20.5, 1.57))
+            parse_pose("10, -20.5, 1.57").ok(),
+            Some(RobotPose::new(10.0, -20.5, 1.57))
         );
         assert!(parse_pose("1,2").is_err());
         assert!(parse_pose("a,b,c").is_err());

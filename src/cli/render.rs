@@ -168,22 +168,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 .filter(|p| wanted(&args.overlays, p)),
         );
         canvas.draw(&prims);
-        // The canvas has no fonts: the patterns' labels are written in the plots' pixel font.
-        for p in &prims {
-            if let Primitive::Label { at, text, .. } = p {
-                let scale = i64::from(args.scale);
-                let (x, y) = ((at.0 * scale as f64) as i64, (at.1 * scale as f64) as i64);
-                let font = (scale / 2).max(1);
-                crate::eval::plots::label_on(
-                    &mut canvas,
-                    text,
-                    x,
-                    y - 8 * font,
-                    font,
-                    [255, 255, 255],
-                );
-            }
-        }
         let name = inputs.name(i);
         let stem = name.rsplit_once('.').map_or(name.as_str(), |(s, _)| s);
         let out = args.output.join(format!("{stem}.png"));

@@ -2,15 +2,15 @@
 //! rates per distance band — and of a size → distance calibration: people would rather look
 //! than read a table of percentiles.
 //!
-//! Drawn on [`Canvas`] with a built-in 5×7 pixel font, so nothing depends on system fonts or a
-//! plotting crate. Every chart is a fixed-size RGB image with a title, labelled axes and a
+//! Drawn on [`Canvas`] in the overlays' 8×8 bitmap font ([`Canvas::text`]), so nothing depends
+//! on system fonts or a plotting crate. Every chart is a fixed-size RGB image with a title, labelled axes and a
 //! legend.
 
 use std::io;
 use std::path::{Path, PathBuf};
 
 use super::FrameEval;
-use crate::overlay::Canvas;
+use crate::overlay::{Canvas, FONT_CELL_PX, text_size_px};
 
 /// Chart size, pixels.
 const WIDTH: usize = 720;
@@ -18,8 +18,13 @@ const WIDTH: usize = 720;
 const HEIGHT: usize = 480;
 /// Plot area margins (left, right, top, bottom), pixels.
 const MARGIN: (f64, f64, f64, f64) = (78.0, 24.0, 52.0, 56.0);
-/// Text scale: each font pixel is drawn as a 2 × 2 block.
-const TEXT_SCALE: i64 = 2;
+/// Text scale of ticks, axis labels and legends: one output pixel per font pixel (8 pixels a
+/// character).
+const TEXT_SCALE: usize = 1;
+/// Text scale of a title: each font pixel a 2 × 2 block, when the title fits the chart's width.
+const TITLE_SCALE: usize = 2;
+/// Half the height of a line of text at [`TEXT_SCALE`], pixels: text centred on `y` starts here.
+const TEXT_HALF_HEIGHT: f64 = (FONT_CELL_PX * TEXT_SCALE) as f64 / 2.0;
 
 /// Colours of the series.
 const BALL: [u8; 3] = [235, 120, 20];
@@ -31,68 +36,9 @@ const LIGHT: [u8; 3] = [225, 225, 225];
 const BLACK: [u8; 3] = [20, 20, 20];
 const RED: [u8; 3] = [200, 30, 30];
 
-/// 5×7 glyphs (rows top to bottom, bit 4 = leftmost column) for the characters charts use;
-/// lower case is drawn as upper case, anything else as a hollow box.
-fn glyph(c: char) -> [u8; 7] {
-    match c.to_ascii_uppercase() {
-        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
-        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
-        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
-        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
-        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
-        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
-        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
-        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
-        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
-        'A' => [0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
-        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
-        'D' => [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C],
-        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
-        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
-        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
-        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
-        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
-        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
-        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
-        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
-        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
-        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
-        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
-        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
-        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
-        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
-        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
-        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
-        'Y' => [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04],
-        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
-        ' ' => [0; 7],
-        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
-        ',' => [0, 0, 0, 0, 0x0C, 0x04, 0x08],
-        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
-        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
-        '%' => [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03],
-        '/' => [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0],
-        ':' => [0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0],
-        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
-        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
-        '=' => [0, 0, 0x1F, 0, 0x1F, 0, 0],
-        '<' => [0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02],
-        '>' => [0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08],
-        '_' => [0, 0, 0, 0, 0, 0, 0x1F],
-        '*' => [0, 0x04, 0x15, 0x0E, 0x15, 0x04, 0],
-        _ => [0x1F, 0x11, 0x11, 0x11, 0x11, 0x11, 0x1F],
-    }
-}
-
 /// Width of `text` drawn at [`TEXT_SCALE`], pixels.
 fn text_width(text: &str) -> f64 {
-    (text.chars().count() as i64 * 6 * TEXT_SCALE) as f64
+    text_size_px(text, TEXT_SCALE).0 as f64
 }
 
 /// A chart being drawn: a canvas, the plot area and the data ranges it maps.
@@ -171,7 +117,19 @@ impl Chart {
         };
         let mut c = Self { canvas, x, y };
         let (l, r, t, b) = c.area();
-        c.text(title, (WIDTH as f64 - text_width(title)) / 2.0, 14.0, BLACK);
+        let title_scale = if text_size_px(title, TITLE_SCALE).0 + 16 <= WIDTH {
+            TITLE_SCALE
+        } else {
+            TEXT_SCALE
+        };
+        let title_width = text_size_px(title, title_scale).0 as f64;
+        c.text_scaled(
+            title,
+            (WIDTH as f64 - title_width) / 2.0,
+            10.0,
+            title_scale,
+            BLACK,
+        );
         c.text(y_label, 8.0, t - 22.0, BLACK);
         c.text(
             x_label,
@@ -196,7 +154,7 @@ impl Chart {
             c.canvas.line((l, py), (r, py), LIGHT);
             c.canvas.line((l - 5.0, py), (l, py), BLACK);
             let s = tick_label(v, ys);
-            c.text(&s, l - 8.0 - text_width(&s), py - 7.0, BLACK);
+            c.text(&s, l - 8.0 - text_width(&s), py - TEXT_HALF_HEIGHT, BLACK);
             v += ys;
         }
         c.canvas.line((l, t), (l, b), BLACK);
@@ -239,20 +197,14 @@ impl Chart {
         }
     }
 
+    /// Writes `s` at [`TEXT_SCALE`], its top-left corner at (`x`, `y`) pixels.
     fn text(&mut self, s: &str, x: f64, y: f64, c: [u8; 3]) {
-        let (x0, y0) = (x.round() as i64, y.round() as i64);
-        for (k, ch) in s.chars().enumerate() {
-            let gx = x0 + k as i64 * 6 * TEXT_SCALE;
-            for (row, bits) in glyph(ch).iter().enumerate() {
-                for col in 0..5 {
-                    if bits & (0x10 >> col) != 0 {
-                        let px = (gx + col * TEXT_SCALE) as f64;
-                        let py = (y0 + row as i64 * TEXT_SCALE) as f64;
-                        self.fill(px, py, px + TEXT_SCALE as f64, py + TEXT_SCALE as f64, c);
-                    }
-                }
-            }
-        }
+        self.text_scaled(s, x, y, TEXT_SCALE, c);
+    }
+
+    fn text_scaled(&mut self, s: &str, x: f64, y: f64, scale: usize, c: [u8; 3]) {
+        let top_left = (x.round() as i64, y.round() as i64);
+        self.canvas.text(top_left, s, scale, c);
     }
 
     /// A data point as a small filled square (points outside the ranges are left out).
@@ -298,7 +250,7 @@ impl Chart {
         for (i, (label, c)) in entries.iter().enumerate() {
             let y = t + 8.0 + i as f64 * 20.0;
             self.fill(l + 10.0, y + 2.0, l + 20.0, y + 12.0, *c);
-            self.text(label, l + 26.0, y, BLACK);
+            self.text(label, l + 26.0, y + 7.0 - TEXT_HALF_HEIGHT, BLACK);
         }
     }
 
@@ -407,7 +359,7 @@ fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3
         c.bar(x0 + band_cm * 0.1, x0 + band_cm * 0.9, 0.0, rate, colour);
         let label = format!("{}/{}", found[i], n[i]);
         let (px, py) = c.to_px(x0 + band_cm / 2.0, rate);
-        c.text(&label, px - text_width(&label) / 2.0, py - 18.0, BLACK);
+        c.text(&label, px - text_width(&label) / 2.0, py - 12.0, BLACK);
     }
     c
 }
@@ -628,43 +580,6 @@ pub fn write_calibration_plot(
     c.save(path)
 }
 
-/// Writes `text` on any canvas in the charts' built-in 5×7 font, `scale` canvas pixels per
-/// font pixel, its top-left corner at (`x`, `y`) canvas pixels, on a dark box so that it reads
-/// over a camera image (`eotn render` labels). Clipped to the canvas.
-pub fn label_on(canvas: &mut Canvas, text: &str, x: i64, y: i64, scale: i64, colour: [u8; 3]) {
-    let scale = scale.max(1);
-    let (w, h) = (canvas.width as i64, canvas.height as i64);
-    let n = text.chars().count() as i64;
-    // Kept inside the canvas, as the app keeps its labels inside the view.
-    let x = x.min(w - n * 6 * scale - 1).max(0);
-    let y = y.min(h - 9 * scale).max(0);
-    let mut put = |px: i64, py: i64, c: [u8; 3]| {
-        if (0..w).contains(&px) && (0..h).contains(&py) {
-            let i = (py as usize * canvas.width + px as usize) * 3;
-            canvas.rgb[i..i + 3].copy_from_slice(&c);
-        }
-    };
-    for py in y - scale..y + 8 * scale {
-        for px in x - scale..x + n * 6 * scale {
-            put(px, py, [0, 0, 0]);
-        }
-    }
-    for (k, ch) in text.chars().enumerate() {
-        let gx = x + k as i64 * 6 * scale;
-        for (row, bits) in glyph(ch).iter().enumerate() {
-            for col in 0..5 {
-                if bits & (0x10 >> col) != 0 {
-                    for dy in 0..scale {
-                        for dx in 0..scale {
-                            put(gx + col * scale + dx, y + row as i64 * scale + dy, colour);
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -674,8 +589,37 @@ mod tests {
         assert_eq!(tick_step(100.0, 8.0), 10.0);
         assert_eq!(tick_step(7.0, 6.0), 1.0);
         assert_eq!(tick_step(0.0, 6.0), 1.0);
-        assert_eq!(text_width("ab"), 24.0);
+        assert_eq!(text_width("ab"), 16.0);
         assert_eq!(range_of(std::iter::empty(), &[]), (0.0, 1.0));
+    }
+
+    /// The columns and rows of the title band (above the plot area) that hold black text.
+    fn title_extent(c: &Chart) -> Option<[usize; 4]> {
+        let mut b: Option<[usize; 4]> = None;
+        for y in 0..MARGIN.2 as usize - 22 {
+            for x in 0..WIDTH {
+                let i = (y * WIDTH + x) * 3;
+                if c.canvas.rgb[i..i + 3] == BLACK {
+                    b = Some(b.map_or([x, y, x, y], |[x0, y0, x1, y1]| {
+                        [x0.min(x), y0.min(y), x1.max(x), y1.max(y)]
+                    }));
+                }
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn a_title_is_written_centred_and_a_long_one_smaller_to_fit() {
+        let short = Chart::new("ball distance error", "x", "y", (0.0, 1.0), (0.0, 1.0));
+        let [x0, y0, x1, y1] = title_extent(&short).expect("title drawn");
+        assert!(y1 - y0 >= 12, "twice the font's size: rows {y0}..{y1}");
+        assert!(x0.abs_diff(WIDTH - 1 - x1) <= 16, "centred: {x0}..{x1}");
+        let long = "post position error (worst of top and foot) (n=1234)";
+        let long = Chart::new(long, "x", "y", (0.0, 1.0), (0.0, 1.0));
+        let [x0, y0, x1, y1] = title_extent(&long).expect("title drawn");
+        assert!(y1 - y0 < 8, "at the font's own size: rows {y0}..{y1}");
+        assert!(x0 > 0 && x1 < WIDTH - 1, "inside the picture: {x0}..{x1}");
     }
 
     #[test]

@@ -160,7 +160,7 @@ fn run(
                 let _ = ws.flush();
                 reason
             }
-            Err(reason) => Some(reason),
+            Err(reason) => Some(reason.to_string()),
         };
         let Some(reason) = reason else { return };
         if got_info {
@@ -181,36 +181,74 @@ fn run(
     }
 }
 
-fn connect(url: &RobotUrl, options: &ClientOptions) -> Result<WebSocket<TcpStream>, String> {
+/// Why a connection could not be opened (said in [`LiveEvent::Disconnected`]'s reason).
+#[derive(Debug, thiserror::Error)]
+enum ConnectError {
+    /// The host name does not resolve.
+    #[error("cannot resolve {host}: {source}")]
+    Resolve {
+        /// The robot's host.
+        host: String,
+        /// What the resolver said.
+        source: std::io::Error,
+    },
+    /// The host resolved to no address.
+    #[error("{host} has no address")]
+    NoAddress {
+        /// The robot's host.
+        host: String,
+    },
+    /// No address accepted the connection (the last address's error).
+    #[error("cannot connect: {0}")]
+    Connect(#[source] std::io::Error),
+    /// The socket's options could not be set.
+    #[error("socket: {0}")]
+    Socket(#[source] std::io::Error),
+    /// The URL is no WebSocket request.
+    #[error("bad address: {0}")]
+    Address(#[source] tungstenite::Error),
+    /// The WebSocket handshake failed.
+    #[error("handshake failed: {0}")]
+    Handshake(#[source] tungstenite::Error),
+    /// The robot did not finish the handshake in time.
+    #[error("handshake timed out")]
+    HandshakeTimeout,
+}
+
+fn connect(url: &RobotUrl, options: &ClientOptions) -> Result<WebSocket<TcpStream>, ConnectError> {
     let addrs: Vec<_> = (url.host.as_str(), url.port)
         .to_socket_addrs()
-        .map_err(|e| format!("cannot resolve {}: {e}", url.host))?
+        .map_err(|source| ConnectError::Resolve {
+            host: url.host.clone(),
+            source,
+        })?
         .collect();
-    let mut last = format!("{} has no address", url.host);
+    let mut last = ConnectError::NoAddress {
+        host: url.host.clone(),
+    };
     let stream = addrs
         .iter()
         .find_map(
             |a| match TcpStream::connect_timeout(a, options.connect_timeout) {
                 Ok(s) => Some(s),
                 Err(e) => {
-                    last = format!("cannot connect: {e}");
+                    last = ConnectError::Connect(e);
                     None
                 }
             },
         )
         .ok_or(last)?;
-    let io = |e: std::io::Error| format!("socket: {e}");
-    stream.set_nodelay(true).map_err(io)?;
+    stream.set_nodelay(true).map_err(ConnectError::Socket)?;
     stream
         .set_read_timeout(Some(options.connect_timeout))
-        .map_err(io)?;
+        .map_err(ConnectError::Socket)?;
     stream
         .set_write_timeout(Some(options.connect_timeout))
-        .map_err(io)?;
+        .map_err(ConnectError::Socket)?;
     let mut request = url
         .to_string()
         .into_client_request()
-        .map_err(|e| format!("bad address: {e}"))?;
+        .map_err(ConnectError::Address)?;
     request.headers_mut().insert(
         "Sec-WebSocket-Protocol",
         tungstenite::http::HeaderValue::from_static(SUBPROTOCOLS),
@@ -220,10 +258,12 @@ fn connect(url: &RobotUrl, options: &ClientOptions) -> Result<WebSocket<TcpStrea
         .max_frame_size(Some(options.max_message_bytes));
     let (ws, _response) = tungstenite::client::client_with_config(request, stream, Some(config))
         .map_err(|e| match e {
-            tungstenite::HandshakeError::Failure(e) => format!("handshake failed: {e}"),
-            tungstenite::HandshakeError::Interrupted(_) => "handshake timed out".to_owned(),
+            tungstenite::HandshakeError::Failure(e) => ConnectError::Handshake(e),
+            tungstenite::HandshakeError::Interrupted(_) => ConnectError::HandshakeTimeout,
         })?;
-    ws.get_ref().set_read_timeout(Some(POLL)).map_err(io)?;
+    ws.get_ref()
+        .set_read_timeout(Some(POLL))
+        .map_err(ConnectError::Socket)?;
     Ok(ws)
 }
 

@@ -16,9 +16,9 @@ use foxglove::{ChannelBuilder, Context, PartialMetadata, RawChannel, Schema, Web
 
 use super::unix_time_ns;
 use crate::streams::schema::{
-    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, ImageEncoding, RECOGNITION_SCHEMA_NAME,
-    SENSORS_SCHEMA_NAME, any_json_schema, encode_image, object_json_schema, raw_image_schema,
-    sensors_json_schema,
+    EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, ImageEncoding, ImageMessageError,
+    RECOGNITION_SCHEMA_NAME, SENSORS_SCHEMA_NAME, any_json_schema, encode_image,
+    object_json_schema, raw_image_schema, sensors_json_schema,
 };
 use crate::streams::{
     FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError,
@@ -47,12 +47,37 @@ pub enum ServeError {
     /// The stream could not be read.
     #[error(transparent)]
     Stream(#[from] StreamError),
-    /// A frame could not be encoded.
-    #[error("frame {index}: {detail}")]
+    /// A frame could not be sent.
+    #[error("frame {index}: {error}")]
     Frame {
         /// The frame.
         index: usize,
         /// What is wrong.
+        #[source]
+        error: SendError,
+    },
+}
+
+/// Why one frame could not be sent ([`StandInRobot::send`]).
+#[derive(Debug, thiserror::Error)]
+pub enum SendError {
+    /// Its image cannot become a `foxglove.RawImage` (odd width, too large).
+    #[error(transparent)]
+    Image(#[from] ImageMessageError),
+    /// A value of a JSON channel (sensor readings, ground truth, …) cannot be written as JSON.
+    #[error("{topic}: {source}")]
+    Json {
+        /// The channel's topic.
+        topic: String,
+        /// What serde said.
+        source: serde_json::Error,
+    },
+    /// A JSON channel could not be made.
+    #[error("cannot make channel {topic}: {detail}")]
+    Channel {
+        /// The topic.
+        topic: String,
+        /// What the SDK said.
         detail: String,
     },
 }
@@ -152,20 +177,22 @@ impl StandInRobot {
     /// machine's clock as their log time; returns that time, nanoseconds since the Unix epoch.
     ///
     /// # Errors
-    /// A message when the frame cannot be encoded or a channel made.
-    pub fn send(&mut self, record: &FrameRecord) -> Result<u64, String> {
+    /// [`SendError`] when the frame cannot be encoded or a channel made.
+    pub fn send(&mut self, record: &FrameRecord) -> Result<u64, SendError> {
         encode_image(
             record.time_ns,
             &record.frame,
             ImageEncoding::default(),
             &mut self.buf,
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let meta = PartialMetadata::with_log_time(unix_time_ns());
         let log_time = meta.log_time.unwrap_or(0);
         self.image.log_with_meta(&self.buf, meta);
         if let Some(s) = &record.sensors {
-            let json = serde_json::to_vec(&s.sanitised().0).map_err(|e| e.to_string())?;
+            let json = serde_json::to_vec(&s.sanitised().0).map_err(|source| SendError::Json {
+                topic: SENSORS_TOPIC.to_owned(),
+                source,
+            })?;
             self.sensors.log_with_meta(&json, meta);
         }
         let fixed = [
@@ -175,36 +202,43 @@ impl StandInRobot {
         let extra = record.extra.iter().map(|(t, v)| (t.as_str(), Some(v)));
         for (topic, value) in fixed.into_iter().chain(extra) {
             let Some(value) = value else { continue };
-            let json = serde_json::to_vec(value).map_err(|e| e.to_string())?;
+            let json = serde_json::to_vec(value).map_err(|source| SendError::Json {
+                topic: topic.to_owned(),
+                source,
+            })?;
             self.json_channel(topic)?.log_with_meta(&json, meta);
         }
         Ok(log_time)
     }
 
-    fn json_channel(&mut self, topic: &str) -> Result<&Arc<RawChannel>, String> {
-        if !self.json.contains_key(topic) {
-            let schema = match topic {
-                GROUND_TRUTH_TOPIC => json_schema(
-                    GROUND_TRUTH_SCHEMA_NAME,
-                    &object_json_schema(GROUND_TRUTH_SCHEMA_NAME, "Ground truth."),
-                ),
-                RECOGNITION_TOPIC => json_schema(
-                    RECOGNITION_SCHEMA_NAME,
-                    &object_json_schema(RECOGNITION_SCHEMA_NAME, "Recognition results."),
-                ),
-                _ => json_schema(EXTRA_SCHEMA_NAME, &any_json_schema()),
-            };
-            let channel = ChannelBuilder::new(topic)
-                .context(&self.context)
-                .message_encoding("json")
-                .schema(schema)
-                .build_raw()
-                .map_err(|e| format!("cannot make channel {topic}: {e}"))?;
-            self.json.insert(topic.to_owned(), channel);
-        }
-        self.json
-            .get(topic)
-            .ok_or_else(|| format!("channel {topic} is missing"))
+    /// The JSON channel of `topic`, made the first time it is asked for.
+    fn json_channel(&mut self, topic: &str) -> Result<&Arc<RawChannel>, SendError> {
+        use std::collections::hash_map::Entry;
+        let slot = match self.json.entry(topic.to_owned()) {
+            Entry::Occupied(made) => return Ok(made.into_mut()),
+            Entry::Vacant(slot) => slot,
+        };
+        let schema = match topic {
+            GROUND_TRUTH_TOPIC => json_schema(
+                GROUND_TRUTH_SCHEMA_NAME,
+                &object_json_schema(GROUND_TRUTH_SCHEMA_NAME, "Ground truth."),
+            ),
+            RECOGNITION_TOPIC => json_schema(
+                RECOGNITION_SCHEMA_NAME,
+                &object_json_schema(RECOGNITION_SCHEMA_NAME, "Recognition results."),
+            ),
+            _ => json_schema(EXTRA_SCHEMA_NAME, &any_json_schema()),
+        };
+        let channel = ChannelBuilder::new(topic)
+            .context(&self.context)
+            .message_encoding("json")
+            .schema(schema)
+            .build_raw()
+            .map_err(|e| SendError::Channel {
+                topic: topic.to_owned(),
+                detail: e.to_string(),
+            })?;
+        Ok(slot.insert(channel))
     }
 
     /// Plays a stream at its recorded rate (again and again with `looping`) until it ends or
@@ -243,7 +277,7 @@ impl StandInRobot {
                 }
                 let record = reader.read(index)?;
                 self.send(&record)
-                    .map_err(|detail| ServeError::Frame { index, detail })?;
+                    .map_err(|error| ServeError::Frame { index, error })?;
                 sent += 1;
             }
             if !looping || reader.is_empty() {

@@ -101,13 +101,30 @@ pub enum FieldError {
         /// The error.
         source: serde_json::Error,
     },
-    /// A value is out of range.
-    #[error("{path}: {what}")]
+    /// JSON of the right shape with a value out of range.
+    #[error("{path}: {problem}")]
     Invalid {
         /// The file.
         path: String,
         /// What is wrong.
-        what: String,
+        #[source]
+        problem: FieldProblem,
+    },
+}
+
+/// What makes a field description of the right shape unusable.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum FieldProblem {
+    /// A landmark, line or arc coordinate that is NaN or infinite.
+    #[error("a coordinate is not a finite number")]
+    NotFinite,
+    /// A size that must be positive is not (`line_width_cm`, `ball_radius_cm`, …).
+    #[error("{key} must be positive, is {value}")]
+    NotPositive {
+        /// The key in the file.
+        key: &'static str,
+        /// Its value.
+        value: f64,
     },
 }
 
@@ -127,13 +144,14 @@ impl FieldDescription {
             path: name.clone(),
             source,
         })?;
-        field
-            .check()
-            .map_err(|what| FieldError::Invalid { path: name, what })?;
+        field.check().map_err(|problem| FieldError::Invalid {
+            path: name,
+            problem,
+        })?;
         Ok(field)
     }
 
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), FieldProblem> {
         let finite = self
             .landmarks
             .iter()
@@ -154,16 +172,16 @@ impl FieldDescription {
             }))
             .all(f64::is_finite);
         if !finite {
-            return Err("a coordinate is not a finite number".into());
+            return Err(FieldProblem::NotFinite);
         }
-        for (what, v) in [
+        for (key, value) in [
             ("line_width_cm", self.line_width_cm),
             ("ball_radius_cm", self.ball_radius_cm),
             ("plate_height_cm", self.plate_height_cm),
             ("camera_height_guess_cm", self.camera_height_guess_cm),
         ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{what} must be positive, is {v}"));
+            if !(value.is_finite() && value > 0.0) {
+                return Err(FieldProblem::NotPositive { key, value });
             }
         }
         Ok(())
@@ -376,5 +394,18 @@ mod tests {
         std::fs::write(&p, serde_json::to_string(&f).expect("json")).expect("write");
         let err = FieldDescription::load(&p).expect_err("negative height");
         assert!(err.to_string().contains("camera_height_guess_cm"), "{err}");
+        assert!(
+            matches!(
+                &err,
+                FieldError::Invalid {
+                    problem: FieldProblem::NotPositive {
+                        key: "camera_height_guess_cm",
+                        ..
+                    },
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
     }
 }

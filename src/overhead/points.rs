@@ -71,13 +71,33 @@ pub enum PointsError {
         /// The error.
         source: serde_json::Error,
     },
-    /// A value is unusable.
-    #[error("{path}: {what}")]
+    /// JSON of the right shape with a value that is unusable.
+    #[error("{path}: {problem}")]
     Invalid {
         /// The file.
         path: String,
         /// What is wrong.
-        what: String,
+        #[source]
+        problem: PointsProblem,
+    },
+}
+
+/// What makes a points file of the right shape unusable.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PointsProblem {
+    /// A zero width or height.
+    #[error("image size {width}x{height} is empty")]
+    EmptyImage {
+        /// The file's width, pixels.
+        width: usize,
+        /// The file's height, pixels.
+        height: usize,
+    },
+    /// A coordinate or height that is NaN or infinite.
+    #[error("point {name:?} has a value that is not a number")]
+    NotANumber {
+        /// The point's name.
+        name: String,
     },
 }
 
@@ -106,17 +126,19 @@ impl PointsFile {
             path: name.clone(),
             source,
         })?;
-        file.check()
-            .map_err(|what| PointsError::Invalid { path: name, what })?;
+        file.check().map_err(|problem| PointsError::Invalid {
+            path: name,
+            problem,
+        })?;
         Ok(file)
     }
 
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), PointsProblem> {
         if self.width == 0 || self.height == 0 {
-            return Err(format!(
-                "image size {}x{} is empty",
-                self.width, self.height
-            ));
+            return Err(PointsProblem::EmptyImage {
+                width: self.width,
+                height: self.height,
+            });
         }
         for p in &self.points {
             let values = [
@@ -127,10 +149,9 @@ impl PointsFile {
                 p.image_px[1],
             ];
             if !values.iter().all(|v| v.is_finite()) {
-                return Err(format!(
-                    "point {:?} has a value that is not a number",
-                    p.name
-                ));
+                return Err(PointsProblem::NotANumber {
+                    name: p.name.clone(),
+                });
             }
         }
         Ok(())
@@ -215,10 +236,53 @@ mod tests {
         std::fs::write(&path, r#"{"width": 0, "height": 480, "points": []}"#).expect("write");
         let err = PointsFile::load(&path).expect_err("empty size");
         assert!(err.to_string().contains("bad.points.json"), "{err}");
+        assert!(
+            matches!(
+                &err,
+                PointsError::Invalid {
+                    problem: PointsProblem::EmptyImage {
+                        width: 0,
+                        height: 480
+                    },
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        assert!(
+            err.to_string().contains("image size 0x480 is empty"),
+            "{err}"
+        );
         std::fs::write(&path, "{\"width\": 640").expect("write");
         assert!(matches!(
             PointsFile::load(&path),
             Err(PointsError::Parse { .. })
         ));
+    }
+
+    #[test]
+    fn a_points_file_of_the_wrong_shape_names_what_is_wrong() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("shape.points.json");
+        // One image coordinate instead of two.
+        std::fs::write(
+            &path,
+            r#"{"width": 640, "height": 480, "points": [{"name": "centre",
+                "field_cm": [0, 0], "image_px": [321.4]}]}"#,
+        )
+        .expect("write");
+        let err = PointsFile::load(&path).expect_err("short image_px");
+        assert!(matches!(err, PointsError::Parse { .. }), "{err:?}");
+        let text = err.to_string();
+        assert!(
+            text.contains("shape.points.json")
+                && text.contains("not a calibration points file")
+                && text.contains("expected an array of length 2"),
+            "{text}"
+        );
+        // No list of points at all.
+        std::fs::write(&path, r#"{"width": 640, "height": 480}"#).expect("write");
+        let text = PointsFile::load(&path).expect_err("no points").to_string();
+        assert!(text.contains("missing field `points`"), "{text}");
     }
 }

@@ -8,6 +8,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::{FrameSource, Recorder, SourceError, SourceFrame, SourceInfo, SourceSettings};
+use crate::streams::StreamError;
 
 /// Frames waiting for the UI before new ones are dropped (the UI shows the latest anyway).
 const QUEUE_FRAMES: usize = 4;
@@ -23,11 +24,11 @@ pub enum StreamerEvent {
     RecordingStopped {
         /// The stream written.
         path: std::path::PathBuf,
-        /// Frames written, or the error.
-        result: Result<usize, String>,
+        /// Frames written, or why writing failed.
+        result: Result<usize, StreamError>,
     },
-    /// Something failed (a grab, a settings change, a write); streaming goes on.
-    Error(String),
+    /// A grab or a settings change failed; streaming goes on.
+    Error(SourceError),
 }
 
 enum Control {
@@ -279,7 +280,7 @@ impl Worker {
                 {
                     let path = r.path().to_owned();
                     self.recorder = None;
-                    let result = Err(format!("{e}"));
+                    let result = Err(e);
                     out.event(StreamerEvent::RecordingStopped { path, result });
                 }
                 match out.frames.try_send(frame) {
@@ -290,7 +291,7 @@ impl Worker {
             Err(e) => {
                 let msg = e.to_string();
                 if msg != self.last_error {
-                    out.event(StreamerEvent::Error(msg.clone()));
+                    out.event(StreamerEvent::Error(e));
                     self.last_error = msg;
                 }
                 true
@@ -318,7 +319,7 @@ impl Worker {
                 Control::SetSettings(s) => {
                     let event = match self.source.set_settings(&s) {
                         Ok(now) => StreamerEvent::Settings(now),
-                        Err(e) => StreamerEvent::Error(e.to_string()),
+                        Err(e) => StreamerEvent::Error(e),
                     };
                     out.event(event);
                 }
@@ -344,7 +345,7 @@ impl Worker {
 fn finish(recorder: Option<Box<Recorder>>, out: &Outbox) {
     if let Some(r) = recorder {
         let path = r.path().to_owned();
-        let result = r.finish().map_err(|e| e.to_string());
+        let result = r.finish();
         out.event(StreamerEvent::RecordingStopped { path, result });
     }
 }
@@ -406,7 +407,7 @@ mod tests {
         });
         let e = s.wait_event(Duration::from_secs(5));
         assert!(
-            matches!(&e, Some(StreamerEvent::Error(m)) if m.contains("exposure")),
+            matches!(&e, Some(StreamerEvent::Error(m)) if m.to_string().contains("exposure")),
             "{e:?}"
         );
         assert!(Streamer::start(Box::new(two_frames(dir.path())), 0.0).is_err());

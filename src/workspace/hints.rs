@@ -163,7 +163,8 @@ impl Workspace {
             .unwrap_or_default();
         if let Some(t) = &self.try_edit {
             out.extend(
-                t.rows
+                t.stream
+                    .rows
                     .iter()
                     .filter(|r| r.blobs_before != r.blobs_after)
                     .map(|r| Event {

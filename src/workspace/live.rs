@@ -268,7 +268,7 @@ impl Workspace {
                     }
                     Err(e) => self.warn(format!("recording into {} stopped: {e}", path.display())),
                 },
-                StreamerEvent::Error(e) => self.warn(e),
+                StreamerEvent::Error(e) => self.warn(e.to_string()),
             }
         }
         if let Some(f) = latest {

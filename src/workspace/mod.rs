@@ -18,6 +18,7 @@
 //! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
+//! | `stream_scan.rs` | [`StreamScan`]: the whole-stream checks' one loop, a few frames per UI frame |
 //! | `coverage.rs`, `cell_origin.rs`, `bookmarks.rs`, `hints.rs` | what is unclassified, who set a cell, events and bookmarks |
 //! | `params.rs` | recognition parameters: open, tune, reset, save, the set a stream names, [`params::TryParams`] |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
@@ -41,6 +42,7 @@ pub mod player;
 mod robots;
 mod settings;
 pub mod source;
+mod stream_scan;
 mod table;
 mod timings;
 mod try_edit;
@@ -62,6 +64,7 @@ pub use settings::{
     ZOOM_PRESETS, ZOOM_RANGE,
 };
 pub use source::Source;
+pub use stream_scan::StreamScan;
 pub use table::TableSlot;
 pub use timings::{StepTiming, Timings, median};
 pub use try_edit::{TryEdit, TryEditRow};

@@ -4,13 +4,14 @@
 //! saving as a parameters file, and trying a change over the whole stream.
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::Context as _;
 use serde_json::Value;
 
 use super::Workspace;
 use super::source::Source;
+use super::stream_scan::StreamScan;
 use crate::lut::LookupTable;
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::{Recognition, RecognitionParams, params_file};
@@ -169,14 +170,8 @@ pub struct TryParams {
     after: Pipeline,
     /// The changed values (`ball.diameter_cm: 8.5 -> 8.6`).
     pub changes: Vec<String>,
-    /// Next frame to scan.
-    pub next: usize,
-    /// Frames in the source.
-    pub total: usize,
-    /// Frames whose recognition changes, in order.
-    pub rows: Vec<TryParamsRow>,
-    /// Frames that could not be read.
-    pub errors: usize,
+    /// The frames read so far and those whose recognition changes.
+    pub stream: StreamScan<TryParamsRow>,
 }
 
 impl TryParams {
@@ -196,40 +191,30 @@ impl TryParams {
             before: Pipeline::new(lut.clone(), before),
             after: Pipeline::new(lut.clone(), after),
             changes,
-            next: 0,
-            total,
-            rows: Vec::new(),
-            errors: 0,
+            stream: StreamScan::new(total),
         }
     }
 
     /// True when every frame was scanned.
     #[must_use]
-    pub fn done(&self) -> bool {
-        self.next >= self.total
+    pub const fn done(&self) -> bool {
+        self.stream.done()
     }
 
     /// Scans frames of `src` for up to `budget`.
     pub fn scan(&mut self, src: &mut Source, budget: Duration) {
-        let start = Instant::now();
-        while !self.done() && start.elapsed() < budget {
-            let i = self.next;
-            self.next += 1;
-            let Ok(f) = src.read_uncached(i) else {
-                self.errors += 1;
-                continue;
-            };
+        let (before_pipeline, after_pipeline) = (&mut self.before, &mut self.after);
+        self.stream.scan(src, budget, |index, f| {
             let sensors = f.sensors.as_ref();
-            let before = recognition_summary(self.before.process(&f.frame, sensors).recognition);
-            let after = recognition_summary(self.after.process(&f.frame, sensors).recognition);
-            if before != after {
-                self.rows.push(TryParamsRow {
-                    index: i,
-                    before,
-                    after,
-                });
-            }
-        }
+            let before =
+                recognition_summary(before_pipeline.process(&f.frame, sensors).recognition);
+            let after = recognition_summary(after_pipeline.process(&f.frame, sensors).recognition);
+            (before != after).then_some(TryParamsRow {
+                index,
+                before,
+                after,
+            })
+        });
     }
 }
 

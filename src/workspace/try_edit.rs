@@ -1,9 +1,10 @@
 //! "Try edit on the stream": the frames a pending edit would change, scanned a few frames per UI
 //! frame so the window stays responsive.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use super::source::Source;
+use super::stream_scan::StreamScan;
 use crate::blobs::{BlobSet, Connectivity};
 use crate::classify::ClassifiedImage;
 use crate::lut::{ColourClass, LookupTable, Region};
@@ -29,21 +30,15 @@ pub struct TryEdit {
     /// The cells.
     pub region: Region,
     edited: LookupTable,
-    /// Next frame to scan.
-    pub next: usize,
-    /// Frames in the source.
-    pub total: usize,
-    /// Frames that would change, in order.
-    pub rows: Vec<TryEditRow>,
-    /// Frames that could not be read.
-    pub errors: usize,
+    /// The frames read so far and those that would change.
+    pub stream: StreamScan<TryEditRow>,
 }
 
 impl TryEdit {
     /// True when every frame was scanned.
     #[must_use]
-    pub fn done(&self) -> bool {
-        self.next >= self.total
+    pub const fn done(&self) -> bool {
+        self.stream.done()
     }
 
     /// A check of writing `region` as `class` into `lut`, over the `total` frames of a source.
@@ -55,10 +50,7 @@ impl TryEdit {
             class,
             region,
             edited,
-            next: 0,
-            total,
-            rows: Vec::new(),
-            errors: 0,
+            stream: StreamScan::new(total),
         }
     }
 
@@ -72,16 +64,10 @@ impl TryEdit {
         min_pixels: u32,
         budget: Duration,
     ) {
-        let start = Instant::now();
-        while !self.done() && start.elapsed() < budget {
-            let i = self.next;
-            self.next += 1;
-            let Ok(f) = src.read_uncached(i) else {
-                self.errors += 1;
-                continue;
-            };
+        let edited = &self.edited;
+        self.stream.scan(src, budget, |index, f| {
             let before = ClassifiedImage::from_frame(&f.frame, lut);
-            let after = ClassifiedImage::from_frame(&f.frame, &self.edited);
+            let after = ClassifiedImage::from_frame(&f.frame, edited);
             let changed = before
                 .codes()
                 .iter()
@@ -89,7 +75,7 @@ impl TryEdit {
                 .filter(|(a, b)| a != b)
                 .count();
             if changed == 0 {
-                continue;
+                return None;
             }
             let count = |img: &ClassifiedImage| {
                 BlobSet::from_image(img, connectivity)
@@ -97,12 +83,12 @@ impl TryEdit {
                     .filter(|b| b.pixels >= min_pixels)
                     .count()
             };
-            self.rows.push(TryEditRow {
-                index: i,
+            Some(TryEditRow {
+                index,
                 changed_pixels: changed,
                 blobs_before: count(&before),
                 blobs_after: count(&after),
-            });
-        }
+            })
+        });
     }
 }

@@ -3,87 +3,19 @@
 
 use std::path::{Path, PathBuf};
 
-use egui::{Event, Key, Modifiers, PointerButton, Pos2, Vec2};
+use egui::{Event, Key, Modifiers, PointerButton, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use eotn::app::EotnApp;
-use eotn::frame::{Frame, Yuv};
-use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
+use eotn::lut::{ColourClass, Sensitivity};
 use eotn::workspace::journal;
 use eotn::workspace::{Command, ViewKind, Window, Workspace};
 
-const GREEN: Yuv = Yuv::new(100, 110, 100);
-const ORANGE: Yuv = Yuv::new(120, 80, 190);
-const YELLOW: Yuv = Yuv::new(190, 40, 150);
-
-/// A 208×160 field: green everywhere, an orange 20×20 ball whose place depends on `n`, a
-/// yellow goal bar on the left.
-fn scene(n: usize) -> Frame {
-    Frame::uyvy_from_fn(208, 160, |x, y| {
-        let bx = 60 + 10 * n;
-        if (bx..bx + 20).contains(&x) && (40..60).contains(&y) {
-            ORANGE
-        } else if x < 12 && (20..100).contains(&y) {
-            YELLOW
-        } else {
-            GREEN
-        }
-    })
-    .unwrap()
-}
-
-/// Three frame files and a 7-bit table with green and yellow classified, orange not.
-fn fixture(dir: &Path) -> (Vec<PathBuf>, PathBuf) {
-    let mut frames = Vec::new();
-    for n in 0..3 {
-        let p = dir.join(format!("f{n}.uyvy"));
-        std::fs::write(&p, scene(n).data()).unwrap();
-        frames.push(p);
-    }
-    let mut lut = LookupTable::new(7).unwrap();
-    for (class, sample) in [(ColourClass::Green, GREEN), (ColourClass::Yellow, YELLOW)] {
-        lut.apply(EditRecord::now(
-            class,
-            Region::AroundSample {
-                sample,
-                sensitivity: Sensitivity::uniform(2),
-            },
-        ));
-    }
-    let table = dir.join("field.lut");
-    lut.save(&table).unwrap();
-    (frames, table)
-}
-
-fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
-    Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
-}
-
-/// Where pixel (x, y) of the enlarged view is on screen.
-fn pixel_pos(h: &Harness<'_, EotnApp>, x: usize, y: usize) -> Pos2 {
-    h.state()
-        .last_view
-        .expect("the view was drawn")
-        .pixel_centre(x, y)
-}
-
-fn click_at(h: &Harness<'_, EotnApp>, pos: Pos2, button: PointerButton) {
-    h.event(Event::PointerMoved(pos));
-    for pressed in [true, false] {
-        h.event(Event::PointerButton {
-            pos,
-            button,
-            pressed,
-            modifiers: Modifiers::NONE,
-        });
-    }
-}
-
-fn state<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
-    &h.state().state
-}
+use crate::common::repo_file;
+use crate::harness::{
+    ORANGE, click_at, click_label, close_window, fixture, fixture_files, harness, opened_fixture,
+    pixel_pos, scene, show_window, snapshot_harness, workspace, write_stream,
+};
 
 #[test]
 fn step_switch_views_zoom_pan_classify_undo_save() {
@@ -94,42 +26,39 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     let mut h = harness(paths);
     h.run();
     assert!(
-        state(&h).warnings().is_empty(),
+        workspace(&h).warnings().is_empty(),
         "{:?}",
-        state(&h).warnings()
+        workspace(&h).warnings()
     );
-    assert_eq!(state(&h).source().unwrap().len(), 3);
-    assert_eq!(state(&h).table_path(), Some(table.as_path()));
+    assert_eq!(workspace(&h).source().unwrap().len(), 3);
+    assert_eq!(workspace(&h).table_path(), Some(table.as_path()));
 
     // Step with the arrow keys and the timeline button.
     h.key_press(Key::ArrowRight);
     h.run();
-    assert_eq!(state(&h).index(), 1);
-    h.get_by_label("Next").click();
-    h.run();
-    assert_eq!(state(&h).index(), 2);
+    assert_eq!(workspace(&h).index(), 1);
+    click_label(&mut h, "Next");
+    assert_eq!(workspace(&h).index(), 2);
     h.key_press(Key::ArrowRight);
     h.run();
-    assert_eq!(state(&h).index(), 2, "stepping stops at the last frame");
+    assert_eq!(workspace(&h).index(), 2, "stepping stops at the last frame");
     h.key_press(Key::Home);
     h.run();
-    assert_eq!(state(&h).index(), 0);
+    assert_eq!(workspace(&h).index(), 0);
 
     // Thumbnails swap with the enlarged view.
-    h.get_by_label("Classified").click();
-    h.run();
-    assert_eq!(state(&h).settings.main_view, ViewKind::Classified);
-    h.get_by_label("Raw").click();
-    h.run();
-    assert_eq!(state(&h).settings.main_view, ViewKind::Raw);
+    click_label(&mut h, "Classified");
+    assert_eq!(workspace(&h).settings.main_view, ViewKind::Classified);
+    click_label(&mut h, "Raw");
+    assert_eq!(workspace(&h).settings.main_view, ViewKind::Raw);
 
     // Overlays switch.
-    let mut o = state(&h).settings.overlays;
+    let mut o = workspace(&h).settings.overlays;
     o.classified = true;
     o.opacity = 0.7;
     h.state_mut().state.run(Command::SetOverlays(o));
     h.run();
-    assert!(state(&h).settings.overlays.classified);
+    assert!(workspace(&h).settings.overlays.classified);
 
     // Hover readout.
     let ball = pixel_pos(&h, 65, 45);
@@ -142,7 +71,7 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     // Zoom about the cursor: the pixel under it stays under it.
     h.event(Event::Zoom(2.0));
     h.run();
-    let z = state(&h).settings.transform.zoom.expect("zoom set");
+    let z = workspace(&h).settings.transform.zoom.expect("zoom set");
     let xf = h.state().last_view.unwrap();
     assert!((xf.zoom - z).abs() < 1e-4);
     assert_eq!(xf.pixel_at(ball), Some((65, 45)));
@@ -174,7 +103,7 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     assert!((after.y - before.y).abs() < 1e-3);
     h.state_mut().state.run(Command::ResetView);
     h.run();
-    assert_eq!(state(&h).settings.transform.zoom, None);
+    assert_eq!(workspace(&h).settings.transform.zoom, None);
 
     // Left-click samples with a sensitivity: the preview marks the ball, nothing is written.
     h.state_mut()
@@ -186,22 +115,22 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     let original = std::fs::read(&table).unwrap();
     click_at(&h, pixel_pos(&h, 65, 45), PointerButton::Primary);
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     assert_eq!(s.selection().and_then(|s| s.pixel), Some((65, 45)));
     assert_eq!(s.preview_mask().iter().filter(|&&m| m).count(), 400);
     assert_eq!(s.lut().cells(), &original[..], "preview writes nothing");
     // Keys widen the sensitivity.
     h.key_press(Key::Y);
     h.run();
-    assert_eq!(state(&h).settings.sensitivity.y, 2);
+    assert_eq!(workspace(&h).settings.sensitivity.y, 2);
     h.key_press_modifiers(Modifiers::SHIFT, Key::Y);
     h.run();
-    assert_eq!(state(&h).settings.sensitivity.y, 1);
+    assert_eq!(workspace(&h).settings.sensitivity.y, 1);
 
     // Right-click commits; the pipeline re-runs at once.
     click_at(&h, pixel_pos(&h, 65, 45), PointerButton::Secondary);
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     assert!(s.dirty());
     assert!(s.title().contains('*'), "{}", s.title());
     assert_eq!(s.lut().class_counts()[1], 27);
@@ -216,16 +145,19 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     // Undo and redo with the keys.
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
-    assert_eq!(state(&h).lut().cells(), &original[..]);
-    assert_eq!(state(&h).blobs().of_class(ColourClass::Orange).count(), 0);
+    assert_eq!(workspace(&h).lut().cells(), &original[..]);
+    assert_eq!(
+        workspace(&h).blobs().of_class(ColourClass::Orange).count(),
+        0
+    );
     h.key_press_modifiers(Modifiers::COMMAND, Key::Y);
     h.run();
-    assert_eq!(state(&h).lut(), &committed);
+    assert_eq!(workspace(&h).lut(), &committed);
 
     // Save: the file holds exactly the table, atomically replaced; the journal replays to it.
     h.key_press_modifiers(Modifiers::COMMAND, Key::S);
     h.run();
-    assert!(!state(&h).dirty(), "{}", state(&h).status);
+    assert!(!workspace(&h).dirty(), "{}", workspace(&h).status);
     assert_eq!(std::fs::read(&table).unwrap(), committed.cells());
     let r = journal::replay(&table).unwrap();
     assert_eq!(r.table, committed);
@@ -311,11 +243,7 @@ fn bad_files_are_reported_not_fatal() {
 #[test]
 fn try_edit_lists_the_frames_that_would_change() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut s = Workspace::default();
-    let mut paths = frames;
-    paths.push(table);
-    s.apply(Command::Open(paths)).unwrap();
+    let mut s = opened_fixture(dir.path());
     // Selecting green as white would change every frame's field.
     s.apply(Command::SetClass(ColourClass::White)).unwrap();
     s.apply(Command::Sample { x: 150, y: 120 }).unwrap();
@@ -323,7 +251,7 @@ fn try_edit_lists_the_frames_that_would_change() {
     while !s.try_edit().unwrap().done() {
         s.tick(std::time::Duration::from_millis(16));
     }
-    let t = s.try_edit().unwrap();
+    let t = &s.try_edit().unwrap().stream;
     assert_eq!(t.rows.len(), 3);
     let field = 208 * 160 - 400 - 12 * 80;
     assert!(
@@ -338,9 +266,7 @@ fn try_edit_lists_the_frames_that_would_change() {
 #[test]
 fn every_window_and_menu_opens() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut paths = frames;
-    paths.push(table);
+    let paths = fixture_files(dir.path());
     let mut h = harness(paths);
     h.run();
     for w in Window::ALL {
@@ -355,18 +281,17 @@ fn every_window_and_menu_opens() {
         h.root()
     );
     for menu in ["File", "Classification", "View", "Stream", "Windows"] {
-        h.get_by_label(menu).click();
-        h.run();
+        click_label(&mut h, menu);
     }
     // Clicking the U–V plane selects around a cell and previews matching pixels.
     h.state_mut().state.run(Command::ClearSelection);
     h.state_mut().state.run(Command::SetUvPlaneY(100));
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     assert!(s.selection().is_none());
     h.state_mut().state.run(Command::SampleCell([50, 55, 50]));
     assert_eq!(
-        state(&h).preview_mask().iter().filter(|&&m| m).count(),
+        workspace(&h).preview_mask().iter().filter(|&&m| m).count(),
         208 * 160 - 400 - 12 * 80,
         "the green cell marks the field"
     );
@@ -381,29 +306,19 @@ fn closing_with_unsaved_changes_asks_first() {
     h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
     h.state_mut().state.run(Command::Commit);
     h.run();
-    assert!(state(&h).dirty());
-    h.input_mut()
-        .viewports
-        .entry(egui::ViewportId::ROOT)
-        .or_default()
-        .events
-        .push(egui::ViewportEvent::Close);
+    assert!(workspace(&h).dirty());
+    close_window(&mut h);
     h.run();
     assert!(h.state().confirming_close());
     assert!(h.query_by_label("Quit without saving").is_some());
-    h.get_by_label("Cancel").click();
-    h.run();
+    click_label(&mut h, "Cancel");
     assert!(!h.state().confirming_close());
 }
 
 #[test]
 fn snapshot_with_overlays() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut s = Workspace::default();
-    let mut paths = frames;
-    paths.push(table);
-    s.apply(Command::Open(paths)).unwrap();
+    let mut s = opened_fixture(dir.path());
     let mut o = s.settings.overlays;
     o.classified = true;
     o.opacity = 0.6;
@@ -412,10 +327,7 @@ fn snapshot_with_overlays() {
     s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
     // Timings differ from run to run; everything else on screen is deterministic.
     s.apply(Command::ShowTimings(false)).unwrap();
-    let mut h = Harness::builder()
-        .with_size(Vec2::new(1000.0, 700.0))
-        .wgpu()
-        .build_eframe(move |_| EotnApp::with_state(s));
+    let mut h = snapshot_harness(s, Vec2::new(1000.0, 700.0));
     h.run();
     h.snapshot("app_overlays");
 }
@@ -423,14 +335,8 @@ fn snapshot_with_overlays() {
 /// A short recorded stream: the scenes above at 25 fps with head-pan readings.
 fn stream_fixture(dir: &Path, frames: usize) -> PathBuf {
     use eotn::sensors::SensorReadings;
-    use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
-    let path = dir.join("s.mcap");
-    let info = StreamInfo {
-        source: "robot".to_owned(),
-        description: "app test".to_owned(),
-    };
-    let mut w = StreamWriter::create(&path, &info).unwrap();
-    for i in 0..frames {
+    use eotn::streams::FrameRecord;
+    let records = (0..frames).map(|i| {
         let mut r = FrameRecord::new(i as u64 * 40_000_000, scene(i % 3));
         r.sensors = Some(SensorReadings {
             head_pan_rad: Some(0.1 * i as f64),
@@ -439,10 +345,9 @@ fn stream_fixture(dir: &Path, frames: usize) -> PathBuf {
             pan_pwm: if i == 2 { Some(f64::NAN) } else { Some(0.5) },
             ..SensorReadings::default()
         });
-        w.write(&r).unwrap();
-    }
-    w.finish().unwrap();
-    path
+        r
+    });
+    write_stream(&dir.join("s.mcap"), "robot", records)
 }
 
 #[test]
@@ -452,13 +357,13 @@ fn stream_steps_plays_and_plots_sensors() {
     let stream = stream_fixture(dir.path(), 20);
     let mut h = harness(vec![stream, table]);
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     assert_eq!(s.source().unwrap().len(), 20);
     assert!(s.source().unwrap().is_stream());
     h.key_press(Key::ArrowRight);
     h.key_press(Key::ArrowRight);
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     assert_eq!(s.index(), 2);
     let c = s.current().unwrap();
     assert_eq!(c.time_ns, 80_000_000);
@@ -471,12 +376,9 @@ fn stream_steps_plays_and_plots_sensors() {
     for i in 0..15 {
         h.state_mut().state.run(Command::Seek(i));
     }
-    assert!(state(&h).source().unwrap().cached() <= eotn::workspace::source::CACHE_FRAMES);
+    assert!(workspace(&h).source().unwrap().cached() <= eotn::workspace::source::CACHE_FRAMES);
     // The sensor dialog reads the whole series in the background.
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Sensors, true));
-    h.run();
+    show_window(&mut h, Window::Sensors);
     let st = &mut h.state_mut().state;
     for _ in 0..100 {
         st.tick(std::time::Duration::from_millis(16));
@@ -496,11 +398,6 @@ fn stream_steps_plays_and_plots_sensors() {
     assert_eq!(st.index(), 19);
     assert!(!st.playing(), "stops at the end");
     h.run();
-}
-
-/// A file of the repository (sample streams and tables).
-fn repo_file(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
 }
 
 /// Circles drawn in the last frame with their stroke widths and alphas.
@@ -523,7 +420,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     let table = repo_file("lookup_tables/sim.lut");
     let mut h = harness(vec![stream, table]);
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     assert_eq!(s.index(), 0);
     assert!(
         s.current().unwrap().sensors.is_some(),
@@ -555,18 +452,15 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     assert!(!drawn_circles(&h).is_empty());
 
     // View > Overlays > Circle fits switches the circles off everywhere but the objects view.
-    h.get_by_label("View").click();
-    h.run();
-    h.get_by_label("Overlays").click();
-    h.run();
-    h.get_by_label("Circle fits").click();
-    h.run();
-    assert!(!state(&h).settings.overlays.circles);
+    click_label(&mut h, "View");
+    click_label(&mut h, "Overlays");
+    click_label(&mut h, "Circle fits");
+    assert!(!workspace(&h).settings.overlays.circles);
     h.key_press(Key::Escape);
     h.state_mut().state.run(Command::SetMainView(ViewKind::Raw));
     h.run();
     let with_objects_thumb = drawn_circles(&h).len();
-    let mut o = state(&h).settings.overlays;
+    let mut o = workspace(&h).settings.overlays;
     o.set_recognition(false);
     h.state_mut().state.run(Command::SetOverlays(o));
     h.run();
@@ -584,14 +478,11 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
 
     // The inspector lists every candidate; selecting the ball shows its breakdown and
     // highlights its overlays.
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Inspector, true));
-    h.run();
+    show_window(&mut h, Window::Inspector);
     let n = eotn::app::inspector::candidates(
-        state(&h).recognition(),
-        state(&h).places(),
-        state(&h).image_size(),
+        workspace(&h).recognition(),
+        workspace(&h).places(),
+        workspace(&h).image_size(),
     )
     .len();
     assert!(n >= 2, "ball and goal candidates, got {n}");
@@ -604,7 +495,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     h.get_by_label_contains(&format!("accepted {ball_owner}"))
         .click();
     h.run();
-    assert_eq!(state(&h).selected_object(), Some(ball_owner.as_str()));
+    assert_eq!(workspace(&h).selected_object(), Some(ball_owner.as_str()));
     assert!(
         h.query_all_by_label("pixel_ratio").count() == 1,
         "{:#?}",
@@ -619,9 +510,9 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     );
     // Selecting another candidate dims the ball.
     let goal = eotn::app::inspector::candidates(
-        state(&h).recognition(),
-        state(&h).places(),
-        state(&h).image_size(),
+        workspace(&h).recognition(),
+        workspace(&h).places(),
+        workspace(&h).image_size(),
     )
     .into_iter()
     .map(|c| c.owner)
@@ -643,12 +534,12 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
             .is_err()
     );
     h.state_mut().state.run(Command::Seek(14));
-    let s = state(&h);
+    let s = workspace(&h);
     if !s.primitives().iter().any(|p| p.owner() == goal) {
         assert_eq!(s.selected_object(), None);
     }
     // Export draws the same primitives.
-    let (w, hgt, rgb) = state(&h).compose_view_rgb(ViewKind::Objects).unwrap();
+    let (w, hgt, rgb) = workspace(&h).compose_view_rgb(ViewKind::Objects).unwrap();
     assert_eq!(rgb.len(), w * hgt * 3);
 }
 
@@ -665,11 +556,11 @@ fn nan_sensor_readings_of_a_side_file_show_as_warnings() {
     paths.push(table);
     let mut h = harness(paths);
     h.run();
-    assert!(state(&h).warnings().is_empty());
+    assert!(workspace(&h).warnings().is_empty());
     assert!(h.query_by_label_contains("this frame:").is_none());
     h.key_press(Key::ArrowRight);
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     assert_eq!(s.index(), 1);
     let c = s.current().unwrap();
     let r = c.sensors.unwrap();
@@ -686,7 +577,7 @@ fn nan_sensor_readings_of_a_side_file_show_as_warnings() {
     h.key_press(Key::ArrowRight);
     h.run();
     assert!(h.query_by_label_contains("this frame:").is_none());
-    assert_eq!(state(&h).warnings().len(), 1);
+    assert_eq!(workspace(&h).warnings().len(), 1);
 }
 
 #[test]
@@ -711,10 +602,7 @@ fn snapshot_with_recognition_and_inspector() {
         ball.candidate
     ))))
     .unwrap();
-    let mut h = Harness::builder()
-        .with_size(Vec2::new(1280.0, 800.0))
-        .wgpu()
-        .build_eframe(move |_| EotnApp::with_state(s));
+    let mut h = snapshot_harness(s, Vec2::new(1280.0, 800.0));
     h.run();
     h.snapshot("app_recognition");
 }
@@ -771,7 +659,7 @@ fn nan_in_a_recorded_stream_shows_as_a_warning_of_its_frame() {
     assert!(h.query_by_label_contains("this frame:").is_none());
     h.key_press(Key::ArrowRight);
     h.run();
-    let s = state(&h);
+    let s = workspace(&h);
     let c = s.current().unwrap();
     assert_eq!(s.index(), 1, "{:?}", s.warnings());
     assert_eq!(c.sensors.unwrap().head_pan_rad, None, "{:?}", s.warnings());
@@ -790,22 +678,15 @@ fn nan_in_a_recorded_stream_shows_as_a_warning_of_its_frame() {
 /// stream with the robot's readings.
 fn pattern_stream(dir: &Path) -> PathBuf {
     use eotn::sim::{Scenario, ScenarioKind, Simulator};
-    use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
-    let path = dir.join("tour.mcap");
-    let info = StreamInfo {
-        source: "sim:pattern-tour".to_owned(),
-        description: "app test".to_owned(),
-    };
-    let mut w = StreamWriter::create(&path, &info).unwrap();
+    use eotn::streams::FrameRecord;
     let sim = Simulator::new(Scenario::new(ScenarioKind::PatternTour, 1));
-    for i in 8..32 {
+    let records = (8..32).map(|i| {
         let f = sim.frame(i).unwrap();
         let mut r = FrameRecord::new(f.time_ns, f.frame);
         r.sensors = f.sensors;
-        w.write(&r).unwrap();
-    }
-    w.finish().unwrap();
-    path
+        r
+    });
+    write_stream(&dir.join("tour.mcap"), "sim:pattern-tour", records)
 }
 
 #[test]
@@ -855,13 +736,10 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     // The places file opens like any file (by its extension), and the marker is identified.
     let mut h = harness(vec![stream, table, places.clone()]);
     h.run();
-    assert_eq!(state(&h).places_path(), Some(places.as_path()));
+    assert_eq!(workspace(&h).places_path(), Some(places.as_path()));
     h.state_mut().state.run(Command::Seek(index));
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Inspector, true));
-    h.run();
-    let s = state(&h);
+    show_window(&mut h, Window::Inspector);
+    let s = workspace(&h);
     let (k, c) = s
         .recognition()
         .patterns
@@ -886,7 +764,7 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     h.get_by_label_contains(&format!("accepted {owner}"))
         .click();
     h.run();
-    assert_eq!(state(&h).selected_object(), Some(owner.as_str()));
+    assert_eq!(workspace(&h).selected_object(), Some(owner.as_str()));
     assert!(
         h.query_by_label_contains("pink marker: place 7").is_some(),
         "{:#?}",
@@ -908,27 +786,32 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     // Closing the places file leaves the marker unidentified; a garbled one is a warning.
     h.state_mut().state.run(Command::ClosePlaces);
     h.run();
-    assert!(state(&h).recognition().patterns.iter().all(|c| !c.accepted));
-    assert_eq!(state(&h).settings.last_places, None);
+    assert!(
+        workspace(&h)
+            .recognition()
+            .patterns
+            .iter()
+            .all(|c| !c.accepted)
+    );
+    assert_eq!(workspace(&h).settings.last_places, None);
     let garbled = dir.path().join("garbled.json");
     std::fs::write(&garbled, "{\"format\": \"eotn.places\", \"objects\": 3}").unwrap();
     h.state_mut().state.run(Command::OpenPlaces(garbled));
     h.run();
-    let w = state(&h).warnings().last().cloned().unwrap_or_default();
+    let w = workspace(&h).warnings().last().cloned().unwrap_or_default();
     assert!(
         w.contains("garbled.json") && w.contains("not a places file"),
         "{w}"
     );
-    assert_eq!(state(&h).places_path(), None);
+    assert_eq!(workspace(&h).places_path(), None);
     // The menu offers it; the recent files list has it.
     assert!(
-        state(&h)
+        workspace(&h)
             .settings
             .recent
             .iter()
             .any(|p| p.ends_with("places.json"))
     );
-    h.get_by_label("Classification").click();
-    h.run();
+    click_label(&mut h, "Classification");
     assert!(h.query_by_label("Open places…").is_some());
 }

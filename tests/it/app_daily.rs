@@ -9,20 +9,23 @@ use egui::{Key, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use eotn::app::EotnApp;
-use eotn::frame::{Frame, Yuv};
-use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
+use eotn::frame::Frame;
+use eotn::lut::{ColourClass, LookupTable, Sensitivity};
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::recognition::params_file;
 use eotn::streams::StreamReader;
 use eotn::workspace::params::{JsonKind, json_kind};
 use eotn::workspace::{Command, Window, Workspace};
 
-const GREEN: Yuv = Yuv::new(100, 110, 100);
-const ORANGE: Yuv = Yuv::new(120, 80, 190);
-const YELLOW: Yuv = Yuv::new(190, 40, 150);
+use crate::common::repo_file;
+use crate::harness::{
+    GREEN, click_label, close_window, fixture, fixture_files, harness_sized, opened_fixture,
+    show_window, workspace,
+};
 
-fn repo_file(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+/// The app in a 1280 × 800 window (the docked windows need the width).
+fn wide_harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
+    harness_sized(paths, Vec2::new(1280.0, 800.0))
 }
 
 /// The shipped B-Human stream, its table and the 2009 SPL parameters.
@@ -275,44 +278,11 @@ fn try_params_lists_the_frames_whose_recognition_changes() {
     let t = s.params_slot().try_run.as_ref().unwrap();
     assert_eq!(t.changes.len(), 1, "{:?}", t.changes);
     assert!(t.changes[0].contains("goals.distance_multiplier"));
+    let t = &t.stream;
     assert!(t.rows.iter().any(|r| r.index == 5), "{:?}", t.rows);
     assert!(t.rows.iter().all(|r| r.before != r.after));
     // Frames without a goal do not change: not every frame is listed.
     assert!(t.rows.len() < t.total, "{} of {}", t.rows.len(), t.total);
-}
-
-/// Three frame files and a 7-bit table with green and yellow classified, orange not.
-fn fixture(dir: &Path) -> (Vec<PathBuf>, PathBuf) {
-    let mut frames = Vec::new();
-    for n in 0..3 {
-        let p = dir.join(format!("f{n}.uyvy"));
-        let f = Frame::uyvy_from_fn(208, 160, |x, y| {
-            let bx = 60 + 10 * n;
-            if (bx..bx + 20).contains(&x) && (40..60).contains(&y) {
-                ORANGE
-            } else if x < 12 && (20..100).contains(&y) {
-                YELLOW
-            } else {
-                GREEN
-            }
-        })
-        .unwrap();
-        std::fs::write(&p, f.data()).unwrap();
-        frames.push(p);
-    }
-    let mut lut = LookupTable::new(7).unwrap();
-    for (class, sample) in [(ColourClass::Green, GREEN), (ColourClass::Yellow, YELLOW)] {
-        lut.apply(EditRecord::now(
-            class,
-            Region::AroundSample {
-                sample,
-                sensitivity: Sensitivity::uniform(2),
-            },
-        ));
-    }
-    let table = dir.join("field.lut");
-    lut.save(&table).unwrap();
-    (frames, table)
 }
 
 #[test]
@@ -343,11 +313,7 @@ fn each_file_opens_or_fails_on_its_own() {
 #[test]
 fn selection_and_try_edit_count_the_same_pixels() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut s = Workspace::default();
-    let mut paths = frames;
-    paths.push(table);
-    s.apply(Command::Open(paths)).unwrap();
+    let mut s = opened_fixture(dir.path());
     // Green over the ball with a reach that takes in every colour of the frame: the field is
     // selected too, but it is green already.
     s.apply(Command::SetClass(ColourClass::Green)).unwrap();
@@ -360,7 +326,7 @@ fn selection_and_try_edit_count_the_same_pixels() {
     while !s.try_edit().unwrap().done() {
         s.tick(std::time::Duration::from_millis(16));
     }
-    let row = s.try_edit().unwrap().rows[0];
+    let row = s.try_edit().unwrap().stream.rows[0];
     assert_eq!(row.index, 0);
     assert_eq!(row.changed_pixels, changing);
     assert_eq!(changing, 400 + 12 * 80, "the ball and the goal bar");
@@ -418,20 +384,10 @@ fn a_black_preview_shows_on_dark_pixels() {
     assert!(luma(img.pixels[45 * 208 + 65]) > 100.0);
 }
 
-fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
-    Harness::builder()
-        .with_size(Vec2::new(1280.0, 800.0))
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
-}
-
-fn ws<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
-    &h.state().state
-}
-
 #[test]
 fn windows_opened_one_after_another_are_stacked_and_seen_together() {
     let (stream, table, params) = bhuman();
-    let mut h = harness(vec![stream, table, params]);
+    let mut h = wide_harness(vec![stream, table, params]);
     h.run_steps(2);
     let stacked = [Window::Sensors, Window::UvPlane, Window::Inspector];
     for w in stacked {
@@ -462,7 +418,7 @@ fn windows_opened_one_after_another_are_stacked_and_seen_together() {
 #[test]
 fn windows_dock_beside_the_image_and_the_parameters_window_works() {
     let (stream, table, params) = bhuman();
-    let mut h = harness(vec![stream, table, params]);
+    let mut h = wide_harness(vec![stream, table, params]);
     h.run();
     let full = h.state().last_view.expect("the image is drawn").view;
     for w in [Window::Parameters, Window::UvPlane, Window::Inspector] {
@@ -484,11 +440,10 @@ fn windows_dock_beside_the_image_and_the_parameters_window_works() {
         h.query_by_label_contains("Parameters: spl2009.json")
             .is_some()
     );
-    h.get_by_label("Defaults").click();
-    h.run();
-    assert!(ws(&h).params_slot().path.is_none());
+    click_label(&mut h, "Defaults");
+    assert!(workspace(&h).params_slot().path.is_none());
     assert_eq!(
-        *ws(&h).recognition_params(),
+        *workspace(&h).recognition_params(),
         eotn::recognition::RecognitionParams::default()
     );
     // Closing a window through its command removes its tab; the image grows back.
@@ -507,15 +462,10 @@ fn windows_dock_beside_the_image_and_the_parameters_window_works() {
 #[test]
 fn try_edit_window_says_what_to_do_before_a_run_and_rows_click_whole() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut paths = frames;
-    paths.push(table);
-    let mut h = harness(paths);
+    let paths = fixture_files(dir.path());
+    let mut h = wide_harness(paths);
     h.run();
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::TryEdit, true));
-    h.run();
+    show_window(&mut h, Window::TryEdit);
     assert!(h.query_by_label_contains("No check yet").is_some());
     h.state_mut()
         .state
@@ -528,15 +478,15 @@ fn try_edit_window_says_what_to_do_before_a_run_and_rows_click_whole() {
         h.run();
     }
     assert!(
-        ws(&h)
+        workspace(&h)
             .try_edit()
             .is_some_and(eotn::workspace::TryEdit::done)
     );
-    assert_eq!(ws(&h).index(), 0);
+    assert_eq!(workspace(&h).index(), 0);
     // A click in the middle of the row (not on its frame number) shows the frame.
     h.get_by_label_contains("frame     2").click();
     h.run();
-    assert_eq!(ws(&h).index(), 2);
+    assert_eq!(workspace(&h).index(), 2);
 }
 
 #[test]
@@ -558,21 +508,17 @@ fn closing_the_inspector_clears_its_highlight() {
 #[test]
 fn small_things_last_frame_escape_one_warning() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut paths = frames;
-    paths.push(table);
-    let mut h = harness(paths);
+    let paths = fixture_files(dir.path());
+    let mut h = wide_harness(paths);
     h.run();
     // Stream ▸ Last frame.
-    h.get_by_label("Stream").click();
-    h.run();
+    click_label(&mut h, "Stream");
     h.get_by_label_contains("Last frame").click();
     h.run();
-    assert_eq!(ws(&h).index(), 2);
+    assert_eq!(workspace(&h).index(), 2);
     // Escape closes an open menu (and keeps the selection while it does).
     h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
-    h.get_by_label("File").click();
-    h.run();
+    click_label(&mut h, "File");
     assert!(h.query_by_label("Open parameters…").is_some());
     h.key_press(Key::Escape);
     h.run();
@@ -581,11 +527,11 @@ fn small_things_last_frame_escape_one_warning() {
         h.query_by_label("Open parameters…").is_none(),
         "the menu closed"
     );
-    assert!(ws(&h).selection().is_some());
+    assert!(workspace(&h).selection().is_some());
     h.key_press(Key::Escape);
     h.run();
     assert!(
-        ws(&h).selection().is_none(),
+        workspace(&h).selection().is_none(),
         "then Escape drops the selection"
     );
     // "1 warning", not "1 warnings".
@@ -600,7 +546,7 @@ fn small_things_last_frame_escape_one_warning() {
 fn quit_without_saving_keeps_the_undo_history_and_warns_of_no_crash() {
     let dir = tempfile::tempdir().unwrap();
     let (frames, table) = fixture(dir.path());
-    let mut h = harness(vec![frames[0].clone(), table.clone()]);
+    let mut h = wide_harness(vec![frames[0].clone(), table.clone()]);
     h.run();
     // One saved edit, then one that is not saved.
     h.state_mut()
@@ -616,17 +562,11 @@ fn quit_without_saving_keeps_the_undo_history_and_warns_of_no_crash() {
     h.state_mut().state.run(Command::Sample { x: 150, y: 120 });
     h.state_mut().state.run(Command::Commit);
     h.run();
-    assert!(ws(&h).dirty());
-    h.input_mut()
-        .viewports
-        .entry(egui::ViewportId::ROOT)
-        .or_default()
-        .events
-        .push(egui::ViewportEvent::Close);
+    assert!(workspace(&h).dirty());
+    close_window(&mut h);
     h.run();
-    h.get_by_label("Quit without saving").click();
-    h.run();
-    assert!(!ws(&h).dirty());
+    click_label(&mut h, "Quit without saving");
+    assert!(!workspace(&h).dirty());
     assert_eq!(
         std::fs::read(&table).unwrap(),
         saved,
@@ -686,13 +626,10 @@ fn file_open_table_shows_the_in_app_dialog() {
         .with_accessibility_check(false)
         .build_eframe(move |cc| EotnApp::new(cc, paths.clone()));
     h.run();
-    h.get_by_label("File").click();
-    h.run();
-    h.get_by_label("Open table…").click();
-    h.run();
+    click_label(&mut h, "File");
+    click_label(&mut h, "Open table…");
     assert_eq!(h.state().file_dialogs.shown(), Some(FileAction::OpenTable));
     assert!(h.query_by_label_contains("Cancel").is_some());
-    h.get_by_label("Cancel").click();
-    h.run();
+    click_label(&mut h, "Cancel");
     assert_eq!(h.state().file_dialogs.shown(), None);
 }

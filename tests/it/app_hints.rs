@@ -4,19 +4,23 @@
 //! bookmarks on the timeline).
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
-use egui::{Event, Key, Modifiers, Pos2, Vec2};
-use egui_kittest::Harness;
+use egui::{Event, Key, Modifiers};
 use egui_kittest::kittest::Queryable as _;
-use eotn::app::EotnApp;
 use eotn::frame::{Frame, Yuv};
 use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
 use eotn::workspace::bookmarks::{EventKind, bookmarks_path};
 use eotn::workspace::cell_origin::CellOrigin;
 use eotn::workspace::{Command, Window, Workspace};
 
-const GREEN: Yuv = Yuv::new(100, 110, 100);
-const ORANGE: Yuv = Yuv::new(120, 80, 190);
+use crate::harness::{
+    GREEN, ORANGE, click_label, harness, pixel_pos, run_until, show_window, workspace,
+};
+
+/// How long a background scan may take.
+const WITHIN: Duration = Duration::from_secs(60);
+
 const PINK: Yuv = Yuv::new(170, 150, 200);
 
 /// 208×160 green; an orange 20×20 ball on frames 1 and 2 (not 0); a pink 10×10 patch on all.
@@ -56,61 +60,30 @@ fn fixture(dir: &Path) -> Vec<PathBuf> {
     paths
 }
 
-fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
-    Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
-}
-
-fn state<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
-    &h.state().state
-}
-
-fn pixel_pos(h: &Harness<'_, EotnApp>, x: usize, y: usize) -> Pos2 {
-    h.state()
-        .last_view
-        .expect("the view was drawn")
-        .pixel_centre(x, y)
-}
-
-/// Runs UI frames until `done` (at most 200).
-fn run_until(h: &mut Harness<'_, EotnApp>, done: impl Fn(&Workspace) -> bool) {
-    for _ in 0..200 {
-        if done(state(h)) {
-            return;
-        }
-        h.run();
-    }
-    panic!("a scan did not finish");
-}
-
 #[test]
 fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(fixture(dir.path()));
     h.run();
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Coverage, true));
+    show_window(&mut h, Window::Coverage);
+    click_label(&mut h, "Find unclassified");
+    run_until(&mut h, WITHIN, |a| {
+        a.state.coverage().is_some_and(|c| c.done())
+    });
     h.run();
-    h.get_by_label("Find unclassified").click();
-    h.run();
-    run_until(&mut h, |s| s.coverage().is_some_and(|c| c.done()));
-    h.run();
-    let scan = state(&h).coverage().unwrap();
+    let scan = workspace(&h).coverage().unwrap();
     // Orange: 2 frames × 400 pixels; pink: 3 × 100. Green is classified.
     let pixels: Vec<u64> = scan.hints().iter().map(|x| x.pixels).collect();
     assert_eq!(pixels, vec![800, 300], "{:?}", scan.hints());
     assert_eq!(scan.unclassified_pixels(), 1100);
     let orange_cells = scan.hints()[0].cells.clone();
-    assert_eq!(orange_cells, vec![state(&h).lut().index(ORANGE)]);
+    assert_eq!(orange_cells, vec![workspace(&h).lut().index(ORANGE)]);
 
     // Clicking the first hint selects its cells and previews its pixels in the image.
     h.state_mut().state.run(Command::Seek(1));
     h.run();
-    h.get_by_label("hint 1").click();
-    h.run();
-    let previewed = state(&h).preview_mask().iter().filter(|&&m| m).count();
+    click_label(&mut h, "hint 1");
+    let previewed = workspace(&h).preview_mask().iter().filter(|&&m| m).count();
     assert_eq!(previewed, 400, "the ball's pixels are previewed");
     h.state_mut()
         .state
@@ -118,12 +91,11 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     // The class panel scrolls: bring its Commit button into view first, as a user would.
     h.get_by_label("Commit").scroll_to_me();
     h.run();
-    h.get_by_label("Commit").click();
-    h.run();
-    assert_eq!(state(&h).lut().class_of(ORANGE), ColourClass::Orange);
+    click_label(&mut h, "Commit");
+    assert_eq!(workspace(&h).lut().class_of(ORANGE), ColourClass::Orange);
     // The hints re-rank at once: orange is classified now, pink is left.
     h.run();
-    let pixels: Vec<u64> = state(&h)
+    let pixels: Vec<u64> = workspace(&h)
         .coverage()
         .unwrap()
         .hints()
@@ -133,7 +105,7 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     assert_eq!(pixels, vec![300]);
 
     // Why is the ball orange? The hint's edit. Why is a pink pixel unclassified? As loaded.
-    let origin = state(&h).pixel_origin(75, 45).unwrap();
+    let origin = workspace(&h).pixel_origin(75, 45).unwrap();
     let CellOrigin::Edit(e) = origin else {
         panic!("the commit set the ball's cell: {origin:?}");
     };
@@ -141,7 +113,10 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
         (e.number, e.class, e.picked_cells),
         (1, ColourClass::Orange, Some(1))
     );
-    assert_eq!(state(&h).pixel_origin(155, 105), Some(CellOrigin::AsLoaded));
+    assert_eq!(
+        workspace(&h).pixel_origin(155, 105),
+        Some(CellOrigin::AsLoaded)
+    );
     // A sampled commit records its frame and pixel, shown when hovering.
     h.state_mut().state.run(Command::Sample { x: 155, y: 105 });
     h.state_mut()
@@ -170,10 +145,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     lut.save(&paths[3]).unwrap();
     let mut h = harness(paths.clone());
     h.run();
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Bookmarks, true));
-    h.run();
+    show_window(&mut h, Window::Bookmarks);
     // A bookmark with a note on frame 2, saved beside the first frame file.
     h.state_mut().state.run(Command::Seek(2));
     h.run();
@@ -181,8 +153,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     field.focus();
     field.type_text("ball near the line");
     h.run();
-    h.get_by_label("Bookmark this frame").click();
-    h.run();
+    click_label(&mut h, "Bookmark this frame");
     let file = bookmarks_path(&paths[0]);
     let text = std::fs::read_to_string(&file).expect("saved");
     assert!(
@@ -195,12 +166,13 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     h.run();
     h.key_press_modifiers(Modifiers::COMMAND, Key::ArrowRight);
     h.run();
-    assert_eq!(state(&h).index(), 2);
+    assert_eq!(workspace(&h).index(), 2);
 
-    h.get_by_label("Find events").click();
-    h.run();
-    run_until(&mut h, |s| s.event_scan().is_some_and(|e| e.done()));
-    let kinds: Vec<(usize, EventKind)> = state(&h)
+    click_label(&mut h, "Find events");
+    run_until(&mut h, WITHIN, |a| {
+        a.state.event_scan().is_some_and(|e| e.done())
+    });
+    let kinds: Vec<(usize, EventKind)> = workspace(&h)
         .events()
         .iter()
         .map(|e| (e.frame, e.kind))
@@ -214,25 +186,22 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     // Jumps: from 0 the next mark is the event at 1, then the bookmark at 2; and back.
     h.state_mut().state.run(Command::Seek(0));
     h.run();
-    h.get_by_label("Next mark").click();
-    h.run();
-    assert_eq!(state(&h).index(), 1);
-    h.get_by_label("Next mark").click();
-    h.run();
-    assert_eq!(state(&h).index(), 2);
-    h.get_by_label("Previous mark").click();
-    h.run();
-    assert_eq!(state(&h).index(), 1);
+    click_label(&mut h, "Next mark");
+    assert_eq!(workspace(&h).index(), 1);
+    click_label(&mut h, "Next mark");
+    assert_eq!(workspace(&h).index(), 2);
+    click_label(&mut h, "Previous mark");
+    assert_eq!(workspace(&h).index(), 1);
 
     // Reopening finds the bookmark; removing it saves the file again.
     drop(h);
     let mut h = harness(paths);
     h.run();
-    assert_eq!(state(&h).bookmarks().len(), 1);
-    assert_eq!(state(&h).bookmarks()[0].note, "ball near the line");
+    assert_eq!(workspace(&h).bookmarks().len(), 1);
+    assert_eq!(workspace(&h).bookmarks()[0].note, "ball near the line");
     h.state_mut().state.run(Command::RemoveBookmark(2));
     h.run();
-    assert!(state(&h).bookmarks().is_empty());
+    assert!(workspace(&h).bookmarks().is_empty());
     assert!(!std::fs::read_to_string(&file).unwrap().contains("line"));
     // A damaged bookmarks file is a warning, not a failure to open.
     std::fs::write(&file, "not json").unwrap();

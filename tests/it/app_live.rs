@@ -3,78 +3,53 @@
 //! Camera ▸ Connect to robot…: two robots at once in the robots window, clicking one shows it,
 //! the Live switch holds the view while frames keep arriving, Record all writes one file each.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use egui::Vec2;
-use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use eotn::app::EotnApp;
 use eotn::sources::{CameraKind, SourceKind};
 use eotn::workspace::Window;
 
-use crate::live::{serve, sim_stream};
+use crate::common::sim_stream;
+use crate::harness::{click_label, harness, harness_sized, run_steps_until, run_until};
+use crate::live::serve;
+
+/// How long a robot may take to deliver what a step waits for.
+const WITHIN: Duration = Duration::from_secs(30);
 
 #[test]
 fn camera_connect_to_a_robot_served_by_eotn_serve_shows_its_frames() {
     let dir = tempfile::tempdir().unwrap();
-    let stream = sim_stream(dir.path(), 10);
+    let stream = sim_stream(dir.path(), "walk-and-pan", 10, None);
     let served = serve(&stream, "127.0.0.1:0", &["--loop"]);
-    let mut h: Harness<'static, EotnApp> = Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .build_eframe(|cc| EotnApp::new(cc, Vec::new()));
+    let mut h = harness(Vec::new());
     h.run();
-    h.get_by_label("Camera").click();
-    h.run();
-    h.get_by_label("Connect…").click();
-    h.run();
+    click_label(&mut h, "Camera");
+    click_label(&mut h, "Connect…");
     assert!(h.state().state.window_open(Window::Connect));
-    h.get_by_label("network").click();
-    h.run();
+    click_label(&mut h, "network");
     h.state_mut().camera.address.clear();
     h.run();
     let field = h.get_by_label("address");
     field.focus();
     field.type_text(&format!("ws://127.0.0.1:{}", served.port));
     h.run();
-    h.get_by_label("Connect").click();
-    h.run();
+    click_label(&mut h, "Connect");
     // Connect… ▸ network puts the robot into the robots list, shown at once.
     let frames = |a: &EotnApp| a.state.robots().first().map_or(0, |r| r.stats.frames);
-    let start = Instant::now();
-    while frames(h.state()) < 5 || h.state().state.frame().is_none() {
-        assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "{:?}",
-            h.state().state.warnings()
-        );
-        h.run();
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    run_until(&mut h, WITHIN, |a| {
+        frames(a) >= 5 && a.state.frame().is_some()
+    });
     let info = h.state().state.connected_info().unwrap();
     assert_eq!(info.kind, SourceKind::Network);
     assert!(info.label.starts_with("robot "), "{}", info.label);
     assert_eq!(h.state().state.camera_kind(), CameraKind::Robot);
     assert!(h.state().state.shown_robot().is_some());
-    h.get_by_label("Camera").click();
-    h.run();
-    h.get_by_label("Disconnect").click();
-    h.run();
+    click_label(&mut h, "Camera");
+    click_label(&mut h, "Disconnect");
     assert!(h.state().state.robots().is_empty());
     assert!(h.state().state.connected_info().is_none());
-}
-
-/// Runs the app until `done` holds, at most 30 s.
-fn run_until(h: &mut Harness<'static, EotnApp>, done: impl Fn(&EotnApp) -> bool) {
-    let start = Instant::now();
-    while !done(h.state()) {
-        assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "{:?}",
-            h.state().state.warnings()
-        );
-        h.run_steps(4);
-        std::thread::sleep(Duration::from_millis(10));
-    }
 }
 
 fn robot_frames(a: &EotnApp, name: &str) -> usize {
@@ -88,12 +63,10 @@ fn robot_frames(a: &EotnApp, name: &str) -> usize {
 #[test]
 fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows_it() {
     let dir = tempfile::tempdir().unwrap();
-    let stream = sim_stream(dir.path(), 10);
+    let stream = sim_stream(dir.path(), "walk-and-pan", 10, None);
     let alpha = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "alpha"]);
     let bravo = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "bravo"]);
-    let mut h: Harness<'static, EotnApp> = Harness::builder()
-        .with_size(Vec2::new(1280.0, 800.0))
-        .build_eframe(|cc| EotnApp::new(cc, Vec::new()));
+    let mut h = harness_sized(Vec::new(), Vec2::new(1280.0, 800.0));
     h.run_steps(4);
     h.get_by_label("Camera").click();
     h.run_steps(4);
@@ -110,7 +83,7 @@ fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows
         h.get_by_label("Connect robot").click();
         h.run_steps(4);
     }
-    run_until(&mut h, |a| {
+    run_steps_until(&mut h, WITHIN, |a| {
         robot_frames(a, "alpha") >= 3 && robot_frames(a, "bravo") >= 3
     });
     let rows = h.state().state.robots();
@@ -130,17 +103,17 @@ fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows
     );
     // Alpha, not shown, keeps receiving.
     let before = robot_frames(h.state(), "alpha");
-    run_until(&mut h, |a| robot_frames(a, "alpha") > before + 2);
+    run_steps_until(&mut h, WITHIN, |a| robot_frames(a, "alpha") > before + 2);
 
     // The Live switch holds the view; frames keep arriving; Live again shows the newest.
-    run_until(&mut h, |a| a.state.frame().is_some());
+    run_steps_until(&mut h, WITHIN, |a| a.state.frame().is_some());
     // (The switch is in the timeline and in the robots window.)
     h.get_all_by_label("Live").next().unwrap().click();
     h.run_steps(4);
     assert!(!h.state().state.following_live());
     let held = h.state().state.index();
     let received = robot_frames(h.state(), "bravo");
-    run_until(&mut h, |a| robot_frames(a, "bravo") > received + 2);
+    run_steps_until(&mut h, WITHIN, |a| robot_frames(a, "bravo") > received + 2);
     assert_eq!(h.state().state.index(), held, "the view is held");
     h.get_all_by_label("Live").next().unwrap().click();
     h.run_steps(4);
@@ -153,7 +126,7 @@ fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows
     h.run_steps(4);
     h.get_by_label("Record all").click();
     h.run_steps(4);
-    run_until(&mut h, |a| {
+    run_steps_until(&mut h, WITHIN, |a| {
         a.state
             .robots()
             .iter()

@@ -8,24 +8,21 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use egui::{Event, Modifiers, PointerButton, Pos2, Vec2};
-use egui_kittest::Harness;
+use egui::{PointerButton, Pos2};
 use egui_kittest::kittest::Queryable as _;
-use eotn::app::EotnApp;
 use eotn::app::field_view::FieldTransform;
 use eotn::geometry::{ImagePoint, Point};
 use eotn::overhead::calibration::Calibration;
 use eotn::overhead::{FieldDescription, PointsFile};
 use eotn::sim::truth::{GroundTruth, OverheadTruth};
 use eotn::sources::CameraKind;
-use eotn::streams::{FrameRecord, StreamInfo, StreamReader, StreamWriter};
+use eotn::streams::{FrameRecord, StreamReader};
 use eotn::workspace::{
     CalibrationSource, Command, OverheadCommand, RobotKey, ViewKind, Window, Workspace,
 };
 
-fn repo_file(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
+use crate::common::{repo_file, sim_stream};
+use crate::harness::{click_at, click_label, harness_with, show_window, write_stream};
 
 /// An overhead-game stream of 4 frames rendered once for every test (markers, truth, world
 /// models), and a table learnt from its own labels.
@@ -33,18 +30,7 @@ fn fixture() -> (&'static PathBuf, &'static PathBuf) {
     static FIXTURE: OnceLock<(tempfile::TempDir, PathBuf, PathBuf)> = OnceLock::new();
     let (_, stream, table) = FIXTURE.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
-        let stream = dir.path().join("overhead.mcap");
-        crate::common::eotn_ok(&[
-            "sim".as_ref(),
-            "--scenario".as_ref(),
-            "overhead-game".as_ref(),
-            "--frames".as_ref(),
-            "4".as_ref(),
-            "--seed".as_ref(),
-            "3".as_ref(),
-            "-o".as_ref(),
-            stream.as_os_str(),
-        ]);
+        let stream = sim_stream(dir.path(), "overhead-game", 4, Some(3));
         let table = dir.path().join("overhead.lut");
         let sim = eotn::sim::Simulator::new(eotn::sim::Scenario::new(
             eotn::sim::ScenarioKind::OverheadGame,
@@ -161,18 +147,11 @@ fn a_robot_stream_keeps_the_robot_recogniser() {
 fn stream_without_truth(dir: &Path) -> PathBuf {
     let (stream, _) = fixture();
     let mut reader = StreamReader::open(stream).unwrap();
-    let out = dir.join("real.mcap");
-    let info = StreamInfo {
-        source: "overhead camera".into(),
-        description: "no truth".into(),
-    };
-    let mut writer = StreamWriter::create(&out, &info).unwrap();
-    for i in 0..2 {
+    let records = (0..2).map(|i| {
         let r = reader.read(i).unwrap();
-        writer.write(&FrameRecord::new(r.time_ns, r.frame)).unwrap();
-    }
-    writer.finish().unwrap();
-    out
+        FrameRecord::new(r.time_ns, r.frame)
+    });
+    write_stream(&dir.join("real.mcap"), "overhead camera", records)
 }
 
 #[test]
@@ -380,31 +359,12 @@ fn world_models_are_compared_with_the_overhead_robots() {
     assert!(model.trails().values().any(|t| t.len() == 3));
 }
 
-fn harness(w: Workspace) -> Harness<'static, EotnApp> {
-    let mut cell = Some(w);
-    Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .build_eframe(move |_| EotnApp::with_state(cell.take().unwrap_or_default()))
-}
-
-fn click_at(h: &Harness<'_, EotnApp>, pos: Pos2) {
-    h.event(Event::PointerMoved(pos));
-    for pressed in [true, false] {
-        h.event(Event::PointerButton {
-            pos,
-            button: PointerButton::Primary,
-            pressed,
-            modifiers: Modifiers::NONE,
-        });
-    }
-}
-
 #[test]
 fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
     let (stream, _) = fixture();
     let w = opened();
     let clicks = true_clicks(stream);
-    let mut h = harness(w);
+    let mut h = harness_with(w);
     h.run();
     let first = clicks[0].0.clone();
     h.state_mut()
@@ -428,7 +388,11 @@ fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
             h.run();
         }
         let xf = h.state().last_view.expect("the view was drawn");
-        click_at(&h, xf.to_screen(Pos2::new(p.x_px as f32, p.y_px as f32)));
+        click_at(
+            &h,
+            xf.to_screen(Pos2::new(p.x_px as f32, p.y_px as f32)),
+            PointerButton::Primary,
+        );
         h.run();
         assert_eq!(h.state().state.overhead().points().points.len(), k + 1);
         assert!(
@@ -456,12 +420,8 @@ fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
         assert!(got.distance_to(p) < 1.5, "{name}: {got:?} vs {p:?}");
     }
     // The window docks beside the image; its buttons fit the column (no sideways scrolling).
-    h.state_mut()
-        .state
-        .run(Command::ShowWindow(Window::Calibration, true));
-    h.run();
-    h.get_by_label("Undo pick").click();
-    h.run();
+    show_window(&mut h, Window::Calibration);
+    click_label(&mut h, "Undo pick");
     assert_eq!(
         h.state().state.overhead().points().points.len(),
         clicks.len() - 1
@@ -500,12 +460,12 @@ fn clicking_a_robot_in_the_field_view_selects_it_everywhere() {
         team: robot.team,
         identity: robot.identity,
     };
-    let mut h = harness(w);
+    let mut h = harness_with(w);
     h.run();
     h.run();
     let rect = h.get_by_label("field drawing").rect();
     let xf = FieldTransform::fit(rect, h.state().state.overhead().field());
-    click_at(&h, xf.to_screen(robot.field_cm));
+    click_at(&h, xf.to_screen(robot.field_cm), PointerButton::Primary);
     h.run();
     assert_eq!(h.state().state.overhead().selected(), Some(key));
     // The inspector lists it selected; clicking it there clears the selection.

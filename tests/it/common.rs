@@ -117,3 +117,32 @@ fn python_with(import_line: &str, packages: &str, check: &str) -> Option<PathBuf
     eprintln!("SKIPPED: python3 with {packages} not found; {check} did not run");
     None
 }
+
+/// A file of the repository (sample streams, tables, parameters).
+pub fn repo_file(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// A stream of `frames` frames of `scenario` made by `eotn sim` in `dir` (with `--seed` when
+/// given): `SCENARIO.mcap`, or `SCENARIO-SEED.mcap` with a seed.
+pub fn sim_stream(dir: &Path, scenario: &str, frames: usize, seed: Option<u64>) -> PathBuf {
+    let out = dir.join(match seed {
+        Some(seed) => format!("{scenario}-{seed}.mcap"),
+        None => format!("{scenario}.mcap"),
+    });
+    let frames = frames.to_string();
+    let seed = seed.map(|s| s.to_string());
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "sim".as_ref(),
+        "--scenario".as_ref(),
+        scenario.as_ref(),
+        "--frames".as_ref(),
+        frames.as_ref(),
+    ];
+    if let Some(seed) = &seed {
+        args.extend([std::ffi::OsStr::new("--seed"), std::ffi::OsStr::new(seed)]);
+    }
+    args.extend(["-o".as_ref(), out.as_os_str()]);
+    eotn_ok(&args);
+    out
+}

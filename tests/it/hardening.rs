@@ -6,7 +6,7 @@ use std::io::{BufRead as _, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use crate::common::{eotn, eotn_ok};
+use crate::common::{eotn, eotn_ok, sim_stream};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -24,21 +24,6 @@ fn fails(args: &[&OsStr]) -> String {
     let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("eotn:")).collect();
     assert_eq!(lines.len(), 1, "one error line expected: {err}");
     err
-}
-
-/// A stream of `frames` walk-and-pan frames in three chunks or more.
-fn sim_stream(dir: &Path, frames: u32) -> PathBuf {
-    let p = dir.join("walk.mcap");
-    eotn_ok(&[
-        "sim".as_ref(),
-        "--scenario".as_ref(),
-        "walk-and-pan".as_ref(),
-        "--frames".as_ref(),
-        frames.to_string().as_ref(),
-        "-o".as_ref(),
-        p.as_os_str(),
-    ]);
-    p
 }
 
 #[test]
@@ -133,7 +118,7 @@ fn commands_refuse_to_replace_their_own_inputs() {
 #[test]
 fn a_damaged_chunk_costs_only_its_frames_with_a_warning_naming_them() {
     let dir = tempfile::tempdir().unwrap();
-    let good = sim_stream(dir.path(), 40);
+    let good = sim_stream(dir.path(), "walk-and-pan", 40, None);
     let mut bytes = std::fs::read(&good).unwrap();
     let middle = bytes.len() / 2;
     bytes[middle] ^= 0xff;
@@ -171,7 +156,7 @@ fn a_damaged_chunk_costs_only_its_frames_with_a_warning_naming_them() {
 #[test]
 fn a_partial_stream_left_by_a_crash_opens_by_its_own_name_and_can_be_finished() {
     let dir = tempfile::tempdir().unwrap();
-    let good = sim_stream(dir.path(), 40);
+    let good = sim_stream(dir.path(), "walk-and-pan", 40, None);
     let bytes = std::fs::read(&good).unwrap();
     // A writer killed after its second chunk: no summary, the rest cut off.
     let partial = dir.path().join("rec.mcap.partial");

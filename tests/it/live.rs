@@ -5,7 +5,7 @@
 use std::ffi::OsStr;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{TcpListener, TcpStream};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -20,7 +20,7 @@ use eotn::streams::schema::{ImageEncoding, encode_image, raw_image_schema};
 use eotn::streams::{FrameRecord, StreamReader};
 use tungstenite::Message;
 
-use crate::common::{eotn_ok, python_with_foxglove};
+use crate::common::{eotn_ok, python_with_foxglove, sim_stream};
 
 /// A small frame whose every byte depends on the frame number, so mix-ups show.
 pub fn frame(i: usize) -> Frame {
@@ -313,21 +313,6 @@ fn four_robots_at_30_fps_lose_no_frame_and_keep_up() {
     }
 }
 
-/// A stream made by `eotn sim` in `dir`.
-pub fn sim_stream(dir: &Path, frames: usize) -> PathBuf {
-    let path = dir.join("walk.mcap");
-    eotn_ok(&[
-        OsStr::new("sim"),
-        OsStr::new("--scenario"),
-        OsStr::new("walk-and-pan"),
-        OsStr::new("--frames"),
-        OsStr::new(&frames.to_string()),
-        OsStr::new("-o"),
-        path.as_os_str(),
-    ]);
-    path
-}
-
 /// `eotn serve` in the background; its port, read from its first line.
 pub struct Served {
     child: Child,
@@ -378,7 +363,7 @@ pub fn image_payloads(path: &Path) -> Vec<Vec<u8>> {
 #[test]
 fn frames_from_eotn_serve_are_recorded_bit_exact_by_eotn_record() {
     let dir = tempfile::tempdir().unwrap();
-    let stream = sim_stream(dir.path(), 12);
+    let stream = sim_stream(dir.path(), "walk-and-pan", 12, None);
     let served = serve(&stream, "127.0.0.1:0", &["--wait"]);
     let out = dir.path().join("rec.mcap");
     let address = format!("ws://127.0.0.1:{}", served.port);
@@ -426,7 +411,7 @@ pub fn free_port() -> u16 {
 fn a_sender_that_stops_and_comes_back_is_reconnected_and_a_killed_recorder_leaves_a_readable_file()
 {
     let dir = tempfile::tempdir().unwrap();
-    let stream = sim_stream(dir.path(), 10);
+    let stream = sim_stream(dir.path(), "walk-and-pan", 10, None);
     let port = free_port();
     let listen = format!("127.0.0.1:{port}");
     let first = serve(&stream, &listen, &["--loop"]);

@@ -18,6 +18,8 @@ mod cli;
 mod common;
 mod crash_safety;
 mod hardening;
+#[cfg(feature = "gui")]
+mod harness;
 mod live;
 mod motion;
 mod overhead;

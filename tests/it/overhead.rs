@@ -16,7 +16,7 @@ use eotn::overhead::{
 use eotn::sim::truth::{GroundTruth, OverheadTruth};
 use eotn::sim::{Scenario, ScenarioKind, SimFrame, Simulator};
 
-use crate::common::eotn_ok;
+use crate::common::{eotn_ok, sim_stream};
 
 fn overhead_truth(f: &SimFrame) -> &OverheadTruth {
     match &f.ground_truth {
@@ -153,26 +153,10 @@ fn calibrated_from_noisy_clicks_the_overhead_recogniser_meets_the_figures() {
     assert!(r.robots_false <= frames.len() / 20, "{r:?}");
 }
 
-fn sim_stream(dir: &Path, seed: &str) -> std::path::PathBuf {
-    let out = dir.join(format!("overhead-{seed}.mcap"));
-    eotn_ok(&[
-        OsStr::new("sim"),
-        OsStr::new("--scenario"),
-        OsStr::new("overhead-game"),
-        OsStr::new("--frames"),
-        OsStr::new("3"),
-        OsStr::new("--seed"),
-        OsStr::new(seed),
-        OsStr::new("-o"),
-        out.as_os_str(),
-    ]);
-    out
-}
-
 #[test]
 fn the_overhead_command_line_calibrates_detects_and_evaluates() {
     let dir = tempfile::tempdir().unwrap();
-    let stream = sim_stream(dir.path(), "4");
+    let stream = sim_stream(dir.path(), "overhead-game", 3, Some(4));
     // `eotn sim`'s overhead scene puts a marker on every robot, with its truth.
     let mut reader = eotn::streams::StreamReader::open(&stream).unwrap();
     for i in 0..reader.len() {

@@ -13,7 +13,7 @@ use eotn::import::bhuman;
 use eotn::lut::convert::{Converted, SourceFormat, convert_file};
 use eotn::lut::{ColourClass, LookupTable};
 
-use crate::common::shared_file;
+use crate::common::{repo_file, shared_file};
 
 fn convert(rel: &str, format: SourceFormat) -> Option<Converted> {
     let path = shared_file(rel)?;
@@ -461,10 +461,6 @@ fn bhuman_camera_matrices_give_the_naos_pose_and_horizon() {
 }
 
 /// A file of this repository.
-fn repo_file(relative: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
-
 /// Recognition on the shipped B-Human stream scored against its hand labels.
 fn bhuman_labels_report(
     params: eotn::recognition::RecognitionParams,

@@ -9,15 +9,10 @@
 //! streams. Review a change with `cargo insta review` (or `INSTA_UPDATE=always` and `git diff`).
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
 
 use serde_json::Value;
 
-use crate::common::eotn_ok;
-
-fn repo_file(relative: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
+use crate::common::{eotn_ok, repo_file};
 
 /// The parsed `eotn detect --json` lines of `stream` with `lut` (and `extra` arguments).
 fn detect_lines(stream: &str, lut: &str, extra: &[&str]) -> Vec<Value> {
