@@ -11,17 +11,16 @@ use egui::{Color32, RichText, Ui};
 use crate::frame::PixelBox;
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
-use crate::recognition::draw::owner;
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::scan::CutOff;
-use crate::recognition::{Recognition, Relative};
+use crate::recognition::{ObjectId, Recognition, Relative};
 use crate::workspace::{Command, Workspace};
 
 /// One candidate as the inspector lists it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CandidateInfo {
-    /// The owner its primitives carry (`"ball#0"`, `"goal:yellow#1"`, `"beacon#0"`).
-    pub owner: String,
+    /// The object its primitives belong to (shown as `ball#0`, `goal:yellow#1`, `beacon#0`).
+    pub owner: ObjectId,
     /// What it would be: `"ball"`, `"yellow goal"`, `"beacon pink over yellow"`.
     pub kind: String,
     /// Accepted as an object.
@@ -134,7 +133,7 @@ fn pattern_candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<Ca
             };
             let (bearing, elevation) = (obs.bearing_rad, obs.elevation_rad);
             CandidateInfo {
-                owner: owner::pattern(i),
+                owner: ObjectId::Pattern(i),
                 kind,
                 accepted: c.accepted,
                 confidence: c.confidence.clone(),
@@ -256,7 +255,7 @@ pub fn candidates(
             _ => (c.camera, None),
         };
         out.push(CandidateInfo {
-            owner: owner::ball(i),
+            owner: ObjectId::Ball(i),
             kind: "ball".to_owned(),
             accepted: c.accepted,
             reason: reason(&c.confidence, c.accepted),
@@ -295,7 +294,7 @@ pub fn candidates(
                 .map(|p| format!("post refused: {p}")),
         );
         out.push(CandidateInfo {
-            owner: owner::goal(g.colour, i),
+            owner: ObjectId::Goal(g.colour, i),
             kind: format!("{} goal", g.colour.name()),
             accepted: g.accepted,
             reason: reason(&g.confidence, g.accepted),
@@ -310,7 +309,7 @@ pub fn candidates(
     }
     for (i, b) in r.beacons.iter().enumerate() {
         out.push(CandidateInfo {
-            owner: owner::beacon(i),
+            owner: ObjectId::Beacon(i),
             kind: format!("beacon {}", b.kind.name()),
             accepted: b.accepted,
             reason: reason(&b.confidence, b.accepted),
@@ -378,7 +377,7 @@ pub fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
                 .max_height(360.0)
                 .show(ui, |ui| {
                     for c in &list {
-                        let is_sel = selected == Some(c.owner.as_str());
+                        let is_sel = selected == Some(c.owner);
                         let text = RichText::new(format!(
                             "{} {}  {:+.2}",
                             if c.accepted { "accepted" } else { "rejected" },
@@ -388,21 +387,18 @@ pub fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
                         .color(verdict_colour(c.accepted));
                         let r = ui.selectable_label(is_sel, text).on_hover_text(&c.kind);
                         if r.clicked() {
-                            commands
-                                .push(Command::SelectObject((!is_sel).then(|| c.owner.clone())));
+                            commands.push(Command::SelectObject((!is_sel).then_some(c.owner)));
                         }
                     }
                 });
         });
         ui.add_space(8.0);
-        ui.vertical(
-            |ui| match list.iter().find(|c| Some(c.owner.as_str()) == selected) {
-                None => {
-                    ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
-                }
-                Some(c) => details_ui(ui, c),
-            },
-        );
+        ui.vertical(|ui| match list.iter().find(|c| Some(c.owner) == selected) {
+            None => {
+                ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
+            }
+            Some(c) => details_ui(ui, c),
+        });
     });
 }
 
@@ -446,10 +442,10 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
         ui.weak(n);
     }
     if let Some(p) = &c.pattern {
-        pattern_regions_ui(ui, &c.owner, p);
+        pattern_regions_ui(ui, c.owner, p);
     }
     ui.separator();
-    egui::Grid::new(("breakdown", &c.owner))
+    egui::Grid::new(("breakdown", c.owner))
         .striped(true)
         .num_columns(5)
         .show(ui, |ui| {
@@ -481,7 +477,7 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
 
 /// The nine regions in their 3 × 3 layout: colours, and whether each agrees with the closest
 /// place.
-fn pattern_regions_ui(ui: &mut Ui, owner: &str, p: &PatternInfo) {
+fn pattern_regions_ui(ui: &mut Ui, owner: ObjectId, p: &PatternInfo) {
     ui.separator();
     ui.label(match (p.closest, p.with_places) {
         (Some((id, a)), _) => {
@@ -563,7 +559,12 @@ fn overhead_results_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
     if !d.rejected.is_empty() {
         ui.collapsing(format!("{} rejected candidates", d.rejected.len()), |ui| {
             for c in &d.rejected {
-                ui.label(format!("{:?} at {:?}: {:?}", c.colour, c.bounds, c.reason));
+                ui.label(format!(
+                    "{:?} at {:?}: {:?}",
+                    c.colour,
+                    c.bounds.to_array(),
+                    c.reason
+                ));
             }
         });
     }

@@ -8,7 +8,7 @@ use egui::{
 };
 
 use crate::blobs::Blob;
-use crate::recognition::{CircleRole, Primitive};
+use crate::recognition::{CircleRole, ObjectId, Primitive};
 use crate::workspace::{PrimitiveFilter, ViewKind, Workspace, box_colour};
 
 /// Alpha of the overlays of objects other than the selected one.
@@ -260,15 +260,15 @@ pub fn paint_primitives(
     xf: &ImageTransform,
     primitives: &[Primitive],
     filter: &PrimitiveFilter<'_>,
-    selected: Option<&str>,
+    selected: Option<ObjectId>,
 ) {
     let at = |p: (f64, f64)| xf.to_screen(pos2(p.0 as f32, p.1 as f32));
     // Edge points: a dot about a pixel wide, never smaller than 1.5 points.
     let dot = (xf.zoom * 0.5).clamp(1.5, 4.0);
     let clip = painter.clip_rect().expand(8.0);
     for p in primitives.iter().filter(|p| filter.shows(p)) {
-        let mine = selected.is_some_and(|s| s == p.owner());
-        let dim = selected.is_some() && !mine && p.owner() != "horizon";
+        let mine = selected == Some(p.owner());
+        let dim = selected.is_some() && !mine && p.owner() != ObjectId::Horizon;
         let mut colour = primitive_colour(p);
         if dim {
             colour = colour.gamma_multiply(DIMMED_ALPHA);
@@ -277,7 +277,7 @@ pub fn paint_primitives(
         let stroke = Stroke::new(width, colour);
         match p {
             Primitive::Box { bounds, .. } => {
-                let [x0, y0, x1, y1] = bounds.map(|v| v as f32);
+                let [x0, y0, x1, y1] = bounds.to_array().map(|v| v as f32);
                 let rect = Rect::from_min_max(
                     xf.to_screen(pos2(x0, y0)),
                     xf.to_screen(pos2(x1 + 1.0, y1 + 1.0)),

@@ -4,8 +4,7 @@
 use super::Workspace;
 use super::settings::{Overlays, ViewKind};
 use crate::lut::ColourClass;
-use crate::recognition::draw::owner;
-use crate::recognition::{LineRole, Primitive};
+use crate::recognition::{LineRole, ObjectId, Primitive};
 
 /// Which recognition primitives a view draws.
 #[derive(Debug, Clone, Copy)]
@@ -13,7 +12,7 @@ pub struct PrimitiveFilter<'a> {
     /// The overlay switches.
     pub overlays: Overlays,
     /// Only these owners (the objects view: accepted objects); `None` draws every candidate.
-    pub owners: Option<&'a [String]>,
+    pub owners: Option<&'a [ObjectId]>,
 }
 
 impl<'a> PrimitiveFilter<'a> {
@@ -28,7 +27,7 @@ impl<'a> PrimitiveFilter<'a> {
 
     /// Accepted objects only, always with their boxes and labels (the objects view).
     #[must_use]
-    pub const fn objects(overlays: Overlays, accepted: &'a [String]) -> Self {
+    pub const fn objects(overlays: Overlays, accepted: &'a [ObjectId]) -> Self {
         let mut o = overlays;
         o.candidates = true;
         o.object_labels = true;
@@ -54,7 +53,7 @@ impl<'a> PrimitiveFilter<'a> {
             },
             Primitive::PatternRegion { .. } => o.patterns,
             Primitive::Label { owner, .. } => {
-                o.object_labels && (o.patterns || !owner::is_pattern(owner))
+                o.object_labels && (o.patterns || !owner.is_pattern())
             }
         };
         let horizon = matches!(
@@ -64,7 +63,7 @@ impl<'a> PrimitiveFilter<'a> {
                 ..
             }
         );
-        on && (horizon || self.owners.is_none_or(|w| w.iter().any(|x| x == p.owner())))
+        on && (horizon || self.owners.is_none_or(|w| w.contains(&p.owner())))
     }
 }
 
@@ -135,13 +134,7 @@ impl Workspace {
             _ => Vec::new(),
         };
         for b in boxes {
-            crate::overlay::outline_box(
-                &mut out,
-                w,
-                h,
-                [b.minx, b.miny, b.maxx, b.maxy],
-                box_colour(b.colour),
-            );
+            crate::overlay::outline_box(&mut out, w, h, b.bounds(), box_colour(b.colour));
         }
         let filter = match kind {
             ViewKind::Objects => Some(PrimitiveFilter::objects(o, &self.accepted_owners)),
