@@ -226,6 +226,15 @@ pub fn candidates(
     places: Option<&PatternMemory>,
     image_size: (usize, usize),
 ) -> Vec<CandidateInfo> {
+    let mut out = ball_candidates(r, image_size);
+    out.extend(goal_candidates(r, image_size));
+    out.extend(beacon_candidates(r));
+    out.extend(pattern_candidates(r, places));
+    out
+}
+
+/// The inspector's rows for the ball candidates of `r` (`image_size`, pixels: see [`sides`]).
+fn ball_candidates(r: &Recognition, image_size: (usize, usize)) -> Vec<CandidateInfo> {
     let mut out = Vec::new();
     for (i, c) in r.ball.candidates.iter().enumerate() {
         let mut notes = vec![format!(
@@ -268,6 +277,12 @@ pub fn candidates(
             pattern: None,
         });
     }
+    out
+}
+
+/// The inspector's rows for the goal candidates of `r` (`image_size`, pixels: see [`sides`]).
+fn goal_candidates(r: &Recognition, image_size: (usize, usize)) -> Vec<CandidateInfo> {
+    let mut out = Vec::new();
     for (i, g) in r.goals.candidates.iter().enumerate() {
         let mut notes = vec![format!(
             "{} pixels in {} blobs; height {:.1} px{}",
@@ -307,6 +322,12 @@ pub fn candidates(
             pattern: None,
         });
     }
+    out
+}
+
+/// The inspector's rows for the beacon candidates of `r`.
+fn beacon_candidates(r: &Recognition) -> Vec<CandidateInfo> {
+    let mut out = Vec::new();
     for (i, b) in r.beacons.iter().enumerate() {
         out.push(CandidateInfo {
             owner: ObjectId::Beacon(i),
@@ -326,7 +347,6 @@ pub fn candidates(
             pattern: None,
         });
     }
-    out.extend(pattern_candidates(r, places));
     out
 }
 
