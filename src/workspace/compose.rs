@@ -167,3 +167,54 @@ impl Workspace {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::PixelBox;
+
+    fn boxed(owner: ObjectId) -> Primitive {
+        Primitive::Box {
+            owner,
+            colour: 1,
+            bounds: PixelBox::new(0, 0, 3, 3),
+        }
+    }
+
+    fn label(owner: ObjectId) -> Primitive {
+        Primitive::Label {
+            owner,
+            at: (1.0, 1.0),
+            text: "x".to_owned(),
+        }
+    }
+
+    #[test]
+    fn the_objects_view_draws_the_accepted_objects_and_the_horizon_only() {
+        let accepted = [ObjectId::Ball(1), ObjectId::Goal(ColourClass::Yellow, 0)];
+        let f = PrimitiveFilter::objects(Overlays::all_on(), &accepted);
+        assert!(f.shows(&boxed(ObjectId::Ball(1))));
+        assert!(f.shows(&boxed(ObjectId::Goal(ColourClass::Yellow, 0))));
+        assert!(!f.shows(&boxed(ObjectId::Ball(0))), "a rejected ball");
+        assert!(!f.shows(&boxed(ObjectId::Goal(ColourClass::SkyBlue, 0))));
+        let horizon = Primitive::Line {
+            owner: ObjectId::Horizon,
+            role: LineRole::Horizon,
+            from: (0.0, 5.0),
+            to: (10.0, 5.0),
+        };
+        assert!(f.shows(&horizon));
+        assert!(PrimitiveFilter::all(Overlays::all_on()).shows(&boxed(ObjectId::Ball(0))));
+    }
+
+    #[test]
+    fn a_patterns_label_follows_the_patterns_switch_and_other_labels_do_not() {
+        let mut o = Overlays::all_on();
+        o.patterns = false;
+        let f = PrimitiveFilter::all(o);
+        assert!(!f.shows(&label(ObjectId::Pattern(0))));
+        assert!(f.shows(&label(ObjectId::Ball(0))));
+        o.patterns = true;
+        assert!(PrimitiveFilter::all(o).shows(&label(ObjectId::Pattern(0))));
+    }
+}
