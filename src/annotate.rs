@@ -12,7 +12,7 @@ use foxglove::messages::{
 };
 
 use crate::overlay::primitive_rgb;
-use crate::recognition::{CircleRole, Primitive, Recognition};
+use crate::recognition::{CircleRole, ObjectId, Primitive, Recognition};
 
 /// Line width of outlines, pixels.
 const THICKNESS_PX: f64 = 1.0;
@@ -36,7 +36,7 @@ pub fn image_annotations(
     let shown = r
         .primitives(width, height)
         .into_iter()
-        .filter(|p| p.owner() == "horizon" || accepted.iter().any(|o| o == p.owner()));
+        .filter(|p| p.owner() == ObjectId::Horizon || accepted.contains(&p.owner()));
     let stamp = timestamp(time_ns);
     let mut out = ImageAnnotations {
         timestamp: Some(stamp),
@@ -61,7 +61,7 @@ fn add(out: &mut ImageAnnotations, p: &Primitive, stamp: Timestamp) {
     };
     match p {
         Primitive::Box { bounds, .. } => {
-            let [x0, y0, x1, y1] = bounds.map(f64::from);
+            let [x0, y0, x1, y1] = bounds.to_array().map(f64::from);
             out.points.push(points(
                 PointsType::LineLoop,
                 rect(x0, y0, x1 + 1.0, y1 + 1.0),
@@ -170,7 +170,7 @@ mod tests {
         add(
             &mut out,
             &Primitive::Circle {
-                owner: "ball#0".into(),
+                owner: ObjectId::Ball(0),
                 center: (10.5, 20.0),
                 radius: 4.0,
                 role: CircleRole::SkewCorrected,
@@ -180,9 +180,9 @@ mod tests {
         add(
             &mut out,
             &Primitive::Box {
-                owner: "ball#0".into(),
+                owner: ObjectId::Ball(0),
                 colour: 1,
-                bounds: [2, 3, 5, 7],
+                bounds: crate::frame::PixelBox::new(2, 3, 5, 7),
             },
             stamp,
         );

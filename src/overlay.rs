@@ -6,19 +6,20 @@
 //! (FORMATS.md). An optional integer `scale` enlarges the picture first so thin lines stay
 //! readable on 208×160 frames.
 
+use crate::frame::PixelBox;
 use crate::lut::classes::code_display_rgb;
 use crate::recognition::{CircleRole, LineRole, Primitive};
 
-/// Outlines the inclusive pixel box `[minx, miny, maxx, maxy]` on a packed RGB image of
+/// Outlines the inclusive pixel box `bounds` on a packed RGB image of
 /// `width` × `height` at its own resolution (one-pixel lines), clamped to the image: blob boxes in
 /// exports and the app's blob view.
-pub fn outline_box(rgb: &mut [u8], width: usize, height: usize, bounds: [u32; 4], colour: [u8; 3]) {
+pub fn outline_box(rgb: &mut [u8], width: usize, height: usize, bounds: PixelBox, colour: [u8; 3]) {
     if width == 0 || height == 0 || rgb.len() < width * height * 3 {
         return;
     }
     let clamp = |v: u32, max: usize| (v as usize).min(max - 1);
-    let (x0, y0) = (clamp(bounds[0], width), clamp(bounds[1], height));
-    let (x1, y1) = (clamp(bounds[2], width), clamp(bounds[3], height));
+    let (x0, y0) = (clamp(bounds.min_x, width), clamp(bounds.min_y, height));
+    let (x1, y1) = (clamp(bounds.max_x, width), clamp(bounds.max_y, height));
     let mut put = |x: usize, y: usize| {
         let i = (y * width + x) * 3;
         rgb[i..i + 3].copy_from_slice(&colour);
@@ -125,9 +126,9 @@ impl Canvas {
     }
 
     /// An inclusive pixel box's outline.
-    pub fn rect(&mut self, [minx, miny, maxx, maxy]: [u32; 4], c: [u8; 3]) {
-        let (x0, y0) = (f64::from(minx), f64::from(miny));
-        let (x1, y1) = (f64::from(maxx) + 1.0, f64::from(maxy) + 1.0);
+    pub fn rect(&mut self, bounds: PixelBox, c: [u8; 3]) {
+        let (x0, y0) = (f64::from(bounds.min_x), f64::from(bounds.min_y));
+        let (x1, y1) = (f64::from(bounds.max_x) + 1.0, f64::from(bounds.max_y) + 1.0);
         let e = 0.5 / self.scale as f64;
         self.line((x0, y0), (x1 - e, y0), c);
         self.line((x1 - e, y0), (x1 - e, y1 - e), c);
@@ -312,10 +313,11 @@ pub fn pattern_region_rgb(code: u8) -> [u8; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::recognition::ObjectId;
 
     fn label(at: (f64, f64), text: &str) -> Primitive {
         Primitive::Label {
-            owner: "ball#0".into(),
+            owner: ObjectId::Ball(0),
             at,
             text: text.into(),
         }
@@ -425,18 +427,18 @@ mod tests {
         assert_eq!((c.width, c.height), (20, 20));
         c.draw(&[
             Primitive::Box {
-                owner: "b".into(),
+                owner: ObjectId::Blob(0),
                 colour: 1,
-                bounds: [1, 1, 3, 3],
+                bounds: PixelBox::new(1, 1, 3, 3),
             },
             Primitive::Line {
-                owner: "h".into(),
+                owner: ObjectId::Horizon,
                 role: LineRole::Horizon,
                 from: (-5.0, 1.0),
                 to: (50.0, 1.0),
             },
             Primitive::Circle {
-                owner: "c".into(),
+                owner: ObjectId::Ball(0),
                 center: (5.0, 5.0),
                 radius: 3.0,
                 role: CircleRole::Observed,
@@ -459,7 +461,7 @@ mod tests {
         let draw = |role| {
             let mut c = Canvas::from_rgb(40, 40, &[0u8; 40 * 40 * 3], 2).expect("canvas");
             c.draw(&[Primitive::Circle {
-                owner: "ball#0".into(),
+                owner: ObjectId::Ball(0),
                 center: (20.0, 20.0),
                 radius: 12.0,
                 role,

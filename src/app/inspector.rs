@@ -11,17 +11,16 @@ use egui::{Color32, RichText, Ui};
 use crate::frame::PixelBox;
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestOutcome};
-use crate::recognition::draw::owner;
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::scan::CutOff;
-use crate::recognition::{Recognition, Relative};
+use crate::recognition::{ObjectId, Recognition, Relative};
 use crate::workspace::{Command, Workspace};
 
 /// One candidate as the inspector lists it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CandidateInfo {
-    /// The owner its primitives carry (`"ball#0"`, `"goal:yellow#1"`, `"beacon#0"`).
-    pub owner: String,
+    /// The object its primitives belong to (shown as `ball#0`, `goal:yellow#1`, `beacon#0`).
+    pub owner: ObjectId,
     /// What it would be: `"ball"`, `"yellow goal"`, `"beacon pink over yellow"`.
     pub kind: String,
     /// Accepted as an object.
@@ -134,7 +133,7 @@ fn pattern_candidates(r: &Recognition, places: Option<&PatternMemory>) -> Vec<Ca
             };
             let (bearing, elevation) = (obs.bearing_rad, obs.elevation_rad);
             CandidateInfo {
-                owner: owner::pattern(i),
+                owner: ObjectId::Pattern(i),
                 kind,
                 accepted: c.accepted,
                 confidence: c.confidence.clone(),
@@ -227,6 +226,15 @@ pub fn candidates(
     places: Option<&PatternMemory>,
     image_size: (usize, usize),
 ) -> Vec<CandidateInfo> {
+    let mut out = ball_candidates(r, image_size);
+    out.extend(goal_candidates(r, image_size));
+    out.extend(beacon_candidates(r));
+    out.extend(pattern_candidates(r, places));
+    out
+}
+
+/// The inspector's rows for the ball candidates of `r` (`image_size`, pixels: see [`sides`]).
+fn ball_candidates(r: &Recognition, image_size: (usize, usize)) -> Vec<CandidateInfo> {
     let mut out = Vec::new();
     for (i, c) in r.ball.candidates.iter().enumerate() {
         let mut notes = vec![format!(
@@ -256,7 +264,7 @@ pub fn candidates(
             _ => (c.camera, None),
         };
         out.push(CandidateInfo {
-            owner: owner::ball(i),
+            owner: ObjectId::Ball(i),
             kind: "ball".to_owned(),
             accepted: c.accepted,
             reason: reason(&c.confidence, c.accepted),
@@ -269,6 +277,12 @@ pub fn candidates(
             pattern: None,
         });
     }
+    out
+}
+
+/// The inspector's rows for the goal candidates of `r` (`image_size`, pixels: see [`sides`]).
+fn goal_candidates(r: &Recognition, image_size: (usize, usize)) -> Vec<CandidateInfo> {
+    let mut out = Vec::new();
     for (i, g) in r.goals.candidates.iter().enumerate() {
         let mut notes = vec![format!(
             "{} pixels in {} blobs; height {:.1} px{}",
@@ -295,7 +309,7 @@ pub fn candidates(
                 .map(|p| format!("post refused: {p}")),
         );
         out.push(CandidateInfo {
-            owner: owner::goal(g.colour, i),
+            owner: ObjectId::Goal(g.colour, i),
             kind: format!("{} goal", g.colour.name()),
             accepted: g.accepted,
             reason: reason(&g.confidence, g.accepted),
@@ -308,9 +322,15 @@ pub fn candidates(
             pattern: None,
         });
     }
+    out
+}
+
+/// The inspector's rows for the beacon candidates of `r`.
+fn beacon_candidates(r: &Recognition) -> Vec<CandidateInfo> {
+    let mut out = Vec::new();
     for (i, b) in r.beacons.iter().enumerate() {
         out.push(CandidateInfo {
-            owner: owner::beacon(i),
+            owner: ObjectId::Beacon(i),
             kind: format!("beacon {}", b.kind.name()),
             accepted: b.accepted,
             reason: reason(&b.confidence, b.accepted),
@@ -327,7 +347,6 @@ pub fn candidates(
             pattern: None,
         });
     }
-    out.extend(pattern_candidates(r, places));
     out
 }
 
@@ -378,7 +397,7 @@ pub fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
                 .max_height(360.0)
                 .show(ui, |ui| {
                     for c in &list {
-                        let is_sel = selected == Some(c.owner.as_str());
+                        let is_sel = selected == Some(c.owner);
                         let text = RichText::new(format!(
                             "{} {}  {:+.2}",
                             if c.accepted { "accepted" } else { "rejected" },
@@ -388,21 +407,18 @@ pub fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
                         .color(verdict_colour(c.accepted));
                         let r = ui.selectable_label(is_sel, text).on_hover_text(&c.kind);
                         if r.clicked() {
-                            commands
-                                .push(Command::SelectObject((!is_sel).then(|| c.owner.clone())));
+                            commands.push(Command::SelectObject((!is_sel).then_some(c.owner)));
                         }
                     }
                 });
         });
         ui.add_space(8.0);
-        ui.vertical(
-            |ui| match list.iter().find(|c| Some(c.owner.as_str()) == selected) {
-                None => {
-                    ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
-                }
-                Some(c) => details_ui(ui, c),
-            },
-        );
+        ui.vertical(|ui| match list.iter().find(|c| Some(c.owner) == selected) {
+            None => {
+                ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
+            }
+            Some(c) => details_ui(ui, c),
+        });
     });
 }
 
@@ -446,10 +462,10 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
         ui.weak(n);
     }
     if let Some(p) = &c.pattern {
-        pattern_regions_ui(ui, &c.owner, p);
+        pattern_regions_ui(ui, c.owner, p);
     }
     ui.separator();
-    egui::Grid::new(("breakdown", &c.owner))
+    egui::Grid::new(("breakdown", c.owner))
         .striped(true)
         .num_columns(5)
         .show(ui, |ui| {
@@ -481,7 +497,7 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
 
 /// The nine regions in their 3 × 3 layout: colours, and whether each agrees with the closest
 /// place.
-fn pattern_regions_ui(ui: &mut Ui, owner: &str, p: &PatternInfo) {
+fn pattern_regions_ui(ui: &mut Ui, owner: ObjectId, p: &PatternInfo) {
     ui.separator();
     ui.label(match (p.closest, p.with_places) {
         (Some((id, a)), _) => {
@@ -563,7 +579,12 @@ fn overhead_results_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
     if !d.rejected.is_empty() {
         ui.collapsing(format!("{} rejected candidates", d.rejected.len()), |ui| {
             for c in &d.rejected {
-                ui.label(format!("{:?} at {:?}: {:?}", c.colour, c.bounds, c.reason));
+                ui.label(format!(
+                    "{:?} at {:?}: {:?}",
+                    c.colour,
+                    c.bounds.to_array(),
+                    c.reason
+                ));
             }
         });
     }

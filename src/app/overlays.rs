@@ -8,7 +8,7 @@ use egui::{
 };
 
 use crate::blobs::Blob;
-use crate::recognition::{CircleRole, Primitive};
+use crate::recognition::{CircleRole, ObjectId, Primitive};
 use crate::workspace::{PrimitiveFilter, ViewKind, Workspace, box_colour};
 
 /// Alpha of the overlays of objects other than the selected one.
@@ -204,10 +204,7 @@ pub fn paint_view(
 
 /// A blob's box on screen (pixel edges inclusive).
 fn blob_rect(xf: &ImageTransform, b: &Blob) -> Rect {
-    Rect::from_min_max(
-        xf.to_screen(pos2(b.minx as f32, b.miny as f32)),
-        xf.to_screen(pos2(b.maxx as f32 + 1.0, b.maxy as f32 + 1.0)),
-    )
+    pixel_box_rect(xf, b.bounds().to_array().map(|v| v as f32))
 }
 
 /// One blob's box in its class's box colour.
@@ -260,15 +257,15 @@ pub fn paint_primitives(
     xf: &ImageTransform,
     primitives: &[Primitive],
     filter: &PrimitiveFilter<'_>,
-    selected: Option<&str>,
+    selected: Option<ObjectId>,
 ) {
     let at = |p: (f64, f64)| xf.to_screen(pos2(p.0 as f32, p.1 as f32));
     // Edge points: a dot about a pixel wide, never smaller than 1.5 points.
     let dot = (xf.zoom * 0.5).clamp(1.5, 4.0);
     let clip = painter.clip_rect().expand(8.0);
     for p in primitives.iter().filter(|p| filter.shows(p)) {
-        let mine = selected.is_some_and(|s| s == p.owner());
-        let dim = selected.is_some() && !mine && p.owner() != "horizon";
+        let mine = selected == Some(p.owner());
+        let dim = selected.is_some() && !mine && p.owner() != ObjectId::Horizon;
         let mut colour = primitive_colour(p);
         if dim {
             colour = colour.gamma_multiply(DIMMED_ALPHA);
@@ -277,11 +274,7 @@ pub fn paint_primitives(
         let stroke = Stroke::new(width, colour);
         match p {
             Primitive::Box { bounds, .. } => {
-                let [x0, y0, x1, y1] = bounds.map(|v| v as f32);
-                let rect = Rect::from_min_max(
-                    xf.to_screen(pos2(x0, y0)),
-                    xf.to_screen(pos2(x1 + 1.0, y1 + 1.0)),
-                );
+                let rect = pixel_box_rect(xf, bounds.to_array().map(|v| v as f32));
                 painter.rect_stroke(rect, 0.0, stroke, StrokeKind::Outside);
             }
             Primitive::ScanArea { corners, .. } => {
@@ -306,39 +299,19 @@ pub fn paint_primitives(
                 role,
                 ..
             } => {
-                let r = (*radius as f32) * xf.zoom;
-                if !(r.is_finite() && r > 0.0) {
-                    continue;
-                }
-                match role {
-                    CircleRole::Observed => {
-                        painter.circle_stroke(at(*center), r, stroke);
-                    }
-                    CircleRole::SkewCorrected => {
-                        // Thin and dashed: where the skew correction puts the ball, beside
-                        // the solid circle on the ball's pixels.
-                        let c = at(*center);
-                        let n = ((r * 0.8) as usize).clamp(16, 256);
-                        let pts: Vec<Pos2> = (0..=n)
-                            .map(|i| {
-                                let t = i as f32 / n as f32 * std::f32::consts::TAU;
-                                c + vec2(r * t.cos(), r * t.sin())
-                            })
-                            .collect();
-                        let thin = Stroke::new(width * 0.6, colour);
-                        painter.extend(egui::Shape::dashed_line(&pts, thin, 4.0, 3.0));
-                    }
-                }
+                paint_circle(
+                    painter,
+                    at(*center),
+                    (*radius as f32) * xf.zoom,
+                    *role,
+                    stroke,
+                );
             }
             Primitive::Line { from, to, .. } => {
                 painter.line_segment([at(*from), at(*to)], stroke);
             }
             Primitive::PatternRegion { bounds, centre, .. } => {
-                let [x0, y0, x1, y1] = bounds.map(|v| v as f32);
-                let rect = Rect::from_min_max(
-                    xf.to_screen(pos2(x0, y0)),
-                    xf.to_screen(pos2(x1 + 1.0, y1 + 1.0)),
-                );
+                let rect = pixel_box_rect(xf, bounds.map(|v| v as f32));
                 let stroke = if *centre {
                     Stroke::new(width + 1.0, colour)
                 } else {
@@ -347,21 +320,59 @@ pub fn paint_primitives(
                 painter.rect_stroke(rect.shrink(1.0), 0.0, stroke, StrokeKind::Inside);
             }
             Primitive::Label { at: pos, text, .. } => {
-                let galley =
-                    painter.layout_no_wrap(text.clone(), FontId::proportional(12.0), colour);
-                let anchor = at(*pos);
-                let bg =
-                    Rect::from_min_size(anchor - vec2(0.0, galley.size().y + 2.0), galley.size())
-                        .expand(2.0);
-                // Kept inside the view: a ball at the top edge, or outside the view when
-                // zoomed in, still shows its distance at the edge nearest to it.
-                let bg = keep_inside(bg, painter.clip_rect());
-                let bg_alpha = if dim { 60 } else { 180 };
-                painter.rect_filled(bg, 3.0, Color32::from_black_alpha(bg_alpha));
-                painter.galley(bg.min + vec2(2.0, 2.0), galley, colour);
+                paint_label(painter, at(*pos), text, colour, dim);
             }
         }
     }
+}
+
+/// The screen rectangle of an inclusive pixel box `[minx, miny, maxx, maxy]` (pixels; the
+/// right and bottom edges are those of the last column and row).
+fn pixel_box_rect(xf: &ImageTransform, [x0, y0, x1, y1]: [f32; 4]) -> Rect {
+    Rect::from_min_max(
+        xf.to_screen(pos2(x0, y0)),
+        xf.to_screen(pos2(x1 + 1.0, y1 + 1.0)),
+    )
+}
+
+/// A circle of `radius` (screen points) about `centre`: solid where the ball is seen, thin and
+/// dashed where the skew correction puts it. Nothing for a radius that is not positive.
+fn paint_circle(painter: &Painter, centre: Pos2, radius: f32, role: CircleRole, stroke: Stroke) {
+    let r = radius;
+    if !(r.is_finite() && r > 0.0) {
+        return;
+    }
+    match role {
+        CircleRole::Observed => {
+            painter.circle_stroke(centre, r, stroke);
+        }
+        CircleRole::SkewCorrected => {
+            // Thin and dashed: where the skew correction puts the ball, beside the solid
+            // circle on the ball's pixels.
+            let n = ((r * 0.8) as usize).clamp(16, 256);
+            let pts: Vec<Pos2> = (0..=n)
+                .map(|i| {
+                    let t = i as f32 / n as f32 * std::f32::consts::TAU;
+                    centre + vec2(r * t.cos(), r * t.sin())
+                })
+                .collect();
+            let thin = Stroke::new(stroke.width * 0.6, stroke.color);
+            painter.extend(egui::Shape::dashed_line(&pts, thin, 4.0, 3.0));
+        }
+    }
+}
+
+/// An object's label just above `anchor` (screen) on a dark backing (fainter when `dim`).
+fn paint_label(painter: &Painter, anchor: Pos2, text: &str, colour: Color32, dim: bool) {
+    let galley = painter.layout_no_wrap(text.to_owned(), FontId::proportional(12.0), colour);
+    let bg =
+        Rect::from_min_size(anchor - vec2(0.0, galley.size().y + 2.0), galley.size()).expand(2.0);
+    // Kept inside the view: a ball at the top edge, or outside the view when zoomed in, still
+    // shows its distance at the edge nearest to it.
+    let bg = keep_inside(bg, painter.clip_rect());
+    let bg_alpha = if dim { 60 } else { 180 };
+    painter.rect_filled(bg, 3.0, Color32::from_black_alpha(bg_alpha));
+    painter.galley(bg.min + vec2(2.0, 2.0), galley, colour);
 }
 
 /// `bg` moved the least distance that puts it inside `view` (pinned to the nearest edge).

@@ -104,7 +104,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         &mut rgb,
                         w,
                         frame.height(),
-                        [b.minx, b.miny, b.maxx, b.maxy],
+                        b.bounds(),
                         code_display_rgb(b.colour),
                     );
                 }
@@ -141,7 +141,7 @@ mod tests {
         let set = BlobSet::from_image(&img, Connectivity::Eight);
         let b = set.active().next().unwrap();
         let mut rgb = vec![0u8; 8 * 6 * 3];
-        crate::overlay::outline_box(&mut rgb, 8, 6, [b.minx, b.miny, b.maxx, b.maxy], [9, 9, 9]);
+        crate::overlay::outline_box(&mut rgb, 8, 6, b.bounds(), [9, 9, 9]);
         let lit = |x: usize, y: usize| rgb[(y * 8 + x) * 3] == 9;
         assert!(lit(2, 1) && lit(5, 3) && lit(2, 3) && lit(5, 1));
         assert!(!lit(3, 2), "inside stays");

@@ -10,7 +10,7 @@ use super::inputs::InputArgs;
 use crate::frame::save_rgb_png;
 use crate::overlay::Canvas;
 use crate::pipeline::{Pipeline, PipelineParams};
-use crate::recognition::{LineRole, Primitive};
+use crate::recognition::{LineRole, ObjectId, Primitive};
 
 /// Which picture is drawn under the overlays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -96,9 +96,7 @@ fn wanted(overlays: &[Overlay], p: &Primitive) -> bool {
             LineRole::Gap | LineRole::Scan => on(Overlay::Gaps),
         },
         Primitive::PatternRegion { .. } => on(Overlay::Patterns),
-        Primitive::Label { owner, .. } => {
-            crate::recognition::draw::owner::is_pattern(owner) && on(Overlay::Patterns)
-        }
+        Primitive::Label { owner, .. } => owner.is_pattern() && on(Overlay::Patterns),
     }
 }
 
@@ -154,9 +152,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     .active()
                     .filter(|b| b.pixels >= args.min_blob_pixels)
                     .map(|b| Primitive::Box {
-                        owner: format!("blob#{}", b.number),
+                        owner: ObjectId::Blob(b.number),
                         colour: b.colour,
-                        bounds: [b.minx, b.miny, b.maxx, b.maxy],
+                        bounds: b.bounds(),
                     }),
             );
         }

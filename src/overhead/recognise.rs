@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
 use crate::geometry::marker::{
     ID_DOT_ANGLES_DEG, ID_DOT_DIAMETER_CM, ID_DOT_RADIUS_CM, TEAM_DOT_DIAMETER_CM,
 };
@@ -112,8 +113,8 @@ pub enum OverheadRejection {
 /// A rejected candidate, for overlays.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RejectedCandidate {
-    /// Blob box `[minx, miny, maxx, maxy]`, inclusive pixels.
-    pub bounds: [u32; 4],
+    /// Blob box, inclusive pixels (`[minx, miny, maxx, maxy]` in JSON).
+    pub bounds: PixelBox,
     /// Blob class code.
     pub colour: u8,
     /// Why.
@@ -179,15 +180,15 @@ pub fn recognise_overhead(
 
 fn rejected(blob: &Blob, reason: OverheadRejection) -> RejectedCandidate {
     RejectedCandidate {
-        bounds: [blob.minx, blob.miny, blob.maxx, blob.maxy],
+        bounds: blob.bounds(),
         colour: blob.colour,
         reason,
     }
 }
 
-fn box_around(p: ImagePoint, r: f64) -> [u32; 4] {
+fn box_around(p: ImagePoint, r: f64) -> PixelBox {
     let c = |v: f64| v.max(0.0) as u32;
-    [c(p.x_px - r), c(p.y_px - r), c(p.x_px + r), c(p.y_px + r)]
+    PixelBox::new(c(p.x_px - r), c(p.y_px - r), c(p.x_px + r), c(p.y_px + r))
 }
 
 /// Image radius (pixels) of a disc or sphere of `radius_cm` centred at field point `p`: the

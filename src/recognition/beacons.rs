@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::confidence::{Confidence, TestName, TestWeight};
 use super::context::{Relative, ViewContext};
-use super::draw::Primitive;
+use super::draw::{ObjectId, Primitive};
 use super::fit::rotate_about;
 use crate::blobs::{Blob, BlobSet};
 use crate::frame::PixelBox;
@@ -201,11 +201,11 @@ pub fn recognise_beacons(blobs: &BlobSet, ctx: &ViewContext, p: &BeaconParams) -
 pub fn beacon_primitives(beacons: &[Beacon]) -> Vec<Primitive> {
     let mut out = Vec::new();
     for (i, b) in beacons.iter().enumerate() {
-        let owner = super::draw::owner::beacon(i);
+        let owner = ObjectId::Beacon(i);
         out.push(Primitive::Box {
-            owner: owner.clone(),
+            owner,
             colour: ColourClass::Pink.code(),
-            bounds: b.bounds.to_array(),
+            bounds: b.bounds,
         });
         if b.accepted {
             out.push(Primitive::Label {

@@ -1,80 +1,94 @@
 //! Drawing primitives as data: what recognition looked at and found, in image pixels, so the
 //! app, `eotn render` and the JSON all draw the same thing. Each primitive names the object it
-//! belongs to (`owner`, e.g. `"ball#0"`, `"goal:yellow#1"`) so a selected candidate can be
+//! belongs to (`owner`, an [`ObjectId`]) so a selected candidate can be
 //! highlighted.
 
 use serde::{Deserialize, Serialize};
 
 use super::fit::Point;
+use crate::frame::PixelBox;
 use crate::lut::ColourClass;
 
-/// The `owner` names of primitives, made in one place so that recognition, the app's selection
-/// and its object inspector always agree on them. `i` is the candidate's index in its list.
-pub mod owner {
-    use super::ColourClass;
+/// The object a primitive belongs to: what the app selects, the inspector lists and the
+/// objects view filters by, made in one place so that they always agree. Indices are the
+/// candidate's place in its list. [`Display`](std::fmt::Display) gives the readable name the
+/// app shows (`ball#0`, `goal:yellow#1`, `beacon#0`, `pattern#2`, `horizon`, `blob#7`); a
+/// serialised primitive carries that same text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ObjectId {
+    /// A ball candidate.
+    Ball(usize),
+    /// A goal candidate of a goal colour (yellow or sky blue).
+    Goal(ColourClass, usize),
+    /// A beacon candidate.
+    Beacon(usize),
+    /// A pink marker's coloured pattern.
+    Pattern(usize),
+    /// The horizon line (belongs to no object; never dimmed by a selection).
+    Horizon,
+    /// A blob of `eotn render`'s blob overlay, by its blob number.
+    Blob(u32),
+}
 
-    /// A ball candidate: `ball#i`.
+impl ObjectId {
+    /// Whether this is a pink marker's coloured pattern.
     #[must_use]
-    pub fn ball(i: usize) -> String {
-        format!("ball#{i}")
-    }
-
-    /// A goal candidate of a goal colour: `goal:yellow#i`.
-    #[must_use]
-    pub fn goal(colour: ColourClass, i: usize) -> String {
-        format!("goal:{}#{i}", colour.name())
-    }
-
-    /// A beacon candidate: `beacon#i`.
-    #[must_use]
-    pub fn beacon(i: usize) -> String {
-        format!("beacon#{i}")
-    }
-
-    /// A pink marker's coloured pattern: `pattern#i`.
-    #[must_use]
-    pub fn pattern(i: usize) -> String {
-        format!("pattern#{i}")
-    }
-
-    /// Whether an owner name is a coloured pattern's.
-    #[must_use]
-    pub fn is_pattern(owner: &str) -> bool {
-        owner.starts_with("pattern#")
+    pub const fn is_pattern(self) -> bool {
+        matches!(self, Self::Pattern(_))
     }
 }
 
-/// One thing to draw over the image.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+impl std::fmt::Display for ObjectId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Ball(i) => write!(f, "ball#{i}"),
+            Self::Goal(colour, i) => write!(f, "goal:{}#{i}", colour.name()),
+            Self::Beacon(i) => write!(f, "beacon#{i}"),
+            Self::Pattern(i) => write!(f, "pattern#{i}"),
+            Self::Horizon => f.write_str("horizon"),
+            Self::Blob(n) => write!(f, "blob#{n}"),
+        }
+    }
+}
+
+impl Serialize for ObjectId {
+    /// As its readable name, the form owners had when they were strings.
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+/// One thing to draw over the image. Serialised (as JSON) for reading; nothing reads it back.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Primitive {
     /// An inclusive pixel box, e.g. a blob or a candidate's extent.
     Box {
         /// Which object this belongs to.
-        owner: String,
+        owner: ObjectId,
         /// Class code whose display colour to use.
         colour: u8,
-        /// `[minx, miny, maxx, maxy]`, inclusive pixels.
-        bounds: [u32; 4],
+        /// The box, inclusive pixels (written as `[minx, miny, maxx, maxy]`).
+        bounds: PixelBox,
     },
     /// A scanned quadrilateral (colour-below areas, goal scans).
     ScanArea {
         /// Which object this belongs to.
-        owner: String,
+        owner: ObjectId,
         /// Corners in order, pixels.
         corners: [Point; 4],
     },
     /// Points found by edge scans.
     ScanPoints {
         /// Which object this belongs to.
-        owner: String,
+        owner: ObjectId,
         /// The points, pixels.
         points: Vec<Point>,
     },
     /// A fitted circle.
     Circle {
         /// Which object this belongs to.
-        owner: String,
+        owner: ObjectId,
         /// Centre, pixels.
         center: Point,
         /// Radius, pixels.
@@ -87,7 +101,7 @@ pub enum Primitive {
     /// A straight segment: a goal post, a gap, a horizon.
     Line {
         /// Which object this belongs to.
-        owner: String,
+        owner: ObjectId,
         /// What the line is.
         role: LineRole,
         /// Start, pixels.
@@ -97,8 +111,8 @@ pub enum Primitive {
     },
     /// One of the nine regions of a coloured pattern around a pink marker.
     PatternRegion {
-        /// Which pattern this belongs to (`pattern#i`).
-        owner: String,
+        /// Which pattern this belongs to ([`ObjectId::Pattern`]).
+        owner: ObjectId,
         /// Inclusive pixel box `[minx, miny, maxx, maxy]`; may reach outside the image.
         bounds: [i64; 4],
         /// The region's most common class code (0: nothing), whose display colour to use.
@@ -109,7 +123,7 @@ pub enum Primitive {
     /// A text label at a point (object name, distance, bearing).
     Label {
         /// Which object this belongs to.
-        owner: String,
+        owner: ObjectId,
         /// Where, pixels.
         at: Point,
         /// The text.
@@ -148,7 +162,7 @@ pub enum LineRole {
 impl Primitive {
     /// The object this primitive belongs to.
     #[must_use]
-    pub fn owner(&self) -> &str {
+    pub const fn owner(&self) -> ObjectId {
         match self {
             Self::Box { owner, .. }
             | Self::ScanArea { owner, .. }
@@ -156,7 +170,76 @@ impl Primitive {
             | Self::Circle { owner, .. }
             | Self::Line { owner, .. }
             | Self::PatternRegion { owner, .. }
-            | Self::Label { owner, .. } => owner,
+            | Self::Label { owner, .. } => *owner,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_object_id_displays_as_the_name_the_app_shows() {
+        assert_eq!(ObjectId::Ball(0).to_string(), "ball#0");
+        assert_eq!(
+            ObjectId::Goal(ColourClass::Yellow, 1).to_string(),
+            "goal:yellow#1"
+        );
+        assert_eq!(
+            ObjectId::Goal(ColourClass::SkyBlue, 0).to_string(),
+            "goal:sky blue#0"
+        );
+        assert_eq!(ObjectId::Beacon(3).to_string(), "beacon#3");
+        assert_eq!(ObjectId::Pattern(12).to_string(), "pattern#12");
+        assert_eq!(ObjectId::Horizon.to_string(), "horizon");
+        assert_eq!(ObjectId::Blob(7).to_string(), "blob#7");
+    }
+
+    #[test]
+    fn only_a_pattern_is_a_pattern() {
+        assert!(ObjectId::Pattern(0).is_pattern());
+        for other in [
+            ObjectId::Ball(0),
+            ObjectId::Goal(ColourClass::Yellow, 0),
+            ObjectId::Beacon(0),
+            ObjectId::Horizon,
+            ObjectId::Blob(0),
+        ] {
+            assert!(!other.is_pattern(), "{other}");
+        }
+    }
+
+    #[test]
+    fn candidates_of_different_kinds_or_indices_are_different_objects() {
+        let ids = [
+            ObjectId::Ball(0),
+            ObjectId::Ball(1),
+            ObjectId::Goal(ColourClass::Yellow, 0),
+            ObjectId::Goal(ColourClass::SkyBlue, 0),
+            ObjectId::Beacon(0),
+            ObjectId::Pattern(0),
+            ObjectId::Horizon,
+            ObjectId::Blob(0),
+        ];
+        let distinct: std::collections::HashSet<ObjectId> = ids.into_iter().collect();
+        assert_eq!(distinct.len(), ids.len());
+        let names: std::collections::HashSet<String> =
+            ids.iter().map(ToString::to_string).collect();
+        assert_eq!(names.len(), ids.len(), "each has its own name");
+    }
+
+    #[test]
+    fn a_primitive_serialises_its_owner_and_box_as_before_they_had_types() {
+        let p = Primitive::Box {
+            owner: ObjectId::Goal(ColourClass::Yellow, 1),
+            colour: 3,
+            bounds: PixelBox::new(1, 2, 30, 40),
+        };
+        assert_eq!(
+            serde_json::to_string(&p).expect("serialises"),
+            r#"{"kind":"box","owner":"goal:yellow#1","colour":3,"bounds":[1,2,30,40]}"#
+        );
+        assert_eq!(p.owner(), ObjectId::Goal(ColourClass::Yellow, 1));
     }
 }

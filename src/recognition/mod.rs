@@ -33,7 +33,7 @@ use crate::sensors::SensorReadings;
 pub use ball::{Ball, BallParams, BallResult};
 pub use beacons::{Beacon, BeaconParams};
 pub use context::{Relative, ViewContext};
-pub use draw::{CircleRole, LineRole, Primitive};
+pub use draw::{CircleRole, LineRole, ObjectId, Primitive};
 pub use goals::{GoalCandidate, GoalParams, GoalResult};
 
 /// Settings of every recogniser, and the camera to assume for frames that are not the ERS-7's.
@@ -167,24 +167,23 @@ pub fn recognise(
 }
 
 impl Recognition {
-    /// The owner names (see [`draw::owner`]) of every accepted object: what a viewer shows
-    /// when it shows only what was found.
+    /// Every accepted object: what a viewer shows when it shows only what was found.
     #[must_use]
-    pub fn accepted_owners(&self) -> Vec<String> {
+    pub fn accepted_owners(&self) -> Vec<ObjectId> {
         let balls = self.ball.candidates.iter().enumerate();
         let balls = balls
             .filter(|(_, c)| c.accepted)
-            .map(|(i, _)| draw::owner::ball(i));
+            .map(|(i, _)| ObjectId::Ball(i));
         let goals = self.goals.candidates.iter().enumerate();
         let goals = goals
             .filter(|(_, c)| c.accepted)
-            .map(|(i, c)| draw::owner::goal(c.colour, i));
+            .map(|(i, c)| ObjectId::Goal(c.colour, i));
         let beacons = self.beacons.iter().enumerate().filter(|(_, b)| b.accepted);
         let patterns = self.patterns.iter().enumerate().filter(|(_, p)| p.accepted);
         balls
             .chain(goals)
-            .chain(beacons.map(|(i, _)| draw::owner::beacon(i)))
-            .chain(patterns.map(|(i, _)| draw::owner::pattern(i)))
+            .chain(beacons.map(|(i, _)| ObjectId::Beacon(i)))
+            .chain(patterns.map(|(i, _)| ObjectId::Pattern(i)))
             .collect()
     }
 
@@ -197,7 +196,7 @@ impl Recognition {
             .and_then(|h| h.clip_to_image(width as f64, height as f64))
         {
             out.push(Primitive::Line {
-                owner: "horizon".to_owned(),
+                owner: ObjectId::Horizon,
                 role: LineRole::Horizon,
                 from: (a.x_px, a.y_px),
                 to: (b.x_px, b.y_px),

@@ -9,6 +9,7 @@ use super::robots::RobotId;
 use super::settings::{OverheadView, Overlays, ViewKind};
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
+use crate::recognition::ObjectId;
 
 /// Everything the UI can ask for.
 #[derive(Debug, Clone, PartialEq)]
@@ -148,9 +149,9 @@ pub enum Command {
     StartRecording(PathBuf),
     /// Finish the recording.
     StopRecording,
-    /// Select a recognition candidate by its owner name (`"ball#0"`, `"goal:yellow#1"`,
-    /// `"beacon#0"`) to highlight its overlays; `None` shows all alike.
-    SelectObject(Option<String>),
+    /// Select a recognition candidate (the object its primitives belong to) to highlight its
+    /// overlays; `None` shows all alike. Refused for an object not in the shown frame.
+    SelectObject(Option<ObjectId>),
     /// Connect a robot at `HOST:PORT` (or `ws://HOST:PORT`) beside those connected already
     /// (Camera ▸ Connect to robot…); shown when no robot is.
     ConnectRobot(String),

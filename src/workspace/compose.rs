@@ -4,8 +4,7 @@
 use super::Workspace;
 use super::settings::{Overlays, ViewKind};
 use crate::lut::ColourClass;
-use crate::recognition::draw::owner;
-use crate::recognition::{LineRole, Primitive};
+use crate::recognition::{LineRole, ObjectId, Primitive};
 
 /// Which recognition primitives a view draws.
 #[derive(Debug, Clone, Copy)]
@@ -13,7 +12,7 @@ pub struct PrimitiveFilter<'a> {
     /// The overlay switches.
     pub overlays: Overlays,
     /// Only these owners (the objects view: accepted objects); `None` draws every candidate.
-    pub owners: Option<&'a [String]>,
+    pub owners: Option<&'a [ObjectId]>,
 }
 
 impl<'a> PrimitiveFilter<'a> {
@@ -28,7 +27,7 @@ impl<'a> PrimitiveFilter<'a> {
 
     /// Accepted objects only, always with their boxes and labels (the objects view).
     #[must_use]
-    pub const fn objects(overlays: Overlays, accepted: &'a [String]) -> Self {
+    pub const fn objects(overlays: Overlays, accepted: &'a [ObjectId]) -> Self {
         let mut o = overlays;
         o.candidates = true;
         o.object_labels = true;
@@ -54,7 +53,7 @@ impl<'a> PrimitiveFilter<'a> {
             },
             Primitive::PatternRegion { .. } => o.patterns,
             Primitive::Label { owner, .. } => {
-                o.object_labels && (o.patterns || !owner::is_pattern(owner))
+                o.object_labels && (o.patterns || !owner.is_pattern())
             }
         };
         let horizon = matches!(
@@ -64,7 +63,7 @@ impl<'a> PrimitiveFilter<'a> {
                 ..
             }
         );
-        on && (horizon || self.owners.is_none_or(|w| w.iter().any(|x| x == p.owner())))
+        on && (horizon || self.owners.is_none_or(|w| w.contains(&p.owner())))
     }
 }
 
@@ -135,13 +134,7 @@ impl Workspace {
             _ => Vec::new(),
         };
         for b in boxes {
-            crate::overlay::outline_box(
-                &mut out,
-                w,
-                h,
-                [b.minx, b.miny, b.maxx, b.maxy],
-                box_colour(b.colour),
-            );
+            crate::overlay::outline_box(&mut out, w, h, b.bounds(), box_colour(b.colour));
         }
         let filter = match kind {
             ViewKind::Objects => Some(PrimitiveFilter::objects(o, &self.accepted_owners)),
@@ -172,5 +165,56 @@ impl Workspace {
             ColourClass::Unclassified => [255, 0, 255],
             c => c.display_rgb(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::PixelBox;
+
+    fn boxed(owner: ObjectId) -> Primitive {
+        Primitive::Box {
+            owner,
+            colour: 1,
+            bounds: PixelBox::new(0, 0, 3, 3),
+        }
+    }
+
+    fn label(owner: ObjectId) -> Primitive {
+        Primitive::Label {
+            owner,
+            at: (1.0, 1.0),
+            text: "x".to_owned(),
+        }
+    }
+
+    #[test]
+    fn the_objects_view_draws_the_accepted_objects_and_the_horizon_only() {
+        let accepted = [ObjectId::Ball(1), ObjectId::Goal(ColourClass::Yellow, 0)];
+        let f = PrimitiveFilter::objects(Overlays::all_on(), &accepted);
+        assert!(f.shows(&boxed(ObjectId::Ball(1))));
+        assert!(f.shows(&boxed(ObjectId::Goal(ColourClass::Yellow, 0))));
+        assert!(!f.shows(&boxed(ObjectId::Ball(0))), "a rejected ball");
+        assert!(!f.shows(&boxed(ObjectId::Goal(ColourClass::SkyBlue, 0))));
+        let horizon = Primitive::Line {
+            owner: ObjectId::Horizon,
+            role: LineRole::Horizon,
+            from: (0.0, 5.0),
+            to: (10.0, 5.0),
+        };
+        assert!(f.shows(&horizon));
+        assert!(PrimitiveFilter::all(Overlays::all_on()).shows(&boxed(ObjectId::Ball(0))));
+    }
+
+    #[test]
+    fn a_patterns_label_follows_the_patterns_switch_and_other_labels_do_not() {
+        let mut o = Overlays::all_on();
+        o.patterns = false;
+        let f = PrimitiveFilter::all(o);
+        assert!(!f.shows(&label(ObjectId::Pattern(0))));
+        assert!(f.shows(&label(ObjectId::Ball(0))));
+        o.patterns = true;
+        assert!(PrimitiveFilter::all(o).shows(&label(ObjectId::Pattern(0))));
     }
 }

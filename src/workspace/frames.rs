@@ -189,7 +189,6 @@ impl Workspace {
         self.frame_counts = self.pipeline.result().classified.histogram();
         if self
             .selected_object
-            .as_ref()
             .is_some_and(|o| !self.primitives.iter().any(|p| p.owner() == o))
         {
             self.selected_object = None;

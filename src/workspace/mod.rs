@@ -150,8 +150,8 @@ pub struct Workspace {
     table_counts: crate::lut::ClassCounts,
     frame_counts: [usize; 256],
     primitives: Vec<Primitive>,
-    accepted_owners: Vec<String>,
-    selected_object: Option<String>,
+    accepted_owners: Vec<crate::recognition::ObjectId>,
+    selected_object: Option<crate::recognition::ObjectId>,
     live: Option<Live>,
     /// Robots over the network, one of them perhaps shown.
     robots: robots::Robots,
@@ -391,7 +391,7 @@ impl Workspace {
             | Command::StopRecordingRobot(_)
             | Command::SetFollowLive(_)) => self.apply_robot_command(c)?,
             Command::SelectObject(owner) => {
-                if let Some(o) = &owner {
+                if let Some(o) = owner {
                     anyhow::ensure!(
                         self.primitives.iter().any(|p| p.owner() == o),
                         "no object {o} in this frame"
@@ -640,17 +640,16 @@ impl Workspace {
         &self.primitives
     }
 
-    /// Owners (`"ball#0"`, `"goal:yellow#1"`, `"beacon#0"`) of the accepted objects: what the
-    /// objects view shows.
+    /// The accepted objects: what the objects view shows.
     #[must_use]
-    pub fn accepted_owners(&self) -> &[String] {
+    pub fn accepted_owners(&self) -> &[crate::recognition::ObjectId] {
         &self.accepted_owners
     }
 
     /// The candidate selected in the inspector, whose overlays are highlighted.
     #[must_use]
-    pub fn selected_object(&self) -> Option<&str> {
-        self.selected_object.as_deref()
+    pub const fn selected_object(&self) -> Option<crate::recognition::ObjectId> {
+        self.selected_object
     }
 
     /// Blobs large enough to draw, largest first within each class.

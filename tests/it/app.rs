@@ -8,6 +8,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use eotn::app::EotnApp;
 use eotn::lut::{ColourClass, Sensitivity};
+use eotn::recognition::ObjectId;
 use eotn::workspace::journal;
 use eotn::workspace::{Command, ViewKind, Window, Workspace};
 
@@ -432,7 +433,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         .ball
         .clone()
         .expect("frame 0 shows the ball");
-    let ball_owner = format!("ball#{}", ball.candidate);
+    let ball_owner = ObjectId::Ball(ball.candidate);
     assert!(s.accepted_owners().contains(&ball_owner));
     let prims = s.primitives();
     assert!(
@@ -495,7 +496,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     h.get_by_label_contains(&format!("accepted {ball_owner}"))
         .click();
     h.run();
-    assert_eq!(workspace(&h).selected_object(), Some(ball_owner.as_str()));
+    assert_eq!(workspace(&h).selected_object(), Some(ball_owner));
     assert!(
         h.query_all_by_label("pixel_ratio").count() == 1,
         "{:#?}",
@@ -518,9 +519,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     .map(|c| c.owner)
     .find(|o| *o != ball_owner)
     .expect("another candidate in frame 0");
-    h.state_mut()
-        .state
-        .run(Command::SelectObject(Some(goal.clone())));
+    h.state_mut().state.run(Command::SelectObject(Some(goal)));
     h.run();
     let circles = drawn_circles(&h);
     assert!(
@@ -530,7 +529,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     // An unknown owner is refused; stepping to a frame without it clears the selection.
     let mut st = Workspace::default();
     assert!(
-        st.apply(Command::SelectObject(Some("ball#9".into())))
+        st.apply(Command::SelectObject(Some(ObjectId::Ball(9))))
             .is_err()
     );
     h.state_mut().state.run(Command::Seek(14));
@@ -597,11 +596,8 @@ fn snapshot_with_recognition_and_inspector() {
         .ball
         .clone()
         .expect("a ball in frame 0");
-    s.apply(Command::SelectObject(Some(format!(
-        "ball#{}",
-        ball.candidate
-    ))))
-    .unwrap();
+    s.apply(Command::SelectObject(Some(ObjectId::Ball(ball.candidate))))
+        .unwrap();
     let mut h = snapshot_harness(s, Vec2::new(1280.0, 800.0));
     h.run();
     h.snapshot("app_recognition");
@@ -748,7 +744,7 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
         .find(|(_, c)| c.accepted)
         .expect("identified");
     assert_eq!(c.identification.map(|m| (m.id, m.agreement)), Some((7, 9)));
-    let owner = format!("pattern#{k}");
+    let owner = ObjectId::Pattern(k);
     assert!(
         s.accepted_owners().contains(&owner),
         "the objects view shows it"
@@ -764,7 +760,7 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     h.get_by_label_contains(&format!("accepted {owner}"))
         .click();
     h.run();
-    assert_eq!(workspace(&h).selected_object(), Some(owner.as_str()));
+    assert_eq!(workspace(&h).selected_object(), Some(owner));
     assert!(
         h.query_by_label_contains("pink marker: place 7").is_some(),
         "{:#?}",

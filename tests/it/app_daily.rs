@@ -497,7 +497,7 @@ fn closing_the_inspector_clears_its_highlight() {
     s.apply(Command::Seek(5)).unwrap();
     s.apply(Command::ShowWindow(Window::Inspector, true))
         .unwrap();
-    let owner = s.accepted_owners()[0].clone();
+    let owner = s.accepted_owners()[0];
     s.apply(Command::SelectObject(Some(owner))).unwrap();
     assert!(s.selected_object().is_some());
     s.apply(Command::ShowWindow(Window::Inspector, false))

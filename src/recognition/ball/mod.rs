@@ -451,21 +451,21 @@ impl BallResult {
     pub fn primitives(&self) -> Vec<Primitive> {
         let mut out = Vec::new();
         for (i, c) in self.candidates.iter().enumerate() {
-            let owner = super::draw::owner::ball(i);
+            let owner = super::draw::ObjectId::Ball(i);
             out.push(Primitive::Box {
-                owner: owner.clone(),
+                owner,
                 colour: ColourClass::Orange.code(),
-                bounds: c.bounds,
+                bounds: c.bounds.into(),
             });
             if let Some(area) = c.below {
                 out.push(Primitive::ScanArea {
-                    owner: owner.clone(),
+                    owner,
                     corners: area.corners,
                 });
             }
             if !c.scanned_points.is_empty() {
                 out.push(Primitive::ScanPoints {
-                    owner: owner.clone(),
+                    owner,
                     points: c.scanned_points.clone(),
                 });
             }
@@ -474,14 +474,14 @@ impl BallResult {
                 // second, dashed circle when that is visibly elsewhere.
                 let seen = c.observed_center;
                 out.push(Primitive::Circle {
-                    owner: owner.clone(),
+                    owner,
                     center: seen,
                     radius: c.radius_px,
                     role: CircleRole::Observed,
                 });
                 if (c.center.0 - seen.0).hypot(c.center.1 - seen.1) > 0.5 {
                     out.push(Primitive::Circle {
-                        owner: owner.clone(),
+                        owner,
                         center: c.center,
                         radius: c.radius_px,
                         role: CircleRole::SkewCorrected,

@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 
 use super::confidence::{Confidence, TestName, TestWeight};
 use super::context::{Relative, ViewContext};
-use super::draw::{LineRole, Primitive};
+use super::draw::{LineRole, ObjectId, Primitive};
 use super::fit::{LineFit, Point};
 use super::scan::CutOff;
 use crate::blobs::BlobSet;
@@ -478,21 +478,21 @@ impl GoalResult {
     pub fn primitives(&self) -> Vec<Primitive> {
         let mut out = Vec::new();
         for (i, c) in self.candidates.iter().enumerate() {
-            let owner = super::draw::owner::goal(c.colour, i);
+            let owner = ObjectId::Goal(c.colour, i);
             out.push(Primitive::Box {
-                owner: owner.clone(),
+                owner,
                 colour: c.colour.code(),
-                bounds: c.bounds.to_array(),
+                bounds: c.bounds,
             });
             if !c.post_points.is_empty() {
                 out.push(Primitive::ScanPoints {
-                    owner: owner.clone(),
+                    owner,
                     points: c.post_points.clone(),
                 });
             }
             for post in &c.posts {
                 out.push(Primitive::Line {
-                    owner: owner.clone(),
+                    owner,
                     role: LineRole::Post,
                     from: post.top,
                     to: post.bottom,
@@ -500,7 +500,7 @@ impl GoalResult {
             }
             if let Some((a, b)) = c.gap_scan {
                 out.push(Primitive::Line {
-                    owner: owner.clone(),
+                    owner,
                     role: LineRole::Scan,
                     from: a,
                     to: b,
@@ -508,7 +508,7 @@ impl GoalResult {
             }
             if let Some(gap) = &c.gap {
                 out.push(Primitive::Line {
-                    owner: owner.clone(),
+                    owner,
                     role: LineRole::Gap,
                     from: gap.left,
                     to: gap.right,

@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 
 use super::confidence::{Confidence, TestWeight};
 use super::context::Relative;
-use super::draw::{Primitive, owner};
+use super::draw::{ObjectId, Primitive};
 
 pub use learning::{LearnParams, LearnReport, LearnView, Triangulation, triangulate};
 use learning::{median, theil_sen};
@@ -346,11 +346,11 @@ pub struct PatternCandidate {
 pub fn pattern_primitives(candidates: &[PatternCandidate]) -> Vec<Primitive> {
     let mut out = Vec::new();
     for (i, c) in candidates.iter().enumerate() {
-        let owner = owner::pattern(i);
+        let owner = ObjectId::Pattern(i);
         let obs = &c.observation;
         for k in 0..9 {
             out.push(Primitive::PatternRegion {
-                owner: owner.clone(),
+                owner,
                 bounds: obs.region_bounds(k),
                 colour: obs.signature.0[k][0],
                 centre: k == 4,
