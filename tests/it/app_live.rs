@@ -35,7 +35,9 @@ fn camera_connect_to_a_robot_served_by_eotn_serve_shows_its_frames() {
     field.focus();
     field.type_text(&format!("ws://127.0.0.1:{}", served.port));
     h.run();
-    click_label(&mut h, "Connect");
+    // Frames keep arriving once connected, so the UI never settles: step, do not `run`.
+    h.get_by_label("Connect").click();
+    h.run_steps(4);
     // Connect… ▸ network puts the robot into the robots list, shown at once.
     let frames = |a: &EotnApp| a.state.robots().first().map_or(0, |r| r.stats.frames);
     run_until(&mut h, WITHIN, |a| {
@@ -46,7 +48,8 @@ fn camera_connect_to_a_robot_served_by_eotn_serve_shows_its_frames() {
     assert!(info.label.starts_with("robot "), "{}", info.label);
     assert_eq!(h.state().state.camera_kind(), CameraKind::Robot);
     assert!(h.state().state.shown_robot().is_some());
-    click_label(&mut h, "Camera");
+    h.get_by_label("Camera").click();
+    h.run_steps(4);
     click_label(&mut h, "Disconnect");
     assert!(h.state().state.robots().is_empty());
     assert!(h.state().state.connected_info().is_none());
