@@ -185,7 +185,7 @@ fn shipped_sim_streams_classify_with_the_shipped_table() {
             let mut orange = 0;
             for y in b.min_y..=b.max_y {
                 for x in b.min_x..=b.max_x {
-                    if img.get(x, y) == Some(ColourClass::Orange.code()) {
+                    if img.get(x as usize, y as usize) == Some(ColourClass::Orange.code()) {
                         orange += 1;
                     }
                 }

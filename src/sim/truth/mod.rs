@@ -23,6 +23,9 @@ pub use robot_view::{GAP_SCAN_HEIGHT_CM, robot_view_truth};
 use serde::{Deserialize, Serialize};
 
 use super::scene::{GoalColour, Team};
+pub use crate::frame::CutOff;
+
+use crate::frame::PixelBox;
 use crate::geometry::{
     BodyPose, CameraPose, Field, HeadJoints, Horizon, ImagePoint, MarkerIdentity, MarkerTeam,
     OverheadCamera, Point, PoseRecord, RobotPose,
@@ -37,32 +40,6 @@ pub enum GroundTruth {
     Robot(Box<RobotViewTruth>),
     /// A frame from the overhead camera.
     Overhead(OverheadTruth),
-}
-
-/// An inclusive pixel box, `FORMATS.md` convention.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct PixelBox {
-    /// Leftmost column.
-    pub min_x: usize,
-    /// Topmost row.
-    pub min_y: usize,
-    /// Rightmost column.
-    pub max_x: usize,
-    /// Bottom row.
-    pub max_y: usize,
-}
-
-/// Which image borders cut an object's outline.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub struct CutOff {
-    /// Cut by the left border.
-    pub left: bool,
-    /// Cut by the right border.
-    pub right: bool,
-    /// Cut by the top border.
-    pub top: bool,
-    /// Cut by the bottom border.
-    pub bottom: bool,
 }
 
 /// Truth of a robot-camera frame.
@@ -134,6 +111,7 @@ pub struct BallTruth {
     /// Image borders that cut the disc.
     pub cut_off: CutOff,
     /// Box of the visible ball pixels.
+    #[serde(with = "box_fields", default)]
     pub image_box: Option<PixelBox>,
     /// The ball's velocity on the ground in the observer's frame (x ahead, y left),
     /// centimetres per second.
@@ -210,6 +188,7 @@ pub struct GoalTruth {
     /// Pixels that show the goal.
     pub visible_pixels: usize,
     /// Box of those pixels.
+    #[serde(with = "box_fields", default)]
     pub image_box: Option<PixelBox>,
     /// Left and right post as seen from the field (left = +y side for the yellow goal seen
     /// from the centre).
@@ -233,6 +212,7 @@ pub struct BeaconTruth {
     /// Pixels that show the beacon.
     pub visible_pixels: usize,
     /// Box of those pixels.
+    #[serde(with = "box_fields", default)]
     pub image_box: Option<PixelBox>,
 }
 
@@ -256,6 +236,7 @@ pub struct MarkerTruth {
     /// image border or hidden behind something.
     pub pink_visible_fraction: f64,
     /// Box of the visible pink pixels.
+    #[serde(with = "box_fields", default)]
     pub image_box: Option<PixelBox>,
     /// Every corner of the whole 3 × 3 panel projects inside the image.
     pub panel_in_image: bool,
@@ -278,6 +259,7 @@ pub struct RobotTruth {
     /// Pixels that show the robot.
     pub visible_pixels: usize,
     /// Box of those pixels.
+    #[serde(with = "box_fields", default)]
     pub image_box: Option<PixelBox>,
 }
 
@@ -360,20 +342,19 @@ fn coverage(objects: &[u16], width: usize, id: u16) -> Coverage {
     let mut c = Coverage::default();
     for (k, _) in objects.iter().enumerate().filter(|(_, o)| **o == id) {
         let (x, y) = (k % width, k / width);
+        let (x, y) = (
+            u32::try_from(x).unwrap_or(u32::MAX),
+            u32::try_from(y).unwrap_or(u32::MAX),
+        );
         c.pixels += 1;
         c.bbox = Some(match c.bbox {
-            None => PixelBox {
-                min_x: x,
-                min_y: y,
-                max_x: x,
-                max_y: y,
-            },
-            Some(b) => PixelBox {
-                min_x: b.min_x.min(x),
-                min_y: b.min_y.min(y),
-                max_x: b.max_x.max(x),
-                max_y: b.max_y.max(y),
-            },
+            None => PixelBox::new(x, y, x, y),
+            Some(b) => PixelBox::new(
+                b.min_x.min(x),
+                b.min_y.min(y),
+                b.max_x.max(x),
+                b.max_y.max(y),
+            ),
         });
     }
     c
@@ -389,6 +370,40 @@ fn covered_fraction(pixels: usize, area: f64) -> f64 {
     }
 }
 
+/// The ground truth's boxes in JSON: `{"min_x", "min_y", "max_x", "max_y"}` or `null`, the form
+/// they had before [`PixelBox`] (which writes four numbers), so the shipped streams' truth reads
+/// and compares unchanged.
+mod box_fields {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use crate::frame::PixelBox;
+
+    #[derive(Serialize, Deserialize)]
+    struct Fields {
+        min_x: u32,
+        min_y: u32,
+        max_x: u32,
+        max_y: u32,
+    }
+
+    pub(super) fn serialize<S: Serializer>(b: &Option<PixelBox>, s: S) -> Result<S::Ok, S::Error> {
+        b.map(|b| Fields {
+            min_x: b.min_x,
+            min_y: b.min_y,
+            max_x: b.max_x,
+            max_y: b.max_y,
+        })
+        .serialize(s)
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<Option<PixelBox>, D::Error> {
+        Ok(Option::<Fields>::deserialize(d)?
+            .map(|f| PixelBox::new(f.min_x, f.min_y, f.max_x, f.max_y)))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -400,14 +415,6 @@ mod tests {
         objects[27] = 1;
         let c = coverage(&objects, 10, 1);
         assert_eq!(c.pixels, 2);
-        assert_eq!(
-            c.bbox,
-            Some(PixelBox {
-                min_x: 2,
-                min_y: 1,
-                max_x: 7,
-                max_y: 2
-            })
-        );
+        assert_eq!(c.bbox, Some(PixelBox::new(2, 1, 7, 2)));
     }
 }
