@@ -326,7 +326,7 @@ pub fn ball_rim_study() {
                     } else {
                         "inside"
                     };
-                    let c = img.get(x, y).unwrap_or(0);
+                    let c = img.get(x as usize, y as usize).unwrap_or(0);
                     let is_ball = eotn::recognition::ball::is_ball_colour(c);
                     let e = tally
                         .entry(format!("{} {region}", kind.name()))

@@ -22,6 +22,17 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
             .weak(),
     );
     ui.separator();
+    classes_ui(ui, state, commands);
+    ui.separator();
+    sensitivity_ui(ui, state, commands);
+    ui.separator();
+    pending_selection_ui(ui, state, commands);
+    ui.separator();
+    undo_redo_ui(ui, state, commands);
+}
+
+/// Each class with its table cells and frame pixels; clicking one picks it.
+fn classes_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let counts = state.table_counts();
     let frame_counts = state.frame_counts();
     egui::Grid::new("classes").num_columns(3).show(ui, |ui| {
@@ -49,7 +60,10 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
             ui.end_row();
         }
     });
-    ui.separator();
+}
+
+/// The Y, U and V reach of a selection, with presets.
+fn sensitivity_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     ui.label("Sensitivity (± cells)");
     let max = state.max_sensitivity();
     let mut s = state.settings.sensitivity;
@@ -72,7 +86,10 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
             }
         }
     });
-    ui.separator();
+}
+
+/// The pending selection: where it came from, what it changes, Commit, Clear, Try.
+fn pending_selection_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     match (state.selection(), state.resolved_selection()) {
         (Some(sel), Some(resolved)) => {
             let cells = resolved.indices(state.lut()).count();
@@ -115,7 +132,10 @@ pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
             ui.weak("no pending selection");
         }
     }
-    ui.separator();
+}
+
+/// Undo and Redo with the history's lengths.
+fn undo_redo_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let h = state.history();
     ui.horizontal(|ui| {
         if ui

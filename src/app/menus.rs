@@ -256,6 +256,15 @@ fn classification_menu_ui(
     input: &mut MenuInput,
     commands: &mut Vec<Command>,
 ) {
+    class_menus_ui(ui, state, commands);
+    ui.separator();
+    table_edit_items_ui(ui, state, commands);
+    ui.separator();
+    places_items_ui(ui, state, input, commands);
+}
+
+/// The Class and Sensitivity submenus.
+fn class_menus_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     ui.menu_button(format!("Class: {}", state.settings.class.name()), |ui| {
         for class in ColourClass::ALL {
             if ui
@@ -281,7 +290,10 @@ fn classification_menu_ui(
             }
         }
     });
-    ui.separator();
+}
+
+/// Undo, Redo, Commit selection, Try selection on whole stream.
+fn table_edit_items_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let h = state.history();
     if ui
         .add_enabled(
@@ -323,7 +335,15 @@ fn classification_menu_ui(
         commands.push(Command::TryEditOnStream);
         ui.close();
     }
-    ui.separator();
+}
+
+/// Open and Close places, Rebuild table from journal.
+fn places_items_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    input: &mut MenuInput,
+    commands: &mut Vec<Command>,
+) {
     if ui
         .button("Open places…")
         .on_hover_text(

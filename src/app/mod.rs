@@ -5,6 +5,12 @@
 //!
 //! | file | role |
 //! |---|---|
+//! | `mod.rs` | the app shell: [`EotnApp`](crate::app::EotnApp), starting the window, one UI frame in order (clock, keys, textures, panels, windows, commands) |
+//! | `panels.rs` | the window's layout: menu bar, status bar, timeline, thumbnails, Classify panel, the dock; the floating windows |
+//! | `status_bar.rs` | the status bar, the warnings window, Help ▸ About |
+//! | `timeline.rs` | the timeline bar: play, step, speed, frame number, slider with marks |
+//! | `keyboard.rs` | the keyboard shortcuts |
+//! | `textures.rs` | the shown frame's images and highlight, uploaded when they change |
 //! | `views.rs` | the enlarged view (zoom, pan, hover, clicks) and the thumbnails |
 //! | `overlays.rs` | drawing in image pixels through one transform: boxes, labels, markers |
 //! | `classify_panel.rs` | class picker, sensitivity, commit/undo/redo, try-on-stream |
@@ -36,29 +42,33 @@ pub mod dock;
 pub mod field_view;
 pub mod file_dialog;
 pub mod inspector;
+mod keyboard;
 pub mod menus;
 pub mod overhead_menu;
 pub mod overhead_overlays;
 pub mod overlays;
+mod panels;
 pub mod params_panel;
 pub mod renderer;
 pub mod robots_panel;
 pub mod sensors_dialog;
+mod status_bar;
+mod textures;
+mod timeline;
 pub mod uv_plane;
 pub mod views;
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use egui::{Color32, ColorImage, Key, KeyboardShortcut, Modifiers, TextureHandle, TextureOptions};
+use egui::Color32;
 
 pub use crate::workspace::{Command, Settings, ViewKind, Workspace};
+pub use textures::{ViewImages, palette, preview_image, view_images, visible_preview_colour};
 
-use crate::workspace::{PixelInfo, SPEEDS, median};
-use overlays::{FrameTextures, ImageTransform};
-
-/// How much the pixels outside a pending selection are darkened (alpha of black over them).
-const PREVIEW_DIM_ALPHA: u8 = 110;
+use crate::workspace::{PixelInfo, median};
+use overlays::ImageTransform;
+use textures::Textures;
 
 /// Key of the persisted [`Settings`] in eframe's storage.
 pub const SETTINGS_KEY: &str = "eotn-settings";
@@ -186,105 +196,6 @@ fn start_window(
     )
 }
 
-/// The textures of the shown frame and what they were built from.
-struct Textures {
-    raw: TextureHandle,
-    classified: TextureHandle,
-    preview: TextureHandle,
-    frame_generation: u64,
-    preview_generation: u64,
-    /// The preview texture holds no highlight (nothing to re-upload while none is pending).
-    preview_empty: bool,
-}
-
-impl Textures {
-    fn ids(&self) -> FrameTextures {
-        FrameTextures {
-            raw: self.raw.id(),
-            classified: self.classified.id(),
-            preview: self.preview.id(),
-        }
-    }
-}
-
-/// Display colours of every class code, transparent for unclassified.
-#[must_use]
-pub fn palette() -> [Color32; 256] {
-    let mut p = [Color32::TRANSPARENT; 256];
-    for (code, c) in p.iter_mut().enumerate().skip(1) {
-        let [r, g, b] = crate::lut::code_display_rgb(u8::try_from(code).unwrap_or(0));
-        *c = Color32::from_rgb(r, g, b);
-    }
-    p
-}
-
-/// The images the views are drawn from, before they go to the GPU.
-#[derive(Debug, Clone)]
-pub struct ViewImages {
-    /// The frame in colour.
-    pub raw: ColorImage,
-    /// Class colours, transparent where unclassified.
-    pub classified: ColorImage,
-}
-
-/// Builds the colour and class-colour images of the shown frame (`palette` from [`palette`]);
-/// `None` when no frame is open. This is the CPU side of a texture update.
-#[must_use]
-pub fn view_images(state: &Workspace, palette: &[Color32; 256]) -> Option<ViewImages> {
-    let frame = state.frame()?;
-    let size = [frame.width(), frame.height()];
-    // The undistorted view of an overhead frame, when chosen, else the frame as it is.
-    let raw = ColorImage::from_rgb(size, &state.view_rgb());
-    let classified = ColorImage::new(
-        size,
-        state
-            .view_codes()
-            .iter()
-            .map(|&c| palette[usize::from(c)])
-            .collect(),
-    );
-    Some(ViewImages { raw, classified })
-}
-
-/// The preview highlight image of the pending selection (class colour on selected pixels,
-/// dimmed elsewhere; transparent with no selection).
-#[must_use]
-pub fn preview_image(state: &Workspace, size: [usize; 2]) -> ColorImage {
-    let mask = state.preview_mask();
-    let colour = state
-        .preview_colour()
-        .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
-    if mask.len() != size[0] * size[1] {
-        return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
-    }
-    // Unselected pixels are dimmed, so the highlight shows even where the class colour is
-    // the colour of the pixels themselves (orange on an orange ball).
-    let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
-    // A dark class colour (black, dark blue) would vanish on the dimmed dark pixels: those
-    // classes are previewed in a light colour instead.
-    let colour = visible_preview_colour(colour);
-    ColorImage::new(
-        size,
-        mask.iter().map(|&m| if m { colour } else { dim }).collect(),
-    )
-}
-
-/// The highlight colour of a previewed class: its own colour, or a light magenta for classes
-/// too dark to show over dimmed pixels (black's near-black, dark blue).
-#[must_use]
-pub fn visible_preview_colour(class_colour: Color32) -> Color32 {
-    let [r, g, b, a] = class_colour.to_array();
-    let luma = 0.299 * f32::from(r) + 0.587 * f32::from(g) + 0.114 * f32::from(b);
-    if a > 0 && luma < PREVIEW_MIN_LUMA {
-        Color32::from_rgb(255, 96, 255)
-    } else {
-        class_colour
-    }
-}
-
-/// Class colours darker than this (0..255 luma) get a light preview colour.
-const PREVIEW_MIN_LUMA: f32 = 100.0;
-
 /// The eframe application: the state plus the runtime resources of the window.
 pub struct EotnApp {
     /// Everything that is not a widget.
@@ -399,347 +310,6 @@ impl EotnApp {
         self.confirm_close
     }
 
-    fn update_textures(&mut self, ctx: &egui::Context) {
-        let Some(frame) = self.state.frame() else {
-            return;
-        };
-        let size = [frame.width(), frame.height()];
-        let opts = TextureOptions::NEAREST;
-        let fg = self.state.frame_generation();
-        let pg = self.state.preview_generation();
-        if self
-            .textures
-            .as_ref()
-            .is_some_and(|t| t.frame_generation == fg && t.preview_generation == pg)
-        {
-            return;
-        }
-        let t0 = Instant::now();
-        let frame_changed = self
-            .textures
-            .as_ref()
-            .is_none_or(|t| t.frame_generation != fg);
-        let empty = self.state.selection().is_none();
-        if frame_changed
-            && let Some(ViewImages { raw, classified }) = view_images(&self.state, &self.palette)
-        {
-            match &mut self.textures {
-                Some(t) => {
-                    t.raw.set(raw, opts);
-                    t.classified.set(classified, opts);
-                }
-                None => {
-                    let preview = preview_image(&self.state, size);
-                    self.textures = Some(Textures {
-                        raw: ctx.load_texture("raw", raw, opts),
-                        classified: ctx.load_texture("classified", classified, opts),
-                        preview: ctx.load_texture("preview", preview, opts),
-                        frame_generation: fg,
-                        preview_generation: pg,
-                        preview_empty: empty,
-                    });
-                }
-            }
-        }
-        if let Some(t) = &mut self.textures {
-            // With nothing selected the preview is not drawn: an empty one is uploaded once,
-            // not on every step of playback.
-            if t.preview_generation != pg && !(empty && t.preview_empty) {
-                t.preview.set(preview_image(&self.state, size), opts);
-                t.preview_empty = empty;
-            }
-            t.frame_generation = fg;
-            t.preview_generation = pg;
-        }
-        if frame_changed {
-            self.state.record_upload(t0.elapsed());
-        }
-    }
-
-    fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
-        let mut quit = false;
-        if ctx.egui_wants_keyboard_input() {
-            return quit;
-        }
-        let menu_open = egui::Popup::is_any_open(ctx);
-        ctx.input_mut(|i| {
-            let cmd = |k| KeyboardShortcut::new(Modifiers::COMMAND, k);
-            if i.consume_shortcut(&KeyboardShortcut::new(
-                Modifiers::COMMAND | Modifiers::SHIFT,
-                Key::Z,
-            )) || i.consume_shortcut(&cmd(Key::Y))
-            {
-                commands.push(Command::Redo);
-            }
-            if i.consume_shortcut(&cmd(Key::Z)) {
-                commands.push(Command::Undo);
-            }
-            if i.consume_shortcut(&cmd(Key::S)) {
-                commands.push(Command::SaveTable);
-            }
-            if i.consume_shortcut(&cmd(Key::Q)) {
-                quit = true;
-            }
-            for (key, channel) in [(Key::Y, 0), (Key::U, 1), (Key::V, 2)] {
-                let down = i.count_and_consume_key(Modifiers::SHIFT, key) as i32;
-                let up = i.count_and_consume_key(Modifiers::NONE, key) as i32;
-                if up != down {
-                    commands.push(Command::AdjustSensitivity {
-                        channel,
-                        delta: up - down,
-                    });
-                }
-            }
-            for (key, delta) in [(Key::Plus, 1), (Key::Equals, 1), (Key::Minus, -1)] {
-                if i.consume_key(Modifiers::NONE, key) {
-                    for channel in 0..3 {
-                        commands.push(Command::AdjustSensitivity { channel, delta });
-                    }
-                }
-            }
-            if self.state.source().is_some() {
-                for (key, delta) in [
-                    (Key::ArrowRight, 1),
-                    (Key::ArrowLeft, -1),
-                    (Key::PageDown, 10),
-                    (Key::PageUp, -10),
-                ] {
-                    // Every press counts, even several within one slow frame.
-                    let n = i.count_and_consume_key(Modifiers::NONE, key);
-                    if n > 0 {
-                        commands.push(Command::Step(delta * n as i64));
-                    }
-                }
-                for (key, forward) in [(Key::ArrowRight, true), (Key::ArrowLeft, false)] {
-                    if i.consume_key(Modifiers::COMMAND, key) {
-                        commands.push(Command::JumpToMark { forward });
-                    }
-                }
-                if i.consume_key(Modifiers::NONE, Key::Home) {
-                    commands.push(Command::Seek(0));
-                }
-                if i.consume_key(Modifiers::NONE, Key::End) {
-                    commands.push(Command::Seek(usize::MAX));
-                }
-                if i.consume_key(Modifiers::NONE, Key::Space) {
-                    commands.push(Command::SetPlaying(!self.state.playing()));
-                }
-            }
-            // Escape closes an open menu first; only then does it drop the selection.
-            if !menu_open && i.consume_key(Modifiers::NONE, Key::Escape) {
-                commands.push(Command::ClearSelection);
-            }
-        });
-        quit
-    }
-
-    fn timeline_ui(&self, ui: &mut egui::Ui, commands: &mut Vec<Command>) {
-        let Some(src) = self.state.source() else {
-            return;
-        };
-        let len = src.len();
-        let index = self.state.index();
-        ui.horizontal(|ui| {
-            robots_panel::live_controls_ui(ui, &self.state, commands);
-            if ui.button("Previous").on_hover_text("Left arrow").clicked() {
-                commands.push(Command::Step(-1));
-            }
-            let play = if self.state.playing() {
-                "Pause"
-            } else {
-                "Play"
-            };
-            if ui.button(play).on_hover_text("Space").clicked() {
-                commands.push(Command::SetPlaying(!self.state.playing()));
-            }
-            if ui.button("Next").on_hover_text("Right arrow").clicked() {
-                commands.push(Command::Step(1));
-            }
-            let mut speed = self.state.settings.speed;
-            egui::ComboBox::from_label("speed")
-                .selected_text(menus::speed_name(speed))
-                .width(90.0)
-                .show_ui(ui, |ui| {
-                    for s in SPEEDS {
-                        ui.selectable_value(&mut speed, s, menus::speed_name(s));
-                    }
-                });
-            if (speed - self.state.settings.speed).abs() > f32::EPSILON {
-                commands.push(Command::SetSpeed(speed));
-            }
-            let mut i = index;
-            ui.label("frame");
-            if ui
-                .add(egui::DragValue::new(&mut i).range(0..=len.saturating_sub(1)))
-                .on_hover_text("type a frame number to jump")
-                .changed()
-            {
-                commands.push(Command::Seek(i));
-            }
-            let t = src.time_ns(index) as f64 / 1e9;
-            let end = src.time_ns(len.saturating_sub(1)) as f64 / 1e9;
-            ui.monospace(format!(
-                "/ {}  {t:8.3} s / {end:.3} s",
-                len.saturating_sub(1)
-            ));
-            ui.spacing_mut().slider_width = (ui.available_width() - 70.0).max(100.0);
-            let mut j = index;
-            let slider = ui.add(
-                egui::Slider::new(&mut j, 0..=len.saturating_sub(1))
-                    .show_value(false)
-                    .text("timeline"),
-            );
-            if slider.changed() {
-                commands.push(Command::Seek(j));
-            }
-            bookmarks_panel::timeline_marks(ui.painter(), slider.rect, &self.state, len);
-        });
-    }
-
-    fn status_ui(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            let n = self.state.warnings().len();
-            let label = match n {
-                0 => "no warnings".to_owned(),
-                1 => "1 warning".to_owned(),
-                _ => format!("{n} warnings"),
-            };
-            let button = egui::Button::new(label).selected(self.show_warnings);
-            if ui.add_enabled(n > 0, button).clicked() {
-                self.show_warnings = !self.show_warnings;
-            }
-            let s = self.state.timings.last_step;
-            let ms = |d: Duration| d.as_secs_f64() * 1e3;
-            if self.state.settings.show_timings {
-            ui.monospace(format!(
-                "step {:.1} ms (read {:.1} classify {:.1} blobs {:.1} recognition {:.1} prep {:.1} upload {:.1}) | frame {:.1} ms",
-                ms(s.total()),
-                ms(s.read),
-                ms(s.classify),
-                ms(s.blobs),
-                ms(s.recognition),
-                ms(s.prepare),
-                ms(s.upload),
-                self.state.timings.frames_ms.last().copied().unwrap_or(0.0),
-            ))
-            .on_hover_text(format!(
-                "medians: step {:.2} ms, frame {:.2} ms, playing {:.2} ms",
-                median(&self.state.timings.steps_ms),
-                median(&self.state.timings.frames_ms),
-                median(&self.state.timings.playing_frames_ms),
-            ));
-            }
-            ui.separator();
-            ui.label(&self.state.status);
-            if let Some(r) = &self.renderer {
-                ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                    let b = ui
-                        .small_button(r.kind.name())
-                        .on_hover_text(format!("{}: {}", r.adapter, r.reason));
-                    if b.clicked() {
-                        self.show_about = !self.show_about;
-                    }
-                });
-            }
-        });
-        // This frame's own problems (NaN sensor readings, skipped channels) stay in view while
-        // it is shown, not only in the warnings list.
-        if let Some(c) = self.state.current()
-            && !c.warnings.is_empty()
-        {
-            let colour = ui.visuals().warn_fg_color;
-            for w in &c.warnings {
-                ui.colored_label(colour, format!("this frame: {w}"));
-            }
-        }
-        ui.horizontal(|ui| {
-            views::pixel_readout_ui(ui, self.hovered.as_ref());
-            // Why this pixel has its class: the edit that last set its cell. A "|", not a
-            // separator: a styled widget appearing costs egui two more repaints.
-            if let Some(o) = self
-                .hovered
-                .as_ref()
-                .and_then(|h| self.state.pixel_origin(h.x, h.y))
-            {
-                ui.monospace(format!("| {o}"));
-            }
-        });
-    }
-
-    fn warnings_window(&mut self, ctx: &egui::Context) {
-        if !self.show_warnings {
-            return;
-        }
-        let mut open = true;
-        let mut clear = false;
-        egui::Window::new("Warnings")
-            .open(&mut open)
-            .default_width(520.0)
-            .show(ctx, |ui| {
-                if ui.button("Clear").clicked() {
-                    clear = true;
-                }
-                egui::ScrollArea::vertical()
-                    .max_height(300.0)
-                    .show(ui, |ui| {
-                        for w in self.state.warnings().iter().rev() {
-                            ui.label(w);
-                        }
-                    });
-            });
-        if clear {
-            self.state.clear_warnings();
-            open = false;
-        }
-        self.show_warnings = open;
-    }
-
-    /// Help ▸ About: the version and what draws the window.
-    fn about_window(&mut self, ctx: &egui::Context) {
-        if !self.show_about {
-            return;
-        }
-        let mut open = true;
-        egui::Window::new("About eotn")
-            .open(&mut open)
-            .default_width(420.0)
-            .show(ctx, |ui| {
-                ui.label(concat!(
-                    "eotn ",
-                    env!("CARGO_PKG_VERSION"),
-                    ": Eye Of The NUbot and the World Model Debugger"
-                ));
-                ui.separator();
-                match &self.renderer {
-                    Some(r) => {
-                        egui::Grid::new("about-renderer")
-                            .num_columns(2)
-                            .show(ui, |ui| {
-                                ui.label("Renderer");
-                                ui.label(r.kind.name());
-                                ui.end_row();
-                                ui.label("Adapter");
-                                ui.label(&r.adapter);
-                                ui.end_row();
-                                ui.label("Why");
-                                ui.label(&r.reason);
-                                ui.end_row();
-                                ui.label("Setting");
-                                ui.label(format!(
-                                    "{} (eotn open --renderer auto|wgpu|gl changes it)",
-                                    r.setting.name()
-                                ));
-                                ui.end_row();
-                            });
-                    }
-                    None => {
-                        ui.label("Renderer: none (headless)");
-                    }
-                }
-            });
-        self.show_about = open;
-    }
-
     fn close_dialog(&mut self, ctx: &egui::Context, commands: &mut Vec<Command>) {
         if ctx.input(|i| i.viewport().close_requested()) && self.state.dirty() && !self.allow_close
         {
@@ -784,6 +354,62 @@ impl EotnApp {
             }
             Some(_) => self.confirm_close = false,
             None => {}
+        }
+    }
+
+    /// Measures the UI frame interval and moves playback and the scans on by it; starts
+    /// `--play` once the first frame is on screen.
+    fn advance_clock(&mut self, ctx: &egui::Context, now: Instant) {
+        let dt = self.last_frame.map_or(Duration::ZERO, |t| now - t);
+        self.last_frame = Some(now);
+        if dt > Duration::ZERO {
+            self.state.record_frame_time(dt);
+        }
+        // Playback and scans use wall time, capped so a stall does not skip half the stream.
+        self.state.tick(dt.min(Duration::from_millis(250)));
+        // The first frame has been drawn when the second starts (dt > 0).
+        if dt > Duration::ZERO
+            && let Some(speed) = self.play_when_shown.take()
+        {
+            self.state.run(Command::SetSpeed(speed));
+            self.state.run(Command::SetPlaying(true));
+        }
+        if self.play_when_shown.is_some() {
+            ctx.request_repaint();
+        }
+    }
+
+    /// After the commands: the window title, when to draw again, the UI-time records and the
+    /// end-of-playback report.
+    fn after_commands(&mut self, ctx: &egui::Context, now: Instant, cpu: Option<f32>) {
+        let title = self.state.title();
+        if title != self.title {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
+            self.title = title;
+        }
+        // Playback redraws when the next frame is due, not as fast as it can: an unchanged
+        // frame costs the renderer as much as a new one.
+        if let Some(due) = self.state.next_frame_due() {
+            ctx.request_repaint_after(due);
+        }
+        let busy = self.state.try_edit().is_some_and(|t| !t.done())
+            || self.state.hints_busy()
+            || self
+                .state
+                .params_slot()
+                .try_run
+                .as_ref()
+                .is_some_and(|t| !t.done())
+            || (self.state.settings.show_sensors
+                && self.state.sensor_series.points.len() < self.state.sensor_series.total);
+        self.state.record_ui_time(now.elapsed(), cpu);
+        if self.was_playing && !self.state.playing() {
+            // The end of a playback is when its figures are complete.
+            self.report_stats();
+        }
+        self.was_playing = self.state.playing();
+        if busy {
+            ctx.request_repaint();
         }
     }
 
@@ -832,80 +458,12 @@ impl eframe::App for EotnApp {
         let ctx = ui.ctx().clone();
         let now = Instant::now();
         let cpu = frame.info().cpu_usage;
-        let dt = self.last_frame.map_or(Duration::ZERO, |t| now - t);
-        self.last_frame = Some(now);
-        if dt > Duration::ZERO {
-            self.state.record_frame_time(dt);
-        }
-        // Playback and scans use wall time, capped so a stall does not skip half the stream.
-        self.state.tick(dt.min(Duration::from_millis(250)));
-        // The first frame has been drawn when the second starts (dt > 0).
-        if dt > Duration::ZERO
-            && let Some(speed) = self.play_when_shown.take()
-        {
-            self.state.run(Command::SetSpeed(speed));
-            self.state.run(Command::SetPlaying(true));
-        }
-        if self.play_when_shown.is_some() {
-            ctx.request_repaint();
-        }
-
+        self.advance_clock(&ctx, now);
         let mut commands = Vec::new();
         let mut quit = self.keyboard(&ctx, &mut commands);
         self.update_textures(&ctx);
-        let tex = self.textures.as_ref().map(Textures::ids);
-
-        egui::Panel::top("menu").show(ui, |ui| {
-            let out = menus::menu_bar_ui(ui, &self.state, &mut self.menu_input, &mut commands);
-            quit |= out.quit;
-            self.show_about |= out.about;
-        });
-        egui::Panel::bottom("status").show(ui, |ui| self.status_ui(ui));
-        if self.state.source().is_some() {
-            egui::Panel::bottom("timeline").show(ui, |ui| self.timeline_ui(ui, &mut commands));
-        }
-        egui::Panel::bottom("thumbnails")
-            .resizable(true)
-            .default_size(120.0)
-            .size_range(60.0..=300.0)
-            .show(ui, |ui| {
-                views::thumbnails_ui(ui, &self.state, tex.as_ref(), &mut commands)
-            });
-        egui::Panel::left("classify")
-            .resizable(true)
-            .default_size(230.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    classify_panel::classify_panel_ui(ui, &self.state, &mut commands);
-                });
-            });
-        self.dock.sync(&self.state);
-        egui::CentralPanel::default()
-            .frame(egui::Frame::NONE)
-            .show(ui, |ui| {
-                let mut behavior = dock::DockBehavior {
-                    state: &self.state,
-                    tex: tex.as_ref(),
-                    uv_plane: &mut self.uv_plane,
-                    overhead_paths: &mut self.overhead,
-                    robots: &mut self.robots,
-                    commands: &mut commands,
-                    dialog: &mut self.menu_input.dialog,
-                    view: views::MainViewOutput::default(),
-                };
-                let out = self.dock.ui(ui, &mut behavior);
-                self.hovered = out.hovered;
-                self.last_view = out.transform;
-            });
-        if let Some((action, name)) = self.menu_input.dialog.take() {
-            let folder = self.dialog_folder(action);
-            self.file_dialogs.open(action, folder.as_deref(), name);
-        }
-        self.file_dialogs.show(&ctx, &mut commands);
-        self.warnings_window(&ctx);
-        self.about_window(&ctx);
-        menus::open_path_window(&ctx, &mut self.menu_input, &mut commands);
-        camera_menu::camera_windows(&ctx, &self.state, &mut self.camera, &mut commands);
+        quit |= self.panels_ui(ui, &mut commands);
+        self.windows_ui(&ctx, &mut commands);
         if let Some(at) = self.quit_at {
             if now >= at {
                 // Unsaved table edits still get the question: a timer never discards work.
@@ -920,36 +478,7 @@ impl eframe::App for EotnApp {
         }
         self.close_dialog(&ctx, &mut commands);
         self.apply_all(&ctx, commands);
-
-        let title = self.state.title();
-        if title != self.title {
-            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
-            self.title = title;
-        }
-        // Playback redraws when the next frame is due, not as fast as it can: an unchanged
-        // frame costs the renderer as much as a new one.
-        if let Some(due) = self.state.next_frame_due() {
-            ctx.request_repaint_after(due);
-        }
-        let busy = self.state.try_edit().is_some_and(|t| !t.done())
-            || self.state.hints_busy()
-            || self
-                .state
-                .params_slot()
-                .try_run
-                .as_ref()
-                .is_some_and(|t| !t.done())
-            || (self.state.settings.show_sensors
-                && self.state.sensor_series.points.len() < self.state.sensor_series.total);
-        self.state.record_ui_time(now.elapsed(), cpu);
-        if self.was_playing && !self.state.playing() {
-            // The end of a playback is when its figures are complete.
-            self.report_stats();
-        }
-        self.was_playing = self.state.playing();
-        if busy {
-            ctx.request_repaint();
-        }
+        self.after_commands(&ctx, now, cpu);
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {

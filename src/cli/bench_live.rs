@@ -148,25 +148,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let (width, height) = frames
         .first()
         .map_or((0, 0), |f| (f.frame.width(), f.frame.height()));
-    let mut servers = Vec::new();
-    let mut robots = Vec::new();
-    let mut app = args.app.then(Workspace::default);
-    for i in 0..args.robots {
-        let server = StandInRobot::start(&format!("bench{i}"), "127.0.0.1", 0)?;
-        let url: RobotUrl = format!("127.0.0.1:{}", server.port()).parse()?;
-        if let Some(w) = app.as_mut() {
-            w.apply(Command::ConnectRobot(url.to_string()))?;
-        } else {
-            let keep = DEFAULT_KEEP_BYTES.max(frames_needed(args) * width * height * 2);
-            robots.push(LiveRobot::connect(
-                url,
-                ClientOptions::default(),
-                keep,
-                None,
-            )?);
-        }
-        servers.push(server);
-    }
+    let (servers, robots, mut app) = connect_robots(args, width * height)?;
     let folder = std::env::temp_dir().join(format!("eotn-bench-live-{}", std::process::id()));
     let views: Vec<RobotFrames> = match app.as_mut() {
         Some(w) => {
@@ -189,48 +171,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let stop = Arc::new(AtomicBool::new(false));
     let cpu_before = cpu_seconds();
     let start = Instant::now();
-    let senders: Vec<_> = servers
-        .into_iter()
-        .enumerate()
-        .map(|(i, mut server)| {
-            let (frames, stop, fps, seconds) = (
-                Arc::clone(&frames),
-                Arc::clone(&stop),
-                args.fps,
-                args.seconds,
-            );
-            std::thread::Builder::new()
-                .name(format!("sender {i}"))
-                .spawn(move || -> Result<(usize, StandInRobot), SendError> {
-                    let period = Duration::from_secs_f64(1.0 / fps.max(0.1));
-                    let t0 = Instant::now();
-                    let mut n = 0_usize;
-                    while t0.elapsed().as_secs_f64() < seconds && !stop.load(Ordering::Relaxed) {
-                        let due = t0 + period * u32::try_from(n).unwrap_or(u32::MAX);
-                        std::thread::sleep(due.saturating_duration_since(Instant::now()));
-                        let Some(f) = frames.get(n % frames.len().max(1)) else {
-                            break;
-                        };
-                        server.send(f)?;
-                        n += 1;
-                    }
-                    Ok((n, server))
-                })
-        })
-        .collect::<Result<_, _>>()
-        .context("cannot start a sender thread")?;
+    let senders = start_senders(servers, &frames, args, &stop)?;
     let shown = app
         .as_mut()
         .map(|w| follow_in_app(w, &senders, views.first()));
-    let mut sent = 0;
-    let mut servers = Vec::new();
-    for s in senders {
-        let (n, server) = s
-            .join()
-            .map_err(|_| anyhow::anyhow!("a sender thread panicked"))??;
-        sent += n;
-        servers.push(server);
-    }
+    let (sent, servers) = join_senders(senders)?;
     // The last frames are in flight for a few milliseconds.
     let settle = Instant::now() + Duration::from_secs(2);
     while views.iter().map(RobotFrames::len).sum::<usize>() < sent && Instant::now() < settle {
@@ -261,6 +206,88 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         s.stop();
     }
     print_report(&report, args.json)
+}
+
+/// Starts `args.robots` stand-in robots and connects to each, through a workspace with
+/// `--app`, else as bare [`LiveRobot`]s keeping enough bytes for every frame of `pixels`.
+fn connect_robots(
+    args: &Args,
+    pixels: usize,
+) -> anyhow::Result<(Vec<StandInRobot>, Vec<LiveRobot>, Option<Workspace>)> {
+    let mut servers = Vec::new();
+    let mut robots = Vec::new();
+    let mut app = args.app.then(Workspace::default);
+    for i in 0..args.robots {
+        let server = StandInRobot::start(&format!("bench{i}"), "127.0.0.1", 0)?;
+        let url: RobotUrl = format!("127.0.0.1:{}", server.port()).parse()?;
+        if let Some(w) = app.as_mut() {
+            w.apply(Command::ConnectRobot(url.to_string()))?;
+        } else {
+            let keep = DEFAULT_KEEP_BYTES.max(frames_needed(args) * pixels * 2);
+            robots.push(LiveRobot::connect(
+                url,
+                ClientOptions::default(),
+                keep,
+                None,
+            )?);
+        }
+        servers.push(server);
+    }
+    Ok((servers, robots, app))
+}
+
+/// One thread per stand-in robot sending `frames` round and round at `args.fps` for
+/// `args.seconds` (or until `stop`); each returns how many it sent and its robot.
+fn start_senders(
+    servers: Vec<StandInRobot>,
+    frames: &Arc<Vec<FrameRecord>>,
+    args: &Args,
+    stop: &Arc<AtomicBool>,
+) -> anyhow::Result<Vec<Sender>> {
+    let senders = servers
+        .into_iter()
+        .enumerate()
+        .map(|(i, mut server)| {
+            let (frames, stop, fps, seconds) =
+                (Arc::clone(frames), Arc::clone(stop), args.fps, args.seconds);
+            std::thread::Builder::new()
+                .name(format!("sender {i}"))
+                .spawn(move || -> Result<(usize, StandInRobot), SendError> {
+                    let period = Duration::from_secs_f64(1.0 / fps.max(0.1));
+                    let t0 = Instant::now();
+                    let mut n = 0_usize;
+                    while t0.elapsed().as_secs_f64() < seconds && !stop.load(Ordering::Relaxed) {
+                        let due = t0 + period * u32::try_from(n).unwrap_or(u32::MAX);
+                        std::thread::sleep(due.saturating_duration_since(Instant::now()));
+                        let Some(f) = frames.get(n % frames.len().max(1)) else {
+                            break;
+                        };
+                        server.send(f)?;
+                        n += 1;
+                    }
+                    Ok((n, server))
+                })
+        })
+        .collect::<Result<_, _>>()
+        .context("cannot start a sender thread")?;
+    Ok(senders)
+}
+
+/// A sender thread: frames sent and its robot, or why sending failed.
+type Sender = std::thread::JoinHandle<Result<(usize, StandInRobot), SendError>>;
+
+/// Waits for every sender: the frames sent in all, and the robots back.
+fn join_senders(senders: Vec<Sender>) -> anyhow::Result<(usize, Vec<StandInRobot>)> {
+    let mut sent = 0;
+    let mut servers = Vec::new();
+    for s in senders {
+        let (n, server) = s
+            .join()
+            .map_err(|_| anyhow::anyhow!("a sender thread panicked"))??;
+        sent += n;
+        servers.push(server);
+    }
+    Ok((sent, servers))
 }
 
 /// Ticks the workspace as the window does (when the shown robot's new frame wakes it, else every

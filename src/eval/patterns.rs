@@ -114,7 +114,7 @@ pub fn evaluate_patterns(
         // The candidate whose pink blob holds the marker's pink box centre.
         let (cx, cy) = ((b.min_x + b.max_x) / 2, (b.min_y + b.max_y) / 2);
         let found = r.patterns.iter().position(|c| {
-            let [x0, y0, x1, y1] = c.observation.bounds.to_array().map(|v| v as usize);
+            let [x0, y0, x1, y1] = c.observation.bounds.to_array();
             (x0..=x1).contains(&cx) && (y0..=y1).contains(&cy)
         });
         if let Some(k) = found {

@@ -15,7 +15,7 @@ pub use io::{
     FrameFileError, MAX_FRAME_PIXELS, display_name, infer_uyvy_size, is_image_file, load_frame,
     load_raw_uyvy, save_rgb_png,
 };
-pub use pixel_box::PixelBox;
+pub use pixel_box::{CutOff, PixelBox};
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

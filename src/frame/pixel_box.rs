@@ -1,4 +1,5 @@
-//! [`PixelBox`]: an inclusive box of whole pixels, the bounds of a blob or an object.
+//! [`PixelBox`]: an inclusive box of whole pixels, the bounds of a blob or an object; [`CutOff`]:
+//! which sides of an object's outline are not seen.
 
 use serde::{Deserialize, Serialize};
 
@@ -95,6 +96,29 @@ impl From<[u32; 4]> for PixelBox {
 impl From<PixelBox> for [u32; 4] {
     fn from(b: PixelBox) -> Self {
         b.to_array()
+    }
+}
+
+/// Which sides of an object's outline are not seen: cut off by the image border (the ground
+/// truth's only reason) or, in recognition, hidden by something in front. JSON: an object of four
+/// booleans.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct CutOff {
+    /// Left side not visible.
+    pub left: bool,
+    /// Right side not visible.
+    pub right: bool,
+    /// Top not visible.
+    pub top: bool,
+    /// Bottom not visible.
+    pub bottom: bool,
+}
+
+impl CutOff {
+    /// True when any side is cut off.
+    #[must_use]
+    pub fn any(&self) -> bool {
+        self.left || self.right || self.top || self.bottom
     }
 }
 

@@ -275,9 +275,7 @@ fn session(
     handler: &mut impl FnMut(LiveEvent),
     got_info: &mut bool,
 ) -> Option<String> {
-    let mut channels: HashMap<u32, Arc<AdvertisedChannel>> = HashMap::new();
-    let mut subscriptions: HashMap<u32, Arc<AdvertisedChannel>> = HashMap::new();
-    let mut next_subscription = 1_u32;
+    let mut channels = Channels::new();
     let mut last_heard = Instant::now();
     let mut pinged = false;
     loop {
@@ -306,26 +304,70 @@ fn session(
         let received_ns = unix_time_ns();
         last_heard = Instant::now();
         pinged = false;
-        let parsed = match &message {
-            Message::Text(t) => parse_text(t.as_str()),
-            Message::Binary(b) => parse_binary(b),
-            Message::Close(frame) => {
-                return Some(match frame {
-                    Some(f) if !f.reason.is_empty() => {
-                        format!("the robot closed the connection: {}", f.reason)
-                    }
-                    _ => "the robot closed the connection".to_owned(),
-                });
-            }
-            Message::Ping(_) | Message::Pong(_) | Message::Frame(_) => continue,
+        let parsed = match parse_message(&message) {
+            Ok(Some(p)) => p,
+            Ok(None) => continue,
+            Err(why) => return Some(why),
         };
-        let parsed = match parsed {
-            Ok(p) => p,
-            Err(e) => return Some(format!("malformed message: {e}")),
-        };
+        if matches!(parsed, ServerMessage::ServerInfo { .. }) {
+            *got_info = true;
+        }
+        if let Err(why) = channels.handle(parsed, received_ns, ws, options, handler) {
+            return Some(why);
+        }
+    }
+}
+
+/// A received message parsed: `None` for the WebSocket's own (ping, pong), `Err` with why the
+/// session ends for a close or a malformed message.
+fn parse_message(message: &Message) -> Result<Option<ServerMessage<'_>>, String> {
+    let parsed = match message {
+        Message::Text(t) => parse_text(t.as_str()),
+        Message::Binary(b) => parse_binary(b),
+        Message::Close(frame) => {
+            return Err(match frame {
+                Some(f) if !f.reason.is_empty() => {
+                    format!("the robot closed the connection: {}", f.reason)
+                }
+                _ => "the robot closed the connection".to_owned(),
+            });
+        }
+        Message::Ping(_) | Message::Pong(_) | Message::Frame(_) => return Ok(None),
+    };
+    parsed
+        .map(Some)
+        .map_err(|e| format!("malformed message: {e}"))
+}
+
+/// The channels one session has seen advertised and the subscriptions it made to them.
+struct Channels {
+    channels: HashMap<u32, Arc<AdvertisedChannel>>,
+    subscriptions: HashMap<u32, Arc<AdvertisedChannel>>,
+    next_subscription: u32,
+}
+
+impl Channels {
+    fn new() -> Self {
+        Self {
+            channels: HashMap::new(),
+            subscriptions: HashMap::new(),
+            next_subscription: 1,
+        }
+    }
+
+    /// Acts on one server message: subscribes to new channels, forgets withdrawn ones, hands
+    /// the rest to `handler`; `Err` with why the session ends when a subscription cannot be
+    /// sent.
+    fn handle(
+        &mut self,
+        parsed: ServerMessage<'_>,
+        received_ns: u64,
+        ws: &mut WebSocket<TcpStream>,
+        options: &ClientOptions,
+        handler: &mut impl FnMut(LiveEvent),
+    ) -> Result<(), String> {
         match parsed {
             ServerMessage::ServerInfo { name } => {
-                *got_info = true;
                 handler(LiveEvent::Connected { server_name: name });
             }
             ServerMessage::Advertise(list) => {
@@ -333,24 +375,25 @@ fn session(
                 let mut subs = Vec::new();
                 for c in list {
                     let c = Arc::new(c);
-                    if channels.insert(c.id, Arc::clone(&c)).is_none() {
-                        subs.push((next_subscription, c.id));
-                        subscriptions.insert(next_subscription, Arc::clone(&c));
-                        next_subscription = next_subscription.wrapping_add(1);
+                    if self.channels.insert(c.id, Arc::clone(&c)).is_none() {
+                        subs.push((self.next_subscription, c.id));
+                        self.subscriptions
+                            .insert(self.next_subscription, Arc::clone(&c));
+                        self.next_subscription = self.next_subscription.wrapping_add(1);
                         new.push(c);
                     }
                 }
                 if !subs.is_empty()
                     && let Err(e) = ws.send(Message::text(subscribe_request(&subs)))
                 {
-                    return Some(describe(&e, options));
+                    return Err(describe(&e, options));
                 }
                 handler(LiveEvent::Advertised(new));
             }
             ServerMessage::Unadvertise(ids) => {
                 for id in ids {
-                    channels.remove(&id);
-                    subscriptions.retain(|_, c| c.id != id);
+                    self.channels.remove(&id);
+                    self.subscriptions.retain(|_, c| c.id != id);
                 }
             }
             ServerMessage::MessageData {
@@ -358,7 +401,7 @@ fn session(
                 log_time_ns,
                 payload,
             } => {
-                if let Some(channel) = subscriptions.get(&subscription_id) {
+                if let Some(channel) = self.subscriptions.get(&subscription_id) {
                     handler(LiveEvent::Message {
                         channel: Arc::clone(channel),
                         log_time_ns,
@@ -377,6 +420,7 @@ fn session(
             }
             ServerMessage::Time(_) | ServerMessage::Other(_) => {}
         }
+        Ok(())
     }
 }
 

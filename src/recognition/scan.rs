@@ -7,6 +7,8 @@ use serde::{Deserialize, Serialize};
 use super::fit::{Point, rotate_about};
 use crate::classify::ClassifiedImage;
 
+pub use crate::frame::CutOff;
+
 /// A scanned quadrilateral, kept for drawing (corners in image pixels, in order).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ScanArea {
@@ -105,27 +107,6 @@ pub enum EdgeScanPattern {
     BottomToTop,
     /// Each column from top and bottom towards the centre.
     TopBottomToCentre,
-}
-
-/// Which sides of an object are cut off by the image edge or hidden by something in front.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub struct CutOff {
-    /// Left side not visible.
-    pub left: bool,
-    /// Right side not visible.
-    pub right: bool,
-    /// Top not visible.
-    pub top: bool,
-    /// Bottom not visible.
-    pub bottom: bool,
-}
-
-impl CutOff {
-    /// True when any side is cut off.
-    #[must_use]
-    pub fn any(&self) -> bool {
-        self.left || self.right || self.top || self.bottom
-    }
 }
 
 impl EdgeScanPattern {

@@ -24,7 +24,8 @@ pub use truth::GroundTruth;
 
 use crate::frame::{Frame, FrameError};
 use crate::geometry::{
-    CameraPose, Ers7Dimensions, OverheadCamera, PinholeCamera, Transform, Vector,
+    BodyPose, Camera, CameraPose, Ers7Dimensions, Field, HeadJoints, OverheadCamera, PinholeCamera,
+    Transform, Vector,
 };
 use crate::sensors::SensorReadings;
 
@@ -132,118 +133,159 @@ impl Simulator {
         let scene = self.scenario.scene_at(t);
         let world = World::compile(&scene);
         let mut rng = SimRng::derived(self.scenario.seed, index);
-        let name = self.scenario.kind.name();
-        let frame_err = |source| SimError::Frame {
-            scenario: name,
-            source,
+        let at = FrameAt {
+            index,
+            t,
+            time_ns,
+            scene: &scene,
+            world: &world,
         };
         match self.scenario.view() {
-            View::Overhead => {
-                let pose = self.overhead_camera.field_from_camera().isometry;
-                let out = self
-                    .renderer
-                    .render(&world, &|_| pose, &self.effects, u16::MAX, &mut rng)
-                    .map_err(frame_err)?;
-                let truth = truth::overhead_truth(&scene, t, &self.overhead_camera, &out.objects);
-                Ok(SimFrame {
-                    time_ns,
-                    frame: out.frame,
-                    labels: out.labels,
-                    sensors: None,
-                    ground_truth: GroundTruth::Overhead(truth),
-                    extra: self.scenario.world_models(&scene, t, index),
-                })
-            }
-            View::Robot { observer_id } => {
-                let missing = |time_s| SimError::MissingObserver {
-                    scenario: name,
-                    id: observer_id,
-                    time_s,
-                };
-                let (robot, body, joints) =
-                    self.scenario.observer_at(t).ok_or_else(|| missing(t))?;
-                let dims = Ers7Dimensions::ERS7;
-                let mid: Transform<_, _> =
-                    body.field_from_body(&robot) * dims.body_from_camera(&joints);
-                let height = self.head_camera.height_px;
-                let readout = self.effects.readout_s;
-                let row_pose = |row: usize| {
-                    let tr = t + ((row as f64 + 0.5) / height as f64 - 0.5) * readout;
-                    match self.scenario.observer_at(tr) {
-                        Some((r, b, j)) if readout > 0.0 => {
-                            (b.field_from_body(&r) * dims.body_from_camera(&j)).isometry
-                        }
-                        _ => mid.isometry,
-                    }
-                };
-                let skip =
-                    render::object_id::ROBOT + u16::try_from(observer_id).unwrap_or(0).min(899);
-                let moves = self.scenario.ball_moves_during_readout() && readout > 0.0;
-                let ball_at_row = |row: usize| {
-                    if !moves {
-                        return None;
-                    }
-                    let tr = t + ((row as f64 + 0.5) / height as f64 - 0.5) * readout;
-                    self.scenario
-                        .scene_at(tr)
-                        .ball
-                        .map(|b| nalgebra::Vector3::new(b.x_cm, b.y_cm, b.radius_cm))
-                };
-                let out = self
-                    .renderer
-                    .render_moving_ball(
-                        &world,
-                        &row_pose,
-                        &ball_at_row,
-                        &self.effects,
-                        skip,
-                        &mut rng,
-                    )
-                    .map_err(frame_err)?;
-                let pose = CameraPose {
-                    camera: self.head_camera,
-                    field_from_camera: mid,
-                };
-                let mut sensors = SensorReadings::default();
-                joints.write_to(&mut sensors);
-                body.write_to(&mut sensors);
-                let before = self.scenario.observer_at(t - FRAME_INTERVAL_S).map(|o| o.2);
-                sensors.previous_head_pan_rad = before.map(|j| j.pan_rad);
-                sensors.previous_head_tilt_rad = before.map(|j| j.tilt1_rad);
-                sensors.frame_interval_s = Some(FRAME_INTERVAL_S);
-                if let Some(v) = sensors.pan_velocity_rad_per_s() {
-                    // Duty grows with speed; the ERS-7's pan saturates around 8 rad/s.
-                    sensors.pan_pwm = Some((v / 8.0).clamp(-1.0, 1.0));
-                }
-                // The head's far infra-red sensor looks along the optical axis (10–150 cm).
-                let axis = mid * Vector::<crate::geometry::Camera>::new(1.0, 0.0, 0.0);
-                let d = world.distance_along(&mid.origin(), &axis, skip);
-                sensors.ir_far_cm = (10.0..=150.0).contains(&d).then_some(d);
-                let mut truth = truth::robot_view_truth(
-                    &scene,
-                    t,
-                    observer_id,
-                    robot,
-                    body,
-                    joints,
-                    &pose,
-                    sensors,
-                    &out.objects,
-                );
-                if let (Some(b), Some(v)) =
-                    (truth.ball.as_mut(), self.scenario.ball_velocity_cm_s(t))
-                {
-                    truth::add_ball_velocity(b, v, &robot, &pose);
-                }
-                Ok(SimFrame {
-                    time_ns,
-                    frame: out.frame,
-                    labels: out.labels,
-                    sensors: Some(sensors),
-                    ground_truth: GroundTruth::Robot(Box::new(truth)),
-                    extra: Vec::new(),
-                })
-            }
+            View::Overhead => self.overhead_frame(&at, &mut rng),
+            View::Robot { observer_id } => self.robot_frame(&at, observer_id, &mut rng),
         }
     }
+
+    fn frame_error(&self) -> impl Fn(FrameError) -> SimError {
+        let name = self.scenario.kind.name();
+        move |source| SimError::Frame {
+            scenario: name,
+            source,
+        }
+    }
+
+    /// The overhead camera's frame, with the robots' world models.
+    fn overhead_frame(&self, at: &FrameAt<'_>, rng: &mut SimRng) -> Result<SimFrame, SimError> {
+        let (t, scene) = (at.t, at.scene);
+        let pose = self.overhead_camera.field_from_camera().isometry;
+        let out = self
+            .renderer
+            .render(at.world, &|_| pose, &self.effects, u16::MAX, rng)
+            .map_err(self.frame_error())?;
+        let truth = truth::overhead_truth(scene, t, &self.overhead_camera, &out.objects);
+        Ok(SimFrame {
+            time_ns: at.time_ns,
+            frame: out.frame,
+            labels: out.labels,
+            sensors: None,
+            ground_truth: GroundTruth::Overhead(truth),
+            extra: self.scenario.world_models(scene, t, at.index),
+        })
+    }
+
+    /// A robot's head-camera frame: each row exposed at its own time (rolling shutter), with the
+    /// robot's sensor readings.
+    fn robot_frame(
+        &self,
+        at: &FrameAt<'_>,
+        observer_id: u32,
+        rng: &mut SimRng,
+    ) -> Result<SimFrame, SimError> {
+        let (t, scene, world) = (at.t, at.scene, at.world);
+        let name = self.scenario.kind.name();
+        let missing = |time_s| SimError::MissingObserver {
+            scenario: name,
+            id: observer_id,
+            time_s,
+        };
+        let (robot, body, joints) = self.scenario.observer_at(t).ok_or_else(|| missing(t))?;
+        let dims = Ers7Dimensions::ERS7;
+        let mid: Transform<_, _> = body.field_from_body(&robot) * dims.body_from_camera(&joints);
+        let height = self.head_camera.height_px;
+        let readout = self.effects.readout_s;
+        let row_pose = |row: usize| {
+            let tr = t + ((row as f64 + 0.5) / height as f64 - 0.5) * readout;
+            match self.scenario.observer_at(tr) {
+                Some((r, b, j)) if readout > 0.0 => {
+                    (b.field_from_body(&r) * dims.body_from_camera(&j)).isometry
+                }
+                _ => mid.isometry,
+            }
+        };
+        let skip = render::object_id::ROBOT + u16::try_from(observer_id).unwrap_or(0).min(899);
+        let moves = self.scenario.ball_moves_during_readout() && readout > 0.0;
+        let ball_at_row = |row: usize| {
+            if !moves {
+                return None;
+            }
+            let tr = t + ((row as f64 + 0.5) / height as f64 - 0.5) * readout;
+            self.scenario
+                .scene_at(tr)
+                .ball
+                .map(|b| nalgebra::Vector3::new(b.x_cm, b.y_cm, b.radius_cm))
+        };
+        let out = self
+            .renderer
+            .render_moving_ball(world, &row_pose, &ball_at_row, &self.effects, skip, rng)
+            .map_err(self.frame_error())?;
+        let pose = CameraPose {
+            camera: self.head_camera,
+            field_from_camera: mid,
+        };
+        let sensors = self.robot_sensors(t, &body, &joints, &mid, world, skip);
+        let mut truth = truth::robot_view_truth(
+            scene,
+            t,
+            observer_id,
+            robot,
+            body,
+            joints,
+            &pose,
+            sensors,
+            &out.objects,
+        );
+        if let (Some(b), Some(v)) = (truth.ball.as_mut(), self.scenario.ball_velocity_cm_s(t)) {
+            truth::add_ball_velocity(b, v, &robot, &pose);
+        }
+        Ok(SimFrame {
+            time_ns: at.time_ns,
+            frame: out.frame,
+            labels: out.labels,
+            sensors: Some(sensors),
+            ground_truth: GroundTruth::Robot(Box::new(truth)),
+            extra: Vec::new(),
+        })
+    }
+
+    /// What the observing robot's sensors read at `t` (seconds): joints and body, the head's
+    /// previous angles and pan duty, and the far infra-red distance along the optical axis of
+    /// the camera pose `mid` (the middle of the readout), leaving out the robot itself (`skip`).
+    fn robot_sensors(
+        &self,
+        t: f64,
+        body: &BodyPose,
+        joints: &HeadJoints,
+        mid: &Transform<Field, Camera>,
+        world: &World,
+        skip: u16,
+    ) -> SensorReadings {
+        let mut sensors = SensorReadings::default();
+        joints.write_to(&mut sensors);
+        body.write_to(&mut sensors);
+        let before = self.scenario.observer_at(t - FRAME_INTERVAL_S).map(|o| o.2);
+        sensors.previous_head_pan_rad = before.map(|j| j.pan_rad);
+        sensors.previous_head_tilt_rad = before.map(|j| j.tilt1_rad);
+        sensors.frame_interval_s = Some(FRAME_INTERVAL_S);
+        if let Some(v) = sensors.pan_velocity_rad_per_s() {
+            // Duty grows with speed; the ERS-7's pan saturates around 8 rad/s.
+            sensors.pan_pwm = Some((v / 8.0).clamp(-1.0, 1.0));
+        }
+        // The head's far infra-red sensor looks along the optical axis (10–150 cm).
+        let axis = *mid * Vector::<crate::geometry::Camera>::new(1.0, 0.0, 0.0);
+        let d = world.distance_along(&mid.origin(), &axis, skip);
+        sensors.ir_far_cm = (10.0..=150.0).contains(&d).then_some(d);
+        sensors
+    }
+}
+
+/// The instant of one frame and the world then, shared by the frame's parts.
+struct FrameAt<'a> {
+    /// Frame index.
+    index: u64,
+    /// Time, seconds since the scenario start.
+    t: f64,
+    /// The same, nanoseconds.
+    time_ns: u64,
+    scene: &'a Scene,
+    world: &'a World,
 }

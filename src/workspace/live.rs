@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 
-use super::Workspace;
 use super::source::Source;
+use super::{Command, Workspace};
 use crate::sources::{
     Recorder, SourceControls, SourceFrame, SourceInfo, SourceSettings, SourceSpec, Streamer,
     StreamerEvent,
@@ -58,6 +58,22 @@ impl Live {
 }
 
 impl Workspace {
+    /// Applies the Camera menu's source commands: connect, disconnect, settings, grab,
+    /// streaming, recording (the rest of [`Workspace::apply`]).
+    pub(super) fn apply_source(&mut self, command: Command) -> anyhow::Result<()> {
+        match command {
+            Command::Connect(spec) => self.connect(&spec)?,
+            Command::Disconnect => self.disconnect()?,
+            Command::SetSourceSettings(s) => self.set_source_settings(s)?,
+            Command::GrabImage => self.grab_image()?,
+            Command::SetStreaming(on) => self.set_streaming(on)?,
+            Command::StartRecording(p) => self.start_recording(&p)?,
+            Command::StopRecording => self.stop_recording()?,
+            _ => anyhow::bail!("not a source command"),
+        }
+        Ok(())
+    }
+
     /// Connects `spec`: a recorded source is opened for stepping and playback, a live one starts
     /// streaming on its own thread. What was connected before is disconnected.
     pub(super) fn connect(&mut self, spec: &SourceSpec) -> anyhow::Result<()> {

@@ -7,15 +7,17 @@
 //!
 //! | file | role |
 //! |---|---|
-//! | `mod.rs` | [`Workspace`]: its fields, [`Workspace::apply`], what the UI reads |
+//! | `mod.rs` | [`Workspace`]: its fields, [`Workspace::apply`] (it hands each area's commands to that area's `apply_…`), what the UI reads |
 //! | `command.rs` | [`Command`]: everything the UI can ask for; [`Window`] |
 //! | `settings.rs` | [`Settings`] that persist; [`ViewKind`], [`Overlays`], [`ViewTransform`] |
 //! | `source.rs` | [`Source`]: the open recorded source with a cache of decoded frames |
 //! | `frames.rs` | opening sources, showing a frame, the sensor-series scan |
 //! | `player.rs` | [`Player`]: playback clock, `tick`, `next_frame_due` |
-//! | `live.rs` | [`Live`]: a connected live source streaming on its thread; recording |
+//! | `playback.rs` | the Step/Seek/Play/Speed commands, [`Workspace::tick`] (playback and background scans), [`Workspace::next_frame_due`], frame-time records |
+//! | `view.rs` | view options (enlarged view, overlays, blob filter, zoom, pan, Export view) and which windows are open |
+//! | `live.rs` | [`Live`]: a connected live source streaming on its thread; recording; the Camera menu's commands |
 //! | `robots.rs` | robots over the network, several at once: the list, the shown one, following live, recording each |
-//! | `table.rs` | the table: open, save, commit, undo/redo, journal, places file; one table per camera kind |
+//! | `table.rs` | the table: its commands (open, save, class, sensitivity, selection, commit, undo/redo, journal, try on the stream), places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
 //! | `stream_scan.rs` | [`StreamScan`]: the whole-stream checks' one loop, a few frames per UI frame |
@@ -38,6 +40,7 @@ pub mod journal;
 mod live;
 pub mod overhead;
 pub mod params;
+mod playback;
 pub mod player;
 mod robots;
 mod settings;
@@ -46,11 +49,10 @@ mod stream_scan;
 mod table;
 mod timings;
 mod try_edit;
+mod view;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
-
-use anyhow::Context as _;
 
 pub use command::{Command, OverheadCommand, Window};
 pub use compose::{PrimitiveFilter, box_colour};
@@ -69,11 +71,9 @@ pub use table::TableSlot;
 pub use timings::{StepTiming, Timings, median};
 pub use try_edit::{TryEdit, TryEditRow};
 
-use timings::push_capped;
-
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
-use crate::frame::{Frame, Yuv, save_rgb_png, yuv_to_rgb};
+use crate::frame::{Frame, Yuv, yuv_to_rgb};
 use crate::lut::edit::Selection;
 use crate::lut::{ColourClass, EditHistory, LookupTable, Region};
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -294,80 +294,37 @@ impl Workspace {
             | Command::ResetParams
             | Command::SaveParams(_)
             | Command::TryParamsOnStream) => self.apply_params(c)?,
-            Command::NewTable(bits) => self.new_table(bits)?,
-            Command::SaveTable => {
-                let path = self
-                    .table_path
-                    .clone()
-                    .context("the table has no file yet: use Save table as…")?;
-                self.save_table(&path)?;
-            }
-            Command::SaveTableAs(p) => self.save_table(&p)?,
-            Command::RebuildFromJournal => self.rebuild_from_journal()?,
-            Command::DiscardUnsaved => self.discard_unsaved()?,
-            Command::Step(delta) => self.step(delta)?,
-            Command::Seek(i) => self.seek(i)?,
-            Command::SetPlaying(p) => self.set_playing(p)?,
-            Command::SetSpeed(s) => {
-                self.settings.speed = if s.is_finite() { s.max(0.0) } else { 1.0 }
-            }
-            Command::SetClass(c) => self.settings.class = c,
-            Command::SetSensitivity(s) => self.set_sensitivity(s),
-            Command::AdjustSensitivity { channel, delta } => {
-                self.adjust_sensitivity(channel, delta)?;
-            }
-            Command::Sample { x, y } => self.sample(x, y)?,
-            Command::SampleCell(cell) => self.sample_cell(cell)?,
-            Command::ClearSelection => {
-                self.selection = None;
-                self.refresh_preview();
-            }
-            Command::RestoreSelection(s) => {
-                self.selection = s;
-                self.refresh_preview();
-            }
-            Command::Commit => self.commit()?,
-            Command::Undo => self.undo()?,
-            Command::Redo => self.redo()?,
-            Command::SetMainView(v) => self.settings.main_view = v,
-            Command::SetOverlays(o) => {
-                let mut o = o;
-                o.opacity = if o.opacity.is_finite() {
-                    o.opacity.clamp(0.0, 1.0)
-                } else {
-                    0.5
-                };
-                self.settings.overlays = o;
-            }
-            Command::SetConnectivity(c) => {
-                self.settings.connectivity = c;
-                let mut params = *self.pipeline.params();
-                params.connectivity = c;
-                self.pipeline.set_params(params);
-                self.reprocess();
-            }
-            Command::SetBlobFilter { min_pixels, hidden } => {
-                self.settings.min_blob_pixels = min_pixels;
-                self.settings.hidden_blob_classes = hidden;
-            }
-            Command::SetZoom(z) => {
-                self.settings.transform.zoom = z.filter(|z| z.is_finite()).map(clamp_zoom);
-            }
-            Command::ZoomAbout { factor, about, fit } => self.zoom_about(factor, about, fit)?,
-            Command::Pan(d) => {
-                let size = self.image_size_f32();
-                let t = &mut self.settings.transform;
-                let c = t.effective_centre(size);
-                t.centre = Some([c[0] - d[0], c[1] - d[1]]);
-            }
-            Command::ResetView => self.settings.transform = ViewTransform::default(),
-            Command::ExportView(p) => {
-                let (w, h, rgb) = self.compose_view_rgb(self.settings.main_view)?;
-                save_rgb_png(&p, w, h, &rgb)?;
-                self.status = format!("view saved as {}", p.display());
-            }
-            Command::TryEditOnStream => self.try_edit_on_stream()?,
-            Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
+            c @ (Command::NewTable(_)
+            | Command::SaveTable
+            | Command::SaveTableAs(_)
+            | Command::RebuildFromJournal
+            | Command::DiscardUnsaved
+            | Command::SetClass(_)
+            | Command::SetSensitivity(_)
+            | Command::AdjustSensitivity { .. }
+            | Command::Sample { .. }
+            | Command::SampleCell(_)
+            | Command::ClearSelection
+            | Command::RestoreSelection(_)
+            | Command::Commit
+            | Command::Undo
+            | Command::Redo
+            | Command::TryEditOnStream) => self.apply_table_edit(c)?,
+            c @ (Command::Step(_)
+            | Command::Seek(_)
+            | Command::SetPlaying(_)
+            | Command::SetSpeed(_)) => self.apply_playback(c)?,
+            c @ (Command::SetMainView(_)
+            | Command::SetOverlays(_)
+            | Command::SetConnectivity(_)
+            | Command::SetBlobFilter { .. }
+            | Command::SetZoom(_)
+            | Command::ZoomAbout { .. }
+            | Command::Pan(_)
+            | Command::ResetView
+            | Command::ExportView(_)
+            | Command::SetUvPlaneY(_)
+            | Command::ShowTimings(_)) => self.apply_view(c)?,
             Command::ShowWindow(w, open) => {
                 *self.window_flag(w) = open;
                 if w == Window::Inspector && !open {
@@ -375,14 +332,13 @@ impl Workspace {
                     self.selected_object = None;
                 }
             }
-            Command::ShowTimings(on) => self.settings.show_timings = on,
-            Command::Connect(spec) => self.connect(&spec)?,
-            Command::Disconnect => self.disconnect()?,
-            Command::SetSourceSettings(s) => self.set_source_settings(s)?,
-            Command::GrabImage => self.grab_image()?,
-            Command::SetStreaming(on) => self.set_streaming(on)?,
-            Command::StartRecording(p) => self.start_recording(&p)?,
-            Command::StopRecording => self.stop_recording()?,
+            c @ (Command::Connect(_)
+            | Command::Disconnect
+            | Command::SetSourceSettings(_)
+            | Command::GrabImage
+            | Command::SetStreaming(_)
+            | Command::StartRecording(_)
+            | Command::StopRecording) => self.apply_source(c)?,
             c @ (Command::ConnectRobot(_)
             | Command::ShowRobot(_)
             | Command::DisconnectRobot(_)
@@ -410,142 +366,12 @@ impl Workspace {
         Ok(())
     }
 
-    fn set_playing(&mut self, on: bool) -> anyhow::Result<()> {
-        if !on {
-            self.player.stop();
-            return Ok(());
-        }
-        let len = self
-            .source
-            .as_ref()
-            .context("no stream or frames open")?
-            .len();
-        if self.index + 1 >= len {
-            // Playing from the end starts again.
-            self.seek(0)?;
-        }
-        if let Some(src) = &self.source {
-            self.player.play_from(src, self.index);
-        }
-        Ok(())
-    }
-
-    fn zoom_about(&mut self, factor: f32, about: [f32; 2], fit: f32) -> anyhow::Result<()> {
-        anyhow::ensure!(
-            factor.is_finite() && factor > 0.0 && fit.is_finite() && fit > 0.0,
-            "bad zoom factor"
-        );
-        let size = self.image_size_f32();
-        let t = &mut self.settings.transform;
-        let old = t.effective_zoom(fit);
-        let new = clamp_zoom(old * factor);
-        let c = t.effective_centre(size);
-        // Keep `about` at the same screen offset from the view centre.
-        let k = old / new;
-        t.centre = Some([
-            about[0] - (about[0] - c[0]) * k,
-            about[1] - (about[1] - c[1]) * k,
-        ]);
-        t.zoom = Some(new);
-        Ok(())
-    }
-
-    fn try_edit_on_stream(&mut self) -> anyhow::Result<()> {
-        let sel = self
-            .selection
-            .clone()
-            .context("no pending selection to try")?;
-        let total = self.source.as_ref().context("no stream open")?.len();
-        self.try_edit = Some(TryEdit::new(
-            self.settings.class,
-            sel.region,
-            self.pipeline.lut(),
-            total,
-        ));
-        self.settings.show_try_edit = true;
-        Ok(())
-    }
-
-    /// Advances playback and background scans by `dt` of wall time. Called once per UI frame.
-    pub fn tick(&mut self, dt: Duration) {
-        self.poll_live();
-        self.poll_robots();
-        self.scan_sensor_series();
-        if let (Some(t), Some(src)) = (self.try_edit.as_mut(), self.source.as_mut()) {
-            let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
-            t.scan(src, self.pipeline.lut(), conn, min, SCAN_BUDGET);
-        }
-        self.tick_hints();
-        self.scan_try_params(SCAN_BUDGET);
-        let Some(src) = self.source.as_ref() else {
-            self.player.stop();
-            return;
-        };
-        if let Some(target) = self.player.tick(dt, self.settings.speed, self.index, src) {
-            self.timings.played_frames += 1;
-            self.timings.dropped_frames += target.saturating_sub(self.index + 1) as u64;
-            self.timings.late_frames += u64::from(self.player.last_was_late());
-            self.run(Command::Seek(target));
-        }
-    }
-
-    /// While playing, the wall time until the next frame is due (zero when playing every frame
-    /// or already late); `None` when not playing. The UI sleeps until then instead of redrawing
-    /// an unchanged frame.
-    #[must_use]
-    pub fn next_frame_due(&self) -> Option<Duration> {
-        if let Some(live) = self.live.as_ref().filter(|l| l.streaming()) {
-            // Frames arrive on their own thread: look for one about twice a frame interval.
-            let rate = live
-                .settings()
-                .frame_rate
-                .filter(|r| *r > 0.0)
-                .unwrap_or(30.0);
-            return Some(Duration::from_secs_f64(0.5 / rate.min(240.0)));
-        }
-        let robots = self.robots_poll_due();
-        let player = self.source.as_ref().and_then(|src| {
-            self.player
-                .next_frame_due(self.settings.speed, self.index, src)
-        });
-        match (robots, player) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
-    }
-
     /// Which camera the shown frames come from (robot when nothing is open): it chooses the
     /// recogniser and the lookup table.
     #[must_use]
     pub fn camera_kind(&self) -> CameraKind {
         self.connected_info()
             .map_or(CameraKind::Robot, |s| s.camera)
-    }
-
-    /// Records one UI frame interval for the frame-time readout.
-    pub fn record_frame_time(&mut self, dt: Duration) {
-        let ms = dt.as_secs_f64() * 1e3;
-        push_capped(&mut self.timings.frames_ms, ms);
-        if self.player.playing() {
-            push_capped(&mut self.timings.playing_frames_ms, ms);
-        }
-    }
-
-    /// Records, while playing, how long our UI code and eframe's whole frame took (CPU time).
-    pub fn record_ui_time(&mut self, ui: Duration, cpu_s: Option<f32>) {
-        if self.player.playing() {
-            push_capped(&mut self.timings.playing_ui_ms, ui.as_secs_f64() * 1e3);
-            if let Some(c) = cpu_s.filter(|c| c.is_finite()) {
-                push_capped(&mut self.timings.playing_cpu_ms, f64::from(c) * 1e3);
-            }
-        }
-    }
-
-    /// Records the texture-upload part of the last step (measured by the UI).
-    pub fn record_upload(&mut self, d: Duration) {
-        self.timings.last_step.upload = d;
-        let total = self.timings.last_step.total().as_secs_f64() * 1e3;
-        push_capped(&mut self.timings.steps_ms, total);
     }
 
     // ---- reading ----
@@ -738,44 +564,6 @@ impl Workspace {
         self.try_edit.as_ref()
     }
 
-    /// Whether a window is open.
-    #[must_use]
-    pub const fn window_open(&self, w: Window) -> bool {
-        match w {
-            Window::Sensors => self.settings.show_sensors,
-            Window::UvPlane => self.settings.show_uv_plane,
-            Window::TryEdit => self.settings.show_try_edit,
-            Window::Inspector => self.settings.show_inspector,
-            Window::Connect => self.settings.show_connect,
-            Window::SourceSettings => self.settings.show_source_settings,
-            Window::Record => self.settings.show_record,
-            Window::FieldView => self.settings.show_field_view,
-            Window::Calibration => self.settings.show_calibration,
-            Window::Robots => self.settings.show_robots,
-            Window::Coverage => self.settings.show_coverage,
-            Window::Bookmarks => self.settings.show_bookmarks,
-            Window::Parameters => self.settings.show_params,
-        }
-    }
-
-    fn window_flag(&mut self, w: Window) -> &mut bool {
-        match w {
-            Window::Sensors => &mut self.settings.show_sensors,
-            Window::UvPlane => &mut self.settings.show_uv_plane,
-            Window::TryEdit => &mut self.settings.show_try_edit,
-            Window::Inspector => &mut self.settings.show_inspector,
-            Window::Connect => &mut self.settings.show_connect,
-            Window::SourceSettings => &mut self.settings.show_source_settings,
-            Window::Record => &mut self.settings.show_record,
-            Window::FieldView => &mut self.settings.show_field_view,
-            Window::Calibration => &mut self.settings.show_calibration,
-            Window::Robots => &mut self.settings.show_robots,
-            Window::Coverage => &mut self.settings.show_coverage,
-            Window::Bookmarks => &mut self.settings.show_bookmarks,
-            Window::Parameters => &mut self.settings.show_params,
-        }
-    }
-
     /// The largest useful sensitivity for the table: half its side.
     #[must_use]
     pub fn max_sensitivity(&self) -> u8 {
@@ -827,11 +615,6 @@ impl Workspace {
         self.frame().map_or((0, 0), |f| (f.width(), f.height()))
     }
 
-    fn image_size_f32(&self) -> [f32; 2] {
-        let (w, h) = self.image_size();
-        [w as f32, h as f32]
-    }
-
     // ---- changing ----
 
     pub(super) fn warn(&mut self, w: String) {
@@ -855,35 +638,9 @@ fn seven_bit_table() -> LookupTable {
     LookupTable::new(7).expect("7 bits per channel is a supported table size")
 }
 
-fn clamp_zoom(z: f32) -> f32 {
-    z.clamp(ZOOM_RANGE.0, ZOOM_RANGE.1)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn zoom_about_keeps_the_point_under_the_cursor() {
-        let mut s = Workspace::default();
-        // No frame: image size 0; centre defaults to (0, 0).
-        s.apply(Command::ZoomAbout {
-            factor: 2.0,
-            about: [10.0, 20.0],
-            fit: 1.0,
-        })
-        .unwrap();
-        let t = s.settings.transform;
-        assert_eq!(t.zoom, Some(2.0));
-        // Screen offset of `about` from the centre: before (10 - 0) * 1, after (10 - c) * 2.
-        let c = t.centre.unwrap();
-        assert!(((10.0 - c[0]) * 2.0 - 10.0).abs() < 1e-4);
-        assert!(((20.0 - c[1]) * 2.0 - 20.0).abs() < 1e-4);
-        s.apply(Command::SetZoom(Some(1000.0))).unwrap();
-        assert_eq!(s.settings.transform.zoom, Some(ZOOM_RANGE.1));
-        s.apply(Command::ResetView).unwrap();
-        assert_eq!(s.settings.transform, ViewTransform::default());
-    }
 
     #[test]
     fn commands_without_data_fail_cleanly() {

@@ -6,12 +6,68 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 
 use super::journal::{self, JournalEntry, now_unix_ms};
-use super::{PendingSelection, Workspace};
+use super::{Command, PendingSelection, TryEdit, Workspace};
 use crate::frame::Yuv;
 use crate::lut::{EditRecord, LookupTable, Region, Sensitivity};
 use crate::sources::CameraKind;
 
 impl Workspace {
+    /// Applies the table's commands: new, save, the journal, the class and sensitivity, the
+    /// pending selection, commit, undo and redo, the whole-stream try (the rest of
+    /// [`Workspace::apply`]).
+    pub(super) fn apply_table_edit(&mut self, command: Command) -> anyhow::Result<()> {
+        match command {
+            Command::NewTable(bits) => self.new_table(bits)?,
+            Command::SaveTable => {
+                let path = self
+                    .table_path
+                    .clone()
+                    .context("the table has no file yet: use Save table as…")?;
+                self.save_table(&path)?;
+            }
+            Command::SaveTableAs(p) => self.save_table(&p)?,
+            Command::RebuildFromJournal => self.rebuild_from_journal()?,
+            Command::DiscardUnsaved => self.discard_unsaved()?,
+            Command::SetClass(c) => self.settings.class = c,
+            Command::SetSensitivity(s) => self.set_sensitivity(s),
+            Command::AdjustSensitivity { channel, delta } => {
+                self.adjust_sensitivity(channel, delta)?;
+            }
+            Command::Sample { x, y } => self.sample(x, y)?,
+            Command::SampleCell(cell) => self.sample_cell(cell)?,
+            Command::ClearSelection => {
+                self.selection = None;
+                self.refresh_preview();
+            }
+            Command::RestoreSelection(s) => {
+                self.selection = s;
+                self.refresh_preview();
+            }
+            Command::Commit => self.commit()?,
+            Command::Undo => self.undo()?,
+            Command::Redo => self.redo()?,
+            Command::TryEditOnStream => self.try_edit_on_stream()?,
+            _ => anyhow::bail!("not a table command"),
+        }
+        Ok(())
+    }
+
+    fn try_edit_on_stream(&mut self) -> anyhow::Result<()> {
+        let sel = self
+            .selection
+            .clone()
+            .context("no pending selection to try")?;
+        let total = self.source.as_ref().context("no stream open")?.len();
+        self.try_edit = Some(TryEdit::new(
+            self.settings.class,
+            sel.region,
+            self.pipeline.lut(),
+            total,
+        ));
+        self.settings.show_try_edit = true;
+        Ok(())
+    }
+
     pub(super) fn open_table(&mut self, path: &Path) -> anyhow::Result<()> {
         let lut = LookupTable::load(path)?;
         self.set_table(lut, Some(path.to_owned()));

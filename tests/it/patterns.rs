@@ -189,10 +189,7 @@ fn the_shipped_table_classifies_the_markers() {
             .filter(|m| m.panel_in_image && m.pink_visible_fraction > 0.8 && m.pink_pixels >= 16)
         {
             let Some(b) = m.image_box else { continue };
-            let (cx, cy) = (
-                (b.min_x + b.max_x) as u32 / 2,
-                (b.min_y + b.max_y) as u32 / 2,
-            );
+            let (cx, cy) = ((b.min_x + b.max_x) / 2, (b.min_y + b.max_y) / 2);
             let Some(c) = r.recognition.patterns.iter().find(|c| {
                 let [x0, y0, x1, y1] = c.observation.bounds.to_array();
                 (x0..=x1).contains(&cx) && (y0..=y1).contains(&cy)

@@ -1,0 +1,86 @@
+//! Keyboard shortcuts of the main window: undo/redo/save/quit, the sensitivity keys, stepping,
+//! jumping to marks, playback, Escape.
+
+use egui::{Key, KeyboardShortcut, Modifiers};
+
+use super::{Command, EotnApp};
+
+impl EotnApp {
+    /// Turns this frame's key presses into commands; true when the window should close.
+    pub(super) fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
+        let mut quit = false;
+        if ctx.egui_wants_keyboard_input() {
+            return quit;
+        }
+        let menu_open = egui::Popup::is_any_open(ctx);
+        ctx.input_mut(|i| {
+            let cmd = |k| KeyboardShortcut::new(Modifiers::COMMAND, k);
+            if i.consume_shortcut(&KeyboardShortcut::new(
+                Modifiers::COMMAND | Modifiers::SHIFT,
+                Key::Z,
+            )) || i.consume_shortcut(&cmd(Key::Y))
+            {
+                commands.push(Command::Redo);
+            }
+            if i.consume_shortcut(&cmd(Key::Z)) {
+                commands.push(Command::Undo);
+            }
+            if i.consume_shortcut(&cmd(Key::S)) {
+                commands.push(Command::SaveTable);
+            }
+            if i.consume_shortcut(&cmd(Key::Q)) {
+                quit = true;
+            }
+            for (key, channel) in [(Key::Y, 0), (Key::U, 1), (Key::V, 2)] {
+                let down = i.count_and_consume_key(Modifiers::SHIFT, key) as i32;
+                let up = i.count_and_consume_key(Modifiers::NONE, key) as i32;
+                if up != down {
+                    commands.push(Command::AdjustSensitivity {
+                        channel,
+                        delta: up - down,
+                    });
+                }
+            }
+            for (key, delta) in [(Key::Plus, 1), (Key::Equals, 1), (Key::Minus, -1)] {
+                if i.consume_key(Modifiers::NONE, key) {
+                    for channel in 0..3 {
+                        commands.push(Command::AdjustSensitivity { channel, delta });
+                    }
+                }
+            }
+            if self.state.source().is_some() {
+                for (key, delta) in [
+                    (Key::ArrowRight, 1),
+                    (Key::ArrowLeft, -1),
+                    (Key::PageDown, 10),
+                    (Key::PageUp, -10),
+                ] {
+                    // Every press counts, even several within one slow frame.
+                    let n = i.count_and_consume_key(Modifiers::NONE, key);
+                    if n > 0 {
+                        commands.push(Command::Step(delta * n as i64));
+                    }
+                }
+                for (key, forward) in [(Key::ArrowRight, true), (Key::ArrowLeft, false)] {
+                    if i.consume_key(Modifiers::COMMAND, key) {
+                        commands.push(Command::JumpToMark { forward });
+                    }
+                }
+                if i.consume_key(Modifiers::NONE, Key::Home) {
+                    commands.push(Command::Seek(0));
+                }
+                if i.consume_key(Modifiers::NONE, Key::End) {
+                    commands.push(Command::Seek(usize::MAX));
+                }
+                if i.consume_key(Modifiers::NONE, Key::Space) {
+                    commands.push(Command::SetPlaying(!self.state.playing()));
+                }
+            }
+            // Escape closes an open menu first; only then does it drop the selection.
+            if !menu_open && i.consume_key(Modifiers::NONE, Key::Escape) {
+                commands.push(Command::ClearSelection);
+            }
+        });
+        quit
+    }
+}

@@ -1,0 +1,171 @@
+//! The shown frame's textures: the colour and class-colour images built on the CPU, the
+//! pending selection's highlight, and their upload when the frame or the preview changes.
+
+use std::time::Instant;
+
+use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
+
+use super::EotnApp;
+use super::overlays::FrameTextures;
+use crate::workspace::Workspace;
+
+/// How much the pixels outside a pending selection are darkened (alpha of black over them).
+const PREVIEW_DIM_ALPHA: u8 = 110;
+
+/// The textures of the shown frame and what they were built from.
+pub(super) struct Textures {
+    raw: TextureHandle,
+    classified: TextureHandle,
+    preview: TextureHandle,
+    frame_generation: u64,
+    preview_generation: u64,
+    /// The preview texture holds no highlight (nothing to re-upload while none is pending).
+    preview_empty: bool,
+}
+
+impl Textures {
+    pub(super) fn ids(&self) -> FrameTextures {
+        FrameTextures {
+            raw: self.raw.id(),
+            classified: self.classified.id(),
+            preview: self.preview.id(),
+        }
+    }
+}
+
+/// Display colours of every class code, transparent for unclassified.
+#[must_use]
+pub fn palette() -> [Color32; 256] {
+    let mut p = [Color32::TRANSPARENT; 256];
+    for (code, c) in p.iter_mut().enumerate().skip(1) {
+        let [r, g, b] = crate::lut::code_display_rgb(u8::try_from(code).unwrap_or(0));
+        *c = Color32::from_rgb(r, g, b);
+    }
+    p
+}
+
+/// The images the views are drawn from, before they go to the GPU.
+#[derive(Debug, Clone)]
+pub struct ViewImages {
+    /// The frame in colour.
+    pub raw: ColorImage,
+    /// Class colours, transparent where unclassified.
+    pub classified: ColorImage,
+}
+
+/// Builds the colour and class-colour images of the shown frame (`palette` from [`palette`]);
+/// `None` when no frame is open. This is the CPU side of a texture update.
+#[must_use]
+pub fn view_images(state: &Workspace, palette: &[Color32; 256]) -> Option<ViewImages> {
+    let frame = state.frame()?;
+    let size = [frame.width(), frame.height()];
+    // The undistorted view of an overhead frame, when chosen, else the frame as it is.
+    let raw = ColorImage::from_rgb(size, &state.view_rgb());
+    let classified = ColorImage::new(
+        size,
+        state
+            .view_codes()
+            .iter()
+            .map(|&c| palette[usize::from(c)])
+            .collect(),
+    );
+    Some(ViewImages { raw, classified })
+}
+
+/// The preview highlight image of the pending selection (class colour on selected pixels,
+/// dimmed elsewhere; transparent with no selection).
+#[must_use]
+pub fn preview_image(state: &Workspace, size: [usize; 2]) -> ColorImage {
+    let mask = state.preview_mask();
+    let colour = state
+        .preview_colour()
+        .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
+    if mask.len() != size[0] * size[1] {
+        return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
+    }
+    // Unselected pixels are dimmed, so the highlight shows even where the class colour is
+    // the colour of the pixels themselves (orange on an orange ball).
+    let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
+    // A dark class colour (black, dark blue) would vanish on the dimmed dark pixels: those
+    // classes are previewed in a light colour instead.
+    let colour = visible_preview_colour(colour);
+    ColorImage::new(
+        size,
+        mask.iter().map(|&m| if m { colour } else { dim }).collect(),
+    )
+}
+
+/// The highlight colour of a previewed class: its own colour, or a light magenta for classes
+/// too dark to show over dimmed pixels (black's near-black, dark blue).
+#[must_use]
+pub fn visible_preview_colour(class_colour: Color32) -> Color32 {
+    let [r, g, b, a] = class_colour.to_array();
+    let luma = 0.299 * f32::from(r) + 0.587 * f32::from(g) + 0.114 * f32::from(b);
+    if a > 0 && luma < PREVIEW_MIN_LUMA {
+        Color32::from_rgb(255, 96, 255)
+    } else {
+        class_colour
+    }
+}
+
+/// Class colours darker than this (0..255 luma) get a light preview colour.
+const PREVIEW_MIN_LUMA: f32 = 100.0;
+
+impl EotnApp {
+    pub(super) fn update_textures(&mut self, ctx: &egui::Context) {
+        let Some(frame) = self.state.frame() else {
+            return;
+        };
+        let size = [frame.width(), frame.height()];
+        let opts = TextureOptions::NEAREST;
+        let fg = self.state.frame_generation();
+        let pg = self.state.preview_generation();
+        if self
+            .textures
+            .as_ref()
+            .is_some_and(|t| t.frame_generation == fg && t.preview_generation == pg)
+        {
+            return;
+        }
+        let t0 = Instant::now();
+        let frame_changed = self
+            .textures
+            .as_ref()
+            .is_none_or(|t| t.frame_generation != fg);
+        let empty = self.state.selection().is_none();
+        if frame_changed
+            && let Some(ViewImages { raw, classified }) = view_images(&self.state, &self.palette)
+        {
+            match &mut self.textures {
+                Some(t) => {
+                    t.raw.set(raw, opts);
+                    t.classified.set(classified, opts);
+                }
+                None => {
+                    let preview = preview_image(&self.state, size);
+                    self.textures = Some(Textures {
+                        raw: ctx.load_texture("raw", raw, opts),
+                        classified: ctx.load_texture("classified", classified, opts),
+                        preview: ctx.load_texture("preview", preview, opts),
+                        frame_generation: fg,
+                        preview_generation: pg,
+                        preview_empty: empty,
+                    });
+                }
+            }
+        }
+        if let Some(t) = &mut self.textures {
+            // With nothing selected the preview is not drawn: an empty one is uploaded once,
+            // not on every step of playback.
+            if t.preview_generation != pg && !(empty && t.preview_empty) {
+                t.preview.set(preview_image(&self.state, size), opts);
+                t.preview_empty = empty;
+            }
+            t.frame_generation = fg;
+            t.preview_generation = pg;
+        }
+        if frame_changed {
+            self.state.record_upload(t0.elapsed());
+        }
+    }
+}

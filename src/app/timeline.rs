@@ -1,0 +1,71 @@
+//! The timeline bar under the views: previous/play/next, speed, the frame number, the time and
+//! the slider with the events' and bookmarks' marks.
+
+use super::{Command, EotnApp, bookmarks_panel, menus, robots_panel};
+use crate::workspace::SPEEDS;
+
+impl EotnApp {
+    /// The timeline bar's contents (nothing without an open source).
+    pub(super) fn timeline_ui(&self, ui: &mut egui::Ui, commands: &mut Vec<Command>) {
+        let Some(src) = self.state.source() else {
+            return;
+        };
+        let len = src.len();
+        let index = self.state.index();
+        ui.horizontal(|ui| {
+            robots_panel::live_controls_ui(ui, &self.state, commands);
+            if ui.button("Previous").on_hover_text("Left arrow").clicked() {
+                commands.push(Command::Step(-1));
+            }
+            let play = if self.state.playing() {
+                "Pause"
+            } else {
+                "Play"
+            };
+            if ui.button(play).on_hover_text("Space").clicked() {
+                commands.push(Command::SetPlaying(!self.state.playing()));
+            }
+            if ui.button("Next").on_hover_text("Right arrow").clicked() {
+                commands.push(Command::Step(1));
+            }
+            let mut speed = self.state.settings.speed;
+            egui::ComboBox::from_label("speed")
+                .selected_text(menus::speed_name(speed))
+                .width(90.0)
+                .show_ui(ui, |ui| {
+                    for s in SPEEDS {
+                        ui.selectable_value(&mut speed, s, menus::speed_name(s));
+                    }
+                });
+            if (speed - self.state.settings.speed).abs() > f32::EPSILON {
+                commands.push(Command::SetSpeed(speed));
+            }
+            let mut i = index;
+            ui.label("frame");
+            if ui
+                .add(egui::DragValue::new(&mut i).range(0..=len.saturating_sub(1)))
+                .on_hover_text("type a frame number to jump")
+                .changed()
+            {
+                commands.push(Command::Seek(i));
+            }
+            let t = src.time_ns(index) as f64 / 1e9;
+            let end = src.time_ns(len.saturating_sub(1)) as f64 / 1e9;
+            ui.monospace(format!(
+                "/ {}  {t:8.3} s / {end:.3} s",
+                len.saturating_sub(1)
+            ));
+            ui.spacing_mut().slider_width = (ui.available_width() - 70.0).max(100.0);
+            let mut j = index;
+            let slider = ui.add(
+                egui::Slider::new(&mut j, 0..=len.saturating_sub(1))
+                    .show_value(false)
+                    .text("timeline"),
+            );
+            if slider.changed() {
+                commands.push(Command::Seek(j));
+            }
+            bookmarks_panel::timeline_marks(ui.painter(), slider.rect, &self.state, len);
+        });
+    }
+}
