@@ -442,3 +442,73 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
     assert_eq!(ws(&h).selection().and_then(|s| s.pixel), Some((65, 45)));
     assert_eq!(ws(&h).settings.transform.zoom, Some(2.5));
 }
+
+/// Runs the app until `done` holds, at most 30 s (robots send in real time).
+fn run_until(h: &mut Harness<'static, EotnApp>, done: impl Fn(&EotnApp) -> bool) {
+    let start = std::time::Instant::now();
+    while !done(h.state()) {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(30),
+            "{:?}",
+            h.state().state.warnings()
+        );
+        h.run_steps(4);
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+#[test]
+fn the_robots_window_fits_its_dock_tab_with_two_robots() {
+    use crate::live::{serve, sim_stream};
+    let dir = tempfile::tempdir().unwrap();
+    let stream = sim_stream(dir.path(), 10);
+    let alpha = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "alpha"]);
+    let bravo = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "bravo"]);
+    let mut h = harness(Vec::new());
+    h.run_steps(4);
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Robots, true));
+    for port in [alpha.port, bravo.port] {
+        h.state_mut()
+            .state
+            .run(Command::ConnectRobot(format!("127.0.0.1:{port}")));
+    }
+    run_until(&mut h, |a| {
+        let rows = a.state.robots();
+        rows.len() == 2 && rows.iter().all(|r| r.stats.frames >= 3)
+    });
+    h.run_steps(4);
+    // The dock column is right of the image; every robot's name, figures and buttons lie
+    // between the image and the window's right edge: nothing needs a sideways scroll.
+    let column_left = h.state().last_view.expect("the image is drawn").view.max.x;
+    let screen_right = 1280.0;
+    let mut checked = 0;
+    for label in ["alpha", "bravo", "Record", "Disconnect"] {
+        let nodes: Vec<Rect> = h
+            .query_all_by_label(label)
+            .filter_map(|n| n.accesskit_node().bounding_box())
+            .map(|r| {
+                Rect::from_min_max(
+                    Pos2::new(r.x0 as f32, r.y0 as f32),
+                    Pos2::new(r.x1 as f32, r.y1 as f32),
+                )
+            })
+            .collect();
+        let expected = if label.starts_with(char::is_uppercase) {
+            2
+        } else {
+            1
+        };
+        assert_eq!(nodes.len(), expected, "{label}: {nodes:?}");
+        for r in nodes {
+            assert!(
+                r.min.x >= column_left - 1.0 && r.max.x <= screen_right,
+                "{label} at {r:?}, the column is {column_left}..{screen_right}"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 6);
+    assert!(h.query_all_by_label_contains(" fps").count() >= 2);
+}
