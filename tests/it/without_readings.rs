@@ -391,9 +391,9 @@ fn real_bhuman_frames_without_readings_report_no_false_ball_and_no_other_choice(
     let labels = Labels::load(&repo_file("streams/bhuman2009.labels.json")).unwrap();
     let lut = LookupTable::load(&repo_file("lookup_tables/bhuman2009.lut")).unwrap();
     let spl = params_file::load(&repo_file("params/spl2009.json")).unwrap();
-    let mut spl_before = spl.clone();
+    let mut spl_before = spl;
     spl_before.ball.field_below_without_pose_weight = TestWeight::new(0.0, 0.0);
-    let (with, a) = labelled_choices(&frames, &labels, &lut, spl.clone(), true);
+    let (with, a) = labelled_choices(&frames, &labels, &lut, spl, true);
     let (without, b) = labelled_choices(&frames, &labels, &lut, spl, false);
     let (before, _) = labelled_choices(&frames, &labels, &lut, spl_before, false);
     let differ = differing_choices(&a, &b, 1.0);
