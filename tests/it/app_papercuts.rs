@@ -177,9 +177,10 @@ fn object_labels_stay_inside_the_view_when_the_object_is_beyond_an_edge() {
         );
         let label = ball_label(&h, xf.view).expect("the ball's label is still drawn");
         assert!(
-            xf.view.contains_rect(label),
-            "label {label:?} inside the view {:?}",
-            xf.view
+            xf.view.contains_rect(label) && xf.image_rect().contains_rect(label),
+            "label {label:?} inside the view {:?} and on the image {:?}",
+            xf.view,
+            xf.image_rect()
         );
         let edge_gap = if above {
             label.min.y - xf.view.min.y
