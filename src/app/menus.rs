@@ -386,7 +386,7 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         zoom_value_ui(ui, state, commands);
     });
     stays_open_on_clicks("Blob boxes", ui, |ui| blob_filter_ui(ui, state, commands));
-    ui.menu_button("Overlays", |ui| overlays_menu_ui(ui, state, commands));
+    stays_open_on_clicks("Overlays", ui, |ui| overlays_menu_ui(ui, state, commands));
     let mut inspector = state.window_open(Window::Inspector);
     if ui.checkbox(&mut inspector, "Object inspector").changed() {
         commands.push(Command::ShowWindow(Window::Inspector, inspector));
@@ -408,8 +408,9 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
 }
 
 /// A submenu that a click inside leaves open (egui's menus close on any click inside), for
-/// one holding value fields: clicking a field to type into it must not close the menu. Its
-/// buttons close it themselves (`ui.close()`); a click outside or Escape closes it too.
+/// one holding value fields, sliders or switches: clicking a field to type into it, or the
+/// opacity slider's track, must not close the menu, and several overlays can be switched in
+/// one go. Its buttons close it themselves (`ui.close()`); a click outside or Escape closes it.
 fn stays_open_on_clicks(title: &str, ui: &mut Ui, contents: impl FnOnce(&mut Ui)) {
     use egui::containers::menu::{MenuConfig, SubMenuButton};
     SubMenuButton::new(title)

@@ -312,6 +312,36 @@ fn a_typed_zoom_value_sets_the_zoom() {
 }
 
 #[test]
+fn settings_submenus_stay_open_while_switches_change_and_escape_closes_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, table) = fixture(dir.path());
+    let mut h = harness(vec![frames[0].clone(), table]);
+    h.run();
+    h.get_by_label("View").click();
+    h.run();
+    h.get_by_label("Overlays").click();
+    h.run();
+    let before = ws(&h).settings.overlays;
+    h.get_by_label("Circle fits").click();
+    h.run();
+    h.get_by_label("Horizon").click();
+    h.run();
+    let after = ws(&h).settings.overlays;
+    assert_ne!(after.circles, before.circles);
+    assert_ne!(
+        after.horizon, before.horizon,
+        "a second switch in the same visit"
+    );
+    h.key_press(egui::Key::Escape);
+    h.run();
+    h.run();
+    assert!(
+        h.query_by_label("Circle fits").is_none(),
+        "Escape closed it"
+    );
+}
+
+#[test]
 fn the_uv_plane_has_ticks_and_values_on_both_axes() {
     let dir = tempfile::tempdir().unwrap();
     let (frames, table) = fixture(dir.path());
