@@ -1,7 +1,8 @@
 //! The last papercuts of issue 15 that were done but untested, each driven through the real
 //! window under egui_kittest: object labels kept inside the view, the journal warning naming
-//! the menu's command as the menu does, the class list's column headers, a typed zoom, the U–V
-//! plane's axis ticks, and double-click to fit without sampling a selection.
+//! the menu's command as the menu does, the class list's column headers, a typed zoom (and the
+//! View submenus staying open while values change), the U–V plane's axis ticks, double-click
+//! to fit without sampling a selection, and the Robots window fitting its dock tab.
 
 use std::path::{Path, PathBuf};
 
