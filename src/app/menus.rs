@@ -391,7 +391,7 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             }
         }
     });
-    ui.menu_button("Zoom", |ui| {
+    stays_open_on_clicks("Zoom", ui, |ui| {
         if ui.button("Fit (double-click)").clicked() {
             commands.push(Command::ResetView);
             ui.close();
@@ -405,8 +405,8 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         ui.separator();
         zoom_value_ui(ui, state, commands);
     });
-    ui.menu_button("Blob boxes", |ui| blob_filter_ui(ui, state, commands));
-    ui.menu_button("Overlays", |ui| overlays_menu_ui(ui, state, commands));
+    stays_open_on_clicks("Blob boxes", ui, |ui| blob_filter_ui(ui, state, commands));
+    stays_open_on_clicks("Overlays", ui, |ui| overlays_menu_ui(ui, state, commands));
     let mut inspector = state.window_open(Window::Inspector);
     if ui.checkbox(&mut inspector, "Object inspector").changed() {
         commands.push(Command::ShowWindow(Window::Inspector, inspector));
@@ -425,6 +425,17 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             commands.push(Command::SetConnectivity(conn));
         }
     }
+}
+
+/// A submenu that a click inside leaves open (egui's menus close on any click inside), for
+/// one holding value fields, sliders or switches: clicking a field to type into it, or the
+/// opacity slider's track, must not close the menu, and several overlays can be switched in
+/// one go. Its buttons close it themselves (`ui.close()`); a click outside or Escape closes it.
+fn stays_open_on_clicks(title: &str, ui: &mut Ui, contents: impl FnOnce(&mut Ui)) {
+    use egui::containers::menu::{MenuConfig, SubMenuButton};
+    SubMenuButton::new(title)
+        .config(MenuConfig::new().close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside))
+        .ui(ui, contents);
 }
 
 /// A typed zoom value in percent (Enter or leaving the field applies it).

@@ -28,9 +28,8 @@ impl Default for RobotsPanel {
     }
 }
 
-/// The window's contents: the address field, recording into a folder, the robots list. The
-/// fields come first and wrap, so in a narrow dock tab their buttons stay in view (the list,
-/// wider, scrolls: laid out after it, they would take its width and be cut off).
+/// The window's contents: the address field, recording into a folder, the robots list. Every
+/// line wraps, so in a narrow dock tab all buttons stay in view without scrolling sideways.
 pub fn robots_ui(
     ui: &mut Ui,
     state: &Workspace,
@@ -76,23 +75,17 @@ pub fn robots_ui(
         ui.weak("No robot connected. A team is four or five: connect each by its address.");
         return;
     }
-    egui::Grid::new("robots")
-        .striped(true)
-        .num_columns(7)
-        .show(ui, |ui| {
-            for heading in ["robot", "state", "fps", "drops", "latency", "recording", ""] {
-                ui.strong(heading);
-            }
-            ui.end_row();
-            for row in &rows {
-                robot_row_ui(ui, state, panel, row, commands);
-                ui.end_row();
-            }
-        });
-    ui.separator();
+    // One block per robot, its lines wrapping: the list fits its dock tab at any width (a
+    // table of seven columns was wider than the tab at 1280×800, its buttons off to the right).
+    for row in &rows {
+        robot_row_ui(ui, state, panel, row, commands);
+        ui.separator();
+    }
     live_controls_ui(ui, state, commands);
 }
 
+/// One robot: its name (click to show it) and connection state, then its figures, recording
+/// and buttons.
 fn robot_row_ui(
     ui: &mut Ui,
     state: &Workspace,
@@ -101,56 +94,58 @@ fn robot_row_ui(
     commands: &mut Vec<Command>,
 ) {
     let id = row.id;
-    if ui
-        .selectable_label(row.shown, &row.name)
-        .on_hover_text(format!("{}: click to show it", row.url))
-        .clicked()
-        && !row.shown
-    {
-        commands.push(Command::ShowRobot(id));
-    }
-    let text = row.connection.to_string();
-    let state_label = match &row.connection {
-        Connection::Connected(_) => ui.label(text),
-        Connection::Connecting => ui.weak(text),
-        Connection::Disconnected { .. } => ui.colored_label(ui.visuals().warn_fg_color, text),
-    };
-    state_label.on_hover_text(state.robot_log(id).join("\n"));
-    let s = &row.stats;
-    ui.monospace(format!("{:.0}", s.fps));
-    ui.monospace(s.drops.to_string());
-    ui.monospace(match (s.latency_median_ms, s.latency_p99_ms) {
-        (Some(m), Some(p)) => format!("{m:.1} / {p:.1} ms"),
-        _ => "-".to_owned(),
-    })
-    .on_hover_text("median / 99th percentile, sender's write to the frame here");
-    match &row.recording {
-        Some(path) => {
-            ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
+        if ui
+            .selectable_label(row.shown, RichText::new(&row.name).strong())
+            .on_hover_text(format!("{}: click to show it", row.url))
+            .clicked()
+            && !row.shown
+        {
+            commands.push(Command::ShowRobot(id));
+        }
+        let text = row.connection.to_string();
+        let state_label = match &row.connection {
+            Connection::Connected(_) => ui.label(text),
+            Connection::Connecting => ui.weak(text),
+            Connection::Disconnected { .. } => ui.colored_label(ui.visuals().warn_fg_color, text),
+        };
+        state_label.on_hover_text(state.robot_log(id).join("\n"));
+    });
+    ui.horizontal_wrapped(|ui| {
+        let s = &row.stats;
+        ui.monospace(format!("{:.0} fps", s.fps));
+        ui.monospace(format!("{} drops", s.drops));
+        ui.monospace(match (s.latency_median_ms, s.latency_p99_ms) {
+            (Some(m), Some(p)) => format!("{m:.1} / {p:.1} ms"),
+            _ => "- ms".to_owned(),
+        })
+        .on_hover_text("latency, median / 99th percentile: the sender's write to the frame here");
+        match &row.recording {
+            Some(path) => {
                 ui.label(RichText::new(format!("rec {}", s.recorded.unwrap_or(0))).strong())
                     .on_hover_text(path.display().to_string());
                 if ui.small_button("Stop").clicked() {
                     commands.push(Command::StopRecordingRobot(id));
                 }
-            });
-        }
-        None => {
-            let folder = PathBuf::from(panel.folder.trim());
-            if ui
-                .small_button("Record")
-                .on_hover_text("into the folder below, named after the robot")
-                .clicked()
-            {
-                commands.push(Command::RecordRobot(
-                    id,
-                    state.robot_recording_path(id, &folder),
-                ));
+            }
+            None => {
+                let folder = PathBuf::from(panel.folder.trim());
+                if ui
+                    .small_button("Record")
+                    .on_hover_text("into the folder above, named after the robot")
+                    .clicked()
+                {
+                    commands.push(Command::RecordRobot(
+                        id,
+                        state.robot_recording_path(id, &folder),
+                    ));
+                }
             }
         }
-    }
-    if ui.small_button("Disconnect").clicked() {
-        commands.push(Command::DisconnectRobot(id));
-    }
+        if ui.small_button("Disconnect").clicked() {
+            commands.push(Command::DisconnectRobot(id));
+        }
+    });
 }
 
 /// While a robot is shown: the Live switch (follow its newest frame, or hold the view to step

@@ -14,6 +14,8 @@ mod app_hints;
 mod app_live;
 #[cfg(feature = "gui")]
 mod app_overhead;
+#[cfg(feature = "gui")]
+mod app_papercuts;
 mod cli;
 mod common;
 mod crash_safety;
