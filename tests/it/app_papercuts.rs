@@ -4,71 +4,26 @@
 //! View submenus staying open while values change), the U–V plane's axis ticks, double-click
 //! to fit without sampling a selection, and the Robots window fitting its dock tab.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
+use std::time::Duration;
 
 use egui::{Event, Modifiers, PointerButton, Pos2, Rect, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use eotn::app::EotnApp;
-use eotn::frame::{Frame, Yuv};
-use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
+use eotn::lut::ColourClass;
 use eotn::workspace::{Command, Window, Workspace};
 
-const GREEN: Yuv = Yuv::new(100, 110, 100);
-const ORANGE: Yuv = Yuv::new(120, 80, 190);
-const YELLOW: Yuv = Yuv::new(190, 40, 150);
+use crate::common::repo_file;
+use crate::harness::{fixture, harness_sized, run_steps_until, workspace};
 
-/// A file of the repository.
-fn repo_file(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
-
-/// Three 208×160 frame files (green field, an orange 20×20 square, a yellow bar on the left)
-/// and a 7-bit table with green and yellow classified, orange not.
-fn fixture(dir: &Path) -> (Vec<PathBuf>, PathBuf) {
-    let mut frames = Vec::new();
-    for n in 0..3 {
-        let p = dir.join(format!("f{n}.uyvy"));
-        let f = Frame::uyvy_from_fn(208, 160, |x, y| {
-            let bx = 60 + 10 * n;
-            if (bx..bx + 20).contains(&x) && (40..60).contains(&y) {
-                ORANGE
-            } else if x < 12 && (20..100).contains(&y) {
-                YELLOW
-            } else {
-                GREEN
-            }
-        })
-        .unwrap();
-        std::fs::write(&p, f.data()).unwrap();
-        frames.push(p);
-    }
-    let mut lut = LookupTable::new(7).unwrap();
-    for (class, sample) in [(ColourClass::Green, GREEN), (ColourClass::Yellow, YELLOW)] {
-        lut.apply(EditRecord::now(
-            class,
-            Region::AroundSample {
-                sample,
-                sensitivity: Sensitivity::uniform(2),
-            },
-        ));
-    }
-    let table = dir.join("field.lut");
-    lut.save(&table).unwrap();
-    (frames, table)
-}
+/// The papercut tests' window: the size the user saw.
+const SCREEN: Vec2 = Vec2::new(1280.0, 800.0);
 
 fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
-    Harness::builder()
-        .with_size(Vec2::new(1280.0, 800.0))
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
+    harness_sized(paths, SCREEN)
 }
 
-fn ws<'h>(h: &'h Harness<'_, EotnApp>) -> &'h Workspace {
-    &h.state().state
-}
-
-/// Every text painted in the last frame, with its rectangle on screen.
 fn painted_texts(h: &Harness<'_, EotnApp>) -> Vec<(String, Rect)> {
     fn collect(shape: &egui::Shape, out: &mut Vec<(String, Rect)>) {
         match shape {
@@ -142,7 +97,12 @@ fn object_labels_stay_inside_the_view_when_the_object_is_beyond_an_edge() {
     ]);
     h.run_steps(4);
     // Frame 0: the ball at (172, 149), radius 11 px, in the middle of the image.
-    let ball = ws(&h).recognition().ball.ball.clone().expect("a ball");
+    let ball = workspace(&h)
+        .recognition()
+        .ball
+        .ball
+        .clone()
+        .expect("a ball");
     let (bx, by, r) = (
         ball.observed_center.0,
         ball.observed_center.1,
@@ -160,8 +120,8 @@ fn object_labels_stay_inside_the_view_when_the_object_is_beyond_an_edge() {
         (false, by as f32 - r as f32 - 40.0 - half_height),
     ] {
         h.state_mut().state.run(Command::SetZoom(Some(zoom)));
-        let size = ws(&h).image_size();
-        let c = ws(&h)
+        let size = workspace(&h).image_size();
+        let c = workspace(&h)
             .settings
             .transform
             .effective_centre([size.0 as f32, size.1 as f32]);
@@ -229,7 +189,7 @@ fn the_journal_warning_names_the_menu_command_as_the_menu_shows_it() {
     h.get_by_label(item).click();
     h.run();
     assert_eq!(
-        ws(&h).lut(),
+        workspace(&h).lut(),
         &unsaved,
         "the command the warning names recovers the edit"
     );
@@ -242,8 +202,8 @@ fn the_class_list_count_columns_have_headers_above_them() {
     let mut h = harness(vec![frames[0].clone(), table]);
     h.run();
     let green = usize::from(ColourClass::Green.code());
-    let cells = ws(&h).table_counts()[green];
-    let pixels = ws(&h).frame_counts()[green];
+    let cells = workspace(&h).table_counts()[green];
+    let pixels = workspace(&h).frame_counts()[green];
     assert_ne!(
         cells, pixels,
         "the two columns are told apart by their values"
@@ -275,7 +235,11 @@ fn a_typed_zoom_value_sets_the_zoom() {
     let (frames, table) = fixture(dir.path());
     let mut h = harness(vec![frames[0].clone(), table]);
     h.run();
-    assert_eq!(ws(&h).settings.transform.zoom, None, "fitted at first");
+    assert_eq!(
+        workspace(&h).settings.transform.zoom,
+        None,
+        "fitted at first"
+    );
     h.get_by_label("View").click();
     h.run();
     h.get_by_label("Zoom").click();
@@ -298,7 +262,11 @@ fn a_typed_zoom_value_sets_the_zoom() {
     h.run();
     h.key_press(egui::Key::Enter);
     h.run();
-    let zoom = ws(&h).settings.transform.zoom.expect("a zoom was set");
+    let zoom = workspace(&h)
+        .settings
+        .transform
+        .zoom
+        .expect("a zoom was set");
     assert!((zoom - 2.5).abs() < 1e-4, "{zoom}");
     let xf = h.state().last_view.unwrap();
     assert!(
@@ -322,12 +290,12 @@ fn settings_submenus_stay_open_while_switches_change_and_escape_closes_them() {
     h.run();
     h.get_by_label("Overlays").click();
     h.run();
-    let before = ws(&h).settings.overlays;
+    let before = workspace(&h).settings.overlays;
     h.get_by_label("Circle fits").click();
     h.run();
     h.get_by_label("Horizon").click();
     h.run();
-    let after = ws(&h).settings.overlays;
+    let after = workspace(&h).settings.overlays;
     assert_ne!(after.circles, before.circles);
     assert_ne!(
         after.horizon, before.horizon,
@@ -443,7 +411,7 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
     h.state_mut().state.run(Command::Sample { x: 150, y: 120 });
     h.state_mut().state.run(Command::SetZoom(Some(2.5)));
     h.run();
-    let before = ws(&h).selection().cloned();
+    let before = workspace(&h).selection().cloned();
     assert_eq!(before.as_ref().and_then(|s| s.pixel), Some((150, 120)));
     // Double-click on the orange square: the view fits, the selection is the one from before.
     let ball = h.state().last_view.unwrap().pixel_centre(65, 45);
@@ -451,8 +419,12 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
     click_events(&h, ball);
     click_events(&h, ball);
     h.run();
-    assert_eq!(ws(&h).settings.transform.zoom, None, "fitted");
-    assert_eq!(ws(&h).selection().cloned(), before, "the selection is kept");
+    assert_eq!(workspace(&h).settings.transform.zoom, None, "fitted");
+    assert_eq!(
+        workspace(&h).selection().cloned(),
+        before,
+        "the selection is kept"
+    );
     // With no selection before, none after (half a second later: not a third click).
     h.state_mut().state.run(Command::ClearSelection);
     h.state_mut().state.run(Command::SetZoom(Some(2.5)));
@@ -462,8 +434,12 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
     click_events(&h, ball);
     click_events(&h, ball);
     h.run();
-    assert_eq!(ws(&h).settings.transform.zoom, None);
-    assert!(ws(&h).selection().is_none(), "{:?}", ws(&h).selection());
+    assert_eq!(workspace(&h).settings.transform.zoom, None);
+    assert!(
+        workspace(&h).selection().is_none(),
+        "{:?}",
+        workspace(&h).selection()
+    );
     // A single click still samples at once (and the zoom stays).
     h.state_mut().state.run(Command::SetZoom(Some(2.5)));
     h.run_steps(30);
@@ -471,29 +447,19 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
     h.event(Event::PointerMoved(ball));
     click_events(&h, ball);
     h.run();
-    assert_eq!(ws(&h).selection().and_then(|s| s.pixel), Some((65, 45)));
-    assert_eq!(ws(&h).settings.transform.zoom, Some(2.5));
-}
-
-/// Runs the app until `done` holds, at most 30 s (robots send in real time).
-fn run_until(h: &mut Harness<'static, EotnApp>, done: impl Fn(&EotnApp) -> bool) {
-    let start = std::time::Instant::now();
-    while !done(h.state()) {
-        assert!(
-            start.elapsed() < std::time::Duration::from_secs(30),
-            "{:?}",
-            h.state().state.warnings()
-        );
-        h.run_steps(4);
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
+    assert_eq!(
+        workspace(&h).selection().and_then(|s| s.pixel),
+        Some((65, 45))
+    );
+    assert_eq!(workspace(&h).settings.transform.zoom, Some(2.5));
 }
 
 #[test]
 fn the_robots_window_fits_its_dock_tab_with_two_robots() {
-    use crate::live::{serve, sim_stream};
+    use crate::common::sim_stream;
+    use crate::live::serve;
     let dir = tempfile::tempdir().unwrap();
-    let stream = sim_stream(dir.path(), 10);
+    let stream = sim_stream(dir.path(), "walk-and-pan", 10, None);
     let alpha = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "alpha"]);
     let bravo = serve(&stream, "127.0.0.1:0", &["--loop", "--name", "bravo"]);
     let mut h = harness(Vec::new());
@@ -506,7 +472,7 @@ fn the_robots_window_fits_its_dock_tab_with_two_robots() {
             .state
             .run(Command::ConnectRobot(format!("127.0.0.1:{port}")));
     }
-    run_until(&mut h, |a| {
+    run_steps_until(&mut h, Duration::from_secs(30), |a| {
         let rows = a.state.robots();
         rows.len() == 2 && rows.iter().all(|r| r.stats.frames >= 3)
     });
