@@ -18,7 +18,7 @@ use super::views::{self, MainViewOutput};
 use crate::workspace::{Command, Window, Workspace};
 
 /// Share of the width the image gets beside the docked windows (they get 1).
-const IMAGE_SHARE: f32 = 1.8;
+const IMAGE_SHARE: f32 = 1.6;
 
 /// How many groups of docked windows are stacked in the column beside the image before more
 /// windows become tabs of the last group.

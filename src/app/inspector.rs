@@ -389,37 +389,60 @@ pub fn inspector_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
         }
     });
     ui.separator();
-    ui.horizontal_top(|ui| {
-        ui.vertical(|ui| {
-            ui.set_width(LIST_WIDTH);
-            egui::ScrollArea::vertical()
-                .id_salt("inspector_list")
-                .max_height(360.0)
-                .show(ui, |ui| {
-                    for c in &list {
-                        let is_sel = selected == Some(c.owner);
-                        let text = RichText::new(format!(
-                            "{} {}  {:+.2}",
-                            if c.accepted { "accepted" } else { "rejected" },
-                            c.owner,
-                            c.confidence.total
-                        ))
-                        .color(verdict_colour(c.accepted));
-                        let r = ui.selectable_label(is_sel, text).on_hover_text(&c.kind);
-                        if r.clicked() {
-                            commands.push(Command::SelectObject((!is_sel).then_some(c.owner)));
-                        }
-                    }
-                });
+    let details = |ui: &mut Ui| match list.iter().find(|c| Some(c.owner) == selected) {
+        None => {
+            ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
+        }
+        Some(c) => details_ui(ui, c),
+    };
+    if ui.available_width() >= LIST_WIDTH + DETAILS_MIN_WIDTH {
+        ui.horizontal_top(|ui| {
+            ui.vertical(|ui| {
+                ui.set_width(LIST_WIDTH);
+                candidate_list_ui(ui, &list, selected, 360.0, commands);
+            });
+            ui.add_space(8.0);
+            ui.vertical(details);
         });
-        ui.add_space(8.0);
-        ui.vertical(|ui| match list.iter().find(|c| Some(c.owner) == selected) {
-            None => {
-                ui.weak("Select a candidate to see its confidence breakdown and highlight it.");
+    } else {
+        // Docked beside the image the window is narrow: the list above, the breakdown below at
+        // the window's full width (side by side the breakdown's columns were cut off).
+        candidate_list_ui(ui, &list, selected, 150.0, commands);
+        ui.separator();
+        details(ui);
+    }
+}
+
+/// Width the confidence breakdown needs beside the list (its five columns), points.
+const DETAILS_MIN_WIDTH: f32 = 420.0;
+
+/// The candidates, each a row that selects it (or clears the selection when it is selected).
+fn candidate_list_ui(
+    ui: &mut Ui,
+    list: &[CandidateInfo],
+    selected: Option<ObjectId>,
+    max_height: f32,
+    commands: &mut Vec<Command>,
+) {
+    egui::ScrollArea::vertical()
+        .id_salt("inspector_list")
+        .max_height(max_height)
+        .show(ui, |ui| {
+            for c in list {
+                let is_sel = selected == Some(c.owner);
+                let text = RichText::new(format!(
+                    "{} {}  {:+.2}",
+                    if c.accepted { "accepted" } else { "rejected" },
+                    c.owner,
+                    c.confidence.total
+                ))
+                .color(verdict_colour(c.accepted));
+                let r = ui.selectable_label(is_sel, text).on_hover_text(&c.kind);
+                if r.clicked() {
+                    commands.push(Command::SelectObject((!is_sel).then_some(c.owner)));
+                }
             }
-            Some(c) => details_ui(ui, c),
         });
-    });
 }
 
 fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
@@ -469,19 +492,19 @@ fn details_ui(ui: &mut Ui, c: &CandidateInfo) {
         .striped(true)
         .num_columns(5)
         .show(ui, |ui| {
-            for h in ["test", "value", "range", "effect", "outcome"] {
+            for h in ["test", "value", "range", "effect", "result"] {
                 ui.strong(h);
             }
             ui.end_row();
             for t in &c.confidence.tests {
                 ui.monospace(t.test.as_str());
-                ui.monospace(format!("{:.3}", t.value));
-                ui.monospace(format!("{:.3} … {:.3}", t.range[0], t.range[1]));
+                ui.monospace(format!("{:.2}", t.value));
+                ui.monospace(format!("{:.2}–{:.2}", t.range[0], t.range[1]));
                 ui.monospace(format!("{:+.2}", t.effect));
                 let (text, colour) = match t.outcome {
-                    TestOutcome::Passed => ("passed", verdict_colour(true)),
-                    TestOutcome::Failed => ("failed", verdict_colour(false)),
-                    TestOutcome::Skipped => ("skipped", Color32::GRAY),
+                    TestOutcome::Passed => ("pass", verdict_colour(true)),
+                    TestOutcome::Failed => ("fail", verdict_colour(false)),
+                    TestOutcome::Skipped => ("skip", Color32::GRAY),
                 };
                 ui.colored_label(colour, text);
                 ui.end_row();

@@ -502,7 +502,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         "{:#?}",
         h.root()
     );
-    assert!(h.query_all_by_label("passed").count() >= 1);
+    assert!(h.query_all_by_label("pass").count() >= 1);
     assert!(h.query_all_by_label_contains("bearing").count() >= 1);
     let circles = drawn_circles(&h);
     assert!(

@@ -510,3 +510,42 @@ fn the_robots_window_fits_its_dock_tab_with_two_robots() {
     assert_eq!(checked, 6);
     assert!(h.query_all_by_label_contains(" fps").count() >= 2);
 }
+
+#[test]
+fn the_docked_inspector_shows_the_whole_confidence_breakdown_at_1280_by_800() {
+    let mut s = Workspace::default();
+    s.apply(Command::Open(vec![
+        repo_file("streams/sample.mcap"),
+        repo_file("lookup_tables/sample.lut"),
+    ]))
+    .unwrap();
+    let ball = s
+        .recognition()
+        .ball
+        .ball
+        .clone()
+        .expect("a ball in frame 0");
+    s.apply(Command::ShowWindow(Window::Inspector, true))
+        .unwrap();
+    s.apply(Command::SelectObject(Some(
+        eotn::recognition::ObjectId::Ball(ball.candidate),
+    )))
+    .unwrap();
+    let mut h = Harness::builder()
+        .with_size(SCREEN)
+        .build_eframe(move |_| EotnApp::with_state(s));
+    h.run();
+    // Every column of the breakdown lies on the screen: side by side with the list in the
+    // docked column, the last columns were cut off at its right edge.
+    for label in ["test", "value", "range", "effect", "result"] {
+        let r = node_rect(&h, label);
+        assert!(
+            r.max.x <= SCREEN.x && r.min.x >= 0.0,
+            "{label} at x {}–{}",
+            r.min.x,
+            r.max.x
+        );
+    }
+    let test_name = node_rect(&h, "unclassified_around");
+    assert!(test_name.max.x <= SCREEN.x, "{test_name:?}");
+}
