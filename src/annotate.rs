@@ -11,6 +11,7 @@ use foxglove::messages::{
     points_annotation::Type as PointsType,
 };
 
+use crate::frame::ImagePoint;
 use crate::overlay::primitive_rgb;
 use crate::recognition::{CircleRole, ObjectId, Primitive, Recognition};
 
@@ -77,22 +78,16 @@ fn add(out: &mut ImageAnnotations, p: &Primitive, stamp: Timestamp) {
             ));
         }
         Primitive::ScanArea { corners, .. } => {
-            let pts = corners.iter().map(|&(x, y)| Point2 { x, y }).collect();
+            let pts = corners.iter().copied().map(point2).collect();
             out.points
                 .push(points(PointsType::LineLoop, pts, THICKNESS_PX));
         }
         Primitive::ScanPoints { points: pts, .. } => {
-            let pts = pts.iter().map(|&(x, y)| Point2 { x, y }).collect();
+            let pts = pts.iter().copied().map(point2).collect();
             out.points.push(points(PointsType::Points, pts, POINT_PX));
         }
         Primitive::Line { from, to, .. } => {
-            let pts = vec![
-                Point2 {
-                    x: from.0,
-                    y: from.1,
-                },
-                Point2 { x: to.0, y: to.1 },
-            ];
+            let pts = vec![point2(*from), point2(*to)];
             out.points
                 .push(points(PointsType::LineStrip, pts, THICKNESS_PX));
         }
@@ -103,10 +98,7 @@ fn add(out: &mut ImageAnnotations, p: &Primitive, stamp: Timestamp) {
             ..
         } => out.circles.push(CircleAnnotation {
             timestamp: Some(stamp),
-            position: Some(Point2 {
-                x: center.0,
-                y: center.1,
-            }),
+            position: Some(point2(*center)),
             diameter: 2.0 * radius,
             thickness: match role {
                 CircleRole::Observed => THICKNESS_PX,
@@ -117,7 +109,7 @@ fn add(out: &mut ImageAnnotations, p: &Primitive, stamp: Timestamp) {
         }),
         Primitive::Label { at, text, .. } => out.texts.push(TextAnnotation {
             timestamp: Some(stamp),
-            position: Some(Point2 { x: at.0, y: at.1 }),
+            position: Some(point2(*at)),
             text: text.clone(),
             font_size: FONT_PX,
             text_color: Some(colour),
@@ -133,6 +125,14 @@ fn add(out: &mut ImageAnnotations, p: &Primitive, stamp: Timestamp) {
 }
 
 /// The corners of the pixel-edge rectangle from (x0, y0) to (x1, y1).
+/// An image point as Foxglove's point, pixels.
+fn point2(p: ImagePoint) -> Point2 {
+    Point2 {
+        x: p.x_px,
+        y: p.y_px,
+    }
+}
+
 fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Point2> {
     vec![
         Point2 { x: x0, y: y0 },
@@ -171,7 +171,7 @@ mod tests {
             &mut out,
             &Primitive::Circle {
                 owner: ObjectId::Ball(0),
-                center: (10.5, 20.0),
+                center: ImagePoint::new(10.5, 20.0),
                 radius: 4.0,
                 role: CircleRole::SkewCorrected,
             },

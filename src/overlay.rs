@@ -6,7 +6,7 @@
 //! (FORMATS.md). An optional integer `scale` enlarges the picture first so thin lines stay
 //! readable on 208×160 frames.
 
-use crate::frame::PixelBox;
+use crate::frame::{ImagePoint, PixelBox};
 use crate::lut::classes::code_display_rgb;
 use crate::recognition::{CircleRole, LineRole, Primitive};
 
@@ -80,9 +80,9 @@ impl Canvas {
     }
 
     /// A line between two points in source-image pixels.
-    pub fn line(&mut self, a: (f64, f64), b: (f64, f64), c: [u8; 3]) {
+    pub fn line(&mut self, a: ImagePoint, b: ImagePoint, c: [u8; 3]) {
         let s = self.scale as f64;
-        let (x0, y0, x1, y1) = (a.0 * s, a.1 * s, b.0 * s, b.1 * s);
+        let (x0, y0, x1, y1) = (a.x_px * s, a.y_px * s, b.x_px * s, b.y_px * s);
         if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
             return;
         }
@@ -102,22 +102,22 @@ impl Canvas {
     }
 
     /// A circle in source-image pixels.
-    pub fn circle(&mut self, centre: (f64, f64), r: f64, c: [u8; 3]) {
+    pub fn circle(&mut self, centre: ImagePoint, r: f64, c: [u8; 3]) {
         self.circle_dashed(centre, r, c, None);
     }
 
     /// A circle in source-image pixels; with `dash` = Some(n), drawn as dashes n output pixels
     /// long with equal gaps.
-    pub fn circle_dashed(&mut self, centre: (f64, f64), r: f64, c: [u8; 3], dash: Option<usize>) {
+    pub fn circle_dashed(&mut self, centre: ImagePoint, r: f64, c: [u8; 3], dash: Option<usize>) {
         if !(r.is_finite() && r > 0.0) {
             return;
         }
         // One segment per output pixel of circumference.
         let n = ((r * self.scale as f64 * 6.3).ceil() as usize).clamp(8, 20_000);
-        let mut prev = (centre.0 + r, centre.1);
+        let mut prev = ImagePoint::new(centre.x_px + r, centre.y_px);
         for i in 1..=n {
             let t = i as f64 / n as f64 * std::f64::consts::TAU;
-            let p = (centre.0 + r * t.cos(), centre.1 + r * t.sin());
+            let p = ImagePoint::new(centre.x_px + r * t.cos(), centre.y_px + r * t.sin());
             if dash.is_none_or(|d| (i - 1) / d.max(1) % 2 == 0) {
                 self.line(prev, p, c);
             }
@@ -130,19 +130,30 @@ impl Canvas {
         let (x0, y0) = (f64::from(bounds.min_x), f64::from(bounds.min_y));
         let (x1, y1) = (f64::from(bounds.max_x) + 1.0, f64::from(bounds.max_y) + 1.0);
         let e = 0.5 / self.scale as f64;
-        self.line((x0, y0), (x1 - e, y0), c);
-        self.line((x1 - e, y0), (x1 - e, y1 - e), c);
-        self.line((x1 - e, y1 - e), (x0, y1 - e), c);
-        self.line((x0, y1 - e), (x0, y0), c);
+        self.outline([x0, y0, x1 - e, y1 - e], c);
+    }
+
+    /// The outline of the rectangle `[left, top, right, bottom]` (source-image pixels, the
+    /// right and bottom edges drawn on those coordinates).
+    fn outline(&mut self, [x0, y0, x1, y1]: [f64; 4], c: [u8; 3]) {
+        let corners = [
+            ImagePoint::new(x0, y0),
+            ImagePoint::new(x1, y0),
+            ImagePoint::new(x1, y1),
+            ImagePoint::new(x0, y1),
+        ];
+        for i in 0..4 {
+            self.line(corners[i], corners[(i + 1) % 4], c);
+        }
     }
 
     /// A label anchored at `at` (source-image pixels): its text (up to 64 characters) in the
     /// bitmap font on a dark backing just above the anchor, as the app draws it, moved the least
     /// distance that keeps it inside the picture (a ball at the top or bottom edge still shows
     /// its distance).
-    pub fn label(&mut self, at: (f64, f64), text: &str, c: [u8; 3]) {
+    pub fn label(&mut self, at: ImagePoint, text: &str, c: [u8; 3]) {
         const PAD: i64 = 2;
-        if !(at.0.is_finite() && at.1.is_finite()) || text.is_empty() {
+        if !at.is_finite() || text.is_empty() {
             return;
         }
         let shown: String = text.chars().take(64).collect();
@@ -151,7 +162,7 @@ impl Canvas {
         let box_w = text_w as i64 + 2 * PAD;
         let box_h = text_h as i64 + 2 * PAD;
         let s = self.scale as f64;
-        let (ax, ay) = ((at.0 * s).floor() as i64, (at.1 * s).floor() as i64);
+        let (ax, ay) = ((at.x_px * s).floor() as i64, (at.y_px * s).floor() as i64);
         let x0 = ax.min(w - box_w).max(0);
         let y0 = (ay - box_h - 2).min(h - box_h).max(0);
         for y in y0..(y0 + box_h).min(h) {
@@ -205,8 +216,8 @@ impl Canvas {
                     for q in points {
                         let s = self.scale as f64;
                         self.put(
-                            (q.0 * s).floor() as i64,
-                            (q.1 * s).floor() as i64,
+                            (q.x_px * s).floor() as i64,
+                            (q.y_px * s).floor() as i64,
                             primitive_rgb(p),
                         );
                     }
@@ -234,11 +245,7 @@ impl Canvas {
                         0.0
                     };
                     for d in [0.0, inset] {
-                        let (a, b) = ((x0 + d, y0 + d), (x1 + 1.0 - e - d, y1 + 1.0 - e - d));
-                        self.line(a, (b.0, a.1), c);
-                        self.line((b.0, a.1), b, c);
-                        self.line(b, (a.0, b.1), c);
-                        self.line((a.0, b.1), a, c);
+                        self.outline([x0 + d, y0 + d, x1 + 1.0 - e - d, y1 + 1.0 - e - d], c);
                     }
                 }
                 Primitive::Label { at, text, .. } => self.label(*at, text, primitive_rgb(p)),
@@ -318,7 +325,7 @@ mod tests {
     fn label(at: (f64, f64), text: &str) -> Primitive {
         Primitive::Label {
             owner: ObjectId::Ball(0),
-            at,
+            at: ImagePoint::new(at.0, at.1),
             text: text.into(),
         }
     }
@@ -434,12 +441,12 @@ mod tests {
             Primitive::Line {
                 owner: ObjectId::Horizon,
                 role: LineRole::Horizon,
-                from: (-5.0, 1.0),
-                to: (50.0, 1.0),
+                from: ImagePoint::new(-5.0, 1.0),
+                to: ImagePoint::new(50.0, 1.0),
             },
             Primitive::Circle {
                 owner: ObjectId::Ball(0),
-                center: (5.0, 5.0),
+                center: ImagePoint::new(5.0, 5.0),
                 radius: 3.0,
                 role: CircleRole::Observed,
             },
@@ -462,7 +469,7 @@ mod tests {
             let mut c = Canvas::from_rgb(40, 40, &[0u8; 40 * 40 * 3], 2).expect("canvas");
             c.draw(&[Primitive::Circle {
                 owner: ObjectId::Ball(0),
-                center: (20.0, 20.0),
+                center: ImagePoint::new(20.0, 20.0),
                 radius: 12.0,
                 role,
             }]);

@@ -3,7 +3,7 @@
 //! and as the reference instant sees them.
 
 use crate::debug_setup;
-use eotn::geometry::{CameraPose, Ers7Dimensions, Point};
+use eotn::geometry::{CameraPose, Ers7Dimensions, ImagePoint, Point};
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::sim::truth::GroundTruth;
 use eotn::sim::{FRAME_INTERVAL_S, Scenario, ScenarioKind, Simulator};
@@ -14,7 +14,7 @@ fn rolling_image(
     scenario: &Scenario,
     t: f64,
     p: &Point<eotn::geometry::Field>,
-) -> Option<(f64, f64)> {
+) -> Option<ImagePoint> {
     let dims = Ers7Dimensions::ERS7;
     let camera = eotn::geometry::PinholeCamera::ers7();
     let pose_at = |tr: f64| {
@@ -32,7 +32,7 @@ fn rolling_image(
         x = q.x_px;
         y = q.y_px;
     }
-    Some((x, y))
+    Some(ImagePoint::new(x, y))
 }
 
 /// Per-post detail for one scenario: `EOTN_DEBUG_SCENARIO=walk-and-pan
@@ -68,22 +68,22 @@ pub fn debug_posts() {
                 .find(|t| eotn::eval::goal_class(t.colour) == g.colour)
                 .expect("truth goal");
             for post in &g.posts {
-                let line_x = |a: (f64, f64), b: (f64, f64), y: f64| {
-                    if (b.1 - a.1).abs() > 1e-9 {
-                        a.0 + (b.0 - a.0) * (y - a.1) / (b.1 - a.1)
+                let line_x = |a: ImagePoint, b: ImagePoint, y: f64| {
+                    if (b.y_px - a.y_px).abs() > 1e-9 {
+                        a.x_px + (b.x_px - a.x_px) * (y - a.y_px) / (b.y_px - a.y_px)
                     } else {
-                        a.0
+                        a.x_px
                     }
                 };
                 // Which field post is it: the one whose reference projection is nearest.
-                let mid_y = (post.top.1 + post.bottom.1) / 2.0;
+                let mid_y = (post.top.y_px + post.bottom.y_px) / 2.0;
                 let (k, tp) = tg
                     .posts
                     .iter()
                     .enumerate()
                     .filter_map(|(k, tp)| Some((k, tp.image_base?, tp.image_top?)))
                     .map(|(k, b, top)| {
-                        let x = line_x((top.x_px, top.y_px), (b.x_px, b.y_px), mid_y);
+                        let x = line_x(top, b, mid_y);
                         (k, (x - line_x(post.top, post.bottom, mid_y)).abs())
                     })
                     .min_by(|a, b| a.1.total_cmp(&b.1))
@@ -98,7 +98,7 @@ pub fn debug_posts() {
                     .iter()
                     .map(|(x, y)| {
                         let q = rolling_image(&scenario, t, &Point::new(*x, *y, z))?;
-                        Some(line_x(post.top, post.bottom, q.1) - q.0)
+                        Some(line_x(post.top, post.bottom, q.y_px) - q.x_px)
                     })
                     .collect();
                 // Raw (rolling-shutter) errors of the raw line at the foot and top of the front
@@ -109,7 +109,7 @@ pub fn debug_posts() {
                         let err = |z: f64| {
                             let q = rolling_image(&scenario, t, &Point::new(*x, *y, z))?;
                             Some(
-                                ((line_x(post.top, post.bottom, q.1) - q.0) * 100.0).round()
+                                ((line_x(post.top, post.bottom, q.y_px) - q.x_px) * 100.0).round()
                                     / 100.0,
                             )
                         };
@@ -129,7 +129,7 @@ pub fn debug_posts() {
                 // What `eotn eval` scores: the reference line against the true foot and top.
                 let ends = {
                     let (b, top) = (tp.image_base.expect("b"), tp.image_top.expect("t"));
-                    let at = |q: eotn::geometry::ImagePoint| {
+                    let at = |q: ImagePoint| {
                         ((line_x(post.reference_top, post.reference_bottom, q.y_px) - q.x_px)
                             * 100.0)
                             .round()
@@ -154,13 +154,13 @@ pub fn debug_posts() {
                         },
                     };
                     let m = pose.image_from_field(&fc)?;
-                    let lin = ctx.unskew((q.0, q.1), false);
-                    let body = ctx.unskew_at((q.0, q.1), g.camera.distance_cm, true);
+                    let lin = ctx.unskew(q, false);
+                    let body = ctx.unskew_at(q, g.camera.distance_cm, true);
                     Some((
-                        ((m.x_px - q.0) * 100.0).round() / 100.0,
-                        ((lin.0 - q.0) * 100.0).round() / 100.0,
-                        ((body.0 - q.0) * 100.0).round() / 100.0,
-                        q.1.round(),
+                        ((m.x_px - q.x_px) * 100.0).round() / 100.0,
+                        ((lin.x_px - q.x_px) * 100.0).round() / 100.0,
+                        ((body.x_px - q.x_px) * 100.0).round() / 100.0,
+                        q.y_px.round(),
                     ))
                 });
                 eprintln!("    skew at post (true, linear, body model, row) {skew:?}");
@@ -185,7 +185,7 @@ pub fn debug_posts() {
                     r1(errs[2]),
                     reference,
                     ends,
-                    post.bottom.0 - post.top.0,
+                    post.bottom.x_px - post.top.x_px,
                 );
             }
         }
@@ -199,7 +199,6 @@ pub fn debug_posts() {
 /// (rolling-shutter image at the goal's mid-height) and of the detected post.
 pub fn debug_post_profiles() {
     use eotn::lut::ColourClass;
-    use eotn::recognition::fit::rotate_about;
     let name = std::env::var("EOTN_DEBUG_SCENARIO").unwrap_or_else(|_| "beacon-tour".into());
     let kind = ScenarioKind::from_name(&name).expect("scenario name");
     let frames: Vec<u64> = std::env::var("EOTN_DEBUG_FRAMES")
@@ -221,7 +220,7 @@ pub fn debug_post_profiles() {
         let ctx = PipelineParams::default()
             .recognition
             .context_for(208, 160, f.sensors.as_ref());
-        let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+        let centre = ctx.camera.centre;
         let angle = ctx.horizon_angle();
         let r = pipeline.process(&f.frame, f.sensors.as_ref());
         let img = r.classified;
@@ -240,7 +239,7 @@ pub fn debug_post_profiles() {
             let x1 = s * (field.length_cm / 2.0 + field.goal_depth_cm);
             let z = field.goal_height_cm / 2.0;
             let level_of = |p: &Point<eotn::geometry::Field>| {
-                rolling_image(&scenario, t, p).map(|q| rotate_about(q, centre, angle).0)
+                rolling_image(&scenario, t, p).map(|q| q.rotated_about(centre, angle).x_px)
             };
             let mut marks = Vec::new();
             for side in [1.0, -1.0] {
@@ -250,11 +249,8 @@ pub fn debug_post_profiles() {
                 marks.push(("back-outer", level_of(&Point::new(x1, outer, z))));
             }
             for post in &g.posts {
-                let m = (
-                    (post.top.0 + post.bottom.0) / 2.0,
-                    (post.top.1 + post.bottom.1) / 2.0,
-                );
-                marks.push(("detected", Some(rotate_about(m, centre, angle).0)));
+                let m = post.top.midpoint(post.bottom);
+                marks.push(("detected", Some(m.rotated_about(centre, angle).x_px)));
             }
             for (label, x) in &marks {
                 eprintln!("    {label} {x:.2?}");
@@ -269,9 +265,10 @@ pub fn debug_post_profiles() {
                 for y in (e[1].floor() as i64 - 2)..=(e[3].ceil() as i64 + 2) {
                     let row: String = (a..b)
                         .map(|x| {
-                            let q = rotate_about((x as f64 + 0.5, y as f64 + 0.5), centre, -angle);
+                            let q = ImagePoint::new(x as f64 + 0.5, y as f64 + 0.5)
+                                .rotated_about(centre, -angle);
                             match img
-                                .get_signed(q.0.floor() as i64, q.1.floor() as i64)
+                                .get_signed(q.x_px.floor() as i64, q.y_px.floor() as i64)
                                 .and_then(ColourClass::from_code)
                             {
                                 Some(c) if c == g.colour => 'Y',

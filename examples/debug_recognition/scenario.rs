@@ -112,7 +112,7 @@ pub fn debug_scenario() {
                 g.bounds,
                 g.gap
                     .as_ref()
-                    .map(|g| (g.left.0.round(), g.right.0.round())),
+                    .map(|g| (g.left.x_px.round(), g.right.x_px.round())),
                 g.camera.distance_cm,
                 t.map(|t| (t.relative.camera_distance_cm.round(), t.visible_pixels)),
                 g.posts
@@ -144,8 +144,8 @@ fn print_ball_detail(r: &eotn::pipeline::FrameResult<'_>) {
             c.orange_pixels,
             c.cut_off,
             c.pattern,
-            c.center.0,
-            c.center.1,
+            c.center.x_px,
+            c.center.y_px,
             c.radius_px,
             c.fit,
             c.fit_rejected
@@ -163,10 +163,13 @@ fn print_ball_detail(r: &eotn::pipeline::FrameResult<'_>) {
             "      edge points {:?}",
             c.edge_points
                 .iter()
-                .map(|p| ((p.0 * 10.0).round() / 10.0, (p.1 * 10.0).round() / 10.0))
+                .map(|p| (
+                    (p.x_px * 10.0).round() / 10.0,
+                    (p.y_px * 10.0).round() / 10.0
+                ))
                 .collect::<Vec<_>>()
         );
-        let [x0, y0, x1, y1] = c.bounds;
+        let [x0, y0, x1, y1] = c.bounds.to_array();
         for y in y0.saturating_sub(3)..=(y1 + 3).min(img.height() as u32 - 1) {
             let row: String = (x0.saturating_sub(4)..=(x1 + 4).min(img.width() as u32 - 1))
                 .map(|x| {
@@ -235,7 +238,7 @@ pub fn ball_distance_bias() {
                 }
                 let cand = &r.recognition.ball.candidates[ball.candidate];
                 let img = tb.relative.image.expect("matched ball projects");
-                let [x0, y0, x1, y1] = cand.bounds;
+                let [x0, y0, x1, y1] = cand.bounds.to_array();
                 let (tw, th) = tb.image_box.map_or((0, 0), |bx| {
                     (bx.max_x + 1 - bx.min_x, bx.max_y + 1 - bx.min_y)
                 });

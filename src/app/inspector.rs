@@ -249,14 +249,14 @@ fn ball_candidates(r: &Recognition, image_size: (usize, usize)) -> Vec<Candidate
             (None, None) => {}
         }
         let (seen, fixed) = (c.observed_center, c.center);
-        notes.push(if (seen.0 - fixed.0).hypot(seen.1 - fixed.1) > 0.5 {
+        notes.push(if seen.distance_to(&fixed) > 0.5 {
             format!(
                 "centre ({:.1}, {:.1}) px in the image; ({:.1}, {:.1}) px skew-corrected \
                      (dashed circle)",
-                seen.0, seen.1, fixed.0, fixed.1
+                seen.x_px, seen.y_px, fixed.x_px, fixed.y_px
             )
         } else {
-            format!("centre ({:.1}, {:.1}) px", fixed.0, fixed.1)
+            format!("centre ({:.1}, {:.1}) px", fixed.x_px, fixed.y_px)
         });
         // The accepted ball may carry a fused (ground-plane) placement.
         let (camera, body) = match &r.ball.ball {
@@ -272,7 +272,7 @@ fn ball_candidates(r: &Recognition, image_size: (usize, usize)) -> Vec<Candidate
             camera,
             body,
             distance_is_max: false,
-            cut_sides: sides(c.cut_off, c.bounds.into(), image_size),
+            cut_sides: sides(c.cut_off, c.bounds, image_size),
             notes,
             pattern: None,
         });

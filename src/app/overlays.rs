@@ -8,6 +8,7 @@ use egui::{
 };
 
 use crate::blobs::Blob;
+use crate::frame::ImagePoint;
 use crate::recognition::{CircleRole, ObjectId, Primitive};
 use crate::workspace::{PrimitiveFilter, ViewKind, Workspace, box_colour};
 
@@ -259,7 +260,7 @@ pub fn paint_primitives(
     filter: &PrimitiveFilter<'_>,
     selected: Option<ObjectId>,
 ) {
-    let at = |p: (f64, f64)| xf.to_screen(pos2(p.0 as f32, p.1 as f32));
+    let at = |p: ImagePoint| xf.to_screen(pos2(p.x_px as f32, p.y_px as f32));
     // Edge points: a dot about a pixel wide, never smaller than 1.5 points.
     let dot = (xf.zoom * 0.5).clamp(1.5, 4.0);
     let clip = painter.clip_rect().expand(8.0);

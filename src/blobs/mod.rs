@@ -19,7 +19,7 @@ mod avx2;
 use serde::{Deserialize, Serialize};
 
 use crate::classify::ClassifiedImage;
-use crate::frame::PixelBox;
+use crate::frame::{ImagePoint, PixelBox};
 use crate::lut::ColourClass;
 
 /// Which neighbours join a blob.
@@ -145,10 +145,10 @@ impl Blob {
         (self.sum_x as f64 / n + 0.5, self.sum_y as f64 / n + 0.5)
     }
 
-    /// Box centre in image coordinates.
+    /// Box centre in image coordinates, pixels.
     #[must_use]
-    pub fn box_centre(&self) -> (f64, f64) {
-        (
+    pub fn box_centre(&self) -> ImagePoint {
+        ImagePoint::new(
             f64::from(self.minx + self.maxx + 1) / 2.0,
             f64::from(self.miny + self.maxy + 1) / 2.0,
         )
@@ -675,7 +675,7 @@ mod tests {
     fn centroid_uses_pixel_centres() {
         let set = BlobSet::from_image(&img(&["11", "11"]), Connectivity::Eight);
         assert_eq!(set.all()[0].centroid(), (1.0, 1.0));
-        assert_eq!(set.all()[0].box_centre(), (1.0, 1.0));
+        assert_eq!(set.all()[0].box_centre(), ImagePoint::new(1.0, 1.0));
     }
 
     #[test]

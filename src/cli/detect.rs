@@ -293,14 +293,14 @@ fn goal_json(g: &GoalCandidate) -> GoalJson {
                     crate::recognition::goals::PostSide::Left => "left",
                     crate::recognition::goals::PostSide::Right => "right",
                 },
-                top: [p.top.0, p.top.1],
-                bottom: [p.bottom.0, p.bottom.1],
+                top: [p.top.x_px, p.top.y_px],
+                bottom: [p.bottom.x_px, p.bottom.y_px],
                 bearing_rad: p.camera.bearing_rad,
             })
             .collect(),
         gap: g.gap.as_ref().map(|gap| GapJson {
-            left: [gap.left.0, gap.left.1],
-            right: [gap.right.0, gap.right.1],
+            left: [gap.left.x_px, gap.left.y_px],
+            right: [gap.right.x_px, gap.right.y_px],
             width_px: gap.width_px,
             bearing_rad: gap.camera.bearing_rad,
         }),

@@ -97,12 +97,11 @@ pub fn run(
         let result = pipeline.process(&record.frame, sensors);
         let r = &result.recognition;
         for g in r.goals.goals() {
-            let bottom = (
+            let bottom = crate::geometry::ImagePoint::new(
                 (g.level_extent[0] + g.level_extent[2]) / 2.0,
                 g.level_extent[3],
             );
-            let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
-            let foot = crate::recognition::fit::rotate_about(bottom, centre, -ctx.horizon_angle());
+            let foot = bottom.rotated_about(ctx.camera.centre, -ctx.horizon_angle());
             goal_distances.push(GoalDistances {
                 frame: i,
                 distance_cm: g.camera.distance_cm,

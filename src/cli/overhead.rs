@@ -288,11 +288,7 @@ fn write_lines_png(
             .context("frame size")?;
     for curve in projected_field_lines(field, camera) {
         for pair in curve.windows(2) {
-            canvas.line(
-                (pair[0].x_px, pair[0].y_px),
-                (pair[1].x_px, pair[1].y_px),
-                [255, 40, 200],
-            );
+            canvas.line(pair[0], pair[1], [255, 40, 200]);
         }
     }
     crate::frame::save_rgb_png(path, canvas.width, canvas.height, &canvas.rgb)?;

@@ -332,7 +332,7 @@ pub fn evaluate_labelled_frame(
             fraction >= p.ball_min_visible_fraction && 2.0 * b.radius_px >= p.ball_min_diameter_px;
         if let Some(found) = reported {
             let seen = found.observed_center;
-            let off = (seen.0 - b.center[0]).hypot(seen.1 - b.center[1]);
+            let off = (seen.x_px - b.center[0]).hypot(seen.y_px - b.center[1]);
             let share = if e.ball_cut {
                 1.0
             } else {
@@ -505,7 +505,7 @@ mod tests {
                     candidate: 0,
                     center_x: center.0 + 30.0,
                     center_y: center.1,
-                    observed_center: center,
+                    observed_center: crate::geometry::ImagePoint::new(center.0, center.1),
                     radius_px: radius,
                     camera,
                     body: None,

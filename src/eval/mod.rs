@@ -269,8 +269,8 @@ fn score_goal(
         // Scored against the largest open stretch, or against the second when that is as
         // wide within the tie tolerance and nearer (either is "the largest").
         let error = |t: &GoalGap| {
-            let left = (gap.left.0 - t.from_x_px as f64).abs();
-            let right = (gap.right.0 - (t.to_x_px as f64 + 1.0)).abs();
+            let left = (gap.left.x_px - t.from_x_px as f64).abs();
+            let right = (gap.right.x_px - (t.to_x_px as f64 + 1.0)).abs();
             left.max(right)
         };
         let width = |t: &GoalGap| (t.to_x_px - t.from_x_px) as f64;
@@ -296,10 +296,10 @@ fn post_error_px(post: &Post, tg: &GoalTruth, width: f64, height: f64) -> f64 {
             // (the line through its skew-corrected ends).
             let (a, b) = (post.reference_top, post.reference_bottom);
             let at = |y: f64| {
-                if (b.1 - a.1).abs() > 1e-9 {
-                    a.0 + (b.0 - a.0) * (y - a.1) / (b.1 - a.1)
+                if (b.y_px - a.y_px).abs() > 1e-9 {
+                    a.x_px + (b.x_px - a.x_px) * (y - a.y_px) / (b.y_px - a.y_px)
                 } else {
-                    a.0
+                    a.x_px
                 }
             };
             let error = (at(base.y_px) - base.x_px)

@@ -10,6 +10,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 use super::FrameEval;
+use crate::frame::ImagePoint;
 use crate::overlay::{Canvas, FONT_CELL_PX, text_size_px};
 
 /// Chart size, pixels.
@@ -141,8 +142,10 @@ impl Chart {
         let mut v = (x.0 / xs).ceil() * xs;
         while v <= x.1 + 1e-9 {
             let (px, _) = c.to_px(v, y.0);
-            c.canvas.line((px, t), (px, b), LIGHT);
-            c.canvas.line((px, b), (px, b + 5.0), BLACK);
+            c.canvas
+                .line(ImagePoint::new(px, t), ImagePoint::new(px, b), LIGHT);
+            c.canvas
+                .line(ImagePoint::new(px, b), ImagePoint::new(px, b + 5.0), BLACK);
             let s = tick_label(v, xs);
             c.text(&s, px - text_width(&s) / 2.0, b + 9.0, BLACK);
             v += xs;
@@ -151,14 +154,18 @@ impl Chart {
         let mut v = (y.0 / ys).ceil() * ys;
         while v <= y.1 + 1e-9 {
             let (_, py) = c.to_px(x.0, v);
-            c.canvas.line((l, py), (r, py), LIGHT);
-            c.canvas.line((l - 5.0, py), (l, py), BLACK);
+            c.canvas
+                .line(ImagePoint::new(l, py), ImagePoint::new(r, py), LIGHT);
+            c.canvas
+                .line(ImagePoint::new(l - 5.0, py), ImagePoint::new(l, py), BLACK);
             let s = tick_label(v, ys);
             c.text(&s, l - 8.0 - text_width(&s), py - TEXT_HALF_HEIGHT, BLACK);
             v += ys;
         }
-        c.canvas.line((l, t), (l, b), BLACK);
-        c.canvas.line((l, b), (r, b), BLACK);
+        c.canvas
+            .line(ImagePoint::new(l, t), ImagePoint::new(l, b), BLACK);
+        c.canvas
+            .line(ImagePoint::new(l, b), ImagePoint::new(r, b), BLACK);
         c
     }
 
@@ -220,8 +227,10 @@ impl Chart {
         for w in pts.windows(2) {
             let (a, b) = (self.to_px(w[0].0, w[0].1), self.to_px(w[1].0, w[1].1));
             if self.inside(a) && self.inside(b) {
+                let (a, b) = (ImagePoint::new(a.0, a.1), ImagePoint::new(b.0, b.1));
                 self.canvas.line(a, b, c);
-                self.canvas.line((a.0, a.1 + 1.0), (b.0, b.1 + 1.0), c);
+                let down = ImagePoint::new(0.0, 1.0);
+                self.canvas.line(a + down, b + down, c);
             }
         }
     }
@@ -328,7 +337,11 @@ fn histogram_chart(title: &str, x_label: &str, values: &[f64], colour: [u8; 3]) 
     let (_, zero_y1) = c.to_px(0.0, top);
     let (zx, _) = c.to_px(0.0, 0.0);
     if lo < 0.0 && hi > 0.0 {
-        c.canvas.line((zx, zero_y0), (zx, zero_y1), RED);
+        c.canvas.line(
+            ImagePoint::new(zx, zero_y0),
+            ImagePoint::new(zx, zero_y1),
+            RED,
+        );
     }
     c
 }

@@ -18,7 +18,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::Percentiles;
-use crate::geometry::{Camera, Field, PinholeCamera, Point, Transform};
+use crate::geometry::{Camera, Field, ImagePoint, PinholeCamera, Point, Transform};
 use crate::recognition::Recognition;
 use crate::recognition::fit::fit_circle;
 use crate::recognition::scan::EdgeScanPattern;
@@ -30,8 +30,9 @@ const BALL_RADIUS_CM: f64 = 4.25;
 /// A circle in image pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct OutlineCircle {
-    /// Centre (x, y), pixels.
-    pub center: (f64, f64),
+    /// Centre, pixels.
+    #[serde(with = "crate::frame::xy_array")]
+    pub center: ImagePoint,
     /// Radius, pixels.
     pub radius_px: f64,
 }
@@ -67,13 +68,11 @@ pub fn outline_circle(
         axis.cross(&nalgebra::Vector3::x()).normalize()
     };
     let v = axis.cross(&u);
-    let outline: Vec<(f64, f64)> = (0..720)
+    let outline: Vec<ImagePoint> = (0..720)
         .map(|k| {
             let a = f64::from(k) * std::f64::consts::TAU / 720.0;
             let p = centre + radius * (a.cos() * u + a.sin() * v);
-            camera
-                .project(&Point::<Camera>::new(p.x, p.y, p.z))
-                .map(|q| (q.x_px, q.y_px))
+            camera.project(&Point::<Camera>::new(p.x, p.y, p.z))
         })
         .collect::<Option<Vec<_>>>()?;
     let (w, h) = (camera.width_px as f64, camera.height_px as f64);
@@ -96,8 +95,12 @@ pub fn outline_circle(
             continue;
         };
         for (take, t) in [(take_lo, lo), (take_hi, hi)] {
-            let p = if rows { (t, at) } else { (at, t) };
-            if take && p.0 > 0.0 && p.0 < w && p.1 > 0.0 && p.1 < h {
+            let p = if rows {
+                ImagePoint::new(t, at)
+            } else {
+                ImagePoint::new(at, t)
+            };
+            if take && p.x_px > 0.0 && p.x_px < w && p.y_px > 0.0 && p.y_px < h {
                 points.push(p);
             }
         }
@@ -107,21 +110,21 @@ pub fn outline_circle(
     }
     let f = fit_circle(&points)?;
     Some(OutlineCircle {
-        center: (f.center_x, f.center_y),
+        center: f.center(),
         radius_px: f.radius,
     })
 }
 
 /// The first and last crossing of the closed polygon `outline` with the row `y = at` (`rows`)
 /// or the column `x = at`, as the coordinate along that line.
-fn crossings(outline: &[(f64, f64)], at: f64, rows: bool) -> Option<(f64, f64)> {
+fn crossings(outline: &[ImagePoint], at: f64, rows: bool) -> Option<(f64, f64)> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for (i, a) in outline.iter().enumerate() {
         let b = outline[(i + 1) % outline.len()];
         let (a0, a1, b0, b1) = if rows {
-            (a.1, a.0, b.1, b.0)
+            (a.y_px, a.x_px, b.y_px, b.x_px)
         } else {
-            (a.0, a.1, b.0, b.1)
+            (a.x_px, a.y_px, b.x_px, b.y_px)
         };
         if (a0 - at) * (b0 - at) <= 0.0 && (a0 - b0).abs() > 1e-12 {
             let t = a1 + (b1 - a1) * (at - a0) / (b0 - a0);
@@ -165,11 +168,11 @@ pub fn compare_ball(
     let tb = truth.ball.as_ref()?;
     let tbox = tb.image_box?;
     let true_centre = tb.relative.image?;
-    let on_ball = |p: (f64, f64)| {
-        p.0 >= tbox.min_x as f64 - tolerance_px
-            && p.0 <= tbox.max_x as f64 + 1.0 + tolerance_px
-            && p.1 >= tbox.min_y as f64 - tolerance_px
-            && p.1 <= tbox.max_y as f64 + 1.0 + tolerance_px
+    let on_ball = |p: ImagePoint| {
+        p.x_px >= tbox.min_x as f64 - tolerance_px
+            && p.x_px <= tbox.max_x as f64 + 1.0 + tolerance_px
+            && p.y_px >= tbox.min_y as f64 - tolerance_px
+            && p.y_px <= tbox.max_y as f64 + 1.0 + tolerance_px
     };
     let errors = |r: &Recognition| {
         let ball = r.ball.ball.as_ref()?;
@@ -323,8 +326,8 @@ mod tests {
                 (c.radius_px - expected).abs() < 0.05,
                 "{p:?}: {c:?} vs {expected}"
             );
-            assert!((c.center.0 - camera.centre.x_px).abs() < 0.05);
-            assert!((c.center.1 - camera.centre.y_px).abs() < 0.05);
+            assert!((c.center.x_px - camera.centre.x_px).abs() < 0.05);
+            assert!((c.center.y_px - camera.centre.y_px).abs() < 0.05);
         }
     }
 
@@ -339,7 +342,7 @@ mod tests {
             .sphere_radius_px(BALL_RADIUS_CM, 50.0_f64.hypot(25.0))
             .expect("in front");
         assert!(whole.radius_px > on_axis * 1.02, "{whole:?} vs {on_axis}");
-        assert!(whole.center.0 < camera.centre.x_px - 50.0);
+        assert!(whole.center.x_px < camera.centre.x_px - 50.0);
         assert!((inner.radius_px - whole.radius_px).abs() > 0.05);
     }
 

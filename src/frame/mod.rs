@@ -7,10 +7,15 @@
 //!
 //! Display conversion to RGB uses the exact integer BT.601 formula of `FORMATS.md`
 //! ([`yuv_to_rgb`]); loading PNG/JPEG goes the other way with [`rgb_to_yuv`].
+//!
+//! Positions in a frame are [`ImagePoint`]s (pixels, sub-pixel) and [`PixelBox`]es (whole
+//! pixels), shared by every later stage.
 
+mod image_point;
 mod io;
 mod pixel_box;
 
+pub use image_point::{ImagePoint, xy_array};
 pub use io::{
     FrameFileError, MAX_FRAME_PIXELS, display_name, infer_uyvy_size, is_image_file, load_frame,
     load_raw_uyvy, save_rgb_png,

@@ -16,36 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use super::horizon::Horizon;
 use super::{Camera, Field, Point, Transform, Vector};
-
-/// A position in an image, pixels, `FORMATS.md` convention (x right, y down, pixel centres at
-/// i + 0.5).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct ImagePoint {
-    /// Column, pixels from the left edge.
-    pub x_px: f64,
-    /// Row, pixels from the top edge.
-    pub y_px: f64,
-}
-
-impl ImagePoint {
-    /// A point from its column and row, pixels.
-    #[must_use]
-    pub const fn new(x_px: f64, y_px: f64) -> Self {
-        Self { x_px, y_px }
-    }
-
-    /// The centre of pixel (i, j): (i + 0.5, j + 0.5).
-    #[must_use]
-    pub fn pixel_centre(i: usize, j: usize) -> Self {
-        Self::new(i as f64 + 0.5, j as f64 + 0.5)
-    }
-
-    /// Euclidean distance to another image point, pixels.
-    #[must_use]
-    pub fn distance_to(&self, other: &Self) -> f64 {
-        (self.x_px - other.x_px).hypot(self.y_px - other.y_px)
-    }
-}
+pub use crate::frame::ImagePoint;
 
 /// Horizontal field of view of the ERS-7 head camera, degrees.
 pub const ERS7_HORIZONTAL_FOV_DEG: f64 = 56.9;

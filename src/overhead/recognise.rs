@@ -246,7 +246,7 @@ const DOT_MIN_FILL: f64 = 0.5;
 
 /// Outline points of a blob: the outermost run ends of each row (holes inside a speckled blob
 /// are no outline).
-fn outline_points(blobs: &BlobSet, blob: &Blob) -> Vec<(f64, f64)> {
+fn outline_points(blobs: &BlobSet, blob: &Blob) -> Vec<ImagePoint> {
     let mut rows: Vec<(u16, u16, u16)> = Vec::new();
     for run in blobs.runs_of(blob.number) {
         match rows.iter_mut().find(|r| r.0 == run.y) {
@@ -260,7 +260,10 @@ fn outline_points(blobs: &BlobSet, blob: &Blob) -> Vec<(f64, f64)> {
     rows.iter()
         .flat_map(|&(y, x0, x1)| {
             let y = f64::from(y) + 0.5;
-            [(f64::from(x0), y), (f64::from(x1), y)]
+            [
+                ImagePoint::new(f64::from(x0), y),
+                ImagePoint::new(f64::from(x1), y),
+            ]
         })
         .collect()
 }
@@ -291,7 +294,7 @@ fn find_ball(
                 if (fit.radius - expected_r).abs() < 0.5 * expected_r
                     && (fit.center_x - cx).hypot(fit.center_y - cy) < expected_r =>
             {
-                (ImagePoint::new(fit.center_x, fit.center_y), fit.radius)
+                (fit.center(), fit.radius)
             }
             _ => (
                 ImagePoint::new(cx, cy),

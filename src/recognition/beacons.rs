@@ -7,9 +7,8 @@ use serde::{Deserialize, Serialize};
 use super::confidence::{Confidence, TestName, TestWeight};
 use super::context::{Relative, ViewContext};
 use super::draw::{ObjectId, Primitive};
-use super::fit::rotate_about;
 use crate::blobs::{Blob, BlobSet};
-use crate::frame::PixelBox;
+use crate::frame::{ImagePoint, PixelBox};
 use crate::lut::ColourClass;
 
 /// Settings of beacon recognition.
@@ -98,13 +97,13 @@ pub struct Beacon {
 #[must_use]
 pub fn recognise_beacons(blobs: &BlobSet, ctx: &ViewContext, p: &BeaconParams) -> Vec<Beacon> {
     let height = ctx.camera.height_px as u32;
-    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let centre = ctx.camera.centre;
     let angle = ctx.horizon_angle();
     let level = |b: &Blob| {
-        let (x, y) = rotate_about(b.box_centre(), centre, angle);
+        let c = b.box_centre().rotated_about(centre, angle);
         (
-            x,
-            y,
+            c.x_px,
+            c.y_px,
             f64::from(b.maxx - b.minx + 1),
             f64::from(b.maxy - b.miny + 1),
         )
@@ -210,7 +209,7 @@ pub fn beacon_primitives(beacons: &[Beacon]) -> Vec<Primitive> {
         if b.accepted {
             out.push(Primitive::Label {
                 owner,
-                at: (f64::from(b.bounds.min_x), f64::from(b.bounds.min_y) - 2.0),
+                at: ImagePoint::new(f64::from(b.bounds.min_x), f64::from(b.bounds.min_y) - 2.0),
                 text: format!("{} {:.0} cm", b.kind.name(), b.camera.distance_cm),
             });
         }

@@ -5,7 +5,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::fit::Point;
 use crate::geometry::{
     Body, BodyPose, Camera, CameraPose, Ers7Dimensions, Field, HeadJoints, Horizon, ImagePoint,
     PinholeCamera, Point as GeoPoint, RobotPose, Transform, camera_pose_from_readings, rotation_y,
@@ -335,21 +334,21 @@ impl ViewContext {
     /// version is wrong by the tangent's growth (13× for a point at the image centre with the
     /// head panned 1.3 rad).
     #[must_use]
-    pub fn unskew(&self, p: Point, vertical: bool) -> Point {
+    pub fn unskew(&self, p: ImagePoint, vertical: bool) -> ImagePoint {
         let (c, d) = (self.camera.centre, self.camera.focal_px);
-        let readouts = p.1 / self.camera.height_px.max(1) as f64 - 0.5;
+        let readouts = p.y_px / self.camera.height_px.max(1) as f64 - 0.5;
         // x = cx − d·tan(angle left of the axis); y = cy − d·tan(angle above it).
         let turn = |pos: f64, centre: f64, delta: f64| {
             let moved = centre - d * (((centre - pos) / d).atan() + delta).tan();
             if moved.is_finite() { moved } else { pos }
         };
-        let x = turn(p.0, c.x_px, self.pan_per_readout_rad * readouts);
+        let x = turn(p.x_px, c.x_px, self.pan_per_readout_rad * readouts);
         let y = if vertical {
-            turn(p.1, c.y_px, self.tilt_per_readout_rad * readouts)
+            turn(p.y_px, c.y_px, self.tilt_per_readout_rad * readouts)
         } else {
-            p.1
+            p.y_px
         };
-        (x, y)
+        ImagePoint::new(x, y)
     }
 
     /// Moves an image point to where it would have been seen at the reference row's read-out
@@ -361,19 +360,19 @@ impl ViewContext {
     /// tilt's motion. Without the motion (or when the point does not project back), falls back
     /// to [`Self::unskew`].
     #[must_use]
-    pub fn unskew_at(&self, p: Point, distance_cm: f64, with_tilt: bool) -> Point {
+    pub fn unskew_at(&self, p: ImagePoint, distance_cm: f64, with_tilt: bool) -> ImagePoint {
         let (Some(motion), Some(pose)) = (self.motion, self.pose) else {
             return self.unskew(p, with_tilt);
         };
         let lines = self.camera.height_px.max(1) as f64;
-        let readouts = p.1 / lines - 0.5;
+        let readouts = p.y_px / lines - 0.5;
         if !(readouts.is_finite() && distance_cm.is_finite() && distance_cm > 0.0) {
             return self.unskew(p, with_tilt);
         }
         let then = motion.pose_at(self.camera, readouts, with_tilt);
         let field = then.field_from_camera * self.camera_point(p, distance_cm);
         match pose.image_from_field(&field) {
-            Some(q) if q.x_px.is_finite() && q.y_px.is_finite() => (q.x_px, q.y_px),
+            Some(q) if q.is_finite() => q,
             _ => self.unskew(p, with_tilt),
         }
     }
@@ -387,28 +386,27 @@ impl ViewContext {
 
     /// Camera-relative bearing and elevation of an image point, radians.
     #[must_use]
-    pub fn camera_angles(&self, p: Point) -> (f64, f64) {
-        let ip = ImagePoint::new(p.0, p.1);
-        (self.camera.bearing_rad(ip), self.camera.elevation_rad(ip))
+    pub fn camera_angles(&self, p: ImagePoint) -> (f64, f64) {
+        (self.camera.bearing_rad(p), self.camera.elevation_rad(p))
     }
 
     /// The point `distance_cm` along the ray through `p`, camera frame.
-    fn camera_point(&self, p: Point, distance_cm: f64) -> GeoPoint<Camera> {
-        let ray = self.camera.unit_ray(ImagePoint::new(p.0, p.1)).coords * distance_cm;
+    fn camera_point(&self, p: ImagePoint, distance_cm: f64) -> GeoPoint<Camera> {
+        let ray = self.camera.unit_ray(p).coords * distance_cm;
         GeoPoint::new(ray.x, ray.y, ray.z)
     }
 
     /// Camera-relative distance, bearing and elevation of something at `distance_cm` along the ray
     /// through image point `p`.
     #[must_use]
-    pub fn camera_relative(&self, p: Point, distance_cm: f64) -> Relative {
+    pub fn camera_relative(&self, p: ImagePoint, distance_cm: f64) -> Relative {
         let c = self.camera_point(p, distance_cm);
         Relative::of_point(c.x(), c.y(), c.z())
     }
 
     /// Body-relative distance, bearing and elevation (from the body centre), when the pose is known.
     #[must_use]
-    pub fn body_relative(&self, p: Point, distance_cm: f64) -> Option<Relative> {
+    pub fn body_relative(&self, p: ImagePoint, distance_cm: f64) -> Option<Relative> {
         let b = self.body_from_camera? * self.camera_point(p, distance_cm);
         Some(Relative::of_point(b.x(), b.y(), b.z()))
     }
@@ -416,7 +414,7 @@ impl ViewContext {
     /// Height above the ground of the point `distance_cm` along the ray through `p`,
     /// centimetres, when the pose is known.
     #[must_use]
-    pub fn height_above_ground(&self, p: Point, distance_cm: f64) -> Option<f64> {
+    pub fn height_above_ground(&self, p: ImagePoint, distance_cm: f64) -> Option<f64> {
         let pose = self.pose?;
         let g = pose.field_from_camera * self.camera_point(p, distance_cm);
         Some(g.z())
@@ -425,9 +423,9 @@ impl ViewContext {
     /// Straight-line distance (cm) from the camera to where the ray through `p` meets the plane at
     /// `z_cm`, when the pose is known and the ray goes there.
     #[must_use]
-    pub fn distance_to_plane(&self, p: Point, z_cm: f64) -> Option<f64> {
+    pub fn distance_to_plane(&self, p: ImagePoint, z_cm: f64) -> Option<f64> {
         let pose = self.pose?;
-        let hit = pose.point_on_plane(ImagePoint::new(p.0, p.1), z_cm)?;
+        let hit = pose.point_on_plane(p, z_cm)?;
         Some(hit.distance_to(&pose.position()))
     }
 }
@@ -467,9 +465,9 @@ mod tests {
         let (cx, d) = (camera.centre.x_px, camera.focal_px);
         let row: f64 = 150.0;
         let seen = cx - d * (-0.1 * (row / 160.0 - 0.5)).tan();
-        let (x, y) = ctx.unskew((seen, row), false);
-        assert_relative_eq!(x, cx, epsilon = 1e-9);
-        assert_relative_eq!(y, row);
+        let moved = ctx.unskew(ImagePoint::new(seen, row), false);
+        assert_relative_eq!(moved.x_px, cx, epsilon = 1e-9);
+        assert_relative_eq!(moved.y_px, row);
         // The formula with the head's pan angle shifts that row ten times too far.
         let by_head_pan = ctx.skew_x_per_line * (row - ctx.reference_row());
         assert!(
@@ -487,11 +485,11 @@ mod tests {
             },
             &Ers7Dimensions::ERS7,
         );
-        let p = (cx, 10.0);
-        let shift = p.0 - level.unskew(p, false).0;
+        let p = ImagePoint::new(cx, 10.0);
+        let shift = p.x_px - level.unskew(p, false).x_px;
         assert_relative_eq!(
             shift,
-            level.skew_x_per_line * (p.1 - level.reference_row()),
+            level.skew_x_per_line * (p.y_px - level.reference_row()),
             max_relative = 1e-3
         );
     }
@@ -522,9 +520,9 @@ mod tests {
             epsilon = 1e-12
         );
         // The same point moved to the reference time lands in the same place.
-        let p = (30.0, 10.0);
+        let p = ImagePoint::new(30.0, 10.0);
         let (u, v) = (fast.unskew_at(p, 80.0, true), slow.unskew_at(p, 80.0, true));
-        assert!((u.0 - v.0).hypot(u.1 - v.1) < 0.01, "{u:?} vs {v:?}");
+        assert!(u.distance_to(&v) < 0.01, "{u:?} vs {v:?}");
         // A longer read-out time skews proportionally more.
         let longer = ViewContext::from_sensors_with_readout(
             camera,
@@ -596,7 +594,7 @@ mod tests {
             epsilon = 1e-6
         );
         // Heights: a point on the ground below the centre has height 0.
-        let centre = (160.0, 120.0);
+        let centre = ImagePoint::new(160.0, 120.0);
         let along = ctx.distance_to_plane(centre, 0.0).expect("looks down");
         assert_relative_eq!(along, 48.5 / 0.23_f64.sin(), max_relative = 1e-9);
         assert!(ctx.height_above_ground(centre, along).expect("pose").abs() < 1e-6);

@@ -5,8 +5,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::fit::Point;
-use crate::frame::PixelBox;
+use crate::frame::{PixelBox, xy_array};
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 
 /// The object a primitive belongs to: what the app selects, the inspector lists and the
@@ -76,21 +76,24 @@ pub enum Primitive {
         /// Which object this belongs to.
         owner: ObjectId,
         /// Corners in order, pixels.
-        corners: [Point; 4],
+        #[serde(with = "xy_array")]
+        corners: [ImagePoint; 4],
     },
     /// Points found by edge scans.
     ScanPoints {
         /// Which object this belongs to.
         owner: ObjectId,
         /// The points, pixels.
-        points: Vec<Point>,
+        #[serde(with = "xy_array")]
+        points: Vec<ImagePoint>,
     },
     /// A fitted circle.
     Circle {
         /// Which object this belongs to.
         owner: ObjectId,
         /// Centre, pixels.
-        center: Point,
+        #[serde(with = "xy_array")]
+        center: ImagePoint,
         /// Radius, pixels.
         radius: f64,
         /// Where the circle is: on the ball as the image shows it (drawn solid), or moved to
@@ -105,9 +108,11 @@ pub enum Primitive {
         /// What the line is.
         role: LineRole,
         /// Start, pixels.
-        from: Point,
+        #[serde(with = "xy_array")]
+        from: ImagePoint,
         /// End, pixels.
-        to: Point,
+        #[serde(with = "xy_array")]
+        to: ImagePoint,
     },
     /// One of the nine regions of a coloured pattern around a pink marker.
     PatternRegion {
@@ -125,7 +130,8 @@ pub enum Primitive {
         /// Which object this belongs to.
         owner: ObjectId,
         /// Where, pixels.
-        at: Point,
+        #[serde(with = "xy_array")]
+        at: ImagePoint,
         /// The text.
         text: String,
     },

@@ -1,21 +1,10 @@
-//! Least-squares fits on image points (pixels, FORMATS.md image coordinates): circles for the
-//! ball, straight lines for goal posts, and the rotation about a centre that turns "parallel to
-//! the horizon" into "parallel to the image rows".
+//! Least-squares fits on [`ImagePoint`]s (pixels, FORMATS.md image coordinates): circles for
+//! the ball, the moving circle of a rolling shutter, and straight lines for goal posts.
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// A point in image coordinates, pixels (x right, y down; pixel centres at +0.5).
-pub type Point = (f64, f64);
-
-/// Rotates `p` about `centre` by `angle` radians (counter-clockwise on screen for positive
-/// angles, i.e. with y down the rotation appears clockwise).
-#[must_use]
-pub fn rotate_about(p: Point, centre: Point, angle: f64) -> Point {
-    let (s, c) = angle.sin_cos();
-    let (dx, dy) = (p.0 - centre.0, p.1 - centre.1);
-    (centre.0 + c * dx - s * dy, centre.1 + s * dx + c * dy)
-}
+use crate::geometry::ImagePoint;
 
 /// A fitted circle, pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -32,23 +21,35 @@ pub struct CircleFit {
     pub points: usize,
 }
 
+impl CircleFit {
+    /// The centre, pixels.
+    #[must_use]
+    pub fn center(&self) -> ImagePoint {
+        ImagePoint::new(self.center_x, self.center_y)
+    }
+}
+
 /// Fits a circle to at least three points: an algebraic (Kåsa) fit for the start, refined by a
 /// few Gauss–Newton steps on the geometric distances, which removes the algebraic fit's bias
 /// towards small circles on short arcs (a ball cut off by the image edge). `None` for fewer than
 /// three points, collinear points or non-finite input.
 #[must_use]
-pub fn fit_circle(points: &[Point]) -> Option<CircleFit> {
-    if points.len() < 3 || points.iter().any(|p| !p.0.is_finite() || !p.1.is_finite()) {
+pub fn fit_circle(points: &[ImagePoint]) -> Option<CircleFit> {
+    if points.len() < 3
+        || points
+            .iter()
+            .any(|p| !p.x_px.is_finite() || !p.y_px.is_finite())
+    {
         return None;
     }
     let n = points.len() as f64;
     let (mx, my) = points
         .iter()
-        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+        .fold((0.0, 0.0), |(a, b), p| (a + p.x_px / n, b + p.y_px / n));
     // Kåsa in centred coordinates: minimise Σ (u² + v² − 2au − 2bv − c)².
     let (mut suu, mut suv, mut svv, mut suz, mut svz) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for p in points {
-        let (u, v) = (p.0 - mx, p.1 - my);
+        let (u, v) = (p.x_px - mx, p.y_px - my);
         let z = u * u + v * v;
         suu += u * u;
         suv += u * v;
@@ -67,7 +68,7 @@ pub fn fit_circle(points: &[Point]) -> Option<CircleFit> {
     let mut cy = b + my;
     let mut r = points
         .iter()
-        .map(|p| ((p.0 - cx).powi(2) + (p.1 - cy).powi(2)).sqrt())
+        .map(|p| ((p.x_px - cx).powi(2) + (p.y_px - cy).powi(2)).sqrt())
         .sum::<f64>()
         / n;
     // Gauss–Newton on residuals d_i − r.
@@ -75,7 +76,7 @@ pub fn fit_circle(points: &[Point]) -> Option<CircleFit> {
         let mut jtj = Matrix3::<f64>::zeros();
         let mut jtr = Vector3::<f64>::zeros();
         for p in points {
-            let (dx, dy) = (p.0 - cx, p.1 - cy);
+            let (dx, dy) = (p.x_px - cx, p.y_px - cy);
             let d = (dx * dx + dy * dy).sqrt();
             if d < 1e-12 {
                 continue;
@@ -99,7 +100,7 @@ pub fn fit_circle(points: &[Point]) -> Option<CircleFit> {
     }
     let var = points
         .iter()
-        .map(|p| (((p.0 - cx).powi(2) + (p.1 - cy).powi(2)).sqrt() - r).powi(2))
+        .map(|p| (((p.x_px - cx).powi(2) + (p.y_px - cy).powi(2)).sqrt() - r).powi(2))
         .sum::<f64>()
         / n;
     Some(CircleFit {
@@ -118,18 +119,18 @@ pub fn fit_circle(points: &[Point]) -> Option<CircleFit> {
 /// refit fails.
 #[must_use]
 pub fn fit_circle_trimmed(
-    points: &[Point],
+    points: &[ImagePoint],
     k_sd: f64,
     min_px: f64,
     max_share: f64,
 ) -> Option<CircleFit> {
     let first = fit_circle(points)?;
     let limit = (k_sd * first.residual_sd).max(min_px);
-    let keep: Vec<Point> = points
+    let keep: Vec<ImagePoint> = points
         .iter()
         .copied()
         .filter(|p| {
-            (((p.0 - first.center_x).powi(2) + (p.1 - first.center_y).powi(2)).sqrt()
+            (((p.x_px - first.center_x).powi(2) + (p.y_px - first.center_y).powi(2)).sqrt()
                 - first.radius)
                 .abs()
                 <= limit
@@ -186,7 +187,7 @@ impl ShearedCircleFit {
 /// at `shear_x_sd` / `shear_y_sd`.
 #[must_use]
 pub fn fit_sheared_circle(
-    points: &[Point],
+    points: &[ImagePoint],
     rows: &[f64],
     reference_row: f64,
     vertical_shear: bool,
@@ -215,7 +216,7 @@ pub fn fit_sheared_circle(
 /// the centre x and y, the radius (pixels) and the horizontal and vertical shear (pixels per
 /// line).
 struct ShearedCircle<'a> {
-    points: &'a [Point],
+    points: &'a [ImagePoint],
     /// Per point, lines read after the reference row (negative: before).
     lines_after_reference: Vec<f64>,
     /// Fit the vertical shear too (else it is held at zero).
@@ -224,8 +225,8 @@ struct ShearedCircle<'a> {
 
 impl ShearedCircle<'_> {
     /// A point moved back to the reference row's time, relative to the centre.
-    fn unsheared(q: &[f64; 5], p: Point, s: f64) -> (f64, f64) {
-        (p.0 - q[3] * s - q[0], p.1 - q[4] * s - q[1])
+    fn unsheared(q: &[f64; 5], p: ImagePoint, s: f64) -> (f64, f64) {
+        (p.x_px - q[3] * s - q[0], p.y_px - q[4] * s - q[1])
     }
 
     /// Sum of squared geometric distances to the circle, pixels².
@@ -383,9 +384,13 @@ pub struct LineFit {
 impl LineFit {
     /// The point of the line at image row `y` (for a steep line) or column `x` (otherwise).
     #[must_use]
-    pub fn at(&self, t: f64) -> Point {
+    pub fn at(&self, t: f64) -> ImagePoint {
         let s = self.slope * t + self.intercept;
-        if self.steep { (s, t) } else { (t, s) }
+        if self.steep {
+            ImagePoint::new(s, t)
+        } else {
+            ImagePoint::new(t, s)
+        }
     }
 }
 
@@ -394,17 +399,21 @@ impl LineFit {
 /// well as horizontal bars. `None` for fewer than two points, all points equal, non-finite
 /// input or sums that overflow; never divides by zero.
 #[must_use]
-pub fn fit_line(points: &[Point]) -> Option<LineFit> {
-    if points.len() < 2 || points.iter().any(|p| !p.0.is_finite() || !p.1.is_finite()) {
+pub fn fit_line(points: &[ImagePoint]) -> Option<LineFit> {
+    if points.len() < 2
+        || points
+            .iter()
+            .any(|p| !p.x_px.is_finite() || !p.y_px.is_finite())
+    {
         return None;
     }
     let n = points.len() as f64;
     let (mx, my) = points
         .iter()
-        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+        .fold((0.0, 0.0), |(a, b), p| (a + p.x_px / n, b + p.y_px / n));
     let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
     for p in points {
-        let (dx, dy) = (p.0 - mx, p.1 - my);
+        let (dx, dy) = (p.x_px - mx, p.y_px - my);
         sxx += dx * dx;
         syy += dy * dy;
         sxy += dx * dy;
@@ -453,11 +462,15 @@ pub fn fit_line(points: &[Point]) -> Option<LineFit> {
 mod tests {
     use super::*;
 
-    fn arc(cx: f64, cy: f64, r: f64, from: f64, to: f64, n: usize) -> Vec<Point> {
+    fn pt(x: f64, y: f64) -> ImagePoint {
+        ImagePoint::new(x, y)
+    }
+
+    fn arc(cx: f64, cy: f64, r: f64, from: f64, to: f64, n: usize) -> Vec<ImagePoint> {
         (0..n)
             .map(|i| {
                 let t = from + (to - from) * i as f64 / (n - 1) as f64;
-                (cx + r * t.cos(), cy + r * t.sin())
+                pt(cx + r * t.cos(), cy + r * t.sin())
             })
             .collect()
     }
@@ -470,7 +483,7 @@ mod tests {
         // A quarter arc with alternating ±0.3 px noise: the geometric refinement keeps the radius.
         let mut pts = arc(10.0, 100.0, 30.0, -1.5, 0.0, 20);
         for (i, p) in pts.iter_mut().enumerate() {
-            p.0 += if i % 2 == 0 { 0.3 } else { -0.3 };
+            p.x_px += if i % 2 == 0 { 0.3 } else { -0.3 };
         }
         let part = fit_circle(&pts).expect("fit");
         assert!((part.radius - 30.0).abs() < 1.0, "radius {}", part.radius);
@@ -480,20 +493,20 @@ mod tests {
     #[test]
     fn trimming_drops_a_stray_point_but_not_a_shape() {
         let mut pts = arc(20.0, 20.0, 8.0, 0.0, 6.0, 24);
-        pts[5].0 += 4.0;
+        pts[5].x_px += 4.0;
         let plain = fit_circle(&pts).expect("fit");
         let trimmed = fit_circle_trimmed(&pts, 2.5, 1.0, 0.2).expect("fit");
         assert!((trimmed.radius - 8.0).abs() < 1e-6 && trimmed.points == 23);
         assert!((plain.radius - 8.0).abs() > (trimmed.radius - 8.0).abs());
         // A square's outline is not a circle: too many points would go, so nothing does.
-        let square: Vec<Point> = (0..40)
+        let square: Vec<ImagePoint> = (0..40)
             .map(|i| {
                 let t = f64::from(i % 10);
                 match i / 10 {
-                    0 => (t, 0.0),
-                    1 => (10.0, t),
-                    2 => (10.0 - t, 10.0),
-                    _ => (0.0, 10.0 - t),
+                    0 => pt(t, 0.0),
+                    1 => pt(10.0, t),
+                    2 => pt(10.0 - t, 10.0),
+                    _ => pt(0.0, 10.0 - t),
                 }
             })
             .collect();
@@ -503,32 +516,32 @@ mod tests {
 
     #[test]
     fn degenerate_circles_are_refused() {
-        assert!(fit_circle(&[(0.0, 0.0), (1.0, 1.0)]).is_none());
-        assert!(fit_circle(&[(0.0, 0.0), (1.0, 1.0), (2.0, 2.0), (3.0, 3.0)]).is_none());
-        assert!(fit_circle(&[(0.0, 0.0), (1.0, f64::NAN), (2.0, 5.0)]).is_none());
-        assert!(fit_circle(&[(4.0, 4.0); 5]).is_none());
+        assert!(fit_circle(&[pt(0.0, 0.0), pt(1.0, 1.0)]).is_none());
+        assert!(fit_circle(&[pt(0.0, 0.0), pt(1.0, 1.0), pt(2.0, 2.0), pt(3.0, 3.0)]).is_none());
+        assert!(fit_circle(&[pt(0.0, 0.0), pt(1.0, f64::NAN), pt(2.0, 5.0)]).is_none());
+        assert!(fit_circle(&[pt(4.0, 4.0); 5]).is_none());
     }
 
     #[test]
     fn lines_fit_both_ways_without_dividing_by_zero() {
-        let vertical: Vec<Point> = (0..10).map(|i| (20.0, f64::from(i))).collect();
+        let vertical: Vec<ImagePoint> = (0..10).map(|i| pt(20.0, f64::from(i))).collect();
         let v = fit_line(&vertical).expect("vertical");
         assert!(v.steep && v.slope.abs() < 1e-12 && (v.intercept - 20.0).abs() < 1e-12);
         assert_eq!(v.r_squared, 1.0);
-        let tilted: Vec<Point> = (0..10)
-            .map(|i| (f64::from(i), 2.0 * f64::from(i) + 1.0))
+        let tilted: Vec<ImagePoint> = (0..10)
+            .map(|i| pt(f64::from(i), 2.0 * f64::from(i) + 1.0))
             .collect();
         let t = fit_line(&tilted).expect("tilted");
         assert!(t.steep, "dy spreads more than dx");
-        let (x, y) = t.at(5.0);
-        assert!((x - 2.0).abs() < 1e-9 && (y - 5.0).abs() < 1e-9);
-        let noisy = [(0.0, 0.0), (1.0, 1.0), (2.0, 0.0), (3.0, 1.0)];
+        let at = t.at(5.0);
+        assert!((at.x_px - 2.0).abs() < 1e-9 && (at.y_px - 5.0).abs() < 1e-9);
+        let noisy = [pt(0.0, 0.0), pt(1.0, 1.0), pt(2.0, 0.0), pt(3.0, 1.0)];
         let n = fit_line(&noisy).expect("noisy");
         assert!(!n.steep && n.r_squared < 0.5 && n.residual_variance > 0.0);
-        assert!(fit_line(&[(1.0, 1.0), (1.0, 1.0)]).is_none());
-        assert!(fit_line(&[(1.0, 1.0)]).is_none());
-        assert!(fit_line(&[(1e300, 1e300), (-1e300, -1e300), (1e300, 1e300)]).is_none());
-        assert!(fit_line(&[(0.0, 0.0), (f64::INFINITY, 1.0)]).is_none());
+        assert!(fit_line(&[pt(1.0, 1.0), pt(1.0, 1.0)]).is_none());
+        assert!(fit_line(&[pt(1.0, 1.0)]).is_none());
+        assert!(fit_line(&[pt(1e300, 1e300), pt(-1e300, -1e300), pt(1e300, 1e300)]).is_none());
+        assert!(fit_line(&[pt(0.0, 0.0), pt(f64::INFINITY, 1.0)]).is_none());
     }
 
     /// Outline points of a circle moving `(ax, ay)` px per line, read row by row like a rolling
@@ -540,7 +553,7 @@ mod tests {
         ax: f64,
         ay: f64,
         reference: f64,
-    ) -> Vec<(Point, f64)> {
+    ) -> Vec<(ImagePoint, f64)> {
         let mut out = Vec::new();
         for row in 0..400 {
             let y = f64::from(row) * 0.5;
@@ -549,8 +562,8 @@ mod tests {
             let dy = y - y0;
             if dy.abs() < r {
                 let half = (r * r - dy * dy).sqrt();
-                out.push(((x0 - half, y), y));
-                out.push(((x0 + half, y), y));
+                out.push((pt(x0 - half, y), y));
+                out.push((pt(x0 + half, y), y));
             }
         }
         out
@@ -560,7 +573,7 @@ mod tests {
     fn sheared_circle_recovers_shear_and_velocity_exactly() {
         let (ax, ay) = (0.15, 0.03);
         let data = moving_outline(90.0, 70.0, 20.0, ax, ay, 80.0);
-        let (pts, rows): (Vec<Point>, Vec<f64>) = data.into_iter().unzip();
+        let (pts, rows): (Vec<ImagePoint>, Vec<f64>) = data.into_iter().unzip();
         let f = fit_sheared_circle(&pts, &rows, 80.0, true).expect("fit");
         assert!((f.shear_x - ax).abs() < 1e-6, "{f:?}");
         assert!((f.shear_y - ay).abs() < 1e-6, "{f:?}");
@@ -574,12 +587,12 @@ mod tests {
         assert!((plain.center_x - 90.0).abs() > 0.1 || (plain.radius - 20.0).abs() > 0.1);
         // A still circle gives zero shear.
         let still = moving_outline(50.0, 50.0, 10.0, 0.0, 0.0, 80.0);
-        let (pts, rows): (Vec<Point>, Vec<f64>) = still.into_iter().unzip();
+        let (pts, rows): (Vec<ImagePoint>, Vec<f64>) = still.into_iter().unzip();
         let f = fit_sheared_circle(&pts, &rows, 80.0, true).expect("still");
         assert!(f.shear_x.abs() < 1e-9 && f.shear_y.abs() < 1e-9 && f.shear_x_sd < 1e-3);
         // Horizontal motion only, fitted with the vertical shear held at zero.
         let across = moving_outline(60.0, 90.0, 15.0, -0.2, 0.0, 80.0);
-        let (pts, rows): (Vec<Point>, Vec<f64>) = across.into_iter().unzip();
+        let (pts, rows): (Vec<ImagePoint>, Vec<f64>) = across.into_iter().unzip();
         let f = fit_sheared_circle(&pts, &rows, 80.0, false).expect("across");
         assert!((f.shear_x + 0.2).abs() < 1e-6 && f.shear_y == 0.0 && f.shear_y_sd == 0.0);
         assert!((f.circle.radius - 15.0).abs() < 1e-5);
@@ -587,17 +600,17 @@ mod tests {
 
     #[test]
     fn sheared_circle_refuses_degenerate_input() {
-        let line: Vec<Point> = (0..10).map(|i| (f64::from(i), f64::from(i))).collect();
-        let rows: Vec<f64> = line.iter().map(|p| p.1).collect();
+        let line: Vec<ImagePoint> = (0..10).map(|i| pt(f64::from(i), f64::from(i))).collect();
+        let rows: Vec<f64> = line.iter().map(|p| p.y_px).collect();
         assert!(fit_sheared_circle(&line, &rows, 80.0, true).is_none());
         let five = arc(10.0, 10.0, 5.0, 0.0, 5.0, 5);
-        let rows5: Vec<f64> = five.iter().map(|p| p.1).collect();
+        let rows5: Vec<f64> = five.iter().map(|p| p.y_px).collect();
         assert!(fit_sheared_circle(&five, &rows5, 80.0, true).is_none());
         let mut pts = arc(10.0, 10.0, 5.0, 0.0, 6.0, 12);
-        let rows12: Vec<f64> = pts.iter().map(|p| p.1).collect();
+        let rows12: Vec<f64> = pts.iter().map(|p| p.y_px).collect();
         assert!(fit_sheared_circle(&pts, &rows12[..11], 80.0, true).is_none());
         assert!(fit_sheared_circle(&pts, &rows12, f64::NAN, false).is_none());
-        pts[3].1 = f64::NAN;
+        pts[3].y_px = f64::NAN;
         assert!(fit_sheared_circle(&pts, &rows12, 80.0, true).is_none());
         let mut rows_nan = rows12.clone();
         rows_nan[0] = f64::INFINITY;
@@ -605,22 +618,14 @@ mod tests {
             fit_sheared_circle(&arc(10.0, 10.0, 5.0, 0.0, 6.0, 12), &rows_nan, 80.0, true)
                 .is_none()
         );
-        assert!(fit_sheared_circle(&[(4.0, 4.0); 8], &[4.0; 8], 80.0, false).is_none());
+        assert!(fit_sheared_circle(&[pt(4.0, 4.0); 8], &[4.0; 8], 80.0, false).is_none());
         // Points all on one row: the shear is undetermined; no panic, and either no fit or an
         // infinite / huge shear error.
-        let one_row: Vec<Point> = (0..8)
-            .map(|i| (f64::from(i), 5.0 + f64::from(i % 2)))
+        let one_row: Vec<ImagePoint> = (0..8)
+            .map(|i| pt(f64::from(i), 5.0 + f64::from(i % 2)))
             .collect();
         if let Some(f) = fit_sheared_circle(&one_row, &[5.0; 8], 80.0, true) {
             assert!(f.shear_x_sd.is_nan() || f.shear_x_sd > 1.0 || f.shear_y_sd > 1.0);
         }
-    }
-
-    #[test]
-    fn rotation_about_a_centre() {
-        let p = rotate_about((11.0, 5.0), (10.0, 5.0), std::f64::consts::FRAC_PI_2);
-        assert!((p.0 - 10.0).abs() < 1e-12 && (p.1 - 6.0).abs() < 1e-12);
-        let back = rotate_about(p, (10.0, 5.0), -std::f64::consts::FRAC_PI_2);
-        assert!((back.0 - 11.0).abs() < 1e-12 && (back.1 - 5.0).abs() < 1e-12);
     }
 }

@@ -198,8 +198,8 @@ impl Recognition {
             out.push(Primitive::Line {
                 owner: ObjectId::Horizon,
                 role: LineRole::Horizon,
-                from: (a.x_px, a.y_px),
-                to: (b.x_px, b.y_px),
+                from: a,
+                to: b,
             });
         }
         out.extend(self.ball.primitives());

@@ -4,8 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::fit::{Point, rotate_about};
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
+use crate::frame::xy_array;
+use crate::geometry::ImagePoint;
 
 pub use crate::frame::CutOff;
 
@@ -13,7 +15,8 @@ pub use crate::frame::CutOff;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ScanArea {
     /// The four corners, clockwise on screen.
-    pub corners: [Point; 4],
+    #[serde(with = "xy_array")]
+    pub corners: [ImagePoint; 4],
 }
 
 /// What a scan area found: how many in-image pixels were looked at, and how many of each class.
@@ -50,7 +53,7 @@ impl ScanCount {
 #[must_use]
 pub fn scan_rotated_rect(
     img: &ClassifiedImage,
-    centre: Point,
+    centre: ImagePoint,
     [left, right, top, bottom]: [f64; 4],
     angle: f64,
     step: f64,
@@ -60,7 +63,9 @@ pub fn scan_rotated_rect(
     } else {
         1.0
     };
-    let corner = |x: f64, y: f64| rotate_about((centre.0 + x, centre.1 + y), centre, angle);
+    let corner = |x: f64, y: f64| {
+        ImagePoint::new(centre.x_px + x, centre.y_px + y).rotated_about(centre, angle)
+    };
     let area = ScanArea {
         corners: [
             corner(left, top),
@@ -82,7 +87,7 @@ pub fn scan_rotated_rect(
     for j in 0..=ny {
         for i in 0..=nx {
             let p = corner(left + i as f64 * step, top + j as f64 * step);
-            if let Some(code) = img.get_at(p.0, p.1) {
+            if let Some(code) = img.get_at(p.x_px, p.y_px) {
                 count.scanned += 1;
                 count.per_class[usize::from(code & 15)] += 1;
             }
@@ -126,8 +131,7 @@ impl EdgeScanPattern {
     }
 }
 
-/// Collects outline points of the object in the box `[minx, miny, maxx, maxy]` (inclusive
-/// pixels) by scanning each row or column from `margin` pixels outside the box inward until
+/// Collects outline points of the object in the box `bounds` (inclusive pixels) by scanning each row or column from `margin` pixels outside the box inward until
 /// `run` consecutive pixels whose class satisfies `is_object` (a run of 2 steps over single
 /// noisy pixels outside a ball; 1 stops at the first object pixel). Each point lies on the pixel
 /// boundary where the run starts (e.g. `x` = left edge of its first pixel), at the row's or
@@ -136,12 +140,12 @@ impl EdgeScanPattern {
 #[must_use]
 pub fn edge_points(
     img: &ClassifiedImage,
-    bounds: [u32; 4],
+    bounds: PixelBox,
     pattern: EdgeScanPattern,
     margin: u32,
     run: u32,
     is_object: impl Fn(u8) -> bool,
-) -> Vec<Point> {
+) -> Vec<ImagePoint> {
     edge_points_with_mixed(
         img,
         bounds,
@@ -182,20 +186,20 @@ pub enum MixedEdge {
 )]
 pub fn edge_points_with_mixed(
     img: &ClassifiedImage,
-    [minx, miny, maxx, maxy]: [u32; 4],
+    bounds: PixelBox,
     pattern: EdgeScanPattern,
     margin: u32,
     run: u32,
     is_object: impl Fn(u8) -> bool,
     is_mixed: impl Fn(u8) -> bool,
     mode: MixedEdge,
-) -> Vec<Point> {
+) -> Vec<ImagePoint> {
     let (w, h) = (img.width() as i64, img.height() as i64);
     let (minx, miny, maxx, maxy) = (
-        i64::from(minx),
-        i64::from(miny),
-        i64::from(maxx),
-        i64::from(maxy),
+        i64::from(bounds.min_x),
+        i64::from(bounds.min_y),
+        i64::from(bounds.max_x),
+        i64::from(bounds.max_y),
     );
     let margin = i64::from(margin);
     let mut points = Vec::new();
@@ -217,12 +221,12 @@ pub fn edge_points_with_mixed(
             if matches!(pattern, P::LeftToRight | P::SidesToCentre)
                 && let Some(x) = scan(y, minx - margin, maxx, 1, true)
             {
-                points.push((x, yc));
+                points.push(ImagePoint::new(x, yc));
             }
             if matches!(pattern, P::RightToLeft | P::SidesToCentre)
                 && let Some(x) = scan(y, maxx + margin, minx, -1, true)
             {
-                points.push((x, yc));
+                points.push(ImagePoint::new(x, yc));
             }
         }
     } else {
@@ -231,17 +235,17 @@ pub fn edge_points_with_mixed(
             if matches!(pattern, P::TopToBottom | P::TopBottomToCentre)
                 && let Some(y) = scan(x, miny - margin, maxy, 1, false)
             {
-                points.push((xc, y));
+                points.push(ImagePoint::new(xc, y));
             }
             if matches!(pattern, P::BottomToTop | P::TopBottomToCentre)
                 && let Some(y) = scan(x, maxy + margin, miny, -1, false)
             {
-                points.push((xc, y));
+                points.push(ImagePoint::new(xc, y));
             }
         }
     }
     // Points on the image border are where the object is cut, not its outline.
-    points.retain(|p| p.0 > 0.0 && p.0 < w as f64 && p.1 > 0.0 && p.1 < h as f64);
+    points.retain(|p| p.x_px > 0.0 && p.x_px < w as f64 && p.y_px > 0.0 && p.y_px < h as f64);
     points
 }
 
@@ -312,23 +316,23 @@ impl<O: Fn(u8) -> bool, M: Fn(u8) -> bool> EdgeScanner<'_, O, M> {
 
 /// Removes a rolling shutter's horizontal shear: row `y` was read `y − reference_row` lines after
 /// the reference row, so its content moved by `skew_per_line` pixels per line; shift it back.
-pub fn unskew_points(points: &mut [Point], skew_per_line: f64, reference_row: f64) {
+pub fn unskew_points(points: &mut [ImagePoint], skew_per_line: f64, reference_row: f64) {
     if !skew_per_line.is_finite() || !reference_row.is_finite() {
         return;
     }
     for p in points {
-        p.0 -= skew_per_line * (p.1 - reference_row);
+        p.x_px -= skew_per_line * (p.y_px - reference_row);
     }
 }
 
 /// Removes the vertical counterpart (tilt during read-out): each row moved `skew_per_line` pixels
 /// vertically per line read.
-pub fn unskew_points_vertical(points: &mut [Point], skew_per_line: f64, reference_row: f64) {
+pub fn unskew_points_vertical(points: &mut [ImagePoint], skew_per_line: f64, reference_row: f64) {
     if !skew_per_line.is_finite() || !reference_row.is_finite() {
         return;
     }
     for p in points {
-        p.1 -= skew_per_line * (p.1 - reference_row);
+        p.y_px -= skew_per_line * (p.y_px - reference_row);
     }
 }
 
@@ -353,7 +357,7 @@ mod tests {
     #[test]
     fn edge_scans_fit_the_disc_in_every_pattern() {
         let img = disc(80, 60, 40.0, 30.0, 12.0, 1);
-        let bbox = [28, 18, 51, 41];
+        let bbox = PixelBox::new(28, 18, 51, 41);
         for pattern in [
             EdgeScanPattern::LeftToRight,
             EdgeScanPattern::RightToLeft,
@@ -380,7 +384,9 @@ mod tests {
         };
         let pattern = EdgeScanPattern::for_cut_off(cut);
         assert_eq!(pattern, EdgeScanPattern::RightToLeft);
-        let pts = edge_points(&img, [0, 15, 18, 44], pattern, 3, 2, |c| c == 1);
+        let pts = edge_points(&img, PixelBox::new(0, 15, 18, 44), pattern, 3, 2, |c| {
+            c == 1
+        });
         let fit = fit_circle(&pts).expect("fit");
         assert!((fit.radius - 15.0).abs() < 1.0, "{fit:?}");
         assert!((fit.center_x - 4.0).abs() < 1.0, "{fit:?}");
@@ -389,20 +395,32 @@ mod tests {
     #[test]
     fn rotated_scan_counts_only_inside_pixels() {
         let img = disc(40, 40, 20.0, 20.0, 5.0, 1);
-        let below = scan_rotated_rect(&img, (20.0, 20.0), [-5.0, 5.0, 8.0, 12.0], 0.3, 1.0);
+        let below = scan_rotated_rect(
+            &img,
+            ImagePoint::new(20.0, 20.0),
+            [-5.0, 5.0, 8.0, 12.0],
+            0.3,
+            1.0,
+        );
         assert!(below.scanned > 0);
         assert_eq!(below.ratio(|c| c == 5), Some(1.0));
-        let outside = scan_rotated_rect(&img, (20.0, 20.0), [-5.0, 5.0, 100.0, 120.0], 0.0, 1.0);
+        let outside = scan_rotated_rect(
+            &img,
+            ImagePoint::new(20.0, 20.0),
+            [-5.0, 5.0, 100.0, 120.0],
+            0.0,
+            1.0,
+        );
         assert_eq!(outside.scanned, 0);
         assert_eq!(outside.ratio(|c| c == 5), None);
     }
 
     #[test]
     fn unskewing_straightens_a_sheared_column() {
-        let mut pts: Vec<Point> = (0..10)
-            .map(|y| (10.0 + 0.5 * f64::from(y), f64::from(y)))
+        let mut pts: Vec<ImagePoint> = (0..10)
+            .map(|y| ImagePoint::new(10.0 + 0.5 * f64::from(y), f64::from(y)))
             .collect();
         unskew_points(&mut pts, 0.5, 0.0);
-        assert!(pts.iter().all(|p| (p.0 - 10.0).abs() < 1e-12));
+        assert!(pts.iter().all(|p| (p.x_px - 10.0).abs() < 1e-12));
     }
 }

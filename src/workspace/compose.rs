@@ -171,7 +171,7 @@ impl Workspace {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::PixelBox;
+    use crate::frame::{ImagePoint, PixelBox};
 
     fn boxed(owner: ObjectId) -> Primitive {
         Primitive::Box {
@@ -184,7 +184,7 @@ mod tests {
     fn label(owner: ObjectId) -> Primitive {
         Primitive::Label {
             owner,
-            at: (1.0, 1.0),
+            at: ImagePoint::new(1.0, 1.0),
             text: "x".to_owned(),
         }
     }
@@ -200,8 +200,8 @@ mod tests {
         let horizon = Primitive::Line {
             owner: ObjectId::Horizon,
             role: LineRole::Horizon,
-            from: (0.0, 5.0),
-            to: (10.0, 5.0),
+            from: ImagePoint::new(0.0, 5.0),
+            to: ImagePoint::new(10.0, 5.0),
         };
         assert!(f.shows(&horizon));
         assert!(PrimitiveFilter::all(Overlays::all_on()).shows(&boxed(ObjectId::Ball(0))));

@@ -597,7 +597,7 @@ fn sample_frame_3_ball_in_the_middle_is_not_called_cut_off() {
         .iter()
         .find(|c| c.accepted)
         .expect("a ball at frame 3");
-    let [minx, miny, maxx, maxy] = ball.bounds;
+    let [minx, miny, maxx, maxy] = ball.bounds.to_array();
     assert!(minx > 0 && miny > 0 && (maxx as usize) + 1 < w && (maxy as usize) + 1 < h);
     // A white field line borders its top, but the circle fitted to the rest ends at the blob:
     // the ball is whole, and neither recognition nor the inspector calls a side cut or hidden.

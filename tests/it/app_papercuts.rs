@@ -104,8 +104,8 @@ fn object_labels_stay_inside_the_view_when_the_object_is_beyond_an_edge() {
         .clone()
         .expect("a ball");
     let (bx, by, r) = (
-        ball.observed_center.0,
-        ball.observed_center.1,
+        ball.observed_center.x_px,
+        ball.observed_center.y_px,
         ball.radius_px,
     );
     let fitted = h.state().last_view.expect("the image is drawn");

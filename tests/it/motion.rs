@@ -105,7 +105,7 @@ fn skew_comparison(
             .iter()
             .map(|p| ctx.unskew_at(*p, depth, b.vertical_skew_correction))
             .collect();
-        let fit = |pts: &[(f64, f64)]| {
+        let fit = |pts: &[eotn::geometry::ImagePoint]| {
             fit_circle_trimmed(pts, b.fit_trim_sd, b.fit_trim_min_px, b.fit_trim_max_share)
         };
         if let (Some(a), Some(c)) = (fit(&points), fit(&moved)) {
@@ -127,8 +127,8 @@ fn skew_comparison(
                     a.center_y,
                     c.center_x,
                     c.center_y,
-                    tc.0,
-                    tc.1,
+                    tc.x_px,
+                    tc.y_px,
                     ctx.skew_x_per_line
                 );
             }
@@ -137,8 +137,8 @@ fn skew_comparison(
             e.fixed_r.push((c.radius - tr).abs());
             e.raw_r_axis.push((a.radius - axis_r).abs());
             e.fixed_r_axis.push((c.radius - axis_r).abs());
-            e.raw_c.push((a.center_x - tc.0).hypot(a.center_y - tc.1));
-            e.fixed_c.push((c.center_x - tc.0).hypot(c.center_y - tc.1));
+            e.raw_c.push(a.center().distance_to(&tc));
+            e.fixed_c.push(c.center().distance_to(&tc));
         }
     }
     (uncut, cut)
@@ -250,7 +250,7 @@ fn rolling_shutter_outline(
     t_s: f64,
     ball_cm: [f64; 2],
     camera: &PinholeCamera,
-) -> Vec<(f64, f64)> {
+) -> Vec<eotn::geometry::ImagePoint> {
     use eotn::geometry::{Camera, Ers7Dimensions, Field, ImagePoint, Transform};
     let centre = nalgebra::Vector3::new(ball_cm[0], ball_cm[1], 4.25);
     let (w, h) = (camera.width_px as f64, camera.height_px as f64);
@@ -286,8 +286,8 @@ fn rolling_shutter_outline(
         };
         let (lo, hi) = (edge(inside, -1.0), edge(inside, w + 1.0));
         if lo > 0.0 && hi < w {
-            out.push((lo, y));
-            out.push((hi, y));
+            out.push(ImagePoint::new(lo, y));
+            out.push(ImagePoint::new(hi, y));
         }
     }
     out
@@ -338,8 +338,8 @@ fn skew_removal_restores_exact_outlines_during_fast_pans() {
             };
             raw_r.push((a.radius - outline.radius_px).abs());
             fixed_r.push((b.radius - outline.radius_px).abs());
-            raw_c.push((a.center_x - outline.center.0).hypot(a.center_y - outline.center.1));
-            fixed_c.push((b.center_x - outline.center.0).hypot(b.center_y - outline.center.1));
+            raw_c.push(a.center().distance_to(&outline.center));
+            fixed_c.push(b.center().distance_to(&outline.center));
         }
         let p = Percentiles::of;
         eprintln!(

@@ -11,7 +11,7 @@ use eotn::geometry::overhead::OverheadCamera;
 use eotn::geometry::{Body, Camera, Point, Transform, rotation_x, rotation_y, rotation_z};
 use eotn::lut::edit::{EditHistory, EditRecord, Region, Sensitivity};
 use eotn::lut::{ColourClass, LookupTable};
-use eotn::recognition::fit::{fit_circle, fit_line, rotate_about};
+use eotn::recognition::fit::{fit_circle, fit_line};
 use proptest::prelude::*;
 
 /// (colour, pixels, minx, miny, maxx, maxy) of every blob, sorted: what both finders must agree on.
@@ -126,6 +126,11 @@ proptest! {
     }
 }
 
+/// An image point, pixels.
+fn pt(x: f64, y: f64) -> ImagePoint {
+    ImagePoint::new(x, y)
+}
+
 /// Coordinates a fit meets in images: up to a few thousand pixels, either side of the image.
 fn coordinate() -> impl Strategy<Value = f64> {
     -2000.0f64..2000.0
@@ -140,7 +145,7 @@ proptest! {
         steps in proptest::collection::vec(-300.0f64..300.0, 2..40),
     ) {
         let (dx, dy) = (angle.cos(), angle.sin());
-        let points: Vec<_> = steps.iter().map(|t| (x0 + t * dx, y0 + t * dy)).collect();
+        let points: Vec<_> = steps.iter().map(|t| pt(x0 + t * dx, y0 + t * dy)).collect();
         let spread = steps.iter().fold(f64::MIN, |a, &t| a.max(t)) - steps.iter().fold(f64::MAX, |a, &t| a.min(t));
         match fit_line(&points) {
             // Only points that (nearly) coincide have no line.
@@ -148,9 +153,9 @@ proptest! {
             Some(line) => {
                 prop_assume!(spread > 1e-3);
                 // Every point lies on the fitted line, whichever way it was regressed.
-                for &(x, y) in &points {
+                for &ImagePoint { x_px: x, y_px: y } in &points {
                     let on = if line.steep { line.at(y) } else { line.at(x) };
-                    prop_assert!((on.0 - x).abs() + (on.1 - y).abs() < 1e-6 * (1.0 + x.abs() + y.abs()), "{line:?} misses ({x}, {y})");
+                    prop_assert!((on.x_px - x).abs() + (on.y_px - y).abs() < 1e-6 * (1.0 + x.abs() + y.abs()), "{line:?} misses ({x}, {y})");
                 }
                 prop_assert!(line.slope.abs() <= 1.0 + 1e-9, "the regression is not the flatter way round: {line:?}");
                 prop_assert!(line.residual_variance < 1e-6 * (1.0 + x0.abs() + y0.abs()));
@@ -160,13 +165,13 @@ proptest! {
 
     #[test]
     fn vertical_horizontal_and_two_point_lines_are_exact(c in coordinate(), a in coordinate(), len in 1.0f64..500.0) {
-        let vertical = fit_line(&[(c, a), (c, a + len), (c, a + len / 2.0)]).unwrap();
+        let vertical = fit_line(&[pt(c, a), pt(c, a + len), pt(c, a + len / 2.0)]).unwrap();
         prop_assert!(vertical.steep && vertical.slope.abs() < 1e-12 && (vertical.intercept - c).abs() < 1e-9);
-        let horizontal = fit_line(&[(a, c), (a + len, c)]).unwrap();
+        let horizontal = fit_line(&[pt(a, c), pt(a + len, c)]).unwrap();
         prop_assert!(!horizontal.steep && horizontal.slope.abs() < 1e-12 && (horizontal.intercept - c).abs() < 1e-9);
         prop_assert_eq!(horizontal.residual_variance, 0.0);
-        prop_assert!(fit_line(&[(c, a), (c, a), (c, a)]).is_none(), "coincident points gave a line");
-        prop_assert!(fit_line(&[(c, a)]).is_none() && fit_line(&[]).is_none());
+        prop_assert!(fit_line(&[pt(c, a), pt(c, a), pt(c, a)]).is_none(), "coincident points gave a line");
+        prop_assert!(fit_line(&[pt(c, a)]).is_none() && fit_line(&[]).is_none());
     }
 
     #[test]
@@ -177,7 +182,7 @@ proptest! {
         // Arcs down to about a tenth of the circle: a ball cut off by the image edge.
         let points: Vec<_> = (0..n)
             .map(|i| start + arc * i as f64 / n as f64)
-            .map(|t| (cx + r * t.cos(), cy + r * t.sin()))
+            .map(|t| pt(cx + r * t.cos(), cy + r * t.sin()))
             .collect();
         let fit = fit_circle(&points).unwrap();
         let tolerance = 1e-6 * (1.0 + cx.abs() + cy.abs() + r);
@@ -194,24 +199,25 @@ proptest! {
     ) {
         let (dx, dy) = (angle.cos(), angle.sin());
         // Collinear points, each possibly repeated (coincident), or fewer than three.
-        let points: Vec<_> = steps.iter().flat_map(|t| std::iter::repeat_n((x0 + t * dx, y0 + t * dy), repeat)).collect();
+        let points: Vec<_> = steps.iter().flat_map(|t| std::iter::repeat_n(pt(x0 + t * dx, y0 + t * dy), repeat)).collect();
         if let Some(fit) = fit_circle(&points) {
             prop_assert!(fit.center_x.is_finite() && fit.center_y.is_finite() && fit.radius.is_finite() && fit.radius >= 0.0, "{fit:?}");
         }
-        prop_assert!(fit_circle(&[(x0, y0), (x0, y0), (x0, y0)]).is_none(), "three coincident points gave a circle");
-        prop_assert!(fit_circle(&[(x0, y0), (f64::NAN, y0), (x0 + 1.0, y0 + 5.0)]).is_none());
+        prop_assert!(fit_circle(&[pt(x0, y0), pt(x0, y0), pt(x0, y0)]).is_none(), "three coincident points gave a circle");
+        prop_assert!(fit_circle(&[pt(x0, y0), pt(f64::NAN, y0), pt(x0 + 1.0, y0 + 5.0)]).is_none());
     }
 
     #[test]
     fn a_rotation_about_a_centre_is_undone_by_its_opposite(
         px in coordinate(), py in coordinate(), cx in coordinate(), cy in coordinate(), angle in -7.0f64..7.0,
     ) {
-        let turned = rotate_about((px, py), (cx, cy), angle);
-        let back = rotate_about(turned, (cx, cy), -angle);
-        prop_assert!((back.0 - px).abs() < 1e-9 && (back.1 - py).abs() < 1e-9, "{:?} came back as {:?}", (px, py), back);
+        let (p, centre) = (pt(px, py), pt(cx, cy));
+        let turned = p.rotated_about(centre, angle);
+        let back = turned.rotated_about(centre, -angle);
+        prop_assert!((back.x_px - px).abs() < 1e-9 && (back.y_px - py).abs() < 1e-9, "{:?} came back as {:?}", p, back);
         // Distances from the centre are kept.
-        let r0 = (px - cx).hypot(py - cy);
-        let r1 = (turned.0 - cx).hypot(turned.1 - cy);
+        let r0 = p.distance_to(&centre);
+        let r1 = turned.distance_to(&centre);
         prop_assert!((r0 - r1).abs() < 1e-9 * (1.0 + r0));
     }
 
@@ -247,6 +253,6 @@ proptest! {
 /// them by rounding, and gave a line of slope 0.
 #[test]
 fn three_equal_points_off_the_origin_are_no_line() {
-    let p = (-484.911_564_243_466_44, 0.0);
+    let p = pt(-484.911_564_243_466_44, 0.0);
     assert!(fit_line(&[p, p, p]).is_none());
 }

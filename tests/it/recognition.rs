@@ -292,7 +292,7 @@ fn skew_radius_comparison(
             .iter()
             .map(|p| ctx.unskew_at(*p, depth, b.vertical_skew_correction))
             .collect();
-        let fit = |pts: &[(f64, f64)]| {
+        let fit = |pts: &[eotn::geometry::ImagePoint]| {
             fit_circle_trimmed(pts, b.fit_trim_sd, b.fit_trim_min_px, b.fit_trim_max_share)
         };
         if let (Some(a), Some(c)) = (fit(&points), fit(&moved)) {
@@ -334,7 +334,7 @@ fn drawn_ball_circle_sits_on_the_observed_ball() {
         if r.recognition.ball.ball.is_none() {
             continue;
         }
-        let seen = (
+        let seen = eotn::geometry::ImagePoint::new(
             (bx.min_x + bx.max_x + 1) as f64 / 2.0,
             (bx.min_y + bx.max_y + 1) as f64 / 2.0,
         );
@@ -353,7 +353,7 @@ fn drawn_ball_circle_sits_on_the_observed_ball() {
                 _ => None,
             })
             .collect();
-        let off = |c: (f64, f64)| (c.0 - seen.0).hypot(c.1 - seen.1);
+        let off = |c: eotn::geometry::ImagePoint| c.distance_to(&seen);
         let solid: Vec<_> = circles
             .iter()
             .filter(|c| c.2 == CircleRole::Observed)
@@ -365,7 +365,7 @@ fn drawn_ball_circle_sits_on_the_observed_ball() {
         let raw = eotn::recognition::fit::fit_circle(&cand.scanned_points).expect("raw fit");
         let c = solid[0].0;
         assert!(
-            (c.0 - raw.center_x).hypot(c.1 - raw.center_y) <= 1.0,
+            c.distance_to(&raw.center()) <= 1.0,
             "frame {i}: solid circle at {c:?}, outline as scanned fits ({:.1}, {:.1})",
             raw.center_x,
             raw.center_y

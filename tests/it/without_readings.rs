@@ -95,7 +95,8 @@ fn choices(kind: ScenarioKind, seed: u64, lut: &LookupTable, setting: Setting) -
             // has its centre outside them). Without readings there is no pan velocity, so no
             // skew correction, and a fast pan's ball is reported where the image shows it
             // rather than where the truth puts it at the reference row: not a wrong choice.
-            let reaches = |(x, y): (f64, f64), r: f64| {
+            let reaches = |p: eotn::geometry::ImagePoint, r: f64| {
+                let (x, y) = (p.x_px, p.y_px);
                 let dx = (b.min_x as f64 - x)
                     .max(x - (b.max_x as f64 + 1.0))
                     .max(0.0);
@@ -255,7 +256,7 @@ fn held_out_seeds_11_and_23_no_false_ball_and_the_real_ball_chosen_without_readi
 }
 
 /// Where a frame's reported ball is: observed centre and radius, pixels.
-type Choice = Option<((f64, f64), f64)>;
+type Choice = Option<(eotn::geometry::ImagePoint, f64)>;
 
 /// What detection made of real frames against their hand labels.
 #[derive(Debug, Default, Clone, PartialEq)]
@@ -371,7 +372,7 @@ fn differing_choices(a: &[Choice], b: &[Choice], tolerance_px: f64) -> Vec<usize
         .enumerate()
         .filter(|(_, (x, y))| match (x, y) {
             (None, None) => false,
-            (Some((p, _)), Some((q, _))) => (p.0 - q.0).hypot(p.1 - q.1) > tolerance_px,
+            (Some((p, _)), Some((q, _))) => p.distance_to(q) > tolerance_px,
             _ => true,
         })
         .map(|(i, _)| i)
@@ -416,10 +417,7 @@ fn real_bhuman_frames_without_readings_report_no_false_ball_and_no_other_choice(
     for &i in &differ {
         match (a[i], b[i]) {
             (Some((p, r)), Some((q, _))) => {
-                assert!(
-                    (p.0 - q.0).hypot(p.1 - q.1) < r,
-                    "frame {i}: {p:?} vs {q:?}"
-                );
+                assert!(p.distance_to(&q) < r, "frame {i}: {p:?} vs {q:?}");
             }
             (Some(_), None) => assert!(
                 BHUMAN_MISSED_WITHOUT_READINGS.contains(&i),

@@ -5,10 +5,11 @@ use super::outline::Outline;
 use super::{BallParams, is_ball_colour};
 use crate::blobs::Blob;
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestName, TestWeight};
 use crate::recognition::context::ViewContext;
-use crate::recognition::fit::Point;
 use crate::recognition::scan::{ScanArea, scan_rotated_rect};
 
 /// What the earlier stages measured of one candidate.
@@ -22,9 +23,9 @@ pub(super) struct Measured<'a> {
     /// The fit stage's result.
     pub circle: &'a CircleStage,
     /// Centre at the reference read-out time, pixels.
-    pub center: Point,
+    pub center: ImagePoint,
     /// Centre where the image shows the ball, pixels.
-    pub observed_center: Point,
+    pub observed_center: ImagePoint,
     /// Radius, pixels.
     pub radius: f64,
     /// Camera distance, centimetres.
@@ -67,7 +68,7 @@ fn colour_tests(
         ),
         None => confidence.skipped(TestName::CircleFill, params.circle_fill),
     }
-    if let Some(share) = unclassified_around(img, m.group) {
+    if let Some(share) = unclassified_around(img, m.outline.bounds) {
         confidence.range_test(
             TestName::UnclassifiedAround,
             share,
@@ -170,7 +171,7 @@ fn place_tests(
     let shift = m.outline.box_shift;
     let below_scan = scan_rotated_rect(
         img,
-        (center.0 - shift.0, center.1 - shift.1),
+        center - shift,
         [
             -radius,
             radius,
@@ -195,7 +196,7 @@ fn place_tests(
         // colour (carpet, its shadow on the carpet, or a line) lies right at its foot; at the
         // foot of an off-field thing lie furniture or the floor, even where the carpet shows a
         // little lower in the image.
-        match field_at_foot(img, m.group) {
+        match field_at_foot(img, m.outline.bounds) {
             Some(field) => confidence.range_test(
                 TestName::FieldBelow,
                 field,
@@ -214,9 +215,9 @@ fn place_tests(
 /// lies wholly outside (a ball cut by the bottom edge). White counts only beside some green
 /// (at least a tenth of the band): a line crossing under a ball has carpet beside it, while
 /// the white base of a beacon or a robot's shell standing off the field has none.
-fn field_at_foot(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
-    let (minx, maxx) = (i64::from(b.minx), i64::from(b.maxx));
-    let (miny, maxy) = (i64::from(b.miny), i64::from(b.maxy));
+fn field_at_foot(img: &ClassifiedImage, b: PixelBox) -> Option<f64> {
+    let (minx, maxx) = (i64::from(b.min_x), i64::from(b.max_x));
+    let (miny, maxy) = (i64::from(b.min_y), i64::from(b.max_y));
     let inset = (maxx - minx + 1) / 5;
     let gap = ((maxy - miny + 1) / 16).clamp(1, 3);
     let (mut n, mut green, mut white) = (0u32, 0u32, 0u32);
@@ -239,9 +240,9 @@ fn field_at_foot(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
 
 /// Share of unclassified pixels on the ring one pixel outside the box (pixels inside the image
 /// only); `None` when the ring lies wholly outside.
-fn unclassified_around(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
-    let (minx, miny) = (i64::from(b.minx) - 1, i64::from(b.miny) - 1);
-    let (maxx, maxy) = (i64::from(b.maxx) + 1, i64::from(b.maxy) + 1);
+fn unclassified_around(img: &ClassifiedImage, b: PixelBox) -> Option<f64> {
+    let (minx, miny) = (i64::from(b.min_x) - 1, i64::from(b.min_y) - 1);
+    let (maxx, maxy) = (i64::from(b.max_x) + 1, i64::from(b.max_y) + 1);
     let ring = (minx..=maxx)
         .flat_map(|x| [(x, miny), (x, maxy)])
         .chain((miny + 1..maxy).flat_map(|y| [(minx, y), (maxx, y)]));
@@ -259,22 +260,22 @@ fn unclassified_around(img: &ClassifiedImage, b: &Blob) -> Option<f64> {
 /// `radius` px), sampled every pixel up to a 24-pixel diameter and on a 24 × 24 grid over
 /// larger circles (a close ball or a robot's arm fills tens of thousands of pixels; the share
 /// needs a few hundred); `None` when no sample of the image lies inside.
-pub(super) fn circle_fill(img: &ClassifiedImage, center: Point, radius: f64) -> Option<f64> {
-    if !(center.0.is_finite() && center.1.is_finite() && radius.is_finite() && radius > 0.0) {
+pub(super) fn circle_fill(img: &ClassifiedImage, center: ImagePoint, radius: f64) -> Option<f64> {
+    if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
         return None;
     }
     let step = (2.0 * radius / 24.0).max(1.0);
     let (w, h) = (img.width() as f64, img.height() as f64);
     let (mut n, mut ball) = (0u32, 0u32);
-    let mut y = (center.1 - radius).floor() + 0.5;
-    while y <= center.1 + radius {
-        let mut x = (center.0 - radius).floor() + 0.5;
-        while x <= center.0 + radius {
+    let mut y = (center.y_px - radius).floor() + 0.5;
+    while y <= center.y_px + radius {
+        let mut x = (center.x_px - radius).floor() + 0.5;
+        while x <= center.x_px + radius {
             if x >= 0.0
                 && y >= 0.0
                 && x < w
                 && y < h
-                && (x - center.0).powi(2) + (y - center.1).powi(2) <= radius * radius
+                && (x - center.x_px).powi(2) + (y - center.y_px).powi(2) <= radius * radius
                 && let Some(c) = img.get_at(x, y)
             {
                 n += 1;

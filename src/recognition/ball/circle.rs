@@ -7,10 +7,11 @@ use serde::{Deserialize, Serialize};
 
 use super::BallParams;
 use super::outline::Outline;
-use crate::blobs::Blob;
+use crate::frame::PixelBox;
+use crate::geometry::ImagePoint;
 use crate::recognition::context::ViewContext;
 use crate::recognition::fit::{
-    CircleFit, Point, ShearedCircleFit, fit_circle_trimmed, fit_sheared_circle,
+    CircleFit, ShearedCircleFit, fit_circle_trimmed, fit_sheared_circle,
 };
 use crate::recognition::scan::CutOff;
 
@@ -100,7 +101,7 @@ pub(super) struct CircleStage {
 
 impl CircleStage {
     /// Fits the outline's points and decides whether the fit can be the blob's ball.
-    pub fn fit(outline: &Outline, group: &Blob, ctx: &ViewContext, params: &BallParams) -> Self {
+    pub fn fit(outline: &Outline, ctx: &ViewContext, params: &BallParams) -> Self {
         let points = &outline.points;
         let fit = (points.len() >= 5)
             .then(|| {
@@ -112,7 +113,7 @@ impl CircleStage {
                 )
             })
             .flatten();
-        let rejection = rejection(fit.as_ref(), outline, group, ctx, params);
+        let rejection = rejection(fit.as_ref(), outline, ctx, params);
         let used = fit.is_some() && rejection.is_none();
         let ellipse = (params.ellipse_fit && used && points.len() >= params.ellipse_min_points)
             .then(|| {
@@ -145,14 +146,14 @@ impl CircleStage {
         outline: &Outline,
         ctx: &ViewContext,
         params: &BallParams,
-    ) -> (Point, f64) {
+    ) -> (ImagePoint, f64) {
         let (center, radius) = match (&self.fit, self.used()) {
             (Some(_), true) if self.moving.is_some() => {
-                self.moving.map_or(((0.0, 0.0), 0.0), |e| {
-                    ((e.circle.center_x, e.circle.center_y), e.circle.radius)
+                self.moving.map_or((ImagePoint::default(), 0.0), |e| {
+                    (e.circle.center(), e.circle.radius)
                 })
             }
-            (Some(f), true) => ((f.center_x, f.center_y), f.radius),
+            (Some(f), true) => (f.center(), f.radius),
             _ if params.skew_correction => (
                 outline.unskew(ctx, params, outline.box_centre),
                 outline.box_radius,
@@ -167,7 +168,6 @@ impl CircleStage {
 fn rejection(
     fit: Option<&CircleFit>,
     outline: &Outline,
-    group: &Blob,
     ctx: &ViewContext,
     params: &BallParams,
 ) -> Option<FitRejection> {
@@ -198,7 +198,7 @@ fn rejection(
             diameter_px: diameter,
             extent_px: extent,
         })
-    } else if !circle_holds_blob(f, group, outline.cut, outline.box_shift) {
+    } else if !circle_holds_blob(f, outline.bounds, outline.cut, outline.box_shift) {
         Some(FitRejection::MissesBlob)
     } else {
         None
@@ -209,11 +209,14 @@ fn rejection(
 /// reaches every side the blob is cut at (a short arc of a few outline points can bend the fit
 /// the wrong way, putting the circle beside the blob). `shift` moves the box as the skew removal
 /// moved its centre (the circle is fitted to unskewed points).
-fn circle_holds_blob(f: &CircleFit, b: &Blob, cut: CutOff, shift: Point) -> bool {
-    let (minx, miny) = (f64::from(b.minx) + shift.0, f64::from(b.miny) + shift.1);
+fn circle_holds_blob(f: &CircleFit, b: PixelBox, cut: CutOff, shift: ImagePoint) -> bool {
+    let (minx, miny) = (
+        f64::from(b.min_x) + shift.x_px,
+        f64::from(b.min_y) + shift.y_px,
+    );
     let (maxx, maxy) = (
-        f64::from(b.maxx + 1) + shift.0,
-        f64::from(b.maxy + 1) + shift.1,
+        f64::from(b.max_x + 1) + shift.x_px,
+        f64::from(b.max_y + 1) + shift.y_px,
     );
     let (bx, by) = ((minx + maxx) / 2.0, (miny + maxy) / 2.0);
     let inside = (bx - f.center_x).hypot(by - f.center_y) <= f.radius;
@@ -234,26 +237,29 @@ fn circle_holds_blob(f: &CircleFit, b: &Blob, cut: CutOff, shift: Point) -> bool
 #[must_use]
 pub fn confirmed_cut(
     f: &CircleFit,
-    b: &Blob,
+    b: PixelBox,
     cut: CutOff,
-    shift: Point,
+    shift: ImagePoint,
     image_size: (u32, u32),
     min_overhang_px: f64,
 ) -> CutOff {
-    let (minx, miny) = (f64::from(b.minx) + shift.0, f64::from(b.miny) + shift.1);
+    let (minx, miny) = (
+        f64::from(b.min_x) + shift.x_px,
+        f64::from(b.min_y) + shift.y_px,
+    );
     let (maxx, maxy) = (
-        f64::from(b.maxx + 1) + shift.0,
-        f64::from(b.maxy + 1) + shift.1,
+        f64::from(b.max_x + 1) + shift.x_px,
+        f64::from(b.max_y + 1) + shift.y_px,
     );
     let (w, h) = image_size;
     let keep = |hidden: bool, at_border: bool, overhang: f64| {
         hidden && (at_border || overhang > min_overhang_px)
     };
     CutOff {
-        left: keep(cut.left, b.minx == 0, minx - (f.center_x - f.radius)),
-        right: keep(cut.right, b.maxx + 1 >= w, f.center_x + f.radius - maxx),
-        top: keep(cut.top, b.miny == 0, miny - (f.center_y - f.radius)),
-        bottom: keep(cut.bottom, b.maxy + 1 >= h, f.center_y + f.radius - maxy),
+        left: keep(cut.left, b.min_x == 0, minx - (f.center_x - f.radius)),
+        right: keep(cut.right, b.max_x + 1 >= w, f.center_x + f.radius - maxx),
+        top: keep(cut.top, b.min_y == 0, miny - (f.center_y - f.radius)),
+        bottom: keep(cut.bottom, b.max_y + 1 >= h, f.center_y + f.radius - maxy),
     }
 }
 

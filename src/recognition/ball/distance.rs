@@ -4,8 +4,9 @@
 use super::BallParams;
 use super::circle::CircleStage;
 use super::outline::Outline;
+use crate::geometry::{ImagePoint, PinholeCamera};
 use crate::recognition::context::ViewContext;
-use crate::recognition::fit::{Point, ShearedCircleFit, fit_circle_trimmed};
+use crate::recognition::fit::{ShearedCircleFit, fit_circle_trimmed};
 
 /// Camera distance to the ball's centre, centimetres: from the outline's angle when the circle
 /// fit is used, else from the circle; fused with the ground plane when that is on.
@@ -13,7 +14,7 @@ pub(super) fn ball_distance(
     ctx: &ViewContext,
     outline: &Outline,
     circle: &CircleStage,
-    center: Point,
+    center: ImagePoint,
     radius: f64,
     params: &BallParams,
 ) -> f64 {
@@ -45,30 +46,26 @@ pub(super) fn observed_center(
     ctx: &ViewContext,
     outline: &Outline,
     moving: Option<&ShearedCircleFit>,
-    center: Point,
+    center: ImagePoint,
     params: &BallParams,
-) -> Point {
+) -> ImagePoint {
     let observed = if params.skew_correction {
         let shift = outline.box_shift;
-        let mut p = (center.0 - shift.0, center.1 - shift.1);
+        let mut p = center - shift;
         for _ in 0..3 {
             let q = outline.unskew(ctx, params, p);
-            p = (center.0 - (q.0 - p.0), center.1 - (q.1 - p.1));
+            p = center - (q - p);
         }
-        if p.0.is_finite() && p.1.is_finite() {
-            p
-        } else {
-            center
-        }
+        if p.is_finite() { p } else { center }
     } else {
         center
     };
     match moving {
         Some(e) => {
-            let lines = observed.1 - ctx.reference_row();
-            (
-                observed.0 + e.shear_x * lines,
-                observed.1 + e.shear_y * lines,
+            let lines = observed.y_px - ctx.reference_row();
+            ImagePoint::new(
+                observed.x_px + e.shear_x * lines,
+                observed.y_px + e.shear_y * lines,
             )
         }
         None => observed,
@@ -81,7 +78,7 @@ pub(super) fn observed_center(
 /// disagree by more than a factor of two (a ball in the air or held), the size distance stands.
 fn fuse_with_ground_plane(
     ctx: &ViewContext,
-    center: Point,
+    center: ImagePoint,
     radius: f64,
     radius_sigma_px: f64,
     size_distance: f64,
@@ -90,8 +87,7 @@ fn fuse_with_ground_plane(
     let Some(pose) = ctx.pose else {
         return size_distance;
     };
-    let ip = crate::geometry::ImagePoint::new(center.0, center.1);
-    let Some(hit) = pose.point_on_plane(ip, params.diameter_cm / 2.0) else {
+    let Some(hit) = pose.point_on_plane(center, params.diameter_cm / 2.0) else {
         return size_distance;
     };
     let plane = hit.distance_to(&pose.position());
@@ -118,15 +114,17 @@ fn fuse_with_ground_plane(
 /// Falls back to d × diameter / (2 × radius) when the rays are degenerate.
 #[must_use]
 pub fn distance_from_circle(
-    camera: &crate::geometry::PinholeCamera,
-    center: Point,
+    camera: &PinholeCamera,
+    center: ImagePoint,
     radius: f64,
     diameter_cm: f64,
 ) -> f64 {
-    use crate::geometry::ImagePoint;
     let radius = radius.max(0.25);
     let fallback = camera.focal_px * diameter_cm / (2.0 * radius);
-    let (dx, dy) = (center.0 - camera.centre.x_px, center.1 - camera.centre.y_px);
+    let (dx, dy) = (
+        center.x_px - camera.centre.x_px,
+        center.y_px - camera.centre.y_px,
+    );
     let off = dx.hypot(dy);
     let u = if off > 1e-6 {
         (dx / off, dy / off)
@@ -135,12 +133,12 @@ pub fn distance_from_circle(
     };
     let half_angle = |dir: (f64, f64)| {
         let a = camera.unit_ray(ImagePoint::new(
-            center.0 + radius * dir.0,
-            center.1 + radius * dir.1,
+            center.x_px + radius * dir.0,
+            center.y_px + radius * dir.1,
         ));
         let b = camera.unit_ray(ImagePoint::new(
-            center.0 - radius * dir.0,
-            center.1 - radius * dir.1,
+            center.x_px - radius * dir.0,
+            center.y_px - radius * dir.1,
         ));
         a.coords.dot(&b.coords).clamp(-1.0, 1.0).acos() / 2.0
     };
@@ -161,24 +159,24 @@ pub fn distance_from_circle(
 /// only the side facing the image centre, whose curvature is not the fitted circle's mean).
 /// `None` when the points do not fit a circle.
 fn angular_radius(
-    camera: &crate::geometry::PinholeCamera,
-    points: &[Point],
-    center: Point,
+    camera: &PinholeCamera,
+    points: &[ImagePoint],
+    center: ImagePoint,
     params: &BallParams,
 ) -> Option<f64> {
-    use crate::geometry::ImagePoint;
-    let ray = |p: Point| camera.unit_ray(ImagePoint::new(p.0, p.1)).coords;
+    let ray = |p: ImagePoint| camera.unit_ray(p).coords;
     let e1 = ray(center);
-    let side = ray((center.0 + 1.0, center.1));
+    let side = ray(ImagePoint::new(center.x_px + 1.0, center.y_px));
     let e2 = (side - e1 * side.dot(&e1)).try_normalize(1e-12)?;
     let e3 = e1.cross(&e2);
     let f = camera.focal_px;
-    let turned: Vec<Point> = points
+    // The outline in that virtual camera's image, pixels.
+    let turned: Vec<ImagePoint> = points
         .iter()
         .filter_map(|&p| {
             let r = ray(p);
             let along = r.dot(&e1);
-            (along > 1e-6).then(|| (f * r.dot(&e2) / along, f * r.dot(&e3) / along))
+            (along > 1e-6).then(|| ImagePoint::new(f * r.dot(&e2) / along, f * r.dot(&e3) / along))
         })
         .collect();
     if turned.len() < 5 {
@@ -199,16 +197,16 @@ fn angular_radius(
 /// centres now and 10 ms later.
 pub(super) fn ground_velocity(
     ctx: &ViewContext,
-    center: Point,
+    center: ImagePoint,
     v_px_s: (f64, f64),
     params: &BallParams,
 ) -> Option<[f64; 2]> {
     let pose = ctx.pose?;
     let dt = 0.01;
     let z = params.diameter_cm / 2.0;
-    let a = pose.point_on_plane(crate::geometry::ImagePoint::new(center.0, center.1), z)?;
+    let a = pose.point_on_plane(center, z)?;
     let b = pose.point_on_plane(
-        crate::geometry::ImagePoint::new(center.0 + v_px_s.0 * dt, center.1 + v_px_s.1 * dt),
+        ImagePoint::new(center.x_px + v_px_s.0 * dt, center.y_px + v_px_s.1 * dt),
         z,
     )?;
     let v = [(b.x() - a.x()) / dt, (b.y() - a.y()) / dt];

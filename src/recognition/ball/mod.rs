@@ -21,10 +21,13 @@ use serde::{Deserialize, Serialize};
 use super::confidence::{Confidence, TestWeight};
 use super::context::{Relative, ViewContext};
 use super::draw::{CircleRole, Primitive};
-use super::fit::{CircleFit, Point, ShearedCircleFit};
+use super::fit::{CircleFit, ShearedCircleFit};
 use super::scan::{CutOff, EdgeScanPattern, MixedEdge, ScanArea};
 use crate::blobs::BlobSet;
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
+use crate::frame::xy_array;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 
 pub use circle::FitRejection;
@@ -272,8 +275,8 @@ pub struct Ball {
     pub center_y: f64,
     /// Centre where the ball appears in the image (each row at its own read-out time), pixels:
     /// equal to the centre without skew; several pixels away on a fast pan.
-    #[serde(default)]
-    pub observed_center: Point,
+    #[serde(default, with = "xy_array")]
+    pub observed_center: ImagePoint,
     /// Radius, pixels.
     pub radius_px: f64,
     /// Camera-relative distance, bearing, elevation.
@@ -300,8 +303,8 @@ pub struct Ball {
 /// One scored candidate, accepted or not, with everything that decided it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BallCandidate {
-    /// `[minx, miny, maxx, maxy]`, inclusive pixels (joined blobs).
-    pub bounds: [u32; 4],
+    /// The joined blobs' box, inclusive pixels.
+    pub bounds: PixelBox,
     /// Pixels of ball colours in the joined blobs.
     pub pixels: u32,
     /// Pixels of basic orange.
@@ -313,11 +316,12 @@ pub struct BallCandidate {
     /// The edge-scan pattern used.
     pub pattern: EdgeScanPattern,
     /// Outline points after skew removal, pixels.
-    pub edge_points: Vec<Point>,
+    #[serde(with = "xy_array")]
+    pub edge_points: Vec<ImagePoint>,
     /// The outline points where the scans found them in the image (before skew removal),
     /// pixels: what the overlay draws.
-    #[serde(default)]
-    pub scanned_points: Vec<Point>,
+    #[serde(default, with = "xy_array")]
+    pub scanned_points: Vec<ImagePoint>,
     /// The circle fit, if one was found.
     pub fit: Option<CircleFit>,
     /// The moving-circle (constrained ellipse) fit, when [`BallParams::ellipse_fit`] is on and
@@ -329,10 +333,11 @@ pub struct BallCandidate {
     /// The colour-below scan area.
     pub below: Option<ScanArea>,
     /// Estimated centre, pixels, at the reference read-out time (skew removed).
-    pub center: Point,
+    #[serde(with = "xy_array")]
+    pub center: ImagePoint,
     /// The centre where the ball appears in the image, pixels (see [`Ball::observed_center`]).
-    #[serde(default)]
-    pub observed_center: Point,
+    #[serde(default, with = "xy_array")]
+    pub observed_center: ImagePoint,
     /// Estimated radius, pixels.
     pub radius_px: f64,
     /// Camera-relative estimate.
@@ -369,11 +374,11 @@ pub fn recognise_ball(
     let mut result = BallResult::default();
     for (group, orange_pixels) in outline::candidate_groups(blobs, params) {
         let mut outline = outline::Outline::scan(img, &group, ctx, params);
-        let circle = circle::CircleStage::fit(&outline, &group, ctx, params);
+        let circle = circle::CircleStage::fit(&outline, ctx, params);
         if let Some(fit) = circle.fit.as_ref().filter(|_| circle.used()) {
             outline.cut = circle::confirmed_cut(
                 fit,
-                &group,
+                outline.bounds,
                 outline.cut,
                 outline.box_shift,
                 (img.width() as u32, img.height() as u32),
@@ -404,8 +409,8 @@ pub fn recognise_ball(
             let image_velocity = circle.moving.map(|e| e.velocity_px_s(line_s));
             result.ball = Some(Ball {
                 candidate: index,
-                center_x: center.0,
-                center_y: center.1,
+                center_x: center.x_px,
+                center_y: center.y_px,
                 observed_center,
                 radius_px: radius,
                 camera,
@@ -455,7 +460,7 @@ impl BallResult {
             out.push(Primitive::Box {
                 owner,
                 colour: ColourClass::Orange.code(),
-                bounds: c.bounds.into(),
+                bounds: c.bounds,
             });
             if let Some(area) = c.below {
                 out.push(Primitive::ScanArea {
@@ -479,7 +484,7 @@ impl BallResult {
                     radius: c.radius_px,
                     role: CircleRole::Observed,
                 });
-                if (c.center.0 - seen.0).hypot(c.center.1 - seen.1) > 0.5 {
+                if c.center.distance_to(&seen) > 0.5 {
                     out.push(Primitive::Circle {
                         owner,
                         center: c.center,
@@ -489,7 +494,7 @@ impl BallResult {
                 }
                 out.push(Primitive::Label {
                     owner,
-                    at: (seen.0, seen.1 - c.radius_px - 2.0),
+                    at: ImagePoint::new(seen.x_px, seen.y_px - c.radius_px - 2.0),
                     text: format!(
                         "ball {:.0} cm {:+.0}°",
                         c.camera.distance_cm,

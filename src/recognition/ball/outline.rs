@@ -5,33 +5,34 @@
 use super::{BallParams, is_ball_colour};
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
+use crate::frame::PixelBox;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::context::ViewContext;
-use crate::recognition::fit::Point;
 use crate::recognition::scan::{CutOff, EdgeScanPattern, edge_points_with_mixed};
 
 /// One candidate's outline: where the scans found it and where it is at the reference row's
 /// read-out time, with the box's own estimate beside it.
 #[derive(Debug, Clone)]
 pub(super) struct Outline {
-    /// The group's box `[minx, miny, maxx, maxy]`, inclusive pixels.
-    pub bounds: [u32; 4],
+    /// The group's box, inclusive pixels.
+    pub bounds: PixelBox,
     /// Sides cut off by the image edge or hidden.
     pub cut: CutOff,
     /// The edge-scan pattern the cut sides chose.
     pub pattern: EdgeScanPattern,
     /// Outline points after skew removal (when on), pixels.
-    pub points: Vec<Point>,
+    pub points: Vec<ImagePoint>,
     /// Outline points where the scans found them, pixels.
-    pub scanned_points: Vec<Point>,
+    pub scanned_points: Vec<ImagePoint>,
     /// Each scanned point's image row (its read-out time).
     pub rows: Vec<f64>,
-    /// Centre and radius from the box alone, pixels.
-    pub box_centre: Point,
+    /// Centre from the box alone, pixels.
+    pub box_centre: ImagePoint,
     /// Radius from the box alone, pixels.
     pub box_radius: f64,
     /// How far the skew removal moved the box's centre, pixels.
-    pub box_shift: Point,
+    pub box_shift: ImagePoint,
     /// Box width and height, pixels.
     pub width: f64,
     /// Box height, pixels.
@@ -48,14 +49,14 @@ impl Outline {
         ctx: &ViewContext,
         params: &BallParams,
     ) -> Self {
+        let bounds = group.bounds();
         let cut = cut_off(
             img,
-            group,
+            bounds,
             params.border_cut_min_share,
             params.hidden_min_chord_share,
             params.hidden_chord_min_radius_px,
         );
-        let bounds = [group.minx, group.miny, group.maxx, group.maxy];
         let pattern = EdgeScanPattern::for_cut_off(cut);
         let mut points = edge_points_with_mixed(
             img,
@@ -67,20 +68,20 @@ impl Outline {
             |c| c == ColourClass::Unclassified.code(),
             params.mixed_edge,
         );
-        let (box_centre, box_radius) = box_estimate(group, cut);
+        let (box_centre, box_radius) = box_estimate(bounds, cut);
         // Move every outline point to the read-out time of the reference row, the instant the
         // sensor readings describe: this removes the shear and puts the ball where the camera
         // pose says it is. The body model needs a depth: the distance the box's size implies.
         let depth_cm = ctx.camera.focal_px * params.diameter_cm / (2.0 * box_radius.max(0.5));
         let scanned_points = points.clone();
-        let rows: Vec<f64> = points.iter().map(|p| p.1).collect();
-        let mut box_shift = (0.0, 0.0);
+        let rows: Vec<f64> = points.iter().map(|p| p.y_px).collect();
+        let mut box_shift = ImagePoint::default();
         if params.skew_correction {
             for p in &mut points {
                 *p = unskew_point(ctx, params, *p, depth_cm);
             }
             let c = unskew_point(ctx, params, box_centre, depth_cm);
-            box_shift = (c.0 - box_centre.0, c.1 - box_centre.1);
+            box_shift = c - box_centre;
         }
         Self {
             bounds,
@@ -92,8 +93,8 @@ impl Outline {
             box_centre,
             box_radius,
             box_shift,
-            width: f64::from(group.maxx - group.minx + 1),
-            height: f64::from(group.maxy - group.miny + 1),
+            width: f64::from(bounds.width_px()),
+            height: f64::from(bounds.height_px()),
             depth_cm,
         }
     }
@@ -111,7 +112,7 @@ impl Outline {
     }
 
     /// `p` moved to the reference row's read-out time at this outline's depth.
-    pub fn unskew(&self, ctx: &ViewContext, params: &BallParams, p: Point) -> Point {
+    pub fn unskew(&self, ctx: &ViewContext, params: &BallParams, p: ImagePoint) -> ImagePoint {
         unskew_point(ctx, params, p, self.depth_cm)
     }
 }
@@ -121,13 +122,6 @@ fn is_robot_colour(code: u8) -> bool {
         ColourClass::from_code(code),
         Some(ColourClass::White | ColourClass::Red | ColourClass::DarkBlue | ColourClass::Black)
     )
-}
-
-fn near(a: &Blob, b: &Blob, gap: u32) -> bool {
-    a.minx <= b.maxx + gap + 1
-        && b.minx <= a.maxx + gap + 1
-        && a.miny <= b.maxy + gap + 1
-        && b.miny <= a.maxy + gap + 1
 }
 
 /// Candidate groups: each orange blob joined with the soft-orange blobs near it, then soft blobs
@@ -142,7 +136,7 @@ pub(super) fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blo
     for orange in blobs.of_class(ColourClass::Orange) {
         let mut joined = *orange;
         for (i, s) in soft.iter().enumerate() {
-            if !used[i] && near(&joined, s, params.soft_join_px) {
+            if !used[i] && joined.bounds().is_near(&s.bounds(), params.soft_join_px) {
                 joined = joined.merged_with(s);
                 used[i] = true;
             }
@@ -160,7 +154,7 @@ pub(super) fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blo
     groups
 }
 
-/// Which sides of `b` are cut by the image border or hidden: cut when at least `border_share` of
+/// Which sides of the box `b` are cut by the image border or hidden: cut when at least `border_share` of
 /// the box's own line along the border is ball-coloured; hidden when a robot's white, red, dark
 /// blue or black borders most of that side *and* at least `hidden_share` of the box's line
 /// there is ball-coloured (for a box at least `2 × hidden_min_radius_px` long there; shorter
@@ -169,7 +163,7 @@ pub(super) fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blo
 /// its white stand on the B-Human recording is round there, not hidden).
 fn cut_off(
     img: &ClassifiedImage,
-    b: &Blob,
+    b: PixelBox,
     border_share: f64,
     hidden_share: f64,
     hidden_min_radius_px: f64,
@@ -196,10 +190,10 @@ fn cut_off(
         n >= 3 && robot * 2 > n
     };
     let (minx, miny, maxx, maxy) = (
-        i64::from(b.minx),
-        i64::from(b.miny),
-        i64::from(b.maxx),
-        i64::from(b.maxy),
+        i64::from(b.min_x),
+        i64::from(b.min_y),
+        i64::from(b.max_x),
+        i64::from(b.max_y),
     );
     let rows = |x: i64| (miny..=maxy).map(|y| (x, y)).collect::<Vec<_>>();
     let columns = |y: i64| (minx..=maxx).map(|x| (x, y)).collect::<Vec<_>>();
@@ -214,18 +208,18 @@ fn cut_off(
         }
     };
     CutOff {
-        left: side(b.minx == 0, rows(minx), rows(minx - 1)),
-        right: side(b.maxx + 1 >= w, rows(maxx), rows(maxx + 1)),
-        top: side(b.miny == 0, columns(miny), columns(miny - 1)),
-        bottom: side(b.maxy + 1 >= h, columns(maxy), columns(maxy + 1)),
+        left: side(b.min_x == 0, rows(minx), rows(minx - 1)),
+        right: side(b.max_x + 1 >= w, rows(maxx), rows(maxx + 1)),
+        top: side(b.min_y == 0, columns(miny), columns(miny - 1)),
+        bottom: side(b.max_y + 1 >= h, columns(maxy), columns(maxy + 1)),
     }
 }
 
 /// Centre and radius from the box alone: the uncut extent is the diameter; a cut side puts the
 /// centre a radius from the visible opposite side.
-fn box_estimate(b: &Blob, cut: CutOff) -> (Point, f64) {
-    let w = f64::from(b.maxx - b.minx + 1);
-    let h = f64::from(b.maxy - b.miny + 1);
+fn box_estimate(b: PixelBox, cut: CutOff) -> (ImagePoint, f64) {
+    let w = f64::from(b.width_px());
+    let h = f64::from(b.height_px());
     let horizontal_cut = cut.left || cut.right;
     let vertical_cut = cut.top || cut.bottom;
     let r = match (horizontal_cut, vertical_cut) {
@@ -235,21 +229,26 @@ fn box_estimate(b: &Blob, cut: CutOff) -> (Point, f64) {
         (true, true) => w.max(h) / 2.0,
     };
     let cx = match (cut.left, cut.right) {
-        (true, false) => f64::from(b.maxx + 1) - r,
-        (false, true) => f64::from(b.minx) + r,
-        _ => f64::from(b.minx) + w / 2.0,
+        (true, false) => f64::from(b.max_x + 1) - r,
+        (false, true) => f64::from(b.min_x) + r,
+        _ => f64::from(b.min_x) + w / 2.0,
     };
     let cy = match (cut.top, cut.bottom) {
-        (true, false) => f64::from(b.maxy + 1) - r,
-        (false, true) => f64::from(b.miny) + r,
-        _ => f64::from(b.miny) + h / 2.0,
+        (true, false) => f64::from(b.max_y + 1) - r,
+        (false, true) => f64::from(b.min_y) + r,
+        _ => f64::from(b.min_y) + h / 2.0,
     };
-    ((cx, cy), r)
+    (ImagePoint::new(cx, cy), r)
 }
 
 /// One outline point moved to the reference row's read-out time: through the body model when
 /// asked and possible, else by the linear shear; `depth_cm` is the point's distance estimate.
-fn unskew_point(ctx: &ViewContext, params: &BallParams, p: Point, depth_cm: f64) -> Point {
+fn unskew_point(
+    ctx: &ViewContext,
+    params: &BallParams,
+    p: ImagePoint,
+    depth_cm: f64,
+) -> ImagePoint {
     if params.pose_skew_model && ctx.motion.is_some() && ctx.pose.is_some() {
         ctx.unskew_at(p, depth_cm, params.vertical_skew_correction)
     } else {

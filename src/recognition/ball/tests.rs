@@ -34,25 +34,25 @@ fn scene(cx: f64, cy: f64, r: f64, shear: f64) -> ClassifiedImage {
     ClassifiedImage::from_codes(w, h, codes).expect("size")
 }
 
-fn true_ball(ctx: &ViewContext, x: f64, y: f64) -> (Point, f64, f64) {
+fn true_ball(ctx: &ViewContext, x: f64, y: f64) -> (ImagePoint, f64, f64) {
     let pose = ctx.pose.expect("pose");
     let centre = GeoPoint::new(x, y, 4.25);
     let p = pose.image_from_field(&centre).expect("in front");
     let cam = pose.position();
     let dist = cam.distance_to(&centre);
-    ((p.x_px, p.y_px), ctx.camera.focal_px * 4.25 / dist, dist)
+    (p, ctx.camera.focal_px * 4.25 / dist, dist)
 }
 
 #[test]
 fn finds_a_ball_on_the_field_with_distance_from_the_circle() {
     let ctx = level_context();
     let (c, r, dist) = true_ball(&ctx, 90.0, 10.0);
-    let img = scene(c.0, c.1, r, 0.0);
+    let img = scene(c.x_px, c.y_px, r, 0.0);
     let blobs = BlobSet::from_image(&img, Connectivity::Eight);
     let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
     let ball = res.ball.clone().expect("ball");
     assert!(ball.from_circle_fit);
-    assert!((ball.center_x - c.0).abs() < 0.6 && (ball.center_y - c.1).abs() < 0.6);
+    assert!((ball.center_x - c.x_px).abs() < 0.6 && (ball.center_y - c.y_px).abs() < 0.6);
     let err = (ball.camera.distance_cm - dist).abs() / dist;
     assert!(err < 0.05, "distance {} vs {dist}", ball.camera.distance_cm);
     assert!(ball.body.is_some());
@@ -68,6 +68,36 @@ fn finds_a_ball_on_the_field_with_distance_from_the_circle() {
             .is_some_and(|t| t.effect > 0.0)
     );
     assert!(!res.primitives().is_empty());
+}
+
+#[test]
+fn ball_points_are_written_as_x_y_arrays_and_read_back() {
+    let ctx = level_context();
+    let (c, r, _) = true_ball(&ctx, 90.0, 10.0);
+    let img = scene(c.x_px, c.y_px, r, 0.0);
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
+    let cand = &res.candidates[0];
+    let json = serde_json::to_value(cand).expect("json");
+    let centre = &json["center"];
+    assert_eq!(centre[0].as_f64(), Some(cand.center.x_px), "{centre}");
+    assert_eq!(centre[1].as_f64(), Some(cand.center.y_px), "{centre}");
+    let first = &json["edge_points"][0];
+    assert_eq!(first[0].as_f64(), Some(cand.edge_points[0].x_px), "{first}");
+    assert!(json["bounds"].is_array() && json["observed_center"].is_array());
+    // (A whole candidate does not read back: an open test range is written as null.)
+    #[derive(serde::Deserialize)]
+    struct Points {
+        #[serde(with = "xy_array")]
+        center: ImagePoint,
+        #[serde(with = "xy_array")]
+        edge_points: Vec<ImagePoint>,
+    }
+    let back: Points = serde_json::from_value(json).expect("read back");
+    assert_eq!(
+        (back.center, back.edge_points),
+        (cand.center, cand.edge_points.clone())
+    );
 }
 
 #[test]
@@ -93,7 +123,7 @@ fn a_ball_cut_by_the_image_edge_keeps_its_distance() {
     let y = (0..400)
         .map(|i| f64::from(i) * 0.1)
         .min_by(|a, b| {
-            let off = |y: f64| (true_ball(&ctx, 45.0, y).0.0 - 0.4 * r0).abs();
+            let off = |y: f64| (true_ball(&ctx, 45.0, y).0.x_px - 0.4 * r0).abs();
             off(*a).total_cmp(&off(*b))
         })
         .expect("positions");
@@ -112,9 +142,7 @@ fn a_ball_cut_by_the_image_edge_keeps_its_distance() {
     let (w, h) = (208usize, 160usize);
     let codes = (0..w * h)
         .map(|i| {
-            let ray = ctx
-                .camera
-                .unit_ray(crate::geometry::ImagePoint::pixel_centre(i % w, i / w));
+            let ray = ctx.camera.unit_ray(ImagePoint::pixel_centre(i % w, i / w));
             if ray.coords.dot(&towards) >= cos_alpha {
                 ColourClass::Orange.code()
             } else {
@@ -131,10 +159,10 @@ fn a_ball_cut_by_the_image_edge_keeps_its_distance() {
     // The visible arc is the flatter inner side of the ellipse: the circle through it sits
     // a little inwards.
     assert!(
-        (ball.center_x - c.0).abs() < 3.0,
+        (ball.center_x - c.x_px).abs() < 3.0,
         "{} vs {}",
         ball.center_x,
-        c.0
+        c.x_px
     );
     let err = (ball.camera.distance_cm - dist) / dist;
     assert!(
@@ -158,7 +186,12 @@ fn distance_from_the_subtended_angle_holds_across_the_image() {
         let a = f / 2.0 * ((t + alpha).tan() - (t - alpha).tan());
         let b = f * alpha.sin() / (t.cos().powi(2) - alpha.sin().powi(2)).sqrt();
         let centre_x = camera.centre.x_px + f / 2.0 * ((t + alpha).tan() + (t - alpha).tan());
-        let d = distance_from_circle(&camera, (centre_x, camera.centre.y_px), (a + b) / 2.0, 8.5);
+        let d = distance_from_circle(
+            &camera,
+            ImagePoint::new(centre_x, camera.centre.y_px),
+            (a + b) / 2.0,
+            8.5,
+        );
         assert!((d - 100.0).abs() < 0.5, "{theta_deg}°: {d}");
     }
 }
@@ -168,7 +201,7 @@ fn skew_correction_restores_the_radius_of_a_sheared_ball() {
     let mut ctx = level_context();
     let (c, r, _) = true_ball(&ctx, 70.0, 0.0);
     let shear = 0.6;
-    let img = scene(c.0, c.1, r, shear);
+    let img = scene(c.x_px, c.y_px, r, shear);
     let blobs = BlobSet::from_image(&img, Connectivity::Eight);
     let plain = recognise_ball(
         &img,
@@ -193,7 +226,7 @@ fn ellipse_fit_gives_the_image_velocity_of_a_moving_ball() {
     let (c, r, _) = true_ball(&ctx, 45.0, 0.0);
     // Moving right 0.25 px per line (1200 px/s at 160 lines in 1/30 s), centred on the
     // reference row.
-    let img = scene(c.0, 80.0, r, 0.25);
+    let img = scene(c.x_px, 80.0, r, 0.25);
     let blobs = BlobSet::from_image(&img, Connectivity::Eight);
     let plain = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
     let plain = plain.ball.expect("plain");
@@ -217,12 +250,12 @@ fn ellipse_fit_gives_the_image_velocity_of_a_moving_ball() {
 fn soft_orange_joins_and_a_frame_without_orange_has_no_candidates() {
     let ctx = level_context();
     let (c, r, _) = true_ball(&ctx, 80.0, 0.0);
-    let mut img = scene(c.0, c.1, r, 0.0);
+    let mut img = scene(c.x_px, c.y_px, r, 0.0);
     // Paint the lower half of the ball red-orange (shadow).
     let w = img.width();
     let codes = img.codes_mut();
     for (i, code) in codes.iter_mut().enumerate() {
-        if *code == ColourClass::Orange.code() && (i / w) as f64 > c.1 {
+        if *code == ColourClass::Orange.code() && (i / w) as f64 > c.y_px {
             *code = ColourClass::RedOrange.code();
         }
     }
@@ -369,7 +402,7 @@ fn a_thin_orange_arc_does_not_fill_its_circle() {
         })
         .collect();
     let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
-    assert!(circle_fill(&img, (cx, cy), r).is_some_and(|f| f < 0.2));
+    assert!(circle_fill(&img, ImagePoint::new(cx, cy), r).is_some_and(|f| f < 0.2));
     let blobs = BlobSet::from_image(&img, Connectivity::Eight);
     let res = recognise_ball(&img, &blobs, &ctx, &BallParams::default());
     assert!(res.ball.is_none(), "{:?}", res.candidates[0].confidence);
@@ -380,7 +413,10 @@ fn a_thin_orange_arc_does_not_fill_its_circle() {
     assert!(fill.effect < 0.0, "{fill:?}");
     // A whole disc fills its circle; one outside the image has no fill.
     let disc = scene(60.0, 60.0, 8.0, 0.0);
-    assert!(circle_fill(&disc, (60.0, 60.0), 8.0).is_some_and(|f| f > 0.95));
-    assert_eq!(circle_fill(&disc, (-50.0, 60.0), 8.0), None);
-    assert_eq!(circle_fill(&disc, (60.0, 60.0), f64::NAN), None);
+    assert!(circle_fill(&disc, ImagePoint::new(60.0, 60.0), 8.0).is_some_and(|f| f > 0.95));
+    assert_eq!(circle_fill(&disc, ImagePoint::new(-50.0, 60.0), 8.0), None);
+    assert_eq!(
+        circle_fill(&disc, ImagePoint::new(60.0, 60.0), f64::NAN),
+        None
+    );
 }

@@ -3,9 +3,9 @@
 
 use super::*;
 use crate::blobs::{Blob, BlobSet};
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::context::ViewContext;
-use crate::recognition::fit::{Point, rotate_about};
 use crate::recognition::scan::CutOff;
 
 /// A candidate while it is being built: the joined blob and its basic-colour part.
@@ -16,27 +16,38 @@ pub(super) struct Group {
     pub members: Vec<u32>,
 }
 
-pub(super) fn level_extent(b: &Blob, centre: Point, angle: f64) -> [f64; 4] {
-    let corners = [
-        (f64::from(b.minx), f64::from(b.miny)),
-        (f64::from(b.maxx + 1), f64::from(b.miny)),
-        (f64::from(b.maxx + 1), f64::from(b.maxy + 1)),
-        (f64::from(b.minx), f64::from(b.maxy + 1)),
-    ];
+/// The level-frame extent `[min x, min y, max x, max y]` (pixels) of image points rotated by
+/// `angle` about `centre`; infinite (min above max) for none.
+fn rotated_extent(
+    points: impl IntoIterator<Item = ImagePoint>,
+    centre: ImagePoint,
+    angle: f64,
+) -> [f64; 4] {
     let mut e = [
         f64::INFINITY,
         f64::INFINITY,
         f64::NEG_INFINITY,
         f64::NEG_INFINITY,
     ];
-    for c in corners {
-        let p = rotate_about(c, centre, angle);
-        e[0] = e[0].min(p.0);
-        e[1] = e[1].min(p.1);
-        e[2] = e[2].max(p.0);
-        e[3] = e[3].max(p.1);
+    for p in points {
+        let q = p.rotated_about(centre, angle);
+        e[0] = e[0].min(q.x_px);
+        e[1] = e[1].min(q.y_px);
+        e[2] = e[2].max(q.x_px);
+        e[3] = e[3].max(q.y_px);
     }
     e
+}
+
+/// Level-frame extent of a blob's box (its corners, rotated), pixels.
+pub(super) fn level_extent(b: &Blob, centre: ImagePoint, angle: f64) -> [f64; 4] {
+    let corners = [
+        ImagePoint::new(f64::from(b.minx), f64::from(b.miny)),
+        ImagePoint::new(f64::from(b.maxx + 1), f64::from(b.miny)),
+        ImagePoint::new(f64::from(b.maxx + 1), f64::from(b.maxy + 1)),
+        ImagePoint::new(f64::from(b.minx), f64::from(b.maxy + 1)),
+    ];
+    rotated_extent(corners, centre, angle)
 }
 
 /// Level-frame extent of the pixels of some blobs (their runs' ends, rotated), tighter than
@@ -44,27 +55,19 @@ pub(super) fn level_extent(b: &Blob, centre: Point, angle: f64) -> [f64; 4] {
 pub(super) fn pixel_level_extent(
     blobs: &BlobSet,
     members: impl Iterator<Item = u32>,
-    centre: Point,
+    centre: ImagePoint,
     angle: f64,
 ) -> Option<[f64; 4]> {
-    let mut e = [
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    ];
-    for m in members {
-        for r in blobs.runs_of(m) {
-            let (x0, x1, y) = (f64::from(r.x0), f64::from(r.x1), f64::from(r.y));
-            for c in [(x0, y), (x1, y), (x0, y + 1.0), (x1, y + 1.0)] {
-                let q = rotate_about(c, centre, angle);
-                e[0] = e[0].min(q.0);
-                e[1] = e[1].min(q.1);
-                e[2] = e[2].max(q.0);
-                e[3] = e[3].max(q.1);
-            }
-        }
-    }
+    let run_ends = members.flat_map(|m| blobs.runs_of(m)).flat_map(|r| {
+        let (x0, x1, y) = (f64::from(r.x0), f64::from(r.x1), f64::from(r.y));
+        [
+            ImagePoint::new(x0, y),
+            ImagePoint::new(x1, y),
+            ImagePoint::new(x0, y + 1.0),
+            ImagePoint::new(x1, y + 1.0),
+        ]
+    });
+    let e = rotated_extent(run_ends, centre, angle);
     (e[0] < e[2] && e[1] < e[3]).then_some(e)
 }
 
@@ -101,7 +104,7 @@ pub(super) fn build_groups(
         groups.push(g);
     }
     // Merge until stable: near, lined up, or split by a goalkeeper (level tops/bottoms equal).
-    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let centre = ctx.camera.centre;
     let angle = ctx.horizon_angle();
     loop {
         let mut merged = false;
@@ -145,17 +148,18 @@ pub(super) fn build_groups(
 /// the image; a side is cut off when two or more of its three points are near or outside the edge.
 pub(super) fn detect_cut_off(
     e: [f64; 4],
-    centre: Point,
+    centre: ImagePoint,
     angle: f64,
     w: f64,
     h: f64,
     margin: f64,
 ) -> CutOff {
-    let un = |x: f64, y: f64| rotate_about((x, y), centre, -angle);
+    let un = |x: f64, y: f64| ImagePoint::new(x, y).rotated_about(centre, -angle);
     let (mx, my) = ((e[0] + e[2]) / 2.0, (e[1] + e[3]) / 2.0);
-    let at_edge =
-        |p: Point| p.0 <= margin || p.1 <= margin || p.0 >= w - margin || p.1 >= h - margin;
-    let count = |pts: [Point; 3]| pts.iter().filter(|p| at_edge(**p)).count() >= 2;
+    let at_edge = |p: ImagePoint| {
+        p.x_px <= margin || p.y_px <= margin || p.x_px >= w - margin || p.y_px >= h - margin
+    };
+    let count = |pts: [ImagePoint; 3]| pts.iter().filter(|p| at_edge(**p)).count() >= 2;
     CutOff {
         left: count([un(e[0], e[1]), un(e[0], my), un(e[0], e[3])]),
         right: count([un(e[2], e[1]), un(e[2], my), un(e[2], e[3])]),

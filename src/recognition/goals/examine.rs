@@ -8,7 +8,6 @@ use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::confidence::{Confidence, TestName, TestWeight};
 use crate::recognition::context::{Relative, ViewContext};
-use crate::recognition::fit::{Point, rotate_about};
 use crate::recognition::scan::{CutOff, scan_rotated_rect};
 
 /// What the level frame shows of one candidate.
@@ -21,7 +20,7 @@ struct LevelShape {
     /// pixels.
     height_px: f64,
     /// The middle of the foot, image pixels.
-    bottom_mid: Point,
+    bottom_mid: ImagePoint,
 }
 
 pub(super) fn examine(
@@ -35,15 +34,9 @@ pub(super) fn examine(
     let shape = level_shape(img, blobs, g, colour, ctx, p);
     let (distance, from_ground, from_ir) = goal_distance(ctx, p, &shape);
     let (cut, e_all, height_px) = (shape.cut, shape.e_all, shape.height_px);
-    let (centre, angle) = (
-        (ctx.camera.centre.x_px, ctx.camera.centre.y_px),
-        ctx.horizon_angle(),
-    );
-    let mut mid = rotate_about(
-        ((e_all[0] + e_all[2]) / 2.0, (e_all[1] + e_all[3]) / 2.0),
-        centre,
-        -angle,
-    );
+    let (centre, angle) = (ctx.camera.centre, ctx.horizon_angle());
+    let mut mid = ImagePoint::new((e_all[0] + e_all[2]) / 2.0, (e_all[1] + e_all[3]) / 2.0)
+        .rotated_about(centre, -angle);
     if p.skew_correction {
         mid = unskew(ctx, p, mid, distance);
     }
@@ -85,7 +78,7 @@ fn level_shape(
     p: &GoalParams,
 ) -> LevelShape {
     let (w, h) = (img.width() as f64, img.height() as f64);
-    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let centre = ctx.camera.centre;
     let angle = ctx.horizon_angle();
     // Cut-off from the rotated box (its corners reach the edge when the goal does); sizes and
     // positions from the pixels themselves.
@@ -113,8 +106,8 @@ fn level_shape(
     let level_height = e_h[3] - e_h[1];
     let upright = |x: f64, top: f64, bottom: f64| {
         let (a, b) = (
-            rotate_about((x, top), centre, -angle),
-            rotate_about((x, bottom), centre, -angle),
+            ImagePoint::new(x, top).rotated_about(centre, -angle),
+            ImagePoint::new(x, bottom).rotated_about(centre, -angle),
         );
         if p.off_axis_correction {
             equivalent_height(ctx, a, b).unwrap_or(bottom - top)
@@ -140,7 +133,8 @@ fn level_shape(
             height_px = 2.0 / (1.0 / hl + 1.0 / hr);
         }
     }
-    let bottom_mid = rotate_about(((e_all[0] + e_all[2]) / 2.0, e_all[3]), centre, -angle);
+    let bottom_mid =
+        ImagePoint::new((e_all[0] + e_all[2]) / 2.0, e_all[3]).rotated_about(centre, -angle);
     LevelShape {
         cut,
         e_all,
@@ -354,7 +348,7 @@ pub(super) fn side_height(
     e: [f64; 4],
     left: bool,
     band: f64,
-    centre: Point,
+    centre: ImagePoint,
     angle: f64,
 ) -> Option<(f64, f64, f64)> {
     let columns = band.ceil() as usize;
@@ -369,8 +363,8 @@ pub(super) fn side_height(
         let (mut top, mut bottom) = (None, None);
         for i in 0..rows {
             let y = e[1] - 1.0 + i as f64;
-            let q = rotate_about((x, y + 0.5), centre, -angle);
-            if img.get_at(q.0, q.1).is_some_and(is_goal) {
+            let q = ImagePoint::new(x, y + 0.5).rotated_about(centre, -angle);
+            if img.get_at(q.x_px, q.y_px).is_some_and(is_goal) {
                 top.get_or_insert(y);
                 bottom = Some(y + 1.0);
             }
@@ -389,11 +383,17 @@ pub(super) fn side_height(
 /// elevation above the ground (the camera's own elevation without a pose). A pixel height
 /// alone shrinks off the optical axis and when looking up or down at a goal, so
 /// multiplier / height would not be a distance everywhere in the image.
-pub(super) fn equivalent_height(ctx: &ViewContext, top: Point, bottom: Point) -> Option<f64> {
-    let ray = |p: Point| ctx.camera.unit_ray(ImagePoint::new(p.0, p.1)).coords;
-    let (a, b) = (ray(top), ray(bottom));
+pub(super) fn equivalent_height(
+    ctx: &ViewContext,
+    top: ImagePoint,
+    bottom: ImagePoint,
+) -> Option<f64> {
+    let (a, b) = (
+        ctx.camera.unit_ray(top).coords,
+        ctx.camera.unit_ray(bottom).coords,
+    );
     let phi = a.dot(&b).clamp(-1.0, 1.0).acos();
-    let mid = ((top.0 + bottom.0) / 2.0, (top.1 + bottom.1) / 2.0);
+    let mid = top.midpoint(bottom);
     let elevation = match (
         ctx.height_above_ground(mid, 100.0),
         ctx.height_above_ground(mid, 0.0),

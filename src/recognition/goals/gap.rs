@@ -2,9 +2,9 @@
 
 use super::*;
 use crate::classify::ClassifiedImage;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::context::ViewContext;
-use crate::recognition::fit::{Point, rotate_about};
 
 /// The gap: the longest goal-coloured run on a level row at shoulder height.
 pub(super) fn find_gap(
@@ -14,7 +14,7 @@ pub(super) fn find_gap(
     ctx: &ViewContext,
     p: &GoalParams,
 ) {
-    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let centre = ctx.camera.centre;
     let angle = ctx.horizon_angle();
     let e = cand.level_extent;
     let is_goal = is_goal_colour(colour);
@@ -35,16 +35,18 @@ pub(super) fn find_gap(
     let mut last_goal = (f64::NEG_INFINITY, y);
     let mut x = x0;
     let (w, h) = (img.width() as f64, img.height() as f64);
+    // A level-frame point in the image.
+    let image_at = |x: f64, y: f64| ImagePoint::new(x, y).rotated_about(centre, -angle);
     while x <= x1 {
         // Where the scan row leaves the image (a goal at the top edge under a tilted horizon),
         // look down the level column to the first row inside it, above the goal's bottom.
         let mut yy = y;
-        let mut q = rotate_about((x + 0.5, yy), centre, -angle);
-        while (q.0 < 0.0 || q.1 < 0.0 || q.0 >= w || q.1 >= h) && yy + 1.0 < e[3] {
+        let mut q = image_at(x + 0.5, yy);
+        while (q.x_px < 0.0 || q.y_px < 0.0 || q.x_px >= w || q.y_px >= h) && yy + 1.0 < e[3] {
             yy += 1.0;
-            q = rotate_about((x + 0.5, yy), centre, -angle);
+            q = image_at(x + 0.5, yy);
         }
-        let goal_at = |q: Point| img.get_at(q.0, q.1).is_some_and(&is_goal);
+        let goal_at = |q: ImagePoint| img.get_at(q.x_px, q.y_px).is_some_and(&is_goal);
         // A sample moved into the image lies on its outermost rows, which vignetting and the
         // shared chroma of a cut-off pixel pair leave unclassified now and then: the next row
         // in counts too.
@@ -52,8 +54,7 @@ pub(super) fn find_gap(
             Some(yy)
         } else {
             let below = yy + 1.0;
-            (yy > y && below < e[3] && goal_at(rotate_about((x + 0.5, below), centre, -angle)))
-                .then_some(below)
+            (yy > y && below < e[3] && goal_at(image_at(x + 0.5, below))).then_some(below)
         };
         if let Some(row) = seen_at {
             if run_start.is_none() || x - last_goal.0 > f64::from(p.gap_hole_px) + 1.0 {
@@ -68,13 +69,9 @@ pub(super) fn find_gap(
         }
         x += 1.0;
     }
-    cand.gap_scan = Some((
-        rotate_about((e[0], y), centre, -angle),
-        rotate_about((e[2], y), centre, -angle),
-    ));
+    cand.gap_scan = Some((image_at(e[0], y), image_at(e[2], y)));
     if let Some((a, a_row, b, b_row)) = best {
-        let left = rotate_about((a, a_row), centre, -angle);
-        let right = rotate_about((b, b_row), centre, -angle);
+        let (left, right) = (image_at(a, a_row), image_at(b, b_row));
         let (ref_left, ref_right) = if p.skew_correction {
             (
                 unskew(ctx, p, left, distance),
@@ -83,17 +80,14 @@ pub(super) fn find_gap(
         } else {
             (left, right)
         };
-        let mid = (
-            (ref_left.0 + ref_right.0) / 2.0,
-            (ref_left.1 + ref_right.1) / 2.0,
-        );
+        let mid = ref_left.midpoint(ref_right);
         cand.gap = Some(Gap {
             left,
             right,
             width_px: b - a,
             camera: ctx.camera_relative(mid, distance),
-            left_bearing_rad: ctx.camera_angles(ref_left).0,
-            right_bearing_rad: ctx.camera_angles(ref_right).0,
+            left_bearing_rad: ctx.camera.bearing_rad(ref_left),
+            right_bearing_rad: ctx.camera.bearing_rad(ref_right),
         });
     }
 }

@@ -23,11 +23,13 @@ use serde::{Deserialize, Serialize};
 use super::confidence::{Confidence, TestName, TestWeight};
 use super::context::{Relative, ViewContext};
 use super::draw::{LineRole, ObjectId, Primitive};
-use super::fit::{LineFit, Point};
+use super::fit::LineFit;
 use super::scan::CutOff;
 use crate::blobs::BlobSet;
 use crate::classify::ClassifiedImage;
 use crate::frame::PixelBox;
+use crate::frame::xy_array;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 
 // The stages' items, for each other (each stage file reads them through `use super::*`).
@@ -242,18 +244,20 @@ pub struct Post {
     /// Left or right in the image.
     pub side: PostSide,
     /// Top end of the fitted line, image pixels.
-    pub top: Point,
+    #[serde(with = "xy_array")]
+    pub top: ImagePoint,
     /// Bottom end of the fitted line, image pixels.
-    pub bottom: Point,
+    #[serde(with = "xy_array")]
+    pub bottom: ImagePoint,
     /// The fit (in image coordinates).
     pub fit: LineFit,
     /// Top end moved to the reference row's read-out time (rolling shutter), pixels: where the
     /// post is in the instant the camera pose describes. Equals `top` without skew correction.
-    #[serde(default)]
-    pub reference_top: Point,
+    #[serde(default, with = "xy_array")]
+    pub reference_top: ImagePoint,
     /// Bottom end moved to the reference row's read-out time, pixels.
-    #[serde(default)]
-    pub reference_bottom: Point,
+    #[serde(default, with = "xy_array")]
+    pub reference_bottom: ImagePoint,
     /// Camera-relative direction of the post's centre (distance: the goal's).
     pub camera: Relative,
     /// Body-relative direction of the post's centre.
@@ -269,9 +273,11 @@ pub struct Post {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Gap {
     /// Left end, image pixels (as scanned; the bearings below are skew-corrected).
-    pub left: Point,
+    #[serde(with = "xy_array")]
+    pub left: ImagePoint,
     /// Right end, image pixels (as scanned).
-    pub right: Point,
+    #[serde(with = "xy_array")]
+    pub right: ImagePoint,
     /// Length, pixels.
     pub width_px: f64,
     /// Camera-relative direction of the gap's centre (what a kick should aim at).
@@ -384,11 +390,13 @@ pub struct GoalCandidate {
     /// Posts whose fit was rejected (or not searched for), and why.
     pub rejected_posts: Vec<PostRejection>,
     /// Points scanned for posts, pixels.
-    pub post_points: Vec<Point>,
+    #[serde(with = "xy_array")]
+    pub post_points: Vec<ImagePoint>,
     /// The largest open gap.
     pub gap: Option<Gap>,
     /// The gap scan line, pixels.
-    pub gap_scan: Option<(Point, Point)>,
+    #[serde(with = "xy_array")]
+    pub gap_scan: Option<(ImagePoint, ImagePoint)>,
     /// Accepted as a goal.
     pub accepted: bool,
 }
@@ -517,7 +525,7 @@ impl GoalResult {
             if c.accepted {
                 out.push(Primitive::Label {
                     owner,
-                    at: (f64::from(c.bounds.min_x), f64::from(c.bounds.min_y) - 2.0),
+                    at: ImagePoint::new(f64::from(c.bounds.min_x), f64::from(c.bounds.min_y) - 2.0),
                     text: format!(
                         "{} goal {}{:.0} cm {:+.0}°",
                         c.colour.name(),

@@ -2,9 +2,10 @@
 
 use super::*;
 use crate::classify::ClassifiedImage;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
 use crate::recognition::context::ViewContext;
-use crate::recognition::fit::{LineFit, Point, fit_line, rotate_about};
+use crate::recognition::fit::{LineFit, fit_line};
 
 /// Scans from outside a level x position inward along a level row until a goal-coloured pixel;
 /// returns the level x where the scan line enters that pixel, pixels. Steps of one pixel find
@@ -17,14 +18,14 @@ pub(super) fn scan_level_row(
     y: f64,
     from: f64,
     to: f64,
-    centre: Point,
+    centre: ImagePoint,
     angle: f64,
 ) -> Option<f64> {
     let dir = if to >= from { 1.0 } else { -1.0 };
     let steps = (to - from).abs().ceil() as usize;
     let goal_at = |x: f64| {
-        let q = rotate_about((x, y), centre, -angle);
-        img.get_at(q.0, q.1).is_some_and(is_goal)
+        let q = ImagePoint::new(x, y).rotated_about(centre, -angle);
+        img.get_at(q.x_px, q.y_px).is_some_and(is_goal)
     };
     for k in 0..=steps {
         let x = from + dir * k as f64;
@@ -48,7 +49,12 @@ pub(super) fn scan_level_row(
 }
 
 /// An image point of a goal `distance_cm` away moved to the reference row's read-out time.
-pub(super) fn unskew(ctx: &ViewContext, p: &GoalParams, q: Point, distance_cm: f64) -> Point {
+pub(super) fn unskew(
+    ctx: &ViewContext,
+    p: &GoalParams,
+    q: ImagePoint,
+    distance_cm: f64,
+) -> ImagePoint {
     if p.pose_skew_model {
         ctx.unskew_at(q, distance_cm, true)
     } else {
@@ -65,7 +71,7 @@ pub(super) fn find_posts(
     ctx: &ViewContext,
     p: &GoalParams,
 ) {
-    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let centre = ctx.camera.centre;
     let angle = ctx.horizon_angle();
     let e = cand.level_extent;
     let is_goal = is_goal_colour(colour);
@@ -99,11 +105,11 @@ pub(super) fn find_posts(
             // Inner 80% of the height: the ends are rounded by blur and shading.
             let y = e[1] + height * (0.1 + 0.8 * (k as f64 + 0.5) / n as f64);
             if let Some(x) = scan_level_row(img, &is_goal, y, from, to, centre, angle) {
-                level_pts.push((x, y));
+                level_pts.push(ImagePoint::new(x, y));
             }
         }
         cand.post_points
-            .extend(level_pts.iter().map(|q| rotate_about(*q, centre, -angle)));
+            .extend(level_pts.iter().map(|q| q.rotated_about(centre, -angle)));
         let dir = match side {
             PostSide::Left => 1.0,
             PostSide::Right => -1.0,
@@ -127,16 +133,16 @@ pub(super) fn find_posts(
         };
         if let Some(w) = side_wall {
             for c in std::iter::once(w.foot).chain(w.top) {
-                cand.post_points.push(rotate_about(c.at, centre, -angle));
+                cand.post_points.push(c.at.rotated_about(centre, -angle));
             }
         }
         // The scans find the outline's outer edge; the post's centre is half a wall inside it,
         // or half a wall outside the front corner of a side wall seen from outside.
-        let image_pts: Vec<Point> = level_pts
+        let image_pts: Vec<ImagePoint> = level_pts
             .iter()
             .map(|q| {
-                let shift = side_wall.map_or(inset_px, |w| w.offset_at(q.1) - inset_px);
-                rotate_about((q.0 + dir * shift, q.1), centre, -angle)
+                let shift = side_wall.map_or(inset_px, |w| w.offset_at(q.y_px) - inset_px);
+                ImagePoint::new(q.x_px + dir * shift, q.y_px).rotated_about(centre, -angle)
             })
             .collect();
         let wall_px = side_wall.map(|w| w.foot.offset);
@@ -156,7 +162,10 @@ fn good_fit(f: &LineFit, p: &GoalParams) -> bool {
 /// A line through `pts`; a stray point (a robot's leg or a shadow on one scan row) is dropped,
 /// farthest from the line first, while the fit fails and enough points remain. Returns the
 /// points kept and the fit.
-fn fit_dropping_outliers(mut pts: Vec<Point>, p: &GoalParams) -> (Vec<Point>, Option<LineFit>) {
+fn fit_dropping_outliers(
+    mut pts: Vec<ImagePoint>,
+    p: &GoalParams,
+) -> (Vec<ImagePoint>, Option<LineFit>) {
     let mut fit = fit_line(&pts);
     let mut dropped = 0;
     while let Some(f) = fit
@@ -164,11 +173,11 @@ fn fit_dropping_outliers(mut pts: Vec<Point>, p: &GoalParams) -> (Vec<Point>, Op
         && dropped < p.post_max_outliers
         && pts.len() > 5
     {
-        let off = |q: &Point| {
+        let off = |q: &ImagePoint| {
             if f.steep {
-                (q.0 - f.at(q.1).0).abs()
+                (q.x_px - f.at(q.y_px).x_px).abs()
             } else {
-                (q.1 - f.at(q.0).1).abs()
+                (q.y_px - f.at(q.x_px).y_px).abs()
             }
         };
         let Some(worst) = (0..pts.len()).max_by(|a, b| off(&pts[*a]).total_cmp(&off(&pts[*b])))
@@ -185,7 +194,7 @@ fn fit_dropping_outliers(mut pts: Vec<Point>, p: &GoalParams) -> (Vec<Point>, Op
 /// The post on `side` from its edge points (image pixels, already moved to the post's centre
 /// line), or why there is none: no line, a poor fit, or a lean.
 fn post_from_points(
-    image_pts: Vec<Point>,
+    image_pts: Vec<ImagePoint>,
     side: PostSide,
     side_wall_px: Option<f64>,
     e: [f64; 4],
@@ -193,7 +202,7 @@ fn post_from_points(
     p: &GoalParams,
     distance: f64,
 ) -> Result<Post, PostRejection> {
-    let centre = (ctx.camera.centre.x_px, ctx.camera.centre.y_px);
+    let centre = ctx.camera.centre;
     let angle = ctx.horizon_angle();
     let (pts, fit) = fit_dropping_outliers(image_pts, p);
     let Some(fit) = fit else {
@@ -210,22 +219,24 @@ fn post_from_points(
             points: pts.len(),
         });
     }
-    let top_level = rotate_about(pts[0], centre, angle);
+    let top_level = pts[0].rotated_about(centre, angle);
+    // The line's point at the image row of a level-frame point.
+    let line_at = |level: ImagePoint| fit.at(level.rotated_about(centre, -angle).y_px);
     let top = if fit.steep {
-        fit.at(rotate_about((top_level.0, e[1]), centre, -angle).1)
+        line_at(ImagePoint::new(top_level.x_px, e[1]))
     } else {
         pts[0]
     };
     let bottom = if fit.steep {
-        fit.at(rotate_about((top_level.0, e[3]), centre, -angle).1)
+        line_at(ImagePoint::new(top_level.x_px, e[3]))
     } else {
         pts[pts.len() - 1]
     };
     let (lt, lb) = (
-        rotate_about(top, centre, angle),
-        rotate_about(bottom, centre, angle),
+        top.rotated_about(centre, angle),
+        bottom.rotated_about(centre, angle),
     );
-    let lean = (lb.0 - lt.0).abs().atan2((lb.1 - lt.1).abs());
+    let lean = (lb.x_px - lt.x_px).abs().atan2((lb.y_px - lt.y_px).abs());
     if lean.is_nan() || lean > p.post_max_lean_rad {
         return Err(PostRejection::Leans {
             side,
@@ -240,10 +251,7 @@ fn post_from_points(
     } else {
         (top, bottom)
     };
-    let mid = (
-        (reference_top.0 + reference_bottom.0) / 2.0,
-        (reference_top.1 + reference_bottom.1) / 2.0,
-    );
+    let mid = reference_top.midpoint(reference_bottom);
     Ok(Post {
         side,
         top,

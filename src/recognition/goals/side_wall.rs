@@ -2,8 +2,9 @@
 //! post is at its front corner, found from the wall's descending foot.
 
 use crate::classify::ClassifiedImage;
+use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
-use crate::recognition::fit::{LineFit, Point, fit_line};
+use crate::recognition::fit::{LineFit, fit_line};
 
 /// How much higher (sample rows) the foot of a side wall seen from outside must be at the
 /// outline, and just beyond the wall's front corner, than at the corner. One row is the
@@ -22,7 +23,7 @@ pub(super) const MIN_WALL_COLUMNS: usize = 3;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct WallCorner {
     /// The corner, level frame, pixels.
-    pub at: Point,
+    pub at: ImagePoint,
     /// Its distance inside the outline along the row, pixels.
     pub offset: f64,
 }
@@ -51,8 +52,8 @@ impl SideWall {
     pub(super) fn offset_at(&self, y: f64) -> f64 {
         let f = self.foot;
         match self.top {
-            Some(t) if (f.at.1 - t.at.1).abs() > f64::EPSILON => {
-                f.offset + (t.offset - f.offset) * (f.at.1 - y) / (f.at.1 - t.at.1)
+            Some(t) if (f.at.y_px - t.at.y_px).abs() > f64::EPSILON => {
+                f.offset + (t.offset - f.offset) * (f.at.y_px - y) / (f.at.y_px - t.at.y_px)
             }
             _ => f.offset,
         }
@@ -82,18 +83,18 @@ impl SideWall {
 pub(super) fn front_corner(
     img: &ClassifiedImage,
     is_goal: &impl Fn(u8) -> bool,
-    outline: &[Point],
+    outline: &[ImagePoint],
     e: [f64; 4],
     dir: f64,
     far_side_cut: bool,
-    (centre, angle): (Point, f64),
+    (centre, angle): (ImagePoint, f64),
 ) -> Option<SideWall> {
     let line = fit_line(outline).filter(|f| f.steep)?;
     let height = e[3] - e[1];
     if !(height.is_finite() && height > 0.0 && e[2] > e[0]) {
         return None;
     }
-    // Level frame → image: `rotate_about` by −angle with its sine and cosine taken once.
+    // Level frame → image: `ImagePoint::rotated_about` by −angle with its sine and cosine taken once.
     let (sin, cos) = (-angle).sin_cos();
     let side = SideColumns {
         img,
@@ -143,7 +144,7 @@ struct SideColumns<'a, G: Fn(u8) -> bool> {
     /// +1 for the left side (inward is +x), −1 for the right.
     dir: f64,
     /// The level frame's centre in the image, pixels.
-    centre: Point,
+    centre: ImagePoint,
     /// Sine and cosine of the level frame → image rotation.
     sin: f64,
     cos: f64,
@@ -156,17 +157,16 @@ struct SideColumns<'a, G: Fn(u8) -> bool> {
 impl<G: Fn(u8) -> bool> SideColumns<'_, G> {
     /// The outline's x at level row `y`.
     fn edge_x(&self, y: f64) -> f64 {
-        self.line.at(y).0
+        self.line.at(y).x_px
     }
 
     /// The class code at a level-frame point (`None` outside the image).
     fn code_at(&self, x: f64, y: f64) -> Option<u8> {
-        let (dx, dy) = (x - self.centre.0, y - self.centre.1);
-        let q = (
-            self.centre.0 + self.cos * dx - self.sin * dy,
-            self.centre.1 + self.sin * dx + self.cos * dy,
-        );
-        self.img.get_at(q.0, q.1)
+        let (dx, dy) = (x - self.centre.x_px, y - self.centre.y_px);
+        self.img.get_at(
+            self.centre.x_px + self.cos * dx - self.sin * dy,
+            self.centre.y_px + self.sin * dx + self.cos * dy,
+        )
     }
 
     fn goal_at(&self, x: f64, y: f64) -> bool {
@@ -260,7 +260,7 @@ impl<G: Fn(u8) -> bool> SideColumns<'_, G> {
         }
         // The end of the highest top's plateau, the top lower in the next two columns (the
         // back wall's, farther away).
-        let yf = foot_corner.at.1;
+        let yf = foot_corner.at.y_px;
         Some((0..=k1).find(|&k| top(k) == Some(highest)).and_then(|k| {
             let end = plateau_end(&top, k, highest);
             let lower = |k: usize| k < tops.len() && top(k).is_none_or(|t| t > highest);
@@ -288,7 +288,7 @@ impl<G: Fn(u8) -> bool> SideColumns<'_, G> {
         }
         let x = (inside + outside) / 2.0;
         WallCorner {
-            at: (x, y),
+            at: ImagePoint::new(x, y),
             offset: self.dir * (x - self.edge_x(y)),
         }
     }

@@ -4,7 +4,6 @@ use super::*;
 use crate::blobs::Connectivity;
 use crate::geometry::{Ers7Dimensions, PinholeCamera};
 use crate::recognition::confidence::TestName;
-use crate::recognition::fit::rotate_about;
 use crate::sensors::SensorReadings;
 
 fn ctx() -> ViewContext {
@@ -77,23 +76,33 @@ fn a_goal_split_by_a_keeper_is_one_goal_with_posts_and_the_larger_gap() {
     let d = g.camera.distance_cm;
     assert!(d > 230.0 && d < 250.0, "{d}");
     assert_eq!(g.posts.len(), 2, "{:?}", g.rejected_posts);
+    // Posts, gap and scan points keep their `[x, y]` JSON form.
+    let json = serde_json::to_value(g).expect("json");
+    let top = &json["posts"][0]["top"];
+    assert_eq!(top[0].as_f64(), Some(g.posts[0].top.x_px), "{top}");
+    assert_eq!(top[1].as_f64(), Some(g.posts[0].top.y_px), "{top}");
+    assert!(json["gap"]["left"].is_array() && json["post_points"][0].is_array());
+    assert!(json["gap_scan"][1].is_array(), "{}", json["gap_scan"]);
+    // (A whole candidate does not read back: an open test range is written as null.)
+    let back: Post = serde_json::from_value(json["posts"][0].clone()).expect("read back");
+    assert_eq!(back, g.posts[0]);
     let left = g
         .posts
         .iter()
         .find(|p| p.side == PostSide::Left)
         .expect("left");
-    assert!((left.top.0 - 40.0).abs() < 1.0 && (left.bottom.0 - 40.0).abs() < 1.0);
+    assert!((left.top.x_px - 40.0).abs() < 1.0 && (left.bottom.x_px - 40.0).abs() < 1.0);
     let right = g
         .posts
         .iter()
         .find(|p| p.side == PostSide::Right)
         .expect("right");
-    assert!((right.top.0 - 150.0).abs() < 1.0);
+    assert!((right.top.x_px - 150.0).abs() < 1.0);
     // Seen from in front: no side wall's outer face.
     assert!(g.posts.iter().all(|p| p.side_wall_px.is_none()));
     let gap = g.gap.as_ref().expect("gap");
     assert!(
-        (gap.left.0 - 90.0).abs() < 1.5 && (gap.right.0 - 150.0).abs() < 1.5,
+        (gap.left.x_px - 90.0).abs() < 1.5 && (gap.right.x_px - 150.0).abs() < 1.5,
         "{gap:?}"
     );
     assert!(gap.left_bearing_rad > gap.right_bearing_rad);
@@ -146,7 +155,7 @@ fn a_side_wall_seen_from_outside_puts_the_post_on_its_front_corner() {
     let inset = p.post_inset_cm * ctx.camera.focal_px / g.camera.distance_cm;
     let wall = left.side_wall_px.expect("side wall seen");
     assert!((wall - 8.0).abs() < 0.5, "{wall}");
-    for x in [left.top.0, left.bottom.0] {
+    for x in [left.top.x_px, left.bottom.x_px] {
         assert!((x - (48.0 - inset)).abs() < 0.5, "{left:?}");
     }
     // The right side is seen from in front: its post stays on the outline.
@@ -155,7 +164,7 @@ fn a_side_wall_seen_from_outside_puts_the_post_on_its_front_corner() {
         .iter()
         .find(|q| q.side == PostSide::Right)
         .expect("right post");
-    assert!(right.side_wall_px.is_none() && (right.top.0 - 151.0).abs() < 1.5);
+    assert!(right.side_wall_px.is_none() && (right.top.x_px - 151.0).abs() < 1.5);
     // Without the front-corner search the left post is the back corner's.
     let off = GoalParams {
         post_front_corner: false,
@@ -168,7 +177,7 @@ fn a_side_wall_seen_from_outside_puts_the_post_on_its_front_corner() {
         .iter()
         .find(|q| q.side == PostSide::Left)
         .expect("left");
-    assert!(left.side_wall_px.is_none() && (left.top.0 - (40.0 + inset)).abs() < 0.5);
+    assert!(left.side_wall_px.is_none() && (left.top.x_px - (40.0 + inset)).abs() < 0.5);
 }
 
 #[test]
@@ -181,7 +190,9 @@ fn a_goal_cut_at_the_top_is_measured_at_its_foot() {
     assert!(g.cut_off.left && g.cut_off.top && !g.cut_off.right && !g.cut_off.bottom);
     // The top is cut but the foot is in view: the distance is the foot's on the ground.
     assert!(g.distance_from_ground && !g.distance_is_max);
-    let foot = ctx.distance_to_plane((30.0, 90.0), 0.0).expect("foot");
+    let foot = ctx
+        .distance_to_plane(ImagePoint::new(30.0, 90.0), 0.0)
+        .expect("foot");
     assert!((g.camera.distance_cm - foot).abs() < 5.0, "{foot}");
     assert_eq!(g.posts.len(), 1);
     assert_eq!(g.posts[0].side, PostSide::Right);
@@ -212,16 +223,16 @@ fn level_scans_find_the_edge_to_a_fraction_of_a_pixel_under_a_tilted_horizon() {
         .collect();
     let img = ClassifiedImage::from_codes(w, h, codes).expect("size");
     let is_goal = is_goal_colour(ColourClass::Yellow);
-    let (centre, angle) = ((104.0, 80.0), 0.1);
+    let (centre, angle) = (ImagePoint::new(104.0, 80.0), 0.1);
     for k in 0..20 {
         let y = 60.0 + 1.37 * f64::from(k);
         // The edges' level x at this row (the level frame turns image columns into slants).
-        let level = |x: f64| rotate_about((x, 70.0), centre, angle);
-        let (l0, r0) = (level(30.0).0 - 10.0, level(70.0).0 + 10.0);
+        let level = |x: f64| ImagePoint::new(x, 70.0).rotated_about(centre, angle);
+        let (l0, r0) = (level(30.0).x_px - 10.0, level(70.0).x_px + 10.0);
         for (from, to, edge) in [(l0, 110.0, 40.0), (r0, 20.0, 60.0)] {
             let x = scan_level_row(&img, &is_goal, y, from, to, centre, angle).expect("edge");
-            let q = rotate_about((x, y), centre, -angle);
-            assert!((q.0 - edge).abs() < 0.05, "row {y}: {q:?} vs x = {edge}");
+            let q = ImagePoint::new(x, y).rotated_about(centre, -angle);
+            assert!((q.x_px - edge).abs() < 0.05, "row {y}: {q:?} vs x = {edge}");
         }
     }
 }
@@ -230,7 +241,7 @@ fn level_scans_find_the_edge_to_a_fraction_of_a_pixel_under_a_tilted_horizon() {
 fn cut_off_uses_two_of_three_points_per_side() {
     let c = detect_cut_off(
         [10.0, 10.0, 50.0, 50.0],
-        (104.0, 80.0),
+        ImagePoint::new(104.0, 80.0),
         0.0,
         208.0,
         160.0,
@@ -239,7 +250,7 @@ fn cut_off_uses_two_of_three_points_per_side() {
     assert!(!c.any());
     let c = detect_cut_off(
         [-5.0, 10.0, 50.0, 159.5],
-        (104.0, 80.0),
+        ImagePoint::new(104.0, 80.0),
         0.0,
         208.0,
         160.0,

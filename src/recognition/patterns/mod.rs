@@ -40,6 +40,7 @@ use serde::{Deserialize, Serialize};
 use super::confidence::{Confidence, TestWeight};
 use super::context::Relative;
 use super::draw::{ObjectId, Primitive};
+use crate::geometry::ImagePoint;
 
 pub use learning::{LearnParams, LearnReport, LearnView, Triangulation, triangulate};
 use learning::{median, theil_sen};
@@ -378,7 +379,7 @@ pub fn pattern_primitives(candidates: &[PatternCandidate]) -> Vec<Primitive> {
         };
         out.push(Primitive::Label {
             owner,
-            at: (x0.max(0) as f64, (y0 as f64 - 2.0).max(8.0)),
+            at: ImagePoint::new(x0.max(0) as f64, (y0 as f64 - 2.0).max(8.0)),
             text,
         });
     }

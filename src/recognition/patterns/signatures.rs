@@ -100,9 +100,9 @@ impl PatternObservation {
 
     /// The blob's box centre, image pixels.
     #[must_use]
-    pub fn centre(&self) -> (f64, f64) {
+    pub fn centre(&self) -> ImagePoint {
         let [x0, y0, x1, y1] = self.bounds.to_array().map(f64::from);
-        ((x0 + x1 + 1.0) / 2.0, (y0 + y1 + 1.0) / 2.0)
+        ImagePoint::new((x0 + x1 + 1.0) / 2.0, (y0 + y1 + 1.0) / 2.0)
     }
 }
 
@@ -225,9 +225,13 @@ pub(super) fn observe_blob(
     // matters for the camera's own motion, so a typical one does.
     let seen = obs.centre();
     let centre = ctx.unskew_at(seen, ASSUMED_DISTANCE_CM, true);
-    let below = ctx.unskew_at((seen.0, seen.1 + 1.0), ASSUMED_DISTANCE_CM, true);
-    if (centre.0 - below.0).is_finite() {
-        obs.shear_px_per_row = centre.0 - below.0;
+    let below = ctx.unskew_at(
+        ImagePoint::new(seen.x_px, seen.y_px + 1.0),
+        ASSUMED_DISTANCE_CM,
+        true,
+    );
+    if (centre.x_px - below.x_px).is_finite() {
+        obs.shear_px_per_row = centre.x_px - below.x_px;
     }
     for k in 0..9 {
         let (colours, inside) = region_colours(img, obs.region_bounds(k));
@@ -236,9 +240,8 @@ pub(super) fn observe_blob(
     }
     (obs.bearing_rad, obs.elevation_rad) = ctx.camera_angles(centre);
     obs.ray = ctx.pose.map(|pose| {
-        let p = ImagePoint::new(centre.0, centre.1);
         let o = pose.position();
-        let d = pose.field_ray(p).coords;
+        let d = pose.field_ray(centre).coords;
         GroundRay {
             origin_cm: [o.x(), o.y(), o.z()],
             direction: [d.x, d.y, d.z],
