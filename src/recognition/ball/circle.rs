@@ -205,19 +205,23 @@ fn rejection(
     }
 }
 
+/// The box's outer edges (left, top, right, bottom; pixels, a pixel's far edge for right and
+/// bottom) moved by `shift`, as the skew removal moved the points the circle is fitted to.
+fn shifted_edges(b: PixelBox, shift: ImagePoint) -> [f64; 4] {
+    [
+        f64::from(b.min_x) + shift.x_px,
+        f64::from(b.min_y) + shift.y_px,
+        f64::from(b.max_x + 1) + shift.x_px,
+        f64::from(b.max_y + 1) + shift.y_px,
+    ]
+}
+
 /// Whether a fitted circle can be the blob's ball: the box's centre lies inside it, and it
 /// reaches every side the blob is cut at (a short arc of a few outline points can bend the fit
 /// the wrong way, putting the circle beside the blob). `shift` moves the box as the skew removal
 /// moved its centre (the circle is fitted to unskewed points).
 fn circle_holds_blob(f: &CircleFit, b: PixelBox, cut: CutOff, shift: ImagePoint) -> bool {
-    let (minx, miny) = (
-        f64::from(b.min_x) + shift.x_px,
-        f64::from(b.min_y) + shift.y_px,
-    );
-    let (maxx, maxy) = (
-        f64::from(b.max_x + 1) + shift.x_px,
-        f64::from(b.max_y + 1) + shift.y_px,
-    );
+    let [minx, miny, maxx, maxy] = shifted_edges(b, shift);
     let (bx, by) = ((minx + maxx) / 2.0, (miny + maxy) / 2.0);
     let inside = (bx - f.center_x).hypot(by - f.center_y) <= f.radius;
     let reach = 1.0;
@@ -243,14 +247,7 @@ pub fn confirmed_cut(
     image_size: (u32, u32),
     min_overhang_px: f64,
 ) -> CutOff {
-    let (minx, miny) = (
-        f64::from(b.min_x) + shift.x_px,
-        f64::from(b.min_y) + shift.y_px,
-    );
-    let (maxx, maxy) = (
-        f64::from(b.max_x + 1) + shift.x_px,
-        f64::from(b.max_y + 1) + shift.y_px,
-    );
+    let [minx, miny, maxx, maxy] = shifted_edges(b, shift);
     let (w, h) = image_size;
     let keep = |hidden: bool, at_border: bool, overhang: f64| {
         hidden && (at_border || overhang > min_overhang_px)
