@@ -90,6 +90,10 @@ struct Entry {
 pub struct Robots {
     entries: Vec<Entry>,
     shown: Option<RobotId>,
+    /// True when the user chose the shown robot; false when the workspace did (the first robot
+    /// connected, the next after a disconnection), which it may then change (see
+    /// [`Workspace::poll_robots`]).
+    chosen: bool,
     follow_live: bool,
     next_id: u32,
     wake: WakeSlot,
@@ -133,7 +137,11 @@ impl Workspace {
     pub(super) fn apply_robot_command(&mut self, command: Command) -> anyhow::Result<()> {
         match command {
             Command::ConnectRobot(address) => self.connect_robot(&address).map(drop),
-            Command::ShowRobot(id) => self.show_robot(id),
+            Command::ShowRobot(id) => {
+                self.show_robot(id)?;
+                self.robots.chosen = true;
+                Ok(())
+            }
             Command::DisconnectRobot(id) => self.disconnect_robot(id),
             Command::RecordRobot(id, path) => self.record_robot(id, &path),
             Command::RecordAllRobots(folder) => self.record_all_robots(&folder),
@@ -192,6 +200,7 @@ impl Workspace {
         self.stop_recording_recorded();
         self.source = Some(Source::new(Box::new(view)));
         self.robots.set_shown(Some(id));
+        self.robots.chosen = false;
         self.robots.follow_live = true;
         self.use_table_of(CameraKind::Robot);
         self.player.stop();
@@ -385,6 +394,7 @@ impl Workspace {
             }
             self.status = note;
         }
+        self.show_a_robot_with_frames();
         if self.robots.follow_live {
             self.follow_newest();
         }
@@ -393,6 +403,31 @@ impl Workspace {
         {
             // The sensor dialog's plots grow with the frames that arrive.
             self.sensor_series.total = src.len();
+        }
+    }
+
+    /// When the workspace (not the user) chose the shown robot and it has never delivered a frame
+    /// and is not connected (a wrong address, a robot switched off), shows the first robot that
+    /// has frames instead: the image is not left empty while the others stream.
+    fn show_a_robot_with_frames(&mut self) {
+        let Some(shown) = self.robots.shown.filter(|_| !self.robots.chosen) else {
+            return;
+        };
+        let stuck = self.robots.entry(shown).is_ok_and(|e| {
+            e.robot.is_empty() && matches!(e.robot.connection(), Connection::Disconnected { .. })
+        });
+        let other = self
+            .robots
+            .entries
+            .iter()
+            .find(|e| e.id != shown && !e.robot.is_empty())
+            .map(|e| e.id);
+        if let (true, Some(next)) = (stuck, other) {
+            let status = self.status.clone();
+            if let Err(e) = self.show_robot(next) {
+                self.warn(format!("{e:#}"));
+            }
+            self.status = status;
         }
     }
 

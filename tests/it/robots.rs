@@ -395,3 +395,36 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
         assert_recorded_bit_exact(&p, &all);
     }
 }
+
+#[test]
+fn a_first_robot_that_never_connects_gives_way_to_one_that_sends_unless_the_user_chose_it() {
+    // A port nobody listens on: the first robot connected is shown, and never gets a frame.
+    let dead_port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let mut good = StandInRobot::start("good", "127.0.0.1", 0).unwrap();
+    let mut w = Workspace::default();
+    let dead = connect(&mut w, dead_port);
+    let ok = connect(&mut w, good.port());
+    assert_eq!(w.shown_robot(), Some(dead));
+    assert!(tick_until(&mut w, 10.0, |w| matches!(
+        row(w, dead).connection,
+        Connection::Disconnected { .. }
+    )));
+    assert!(tick_until(&mut w, 10.0, |_| good.has_viewer()));
+    send_ticking(&mut w, &mut good, 0..5);
+    // The workspace chose the dead robot, so it shows the one that sends instead of nothing.
+    assert!(tick_until(&mut w, 5.0, |w| w.shown_robot() == Some(ok)
+        && w.index() == 4));
+    assert_eq!(w.frame(), Some(&frame(4)));
+    // A robot the user chose stays shown, frames or not.
+    w.apply(Command::ShowRobot(dead)).unwrap();
+    send_ticking(&mut w, &mut good, 5..10);
+    assert!(tick_until(&mut w, 2.0, |w| row(w, ok).stats.frames == 10));
+    assert_eq!(w.shown_robot(), Some(dead));
+    assert!(w.frame().is_none());
+    w.apply(Command::Disconnect).unwrap();
+    good.stop();
+}
