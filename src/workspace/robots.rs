@@ -416,13 +416,16 @@ impl Workspace {
         let stuck = self.robots.entry(shown).is_ok_and(|e| {
             e.robot.is_empty() && matches!(e.robot.connection(), Connection::Disconnected { .. })
         });
+        if !stuck {
+            return;
+        }
         let other = self
             .robots
             .entries
             .iter()
             .find(|e| e.id != shown && !e.robot.is_empty())
             .map(|e| e.id);
-        if let (true, Some(next)) = (stuck, other) {
+        if let Some(next) = other {
             let status = self.status.clone();
             if let Err(e) = self.show_robot(next) {
                 self.warn(format!("{e:#}"));

@@ -15,13 +15,19 @@ use eotn::lut::ColourClass;
 use eotn::workspace::{Command, Window, Workspace};
 
 use crate::common::repo_file;
-use crate::harness::{fixture, harness_sized, run_steps_until, workspace};
+use crate::harness::{click_label, fixture, harness_sized, run_steps_until, workspace};
 
 /// The papercut tests' window: the size the user saw.
 const SCREEN: Vec2 = Vec2::new(1280.0, 800.0);
 
 fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
     harness_sized(paths, SCREEN)
+}
+
+/// The app on the first frame of the harness's [`fixture`] and its table.
+fn first_frame_harness(dir: &std::path::Path) -> Harness<'static, EotnApp> {
+    let (frames, table) = fixture(dir);
+    harness(vec![frames[0].clone(), table])
 }
 
 fn painted_texts(h: &Harness<'_, EotnApp>) -> Vec<(String, Rect)> {
@@ -172,8 +178,7 @@ fn the_journal_warning_names_the_menu_command_as_the_menu_shows_it() {
     let mut h = harness(vec![frames[0].clone(), table]);
     h.run();
     // The warning as the user reads it in the warnings window.
-    h.get_by_label("1 warning").click();
-    h.run();
+    click_label(&mut h, "1 warning");
     let warning = node_text(&h.get_by_label_contains("differs from its journal"));
     let command = warning
         .split(": ")
@@ -184,10 +189,8 @@ fn the_journal_warning_names_the_menu_command_as_the_menu_shows_it() {
         .split_once(" > ")
         .unwrap_or_else(|| panic!("MENU > ITEM: {command}"));
     // That menu, and in it that item, exactly as the warning spells them.
-    h.get_by_label(menu).click();
-    h.run();
-    h.get_by_label(item).click();
-    h.run();
+    click_label(&mut h, menu);
+    click_label(&mut h, item);
     assert_eq!(
         workspace(&h).lut(),
         &unsaved,
@@ -198,8 +201,7 @@ fn the_journal_warning_names_the_menu_command_as_the_menu_shows_it() {
 #[test]
 fn the_class_list_count_columns_have_headers_above_them() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut h = harness(vec![frames[0].clone(), table]);
+    let mut h = first_frame_harness(dir.path());
     h.run();
     let green = usize::from(ColourClass::Green.code());
     let cells = workspace(&h).table_counts()[green];
@@ -232,18 +234,15 @@ fn the_class_list_count_columns_have_headers_above_them() {
 #[test]
 fn a_typed_zoom_value_sets_the_zoom() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut h = harness(vec![frames[0].clone(), table]);
+    let mut h = first_frame_harness(dir.path());
     h.run();
     assert_eq!(
         workspace(&h).settings.transform.zoom,
         None,
         "fitted at first"
     );
-    h.get_by_label("View").click();
-    h.run();
-    h.get_by_label("Zoom").click();
-    h.run();
+    click_label(&mut h, "View");
+    click_label(&mut h, "Zoom");
     // The value field beside the presets: the "Zoom" that is a spin button, not the submenu.
     let field = h
         .query_all_by_label("Zoom")
@@ -283,18 +282,13 @@ fn a_typed_zoom_value_sets_the_zoom() {
 #[test]
 fn settings_submenus_stay_open_while_switches_change_and_escape_closes_them() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut h = harness(vec![frames[0].clone(), table]);
+    let mut h = first_frame_harness(dir.path());
     h.run();
-    h.get_by_label("View").click();
-    h.run();
-    h.get_by_label("Overlays").click();
-    h.run();
+    click_label(&mut h, "View");
+    click_label(&mut h, "Overlays");
     let before = workspace(&h).settings.overlays;
-    h.get_by_label("Circle fits").click();
-    h.run();
-    h.get_by_label("Horizon").click();
-    h.run();
+    click_label(&mut h, "Circle fits");
+    click_label(&mut h, "Horizon");
     let after = workspace(&h).settings.overlays;
     assert_ne!(after.circles, before.circles);
     assert_ne!(
@@ -313,8 +307,7 @@ fn settings_submenus_stay_open_while_switches_change_and_escape_closes_them() {
 #[test]
 fn the_uv_plane_has_ticks_and_values_on_both_axes() {
     let dir = tempfile::tempdir().unwrap();
-    let (frames, table) = fixture(dir.path());
-    let mut h = harness(vec![frames[0].clone(), table]);
+    let mut h = first_frame_harness(dir.path());
     h.run();
     h.state_mut()
         .state

@@ -146,3 +146,14 @@ pub fn sim_stream(dir: &Path, scenario: &str, frames: usize, seed: Option<u64>) 
     eotn_ok(&args);
     out
 }
+
+/// The robot-camera scenarios shipped as `streams/sim-NAME.mcap` (`sim-overhead-game.mcap` is
+/// shipped too, but is an overhead camera's).
+pub const SHIPPED_ROBOT_SCENARIOS: [&str; 6] = [
+    "walk-and-pan",
+    "ball-edge",
+    "goalkeeper",
+    "fast-pans",
+    "orange-clutter",
+    "beacon-tour",
+];

@@ -9,7 +9,7 @@ use eotn::lut::{ColourClass, LookupTable};
 use eotn::sim::GroundTruth;
 use eotn::streams::StreamReader;
 
-use crate::common::{eotn, eotn_ok};
+use crate::common::{SHIPPED_ROBOT_SCENARIOS, eotn, eotn_ok};
 
 fn sim(dir: &Path, scenario: &str, frames: &str, seed: &str) -> std::path::PathBuf {
     let out = dir.join(format!("{scenario}-{seed}.mcap"));
@@ -221,15 +221,7 @@ fn shipped_sim_streams_classify_with_the_shipped_table() {
 fn shipped_sim_streams_are_what_eotn_sim_writes() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = tempfile::tempdir().unwrap();
-    for scenario in [
-        "walk-and-pan",
-        "ball-edge",
-        "goalkeeper",
-        "fast-pans",
-        "orange-clutter",
-        "beacon-tour",
-        "overhead-game",
-    ] {
+    for scenario in SHIPPED_ROBOT_SCENARIOS.into_iter().chain(["overhead-game"]) {
         let mut shipped =
             StreamReader::open(&root.join(format!("streams/sim-{scenario}.mcap"))).unwrap();
         let fresh = sim(dir.path(), scenario, &shipped.len().to_string(), "1");

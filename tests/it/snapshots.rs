@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 
 use serde_json::Value;
 
-use crate::common::{eotn_ok, repo_file};
+use crate::common::{SHIPPED_ROBOT_SCENARIOS, eotn_ok, repo_file};
 
 /// The parsed `eotn detect --json` lines of `stream` with `lut` (and `extra` arguments).
 fn detect_lines(stream: &str, lut: &str, extra: &[&str]) -> Vec<Value> {
@@ -138,14 +138,7 @@ fn evidence_summary(lines: &[Value]) -> String {
 
 #[test]
 fn detect_on_the_bundled_simulated_streams_is_unchanged() {
-    for scenario in [
-        "walk-and-pan",
-        "ball-edge",
-        "goalkeeper",
-        "fast-pans",
-        "orange-clutter",
-        "beacon-tour",
-    ] {
+    for scenario in SHIPPED_ROBOT_SCENARIOS {
         let lines = detect_lines(
             &format!("streams/sim-{scenario}.mcap"),
             "lookup_tables/sim.lut",

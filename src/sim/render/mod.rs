@@ -341,33 +341,18 @@ mod tests {
         let world = World::compile(&Scene::four_legged_2005());
         let renderer = Renderer::pinhole(&PinholeCamera::ers7());
         let pose = robot_camera_pose(RobotPose::new(-100.0, 0.0, 0.0), HeadJoints::default());
-        let a = renderer
-            .render(
-                &world,
-                &|_| pose,
-                &CameraEffects::ERS7,
-                0,
-                &mut SimRng::new(5),
-            )
-            .expect("render");
-        let b = renderer
-            .render(
-                &world,
-                &|_| pose,
-                &CameraEffects::ERS7,
-                0,
-                &mut SimRng::new(5),
-            )
-            .expect("render");
-        let c = renderer
-            .render(
-                &world,
-                &|_| pose,
-                &CameraEffects::ERS7,
-                0,
-                &mut SimRng::new(6),
-            )
-            .expect("render");
+        let render = |seed| {
+            renderer
+                .render(
+                    &world,
+                    &|_| pose,
+                    &CameraEffects::ERS7,
+                    0,
+                    &mut SimRng::new(seed),
+                )
+                .expect("render")
+        };
+        let (a, b, c) = (render(5), render(5), render(6));
         assert_eq!(a.frame, b.frame);
         assert_ne!(a.frame, c.frame);
         assert_eq!(a.labels, c.labels);
