@@ -15,7 +15,7 @@ mkdir -p "$WORK"
 [ -f "$WORK/sample_b7.lut" ] || "$PYTHON" "$SHARED/bench/peer_pipeline.py" --make-sample "$WORK" --sample-frames 4 >/dev/null
 gcc -O3 -march=native -o "$WORK/floors" "$SHARED/bench/floors.c"
 cargo build --release --no-default-features --quiet
-EOTN=target/release/eotn
+EOTN="${CARGO_TARGET_DIR:-target}/release/eotn"
 
 for size in 208x160 640x480; do
   w=${size%x*}; h=${size#*x}

@@ -12,7 +12,7 @@ MINUTES=${1:-20}
 FRAMES=$((MINUTES * 60 * 30))
 cargo build --release --quiet
 cargo build --release --quiet --no-default-features --example long_run
-EOTN=target/release/eotn
+EOTN="${CARGO_TARGET_DIR:-target}/release/eotn"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 STREAM="$WORK/long.mcap"
@@ -40,5 +40,5 @@ awk -v frames="$FRAMES" '
   }' "$WORK/cli-rss.txt"
 
 # The app's state.
-target/release/examples/long_run "$STREAM" lookup_tables/sim.lut 16 >"$WORK/app-rss.txt"
+"${CARGO_TARGET_DIR:-target}/release/examples/long_run" "$STREAM" lookup_tables/sim.lut 16 >"$WORK/app-rss.txt"
 tail -1 "$WORK/app-rss.txt"

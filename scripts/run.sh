@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh
 cargo build --release
-EOTN=target/release/eotn
+EOTN="${CARGO_TARGET_DIR:-target}/release/eotn"
 
 if [ $# -gt 0 ]; then
   FILES=("$@")
