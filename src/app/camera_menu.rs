@@ -34,6 +34,8 @@ pub struct CameraDialogs {
     pub found: Option<Available>,
     /// The settings being edited in Settings….
     pub settings: Option<SourceSettings>,
+    /// Browse… was clicked in Record…: the app opens its file dialog for the recording.
+    pub browse_record: bool,
 }
 
 impl Default for CameraDialogs {
@@ -49,6 +51,7 @@ impl Default for CameraDialogs {
             record_path: "recording.mcap".to_owned(),
             found: None,
             settings: None,
+            browse_record: false,
         }
     }
 }
@@ -353,14 +356,11 @@ fn record_ui(ui: &mut Ui, d: &mut CameraDialogs, commands: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         if ui
             .button("Browse…")
-            .on_hover_text("a file dialog (where none is available, type the path)")
+            .on_hover_text("choose the file in a dialog; recording starts when it is chosen")
             .clicked()
-            && let Some(p) = rfd::FileDialog::new()
-                .set_title("Record into")
-                .add_filter("Streams", &["mcap"])
-                .save_file()
         {
-            d.record_path = p.display().to_string();
+            d.browse_record = true;
+            commands.push(Command::ShowWindow(Window::Record, false));
         }
         let p = d.record_path.trim();
         if ui

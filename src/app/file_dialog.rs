@@ -25,6 +25,8 @@ pub enum FileAction {
     SaveParams,
     /// Export the enlarged view as PNG.
     ExportView,
+    /// Record the connected source into a new stream.
+    Record,
 }
 
 impl FileAction {
@@ -39,6 +41,7 @@ impl FileAction {
             Self::SaveTableAs => "Save the lookup table as",
             Self::SaveParams => "Save the recognition parameters as",
             Self::ExportView => "Export the view as PNG",
+            Self::Record => "Record into",
         }
     }
 
@@ -50,13 +53,14 @@ impl FileAction {
             Self::OpenTable | Self::SaveTableAs => &["lut", "cal", "raw", "tm", "col"],
             Self::OpenParams | Self::OpenPlaces | Self::SaveParams => &["json"],
             Self::ExportView => &["png"],
+            Self::Record => &["mcap"],
         }
     }
 
     const fn saves(self) -> bool {
         matches!(
             self,
-            Self::SaveTableAs | Self::SaveParams | Self::ExportView
+            Self::SaveTableAs | Self::SaveParams | Self::ExportView | Self::Record
         )
     }
 
@@ -71,6 +75,7 @@ impl FileAction {
             Self::SaveTableAs => Command::SaveTableAs(path),
             Self::SaveParams => Command::SaveParams(path),
             Self::ExportView => Command::ExportView(path),
+            Self::Record => Command::StartRecording(path),
         }
     }
 }

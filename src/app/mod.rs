@@ -292,7 +292,7 @@ impl EotnApp {
             A::OpenTable | A::SaveTableAs => self.state.table_path().map(std::path::Path::to_owned),
             A::OpenParams | A::SaveParams => self.state.params_slot().path.clone(),
             A::OpenPlaces => self.state.places_path().map(std::path::Path::to_owned),
-            A::Open | A::ExportView => self.state.settings.last_source.first().cloned(),
+            A::Open | A::ExportView | A::Record => self.state.settings.last_source.first().cloned(),
         };
         file.and_then(|f| f.parent().map(std::path::Path::to_owned))
             .filter(|d| !d.as_os_str().is_empty())

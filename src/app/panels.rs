@@ -2,6 +2,7 @@
 //! thumbnails at the bottom; the Classify panel on the left; the image with its docked windows
 //! in the middle; and the floating windows (file dialogs, warnings, About, Open path, Camera).
 
+use super::file_dialog::FileAction;
 use super::textures::Textures;
 use super::{Command, EotnApp, camera_menu, classify_panel, dock, menus, views};
 
@@ -68,5 +69,11 @@ impl EotnApp {
         self.about_window(ctx);
         menus::open_path_window(ctx, &mut self.menu_input, commands);
         camera_menu::camera_windows(ctx, &self.state, &mut self.camera, commands);
+        if std::mem::take(&mut self.camera.browse_record) {
+            let name = self.camera.record_path.trim().to_owned();
+            let folder = self.dialog_folder(FileAction::Record);
+            self.file_dialogs
+                .open(FileAction::Record, folder.as_deref(), Some(name));
+        }
     }
 }

@@ -21,8 +21,8 @@
 use std::path::Path;
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
-use nalgebra_lm::{DMatrix, DVector, Dyn, Owned};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
