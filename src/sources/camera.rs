@@ -3,6 +3,11 @@
 //! buffers and converted to UYVY; frame size, frame rate, exposure and gain are the device's own
 //! controls. A machine without `/dev/video*` lists no camera ([`super::available`]); connecting
 //! to a path that is not a camera fails with a one-line error naming it.
+//!
+//! A frame's time is the driver's own timestamp of the buffer (`v4l2_buffer.timestamp`, taken
+//! when the frame was captured — `CLOCK_MONOTONIC` for UVC and most drivers), counted from the
+//! first frame. A driver that leaves it zero or lets it run backwards gets the time the frame
+//! was dequeued instead (`Instant`, also monotonic), so times always increase.
 
 use std::path::{Path, PathBuf};
 
@@ -57,6 +62,10 @@ pub struct CameraSource {
     format: Option<(u32, u32, Packing)>,
     /// The driver's time of the first frame, microseconds: times start at 0.
     first_us: Option<i64>,
+    /// When the first frame was dequeued: the clock for drivers without timestamps.
+    first_arrival: Option<std::time::Instant>,
+    /// The time given to the latest frame, nanoseconds from the first.
+    last_ns: Option<u64>,
 }
 
 impl std::fmt::Debug for CameraSource {
@@ -81,6 +90,8 @@ impl CameraSource {
             stream: None,
             format: None,
             first_us: None,
+            first_arrival: None,
+            last_ns: None,
         }
     }
 
@@ -181,6 +192,8 @@ impl FrameSource for CameraSource {
         }
         self.device = Some(dev);
         self.first_us = None;
+        self.first_arrival = None;
+        self.last_ns = None;
         if let Err(e) = self.start_stream(None) {
             self.device = None;
             return Err(e);
@@ -306,13 +319,43 @@ impl FrameSource for CameraSource {
             reason = "time_t is i64 here but i32 on 32-bit Linux"
         )]
         let us = i64::from(meta.timestamp.sec) * 1_000_000 + i64::from(meta.timestamp.usec);
-        let first = *self.first_us.get_or_insert(us);
-        let time_ns = u64::try_from(us.saturating_sub(first)).unwrap_or(0) * 1000;
+        let arrival = std::time::Instant::now();
+        let first_arrival = *self.first_arrival.get_or_insert(arrival);
+        let time_ns = frame_time_ns(
+            us,
+            &mut self.first_us,
+            self.last_ns,
+            arrival.duration_since(first_arrival),
+        );
+        self.last_ns = Some(time_ns);
         let frame = Frame::from_uyvy(w, h, data).map_err(|error| SourceError::Frame {
             source_label: label,
             error,
         })?;
         Ok(SourceFrame::new(time_ns, frame))
+    }
+}
+
+/// A frame's time in nanoseconds from the first frame: the driver's timestamp `driver_us`
+/// (microseconds) when it has one that moves forward, else `since_first_arrival`, the time
+/// since the first frame was dequeued. `first_us` is the first driver timestamp seen.
+fn frame_time_ns(
+    driver_us: i64,
+    first_us: &mut Option<i64>,
+    last_ns: Option<u64>,
+    since_first_arrival: std::time::Duration,
+) -> u64 {
+    let arrival_ns = u64::try_from(since_first_arrival.as_nanos()).unwrap_or(u64::MAX);
+    if driver_us <= 0 {
+        return arrival_ns;
+    }
+    let first = *first_us.get_or_insert(driver_us);
+    let driver_ns = u64::try_from(driver_us.saturating_sub(first))
+        .unwrap_or(0)
+        .saturating_mul(1000);
+    match last_ns {
+        Some(last) if driver_ns <= last && last > 0 => arrival_ns.max(last + 1),
+        _ => driver_ns,
     }
 }
 
@@ -340,6 +383,35 @@ mod tests {
         );
         assert_eq!(to_uyvy(&yuyv, 4, 1, Packing::Uyvy).unwrap(), yuyv);
         assert!(to_uyvy(&yuyv[..6], 4, 1, Packing::Yuyv).is_none());
+    }
+
+    #[test]
+    fn frame_times_come_from_the_driver_else_from_arrival() {
+        use std::time::Duration;
+        let mut first = None;
+        // The driver's clock: times from the first frame, whatever the arrival.
+        assert_eq!(
+            frame_time_ns(5_000_000, &mut first, None, Duration::ZERO),
+            0
+        );
+        assert_eq!(
+            frame_time_ns(5_033_000, &mut first, Some(0), Duration::from_millis(50)),
+            33_000_000
+        );
+        // A driver that gives no timestamps: the arrival clock.
+        let mut none = None;
+        assert_eq!(
+            frame_time_ns(0, &mut none, Some(0), Duration::from_millis(40)),
+            40_000_000
+        );
+        // A driver timestamp that runs backwards never makes time go back.
+        let t = frame_time_ns(
+            5_010_000,
+            &mut first,
+            Some(33_000_000),
+            Duration::from_millis(1),
+        );
+        assert!(t > 33_000_000, "{t}");
     }
 
     #[test]
