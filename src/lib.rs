@@ -13,7 +13,8 @@
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
-//! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
+//! | [`model`] | the world described (field, materials, teams, goals) and per-frame ground truth |
+//! | [`sim`] | synthetic frames with ground truth: renders the model, scenarios over time |
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
 //! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
@@ -41,6 +42,7 @@ pub mod import;
 pub mod input_file;
 pub mod live;
 pub mod lut;
+pub mod model;
 pub mod overhead;
 pub mod overlay;
 pub mod pipeline;

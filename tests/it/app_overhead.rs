@@ -12,9 +12,9 @@ use egui::{PointerButton, Pos2};
 use egui_kittest::kittest::Queryable as _;
 use eotn::app::field_view::FieldTransform;
 use eotn::geometry::{ImagePoint, Point};
+use eotn::model::truth::{GroundTruth, OverheadTruth};
 use eotn::overhead::calibration::Calibration;
 use eotn::overhead::{FieldDescription, PointsFile};
-use eotn::sim::truth::{GroundTruth, OverheadTruth};
 use eotn::sources::CameraKind;
 use eotn::streams::{FrameRecord, StreamReader};
 use eotn::workspace::{
