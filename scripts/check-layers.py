@@ -15,7 +15,7 @@ ORDER = [
     "atomic_file", "input_file", "stats", "frame", "lut", "classify", "blobs", "sensors", "geometry",
     "model", "sim", "import",
     "recognition", "overhead", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
-    "live", "workspace", "cli", "app",
+    "live", "workspace", "app_options", "cli", "app",
 ]
 
 root = pathlib.Path(__file__).resolve().parent.parent / "src"

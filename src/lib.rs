@@ -26,12 +26,14 @@
 //! | [`sources`] | frame sources (stream, files, synthetic, V4L2 camera, network), recording |
 //! | [`live`] | live robots over the Foxglove WebSocket protocol: client, frames, recording, `eotn serve` |
 //! | [`workspace`] | what the app, the CLI and the tests share: table, source, playback, edits |
+//! | [`app_options`] | how the desktop app starts (files, renderer, playing): the CLI fills it in |
 //! | [`cli`] | the `eotn` subcommands |
 //! | `app` | the desktop app (feature `gui`) |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
 pub mod annotate;
+pub mod app_options;
 pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
