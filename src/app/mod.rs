@@ -63,7 +63,7 @@ use std::time::{Duration, Instant};
 
 use egui::Color32;
 
-pub use crate::workspace::{Command, Settings, ViewKind, Workspace};
+pub use crate::workspace::{Command, PlaybackCommand, Settings, TableCommand, ViewKind, Workspace};
 
 use crate::app_options::{RendererSetting, RunOptions};
 pub use textures::{ViewImages, palette, preview_image, view_images, visible_preview_colour};
@@ -310,14 +310,14 @@ impl EotnApp {
         });
         match choice {
             Some(1) => {
-                commands.push(Command::SaveTable);
+                commands.push(TableCommand::SaveTable.into());
                 self.allow_close = true;
                 self.confirm_close = false;
             }
             Some(2) => {
                 // The edits are undone in the journal too: the next start finds the table as
                 // saved, with its undo history, and no sign of a crash.
-                commands.push(Command::DiscardUnsaved);
+                commands.push(TableCommand::DiscardUnsaved.into());
                 self.allow_close = true;
                 self.confirm_close = false;
                 ctx.send_viewport_cmd(egui::ViewportCommand::Close);
@@ -341,8 +341,8 @@ impl EotnApp {
         if dt > Duration::ZERO
             && let Some(speed) = self.play_when_shown.take()
         {
-            self.state.run(Command::SetSpeed(speed));
-            self.state.run(Command::SetPlaying(true));
+            self.state.run(PlaybackCommand::SetSpeed(speed).into());
+            self.state.run(PlaybackCommand::SetPlaying(true).into());
         }
         if self.play_when_shown.is_some() {
             ctx.request_repaint();
@@ -386,7 +386,7 @@ impl EotnApp {
     /// Applies queued commands; after "Save and quit", closes once the save succeeded.
     fn apply_all(&mut self, ctx: &egui::Context, commands: Vec<Command>) {
         for c in commands {
-            let saving_to_quit = c == Command::SaveTable && self.allow_close;
+            let saving_to_quit = c == Command::Table(TableCommand::SaveTable) && self.allow_close;
             self.state.run(c);
             if saving_to_quit {
                 if self.state.dirty() {
