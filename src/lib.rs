@@ -6,6 +6,7 @@
 //! | module | role |
 //! |---|---|
 //! | [`atomic_file`] | write-to-temporary, fsync, rename: how files the user cares about are saved |
+//! | [`input_file`] | reading the files a user names: regular files only, bounded in size |
 //! | [`stats`] | the median and the inverse-size least squares shared by recognition and evaluation |
 //! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
 //! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model, other teams' formats |
@@ -17,8 +18,8 @@
 //! | [`sim`] | synthetic frames with ground truth: renders the model, scenarios over time |
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
-//! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
 //! | [`overhead`] | overhead camera: field descriptions, calibration, ball and robot markers |
+//! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
 //! | [`overlay`] | recognition's drawing primitives on RGB images (`eotn render`) |
 //! | [`annotate`] | those primitives as Foxglove image annotations (`eotn detect --annotate`) |
 //! | [`eval`] | recognition against ground truth or hand labels: rates, errors, plots |
