@@ -14,7 +14,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use eotn::app::{palette, view_images};
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
-use eotn::workspace::{Command, Workspace};
+use eotn::workspace::{Command, PlaybackCommand, Workspace};
 
 /// More frames than the app's cache holds, so every step reads and decodes.
 const FRAMES: usize = 24;
@@ -52,7 +52,7 @@ fn bench_stream(c: &mut Criterion, name: &str, stream: PathBuf) {
     group.bench_function("step_and_view_images", |b| {
         b.iter(|| {
             k = (k + 9) % len;
-            state.apply(Command::Seek(k)).expect("seek");
+            state.apply(PlaybackCommand::Seek(k).into()).expect("seek");
             black_box(view_images(&state, &palette))
         });
     });

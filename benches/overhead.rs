@@ -9,8 +9,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use eotn::blobs::{BlobSet, Connectivity};
 use eotn::classify::ClassifiedImage;
 use eotn::lut::learn::{LearnParams, TableBuilder};
+use eotn::model::truth::GroundTruth;
 use eotn::overhead::{OverheadParams, OverheadPipeline, recognise_overhead};
-use eotn::sim::truth::GroundTruth;
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
 fn overhead(c: &mut Criterion) {

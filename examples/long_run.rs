@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use eotn::workspace::{Command, Workspace};
+use eotn::workspace::{Command, PlaybackCommand, Workspace};
 
 /// Samples taken over the stream.
 const SAMPLES: usize = 40;
@@ -47,7 +47,7 @@ fn main() -> ExitCode {
     println!("frame resident_mib");
     for index in 0..frames {
         if index > 0 {
-            state.run(Command::Step(1));
+            state.run(PlaybackCommand::Step(1).into());
         }
         if index % every == 0 || index + 1 == frames {
             let rss = resident_mib().unwrap_or(f64::NAN);

@@ -13,9 +13,9 @@ import sys
 # Data-flow order: frames in, results out, front ends last (STYLE.md, ARCHITECTURE.md).
 ORDER = [
     "atomic_file", "input_file", "stats", "frame", "lut", "classify", "blobs", "sensors", "geometry",
-    "sim", "import",
+    "model", "sim", "import",
     "recognition", "overhead", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
-    "live", "workspace", "cli", "app",
+    "live", "workspace", "app_options", "cli", "app",
 ]
 
 root = pathlib.Path(__file__).resolve().parent.parent / "src"

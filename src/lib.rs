@@ -6,6 +6,7 @@
 //! | module | role |
 //! |---|---|
 //! | [`atomic_file`] | write-to-temporary, fsync, rename: how files the user cares about are saved |
+//! | [`input_file`] | reading the files a user names: regular files only, bounded in size |
 //! | [`stats`] | the median and the inverse-size least squares shared by recognition and evaluation |
 //! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
 //! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model, other teams' formats |
@@ -13,11 +14,12 @@
 //! | [`blobs`] | classified image → connected blobs |
 //! | [`sensors`] | the robot's sensor readings for a frame (units, NaN handling) |
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
-//! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
+//! | [`model`] | the world described (field, materials, teams, goals) and per-frame ground truth |
+//! | [`sim`] | synthetic frames with ground truth: renders the model, scenarios over time |
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
-//! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
 //! | [`overhead`] | overhead camera: field descriptions, calibration, ball and robot markers |
+//! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
 //! | [`overlay`] | recognition's drawing primitives on RGB images (`eotn render`) |
 //! | [`annotate`] | those primitives as Foxglove image annotations (`eotn detect --annotate`) |
 //! | [`eval`] | recognition against ground truth or hand labels: rates, errors, plots |
@@ -25,12 +27,14 @@
 //! | [`sources`] | frame sources (stream, files, synthetic, V4L2 camera, network), recording |
 //! | [`live`] | live robots over the Foxglove WebSocket protocol: client, frames, recording, `eotn serve` |
 //! | [`workspace`] | what the app, the CLI and the tests share: table, source, playback, edits |
+//! | [`app_options`] | how the desktop app starts (files, renderer, playing): the CLI fills it in |
 //! | [`cli`] | the `eotn` subcommands |
 //! | `app` | the desktop app (feature `gui`) |
 //!
 //! See `ARCHITECTURE.md` for the map.
 
 pub mod annotate;
+pub mod app_options;
 pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
@@ -41,6 +45,7 @@ pub mod import;
 pub mod input_file;
 pub mod live;
 pub mod lut;
+pub mod model;
 pub mod overhead;
 pub mod overlay;
 pub mod pipeline;

@@ -10,12 +10,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         #[cfg(feature = "gui")]
-        Some(eotn::cli::Command::Open(args)) => {
-            eotn::app::run(eotn::app::RunOptions::from_args(&args))
-        }
+        Some(eotn::cli::Command::Open(args)) => eotn::app::run(args.run_options()),
         Some(command) => eotn::cli::run(command),
         #[cfg(feature = "gui")]
-        None => eotn::app::run(eotn::app::RunOptions::default()),
+        None => eotn::app::run(eotn::app_options::RunOptions::default()),
         #[cfg(not(feature = "gui"))]
         None => Err(anyhow::anyhow!(
             "this eotn was built without the desktop app (cargo feature `gui`); see `eotn --help` for the headless commands"

@@ -4,8 +4,8 @@
 
 use crate::debug_setup;
 use eotn::geometry::{CameraPose, Ers7Dimensions, ImagePoint, Point};
+use eotn::model::truth::GroundTruth;
 use eotn::pipeline::{Pipeline, PipelineParams};
-use eotn::sim::truth::GroundTruth;
 use eotn::sim::{FRAME_INTERVAL_S, Scenario, ScenarioKind, Simulator};
 
 /// Where a field point appears under the rolling shutter: the row whose own pose images the

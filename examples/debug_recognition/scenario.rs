@@ -1,8 +1,8 @@
 //! Ball and goal detail per frame of a scenario, the ball-distance bias table and the rim study.
 
 use eotn::eval::{EvalParams, evaluate_frame};
+use eotn::model::truth::GroundTruth;
 use eotn::pipeline::{Pipeline, PipelineParams};
-use eotn::sim::truth::GroundTruth;
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
 use crate::{debug_setup, learnt_table};

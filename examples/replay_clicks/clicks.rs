@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::Context;
 use eotn::lut::{ColourClass, Sensitivity};
-use eotn::workspace::{Command, Workspace};
+use eotn::workspace::{TableCommand, Workspace};
 use serde::Deserialize;
 
 /// A clicks file (`*.clicks.json`).
@@ -47,16 +47,16 @@ impl Clicks {
     /// Starts a new table in `ws` (whose frame must be open) and clicks every pixel: left
     /// click (`Sample`) then right click (`Commit`), as in the window.
     pub fn replay(&self, ws: &mut Workspace) -> anyhow::Result<()> {
-        ws.apply(Command::NewTable(self.bits))?;
+        ws.apply(TableCommand::NewTable(self.bits).into())?;
         for g in &self.clicks {
             let class = ColourClass::parse(&g.class)
                 .with_context(|| format!("unknown class {:?}", g.class))?;
             let [y, u, v] = g.sensitivity;
-            ws.apply(Command::SetClass(class))?;
-            ws.apply(Command::SetSensitivity(Sensitivity { y, u, v }))?;
+            ws.apply(TableCommand::SetClass(class).into())?;
+            ws.apply(TableCommand::SetSensitivity(Sensitivity { y, u, v }).into())?;
             for &[x, y] in &g.pixels {
-                ws.apply(Command::Sample { x, y })?;
-                ws.apply(Command::Commit)
+                ws.apply(TableCommand::Sample { x, y }.into())?;
+                ws.apply(TableCommand::Commit.into())
                     .with_context(|| format!("{} at ({x}, {y})", g.class))?;
             }
         }

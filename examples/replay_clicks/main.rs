@@ -9,7 +9,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use eotn::workspace::{Command, Workspace};
+use eotn::workspace::{Command, TableCommand, Workspace};
 
 mod clicks;
 
@@ -24,7 +24,7 @@ fn main() -> ExitCode {
         let mut ws = Workspace::default();
         ws.apply(Command::Open(vec![input.clone()]))?;
         clicks.replay(&mut ws)?;
-        ws.apply(Command::SaveTableAs(out.clone()))?;
+        ws.apply(TableCommand::SaveTableAs(out.clone()).into())?;
         let counts = ws.lut().class_counts();
         eprintln!(
             "{}: {} clicks, {} cells classified",

@@ -5,7 +5,7 @@
 use egui::{Color32, Painter, Rect, Stroke, Ui, pos2};
 
 use crate::workspace::bookmarks::EventKind;
-use crate::workspace::{Command, Workspace};
+use crate::workspace::{Command, HintsCommand, PlaybackCommand, Workspace};
 
 /// Colour of the user's bookmarks on the timeline.
 const BOOKMARK_COLOUR: Color32 = Color32::from_rgb(80, 170, 255);
@@ -22,14 +22,14 @@ pub fn bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
             .on_hover_text("Ctrl+Left: the previous event or bookmark")
             .clicked()
         {
-            commands.push(Command::JumpToMark { forward: false });
+            commands.push(HintsCommand::JumpToMark { forward: false }.into());
         }
         if ui
             .button("Next mark")
             .on_hover_text("Ctrl+Right: the next event or bookmark")
             .clicked()
         {
-            commands.push(Command::JumpToMark { forward: true });
+            commands.push(HintsCommand::JumpToMark { forward: true }.into());
         }
     });
     let id = egui::Id::unique("bookmark_note");
@@ -43,7 +43,7 @@ pub fn bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
             .on_hover_text("saved beside the stream as STREAM.bookmarks.json")
             .clicked()
         {
-            commands.push(Command::AddBookmark(std::mem::take(&mut note)));
+            commands.push(HintsCommand::AddBookmark(std::mem::take(&mut note)).into());
         }
     });
     ui.data_mut(|d| d.insert_temp(id, note));
@@ -66,7 +66,7 @@ fn user_bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
                     .selectable_label(b.frame == state.index(), format!("frame {}", b.frame))
                     .clicked()
                 {
-                    commands.push(Command::Seek(b.frame));
+                    commands.push(PlaybackCommand::Seek(b.frame).into());
                 }
                 ui.label(&b.note);
                 if ui
@@ -74,7 +74,7 @@ fn user_bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
                     .on_hover_text(format!("remove the bookmark at frame {}", b.frame))
                     .clicked()
                 {
-                    commands.push(Command::RemoveBookmark(b.frame));
+                    commands.push(HintsCommand::RemoveBookmark(b.frame).into());
                 }
                 ui.end_row();
             }
@@ -88,7 +88,7 @@ fn events_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             .on_hover_text("run the pipeline over every frame: ball found or lost, goals, warnings")
             .clicked()
         {
-            commands.push(Command::FindEvents);
+            commands.push(HintsCommand::FindEvents.into());
         }
         if let Some(scan) = state.event_scan().filter(|s| !s.done()) {
             ui.add(
@@ -108,7 +108,7 @@ fn events_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 .selectable_label(e.frame == state.index(), format!("frame {}", e.frame))
                 .clicked()
             {
-                commands.push(Command::Seek(e.frame));
+                commands.push(PlaybackCommand::Seek(e.frame).into());
             }
             ui.colored_label(event_colour(e.kind), e.kind.describe());
             ui.label(&e.detail);

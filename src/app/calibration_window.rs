@@ -89,9 +89,7 @@ fn files_ui(
         &[("Open field", true)],
     ) == Some(0)
     {
-        commands.push(Command::Overhead(OverheadCommand::OpenField(path(
-            &paths.field,
-        ))));
+        commands.push(OverheadCommand::OpenField(path(&paths.field)).into());
     }
     let has_cal = overhead.calibration().is_some();
     match path_row(
@@ -101,16 +99,12 @@ fn files_ui(
         &mut paths.calibration,
         &[("Open calibration", true), ("Save calibration", has_cal)],
     ) {
-        Some(0) => commands.push(Command::Overhead(OverheadCommand::OpenCalibration(path(
-            &paths.calibration,
-        )))),
-        Some(_) => commands.push(Command::Overhead(OverheadCommand::SaveCalibration(path(
-            &paths.calibration,
-        )))),
+        Some(0) => commands.push(OverheadCommand::OpenCalibration(path(&paths.calibration)).into()),
+        Some(_) => commands.push(OverheadCommand::SaveCalibration(path(&paths.calibration)).into()),
         None => {}
     }
     if has_cal && ui.button("Close calibration").clicked() {
-        commands.push(Command::Overhead(OverheadCommand::CloseCalibration));
+        commands.push(OverheadCommand::CloseCalibration.into());
     }
     let has_points = !overhead.points().points.is_empty();
     match path_row(
@@ -121,14 +115,10 @@ fn files_ui(
         &[("Open points", true), ("Save points", has_points)],
     ) {
         Some(0) => {
-            commands.push(Command::Overhead(OverheadCommand::OpenPoints(path(
-                &paths.points,
-            ))));
+            commands.push(OverheadCommand::OpenPoints(path(&paths.points)).into());
         }
         Some(_) => {
-            commands.push(Command::Overhead(OverheadCommand::SavePoints(path(
-                &paths.points,
-            ))));
+            commands.push(OverheadCommand::SavePoints(path(&paths.points)).into());
         }
         None => {}
     }
@@ -144,7 +134,7 @@ pub fn view_options_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
         ui.checkbox(&mut v.points, "Picked points");
     });
     if v != before {
-        commands.push(Command::Overhead(OverheadCommand::SetView(v)));
+        commands.push(OverheadCommand::SetView(v).into());
     }
 }
 
@@ -162,7 +152,7 @@ fn picking_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                     .selectable_label(chosen.is_none(), "(not picking)")
                     .clicked()
                 {
-                    commands.push(Command::Overhead(OverheadCommand::ChooseLandmark(None)));
+                    commands.push(OverheadCommand::ChooseLandmark(None).into());
                 }
                 for l in &overhead.field().landmarks {
                     let mark = if picked(&l.name) { " ✔" } else { "" };
@@ -171,9 +161,7 @@ fn picking_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                         .selectable_label(chosen.as_deref() == Some(l.name.as_str()), text)
                         .clicked()
                     {
-                        commands.push(Command::Overhead(OverheadCommand::ChooseLandmark(Some(
-                            l.name.clone(),
-                        ))));
+                        commands.push(OverheadCommand::ChooseLandmark(Some(l.name.clone())).into());
                     }
                 }
             });
@@ -181,7 +169,7 @@ fn picking_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             .add_enabled(overhead.picks_to_undo() > 0, egui::Button::new("Undo pick"))
             .clicked()
         {
-            commands.push(Command::Overhead(OverheadCommand::UndoPick));
+            commands.push(OverheadCommand::UndoPick.into());
         }
         let n = overhead.points().points.len();
         if ui
@@ -191,7 +179,7 @@ fn picking_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             ))
             .clicked()
         {
-            commands.push(Command::Overhead(OverheadCommand::Calibrate));
+            commands.push(OverheadCommand::Calibrate.into());
         }
     });
     if chosen.is_some() {

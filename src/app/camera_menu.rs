@@ -9,7 +9,7 @@ use egui::{Context, Ui};
 
 use crate::sim::ScenarioKind;
 use crate::sources::{Available, CameraKind, SourceKind, SourceSettings, SourceSpec, available};
-use crate::workspace::{Command, Window, Workspace};
+use crate::workspace::{Command, SourceCommand, Window, Workspace};
 
 /// What the Camera dialogs are editing.
 #[derive(Debug)]
@@ -83,7 +83,7 @@ pub fn camera_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command
         ui,
         connected.is_some(),
         "Disconnect",
-        vec![Command::Disconnect],
+        vec![Command::Source(SourceCommand::Disconnect)],
     );
     let live = state.live();
     item(
@@ -98,12 +98,12 @@ pub fn camera_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command
         ui,
         connected.is_some(),
         "Grab image",
-        vec![Command::GrabImage],
+        vec![Command::Source(SourceCommand::GrabImage)],
     );
     if let Some(l) = live {
         let mut on = l.streaming();
         if ui.checkbox(&mut on, "Stream live").changed() {
-            commands.push(Command::SetStreaming(on));
+            commands.push(SourceCommand::SetStreaming(on).into());
         }
     }
     ui.separator();
@@ -120,7 +120,7 @@ pub fn camera_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command
         ui,
         recording.is_some(),
         "Stop recording",
-        vec![Command::StopRecording],
+        vec![Command::Source(SourceCommand::StopRecording)],
     );
     if let Some(p) = recording {
         ui.weak(format!("recording into {}", p.display()));
@@ -270,7 +270,7 @@ fn connect_ui(ui: &mut Ui, d: &mut CameraDialogs, commands: &mut Vec<Command>) {
         .clicked()
         && let Some(spec) = spec
     {
-        commands.push(Command::Connect(spec));
+        commands.push(SourceCommand::Connect(spec).into());
         commands.push(Command::ShowWindow(Window::Connect, false));
     }
 }
@@ -346,7 +346,7 @@ fn settings_ui(ui: &mut Ui, state: &Workspace, d: &mut CameraDialogs, commands: 
             }
         });
     if ui.button("Apply").clicked() {
-        commands.push(Command::SetSourceSettings(s.clone()));
+        commands.push(SourceCommand::SetSourceSettings(s.clone()).into());
     }
 }
 
@@ -367,7 +367,7 @@ fn record_ui(ui: &mut Ui, d: &mut CameraDialogs, commands: &mut Vec<Command>) {
             .add_enabled(!p.is_empty(), egui::Button::new("Start recording"))
             .clicked()
         {
-            commands.push(Command::StartRecording(PathBuf::from(p)));
+            commands.push(SourceCommand::StartRecording(PathBuf::from(p)).into());
             commands.push(Command::ShowWindow(Window::Record, false));
         }
     });

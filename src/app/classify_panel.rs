@@ -4,7 +4,7 @@
 use egui::{Color32, RichText, Sense, Ui, vec2};
 
 use crate::lut::{ColourClass, Sensitivity};
-use crate::workspace::{Command, TryEdit, Workspace};
+use crate::workspace::{Command, ParamsCommand, PlaybackCommand, TableCommand, TryEdit, Workspace};
 
 /// A colour swatch the size of a line of text.
 pub fn swatch(ui: &mut Ui, rgb: [u8; 3]) {
@@ -49,7 +49,7 @@ fn classes_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                     .selectable_label(state.settings.class == class, class.name())
                     .clicked()
                 {
-                    commands.push(Command::SetClass(class));
+                    commands.push(TableCommand::SetClass(class).into());
                 }
             });
             let code = usize::from(class.code());
@@ -77,12 +77,12 @@ fn sensitivity_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             .on_hover_text(format!("keys {keys}; + and - change all three"));
     }
     if s != before {
-        commands.push(Command::SetSensitivity(s));
+        commands.push(TableCommand::SetSensitivity(s).into());
     }
     ui.horizontal(|ui| {
         for n in [0u8, 1, 2, 4] {
             if ui.small_button(format!("{n}")).clicked() {
-                commands.push(Command::SetSensitivity(Sensitivity::uniform(n)));
+                commands.push(TableCommand::SetSensitivity(Sensitivity::uniform(n)).into());
             }
         }
     });
@@ -113,10 +113,10 @@ fn pending_selection_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
                     .on_hover_text("right-click in the image")
                     .clicked()
                 {
-                    commands.push(Command::Commit);
+                    commands.push(TableCommand::Commit.into());
                 }
                 if ui.button("Clear").on_hover_text("Esc").clicked() {
-                    commands.push(Command::ClearSelection);
+                    commands.push(TableCommand::ClearSelection.into());
                 }
             });
             if state.source().is_some_and(|s| s.len() > 1)
@@ -125,7 +125,7 @@ fn pending_selection_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
                     .on_hover_text("list the frames this edit would change")
                     .clicked()
             {
-                commands.push(Command::TryEditOnStream);
+                commands.push(TableCommand::TryEditOnStream.into());
             }
         }
         _ => {
@@ -143,14 +143,14 @@ fn undo_redo_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             .on_hover_text("Ctrl+Z")
             .clicked()
         {
-            commands.push(Command::Undo);
+            commands.push(TableCommand::Undo.into());
         }
         if ui
             .add_enabled(h.redo_len() > 0, egui::Button::new("Redo"))
             .on_hover_text("Ctrl+Y")
             .clicked()
         {
-            commands.push(Command::Redo);
+            commands.push(TableCommand::Redo.into());
         }
         ui.label(format!("{} / {}", h.undo_len(), h.redo_len()));
     });
@@ -173,7 +173,7 @@ pub fn try_edit_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
                 )
                 .clicked()
             {
-                commands.push(Command::TryEditOnStream);
+                commands.push(TableCommand::TryEditOnStream.into());
             }
         }
     }
@@ -194,7 +194,7 @@ pub fn try_edit_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
                 )
                 .clicked()
             {
-                commands.push(Command::TryParamsOnStream);
+                commands.push(ParamsCommand::TryParamsOnStream.into());
             }
         }
     }
@@ -252,7 +252,7 @@ fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Comm
                     egui::Button::selectable(r.index == current, RichText::new(text).monospace())
                         .min_size(vec2(ui.available_width(), 0.0));
                 if ui.add(row).clicked() {
-                    commands.push(Command::Seek(r.index));
+                    commands.push(PlaybackCommand::Seek(r.index).into());
                 }
             }
         });

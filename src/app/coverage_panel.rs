@@ -7,7 +7,7 @@ use egui::{Color32, Painter, Rect, Stroke, Ui, pos2, vec2};
 
 use crate::frame::yuv_to_rgb;
 use crate::lut::Region;
-use crate::workspace::{Command, Workspace};
+use crate::workspace::{Command, HintsCommand, ViewCommand, Workspace};
 
 /// The range, the scan's progress and the hints.
 pub fn coverage_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
@@ -30,10 +30,13 @@ pub fn coverage_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) 
             .on_hover_text("count the colours the table leaves unclassified")
             .clicked()
         {
-            commands.push(Command::FindUnclassified {
-                first: range[0].min(range[1]),
-                last: range[0].max(range[1]),
-            });
+            commands.push(
+                HintsCommand::FindUnclassified {
+                    first: range[0].min(range[1]),
+                    last: range[0].max(range[1]),
+                }
+                .into(),
+            );
         }
     });
     ui.data_mut(|d| d.insert_temp(id, range));
@@ -90,8 +93,8 @@ fn hints_list_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                     )
                     .clicked()
                 {
-                    commands.push(Command::SelectCells(h.cells.clone()));
-                    commands.push(Command::SetUvPlaneY(h.mean.y));
+                    commands.push(HintsCommand::SelectCells(h.cells.clone()).into());
+                    commands.push(ViewCommand::SetUvPlaneY(h.mean.y).into());
                 }
                 ui.horizontal(|ui| {
                     super::classify_panel::swatch(ui, yuv_to_rgb(h.mean));

@@ -113,7 +113,7 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
             .filter(|(d, _)| *d <= CLICK_RADIUS_PT.max(ROBOT_RADIUS_CM * xf.scale()))
             .min_by(|a, b| a.0.total_cmp(&b.0))
             .map(|(_, k)| k);
-        commands.push(Command::Overhead(OverheadCommand::SelectRobot(hit)));
+        commands.push(OverheadCommand::SelectRobot(hit).into());
     }
     if !models.is_empty() {
         errors_ui(ui, state);

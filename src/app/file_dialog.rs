@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use egui_file::{FileDialog, State};
 
-use crate::workspace::Command;
+use crate::workspace::{Command, ParamsCommand, SourceCommand, TableCommand, ViewCommand};
 
 /// What a dialog is for; it decides the title, the filter and the command sent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -70,12 +70,12 @@ impl FileAction {
         match self {
             Self::Open => Command::Open(vec![path]),
             Self::OpenTable => Command::OpenTable(path),
-            Self::OpenParams => Command::OpenParams(path),
+            Self::OpenParams => Command::Params(ParamsCommand::OpenParams(path)),
             Self::OpenPlaces => Command::OpenPlaces(path),
-            Self::SaveTableAs => Command::SaveTableAs(path),
-            Self::SaveParams => Command::SaveParams(path),
-            Self::ExportView => Command::ExportView(path),
-            Self::Record => Command::StartRecording(path),
+            Self::SaveTableAs => Command::Table(TableCommand::SaveTableAs(path)),
+            Self::SaveParams => Command::Params(ParamsCommand::SaveParams(path)),
+            Self::ExportView => Command::View(ViewCommand::ExportView(path)),
+            Self::Record => Command::Source(SourceCommand::StartRecording(path)),
         }
     }
 }

@@ -591,7 +591,7 @@ fn overhead_results_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
                 let mine = selected == Some(key);
                 if ui.selectable_label(mine, key.to_string()).clicked() {
                     let next = if mine { None } else { Some(key) };
-                    commands.push(Command::Overhead(OverheadCommand::SelectRobot(next)));
+                    commands.push(OverheadCommand::SelectRobot(next).into());
                 }
                 ui.monospace(format!("{:7.1} {:7.1}", r.field_cm[0], r.field_cm[1]));
                 ui.monospace(format!("{:6.1}", r.heading_rad.to_degrees()));

@@ -4,6 +4,7 @@
 use egui::{Key, KeyboardShortcut, Modifiers};
 
 use super::{Command, EotnApp};
+use crate::workspace::{HintsCommand, PlaybackCommand, TableCommand};
 
 impl EotnApp {
     /// Turns this frame's key presses into commands; true when the window should close.
@@ -20,13 +21,13 @@ impl EotnApp {
                 Key::Z,
             )) || i.consume_shortcut(&cmd(Key::Y))
             {
-                commands.push(Command::Redo);
+                commands.push(TableCommand::Redo.into());
             }
             if i.consume_shortcut(&cmd(Key::Z)) {
-                commands.push(Command::Undo);
+                commands.push(TableCommand::Undo.into());
             }
             if i.consume_shortcut(&cmd(Key::S)) {
-                commands.push(Command::SaveTable);
+                commands.push(TableCommand::SaveTable.into());
             }
             if i.consume_shortcut(&cmd(Key::Q)) {
                 quit = true;
@@ -35,16 +36,19 @@ impl EotnApp {
                 let down = i.count_and_consume_key(Modifiers::SHIFT, key) as i32;
                 let up = i.count_and_consume_key(Modifiers::NONE, key) as i32;
                 if up != down {
-                    commands.push(Command::AdjustSensitivity {
-                        channel,
-                        delta: up - down,
-                    });
+                    commands.push(
+                        TableCommand::AdjustSensitivity {
+                            channel,
+                            delta: up - down,
+                        }
+                        .into(),
+                    );
                 }
             }
             for (key, delta) in [(Key::Plus, 1), (Key::Equals, 1), (Key::Minus, -1)] {
                 if i.consume_key(Modifiers::NONE, key) {
                     for channel in 0..3 {
-                        commands.push(Command::AdjustSensitivity { channel, delta });
+                        commands.push(TableCommand::AdjustSensitivity { channel, delta }.into());
                     }
                 }
             }
@@ -58,27 +62,27 @@ impl EotnApp {
                     // Every press counts, even several within one slow frame.
                     let n = i.count_and_consume_key(Modifiers::NONE, key);
                     if n > 0 {
-                        commands.push(Command::Step(delta * n as i64));
+                        commands.push(PlaybackCommand::Step(delta * n as i64).into());
                     }
                 }
                 for (key, forward) in [(Key::ArrowRight, true), (Key::ArrowLeft, false)] {
                     if i.consume_key(Modifiers::COMMAND, key) {
-                        commands.push(Command::JumpToMark { forward });
+                        commands.push(HintsCommand::JumpToMark { forward }.into());
                     }
                 }
                 if i.consume_key(Modifiers::NONE, Key::Home) {
-                    commands.push(Command::Seek(0));
+                    commands.push(PlaybackCommand::Seek(0).into());
                 }
                 if i.consume_key(Modifiers::NONE, Key::End) {
-                    commands.push(Command::Seek(usize::MAX));
+                    commands.push(PlaybackCommand::Seek(usize::MAX).into());
                 }
                 if i.consume_key(Modifiers::NONE, Key::Space) {
-                    commands.push(Command::SetPlaying(!self.state.playing()));
+                    commands.push(PlaybackCommand::SetPlaying(!self.state.playing()).into());
                 }
             }
             // Escape closes an open menu first; only then does it drop the selection.
             if !menu_open && i.consume_key(Modifiers::NONE, Key::Escape) {
-                commands.push(Command::ClearSelection);
+                commands.push(TableCommand::ClearSelection.into());
             }
         });
         quit

@@ -9,7 +9,8 @@ use super::file_dialog::FileAction;
 use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
 use crate::workspace::{
-    Command, Overlays, SPEEDS, ViewKind, Window, Workspace, ZOOM_PRESETS, ZOOM_RANGE,
+    Command, Overlays, ParamsCommand, PlaybackCommand, SPEEDS, TableCommand, ViewCommand, ViewKind,
+    Window, Workspace, ZOOM_PRESETS, ZOOM_RANGE,
 };
 
 /// What the menus ask of the app besides commands.
@@ -124,7 +125,7 @@ fn file_menu_ui(
                 .button(format!("{bits} bits ({}³ cells)", 1 << bits))
                 .clicked()
             {
-                commands.push(Command::NewTable(bits));
+                commands.push(TableCommand::NewTable(bits).into());
                 ui.close();
             }
         }
@@ -137,7 +138,7 @@ fn file_menu_ui(
         )
         .clicked()
     {
-        commands.push(Command::SaveTable);
+        commands.push(TableCommand::SaveTable.into());
         ui.close();
     }
     if ui.button("Save table as…").clicked() {
@@ -163,9 +164,7 @@ fn file_menu_ui(
         .on_hover_text("into the current folder, no dialog")
         .clicked()
     {
-        commands.push(Command::ExportView(PathBuf::from(default_export_name(
-            state,
-        ))));
+        commands.push(ViewCommand::ExportView(PathBuf::from(default_export_name(state))).into());
         ui.close();
     }
     ui.separator();
@@ -220,7 +219,7 @@ fn params_menu_items_ui(
             ))
             .clicked()
         {
-            commands.push(Command::UseOfferedParams);
+            commands.push(ParamsCommand::UseOfferedParams.into());
             ui.close();
         }
     }
@@ -231,7 +230,7 @@ fn params_menu_items_ui(
         )
         .clicked()
     {
-        commands.push(Command::DefaultParams);
+        commands.push(ParamsCommand::DefaultParams.into());
         ui.close();
     }
     if ui.button("Save parameters as…").clicked() {
@@ -271,7 +270,7 @@ fn class_menus_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 .selectable_label(state.settings.class == class, class.name())
                 .clicked()
             {
-                commands.push(Command::SetClass(class));
+                commands.push(TableCommand::SetClass(class).into());
                 ui.close();
             }
         }
@@ -285,7 +284,7 @@ fn class_menus_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 )
                 .clicked()
             {
-                commands.push(Command::SetSensitivity(Sensitivity::uniform(n)));
+                commands.push(TableCommand::SetSensitivity(Sensitivity::uniform(n)).into());
                 ui.close();
             }
         }
@@ -302,7 +301,7 @@ fn table_edit_items_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
         )
         .clicked()
     {
-        commands.push(Command::Undo);
+        commands.push(TableCommand::Undo.into());
         ui.close();
     }
     if ui
@@ -312,7 +311,7 @@ fn table_edit_items_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
         )
         .clicked()
     {
-        commands.push(Command::Redo);
+        commands.push(TableCommand::Redo.into());
         ui.close();
     }
     if ui
@@ -322,7 +321,7 @@ fn table_edit_items_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
         )
         .clicked()
     {
-        commands.push(Command::Commit);
+        commands.push(TableCommand::Commit.into());
         ui.close();
     }
     if ui
@@ -332,7 +331,7 @@ fn table_edit_items_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
         )
         .clicked()
     {
-        commands.push(Command::TryEditOnStream);
+        commands.push(TableCommand::TryEditOnStream.into());
         ui.close();
     }
 }
@@ -374,7 +373,7 @@ fn places_items_ui(
         .on_hover_text("replay TABLE.journal.jsonl onto the table it started from")
         .clicked()
     {
-        commands.push(Command::RebuildFromJournal);
+        commands.push(TableCommand::RebuildFromJournal.into());
         ui.close();
     }
 }
@@ -386,19 +385,19 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 .selectable_label(state.settings.main_view == kind, kind.name())
                 .clicked()
             {
-                commands.push(Command::SetMainView(kind));
+                commands.push(ViewCommand::SetMainView(kind).into());
                 ui.close();
             }
         }
     });
     stays_open_on_clicks("Zoom", ui, |ui| {
         if ui.button("Fit (double-click)").clicked() {
-            commands.push(Command::ResetView);
+            commands.push(ViewCommand::ResetView.into());
             ui.close();
         }
         for z in ZOOM_PRESETS {
             if ui.button(format!("{:.0}%", z * 100.0)).clicked() {
-                commands.push(Command::SetZoom(Some(z)));
+                commands.push(ViewCommand::SetZoom(Some(z)).into());
                 ui.close();
             }
         }
@@ -413,7 +412,7 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     }
     let mut timings = state.settings.show_timings;
     if ui.checkbox(&mut timings, "Frame-time readout").changed() {
-        commands.push(Command::ShowTimings(timings));
+        commands.push(ViewCommand::ShowTimings(timings).into());
     }
     ui.separator();
     let c = state.settings.connectivity;
@@ -422,7 +421,7 @@ fn view_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         (Connectivity::Four, "4-connected blobs"),
     ] {
         if ui.selectable_label(c == conn, name).clicked() {
-            commands.push(Command::SetConnectivity(conn));
+            commands.push(ViewCommand::SetConnectivity(conn).into());
         }
     }
 }
@@ -454,7 +453,7 @@ pub fn zoom_value_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
             .labelled_by(l.id)
             .on_hover_text("type a zoom in percent");
         if r.changed() && (percent - before).abs() > f32::EPSILON {
-            commands.push(Command::SetZoom(Some(percent / 100.0)));
+            commands.push(ViewCommand::SetZoom(Some(percent / 100.0)).into());
         }
     });
 }
@@ -491,10 +490,13 @@ fn blob_filter_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         }
     }
     if changed {
-        commands.push(Command::SetBlobFilter {
-            min_pixels: min,
-            hidden,
-        });
+        commands.push(
+            ViewCommand::SetBlobFilter {
+                min_pixels: min,
+                hidden,
+            }
+            .into(),
+        );
     }
 }
 
@@ -526,19 +528,43 @@ fn overlays_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
         }
     });
     if o != before {
-        commands.push(Command::SetOverlays(o));
+        commands.push(ViewCommand::SetOverlays(o).into());
     }
 }
 
 fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let open = state.source().is_some();
     for (label, cmd, key) in [
-        ("Previous frame", Command::Step(-1), "Left"),
-        ("Next frame", Command::Step(1), "Right"),
-        ("Back 10 frames", Command::Step(-10), "PgUp"),
-        ("Forward 10 frames", Command::Step(10), "PgDn"),
-        ("First frame", Command::Seek(0), "Home"),
-        ("Last frame", Command::Seek(usize::MAX), "End"),
+        (
+            "Previous frame",
+            Command::Playback(PlaybackCommand::Step(-1)),
+            "Left",
+        ),
+        (
+            "Next frame",
+            Command::Playback(PlaybackCommand::Step(1)),
+            "Right",
+        ),
+        (
+            "Back 10 frames",
+            Command::Playback(PlaybackCommand::Step(-10)),
+            "PgUp",
+        ),
+        (
+            "Forward 10 frames",
+            Command::Playback(PlaybackCommand::Step(10)),
+            "PgDn",
+        ),
+        (
+            "First frame",
+            Command::Playback(PlaybackCommand::Seek(0)),
+            "Home",
+        ),
+        (
+            "Last frame",
+            Command::Playback(PlaybackCommand::Seek(usize::MAX)),
+            "End",
+        ),
     ] {
         if ui
             .add_enabled(open, egui::Button::new(label).shortcut_text(key))
@@ -552,7 +578,7 @@ fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         .add_enabled(open, egui::Button::new(play).shortcut_text("Space"))
         .clicked()
     {
-        commands.push(Command::SetPlaying(!state.playing()));
+        commands.push(PlaybackCommand::SetPlaying(!state.playing()).into());
         ui.close();
     }
     ui.menu_button("Speed", |ui| {
@@ -562,7 +588,7 @@ fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 .selectable_label((state.settings.speed - s).abs() < 1e-6, name)
                 .clicked()
             {
-                commands.push(Command::SetSpeed(s));
+                commands.push(PlaybackCommand::SetSpeed(s).into());
                 ui.close();
             }
         }

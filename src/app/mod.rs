@@ -63,7 +63,9 @@ use std::time::{Duration, Instant};
 
 use egui::Color32;
 
-pub use crate::workspace::{Command, Settings, ViewKind, Workspace};
+pub use crate::workspace::{Command, PlaybackCommand, Settings, TableCommand, ViewKind, Workspace};
+
+use crate::app_options::{RendererSetting, RunOptions};
 pub use textures::{ViewImages, palette, preview_image, view_images, visible_preview_colour};
 
 use crate::workspace::{PixelInfo, median};
@@ -72,38 +74,6 @@ use textures::Textures;
 
 /// Key of the persisted [`Settings`] in eframe's storage.
 pub const SETTINGS_KEY: &str = "eotn-settings";
-
-/// How the window starts (`eotn open` and its options).
-#[derive(Debug, Clone, Default)]
-pub struct RunOptions {
-    /// Streams, frames, tables to open; none reopens the last session.
-    pub files: Vec<PathBuf>,
-    /// `--renderer`: saved and used when given; else the saved setting, else auto.
-    pub renderer: Option<crate::cli::open::RendererSetting>,
-    /// `--play [--speed]`: start playing at once at this speed.
-    pub play: Option<crate::cli::open::PlaySpeed>,
-    /// `--quit-after`: close the window after this long.
-    pub quit_after: Option<Duration>,
-    /// `--all-overlays`: every overlay on.
-    pub all_overlays: bool,
-}
-
-impl RunOptions {
-    /// From `eotn open`'s arguments.
-    #[must_use]
-    pub fn from_args(args: &crate::cli::open::Args) -> Self {
-        Self {
-            files: args.files.clone(),
-            renderer: args.renderer,
-            play: args.play.then_some(args.speed),
-            quit_after: args
-                .quit_after
-                .filter(|s| s.is_finite() && *s >= 0.0)
-                .map(|s| Duration::from_secs_f64(s.min(1e9))),
-            all_overlays: args.all_overlays,
-        }
-    }
-}
 
 /// What draws the window, for the status bar and the About window.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -115,7 +85,7 @@ pub struct RendererInfo {
     /// The adapter it runs on, as it names itself (wgpu adapter, or GL_RENDERER and version).
     pub adapter: String,
     /// The setting it came from (`auto`, `wgpu`, `gl`).
-    pub setting: crate::cli::open::RendererSetting,
+    pub setting: RendererSetting,
 }
 
 /// Opens the app window (streams, frames, tables; none reopens the last session), on the
@@ -151,7 +121,7 @@ pub fn run(opts: RunOptions) -> anyhow::Result<()> {
 fn start_window(
     kind: renderer::RendererKind,
     reason: &str,
-    setting: crate::cli::open::RendererSetting,
+    setting: RendererSetting,
     opts: &RunOptions,
 ) -> Result<(), eframe::Error> {
     let options = eframe::NativeOptions {
@@ -340,14 +310,14 @@ impl EotnApp {
         });
         match choice {
             Some(1) => {
-                commands.push(Command::SaveTable);
+                commands.push(TableCommand::SaveTable.into());
                 self.allow_close = true;
                 self.confirm_close = false;
             }
             Some(2) => {
                 // The edits are undone in the journal too: the next start finds the table as
                 // saved, with its undo history, and no sign of a crash.
-                commands.push(Command::DiscardUnsaved);
+                commands.push(TableCommand::DiscardUnsaved.into());
                 self.allow_close = true;
                 self.confirm_close = false;
                 ctx.send_viewport_cmd(egui::ViewportCommand::Close);
@@ -371,8 +341,8 @@ impl EotnApp {
         if dt > Duration::ZERO
             && let Some(speed) = self.play_when_shown.take()
         {
-            self.state.run(Command::SetSpeed(speed));
-            self.state.run(Command::SetPlaying(true));
+            self.state.run(PlaybackCommand::SetSpeed(speed).into());
+            self.state.run(PlaybackCommand::SetPlaying(true).into());
         }
         if self.play_when_shown.is_some() {
             ctx.request_repaint();
@@ -416,7 +386,7 @@ impl EotnApp {
     /// Applies queued commands; after "Save and quit", closes once the save succeeded.
     fn apply_all(&mut self, ctx: &egui::Context, commands: Vec<Command>) {
         for c in commands {
-            let saving_to_quit = c == Command::SaveTable && self.allow_close;
+            let saving_to_quit = c == Command::Table(TableCommand::SaveTable) && self.allow_close;
             self.state.run(c);
             if saving_to_quit {
                 if self.state.dirty() {

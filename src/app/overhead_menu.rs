@@ -24,7 +24,7 @@ pub fn overhead_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
     ui.checkbox(&mut v.undistorted, "Undistorted image");
     ui.checkbox(&mut v.points, "Picked points and their errors");
     if v != before {
-        commands.push(Command::Overhead(OverheadCommand::SetView(v)));
+        commands.push(OverheadCommand::SetView(v).into());
     }
     ui.separator();
     if ui
@@ -34,11 +34,11 @@ pub fn overhead_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
         )
         .clicked()
     {
-        commands.push(Command::Overhead(OverheadCommand::CloseCalibration));
+        commands.push(OverheadCommand::CloseCalibration.into());
         ui.close();
     }
     if overhead.selected().is_some() && ui.button("Clear robot selection").clicked() {
-        commands.push(Command::Overhead(OverheadCommand::SelectRobot(None)));
+        commands.push(OverheadCommand::SelectRobot(None).into());
         ui.close();
     }
 }

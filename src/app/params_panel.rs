@@ -10,7 +10,7 @@ use egui::{RichText, Ui};
 use serde_json::Value;
 
 use super::file_dialog::FileAction;
-use crate::workspace::{Command, TryParams, Workspace};
+use crate::workspace::{Command, ParamsCommand, PlaybackCommand, TryParams, Workspace};
 
 /// The Parameters window's contents. `dialog` receives a file dialog request (Open…, Save as…).
 pub fn params_panel_ui(
@@ -37,7 +37,7 @@ pub fn params_panel_ui(
             );
             if o.path.is_some() {
                 if ui.button(format!("Use {}", o.name)).clicked() {
-                    commands.push(Command::UseOfferedParams);
+                    commands.push(ParamsCommand::UseOfferedParams.into());
                 }
             } else {
                 ui.weak(format!("params/{}.json not found: Open…", o.name));
@@ -60,10 +60,10 @@ pub fn params_panel_ui(
             .on_hover_text("every value back to the file's")
             .clicked()
         {
-            commands.push(Command::ResetParams);
+            commands.push(ParamsCommand::ResetParams.into());
         }
         if ui.button("Defaults").clicked() {
-            commands.push(Command::DefaultParams);
+            commands.push(ParamsCommand::DefaultParams.into());
         }
         if ui
             .add_enabled(
@@ -73,7 +73,7 @@ pub fn params_panel_ui(
             .on_hover_text("list the frames whose recognition the tuned values change")
             .clicked()
         {
-            commands.push(Command::TryParamsOnStream);
+            commands.push(ParamsCommand::TryParamsOnStream.into());
         }
     });
     let filter_id = egui::Id::unique("eotn-params-filter");
@@ -155,10 +155,13 @@ impl Rows<'_> {
             let label = ui.label(name);
             let label_id = label.id;
             if let Some(new) = value_editor_ui(ui, label_id, value) {
-                self.commands.push(Command::SetParamValue {
-                    pointer: pointer.to_owned(),
-                    value: new,
-                });
+                self.commands.push(
+                    ParamsCommand::SetParamValue {
+                        pointer: pointer.to_owned(),
+                        value: new,
+                    }
+                    .into(),
+                );
             }
             let reset = ui
                 .add_enabled(changed, egui::Button::new("Reset").small())
@@ -168,7 +171,7 @@ impl Rows<'_> {
                 ));
             if reset.clicked() {
                 self.commands
-                    .push(Command::ResetParamValue(pointer.to_owned()));
+                    .push(ParamsCommand::ResetParamValue(pointer.to_owned()).into());
             }
         });
     }
@@ -271,7 +274,7 @@ pub fn try_params_ui(ui: &mut Ui, t: &TryParams, current: usize, commands: &mut 
                     egui::Button::selectable(r.index == current, RichText::new(text).monospace())
                         .min_size(egui::vec2(ui.available_width(), 0.0));
                 if ui.add(row).clicked() {
-                    commands.push(Command::Seek(r.index));
+                    commands.push(PlaybackCommand::Seek(r.index).into());
                 }
             }
         });

@@ -9,7 +9,7 @@
 
 use std::path::PathBuf;
 
-use crate::cli::open::RendererSetting;
+use crate::app_options::RendererSetting;
 
 /// The renderer that draws the window.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use egui::{RichText, Ui};
 
 use crate::live::Connection;
-use crate::workspace::{Command, RobotRow, Workspace};
+use crate::workspace::{Command, RobotRow, RobotsCommand, Workspace};
 
 /// What the robots window is editing.
 #[derive(Debug)]
@@ -50,7 +50,7 @@ pub fn robots_ui(
             .on_hover_text("connect beside the robots connected already")
             .clicked()
         {
-            commands.push(Command::ConnectRobot(address.to_owned()));
+            commands.push(RobotsCommand::ConnectRobot(address.to_owned()).into());
         }
     });
     ui.horizontal_wrapped(|ui| {
@@ -66,7 +66,7 @@ pub fn robots_ui(
             .on_hover_text("every robot not recording yet, one file each, bit-exact")
             .clicked()
         {
-            commands.push(Command::RecordAllRobots(PathBuf::from(folder)));
+            commands.push(RobotsCommand::RecordAllRobots(PathBuf::from(folder)).into());
         }
     });
     ui.separator();
@@ -101,7 +101,7 @@ fn robot_row_ui(
             .clicked()
             && !row.shown
         {
-            commands.push(Command::ShowRobot(id));
+            commands.push(RobotsCommand::ShowRobot(id).into());
         }
         let text = row.connection.to_string();
         let state_label = match &row.connection {
@@ -125,7 +125,7 @@ fn robot_row_ui(
                 ui.label(RichText::new(format!("rec {}", s.recorded.unwrap_or(0))).strong())
                     .on_hover_text(path.display().to_string());
                 if ui.small_button("Stop").clicked() {
-                    commands.push(Command::StopRecordingRobot(id));
+                    commands.push(RobotsCommand::StopRecordingRobot(id).into());
                 }
             }
             None => {
@@ -135,15 +135,15 @@ fn robot_row_ui(
                     .on_hover_text("into the folder above, named after the robot")
                     .clicked()
                 {
-                    commands.push(Command::RecordRobot(
-                        id,
-                        state.robot_recording_path(id, &folder),
-                    ));
+                    commands.push(
+                        RobotsCommand::RecordRobot(id, state.robot_recording_path(id, &folder))
+                            .into(),
+                    );
                 }
             }
         }
         if ui.small_button("Disconnect").clicked() {
-            commands.push(Command::DisconnectRobot(id));
+            commands.push(RobotsCommand::DisconnectRobot(id).into());
         }
     });
 }
@@ -162,7 +162,7 @@ pub fn live_controls_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
         "back to the newest frame"
     };
     if ui.add(button).on_hover_text(hover).clicked() {
-        commands.push(Command::SetFollowLive(!live));
+        commands.push(RobotsCommand::SetFollowLive(!live).into());
     }
     if !live {
         ui.weak("held")

@@ -2,7 +2,7 @@
 //! the slider with the events' and bookmarks' marks.
 
 use super::{Command, EotnApp, bookmarks_panel, menus, robots_panel};
-use crate::workspace::SPEEDS;
+use crate::workspace::{PlaybackCommand, SPEEDS};
 
 impl EotnApp {
     /// The timeline bar's contents (nothing without an open source).
@@ -15,7 +15,7 @@ impl EotnApp {
         ui.horizontal(|ui| {
             robots_panel::live_controls_ui(ui, &self.state, commands);
             if ui.button("Previous").on_hover_text("Left arrow").clicked() {
-                commands.push(Command::Step(-1));
+                commands.push(PlaybackCommand::Step(-1).into());
             }
             let play = if self.state.playing() {
                 "Pause"
@@ -23,10 +23,10 @@ impl EotnApp {
                 "Play"
             };
             if ui.button(play).on_hover_text("Space").clicked() {
-                commands.push(Command::SetPlaying(!self.state.playing()));
+                commands.push(PlaybackCommand::SetPlaying(!self.state.playing()).into());
             }
             if ui.button("Next").on_hover_text("Right arrow").clicked() {
-                commands.push(Command::Step(1));
+                commands.push(PlaybackCommand::Step(1).into());
             }
             let mut speed = self.state.settings.speed;
             egui::ComboBox::from_label("speed")
@@ -38,7 +38,7 @@ impl EotnApp {
                     }
                 });
             if (speed - self.state.settings.speed).abs() > f32::EPSILON {
-                commands.push(Command::SetSpeed(speed));
+                commands.push(PlaybackCommand::SetSpeed(speed).into());
             }
             let mut i = index;
             ui.label("frame");
@@ -47,7 +47,7 @@ impl EotnApp {
                 .on_hover_text("type a frame number to jump")
                 .changed()
             {
-                commands.push(Command::Seek(i));
+                commands.push(PlaybackCommand::Seek(i).into());
             }
             let t = src.time_ns(index) as f64 / 1e9;
             let end = src.time_ns(len.saturating_sub(1)) as f64 / 1e9;
@@ -63,7 +63,7 @@ impl EotnApp {
                     .text("timeline"),
             );
             if slider.changed() {
-                commands.push(Command::Seek(j));
+                commands.push(PlaybackCommand::Seek(j).into());
             }
             bookmarks_panel::timeline_marks(ui.painter(), slider.rect, &self.state, len);
         });

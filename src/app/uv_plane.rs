@@ -8,7 +8,7 @@ use egui::{
 };
 
 use crate::lut::edit::Selection;
-use crate::workspace::{Command, Workspace};
+use crate::workspace::{Command, TableCommand, ViewCommand, Workspace};
 
 /// The U–V plane texture, rebuilt when the table, frame or Y changes.
 #[derive(Default)]
@@ -29,7 +29,7 @@ impl UvPlane {
             .on_hover_text("the luma of the layer shown")
             .changed()
         {
-            commands.push(Command::SetUvPlaneY(y));
+            commands.push(ViewCommand::SetUvPlaneY(y).into());
         }
         let layer = usize::from(y >> shift);
         let key = (
@@ -101,7 +101,7 @@ impl UvPlane {
         if response.clicked()
             && let Some((u, v)) = response.interact_pointer_pos().and_then(to_cell)
         {
-            commands.push(Command::SampleCell([layer, u, v]));
+            commands.push(TableCommand::SampleCell([layer, u, v]).into());
         }
     }
 

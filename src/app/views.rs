@@ -7,7 +7,8 @@ use egui::{Align2, Color32, PointerButton, Sense, Ui, vec2};
 use super::overlays::{FrameTextures, ImageTransform, corner_text, paint_view};
 use crate::geometry::ImagePoint;
 use crate::workspace::{
-    Command, OverheadCommand, PendingSelection, PixelInfo, ViewKind, Workspace,
+    Command, OverheadCommand, PendingSelection, PixelInfo, TableCommand, ViewCommand, ViewKind,
+    Workspace,
 };
 
 /// Screen points the mouse wheel must move for the zoom to double.
@@ -65,28 +66,31 @@ pub fn main_view_ui(
         };
         if (factor - 1.0).abs() > 1e-4 {
             let about = xf.to_image(pos);
-            commands.push(Command::ZoomAbout {
-                factor,
-                about: [about.x, about.y],
-                fit: ImageTransform::fit_zoom(rect, xf.size),
-            });
+            commands.push(
+                ViewCommand::ZoomAbout {
+                    factor,
+                    about: [about.x, about.y],
+                    fit: ImageTransform::fit_zoom(rect, xf.size),
+                }
+                .into(),
+            );
         }
     }
     if response.dragged_by(PointerButton::Middle) {
         let d = response.drag_delta() / xf.zoom;
         if d != egui::Vec2::ZERO {
-            commands.push(Command::Pan([d.x, d.y]));
+            commands.push(ViewCommand::Pan([d.x, d.y]).into());
         }
     }
     // A click samples at once; when it turns out to be the first of a double-click (fit), the
     // selection from before it is put back, so fitting never changes the selection.
     let before_click = egui::Id::unique("eotn-selection-before-click");
     if response.double_clicked_by(PointerButton::Primary) {
-        commands.push(Command::ResetView);
+        commands.push(ViewCommand::ResetView.into());
         if let Some(before) =
             ui.data_mut(|d| d.remove_temp::<Option<PendingSelection>>(before_click))
         {
-            commands.push(Command::RestoreSelection(before));
+            commands.push(TableCommand::RestoreSelection(before).into());
         }
     } else if response.clicked_by(PointerButton::Primary)
         && let Some(pos) = response.interact_pointer_pos()
@@ -97,7 +101,7 @@ pub fn main_view_ui(
         commands.push(click_command(state, xf.to_image(pos)));
     }
     if response.clicked_by(PointerButton::Secondary) && state.selection().is_some() {
-        commands.push(Command::Commit);
+        commands.push(TableCommand::Commit.into());
     }
     let zoom_text = match state.settings.transform.zoom {
         None => format!("fit {:.0}%", xf.zoom * 100.0),
@@ -128,7 +132,7 @@ fn click_command(state: &Workspace, p: egui::Pos2) -> Command {
         });
     }
     let (x, y) = camera_pixel(state, p).unwrap_or((p.x as usize, p.y as usize));
-    Command::Sample { x, y }
+    Command::Table(TableCommand::Sample { x, y })
 }
 
 /// The thumbnails of the other views in a row; clicking one enlarges it.
@@ -174,7 +178,7 @@ pub fn thumbnails_ui(
                     ui.visuals().text_color(),
                 );
                 if response.clicked() {
-                    commands.push(Command::SetMainView(kind));
+                    commands.push(ViewCommand::SetMainView(kind).into());
                 }
                 response.on_hover_text(format!("Enlarge the {} view", kind.name()));
             }

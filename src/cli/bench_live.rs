@@ -27,7 +27,7 @@ use crate::live::serve::{SendError, StandInRobot};
 use crate::live::{ClientOptions, LiveRobot, RobotUrl};
 use crate::sim::{Scenario, ScenarioKind, Simulator};
 use crate::streams::FrameRecord;
-use crate::workspace::{Command, Workspace};
+use crate::workspace::{RobotsCommand, Workspace};
 
 /// How often `--app` ticks the workspace, as the window does while following a robot.
 const APP_TICK: Duration = Duration::from_millis(16);
@@ -152,7 +152,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let folder = std::env::temp_dir().join(format!("eotn-bench-live-{}", std::process::id()));
     let views: Vec<RobotFrames> = match app.as_mut() {
         Some(w) => {
-            w.apply(Command::RecordAllRobots(folder.clone()))?;
+            w.apply(RobotsCommand::RecordAllRobots(folder.clone()).into())?;
             w.robots()
                 .iter()
                 .filter_map(|r| w.robot_frames(r.id))
@@ -221,7 +221,7 @@ fn connect_robots(
         let server = StandInRobot::start(&format!("bench{i}"), "127.0.0.1", 0)?;
         let url: RobotUrl = format!("127.0.0.1:{}", server.port()).parse()?;
         if let Some(w) = app.as_mut() {
-            w.apply(Command::ConnectRobot(url.to_string()))?;
+            w.apply(RobotsCommand::ConnectRobot(url.to_string()).into())?;
         } else {
             let keep = DEFAULT_KEEP_BYTES.max(frames_needed(args) * pixels * 2);
             robots.push(LiveRobot::connect(

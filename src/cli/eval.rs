@@ -17,10 +17,10 @@ use crate::eval::{
     EvalParams, EvalReport, FrameEval, evaluate_frame, fit_inverse_size,
     fit_inverse_size_multiplier,
 };
+use crate::model::truth::{GroundTruth, RobotViewTruth};
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::{Recognition, RecognitionParams};
-use crate::sim::truth::{GroundTruth, RobotViewTruth};
 use crate::streams::StreamReader;
 
 /// Arguments of `eotn eval`.

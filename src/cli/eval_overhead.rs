@@ -12,8 +12,8 @@ use crate::eval::overhead::{
     OverheadEvalParams, OverheadEvalReport, WorldModel, evaluate_overhead_frame,
     evaluate_world_model,
 };
+use crate::model::truth::GroundTruth;
 use crate::overhead::{Calibration, OverheadPipeline};
-use crate::sim::truth::GroundTruth;
 use crate::streams::StreamReader;
 
 /// Whether the first frame of a stream carries overhead ground truth.

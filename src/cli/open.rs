@@ -1,85 +1,11 @@
 //! `eotn open FILE…`: opens the desktop app on streams, tables and frames. The app itself lives
-//! in `crate::app` (feature `gui`); `main` starts it, so this file only holds the arguments.
+//! in `crate::app` (feature `gui`); `main` starts it with [`Args::run_options`], so this file
+//! holds the arguments and their conversion into the app's [`RunOptions`].
 
 use std::path::PathBuf;
+use std::time::Duration;
 
-/// Which renderer draws the window (`--renderer`); saved for the next start.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum RendererSetting {
-    /// wgpu where it finds a GPU, OpenGL where it finds only a software rasteriser or nothing.
-    #[default]
-    Auto,
-    /// Always wgpu (Vulkan, Metal, DX12).
-    Wgpu,
-    /// Always OpenGL (eframe's glow renderer).
-    Gl,
-}
-
-impl RendererSetting {
-    /// The name on the command line and in the saved setting.
-    #[must_use]
-    pub const fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::Wgpu => "wgpu",
-            Self::Gl => "gl",
-        }
-    }
-}
-
-impl std::str::FromStr for RendererSetting {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "auto" => Ok(Self::Auto),
-            "wgpu" => Ok(Self::Wgpu),
-            "gl" => Ok(Self::Gl),
-            other => Err(format!("unknown renderer '{other}' (auto, wgpu, gl)")),
-        }
-    }
-}
-
-/// How fast `--play` plays.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PlaySpeed {
-    /// At this many times the recorded rate (`1x`, `0.5x`, `2x`): frames that are not ready in
-    /// time are dropped, as a video player does.
-    Times(f32),
-    /// Every frame, as fast as the window can show them (`every`).
-    Every,
-}
-
-impl PlaySpeed {
-    /// The app's speed setting: × recorded rate, 0 for every frame.
-    #[must_use]
-    pub const fn as_factor(self) -> f32 {
-        match self {
-            Self::Times(f) => f,
-            Self::Every => 0.0,
-        }
-    }
-}
-
-impl std::str::FromStr for PlaySpeed {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        if s == "every" {
-            return Ok(Self::Every);
-        }
-        let f: f32 = s
-            .strip_suffix('x')
-            .unwrap_or(s)
-            .parse()
-            .map_err(|_| format!("speed '{s}' is not 'every' or a factor like 1x, 0.5x"))?;
-        if f.is_finite() && f > 0.0 && f <= 64.0 {
-            Ok(Self::Times(f))
-        } else {
-            Err(format!("speed '{s}' must be between 0 and 64 times"))
-        }
-    }
-}
+use crate::app_options::{PlaySpeed, RendererSetting, RunOptions};
 
 /// Arguments of `eotn open`.
 #[derive(Debug, clap::Args)]
@@ -108,6 +34,24 @@ pub struct Args {
     pub quit_after: Option<f64>,
 }
 
+impl Args {
+    /// The app's start options from these arguments: `--speed` only with `--play`, a
+    /// `--quit-after` that is negative or not finite ignored.
+    #[must_use]
+    pub fn run_options(&self) -> RunOptions {
+        RunOptions {
+            files: self.files.clone(),
+            renderer: self.renderer,
+            play: self.play.then_some(self.speed),
+            quit_after: self
+                .quit_after
+                .filter(|s| s.is_finite() && *s >= 0.0)
+                .map(|s| Duration::from_secs_f64(s.min(1e9))),
+            all_overlays: self.all_overlays,
+        }
+    }
+}
+
 /// Runs `eotn open` in a build without the app: there is nothing to open it with.
 ///
 /// # Errors
@@ -125,28 +69,45 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 #[cfg(test)]
 mod tests {
+    use clap::Parser;
+
     use super::*;
 
-    #[test]
-    fn speeds_parse_as_factors_or_every() {
-        assert_eq!("1x".parse(), Ok(PlaySpeed::Times(1.0)));
-        assert_eq!("0.5x".parse(), Ok(PlaySpeed::Times(0.5)));
-        assert_eq!("2".parse(), Ok(PlaySpeed::Times(2.0)));
-        assert_eq!("every".parse(), Ok(PlaySpeed::Every));
-        assert!("0x".parse::<PlaySpeed>().is_err());
-        assert!("NaNx".parse::<PlaySpeed>().is_err());
-        assert!("1e300x".parse::<PlaySpeed>().is_err());
+    #[derive(Parser)]
+    struct Open {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    fn options(line: &[&str]) -> RunOptions {
+        let open = Open::try_parse_from(std::iter::once("open").chain(line.iter().copied()))
+            .expect("the arguments parse");
+        open.args.run_options()
     }
 
     #[test]
-    fn renderer_names_round_trip() {
-        for s in [
-            RendererSetting::Auto,
-            RendererSetting::Wgpu,
-            RendererSetting::Gl,
-        ] {
-            assert_eq!(s.name().parse(), Ok(s));
-        }
-        assert!("vulkan".parse::<RendererSetting>().is_err());
+    fn run_options_take_the_speed_only_with_play_and_a_sane_quit_time() {
+        let o = options(&["a.mcap", "--renderer", "gl", "--all-overlays"]);
+        assert_eq!(o.files, vec![PathBuf::from("a.mcap")]);
+        assert_eq!(o.renderer, Some(RendererSetting::Gl));
+        assert_eq!(o.play, None);
+        assert!(o.all_overlays);
+        assert_eq!(o.quit_after, None);
+        let o = options(&[
+            "a.mcap",
+            "--play",
+            "--speed",
+            "every",
+            "--quit-after",
+            "2.5",
+        ]);
+        assert_eq!(o.play, Some(PlaySpeed::Every));
+        assert_eq!(o.quit_after, Some(Duration::from_millis(2500)));
+        assert_eq!(
+            options(&["a.mcap", "--play"]).play,
+            Some(PlaySpeed::Times(1.0))
+        );
+        assert_eq!(options(&["a.mcap", "--quit-after=-1"]).quit_after, None);
+        assert_eq!(options(&["a.mcap", "--quit-after", "NaN"]).quit_after, None);
     }
 }

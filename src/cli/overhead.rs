@@ -12,6 +12,7 @@ use super::inputs::{
     FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress, refuse_overwriting,
 };
 use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
+use crate::model::GroundTruth;
 use crate::overhead::OverheadPipeline;
 use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
 use crate::overhead::drawing::marker_svg;
@@ -19,7 +20,7 @@ use crate::overhead::field::FieldDescription;
 use crate::overhead::lines::projected_field_lines;
 use crate::overhead::points::{CalibrationPoint, PointsFile};
 use crate::overhead::recognise::{OverheadDetections, OverheadParams};
-use crate::sim::{GroundTruth, SimRng};
+use crate::sim::SimRng;
 use crate::streams::StreamReader;
 
 /// Arguments of `eotn overhead`.

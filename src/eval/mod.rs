@@ -14,10 +14,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::ImagePoint;
 use crate::lut::ColourClass;
+use crate::model::scene::GoalColour;
+use crate::model::truth::{GoalGap, GoalTruth, RobotViewTruth};
 use crate::recognition::Recognition;
 use crate::recognition::goals::Post;
-use crate::sim::scene::GoalColour;
-use crate::sim::truth::{GoalGap, GoalTruth, RobotViewTruth};
 
 /// When an object counts as "should have been found", and when a detection matches.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -128,7 +128,7 @@ pub fn goal_class(c: GoalColour) -> ColourClass {
 /// Share of a goal's mouth — the quadrilateral between the two posts' feet and tops — that lies
 /// inside the image (sampled on a 21 × 21 grid); 0 when a post does not project.
 #[must_use]
-pub fn mouth_fraction_in_image(g: &crate::sim::truth::GoalTruth, width: f64, height: f64) -> f64 {
+pub fn mouth_fraction_in_image(g: &crate::model::truth::GoalTruth, width: f64, height: f64) -> f64 {
     let [a, b] = &g.posts;
     let (Some(lb), Some(lt), Some(rb), Some(rt)) =
         (a.image_base, a.image_top, b.image_base, b.image_top)

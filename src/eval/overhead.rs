@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use super::Percentiles;
 use crate::geometry::{MarkerIdentity, MarkerTeam};
+use crate::model::truth::OverheadTruth;
 use crate::overhead::OverheadDetections;
-use crate::sim::truth::OverheadTruth;
 
 /// Matching rules.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -350,9 +350,9 @@ impl OverheadEvalReport {
 mod tests {
     use super::*;
     use crate::geometry::{ImagePoint, OverheadCamera};
+    use crate::model::scene::Team;
+    use crate::model::truth::{OverheadMarkerTruth, OverheadObject, OverheadRobot as TruthRobot};
     use crate::overhead::recognise::{OverheadBall, OverheadRobot};
-    use crate::sim::scene::Team;
-    use crate::sim::truth::{OverheadMarkerTruth, OverheadObject, OverheadRobot as TruthRobot};
 
     fn truth() -> OverheadTruth {
         let marker = |id| OverheadMarkerTruth {

@@ -8,9 +8,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::Percentiles;
+use crate::model::truth::{MarkerTruth, RobotViewTruth};
 use crate::recognition::Recognition;
 use crate::recognition::patterns::PatternMemory;
-use crate::sim::truth::{MarkerTruth, RobotViewTruth};
 
 /// When a marker has to be identified, and when a learnt place is a marker.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -19,10 +19,10 @@ use serde::{Deserialize, Serialize};
 
 use super::Percentiles;
 use crate::geometry::{Camera, Field, ImagePoint, PinholeCamera, Point, Transform};
+use crate::model::truth::RobotViewTruth;
 use crate::recognition::Recognition;
 use crate::recognition::fit::fit_circle;
 use crate::recognition::scan::EdgeScanPattern;
-use crate::sim::truth::RobotViewTruth;
 
 /// Radius of the simulated ball, centimetres (the 8.5 cm ball of the scene).
 const BALL_RADIUS_CM: f64 = 4.25;
@@ -262,8 +262,8 @@ impl SkewReport {
 mod tests {
     use super::*;
     use crate::geometry::{BodyPose, HeadJoints, PoseRecord, RobotPose};
+    use crate::model::truth::{BallTruth, CutOff, Relative};
     use crate::sensors::SensorReadings;
-    use crate::sim::truth::{BallTruth, CutOff, Relative};
 
     /// Truth for a ball `ahead_cm` in front of a level camera at the ball centres' height,
     /// `left_cm` to its left.

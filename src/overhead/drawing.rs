@@ -10,7 +10,7 @@ use crate::geometry::marker::{
 };
 use crate::geometry::{MarkerIdentity, MarkerTeam};
 use crate::lut::ColourClass;
-use crate::sim::scene::Material;
+use crate::model::scene::Material;
 
 /// The SVG fill of a class as the simulator paints it (sRGB hex).
 fn fill(class: ColourClass) -> String {

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::geometry::marker::DEFAULT_PLATE_HEIGHT_CM;
-use crate::sim::scene::FieldSpec;
+use crate::model::scene::FieldSpec;
 
 /// A named point of the field that a user can click.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -2,25 +2,25 @@
 //!
 //! There is no public archive of 2005 AIBO camera frames, so the project makes its own frames
 //! whose answers are known, from the same camera models recognition uses ([`crate::geometry`]).
-//! [`scene`] describes the world, [`render`] ray-casts it into UYVY frames with the camera's
+//! [`crate::model`] describes the world, [`render`] ray-casts it into UYVY frames with the camera's
 //! faults (noise, vignetting, shared chroma, rolling shutter), [`truth`] says what a perfect
 //! recognition would find, and [`scenario`] moves the world over time. [`Simulator::frame`]
 //! puts them together: frame `k` of a scenario and seed is always the same, whatever order
 //! frames are made in.
 
+mod effects;
 pub mod render;
 pub mod rng;
 pub mod scenario;
-pub mod scene;
 pub mod truth;
 
 use thiserror::Error;
 
+pub use crate::model::{GroundTruth, Scene};
+pub use effects::CameraEffects;
 pub use render::{Rendered, Renderer, World};
 pub use rng::SimRng;
 pub use scenario::{Scenario, ScenarioKind, View};
-pub use scene::{CameraEffects, Scene};
-pub use truth::GroundTruth;
 
 use crate::frame::{Frame, FrameError};
 use crate::geometry::{

@@ -11,7 +11,9 @@ use crate::blobs::Connectivity;
 use crate::lut::{ColourClass, Sensitivity};
 use crate::recognition::ObjectId;
 
-/// Everything the UI can ask for.
+/// Everything the UI can ask for: a few commands that cross areas (open files, windows, the
+/// selected object), the rest by area, each applied by its area's `apply_…`, which matches its
+/// own enum exhaustively (a command no handler takes does not compile).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     /// Open files by kind: `.mcap` streams, frame files (as one sequence), `.json` recognition
@@ -22,6 +24,39 @@ pub enum Command {
     OpenTable(PathBuf),
     /// Open a places file (`eotn patterns learn`): pink markers are identified as its places.
     OpenPlaces(PathBuf),
+    /// Forget the places file: pink markers keep their signatures, unidentified.
+    ClosePlaces,
+    /// Open or close a window.
+    ShowWindow(Window, bool),
+    /// Select a recognition candidate (the object its primitives belong to) to highlight its
+    /// overlays; `None` shows all alike. Refused for an object not in the shown frame.
+    SelectObject(Option<ObjectId>),
+    /// The recognition parameters (`workspace/params.rs`): open, use the stream's set, tune, reset,
+    /// save, try on the stream.
+    Params(ParamsCommand),
+    /// The lookup table (`workspace/table.rs`): new, save, the journal, the class and sensitivity,
+    /// the pending selection, commit, undo and redo, the whole-stream try.
+    Table(TableCommand),
+    /// Moving through the source's frames (`workspace/playback.rs`).
+    Playback(PlaybackCommand),
+    /// How the frame is shown (`workspace/view.rs`): the enlarged view, overlays, blobs, zoom and
+    /// pan, export.
+    View(ViewCommand),
+    /// The Camera menu's source (`workspace/live.rs`): connect, settings, grab, stream, record.
+    Source(SourceCommand),
+    /// Several live robots at once (`workspace/robots.rs`): connect, show, follow, record.
+    Robots(RobotsCommand),
+    /// What the table leaves unclassified, the pipeline's events and the user's bookmarks
+    /// (`workspace/hints.rs`).
+    Hints(HintsCommand),
+    /// The overhead camera: calibration, picked points, robot selection, view options.
+    Overhead(OverheadCommand),
+}
+
+/// The recognition parameters (`workspace/params.rs`): open, use the stream's set, tune, reset,
+/// save, try on the stream.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamsCommand {
     /// Open a recognition parameters file (`params/spl2009.json`): the frame is re-run with it.
     OpenParams(PathBuf),
     /// Use the parameter set the open stream names (the file found for it).
@@ -44,8 +79,18 @@ pub enum Command {
     SaveParams(PathBuf),
     /// Start the whole-stream check of the tuned parameters against the opened ones.
     TryParamsOnStream,
-    /// Forget the places file: pink markers keep their signatures, unidentified.
-    ClosePlaces,
+}
+
+impl From<ParamsCommand> for Command {
+    fn from(c: ParamsCommand) -> Self {
+        Self::Params(c)
+    }
+}
+
+/// The lookup table (`workspace/table.rs`): new, save, the journal, the class and sensitivity, the
+/// pending selection, commit, undo and redo, the whole-stream try.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TableCommand {
     /// A new empty table with the given bits per channel.
     NewTable(u8),
     /// Save the table where it came from.
@@ -58,14 +103,6 @@ pub enum Command {
     DiscardUnsaved,
     /// Replace the table by replaying its journal.
     RebuildFromJournal,
-    /// Move by this many frames.
-    Step(i64),
-    /// Go to a frame.
-    Seek(usize),
-    /// Start or stop playback.
-    SetPlaying(bool),
-    /// Playback speed, × recorded rate (0 = every frame).
-    SetSpeed(f32),
     /// The class being defined.
     SetClass(ColourClass),
     /// Selection reach.
@@ -96,6 +133,39 @@ pub enum Command {
     Undo,
     /// Redo the latest undone edit.
     Redo,
+    /// Start the whole-stream check of the pending selection.
+    TryEditOnStream,
+}
+
+impl From<TableCommand> for Command {
+    fn from(c: TableCommand) -> Self {
+        Self::Table(c)
+    }
+}
+
+/// Moving through the source's frames (`workspace/playback.rs`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum PlaybackCommand {
+    /// Move by this many frames.
+    Step(i64),
+    /// Go to a frame.
+    Seek(usize),
+    /// Start or stop playback.
+    SetPlaying(bool),
+    /// Playback speed, × recorded rate (0 = every frame).
+    SetSpeed(f32),
+}
+
+impl From<PlaybackCommand> for Command {
+    fn from(c: PlaybackCommand) -> Self {
+        Self::Playback(c)
+    }
+}
+
+/// How the frame is shown (`workspace/view.rs`): the enlarged view, overlays, blobs, zoom and pan,
+/// export.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ViewCommand {
     /// Enlarge another view.
     SetMainView(ViewKind),
     /// Overlay switches.
@@ -126,14 +196,21 @@ pub enum Command {
     ResetView,
     /// Write the enlarged view with its overlays as a PNG.
     ExportView(PathBuf),
-    /// Start the whole-stream check of the pending selection.
-    TryEditOnStream,
     /// The Y of the U–V plane.
     SetUvPlaneY(u8),
-    /// Open or close a window.
-    ShowWindow(Window, bool),
     /// Show or hide the frame-time readout.
     ShowTimings(bool),
+}
+
+impl From<ViewCommand> for Command {
+    fn from(c: ViewCommand) -> Self {
+        Self::View(c)
+    }
+}
+
+/// The Camera menu's source (`workspace/live.rs`): connect, settings, grab, stream, record.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SourceCommand {
     /// Connect a source (Camera ▸ Connect…): a recorded one opens for stepping, a live one
     /// streams on its own thread; what was connected before is disconnected.
     Connect(SourceSpec),
@@ -149,9 +226,17 @@ pub enum Command {
     StartRecording(PathBuf),
     /// Finish the recording.
     StopRecording,
-    /// Select a recognition candidate (the object its primitives belong to) to highlight its
-    /// overlays; `None` shows all alike. Refused for an object not in the shown frame.
-    SelectObject(Option<ObjectId>),
+}
+
+impl From<SourceCommand> for Command {
+    fn from(c: SourceCommand) -> Self {
+        Self::Source(c)
+    }
+}
+
+/// Several live robots at once (`workspace/robots.rs`): connect, show, follow, record.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RobotsCommand {
     /// Connect a robot at `HOST:PORT` (or `ws://HOST:PORT`) beside those connected already
     /// (Camera ▸ Connect to robot…); shown when no robot is.
     ConnectRobot(String),
@@ -168,6 +253,18 @@ pub enum Command {
     /// Follow the shown robot's newest frame (true) or hold the view where it is (false);
     /// reception and recording go on either way.
     SetFollowLive(bool),
+}
+
+impl From<RobotsCommand> for Command {
+    fn from(c: RobotsCommand) -> Self {
+        Self::Robots(c)
+    }
+}
+
+/// What the table leaves unclassified, the pipeline's events and the user's bookmarks
+/// (`workspace/hints.rs`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum HintsCommand {
     /// Count the colours the table leaves unclassified over frames `first..=last` (clamped to
     /// the source), a few frames per UI frame: the coverage hints.
     FindUnclassified {
@@ -191,8 +288,18 @@ pub enum Command {
         /// Next when true, previous when false.
         forward: bool,
     },
-    /// The overhead camera: calibration, picked points, robot selection, view options.
-    Overhead(OverheadCommand),
+}
+
+impl From<HintsCommand> for Command {
+    fn from(c: HintsCommand) -> Self {
+        Self::Hints(c)
+    }
+}
+
+impl From<OverheadCommand> for Command {
+    fn from(c: OverheadCommand) -> Self {
+        Self::Overhead(c)
+    }
 }
 
 /// What the UI can ask of the overhead camera's side (`workspace/overhead.rs`).

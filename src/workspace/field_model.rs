@@ -12,8 +12,8 @@ use std::collections::{BTreeMap, VecDeque};
 
 use super::overhead::RobotKey;
 use crate::eval::overhead::WorldModel;
+use crate::model::truth::OverheadTruth;
 use crate::overhead::OverheadDetections;
-use crate::sim::truth::OverheadTruth;
 
 /// Positions a trail keeps (frames).
 pub const TRAIL_FRAMES: usize = 30;

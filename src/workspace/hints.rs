@@ -10,7 +10,7 @@ use anyhow::Context as _;
 use super::bookmarks::{self, Event, EventKind, EventScan, UserBookmark};
 use super::cell_origin::{CellOrigin, cell_origin};
 use super::coverage::CoverageScan;
-use super::{Command, PendingSelection, SCAN_BUDGET, Workspace};
+use super::{HintsCommand, PendingSelection, SCAN_BUDGET, Workspace};
 use crate::lut::Region;
 
 /// Coverage, events and bookmarks of the open source.
@@ -27,15 +27,15 @@ pub struct Hints {
 
 impl Workspace {
     /// Applies the coverage, bookmark and event commands.
-    pub(super) fn apply_hints(&mut self, command: Command) -> anyhow::Result<()> {
+    pub(super) fn apply_hints(&mut self, command: HintsCommand) -> anyhow::Result<()> {
         match command {
-            Command::FindUnclassified { first, last } => {
+            HintsCommand::FindUnclassified { first, last } => {
                 let total = self.source.as_ref().context("no stream open")?.len();
                 let bits = self.pipeline.lut().bits();
                 self.hints.coverage = Some(CoverageScan::new(first, last, total, bits));
                 self.settings.show_coverage = true;
             }
-            Command::SelectCells(indices) => {
+            HintsCommand::SelectCells(indices) => {
                 anyhow::ensure!(!indices.is_empty(), "no cells to select");
                 let len = self.pipeline.lut().cells().len();
                 anyhow::ensure!(
@@ -49,13 +49,13 @@ impl Workspace {
                 });
                 self.refresh_preview();
             }
-            Command::FindEvents => {
+            HintsCommand::FindEvents => {
                 let total = self.source.as_ref().context("no stream open")?.len();
                 let params = *self.pipeline.params();
                 self.hints.events = Some(EventScan::new(self.pipeline.lut(), params, total));
                 self.settings.show_bookmarks = true;
             }
-            Command::AddBookmark(note) => {
+            HintsCommand::AddBookmark(note) => {
                 anyhow::ensure!(self.source.is_some(), "no stream open");
                 let frame = self.index;
                 self.hints.user.retain(|b| b.frame != frame);
@@ -64,7 +64,7 @@ impl Workspace {
                 self.save_bookmarks()?;
                 self.status = format!("bookmark at frame {frame}");
             }
-            Command::RemoveBookmark(frame) => {
+            HintsCommand::RemoveBookmark(frame) => {
                 let before = self.hints.user.len();
                 self.hints.user.retain(|b| b.frame != frame);
                 anyhow::ensure!(
@@ -73,7 +73,7 @@ impl Workspace {
                 );
                 self.save_bookmarks()?;
             }
-            Command::JumpToMark { forward } => {
+            HintsCommand::JumpToMark { forward } => {
                 let frames = self.mark_frames();
                 let target =
                     bookmarks::neighbour(frames, self.index, forward).with_context(|| {
@@ -85,7 +85,6 @@ impl Workspace {
                     })?;
                 self.seek(target)?;
             }
-            _ => anyhow::bail!("not a hints command"),
         }
         Ok(())
     }

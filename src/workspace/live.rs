@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 
 use super::source::Source;
-use super::{Command, Workspace};
+use super::{SourceCommand, Workspace};
 use crate::sources::{
     Recorder, SourceControls, SourceFrame, SourceInfo, SourceSettings, SourceSpec, Streamer,
     StreamerEvent,
@@ -60,16 +60,15 @@ impl Live {
 impl Workspace {
     /// Applies the Camera menu's source commands: connect, disconnect, settings, grab,
     /// streaming, recording (the rest of [`Workspace::apply`]).
-    pub(super) fn apply_source(&mut self, command: Command) -> anyhow::Result<()> {
+    pub(super) fn apply_source(&mut self, command: SourceCommand) -> anyhow::Result<()> {
         match command {
-            Command::Connect(spec) => self.connect(&spec)?,
-            Command::Disconnect => self.disconnect()?,
-            Command::SetSourceSettings(s) => self.set_source_settings(s)?,
-            Command::GrabImage => self.grab_image()?,
-            Command::SetStreaming(on) => self.set_streaming(on)?,
-            Command::StartRecording(p) => self.start_recording(&p)?,
-            Command::StopRecording => self.stop_recording()?,
-            _ => anyhow::bail!("not a source command"),
+            SourceCommand::Connect(spec) => self.connect(&spec)?,
+            SourceCommand::Disconnect => self.disconnect()?,
+            SourceCommand::SetSourceSettings(s) => self.set_source_settings(s)?,
+            SourceCommand::GrabImage => self.grab_image()?,
+            SourceCommand::SetStreaming(on) => self.set_streaming(on)?,
+            SourceCommand::StartRecording(p) => self.start_recording(&p)?,
+            SourceCommand::StopRecording => self.stop_recording()?,
         }
         Ok(())
     }
@@ -369,7 +368,7 @@ mod tests {
     use super::*;
     use crate::sim::ScenarioKind;
     use crate::sources::{CameraKind, FrameSource as _, RecordedSource as _, StreamSource};
-    use crate::workspace::Command;
+    use crate::workspace::{PlaybackCommand, TableCommand};
 
     fn synthetic(scenario: ScenarioKind) -> SourceSpec {
         SourceSpec::Synthetic { scenario, seed: 2 }
@@ -392,7 +391,7 @@ mod tests {
     #[test]
     fn a_connected_scenario_streams_its_frames_into_the_workspace() {
         let mut w = Workspace::default();
-        w.apply(Command::Connect(synthetic(ScenarioKind::BallEdge)))
+        w.apply(SourceCommand::Connect(synthetic(ScenarioKind::BallEdge)).into())
             .unwrap();
         assert!(w.live().is_some() && w.source().is_none());
         assert!(
@@ -403,10 +402,10 @@ mod tests {
         assert_eq!(w.image_size(), (208, 160));
         assert!(w.current().is_some_and(|f| f.sensors.is_some()));
         assert!(w.title().contains("synthetic ball-edge"), "{}", w.title());
-        w.apply(Command::Disconnect).unwrap();
+        w.apply(SourceCommand::Disconnect.into()).unwrap();
         assert!(w.live().is_none());
         assert!(
-            w.apply(Command::Disconnect).is_err(),
+            w.apply(SourceCommand::Disconnect.into()).is_err(),
             "nothing left to disconnect"
         );
     }
@@ -414,30 +413,30 @@ mod tests {
     #[test]
     fn grab_image_holds_a_live_source_on_one_new_frame() {
         let mut w = Workspace::default();
-        w.apply(Command::Connect(synthetic(ScenarioKind::BallEdge)))
+        w.apply(SourceCommand::Connect(synthetic(ScenarioKind::BallEdge)).into())
             .unwrap();
         tick_until(&mut w, |w| w.live().is_some_and(|l| l.frames() >= 1));
-        w.apply(Command::GrabImage).unwrap();
+        w.apply(SourceCommand::GrabImage.into()).unwrap();
         assert!(!w.live().unwrap().streaming());
         assert_eq!(w.next_frame_due(), None, "a held source needs no polling");
         let before = w.live().unwrap().frames();
         tick_until(&mut w, |w| w.live().is_some_and(|l| l.frames() > before));
-        w.apply(Command::SetStreaming(true)).unwrap();
+        w.apply(SourceCommand::SetStreaming(true).into()).unwrap();
         assert!(w.live().unwrap().streaming());
     }
 
     #[test]
     fn an_overhead_source_uses_the_overhead_table_and_keeps_the_robot_table() {
         let mut w = Workspace::default();
-        w.apply(Command::NewTable(6)).unwrap();
+        w.apply(TableCommand::NewTable(6).into()).unwrap();
         assert_eq!(w.lut().bits(), 6);
-        w.apply(Command::Connect(synthetic(ScenarioKind::OverheadGame)))
+        w.apply(SourceCommand::Connect(synthetic(ScenarioKind::OverheadGame)).into())
             .unwrap();
         assert_eq!(w.camera_kind(), CameraKind::Overhead);
         assert_eq!(w.table_kind(), CameraKind::Overhead);
         assert_eq!(w.lut().bits(), 7, "the overhead slot starts as a new table");
         assert_eq!(w.other_table().lut.bits(), 6);
-        w.apply(Command::Connect(synthetic(ScenarioKind::BallEdge)))
+        w.apply(SourceCommand::Connect(synthetic(ScenarioKind::BallEdge)).into())
             .unwrap();
         assert_eq!(w.table_kind(), CameraKind::Robot);
         assert_eq!(w.lut().bits(), 6, "the robot table is back");
@@ -448,19 +447,20 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("live.mcap");
         let mut w = Workspace::default();
-        w.apply(Command::Connect(synthetic(ScenarioKind::OverheadGame)))
+        w.apply(SourceCommand::Connect(synthetic(ScenarioKind::OverheadGame)).into())
             .unwrap();
         assert!(
-            w.apply(Command::StartRecording(dir.path().join("x.txt")))
+            w.apply(SourceCommand::StartRecording(dir.path().join("x.txt")).into())
                 .is_err()
         );
-        w.apply(Command::StartRecording(out.clone())).unwrap();
+        w.apply(SourceCommand::StartRecording(out.clone()).into())
+            .unwrap();
         assert_eq!(w.recording(), Some(out.clone()));
         let start = w.live().unwrap().frames();
         tick_until(&mut w, |w| {
             w.live().is_some_and(|l| l.frames() >= start + 3)
         });
-        w.apply(Command::StopRecording).unwrap();
+        w.apply(SourceCommand::StopRecording.into()).unwrap();
         tick_until(&mut w, |_| out.exists());
         assert!(w.recording().is_none());
         let mut back = StreamSource::open(&out).unwrap();
@@ -480,19 +480,21 @@ mod tests {
             })
             .collect();
         let mut w = Workspace::default();
-        w.apply(Command::Connect(SourceSpec::Files(paths))).unwrap();
+        w.apply(SourceCommand::Connect(SourceSpec::Files(paths)).into())
+            .unwrap();
         let out = dir.path().join("shown.mcap");
-        w.apply(Command::StartRecording(out.clone())).unwrap();
-        w.apply(Command::GrabImage).unwrap();
-        w.apply(Command::Step(1)).unwrap();
-        w.apply(Command::Step(-2)).unwrap();
-        w.apply(Command::StopRecording).unwrap();
+        w.apply(SourceCommand::StartRecording(out.clone()).into())
+            .unwrap();
+        w.apply(SourceCommand::GrabImage.into()).unwrap();
+        w.apply(PlaybackCommand::Step(1).into()).unwrap();
+        w.apply(PlaybackCommand::Step(-2).into()).unwrap();
+        w.apply(SourceCommand::StopRecording.into()).unwrap();
         let back = StreamSource::open(&out).unwrap();
         assert_eq!(
             back.len(),
             3,
             "frames 0, 1, 2; stepping back records nothing"
         );
-        assert!(w.apply(Command::StopRecording).is_err());
+        assert!(w.apply(SourceCommand::StopRecording.into()).is_err());
     }
 }

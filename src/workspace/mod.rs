@@ -7,8 +7,8 @@
 //!
 //! | file | role |
 //! |---|---|
-//! | `mod.rs` | [`Workspace`]: its fields, [`Workspace::apply`] (it hands each area's commands to that area's `apply_…`), what the UI reads |
-//! | `command.rs` | [`Command`]: everything the UI can ask for; [`Window`] |
+//! | `mod.rs` | [`Workspace`]: its fields, [`Workspace::apply`] (it hands each area's enum to that area's `apply_…`, which matches it exhaustively), what the UI reads |
+//! | `command.rs` | [`Command`]: everything the UI can ask for, nested by area ([`TableCommand`], [`PlaybackCommand`], [`ViewCommand`], [`SourceCommand`], [`RobotsCommand`], [`ParamsCommand`], [`HintsCommand`], [`OverheadCommand`]; `From` each into `Command`); [`Window`] |
 //! | `settings.rs` | [`Settings`] that persist; [`ViewKind`], [`Overlays`], [`ViewTransform`] |
 //! | `source.rs` | [`Source`]: the open recorded source with a cache of decoded frames |
 //! | `frames.rs` | opening sources, showing a frame, the sensor-series scan |
@@ -54,7 +54,10 @@ mod view;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-pub use command::{Command, OverheadCommand, Window};
+pub use command::{
+    Command, HintsCommand, OverheadCommand, ParamsCommand, PlaybackCommand, RobotsCommand,
+    SourceCommand, TableCommand, ViewCommand, Window,
+};
 pub use compose::{PrimitiveFilter, box_colour};
 pub use live::Live;
 pub use overhead::{CalibrationSource, Overhead, RobotKey};
@@ -247,14 +250,14 @@ impl Workspace {
             self.run(Command::OpenPlaces(p));
         }
         if let Some(p) = self.settings.last_params.clone() {
-            self.run(Command::OpenParams(p));
+            self.run(ParamsCommand::OpenParams(p).into());
         }
         let src = self.settings.last_source.clone();
         let index = self.settings.last_index;
         if !src.is_empty() {
             self.run(Command::Open(src));
             if self.source.is_some() && index > 0 {
-                self.run(Command::Seek(index));
+                self.run(PlaybackCommand::Seek(index).into());
             }
         }
     }
@@ -276,7 +279,11 @@ impl Workspace {
     pub fn apply(&mut self, command: Command) -> anyhow::Result<()> {
         if matches!(
             command,
-            Command::Step(_) | Command::Seek(_) | Command::SetPlaying(_)
+            Command::Playback(
+                PlaybackCommand::Step(_)
+                    | PlaybackCommand::Seek(_)
+                    | PlaybackCommand::SetPlaying(_)
+            )
         ) {
             // Moving through a shown robot's frames holds the view (reception goes on).
             self.leave_live();
@@ -286,45 +293,6 @@ impl Workspace {
             Command::OpenTable(p) => self.open_table(&p)?,
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),
-            c @ (Command::OpenParams(_)
-            | Command::UseOfferedParams
-            | Command::DefaultParams
-            | Command::SetParamValue { .. }
-            | Command::ResetParamValue(_)
-            | Command::ResetParams
-            | Command::SaveParams(_)
-            | Command::TryParamsOnStream) => self.apply_params(c)?,
-            c @ (Command::NewTable(_)
-            | Command::SaveTable
-            | Command::SaveTableAs(_)
-            | Command::RebuildFromJournal
-            | Command::DiscardUnsaved
-            | Command::SetClass(_)
-            | Command::SetSensitivity(_)
-            | Command::AdjustSensitivity { .. }
-            | Command::Sample { .. }
-            | Command::SampleCell(_)
-            | Command::ClearSelection
-            | Command::RestoreSelection(_)
-            | Command::Commit
-            | Command::Undo
-            | Command::Redo
-            | Command::TryEditOnStream) => self.apply_table_edit(c)?,
-            c @ (Command::Step(_)
-            | Command::Seek(_)
-            | Command::SetPlaying(_)
-            | Command::SetSpeed(_)) => self.apply_playback(c)?,
-            c @ (Command::SetMainView(_)
-            | Command::SetOverlays(_)
-            | Command::SetConnectivity(_)
-            | Command::SetBlobFilter { .. }
-            | Command::SetZoom(_)
-            | Command::ZoomAbout { .. }
-            | Command::Pan(_)
-            | Command::ResetView
-            | Command::ExportView(_)
-            | Command::SetUvPlaneY(_)
-            | Command::ShowTimings(_)) => self.apply_view(c)?,
             Command::ShowWindow(w, open) => {
                 *self.window_flag(w) = open;
                 if w == Window::Inspector && !open {
@@ -332,20 +300,6 @@ impl Workspace {
                     self.selected_object = None;
                 }
             }
-            c @ (Command::Connect(_)
-            | Command::Disconnect
-            | Command::SetSourceSettings(_)
-            | Command::GrabImage
-            | Command::SetStreaming(_)
-            | Command::StartRecording(_)
-            | Command::StopRecording) => self.apply_source(c)?,
-            c @ (Command::ConnectRobot(_)
-            | Command::ShowRobot(_)
-            | Command::DisconnectRobot(_)
-            | Command::RecordRobot(..)
-            | Command::RecordAllRobots(_)
-            | Command::StopRecordingRobot(_)
-            | Command::SetFollowLive(_)) => self.apply_robot_command(c)?,
             Command::SelectObject(owner) => {
                 if let Some(o) = owner {
                     anyhow::ensure!(
@@ -355,13 +309,14 @@ impl Workspace {
                 }
                 self.selected_object = owner;
             }
+            Command::Params(c) => self.apply_params(c)?,
+            Command::Table(c) => self.apply_table_edit(c)?,
+            Command::Playback(c) => self.apply_playback(c)?,
+            Command::View(c) => self.apply_view(c)?,
+            Command::Source(c) => self.apply_source(c)?,
+            Command::Robots(c) => self.apply_robot_command(c)?,
+            Command::Hints(c) => self.apply_hints(c)?,
             Command::Overhead(c) => self.apply_overhead(c)?,
-            c @ (Command::FindUnclassified { .. }
-            | Command::SelectCells(_)
-            | Command::FindEvents
-            | Command::AddBookmark(_)
-            | Command::RemoveBookmark(_)
-            | Command::JumpToMark { .. }) => self.apply_hints(c)?,
         }
         Ok(())
     }
@@ -645,35 +600,44 @@ mod tests {
     #[test]
     fn commands_without_data_fail_cleanly() {
         let mut s = Workspace::default();
-        assert!(s.apply(Command::Commit).is_err());
-        assert!(s.apply(Command::Undo).is_err());
-        assert!(s.apply(Command::Step(1)).is_err());
-        assert!(s.apply(Command::SaveTable).is_err());
-        assert!(s.apply(Command::Sample { x: 0, y: 0 }).is_err());
-        s.run(Command::Undo);
+        assert!(s.apply(TableCommand::Commit.into()).is_err());
+        assert!(s.apply(TableCommand::Undo.into()).is_err());
+        assert!(s.apply(PlaybackCommand::Step(1).into()).is_err());
+        assert!(s.apply(TableCommand::SaveTable.into()).is_err());
+        assert!(s.apply(TableCommand::Sample { x: 0, y: 0 }.into()).is_err());
+        s.run(TableCommand::Undo.into());
         assert_eq!(s.warnings().len(), 1);
     }
 
     #[test]
     fn sensitivity_keys_clamp() {
         let mut s = Workspace::default();
-        s.apply(Command::AdjustSensitivity {
-            channel: 1,
-            delta: -5,
-        })
+        s.apply(
+            TableCommand::AdjustSensitivity {
+                channel: 1,
+                delta: -5,
+            }
+            .into(),
+        )
         .unwrap();
         assert_eq!(s.settings.sensitivity.u, 0);
-        s.apply(Command::AdjustSensitivity {
-            channel: 2,
-            delta: 500,
-        })
+        s.apply(
+            TableCommand::AdjustSensitivity {
+                channel: 2,
+                delta: 500,
+            }
+            .into(),
+        )
         .unwrap();
         assert_eq!(s.settings.sensitivity.v, 64);
         assert!(
-            s.apply(Command::AdjustSensitivity {
-                channel: 3,
-                delta: 1
-            })
+            s.apply(
+                TableCommand::AdjustSensitivity {
+                    channel: 3,
+                    delta: 1
+                }
+                .into()
+            )
             .is_err()
         );
     }

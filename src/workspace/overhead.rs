@@ -651,10 +651,10 @@ fn stream_camera(loaded: &SourceFrame) -> Option<OverheadCamera> {
 }
 
 /// The overhead truth a synthetic frame carries, if any.
-pub(super) fn truth_of(loaded: &SourceFrame) -> Option<crate::sim::truth::OverheadTruth> {
+pub(super) fn truth_of(loaded: &SourceFrame) -> Option<crate::model::truth::OverheadTruth> {
     let value = loaded.channel(crate::streams::GROUND_TRUTH_TOPIC)?;
-    match serde_json::from_value::<crate::sim::truth::GroundTruth>(value.clone()) {
-        Ok(crate::sim::truth::GroundTruth::Overhead(t)) => Some(t),
+    match serde_json::from_value::<crate::model::truth::GroundTruth>(value.clone()) {
+        Ok(crate::model::truth::GroundTruth::Overhead(t)) => Some(t),
         _ => None,
     }
 }

@@ -9,9 +9,9 @@ use std::time::Duration;
 use anyhow::Context as _;
 use serde_json::Value;
 
-use super::Workspace;
 use super::source::Source;
 use super::stream_scan::StreamScan;
+use super::{ParamsCommand, Workspace};
 use crate::lut::LookupTable;
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::{Recognition, RecognitionParams, params_file};
@@ -257,11 +257,10 @@ impl Workspace {
     }
 
     /// Applies the parameter commands (the rest of [`Workspace::apply`]).
-    pub(super) fn apply_params(&mut self, command: super::Command) -> anyhow::Result<()> {
-        use super::Command as C;
+    pub(super) fn apply_params(&mut self, command: ParamsCommand) -> anyhow::Result<()> {
         match command {
-            C::OpenParams(p) => self.open_params(&p)?,
-            C::UseOfferedParams => {
+            ParamsCommand::OpenParams(p) => self.open_params(&p)?,
+            ParamsCommand::UseOfferedParams => {
                 let p = self
                     .params
                     .offer
@@ -270,13 +269,14 @@ impl Workspace {
                     .context("the stream names no parameter set that was found")?;
                 self.open_params(&p)?;
             }
-            C::DefaultParams => self.default_params(),
-            C::SetParamValue { pointer, value } => self.set_param_value(&pointer, value)?,
-            C::ResetParamValue(pointer) => self.reset_param_value(&pointer)?,
-            C::ResetParams => self.reset_params(),
-            C::SaveParams(p) => self.save_params(&p)?,
-            C::TryParamsOnStream => self.try_params_on_stream()?,
-            _ => anyhow::bail!("not a parameter command"),
+            ParamsCommand::DefaultParams => self.default_params(),
+            ParamsCommand::SetParamValue { pointer, value } => {
+                self.set_param_value(&pointer, value)?
+            }
+            ParamsCommand::ResetParamValue(pointer) => self.reset_param_value(&pointer)?,
+            ParamsCommand::ResetParams => self.reset_params(),
+            ParamsCommand::SaveParams(p) => self.save_params(&p)?,
+            ParamsCommand::TryParamsOnStream => self.try_params_on_stream()?,
         }
         Ok(())
     }

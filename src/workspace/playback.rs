@@ -7,19 +7,18 @@ use std::time::Duration;
 use anyhow::Context as _;
 
 use super::timings::push_capped;
-use super::{Command, SCAN_BUDGET, Workspace};
+use super::{PlaybackCommand, SCAN_BUDGET, Workspace};
 
 impl Workspace {
     /// Applies the playback commands (the rest of [`Workspace::apply`]).
-    pub(super) fn apply_playback(&mut self, command: Command) -> anyhow::Result<()> {
+    pub(super) fn apply_playback(&mut self, command: PlaybackCommand) -> anyhow::Result<()> {
         match command {
-            Command::Step(delta) => self.step(delta)?,
-            Command::Seek(i) => self.seek(i)?,
-            Command::SetPlaying(p) => self.set_playing(p)?,
-            Command::SetSpeed(s) => {
+            PlaybackCommand::Step(delta) => self.step(delta)?,
+            PlaybackCommand::Seek(i) => self.seek(i)?,
+            PlaybackCommand::SetPlaying(p) => self.set_playing(p)?,
+            PlaybackCommand::SetSpeed(s) => {
                 self.settings.speed = if s.is_finite() { s.max(0.0) } else { 1.0 }
             }
-            _ => anyhow::bail!("not a playback command"),
         }
         Ok(())
     }
@@ -63,7 +62,7 @@ impl Workspace {
             self.timings.played_frames += 1;
             self.timings.dropped_frames += target.saturating_sub(self.index + 1) as u64;
             self.timings.late_frames += u64::from(self.player.last_was_late());
-            self.run(Command::Seek(target));
+            self.run(PlaybackCommand::Seek(target).into());
         }
     }
 

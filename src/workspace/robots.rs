@@ -15,7 +15,7 @@ use std::time::Duration;
 use anyhow::Context as _;
 
 use super::source::Source;
-use super::{Command, Workspace};
+use super::{RobotsCommand, Workspace};
 use crate::live::recorder::file_stem;
 use crate::live::robot::DEFAULT_KEEP_BYTES;
 use crate::live::{ClientOptions, Connection, LiveRobot, RobotStats, RobotUrl};
@@ -133,21 +133,20 @@ fn same_state(a: &Connection, b: &Connection) -> bool {
 }
 
 impl Workspace {
-    /// Applies one of the robot commands (the others are refused).
-    pub(super) fn apply_robot_command(&mut self, command: Command) -> anyhow::Result<()> {
+    /// Applies a robot command (the robots list, the shown robot, their recordings).
+    pub(super) fn apply_robot_command(&mut self, command: RobotsCommand) -> anyhow::Result<()> {
         match command {
-            Command::ConnectRobot(address) => self.connect_robot(&address).map(drop),
-            Command::ShowRobot(id) => {
+            RobotsCommand::ConnectRobot(address) => self.connect_robot(&address).map(drop),
+            RobotsCommand::ShowRobot(id) => {
                 self.show_robot(id)?;
                 self.robots.chosen = true;
                 Ok(())
             }
-            Command::DisconnectRobot(id) => self.disconnect_robot(id),
-            Command::RecordRobot(id, path) => self.record_robot(id, &path),
-            Command::RecordAllRobots(folder) => self.record_all_robots(&folder),
-            Command::StopRecordingRobot(id) => self.stop_recording_robot(id),
-            Command::SetFollowLive(on) => self.set_follow_live(on),
-            other => anyhow::bail!("not a robot command: {other:?}"),
+            RobotsCommand::DisconnectRobot(id) => self.disconnect_robot(id),
+            RobotsCommand::RecordRobot(id, path) => self.record_robot(id, &path),
+            RobotsCommand::RecordAllRobots(folder) => self.record_all_robots(&folder),
+            RobotsCommand::StopRecordingRobot(id) => self.stop_recording_robot(id),
+            RobotsCommand::SetFollowLive(on) => self.set_follow_live(on),
         }
     }
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 
 use super::journal::{self, JournalEntry, now_unix_ms};
-use super::{Command, PendingSelection, TryEdit, Workspace};
+use super::{PendingSelection, TableCommand, TryEdit, Workspace};
 use crate::frame::Yuv;
 use crate::lut::{EditRecord, LookupTable, Region, Sensitivity};
 use crate::sources::CameraKind;
@@ -15,39 +15,38 @@ impl Workspace {
     /// Applies the table's commands: new, save, the journal, the class and sensitivity, the
     /// pending selection, commit, undo and redo, the whole-stream try (the rest of
     /// [`Workspace::apply`]).
-    pub(super) fn apply_table_edit(&mut self, command: Command) -> anyhow::Result<()> {
+    pub(super) fn apply_table_edit(&mut self, command: TableCommand) -> anyhow::Result<()> {
         match command {
-            Command::NewTable(bits) => self.new_table(bits)?,
-            Command::SaveTable => {
+            TableCommand::NewTable(bits) => self.new_table(bits)?,
+            TableCommand::SaveTable => {
                 let path = self
                     .table_path
                     .clone()
                     .context("the table has no file yet: use Save table as…")?;
                 self.save_table(&path)?;
             }
-            Command::SaveTableAs(p) => self.save_table(&p)?,
-            Command::RebuildFromJournal => self.rebuild_from_journal()?,
-            Command::DiscardUnsaved => self.discard_unsaved()?,
-            Command::SetClass(c) => self.settings.class = c,
-            Command::SetSensitivity(s) => self.set_sensitivity(s),
-            Command::AdjustSensitivity { channel, delta } => {
+            TableCommand::SaveTableAs(p) => self.save_table(&p)?,
+            TableCommand::RebuildFromJournal => self.rebuild_from_journal()?,
+            TableCommand::DiscardUnsaved => self.discard_unsaved()?,
+            TableCommand::SetClass(c) => self.settings.class = c,
+            TableCommand::SetSensitivity(s) => self.set_sensitivity(s),
+            TableCommand::AdjustSensitivity { channel, delta } => {
                 self.adjust_sensitivity(channel, delta)?;
             }
-            Command::Sample { x, y } => self.sample(x, y)?,
-            Command::SampleCell(cell) => self.sample_cell(cell)?,
-            Command::ClearSelection => {
+            TableCommand::Sample { x, y } => self.sample(x, y)?,
+            TableCommand::SampleCell(cell) => self.sample_cell(cell)?,
+            TableCommand::ClearSelection => {
                 self.selection = None;
                 self.refresh_preview();
             }
-            Command::RestoreSelection(s) => {
+            TableCommand::RestoreSelection(s) => {
                 self.selection = s;
                 self.refresh_preview();
             }
-            Command::Commit => self.commit()?,
-            Command::Undo => self.undo()?,
-            Command::Redo => self.redo()?,
-            Command::TryEditOnStream => self.try_edit_on_stream()?,
-            _ => anyhow::bail!("not a table command"),
+            TableCommand::Commit => self.commit()?,
+            TableCommand::Undo => self.undo()?,
+            TableCommand::Redo => self.redo()?,
+            TableCommand::TryEditOnStream => self.try_edit_on_stream()?,
         }
         Ok(())
     }
@@ -243,7 +242,7 @@ impl Workspace {
         Ok(())
     }
 
-    /// See [`super::Command::DiscardUnsaved`]. Where undoing cannot reach the saved table (it
+    /// See [`super::TableCommand::DiscardUnsaved`]. Where undoing cannot reach the saved table (it
     /// was undone and then replaced by new edits) the journal is left as it is.
     pub(super) fn discard_unsaved(&mut self) -> anyhow::Result<()> {
         if !self.dirty {

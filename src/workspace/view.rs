@@ -1,15 +1,15 @@
 //! The workspace's view options: which view is enlarged, overlays, blob connectivity and filter,
 //! zoom and pan, Export view, the U–V plane's Y, the timings readout; and which windows are open.
 
-use super::{Command, ViewTransform, Window, Workspace, ZOOM_RANGE};
+use super::{ViewCommand, ViewTransform, Window, Workspace, ZOOM_RANGE};
 use crate::frame::save_rgb_png;
 
 impl Workspace {
     /// Applies the view commands (the rest of [`Workspace::apply`]).
-    pub(super) fn apply_view(&mut self, command: Command) -> anyhow::Result<()> {
+    pub(super) fn apply_view(&mut self, command: ViewCommand) -> anyhow::Result<()> {
         match command {
-            Command::SetMainView(v) => self.settings.main_view = v,
-            Command::SetOverlays(o) => {
+            ViewCommand::SetMainView(v) => self.settings.main_view = v,
+            ViewCommand::SetOverlays(o) => {
                 let mut o = o;
                 o.opacity = if o.opacity.is_finite() {
                     o.opacity.clamp(0.0, 1.0)
@@ -18,36 +18,35 @@ impl Workspace {
                 };
                 self.settings.overlays = o;
             }
-            Command::SetConnectivity(c) => {
+            ViewCommand::SetConnectivity(c) => {
                 self.settings.connectivity = c;
                 let mut params = *self.pipeline.params();
                 params.connectivity = c;
                 self.pipeline.set_params(params);
                 self.reprocess();
             }
-            Command::SetBlobFilter { min_pixels, hidden } => {
+            ViewCommand::SetBlobFilter { min_pixels, hidden } => {
                 self.settings.min_blob_pixels = min_pixels;
                 self.settings.hidden_blob_classes = hidden;
             }
-            Command::SetZoom(z) => {
+            ViewCommand::SetZoom(z) => {
                 self.settings.transform.zoom = z.filter(|z| z.is_finite()).map(clamp_zoom);
             }
-            Command::ZoomAbout { factor, about, fit } => self.zoom_about(factor, about, fit)?,
-            Command::Pan(d) => {
+            ViewCommand::ZoomAbout { factor, about, fit } => self.zoom_about(factor, about, fit)?,
+            ViewCommand::Pan(d) => {
                 let size = self.image_size_f32();
                 let t = &mut self.settings.transform;
                 let c = t.effective_centre(size);
                 t.centre = Some([c[0] - d[0], c[1] - d[1]]);
             }
-            Command::ResetView => self.settings.transform = ViewTransform::default(),
-            Command::ExportView(p) => {
+            ViewCommand::ResetView => self.settings.transform = ViewTransform::default(),
+            ViewCommand::ExportView(p) => {
                 let (w, h, rgb) = self.compose_view_rgb(self.settings.main_view)?;
                 save_rgb_png(&p, w, h, &rgb)?;
                 self.status = format!("view saved as {}", p.display());
             }
-            Command::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
-            Command::ShowTimings(on) => self.settings.show_timings = on,
-            _ => anyhow::bail!("not a view command"),
+            ViewCommand::SetUvPlaneY(y) => self.settings.uv_plane_y = y,
+            ViewCommand::ShowTimings(on) => self.settings.show_timings = on,
         }
         Ok(())
     }
@@ -128,11 +127,14 @@ mod tests {
     fn zoom_about_keeps_the_point_under_the_cursor() {
         let mut s = Workspace::default();
         // No frame: image size 0; centre defaults to (0, 0).
-        s.apply(Command::ZoomAbout {
-            factor: 2.0,
-            about: [10.0, 20.0],
-            fit: 1.0,
-        })
+        s.apply(
+            ViewCommand::ZoomAbout {
+                factor: 2.0,
+                about: [10.0, 20.0],
+                fit: 1.0,
+            }
+            .into(),
+        )
         .unwrap();
         let t = s.settings.transform;
         assert_eq!(t.zoom, Some(2.0));
@@ -140,9 +142,9 @@ mod tests {
         let c = t.centre.unwrap();
         assert!(((10.0 - c[0]) * 2.0 - 10.0).abs() < 1e-4);
         assert!(((20.0 - c[1]) * 2.0 - 20.0).abs() < 1e-4);
-        s.apply(Command::SetZoom(Some(1000.0))).unwrap();
+        s.apply(ViewCommand::SetZoom(Some(1000.0)).into()).unwrap();
         assert_eq!(s.settings.transform.zoom, Some(ZOOM_RANGE.1));
-        s.apply(Command::ResetView).unwrap();
+        s.apply(ViewCommand::ResetView.into()).unwrap();
         assert_eq!(s.settings.transform, ViewTransform::default());
     }
 }

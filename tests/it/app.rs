@@ -10,7 +10,9 @@ use eotn::app::EotnApp;
 use eotn::lut::{ColourClass, Sensitivity};
 use eotn::recognition::ObjectId;
 use eotn::workspace::journal;
-use eotn::workspace::{Command, ViewKind, Window, Workspace};
+use eotn::workspace::{
+    Command, PlaybackCommand, TableCommand, ViewCommand, ViewKind, Window, Workspace,
+};
 
 use crate::common::repo_file;
 use crate::harness::{
@@ -57,7 +59,7 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
     let mut o = workspace(&h).settings.overlays;
     o.classified = true;
     o.opacity = 0.7;
-    h.state_mut().state.run(Command::SetOverlays(o));
+    h.state_mut().state.run(ViewCommand::SetOverlays(o).into());
     h.run();
     assert!(workspace(&h).settings.overlays.classified);
 
@@ -102,17 +104,17 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
         "panning right moves the centre left: {before:?} → {after:?}"
     );
     assert!((after.y - before.y).abs() < 1e-3);
-    h.state_mut().state.run(Command::ResetView);
+    h.state_mut().state.run(ViewCommand::ResetView.into());
     h.run();
     assert_eq!(workspace(&h).settings.transform.zoom, None);
 
     // Left-click samples with a sensitivity: the preview marks the ball, nothing is written.
     h.state_mut()
         .state
-        .run(Command::SetClass(ColourClass::Orange));
+        .run(TableCommand::SetClass(ColourClass::Orange).into());
     h.state_mut()
         .state
-        .run(Command::SetSensitivity(Sensitivity::uniform(1)));
+        .run(TableCommand::SetSensitivity(Sensitivity::uniform(1)).into());
     let original = std::fs::read(&table).unwrap();
     click_at(&h, pixel_pos(&h, 65, 45), PointerButton::Primary);
     h.run();
@@ -174,7 +176,9 @@ fn step_switch_views_zoom_pan_classify_undo_save() {
 
     // Export the view with overlays.
     let png = dir.path().join("view.png");
-    h.state_mut().state.run(Command::ExportView(png.clone()));
+    h.state_mut()
+        .state
+        .run(ViewCommand::ExportView(png.clone()).into());
     let img = image::open(&png).unwrap().into_rgb8();
     assert_eq!(img.dimensions(), (208, 160));
 }
@@ -187,13 +191,17 @@ fn reopening_a_table_restores_undo_from_the_journal() {
     s.apply(Command::Open(vec![table.clone(), frames[0].clone()]))
         .unwrap();
     let original = s.lut().clone();
-    s.apply(Command::SetClass(ColourClass::Orange)).unwrap();
-    s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
-    s.apply(Command::Commit).unwrap();
-    s.apply(Command::SetClass(ColourClass::White)).unwrap();
-    s.apply(Command::Sample { x: 100, y: 100 }).unwrap();
-    s.apply(Command::Commit).unwrap();
-    s.apply(Command::SaveTable).unwrap();
+    s.apply(TableCommand::SetClass(ColourClass::Orange).into())
+        .unwrap();
+    s.apply(TableCommand::Sample { x: 65, y: 45 }.into())
+        .unwrap();
+    s.apply(TableCommand::Commit.into()).unwrap();
+    s.apply(TableCommand::SetClass(ColourClass::White).into())
+        .unwrap();
+    s.apply(TableCommand::Sample { x: 100, y: 100 }.into())
+        .unwrap();
+    s.apply(TableCommand::Commit.into()).unwrap();
+    s.apply(TableCommand::SaveTable.into()).unwrap();
     let saved = s.lut().clone();
 
     // A new session: the journal gives back both undo steps.
@@ -201,18 +209,18 @@ fn reopening_a_table_restores_undo_from_the_journal() {
     s2.apply(Command::OpenTable(table.clone())).unwrap();
     assert_eq!(s2.lut(), &saved);
     assert_eq!(s2.history().undo_len(), 2);
-    s2.apply(Command::Undo).unwrap();
-    s2.apply(Command::Undo).unwrap();
+    s2.apply(TableCommand::Undo.into()).unwrap();
+    s2.apply(TableCommand::Undo.into()).unwrap();
     assert_eq!(s2.lut(), &original);
     assert!(s2.dirty());
 
     // A crash before saving: the table on disk lags the journal, which recovers it.
-    s2.apply(Command::Redo).unwrap();
+    s2.apply(TableCommand::Redo.into()).unwrap();
     let unsaved = s2.lut().clone();
     let mut s3 = Workspace::default();
     s3.apply(Command::OpenTable(table.clone())).unwrap();
     assert_eq!(s3.warnings().len(), 1, "{:?}", s3.warnings());
-    s3.apply(Command::RebuildFromJournal).unwrap();
+    s3.apply(TableCommand::RebuildFromJournal.into()).unwrap();
     assert_eq!(s3.lut(), &unsaved);
 
     // A torn last line is skipped with a warning, not an error.
@@ -246,9 +254,11 @@ fn try_edit_lists_the_frames_that_would_change() {
     let dir = tempfile::tempdir().unwrap();
     let mut s = opened_fixture(dir.path());
     // Selecting green as white would change every frame's field.
-    s.apply(Command::SetClass(ColourClass::White)).unwrap();
-    s.apply(Command::Sample { x: 150, y: 120 }).unwrap();
-    s.apply(Command::TryEditOnStream).unwrap();
+    s.apply(TableCommand::SetClass(ColourClass::White).into())
+        .unwrap();
+    s.apply(TableCommand::Sample { x: 150, y: 120 }.into())
+        .unwrap();
+    s.apply(TableCommand::TryEditOnStream.into()).unwrap();
     while !s.try_edit().unwrap().done() {
         s.tick(std::time::Duration::from_millis(16));
     }
@@ -273,8 +283,12 @@ fn every_window_and_menu_opens() {
     for w in Window::ALL {
         h.state_mut().state.run(Command::ShowWindow(w, true));
     }
-    h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
-    h.state_mut().state.run(Command::TryEditOnStream);
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 65, y: 45 }.into());
+    h.state_mut()
+        .state
+        .run(TableCommand::TryEditOnStream.into());
     h.run();
     assert!(
         h.query_all_by_label_contains("plane").count() >= 1,
@@ -285,12 +299,16 @@ fn every_window_and_menu_opens() {
         click_label(&mut h, menu);
     }
     // Clicking the U–V plane selects around a cell and previews matching pixels.
-    h.state_mut().state.run(Command::ClearSelection);
-    h.state_mut().state.run(Command::SetUvPlaneY(100));
+    h.state_mut().state.run(TableCommand::ClearSelection.into());
+    h.state_mut()
+        .state
+        .run(ViewCommand::SetUvPlaneY(100).into());
     h.run();
     let s = workspace(&h);
     assert!(s.selection().is_none());
-    h.state_mut().state.run(Command::SampleCell([50, 55, 50]));
+    h.state_mut()
+        .state
+        .run(TableCommand::SampleCell([50, 55, 50]).into());
     assert_eq!(
         workspace(&h).preview_mask().iter().filter(|&&m| m).count(),
         208 * 160 - 400 - 12 * 80,
@@ -304,8 +322,10 @@ fn closing_with_unsaved_changes_asks_first() {
     let (frames, table) = fixture(dir.path());
     let mut h = harness(vec![frames[0].clone(), table]);
     h.run();
-    h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
-    h.state_mut().state.run(Command::Commit);
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 65, y: 45 }.into());
+    h.state_mut().state.run(TableCommand::Commit.into());
     h.run();
     assert!(workspace(&h).dirty());
     close_window(&mut h);
@@ -323,11 +343,13 @@ fn snapshot_with_overlays() {
     let mut o = s.settings.overlays;
     o.classified = true;
     o.opacity = 0.6;
-    s.apply(Command::SetOverlays(o)).unwrap();
-    s.apply(Command::SetClass(ColourClass::Orange)).unwrap();
-    s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
+    s.apply(ViewCommand::SetOverlays(o).into()).unwrap();
+    s.apply(TableCommand::SetClass(ColourClass::Orange).into())
+        .unwrap();
+    s.apply(TableCommand::Sample { x: 65, y: 45 }.into())
+        .unwrap();
     // Timings differ from run to run; everything else on screen is deterministic.
-    s.apply(Command::ShowTimings(false)).unwrap();
+    s.apply(ViewCommand::ShowTimings(false).into()).unwrap();
     let mut h = snapshot_harness(s, Vec2::new(1000.0, 700.0));
     h.run();
     h.snapshot("app_overlays");
@@ -373,9 +395,9 @@ fn stream_steps_plays_and_plots_sensors() {
     // NaN cannot be stored in JSON: it arrives as a missing reading, never as a number.
     assert_eq!(sensors.pan_pwm, None);
     // Jump, and the cache stays small.
-    h.state_mut().state.run(Command::Seek(15));
+    h.state_mut().state.run(PlaybackCommand::Seek(15).into());
     for i in 0..15 {
-        h.state_mut().state.run(Command::Seek(i));
+        h.state_mut().state.run(PlaybackCommand::Seek(i).into());
     }
     assert!(workspace(&h).source().unwrap().cached() <= eotn::workspace::source::CACHE_FRAMES);
     // The sensor dialog reads the whole series in the background.
@@ -386,15 +408,15 @@ fn stream_steps_plays_and_plots_sensors() {
     }
     assert_eq!(st.sensor_series.points.len(), 20);
     // Play at the recorded rate: 0.2 s of wall time moves 5 frames.
-    st.run(Command::Seek(0));
-    st.run(Command::SetSpeed(1.0));
-    st.run(Command::SetPlaying(true));
+    st.run(PlaybackCommand::Seek(0).into());
+    st.run(PlaybackCommand::SetSpeed(1.0).into());
+    st.run(PlaybackCommand::SetPlaying(true).into());
     // The window sleeps until the next frame is due (40 ms at 25 fps) instead of spinning.
     let due = st.next_frame_due().expect("playing");
     assert!((due.as_secs_f64() - 0.04).abs() < 1e-6, "{due:?}");
     st.tick(std::time::Duration::from_millis(200));
     assert_eq!(st.index(), 5);
-    st.run(Command::SetSpeed(4.0));
+    st.run(PlaybackCommand::SetSpeed(4.0).into());
     st.tick(std::time::Duration::from_millis(200));
     assert_eq!(st.index(), 19);
     assert!(!st.playing(), "stops at the end");
@@ -458,12 +480,14 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
     click_label(&mut h, "Circle fits");
     assert!(!workspace(&h).settings.overlays.circles);
     h.key_press(Key::Escape);
-    h.state_mut().state.run(Command::SetMainView(ViewKind::Raw));
+    h.state_mut()
+        .state
+        .run(ViewCommand::SetMainView(ViewKind::Raw).into());
     h.run();
     let with_objects_thumb = drawn_circles(&h).len();
     let mut o = workspace(&h).settings.overlays;
     o.set_recognition(false);
-    h.state_mut().state.run(Command::SetOverlays(o));
+    h.state_mut().state.run(ViewCommand::SetOverlays(o).into());
     h.run();
     assert_eq!(
         drawn_circles(&h).len(),
@@ -471,7 +495,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         "only the objects thumbnail still draws the ball's circle"
     );
     o.set_recognition(true);
-    h.state_mut().state.run(Command::SetOverlays(o));
+    h.state_mut().state.run(ViewCommand::SetOverlays(o).into());
     h.run();
     let all_circles = drawn_circles(&h);
     assert!(all_circles.len() > with_objects_thumb);
@@ -532,7 +556,7 @@ fn recognition_overlays_and_inspector_on_a_sim_stream() {
         st.apply(Command::SelectObject(Some(ObjectId::Ball(9))))
             .is_err()
     );
-    h.state_mut().state.run(Command::Seek(14));
+    h.state_mut().state.run(PlaybackCommand::Seek(14).into());
     let s = workspace(&h);
     if !s.primitives().iter().any(|p| p.owner() == goal) {
         assert_eq!(s.selected_object(), None);
@@ -587,7 +611,7 @@ fn snapshot_with_recognition_and_inspector() {
         repo_file("lookup_tables/sim.lut"),
     ]))
     .unwrap();
-    s.apply(Command::ShowTimings(false)).unwrap();
+    s.apply(ViewCommand::ShowTimings(false).into()).unwrap();
     s.apply(Command::ShowWindow(Window::Inspector, true))
         .unwrap();
     let ball = s
@@ -698,7 +722,7 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
         .unwrap();
     let mut frame = None;
     for i in 0..s.source().unwrap().len() {
-        s.apply(Command::Seek(i)).unwrap();
+        s.apply(PlaybackCommand::Seek(i).into()).unwrap();
         if let Some(c) = s.recognition().patterns.iter().find(|c| {
             c.observation.regions_in_image == 9 && c.observation.signature.coloured_regions() == 9
         }) {
@@ -733,7 +757,7 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     let mut h = harness(vec![stream, table, places.clone()]);
     h.run();
     assert_eq!(workspace(&h).places_path(), Some(places.as_path()));
-    h.state_mut().state.run(Command::Seek(index));
+    h.state_mut().state.run(PlaybackCommand::Seek(index).into());
     show_window(&mut h, Window::Inspector);
     let s = workspace(&h);
     let (k, c) = s

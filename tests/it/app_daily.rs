@@ -15,7 +15,9 @@ use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::recognition::params_file;
 use eotn::streams::StreamReader;
 use eotn::workspace::params::{JsonKind, json_kind};
-use eotn::workspace::{Command, Window, Workspace};
+use eotn::workspace::{
+    Command, ParamsCommand, PlaybackCommand, TableCommand, ViewCommand, Window, Workspace,
+};
 
 use crate::common::repo_file;
 use crate::harness::{
@@ -88,7 +90,7 @@ fn bhuman_stream_with_spl2009_finds_the_goal_at_frame_5_as_the_cli_does() {
         "a parameters file is not a places file"
     );
     assert!(s.params_slot().offer.is_none(), "the named set is in use");
-    s.apply(Command::Seek(5)).unwrap();
+    s.apply(PlaybackCommand::Seek(5).into()).unwrap();
     let app = accepted_goal_cm(&s).expect("a goal at frame 5");
     let cli = cli_goal_cm(&stream, &table, &params, 5).expect("the CLI's goal");
     assert!((app - cli).abs() < 1e-9, "app {app} cm, CLI {cli} cm");
@@ -123,9 +125,9 @@ fn the_stream_names_its_parameter_set_and_the_app_offers_it() {
     );
     assert!(s.status.contains("spl2009"), "{}", s.status);
     // With the defaults (the 2005 field) the goal at frame 5 is not found at 452 cm.
-    s.apply(Command::Seek(5)).unwrap();
+    s.apply(PlaybackCommand::Seek(5).into()).unwrap();
     assert!(accepted_goal_cm(&s).is_none_or(|d| (d - 452.0).abs() > 50.0));
-    s.apply(Command::UseOfferedParams).unwrap();
+    s.apply(ParamsCommand::UseOfferedParams.into()).unwrap();
     assert!(s.params_slot().offer.is_none());
     let d = accepted_goal_cm(&s).expect("the goal with the stream's parameters");
     assert!((d - 452.0).abs() < 15.0, "{d} cm");
@@ -193,13 +195,16 @@ fn tuning_a_value_reruns_the_frame_resets_and_saves() {
     let mut s = Workspace::default();
     s.apply(Command::Open(vec![stream, table, params.clone()]))
         .unwrap();
-    s.apply(Command::Seek(5)).unwrap();
+    s.apply(PlaybackCommand::Seek(5).into()).unwrap();
     let before = accepted_goal_cm(&s).unwrap();
     let generation = s.frame_generation();
-    s.apply(Command::SetParamValue {
-        pointer: "/goals/distance_multiplier".to_owned(),
-        value: serde_json::json!(15421.5),
-    })
+    s.apply(
+        ParamsCommand::SetParamValue {
+            pointer: "/goals/distance_multiplier".to_owned(),
+            value: serde_json::json!(15421.5),
+        }
+        .into(),
+    )
     .unwrap();
     assert!(s.frame_generation() > generation, "the frame was re-run");
     assert!(s.params_modified());
@@ -210,24 +215,31 @@ fn tuning_a_value_reruns_the_frame_resets_and_saves() {
     );
     // A value a parameters file may not hold is refused and changes nothing.
     let e = s
-        .apply(Command::SetParamValue {
-            pointer: "/goals/height_cm".to_owned(),
-            value: serde_json::json!(-3.0),
-        })
+        .apply(
+            ParamsCommand::SetParamValue {
+                pointer: "/goals/height_cm".to_owned(),
+                value: serde_json::json!(-3.0),
+            }
+            .into(),
+        )
         .unwrap_err();
     assert!(format!("{e:#}").contains("height_cm"), "{e:#}");
     assert!(
-        s.apply(Command::SetParamValue {
-            pointer: "/goals/no_such".to_owned(),
-            value: serde_json::json!(1),
-        })
+        s.apply(
+            ParamsCommand::SetParamValue {
+                pointer: "/goals/no_such".to_owned(),
+                value: serde_json::json!(1),
+            }
+            .into()
+        )
         .is_err()
     );
     assert_eq!(goals(&s), tuned);
     // Save: only what differs from the defaults, and it reads back as the same values.
     let dir = tempfile::tempdir().unwrap();
     let saved = dir.path().join("tuned.json");
-    s.apply(Command::SaveParams(saved.clone())).unwrap();
+    s.apply(ParamsCommand::SaveParams(saved.clone()).into())
+        .unwrap();
     assert!(!s.params_modified());
     let back = params_file::load(&saved).unwrap();
     assert_eq!(&back, s.recognition_params());
@@ -242,16 +254,17 @@ fn tuning_a_value_reruns_the_frame_resets_and_saves() {
         "defaults are not written: {text}"
     );
     // Reset per value goes back to the file opened or saved last.
-    s.apply(Command::OpenParams(params)).unwrap();
-    s.apply(Command::SetParamValue {
-        pointer: "/goals/distance_multiplier".to_owned(),
-        value: serde_json::json!(15421.5),
-    })
+    s.apply(ParamsCommand::OpenParams(params).into()).unwrap();
+    s.apply(
+        ParamsCommand::SetParamValue {
+            pointer: "/goals/distance_multiplier".to_owned(),
+            value: serde_json::json!(15421.5),
+        }
+        .into(),
+    )
     .unwrap();
-    s.apply(Command::ResetParamValue(
-        "/goals/distance_multiplier".to_owned(),
-    ))
-    .unwrap();
+    s.apply(ParamsCommand::ResetParamValue("/goals/distance_multiplier".to_owned()).into())
+        .unwrap();
     assert!(!s.params_modified());
     assert_eq!(accepted_goal_cm(&s), Some(before));
 }
@@ -262,15 +275,18 @@ fn try_params_lists_the_frames_whose_recognition_changes() {
     let mut s = Workspace::default();
     s.apply(Command::Open(vec![stream, table, params])).unwrap();
     assert!(
-        s.apply(Command::TryParamsOnStream).is_err(),
+        s.apply(ParamsCommand::TryParamsOnStream.into()).is_err(),
         "nothing tuned yet"
     );
-    s.apply(Command::SetParamValue {
-        pointer: "/goals/distance_multiplier".to_owned(),
-        value: serde_json::json!(15421.5),
-    })
+    s.apply(
+        ParamsCommand::SetParamValue {
+            pointer: "/goals/distance_multiplier".to_owned(),
+            value: serde_json::json!(15421.5),
+        }
+        .into(),
+    )
     .unwrap();
-    s.apply(Command::TryParamsOnStream).unwrap();
+    s.apply(ParamsCommand::TryParamsOnStream.into()).unwrap();
     assert!(s.window_open(Window::TryEdit));
     while !s.params_slot().try_run.as_ref().unwrap().done() {
         s.tick(std::time::Duration::from_millis(16));
@@ -316,13 +332,15 @@ fn selection_and_try_edit_count_the_same_pixels() {
     let mut s = opened_fixture(dir.path());
     // Green over the ball with a reach that takes in every colour of the frame: the field is
     // selected too, but it is green already.
-    s.apply(Command::SetClass(ColourClass::Green)).unwrap();
-    s.apply(Command::SetSensitivity(Sensitivity::uniform(48)))
+    s.apply(TableCommand::SetClass(ColourClass::Green).into())
         .unwrap();
-    s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
+    s.apply(TableCommand::SetSensitivity(Sensitivity::uniform(48)).into())
+        .unwrap();
+    s.apply(TableCommand::Sample { x: 65, y: 45 }.into())
+        .unwrap();
     let (selected, changing) = s.selection_pixel_counts();
     assert_eq!(selected, 208 * 160);
-    s.apply(Command::TryEditOnStream).unwrap();
+    s.apply(TableCommand::TryEditOnStream.into()).unwrap();
     while !s.try_edit().unwrap().done() {
         s.tick(std::time::Duration::from_millis(16));
     }
@@ -342,18 +360,24 @@ fn blob_boxes_leave_out_green_and_white_until_asked() {
     let green = ColourClass::Green.code();
     assert!(s.blobs().active().any(|b| b.colour == green));
     assert!(s.drawn_blobs().iter().all(|b| b.colour != green));
-    s.apply(Command::SetBlobFilter {
-        min_pixels: 1,
-        hidden: vec![ColourClass::Yellow],
-    })
+    s.apply(
+        ViewCommand::SetBlobFilter {
+            min_pixels: 1,
+            hidden: vec![ColourClass::Yellow],
+        }
+        .into(),
+    )
     .unwrap();
     let drawn = s.drawn_blobs();
     assert!(drawn.iter().any(|b| b.colour == green));
     assert!(drawn.iter().all(|b| b.colour != ColourClass::Yellow.code()));
-    s.apply(Command::SetBlobFilter {
-        min_pixels: 100_000,
-        hidden: Vec::new(),
-    })
+    s.apply(
+        ViewCommand::SetBlobFilter {
+            min_pixels: 100_000,
+            hidden: Vec::new(),
+        }
+        .into(),
+    )
     .unwrap();
     assert!(s.drawn_blobs().is_empty());
 }
@@ -378,8 +402,10 @@ fn a_black_preview_shows_on_dark_pixels() {
     let mut s = Workspace::default();
     s.apply(Command::Open(vec![frames[0].clone(), table]))
         .unwrap();
-    s.apply(Command::SetClass(ColourClass::Black)).unwrap();
-    s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
+    s.apply(TableCommand::SetClass(ColourClass::Black).into())
+        .unwrap();
+    s.apply(TableCommand::Sample { x: 65, y: 45 }.into())
+        .unwrap();
     let img = preview_image(&s, [208, 160]);
     assert!(luma(img.pixels[45 * 208 + 65]) > 100.0);
 }
@@ -469,8 +495,10 @@ fn try_edit_window_says_what_to_do_before_a_run_and_rows_click_whole() {
     assert!(h.query_by_label_contains("No check yet").is_some());
     h.state_mut()
         .state
-        .run(Command::SetClass(ColourClass::White));
-    h.state_mut().state.run(Command::Sample { x: 150, y: 120 });
+        .run(TableCommand::SetClass(ColourClass::White).into());
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 150, y: 120 }.into());
     h.run();
     h.get_by_label("Try the selection on the whole stream")
         .click();
@@ -494,7 +522,7 @@ fn closing_the_inspector_clears_its_highlight() {
     let (stream, table, params) = bhuman();
     let mut s = Workspace::default();
     s.apply(Command::Open(vec![stream, table, params])).unwrap();
-    s.apply(Command::Seek(5)).unwrap();
+    s.apply(PlaybackCommand::Seek(5).into()).unwrap();
     s.apply(Command::ShowWindow(Window::Inspector, true))
         .unwrap();
     let owner = s.accepted_owners()[0];
@@ -517,7 +545,9 @@ fn small_things_last_frame_escape_one_warning() {
     h.run();
     assert_eq!(workspace(&h).index(), 2);
     // Escape closes an open menu (and keeps the selection while it does).
-    h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 65, y: 45 }.into());
     click_label(&mut h, "File");
     assert!(h.query_by_label("Open parameters…").is_some());
     h.key_press(Key::Escape);
@@ -551,16 +581,20 @@ fn quit_without_saving_keeps_the_undo_history_and_warns_of_no_crash() {
     // One saved edit, then one that is not saved.
     h.state_mut()
         .state
-        .run(Command::SetClass(ColourClass::Orange));
-    h.state_mut().state.run(Command::Sample { x: 65, y: 45 });
-    h.state_mut().state.run(Command::Commit);
-    h.state_mut().state.run(Command::SaveTable);
+        .run(TableCommand::SetClass(ColourClass::Orange).into());
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 65, y: 45 }.into());
+    h.state_mut().state.run(TableCommand::Commit.into());
+    h.state_mut().state.run(TableCommand::SaveTable.into());
     let saved = std::fs::read(&table).unwrap();
     h.state_mut()
         .state
-        .run(Command::SetClass(ColourClass::White));
-    h.state_mut().state.run(Command::Sample { x: 150, y: 120 });
-    h.state_mut().state.run(Command::Commit);
+        .run(TableCommand::SetClass(ColourClass::White).into());
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 150, y: 120 }.into());
+    h.state_mut().state.run(TableCommand::Commit.into());
     h.run();
     assert!(workspace(&h).dirty());
     close_window(&mut h);
@@ -588,7 +622,7 @@ fn sample_frame_3_ball_in_the_middle_is_not_called_cut_off() {
         repo_file("lookup_tables/sample.lut"),
     ]))
     .unwrap();
-    s.apply(Command::Seek(3)).unwrap();
+    s.apply(PlaybackCommand::Seek(3).into()).unwrap();
     let (w, h) = s.image_size();
     let ball = s
         .recognition()

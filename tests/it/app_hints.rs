@@ -12,7 +12,7 @@ use eotn::frame::{Frame, Yuv};
 use eotn::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
 use eotn::workspace::bookmarks::{EventKind, bookmarks_path};
 use eotn::workspace::cell_origin::CellOrigin;
-use eotn::workspace::{Command, Window, Workspace};
+use eotn::workspace::{Command, HintsCommand, PlaybackCommand, TableCommand, Window, Workspace};
 
 use crate::harness::{
     GREEN, ORANGE, click_label, harness, pixel_pos, run_until, show_window, workspace,
@@ -80,14 +80,14 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
     assert_eq!(orange_cells, vec![workspace(&h).lut().index(ORANGE)]);
 
     // Clicking the first hint selects its cells and previews its pixels in the image.
-    h.state_mut().state.run(Command::Seek(1));
+    h.state_mut().state.run(PlaybackCommand::Seek(1).into());
     h.run();
     click_label(&mut h, "hint 1");
     let previewed = workspace(&h).preview_mask().iter().filter(|&&m| m).count();
     assert_eq!(previewed, 400, "the ball's pixels are previewed");
     h.state_mut()
         .state
-        .run(Command::SetClass(ColourClass::Orange));
+        .run(TableCommand::SetClass(ColourClass::Orange).into());
     // The class panel scrolls: bring its Commit button into view first, as a user would.
     h.get_by_label("Commit").scroll_to_me();
     h.run();
@@ -118,11 +118,13 @@ fn coverage_hints_rank_unclassified_colours_and_a_click_selects_them_for_commit(
         Some(CellOrigin::AsLoaded)
     );
     // A sampled commit records its frame and pixel, shown when hovering.
-    h.state_mut().state.run(Command::Sample { x: 155, y: 105 });
     h.state_mut()
         .state
-        .run(Command::SetClass(ColourClass::Pink));
-    h.state_mut().state.run(Command::Commit);
+        .run(TableCommand::Sample { x: 155, y: 105 }.into());
+    h.state_mut()
+        .state
+        .run(TableCommand::SetClass(ColourClass::Pink).into());
+    h.state_mut().state.run(TableCommand::Commit.into());
     h.run();
     let pos = pixel_pos(&h, 155, 105);
     h.event(Event::PointerMoved(pos));
@@ -147,7 +149,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     h.run();
     show_window(&mut h, Window::Bookmarks);
     // A bookmark with a note on frame 2, saved beside the first frame file.
-    h.state_mut().state.run(Command::Seek(2));
+    h.state_mut().state.run(PlaybackCommand::Seek(2).into());
     h.run();
     let field = h.get_by_label("note");
     field.focus();
@@ -162,7 +164,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     );
 
     // Ctrl+→ from frame 0 jumps to the bookmark (a plain step would go to 1).
-    h.state_mut().state.run(Command::Seek(0));
+    h.state_mut().state.run(PlaybackCommand::Seek(0).into());
     h.run();
     h.key_press_modifiers(Modifiers::COMMAND, Key::ArrowRight);
     h.run();
@@ -184,7 +186,7 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     );
 
     // Jumps: from 0 the next mark is the event at 1, then the bookmark at 2; and back.
-    h.state_mut().state.run(Command::Seek(0));
+    h.state_mut().state.run(PlaybackCommand::Seek(0).into());
     h.run();
     click_label(&mut h, "Next mark");
     assert_eq!(workspace(&h).index(), 1);
@@ -199,7 +201,9 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
     h.run();
     assert_eq!(workspace(&h).bookmarks().len(), 1);
     assert_eq!(workspace(&h).bookmarks()[0].note, "ball near the line");
-    h.state_mut().state.run(Command::RemoveBookmark(2));
+    h.state_mut()
+        .state
+        .run(HintsCommand::RemoveBookmark(2).into());
     h.run();
     assert!(workspace(&h).bookmarks().is_empty());
     assert!(!std::fs::read_to_string(&file).unwrap().contains("line"));

@@ -12,13 +12,14 @@ use egui::{PointerButton, Pos2};
 use egui_kittest::kittest::Queryable as _;
 use eotn::app::field_view::FieldTransform;
 use eotn::geometry::{ImagePoint, Point};
+use eotn::model::truth::{GroundTruth, OverheadTruth};
 use eotn::overhead::calibration::Calibration;
 use eotn::overhead::{FieldDescription, PointsFile};
-use eotn::sim::truth::{GroundTruth, OverheadTruth};
 use eotn::sources::CameraKind;
 use eotn::streams::{FrameRecord, StreamReader};
 use eotn::workspace::{
-    CalibrationSource, Command, OverheadCommand, RobotKey, ViewKind, Window, Workspace,
+    CalibrationSource, Command, OverheadCommand, PlaybackCommand, RobotKey, ViewCommand, ViewKind,
+    Window, Workspace,
 };
 
 use crate::common::{repo_file, sim_stream};
@@ -181,7 +182,7 @@ fn without_a_calibration_nothing_is_placed_and_the_status_says_so_until_one_is_o
     };
     let path = dir.path().join("true.calibration.json");
     cal.save(&path).unwrap();
-    w.apply(Command::Overhead(OverheadCommand::OpenCalibration(path)))
+    w.apply(OverheadCommand::OpenCalibration(path).into())
         .unwrap();
     assert_eq!(
         w.overhead().camera().map(|(_, s)| s),
@@ -189,10 +190,8 @@ fn without_a_calibration_nothing_is_placed_and_the_status_says_so_until_one_is_o
     );
     assert!(w.overhead_detections().is_some_and(|d| d.ball.is_some()));
     assert!(
-        w.apply(Command::Overhead(OverheadCommand::OpenCalibration(
-            dir.path().join("missing.json")
-        )))
-        .is_err()
+        w.apply(OverheadCommand::OpenCalibration(dir.path().join("missing.json")).into())
+            .is_err()
     );
     assert!(
         w.overhead_detections().is_some(),
@@ -216,14 +215,15 @@ fn true_clicks(stream: &Path) -> Vec<(String, ImagePoint)> {
 }
 
 fn pick(w: &mut Workspace, name: &str, p: ImagePoint) {
-    w.apply(Command::Overhead(OverheadCommand::ChooseLandmark(Some(
-        name.to_owned(),
-    ))))
-    .unwrap();
-    w.apply(Command::Overhead(OverheadCommand::PickPoint {
-        x_px: p.x_px,
-        y_px: p.y_px,
-    }))
+    w.apply(OverheadCommand::ChooseLandmark(Some(name.to_owned())).into())
+        .unwrap();
+    w.apply(
+        OverheadCommand::PickPoint {
+            x_px: p.x_px,
+            y_px: p.y_px,
+        }
+        .into(),
+    )
     .unwrap();
 }
 
@@ -237,31 +237,30 @@ fn picked_points_calibrate_with_an_error_per_point_undo_and_files() {
     for (name, p) in clicks.iter().take(5) {
         pick(&mut w, name, *p);
     }
-    let err = w
-        .apply(Command::Overhead(OverheadCommand::Calibrate))
-        .unwrap_err();
+    let err = w.apply(OverheadCommand::Calibrate.into()).unwrap_err();
     assert!(format!("{err}").contains("at least 6"), "{err}");
     // A wrong click, then undone: the point goes and its landmark is chosen again.
     let (name5, p5) = &clicks[5];
     pick(&mut w, name5, ImagePoint::new(10.0, 10.0));
     assert_eq!(w.overhead().points().points.len(), 6);
-    w.apply(Command::Overhead(OverheadCommand::UndoPick))
-        .unwrap();
+    w.apply(OverheadCommand::UndoPick.into()).unwrap();
     assert_eq!(w.overhead().points().points.len(), 5);
     assert_eq!(w.overhead().landmark(), Some(name5.as_str()));
     for (name, p) in &clicks[5..] {
         pick(&mut w, name, *p);
     }
     assert!(
-        w.apply(Command::Overhead(OverheadCommand::PickPoint {
-            x_px: -4.0,
-            y_px: 3.0
-        }))
+        w.apply(
+            OverheadCommand::PickPoint {
+                x_px: -4.0,
+                y_px: 3.0
+            }
+            .into()
+        )
         .is_err()
             || w.overhead().landmark().is_none()
     );
-    w.apply(Command::Overhead(OverheadCommand::Calibrate))
-        .unwrap();
+    w.apply(OverheadCommand::Calibrate.into()).unwrap();
     let cal = w.overhead().calibration().expect("solved").clone();
     assert_eq!(cal.points.len(), clicks.len());
     assert!(cal.median_point_error_px() < 0.5, "{cal:?}");
@@ -276,10 +275,8 @@ fn picked_points_calibrate_with_an_error_per_point_undo_and_files() {
     assert!(dist(ball.field_cm, t.ball.unwrap().field_cm) < 5.0);
 
     let points = dir.path().join("clicked.points.json");
-    w.apply(Command::Overhead(OverheadCommand::SavePoints(
-        points.clone(),
-    )))
-    .unwrap();
+    w.apply(OverheadCommand::SavePoints(points.clone()).into())
+        .unwrap();
     let back = PointsFile::load(&points).unwrap();
     assert_eq!(back.points.len(), w.overhead().points().points.len());
     for (a, b) in back.points.iter().zip(&w.overhead().points().points) {
@@ -287,24 +284,19 @@ fn picked_points_calibrate_with_an_error_per_point_undo_and_files() {
         assert!(a.image().distance_to(&b.image()) < 1e-9);
     }
     let saved = dir.path().join("clicked.calibration.json");
-    w.apply(Command::Overhead(OverheadCommand::SaveCalibration(
-        saved.clone(),
-    )))
-    .unwrap();
+    w.apply(OverheadCommand::SaveCalibration(saved.clone()).into())
+        .unwrap();
     let back = Calibration::load(&saved).unwrap();
     assert_eq!(back.points.len(), cal.points.len());
     assert!((back.camera.focal_px - cal.camera.focal_px).abs() < 1e-9);
-    w.apply(Command::Overhead(OverheadCommand::CloseCalibration))
-        .unwrap();
+    w.apply(OverheadCommand::CloseCalibration.into()).unwrap();
     assert_eq!(
         w.overhead().camera().map(|(_, s)| s),
         Some(CalibrationSource::Stream)
     );
     assert!(
-        w.apply(Command::Overhead(OverheadCommand::ChooseLandmark(Some(
-            "no such landmark".into()
-        ))))
-        .is_err()
+        w.apply(OverheadCommand::ChooseLandmark(Some("no such landmark".into())).into())
+            .is_err()
     );
 }
 
@@ -315,8 +307,7 @@ fn the_undistorted_view_remaps_the_image_and_clicks_go_back_to_camera_pixels() {
     assert_eq!(before, w.rgb());
     let mut v = w.settings.overhead;
     v.undistorted = true;
-    w.apply(Command::Overhead(OverheadCommand::SetView(v)))
-        .unwrap();
+    w.apply(OverheadCommand::SetView(v).into()).unwrap();
     assert!(w.undistorted_view());
     assert_ne!(w.view_rgb().as_ref(), w.rgb());
     assert_eq!(w.view_codes().len(), w.rgb().len() / 3);
@@ -332,8 +323,8 @@ fn the_undistorted_view_remaps_the_image_and_clicks_go_back_to_camera_pixels() {
 fn world_models_are_compared_with_the_overhead_robots() {
     let (stream, _) = fixture();
     let mut w = opened();
-    w.apply(Command::Step(1)).unwrap();
-    w.apply(Command::Step(1)).unwrap();
+    w.apply(PlaybackCommand::Step(1).into()).unwrap();
+    w.apply(PlaybackCommand::Step(1).into()).unwrap();
     let model = &w.overhead().field_model;
     let models = model.world_models();
     assert!(models.len() >= 4, "{models:?}");
@@ -369,9 +360,7 @@ fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
     let first = clicks[0].0.clone();
     h.state_mut()
         .state
-        .run(Command::Overhead(OverheadCommand::ChooseLandmark(Some(
-            first,
-        ))));
+        .run(OverheadCommand::ChooseLandmark(Some(first)).into());
     h.run();
     let mut advanced = 0;
     for (k, (name, p)) in clicks.iter().enumerate() {
@@ -382,9 +371,7 @@ fn the_app_picks_points_by_clicking_and_calibrates_from_the_window() {
         } else {
             h.state_mut()
                 .state
-                .run(Command::Overhead(OverheadCommand::ChooseLandmark(Some(
-                    name.clone(),
-                ))));
+                .run(OverheadCommand::ChooseLandmark(Some(name.clone())).into());
             h.run();
         }
         let xf = h.state().last_view.expect("the view was drawn");
@@ -454,7 +441,8 @@ fn clicking_a_robot_in_the_field_view_selects_it_everywhere() {
         .unwrap();
     w.apply(Command::ShowWindow(Window::Inspector, true))
         .unwrap();
-    w.apply(Command::SetMainView(ViewKind::Objects)).unwrap();
+    w.apply(ViewCommand::SetMainView(ViewKind::Objects).into())
+        .unwrap();
     let robot = w.overhead_detections().unwrap().robots[0];
     let key = RobotKey {
         team: robot.team,

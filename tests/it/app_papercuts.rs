@@ -12,7 +12,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use eotn::app::EotnApp;
 use eotn::lut::ColourClass;
-use eotn::workspace::{Command, Window, Workspace};
+use eotn::workspace::{Command, RobotsCommand, TableCommand, ViewCommand, Window, Workspace};
 
 use crate::common::repo_file;
 use crate::harness::{click_label, fixture, harness_sized, run_steps_until, workspace};
@@ -125,7 +125,9 @@ fn object_labels_stay_inside_the_view_when_the_object_is_beyond_an_edge() {
         (true, by as f32 + r as f32 + 40.0 + half_height),
         (false, by as f32 - r as f32 - 40.0 - half_height),
     ] {
-        h.state_mut().state.run(Command::SetZoom(Some(zoom)));
+        h.state_mut()
+            .state
+            .run(ViewCommand::SetZoom(Some(zoom)).into());
         let size = workspace(&h).image_size();
         let c = workspace(&h)
             .settings
@@ -133,7 +135,7 @@ fn object_labels_stay_inside_the_view_when_the_object_is_beyond_an_edge() {
             .effective_centre([size.0 as f32, size.1 as f32]);
         h.state_mut()
             .state
-            .run(Command::Pan([c[0] - bx as f32, c[1] - centre_y]));
+            .run(ViewCommand::Pan([c[0] - bx as f32, c[1] - centre_y]).into());
         h.run_steps(3);
         let xf = h.state().last_view.unwrap();
         let ball_on_screen = xf.to_screen(Pos2::new(bx as f32, by as f32));
@@ -170,9 +172,11 @@ fn the_journal_warning_names_the_menu_command_as_the_menu_shows_it() {
     let mut s = Workspace::default();
     s.apply(Command::Open(vec![table.clone(), frames[0].clone()]))
         .unwrap();
-    s.apply(Command::SetClass(ColourClass::Orange)).unwrap();
-    s.apply(Command::Sample { x: 65, y: 45 }).unwrap();
-    s.apply(Command::Commit).unwrap();
+    s.apply(TableCommand::SetClass(ColourClass::Orange).into())
+        .unwrap();
+    s.apply(TableCommand::Sample { x: 65, y: 45 }.into())
+        .unwrap();
+    s.apply(TableCommand::Commit.into()).unwrap();
     let unsaved = s.lut().clone();
     drop(s);
     let mut h = harness(vec![frames[0].clone(), table]);
@@ -401,8 +405,12 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
         .build_eframe(move |cc| EotnApp::new(cc, paths.clone()));
     h.run();
     // A selection made earlier (a field pixel), then zoomed in.
-    h.state_mut().state.run(Command::Sample { x: 150, y: 120 });
-    h.state_mut().state.run(Command::SetZoom(Some(2.5)));
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 150, y: 120 }.into());
+    h.state_mut()
+        .state
+        .run(ViewCommand::SetZoom(Some(2.5)).into());
     h.run();
     let before = workspace(&h).selection().cloned();
     assert_eq!(before.as_ref().and_then(|s| s.pixel), Some((150, 120)));
@@ -419,8 +427,10 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
         "the selection is kept"
     );
     // With no selection before, none after (half a second later: not a third click).
-    h.state_mut().state.run(Command::ClearSelection);
-    h.state_mut().state.run(Command::SetZoom(Some(2.5)));
+    h.state_mut().state.run(TableCommand::ClearSelection.into());
+    h.state_mut()
+        .state
+        .run(ViewCommand::SetZoom(Some(2.5)).into());
     h.run_steps(30);
     let ball = h.state().last_view.unwrap().pixel_centre(65, 45);
     h.event(Event::PointerMoved(ball));
@@ -434,7 +444,9 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
         workspace(&h).selection()
     );
     // A single click still samples at once (and the zoom stays).
-    h.state_mut().state.run(Command::SetZoom(Some(2.5)));
+    h.state_mut()
+        .state
+        .run(ViewCommand::SetZoom(Some(2.5)).into());
     h.run_steps(30);
     let ball = h.state().last_view.unwrap().pixel_centre(65, 45);
     h.event(Event::PointerMoved(ball));
@@ -463,7 +475,7 @@ fn the_robots_window_fits_its_dock_tab_with_two_robots() {
     for port in [alpha.port, bravo.port] {
         h.state_mut()
             .state
-            .run(Command::ConnectRobot(format!("127.0.0.1:{port}")));
+            .run(RobotsCommand::ConnectRobot(format!("127.0.0.1:{port}")).into());
     }
     run_steps_until(&mut h, Duration::from_secs(30), |a| {
         let rows = a.state.robots();

@@ -7,11 +7,11 @@ use eotn::eval::skew::{SkewReport, compare_ball, outline_circle};
 use eotn::eval::{EvalParams, EvalReport, Percentiles, evaluate_frame};
 use eotn::geometry::PinholeCamera;
 use eotn::lut::LookupTable;
+use eotn::model::truth::GroundTruth;
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::recognition::ball::is_ball_colour;
 use eotn::recognition::fit::{fit_circle, fit_circle_trimmed};
 use eotn::recognition::scan::{EdgeScanPattern, edge_points};
-use eotn::sim::truth::GroundTruth;
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
 /// A table learnt from every 10th frame of a few robot scenarios with seed 100 (the test

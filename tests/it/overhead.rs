@@ -10,10 +10,10 @@ use eotn::frame::save_rgb_png;
 use eotn::geometry::{OverheadCamera, Point};
 use eotn::lut::LookupTable;
 use eotn::lut::learn::{LearnParams, TableBuilder};
+use eotn::model::truth::{GroundTruth, OverheadTruth};
 use eotn::overhead::{
     CalibrationParams, FieldDescription, OverheadParams, OverheadPipeline, calibrate,
 };
-use eotn::sim::truth::{GroundTruth, OverheadTruth};
 use eotn::sim::{Scenario, ScenarioKind, SimFrame, Simulator};
 
 use crate::common::{eotn_ok, sim_stream};

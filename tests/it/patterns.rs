@@ -10,12 +10,12 @@ use eotn::eval::patterns::{
     PatternEvalParams, PatternEvalReport, PatternFrameEval, evaluate_patterns, place_markers,
 };
 use eotn::lut::LookupTable;
+use eotn::model::truth::GroundTruth;
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::recognition::patterns::{
     LearnParams, LearnReport, LearnView, PatternMemory, PatternParams, Placement,
 };
 use eotn::sim::scenario::pattern_markers;
-use eotn::sim::truth::GroundTruth;
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
 use crate::common::{eotn, eotn_ok};

@@ -5,8 +5,8 @@
 use eotn::eval::{EvalParams, EvalReport, FrameEval, evaluate_frame};
 use eotn::lut::LookupTable;
 use eotn::lut::learn::{LearnParams, TableBuilder};
+use eotn::model::truth::GroundTruth;
 use eotn::pipeline::{Pipeline, PipelineParams};
-use eotn::sim::truth::GroundTruth;
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
 const ROBOT_SCENARIOS: [ScenarioKind; 6] = [

@@ -13,7 +13,9 @@ use eotn::live::serve::StandInRobot;
 use eotn::live::{Connection, unix_time_ns};
 use eotn::streams::StreamReader;
 use eotn::streams::schema::{ImageEncoding, encode_image};
-use eotn::workspace::{Command, RobotId, RobotRow, Window, Workspace};
+use eotn::workspace::{
+    Command, PlaybackCommand, RobotId, RobotRow, RobotsCommand, SourceCommand, Window, Workspace,
+};
 use tungstenite::Message;
 
 use crate::live::{fake_robot_session, frame, image_message, image_payloads, record};
@@ -37,7 +39,7 @@ fn row(w: &Workspace, id: RobotId) -> RobotRow {
 }
 
 fn connect(w: &mut Workspace, port: u16) -> RobotId {
-    w.apply(Command::ConnectRobot(format!("127.0.0.1:{port}")))
+    w.apply(RobotsCommand::ConnectRobot(format!("127.0.0.1:{port}")).into())
         .unwrap();
     w.robots().last().unwrap().id
 }
@@ -103,7 +105,8 @@ fn two_robots_are_recorded_bit_exact_one_file_each_and_a_dropped_robot_leaves_a_
     assert!(w.title().ends_with("robot alpha"), "{}", w.title());
     assert!(tick_until(&mut w, 5.0, |_| alpha.has_viewer() && bravo.has_viewer()));
     let folder = dir.path().join("rec");
-    w.apply(Command::RecordAllRobots(folder.clone())).unwrap();
+    w.apply(RobotsCommand::RecordAllRobots(folder.clone()).into())
+        .unwrap();
     let (pa, pb) = (folder.join("alpha.mcap"), folder.join("bravo.mcap"));
     assert_eq!(row(&w, a).recording.as_deref(), Some(pa.as_path()));
     assert_eq!(row(&w, b).recording.as_deref(), Some(pb.as_path()));
@@ -142,7 +145,8 @@ fn two_robots_are_recorded_bit_exact_one_file_each_and_a_dropped_robot_leaves_a_
     let partial = PathBuf::from(format!("{}.partial", pa.display()));
     assert!(tick_until(&mut w, 5.0, |_| StreamReader::open(&partial)
         .is_ok_and(|r| r.len() == 20)));
-    w.apply(Command::StopRecordingRobot(a)).unwrap();
+    w.apply(RobotsCommand::StopRecordingRobot(a).into())
+        .unwrap();
     assert!(
         w.status.contains("recorded 20 frames of alpha"),
         "{}",
@@ -150,7 +154,7 @@ fn two_robots_are_recorded_bit_exact_one_file_each_and_a_dropped_robot_leaves_a_
     );
     assert_recorded_bit_exact(&pa, &(0..20).collect::<Vec<_>>());
     // Disconnecting bravo finishes its file too.
-    w.apply(Command::DisconnectRobot(b)).unwrap();
+    w.apply(RobotsCommand::DisconnectRobot(b).into()).unwrap();
     assert_recorded_bit_exact(&pb, &(100..120).collect::<Vec<_>>());
     assert_eq!(w.robots().len(), 1);
     bravo.stop();
@@ -165,13 +169,14 @@ fn stepping_back_holds_the_view_while_frames_arrive_and_are_recorded_and_live_re
     assert!(tick_until(&mut w, 10.0, |_| robot.has_viewer()));
     let out = dir.path().join("steps.mcap");
     // Camera ▸ Start recording… records the shown robot with its own bit-exact recorder.
-    w.apply(Command::StartRecording(out.clone())).unwrap();
+    w.apply(SourceCommand::StartRecording(out.clone()).into())
+        .unwrap();
     assert_eq!(w.recording(), Some(out.clone()));
     send_ticking(&mut w, &mut robot, 0..10);
     assert!(tick_until(&mut w, 5.0, |w| w.index() == 9));
     assert!(w.following_live());
 
-    w.apply(Command::Step(-3)).unwrap();
+    w.apply(PlaybackCommand::Step(-3).into()).unwrap();
     assert!(!w.following_live(), "stepping holds the view");
     assert_eq!((w.index(), w.frame()), (6, Some(&frame(6))));
     let pan = |w: &Workspace| w.current().and_then(|c| c.sensors?.head_pan_rad);
@@ -180,15 +185,15 @@ fn stepping_back_holds_the_view_while_frames_arrive_and_are_recorded_and_live_re
     assert!(tick_until(&mut w, 5.0, |w| row(w, id).stats.recorded == Some(20)));
     assert_eq!(w.index(), 6, "the view stayed where it was held");
     assert_eq!(w.source().unwrap().len(), 20, "the timeline grew");
-    w.apply(Command::Seek(2)).unwrap();
+    w.apply(PlaybackCommand::Seek(2).into()).unwrap();
     assert_eq!(w.frame(), Some(&frame(2)));
     // Playing through what has arrived runs at the arrival rate and stops at the newest.
-    w.apply(Command::SetSpeed(0.0)).unwrap();
-    w.apply(Command::SetPlaying(true)).unwrap();
+    w.apply(PlaybackCommand::SetSpeed(0.0).into()).unwrap();
+    w.apply(PlaybackCommand::SetPlaying(true).into()).unwrap();
     assert!(tick_until(&mut w, 5.0, |w| !w.playing()));
     assert_eq!(w.index(), 19);
-    w.apply(Command::Step(-10)).unwrap();
-    w.apply(Command::SetFollowLive(true)).unwrap();
+    w.apply(PlaybackCommand::Step(-10).into()).unwrap();
+    w.apply(RobotsCommand::SetFollowLive(true).into()).unwrap();
     assert!(w.following_live());
     assert_eq!(w.index(), 19, "live is the newest frame");
     send_ticking(&mut w, &mut robot, 20..25);
@@ -205,10 +210,10 @@ fn stepping_back_holds_the_view_while_frames_arrive_and_are_recorded_and_live_re
         .collect();
     assert_eq!(pans[24], Some(0.24));
     assert!(pans.iter().all(Option::is_some));
-    w.apply(Command::StopRecording).unwrap();
+    w.apply(SourceCommand::StopRecording.into()).unwrap();
     assert_eq!(w.recording(), None);
     assert_recorded_bit_exact(&out, &(0..25).collect::<Vec<_>>());
-    w.apply(Command::Disconnect).unwrap();
+    w.apply(SourceCommand::Disconnect.into()).unwrap();
     assert!(w.robots().is_empty() && w.source().is_none());
     robot.stop();
 }
@@ -262,9 +267,9 @@ fn a_faulty_robot_closes_only_its_own_connection_and_a_robot_that_comes_back_is_
     );
     // Showing the faulty robot shows nothing (it has no frame), and the good one is back with
     // a click.
-    w.apply(Command::ShowRobot(bad)).unwrap();
+    w.apply(RobotsCommand::ShowRobot(bad).into()).unwrap();
     assert!(w.frame().is_none());
-    w.apply(Command::ShowRobot(ok)).unwrap();
+    w.apply(RobotsCommand::ShowRobot(ok).into()).unwrap();
     assert_eq!(w.frame(), Some(&frame(29)));
 
     // The good robot goes away and comes back on the same port.
@@ -297,7 +302,7 @@ fn a_faulty_robot_closes_only_its_own_connection_and_a_robot_that_comes_back_is_
     assert_eq!(w.frame(), Some(&frame(34)));
 
     done.store(true, Ordering::Relaxed);
-    w.apply(Command::DisconnectRobot(bad)).unwrap();
+    w.apply(RobotsCommand::DisconnectRobot(bad).into()).unwrap();
     // Unblocks the garbage robot's last accept.
     let _ = TcpStream::connect(("127.0.0.1", gport));
     let _ = g.join();
@@ -339,7 +344,7 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     assert!(tick_until(&mut w, 10.0, |_| robots
         .iter()
         .all(StandInRobot::has_viewer)));
-    w.apply(Command::RecordAllRobots(dir.path().to_owned()))
+    w.apply(RobotsCommand::RecordAllRobots(dir.path().to_owned()).into())
         .unwrap();
     let sender = send_at_30_fps(robots, frames);
     // The UI's loop: tick, and note how long each newly shown frame took from the sender.
@@ -388,7 +393,7 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     let paths: Vec<PathBuf> = w.robots().into_iter().filter_map(|r| r.recording).collect();
     assert_eq!(paths.len(), 4);
     for id in ids {
-        w.apply(Command::DisconnectRobot(id)).unwrap();
+        w.apply(RobotsCommand::DisconnectRobot(id).into()).unwrap();
     }
     let all: Vec<usize> = (0..frames).collect();
     for p in paths {
@@ -420,11 +425,11 @@ fn a_first_robot_that_never_connects_gives_way_to_one_that_sends_unless_the_user
         && w.index() == 4));
     assert_eq!(w.frame(), Some(&frame(4)));
     // A robot the user chose stays shown, frames or not.
-    w.apply(Command::ShowRobot(dead)).unwrap();
+    w.apply(RobotsCommand::ShowRobot(dead).into()).unwrap();
     send_ticking(&mut w, &mut good, 5..10);
     assert!(tick_until(&mut w, 2.0, |w| row(w, ok).stats.frames == 10));
     assert_eq!(w.shown_robot(), Some(dead));
     assert!(w.frame().is_none());
-    w.apply(Command::Disconnect).unwrap();
+    w.apply(SourceCommand::Disconnect.into()).unwrap();
     good.stop();
 }

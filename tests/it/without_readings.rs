@@ -11,11 +11,11 @@ use eotn::eval::labels::{Labels, evaluate_labelled_frame};
 use eotn::eval::{EvalParams, evaluate_frame};
 use eotn::frame::Frame;
 use eotn::lut::LookupTable;
+use eotn::model::truth::GroundTruth;
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::recognition::confidence::TestWeight;
 use eotn::recognition::{RecognitionParams, params_file};
 use eotn::sensors::SensorReadings;
-use eotn::sim::truth::GroundTruth;
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 use eotn::streams::StreamReader;
 

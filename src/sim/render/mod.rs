@@ -27,10 +27,11 @@ pub use world::World;
 
 use nalgebra::{Isometry3, Vector3};
 
+use super::effects::CameraEffects;
 use super::rng::SimRng;
-use super::scene::{CameraEffects, Material};
 use crate::frame::{Frame, FrameError};
 use crate::geometry::{OverheadCamera, PinholeCamera};
+use crate::model::scene::Material;
 
 /// Object identities in [`Rendered::objects`]: what each pixel shows.
 pub mod object_id {
@@ -218,8 +219,8 @@ mod tests {
     use super::*;
     use crate::geometry::{BodyPose, Ers7Dimensions, HeadJoints, RobotPose, Transform};
     use crate::lut::ColourClass;
-    use crate::sim::scene::Ball;
-    use crate::sim::scene::Scene;
+    use crate::model::scene::Ball;
+    use crate::model::scene::Scene;
 
     fn robot_camera_pose(robot: RobotPose, joints: HeadJoints) -> Isometry3<f64> {
         let t: Transform<crate::geometry::Field, crate::geometry::Camera> = BodyPose::ERS7_STANCE

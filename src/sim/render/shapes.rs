@@ -7,7 +7,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 use super::object_id;
 use crate::geometry::{Ers7Dimensions, rotation_z};
 use crate::lut::ColourClass;
-use crate::sim::scene::{Ball, Beacon, Clutter, FieldSpec, GoalColour, Material, Shape};
+use crate::model::scene::{Ball, Beacon, Clutter, FieldSpec, GoalColour, Material, Shape};
 
 #[derive(Debug, Clone)]
 /// How a part is painted.
@@ -204,7 +204,7 @@ const MARKER_PANEL_CM: f64 = 1.0;
 
 /// A marker's eight outer tiles and its post (one object), and its pink middle tile (its own
 /// object, so the truth can count its pixels).
-pub(super) fn marker_parts(m: &crate::sim::scene::Marker) -> (Vec<Part>, Part) {
+pub(super) fn marker_parts(m: &crate::model::scene::Marker) -> (Vec<Part>, Part) {
     let (s, c) = m.facing_rad.sin_cos();
     // Tile boxes sit behind the face plane, so the painted face is where the marker says.
     let back = -MARKER_PANEL_CM / 2.0;
@@ -239,7 +239,7 @@ pub(super) fn marker_parts(m: &crate::sim::scene::Marker) -> (Vec<Part>, Part) {
 
 /// Centres and half sizes of a goal's back and side walls (cm).
 pub(super) fn goal_boxes(
-    f: &crate::sim::scene::FieldSpec,
+    f: &crate::model::scene::FieldSpec,
     colour: GoalColour,
 ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
     let s = match colour {
@@ -296,7 +296,7 @@ pub(super) fn marker_plate(
 /// The ERS-7 as boxes and a sphere: body with a uniform band, four black legs, white head with
 /// a black face. A robot wearing an overhead marker has no head: the plate above it hides the
 /// head from the overhead camera, and the head would poke through the plate at 22.5 cm.
-pub(super) fn robot_parts(r: &crate::sim::scene::Robot) -> Vec<Part> {
+pub(super) fn robot_parts(r: &crate::model::scene::Robot) -> Vec<Part> {
     let field_from_body = r.body.field_from_body(&r.pose);
     let rot = field_from_body.rotation().to_rotation_matrix().into_inner();
     let to_field = |p: Vector3<f64>| {

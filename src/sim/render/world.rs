@@ -8,14 +8,14 @@ use super::shapes::{
     Object, Prim, ball_object, beacon_object, bound_hit, clutter_object, goal_object, intersect,
     marker_parts, marker_plate, object, paint_at, robot_parts,
 };
-use crate::sim::scene::{GoalColour, Lighting, Material, Scene};
+use crate::model::scene::{GoalColour, Lighting, Material, Scene};
 
 /// A scene turned into primitives, ready to render many times (compile once per scene state).
 #[derive(Debug, Clone)]
 pub struct World {
     objects: Vec<Object>,
-    field: crate::sim::scene::FieldSpec,
-    room: crate::sim::scene::RoomSpec,
+    field: crate::model::scene::FieldSpec,
+    room: crate::model::scene::RoomSpec,
     lighting: Lighting,
     towards_lamp: Vector3<f64>,
 }

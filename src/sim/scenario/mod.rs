@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::rng::SimRng;
-use super::scene::{Ball, Scene, Team};
+use crate::model::scene::{Ball, Scene, Team};
 use nalgebra::UnitQuaternion;
 use scenes::{robot, walking_body};
 
@@ -399,7 +399,7 @@ pub fn camera_to(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::scene::Material;
+    use crate::model::scene::Material;
 
     #[test]
     fn names_round_trip() {

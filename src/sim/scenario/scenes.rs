@@ -5,9 +5,9 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-use super::super::scene::{Ball, Clutter, Marker, Material, Robot, Scene, Shape, Team};
 use super::{OBSERVER_ID, look_at};
 use crate::geometry::{BodyPose, HeadJoints, Point, RobotPose};
+use crate::model::scene::{Ball, Clutter, Marker, Material, Robot, Scene, Shape, Team};
 
 /// A robot walks towards the ball, scanning with its head, then tracks the ball.
 pub(super) fn walk_and_pan(scene: &mut Scene, t_s: f64, j: [f64; 4]) {
@@ -284,10 +284,10 @@ fn blend(a: &HeadJoints, b: &HeadJoints, w: f64) -> HeadJoints {
 /// (the tables were never shown carpet on an upright face) and no orange (the ball).
 #[must_use]
 pub fn pattern_markers() -> Vec<Marker> {
-    use crate::sim::scene::Material::{
+    use crate::model::scene::Material::{
         Pink as P, RobotBlack as K, SkyBlue as B, UniformDarkBlue as D,
     };
-    use crate::sim::scene::Material::{UniformRed as R, White as W, Yellow as Y};
+    use crate::model::scene::Material::{UniformRed as R, White as W, Yellow as Y};
     let marker = |name: &str, x_cm: f64, y_cm: f64, facing_rad: f64, tiles| Marker {
         name: name.to_owned(),
         x_cm,

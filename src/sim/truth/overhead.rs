@@ -2,11 +2,10 @@
 //! with how much of each robot's marker plate shows.
 
 use super::super::render::object_id;
-use super::super::scene::{Robot, Scene};
-use super::{
-    OverheadMarkerTruth, OverheadObject, OverheadRobot, OverheadTruth, coverage, covered_fraction,
-};
+use super::{coverage, covered_fraction};
 use crate::geometry::{ImagePoint, OverheadCamera, Point, RobotMarker};
+use crate::model::scene::{Robot, Scene};
+use crate::model::truth::{OverheadMarkerTruth, OverheadObject, OverheadRobot, OverheadTruth};
 
 /// Builds the truth of an overhead frame.
 #[must_use]

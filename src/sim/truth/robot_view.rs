@@ -3,13 +3,15 @@
 //! coloured-pattern markers, each relative to the observing robot.
 
 use super::super::render::object_id;
-use super::super::scene::{GoalColour, Scene};
-use super::{
-    BallTruth, BeaconTruth, CutOff, GoalGap, GoalTruth, MarkerTruth, PixelBox, PostTruth, Relative,
-    RobotTruth, RobotViewTruth, coverage, covered_fraction,
-};
+use super::{coverage, covered_fraction};
+use crate::frame::PixelBox;
 use crate::geometry::{
     BodyPose, CameraPose, Field, HeadJoints, ImagePoint, Point, PoseRecord, RobotPose,
+};
+use crate::model::scene::{GoalColour, Scene};
+use crate::model::truth::{
+    BallTruth, BeaconTruth, CutOff, GoalGap, GoalTruth, MarkerTruth, PostTruth, Relative,
+    RobotTruth, RobotViewTruth,
 };
 use crate::sensors::SensorReadings;
 
