@@ -19,6 +19,7 @@ mod app_papercuts;
 mod cli;
 mod common;
 mod crash_safety;
+mod docs;
 mod hardening;
 #[cfg(feature = "gui")]
 mod harness;
