@@ -120,6 +120,7 @@ fn relative_links_in_readme_and_docs_reach_a_file_and_heading() {
     let mut broken = Vec::new();
     for page in &pages {
         let text = std::fs::read_to_string(page).unwrap();
+        let name = page.strip_prefix(root).unwrap_or(page).display();
         for target in relative_link_targets(&text) {
             let (file, anchor) = target.split_once('#').unwrap_or((&target, ""));
             let file_path = if file.is_empty() {
@@ -128,14 +129,14 @@ fn relative_links_in_readme_and_docs_reach_a_file_and_heading() {
                 page.parent().unwrap().join(file)
             };
             if !file_path.exists() {
-                broken.push(format!("{}: {target} (no such file)", page.display()));
+                broken.push(format!("{name}: {target} (no such file)"));
                 continue;
             }
             let is_markdown = file_path.extension().is_some_and(|x| x == "md");
             if !anchor.is_empty() && is_markdown {
                 let linked = std::fs::read_to_string(&file_path).unwrap();
                 if !anchors(&linked).iter().any(|a| a == anchor) {
-                    broken.push(format!("{}: {target} (no such heading)", page.display()));
+                    broken.push(format!("{name}: {target} (no such heading)"));
                 }
             }
         }
