@@ -20,6 +20,7 @@ mod camera;
 mod cli;
 mod common;
 mod crash_safety;
+mod docs;
 mod hardening;
 #[cfg(feature = "gui")]
 mod harness;
