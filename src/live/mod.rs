@@ -7,12 +7,13 @@
 //! one robot's connection on its own thread with deadlines and reconnection; [`robot`] turns its
 //! messages into frames with statistics ([`gaps`]: lost frames) and an optional bit-exact
 //! recording ([`recorder`]); [`serve`] plays a stream as a Foxglove WebSocket server (`eotn
-//! serve`, a stand-in robot);
+//! serve`, a stand-in robot) behind a [`gate`] that bounds its viewers;
 //! [`source`] is a robot as a [`crate::sources::FrameSource`] for the workspace and the app.
 
 pub mod channels;
 pub mod client;
 pub mod gaps;
+pub mod gate;
 pub mod protocol;
 pub mod recorder;
 pub mod robot;

@@ -1,0 +1,307 @@
+//! The gate in front of `eotn serve`'s Foxglove server: admission and flow control the
+//! `foxglove` crate's server (0.30) does not have.
+//!
+//! That server speaks the protocol (serverInfo, advertise, subscriptions, schemas) and bounds
+//! each client's queue by a message count (`message_backlog_size`), but it stops accepting for
+//! good at the first `accept` error (out of file descriptors: `EMFILE`), has no limit on
+//! clients, no deadline on a handshake, and does not say what it dropped. So the public port is
+//! the gate's own: it accepts (backing off and retrying on any error, logging `EMFILE` once),
+//! closes a handshake that takes longer than its deadline (and the oldest unfinished handshake
+//! when too many are open, or descriptors run out), refuses clients past `--max-clients` with a
+//! close reason, and relays each admitted viewer to the `foxglove` server on loopback through an
+//! [`outbox::Outbox`] of its own: a slow viewer's oldest frames are dropped and counted, and no
+//! other viewer waits for it ([`relay`]).
+
+pub mod outbox;
+mod relay;
+pub mod traffic;
+
+use std::collections::VecDeque;
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use tokio::net::TcpListener;
+use tokio::sync::oneshot;
+use tokio::task::JoinSet;
+
+pub use outbox::QueueBound;
+
+/// What the gate admits and how long it waits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GateOptions {
+    /// Viewers connected at once; the next is refused with a close reason.
+    pub max_clients: usize,
+    /// Time a new connection has to finish its WebSocket handshake.
+    pub handshake_timeout: Duration,
+    /// Handshakes open at once; a new connection past it closes the oldest.
+    pub max_pending: usize,
+    /// Each viewer's outbox.
+    pub queue: QueueBound,
+}
+
+impl Default for GateOptions {
+    fn default() -> Self {
+        Self {
+            max_clients: 64,
+            handshake_timeout: Duration::from_secs(5),
+            max_pending: 256,
+            queue: QueueBound::default(),
+        }
+    }
+}
+
+/// The gate's figures since it started.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct GateFigures {
+    /// Viewers connected now.
+    pub clients: usize,
+    /// Viewers admitted in all.
+    pub served: u64,
+    /// Viewers refused because `max_clients` were connected.
+    pub refused: u64,
+    /// Connections closed because their handshake took longer than its deadline.
+    pub handshake_timeouts: u64,
+    /// Handshakes that failed (not WebSocket, no Foxglove subprotocol).
+    pub handshake_failures: u64,
+    /// Unfinished handshakes closed to make room (too many open, or out of descriptors).
+    pub evicted: u64,
+    /// Errors of `accept` (each retried).
+    pub accept_errors: u64,
+    /// Viewers disconnected because they let control messages pile up.
+    pub overflowed: u64,
+    /// Frames (images) dropped for slow viewers.
+    pub dropped_frames: u64,
+    /// Message data dropped for slow viewers (frames and their JSON).
+    pub dropped_messages: u64,
+}
+
+/// Counters shared by the gate's tasks.
+#[derive(Debug, Default)]
+struct Counters {
+    clients: AtomicUsize,
+    served: AtomicU64,
+    refused: AtomicU64,
+    handshake_timeouts: AtomicU64,
+    handshake_failures: AtomicU64,
+    evicted: AtomicU64,
+    accept_errors: AtomicU64,
+    overflowed: AtomicU64,
+    dropped_frames: AtomicU64,
+    dropped_messages: AtomicU64,
+    /// `EMFILE` has been logged (it is said once).
+    said_out_of_descriptors: AtomicBool,
+    /// A slow viewer has been logged (the first is a warning, the rest informational).
+    said_slow_viewer: AtomicBool,
+}
+
+/// The open handshakes, oldest first: each a way to tell its task to close.
+#[derive(Debug, Default)]
+struct Pending {
+    next_id: u64,
+    open: VecDeque<(u64, oneshot::Sender<()>)>,
+}
+
+/// What the gate's tasks share.
+#[derive(Debug)]
+struct Shared {
+    options: GateOptions,
+    /// The `foxglove` server on loopback.
+    inner: SocketAddr,
+    counters: Counters,
+    pending: Mutex<Pending>,
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+impl Shared {
+    /// Registers a new handshake; closes the oldest when too many are open. Its id and the
+    /// receiver that says "close".
+    fn open_handshake(&self) -> (u64, oneshot::Receiver<()>) {
+        let (tx, rx) = oneshot::channel();
+        let mut pending = lock(&self.pending);
+        let id = pending.next_id;
+        pending.next_id += 1;
+        pending.open.push_back((id, tx));
+        while pending.open.len() > self.options.max_pending {
+            pending.open.pop_front();
+            self.counters.evicted.fetch_add(1, Ordering::Relaxed);
+        }
+        (id, rx)
+    }
+
+    /// The handshake `id` ended; false when it had been closed to make room meanwhile.
+    fn close_handshake(&self, id: u64) -> bool {
+        let mut pending = lock(&self.pending);
+        let before = pending.open.len();
+        pending.open.retain(|(i, _)| *i != id);
+        pending.open.len() < before
+    }
+
+    /// Closes the oldest open handshake (dropping its sender tells its task); false when none
+    /// is open.
+    fn evict_oldest(&self) -> bool {
+        let evicted = lock(&self.pending).open.pop_front().is_some();
+        if evicted {
+            self.counters.evicted.fetch_add(1, Ordering::Relaxed);
+        }
+        evicted
+    }
+
+    /// Takes a viewer's place when fewer than `max_clients` are connected.
+    fn admit(self: &Arc<Self>) -> Option<Admitted> {
+        let clients = &self.counters.clients;
+        let mut now = clients.load(Ordering::Relaxed);
+        loop {
+            if now >= self.options.max_clients {
+                self.counters.refused.fetch_add(1, Ordering::Relaxed);
+                return None;
+            }
+            match clients.compare_exchange(now, now + 1, Ordering::AcqRel, Ordering::Relaxed) {
+                Ok(_) => break,
+                Err(actual) => now = actual,
+            }
+        }
+        self.counters.served.fetch_add(1, Ordering::Relaxed);
+        Some(Admitted(Arc::clone(self)))
+    }
+
+    fn figures(&self) -> GateFigures {
+        let c = &self.counters;
+        let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        GateFigures {
+            clients: c.clients.load(Ordering::Relaxed),
+            served: get(&c.served),
+            refused: get(&c.refused),
+            handshake_timeouts: get(&c.handshake_timeouts),
+            handshake_failures: get(&c.handshake_failures),
+            evicted: get(&c.evicted),
+            accept_errors: get(&c.accept_errors),
+            overflowed: get(&c.overflowed),
+            dropped_frames: get(&c.dropped_frames),
+            dropped_messages: get(&c.dropped_messages),
+        }
+    }
+}
+
+/// A viewer's place among the `max_clients`; given back when dropped.
+struct Admitted(Arc<Shared>);
+
+impl Drop for Admitted {
+    fn drop(&mut self) {
+        self.0.counters.clients.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+/// The running gate: its port and figures. Dropping it does not stop it; [`Gate::stop`] does.
+#[derive(Debug)]
+pub struct Gate {
+    port: u16,
+    shared: Arc<Shared>,
+    accept: tokio::task::JoinHandle<()>,
+}
+
+impl Gate {
+    /// Listens on `host:port` (port 0: any free port) on `runtime`, relaying to the Foxglove
+    /// server at `inner`.
+    ///
+    /// # Errors
+    /// The OS's error when the address cannot be listened on.
+    pub fn start(
+        runtime: &tokio::runtime::Handle,
+        host: &str,
+        port: u16,
+        inner: SocketAddr,
+        options: GateOptions,
+    ) -> std::io::Result<Self> {
+        let listener = runtime.block_on(TcpListener::bind((host, port)))?;
+        let port = listener.local_addr()?.port();
+        let shared = Arc::new(Shared {
+            options,
+            inner,
+            counters: Counters::default(),
+            pending: Mutex::new(Pending::default()),
+        });
+        let accept = runtime.spawn(accept_loop(listener, Arc::clone(&shared)));
+        Ok(Self {
+            port,
+            shared,
+            accept,
+        })
+    }
+
+    /// The port it listens on.
+    #[must_use]
+    pub const fn port(&self) -> u16 {
+        self.port
+    }
+
+    /// Its figures now.
+    #[must_use]
+    pub fn figures(&self) -> GateFigures {
+        self.shared.figures()
+    }
+
+    /// Stops accepting and closes every connection (their tasks end with the accept loop's).
+    pub fn stop(&self) {
+        self.accept.abort();
+    }
+}
+
+/// Shortest and longest wait before `accept` is tried again after an error it cannot work
+/// around.
+const ACCEPT_BACKOFF: (Duration, Duration) = (Duration::from_millis(10), Duration::from_secs(1));
+
+/// True for the errors that say the process or system is out of descriptors or memory.
+fn out_of_resources(e: &std::io::Error) -> bool {
+    // EMFILE 24, ENFILE 23, ENOBUFS 105, ENOMEM 12 on Linux.
+    matches!(e.raw_os_error(), Some(24 | 23 | 105 | 12))
+}
+
+/// Accepts for as long as the gate runs: an error is never the end of serving.
+async fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
+    let mut tasks = JoinSet::new();
+    let mut backoff = ACCEPT_BACKOFF.0;
+    loop {
+        while tasks.try_join_next().is_some() {}
+        match listener.accept().await {
+            Ok((stream, peer)) => {
+                backoff = ACCEPT_BACKOFF.0;
+                let (id, close) = shared.open_handshake();
+                tasks.spawn(relay::viewer(stream, peer, Arc::clone(&shared), id, close));
+            }
+            Err(e) => {
+                shared
+                    .counters
+                    .accept_errors
+                    .fetch_add(1, Ordering::Relaxed);
+                if out_of_resources(&e) {
+                    if !shared
+                        .counters
+                        .said_out_of_descriptors
+                        .swap(true, Ordering::Relaxed)
+                    {
+                        log::warn!(
+                            "eotn serve: cannot accept more connections ({e}) with {} viewers and {} handshakes open: closing the oldest handshakes and retrying; raise `ulimit -n` to serve more (said once)",
+                            shared.counters.clients.load(Ordering::Relaxed),
+                            lock(&shared.pending).open.len()
+                        );
+                    }
+                    if shared.evict_oldest() {
+                        // Its task closes the socket when next polled.
+                        tokio::task::yield_now().await;
+                        tokio::time::sleep(Duration::from_millis(1)).await;
+                        continue;
+                    }
+                } else {
+                    log::info!("eotn serve: accept failed ({e}); retrying");
+                }
+                tokio::time::sleep(backoff).await;
+                backoff = (backoff * 2).min(ACCEPT_BACKOFF.1);
+            }
+        }
+    }
+}

@@ -1,0 +1,269 @@
+//! One viewer of `eotn serve`, from its TCP connection to its end: the handshake (within its
+//! deadline, closed early when the gate needs the room), admission, then the relay to the
+//! `foxglove` server: the viewer's messages go through as they come; the server's wait in the
+//! viewer's own [`Outbox`], so a viewer that does not read loses its oldest frames (counted)
+//! and holds up no one.
+
+use std::net::SocketAddr;
+use std::sync::atomic::Ordering;
+use std::sync::{Arc, Mutex};
+
+use futures_util::{SinkExt, StreamExt};
+use tokio::net::TcpStream;
+use tokio::sync::{Notify, oneshot};
+use tokio_tungstenite::tungstenite::Message;
+use tokio_tungstenite::tungstenite::handshake::server::{ErrorResponse, Request, Response};
+use tokio_tungstenite::tungstenite::protocol::WebSocketConfig;
+use tokio_tungstenite::tungstenite::protocol::frame::CloseFrame;
+use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
+use tokio_tungstenite::{WebSocketStream, tungstenite};
+
+use super::outbox::{Kind, Outbox};
+use super::traffic::Traffic;
+use super::{Shared, lock};
+
+/// The Foxglove subprotocols the `foxglove` server speaks, newest first.
+const SUBPROTOCOLS: [&str; 2] = ["foxglove.sdk.v1.1", "foxglove.sdk.v1"];
+
+/// Largest message a viewer may send, bytes: viewers send subscriptions, not data.
+const MAX_VIEWER_MESSAGE: usize = 1 << 20;
+
+/// Time to open the connection to the `foxglove` server on loopback.
+const INNER_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// The subprotocol to answer with: the newest Foxglove one the viewer offered.
+fn negotiate(request: &Request) -> Option<&'static str> {
+    let offered: Vec<String> = request
+        .headers()
+        .get_all("sec-websocket-protocol")
+        .iter()
+        .flat_map(|h| h.to_str().unwrap_or_default().split(','))
+        .map(|p| p.trim().to_owned())
+        .collect();
+    SUBPROTOCOLS
+        .into_iter()
+        .find(|p| offered.iter().any(|o| o == p))
+}
+
+fn refusal(status: u16, text: &str) -> ErrorResponse {
+    let mut response = ErrorResponse::new(Some(text.to_owned()));
+    *response.status_mut() = tungstenite::http::StatusCode::from_u16(status).unwrap_or_default();
+    response
+}
+
+/// Runs one viewer: `id` is its handshake's place among the open ones, `evicted` fires when the
+/// gate closes it to make room.
+pub(super) async fn viewer(
+    stream: TcpStream,
+    peer: SocketAddr,
+    shared: Arc<Shared>,
+    id: u64,
+    evicted: oneshot::Receiver<()>,
+) {
+    let _ = stream.set_nodelay(true);
+    let mut subprotocol = None;
+    #[expect(
+        clippy::result_large_err,
+        reason = "tungstenite's handshake callback returns its error response by value"
+    )]
+    let callback = |request: &Request, mut response: Response| {
+        let Some(chosen) = negotiate(request) else {
+            return Err(refusal(
+                400,
+                "Missing expected sec-websocket-protocol header (foxglove.sdk.v1)",
+            ));
+        };
+        response.headers_mut().insert(
+            "sec-websocket-protocol",
+            tungstenite::http::HeaderValue::from_static(chosen),
+        );
+        subprotocol = Some(chosen);
+        Ok(response)
+    };
+    let config = WebSocketConfig::default().max_message_size(Some(MAX_VIEWER_MESSAGE));
+    let handshake = tokio_tungstenite::accept_hdr_async_with_config(stream, callback, Some(config));
+    let counters = &shared.counters;
+    let outcome = tokio::select! {
+        r = tokio::time::timeout(shared.options.handshake_timeout, handshake) => r,
+        _ = evicted => return,
+    };
+    if !shared.close_handshake(id) {
+        return;
+    }
+    let ws = match outcome {
+        Ok(Ok(ws)) => ws,
+        Ok(Err(_)) => {
+            counters.handshake_failures.fetch_add(1, Ordering::Relaxed);
+            return;
+        }
+        Err(_) => {
+            counters.handshake_timeouts.fetch_add(1, Ordering::Relaxed);
+            return;
+        }
+    };
+    let Some(subprotocol) = subprotocol else {
+        return;
+    };
+    let Some(_place) = shared.admit() else {
+        let max = shared.options.max_clients;
+        log::info!("eotn serve: {peer} refused: {max} viewers connected");
+        close(ws, CloseCode::Again, &format!("eotn serve: {max} viewers connected, the most --max-clients allows; try again later")).await;
+        return;
+    };
+    match connect_inner(shared.inner, subprotocol).await {
+        Ok(inner) => relay(ws, inner, &shared, peer).await,
+        Err(e) => {
+            log::warn!("eotn serve: {peer}: cannot reach the Foxglove server: {e}");
+            close(ws, CloseCode::Error, "eotn serve: internal error").await;
+        }
+    }
+}
+
+/// Sends a close frame with `reason` (waiting at most a second for a viewer that does not read).
+async fn close(mut ws: WebSocketStream<TcpStream>, code: CloseCode, reason: &str) {
+    let frame = CloseFrame {
+        code,
+        reason: reason.to_owned().into(),
+    };
+    let _ = tokio::time::timeout(std::time::Duration::from_secs(1), ws.close(Some(frame))).await;
+}
+
+type Inner = WebSocketStream<tokio_tungstenite::MaybeTlsStream<TcpStream>>;
+
+/// Connects to the `foxglove` server as the viewer would, with the subprotocol it chose.
+async fn connect_inner(inner: SocketAddr, subprotocol: &'static str) -> Result<Inner, String> {
+    let connect = async {
+        let stream = TcpStream::connect(inner).await.map_err(|e| e.to_string())?;
+        let _ = stream.set_nodelay(true);
+        let mut request =
+            tungstenite::client::IntoClientRequest::into_client_request(format!("ws://{inner}/"))
+                .map_err(|e| e.to_string())?;
+        request.headers_mut().insert(
+            "sec-websocket-protocol",
+            tungstenite::http::HeaderValue::from_static(subprotocol),
+        );
+        let (ws, _) = tokio_tungstenite::client_async_with_config(
+            request,
+            tokio_tungstenite::MaybeTlsStream::Plain(stream),
+            None,
+        )
+        .await
+        .map_err(|e| e.to_string())?;
+        Ok(ws)
+    };
+    tokio::time::timeout(INNER_TIMEOUT, connect)
+        .await
+        .map_err(|_| "timed out".to_owned())?
+}
+
+/// Why a relay ended.
+enum End {
+    /// The viewer closed or dropped the connection.
+    Viewer,
+    /// The server closed (it is stopping).
+    Server,
+    /// The viewer let control messages pile up.
+    Overflow(String),
+}
+
+/// Relays until either side ends; the viewer's outbox is the only queue.
+async fn relay(
+    viewer: WebSocketStream<TcpStream>,
+    inner: Inner,
+    shared: &Shared,
+    peer: SocketAddr,
+) {
+    let (mut to_viewer, mut from_viewer) = viewer.split();
+    let (mut to_server, mut from_server) = inner.split();
+    let outbox = Mutex::new(Outbox::new(shared.options.queue));
+    let traffic = Mutex::new(Traffic::new());
+    let ready = Notify::new();
+    let writer = async {
+        loop {
+            let next = lock(&outbox).pop();
+            match next {
+                Some(m) => {
+                    if to_viewer.send(m).await.is_err() {
+                        return End::Viewer;
+                    }
+                }
+                None => ready.notified().await,
+            }
+        }
+    };
+    let server = async {
+        while let Some(Ok(m)) = from_server.next().await {
+            let (kind, len) = match &m {
+                Message::Text(t) => {
+                    lock(&traffic).from_server(t.as_str());
+                    (Kind::Control, t.len())
+                }
+                Message::Binary(b) => (lock(&traffic).kind_of_binary(b), b.len()),
+                Message::Close(_) => break,
+                _ => continue,
+            };
+            if let Err(e) = lock(&outbox).push(m, kind, len) {
+                return End::Overflow(e.to_string());
+            }
+            ready.notify_one();
+        }
+        End::Server
+    };
+    let viewer = async {
+        while let Some(Ok(m)) = from_viewer.next().await {
+            match &m {
+                Message::Text(t) => lock(&traffic).from_viewer(t.as_str()),
+                Message::Binary(_) => {}
+                Message::Close(_) => break,
+                _ => continue,
+            }
+            if to_server.send(m).await.is_err() {
+                return End::Server;
+            }
+        }
+        End::Viewer
+    };
+    let end = tokio::select! {
+        e = writer => e,
+        e = server => e,
+        e = viewer => e,
+    };
+    let dropped = lock(&outbox).dropped();
+    let counters = &shared.counters;
+    counters
+        .dropped_frames
+        .fetch_add(dropped.frames, Ordering::Relaxed);
+    counters
+        .dropped_messages
+        .fetch_add(dropped.messages, Ordering::Relaxed);
+    if dropped.messages > 0 {
+        let line = format!(
+            "eotn serve: viewer {peer} left; it read too slowly: {} frames ({} messages) dropped for it",
+            dropped.frames, dropped.messages
+        );
+        if counters.said_slow_viewer.swap(true, Ordering::Relaxed) {
+            log::info!("{line}");
+        } else {
+            log::warn!("{line} (later slow viewers are counted in the summary)");
+        }
+    }
+    let _ = to_server.close().await;
+    let mut viewer = match to_viewer.reunite(from_viewer) {
+        Ok(v) => v,
+        Err(_) => return,
+    };
+    let reason = match end {
+        End::Viewer => return,
+        End::Server => (CloseCode::Away, "eotn serve stopped".to_owned()),
+        End::Overflow(why) => {
+            counters.overflowed.fetch_add(1, Ordering::Relaxed);
+            (CloseCode::Policy, format!("eotn serve: {why}"))
+        }
+    };
+    let frame = CloseFrame {
+        code: reason.0,
+        reason: reason.1.into(),
+    };
+    let _ =
+        tokio::time::timeout(std::time::Duration::from_secs(1), viewer.close(Some(frame))).await;
+}
