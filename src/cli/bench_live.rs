@@ -36,13 +36,13 @@ const APP_TICK: Duration = Duration::from_millis(16);
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Robots sending at once (1 to 64).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u16).range(1..=64))]
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u16).range(1..=64), allow_negative_numbers = true)]
     pub robots: u16,
     /// Frames per second each robot sends (above 0, at most 1000).
-    #[arg(long, default_value_t = 30.0, value_parser = super::bounds::rate_hz)]
+    #[arg(long, default_value_t = 30.0, value_parser = super::bounds::rate_hz, allow_negative_numbers = true)]
     pub fps: f64,
     /// Seconds measured (above 0, at most a week).
-    #[arg(long, default_value_t = 10.0, value_parser = super::bounds::seconds)]
+    #[arg(long, default_value_t = 10.0, value_parser = super::bounds::seconds, allow_negative_numbers = true)]
     pub seconds: f64,
     /// Connect through the app's workspace (ticked as the window does), recording every robot.
     #[arg(long)]

@@ -30,11 +30,11 @@ pub struct Args {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Stop once every robot has sent this many frames (1 to 100000000).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_FRAMES))]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_FRAMES), allow_negative_numbers = true)]
     pub frames: Option<u64>,
     /// Stop after this many seconds (above 0, at most 604800: a week). Without `--frames` and
     /// `--seconds`, record until Ctrl+C or SIGTERM.
-    #[arg(long, value_parser = seconds)]
+    #[arg(long, value_parser = seconds, allow_negative_numbers = true)]
     pub seconds: Option<f64>,
 }
 

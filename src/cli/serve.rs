@@ -33,10 +33,10 @@ pub struct Args {
     #[arg(long)]
     pub wait: bool,
     /// Viewers connected at once (1 to 4096); the next is refused with a close reason.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u16).range(1..=4096))]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u16).range(1..=4096), allow_negative_numbers = true)]
     pub max_clients: u16,
     /// Seconds a new connection has to finish its WebSocket handshake (above 0, at most 600).
-    #[arg(long, default_value_t = 5.0, value_parser = deadline_seconds)]
+    #[arg(long, default_value_t = 5.0, value_parser = deadline_seconds, allow_negative_numbers = true)]
     pub handshake_timeout: f64,
 }
 
@@ -72,8 +72,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let played = robot.play(&mut reader, args.looping, args.wait, interrupted.flag());
     // Let the last frames leave the server's queues before it closes.
     std::thread::sleep(Duration::from_millis(300));
-    let (figures, skipped) = (robot.figures(), robot.skipped());
-    robot.stop();
+    let skipped = robot.skipped();
+    let figures = robot.stop();
     let sent = played?;
     eprintln!(
         "eotn serve: sent {sent} frames{}",

@@ -400,9 +400,10 @@ impl StandInRobot {
     }
 
     /// Stops the server, letting queued messages go out first (waiting at most a second for
-    /// viewers that do not read).
-    pub fn stop(mut self) {
+    /// viewers that do not read); the gate's figures at the end.
+    pub fn stop(mut self) -> GateFigures {
         self.shutdown(true);
+        self.gate.figures()
     }
 
     fn shutdown(&mut self, wait: bool) {

@@ -8,7 +8,8 @@
 //! the gate's own: it accepts (backing off and retrying on any error, logging `EMFILE` once),
 //! closes a handshake that takes longer than its deadline (and the oldest unfinished handshake
 //! when too many are open, or descriptors run out), refuses clients past `--max-clients` with a
-//! close reason, and relays each admitted viewer to the `foxglove` server on loopback through an
+//! close reason, keeps viewers and handshakes within the process's descriptor limit (with room
+//! for the `foxglove` server, whose `accept` must never see `EMFILE`), and relays each admitted viewer to the `foxglove` server on loopback through an
 //! [`outbox::Outbox`] of its own: a slow viewer's oldest frames are dropped and counted, and no
 //! other viewer waits for it ([`relay`]).
 
@@ -103,10 +104,48 @@ struct Pending {
     open: VecDeque<(u64, oneshot::Sender<()>)>,
 }
 
+/// Descriptors kept free for the process itself (stdio, the stream, runtimes, listeners) and
+/// for the `foxglove` server's own `accept`, which stops for good at its first `EMFILE`.
+const RESERVED_FDS: u64 = 48;
+
+/// Descriptors one admitted viewer holds: its socket, the relay's connection to the `foxglove`
+/// server and that server's end of it.
+const FDS_PER_VIEWER: u64 = 3;
+
+/// The process's limit on open files (`ulimit -n`), from `/proc/self/limits` (Linux); `None`
+/// when it cannot be read or is unlimited.
+fn open_files_limit() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits.lines().find(|l| l.starts_with("Max open files"))?;
+    line.split_whitespace().nth(3)?.parse().ok()
+}
+
+/// The viewers and open handshakes that fit in `limit` descriptors with room to spare:
+/// `options`' own, or fewer (at least 1 viewer and 4 handshakes).
+fn fit_descriptors(options: GateOptions, limit: Option<u64>) -> (usize, usize) {
+    let Some(limit) = limit else {
+        return (options.max_clients, options.max_pending);
+    };
+    let spare = usize::try_from(limit.saturating_sub(RESERVED_FDS)).unwrap_or(usize::MAX);
+    let per_viewer = FDS_PER_VIEWER as usize;
+    // Half the spare descriptors for viewers at most, the rest for handshakes.
+    let clients = options.max_clients.min(spare / 2 / per_viewer).max(1);
+    let pending = options
+        .max_pending
+        .min(spare.saturating_sub(clients * per_viewer))
+        .max(4);
+    (clients, pending)
+}
+
 /// What the gate's tasks share.
 #[derive(Debug)]
 struct Shared {
     options: GateOptions,
+    /// Viewers admitted at once: `max_clients`, or fewer when the descriptors allow fewer.
+    max_clients: usize,
+    /// Handshakes open at once: `max_pending`, or fewer when descriptors are short; lowered
+    /// when `accept` runs out of them.
+    pending_cap: AtomicUsize,
     /// The `foxglove` server on loopback.
     inner: SocketAddr,
     counters: Counters,
@@ -126,7 +165,7 @@ impl Shared {
         let id = pending.next_id;
         pending.next_id += 1;
         pending.open.push_back((id, tx));
-        while pending.open.len() > self.options.max_pending {
+        while pending.open.len() > self.pending_cap.load(Ordering::Relaxed) {
             pending.open.pop_front();
             self.counters.evicted.fetch_add(1, Ordering::Relaxed);
         }
@@ -141,14 +180,20 @@ impl Shared {
         pending.open.len() < before
     }
 
-    /// Closes the oldest open handshake (dropping its sender tells its task); false when none
-    /// is open.
-    fn evict_oldest(&self) -> bool {
-        let evicted = lock(&self.pending).open.pop_front().is_some();
-        if evicted {
+    /// Out of descriptors: lowers the cap on open handshakes to what fits, less room for the
+    /// `foxglove` server and a viewer to come, closing the oldest above it (dropping a sender
+    /// tells its task). False when no handshake was open to close.
+    fn make_room(&self) -> bool {
+        let mut pending = lock(&self.pending);
+        let cap = pending.open.len().saturating_sub(HEADROOM).max(4);
+        self.pending_cap.fetch_min(cap, Ordering::Relaxed);
+        let mut closed = false;
+        while pending.open.len() > cap || (!closed && !pending.open.is_empty()) {
+            pending.open.pop_front();
             self.counters.evicted.fetch_add(1, Ordering::Relaxed);
+            closed = true;
         }
-        evicted
+        closed
     }
 
     /// Takes a viewer's place when fewer than `max_clients` are connected.
@@ -156,7 +201,7 @@ impl Shared {
         let clients = &self.counters.clients;
         let mut now = clients.load(Ordering::Relaxed);
         loop {
-            if now >= self.options.max_clients {
+            if now >= self.max_clients {
                 self.counters.refused.fetch_add(1, Ordering::Relaxed);
                 return None;
             }
@@ -219,8 +264,19 @@ impl Gate {
     ) -> std::io::Result<Self> {
         let listener = runtime.block_on(TcpListener::bind((host, port)))?;
         let port = listener.local_addr()?.port();
+        let limit = open_files_limit();
+        let (max_clients, max_pending) = fit_descriptors(options, limit);
+        if max_clients < options.max_clients || max_pending < options.max_pending {
+            log::warn!(
+                "eotn serve: `ulimit -n` is {}: at most {max_clients} viewers (of --max-clients {}) and {max_pending} unfinished handshakes; raise it to serve more",
+                limit.unwrap_or(0),
+                options.max_clients
+            );
+        }
         let shared = Arc::new(Shared {
             options,
+            max_clients,
+            pending_cap: AtomicUsize::new(max_pending),
             inner,
             counters: Counters::default(),
             pending: Mutex::new(Pending::default()),
@@ -239,6 +295,13 @@ impl Gate {
         self.port
     }
 
+    /// Viewers it admits at once: `max_clients`, or fewer when the process's descriptor limit
+    /// allows fewer.
+    #[must_use]
+    pub fn max_clients(&self) -> usize {
+        self.shared.max_clients
+    }
+
     /// Its figures now.
     #[must_use]
     pub fn figures(&self) -> GateFigures {
@@ -254,6 +317,10 @@ impl Gate {
 /// Shortest and longest wait before `accept` is tried again after an error it cannot work
 /// around.
 const ACCEPT_BACKOFF: (Duration, Duration) = (Duration::from_millis(10), Duration::from_secs(1));
+
+/// Descriptors left free below the count at which `accept` failed: for the `foxglove` server's
+/// end of a viewer's relay, and a viewer about to be admitted.
+const HEADROOM: usize = 8;
 
 /// True for the errors that say the process or system is out of descriptors or memory.
 fn out_of_resources(e: &std::io::Error) -> bool {
@@ -285,15 +352,14 @@ async fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
                         .swap(true, Ordering::Relaxed)
                     {
                         log::warn!(
-                            "eotn serve: cannot accept more connections ({e}) with {} viewers and {} handshakes open: closing the oldest handshakes and retrying; raise `ulimit -n` to serve more (said once)",
+                            "eotn serve: cannot accept more connections ({e}) with {} viewers and {} handshakes open: closing the oldest handshakes, fewer from now on, and retrying; raise `ulimit -n` to serve more (said once)",
                             shared.counters.clients.load(Ordering::Relaxed),
                             lock(&shared.pending).open.len()
                         );
                     }
-                    if shared.evict_oldest() {
-                        // Its task closes the socket when next polled.
-                        tokio::task::yield_now().await;
-                        tokio::time::sleep(Duration::from_millis(1)).await;
+                    if shared.make_room() {
+                        // The closed handshakes' tasks close their sockets when next polled.
+                        tokio::time::sleep(Duration::from_millis(2)).await;
                         continue;
                     }
                 } else {
@@ -303,5 +369,23 @@ async fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
                 backoff = (backoff * 2).min(ACCEPT_BACKOFF.1);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn viewers_and_handshakes_fit_the_descriptor_limit_with_room_to_spare() {
+        let options = GateOptions::default();
+        assert_eq!(fit_descriptors(options, None), (64, 256));
+        assert_eq!(fit_descriptors(options, Some(20_000)), (64, 256));
+        // 1024: 976 spare, 64 viewers hold 192, 256 handshakes fit.
+        assert_eq!(fit_descriptors(options, Some(1024)), (64, 256));
+        // 128: 80 spare; 13 viewers (39), 41 handshakes.
+        assert_eq!(fit_descriptors(options, Some(128)), (13, 41));
+        assert_eq!(fit_descriptors(options, Some(10)), (1, 4));
+        assert!(open_files_limit().is_some_and(|n| n > 0));
     }
 }

@@ -18,7 +18,7 @@ use tokio_tungstenite::tungstenite::protocol::frame::CloseFrame;
 use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
 use tokio_tungstenite::{WebSocketStream, tungstenite};
 
-use super::outbox::{Kind, Outbox};
+use super::outbox::{Dropped, Kind, Outbox};
 use super::traffic::Traffic;
 use super::{Shared, lock};
 
@@ -105,7 +105,7 @@ pub(super) async fn viewer(
         return;
     };
     let Some(_place) = shared.admit() else {
-        let max = shared.options.max_clients;
+        let max = shared.max_clients;
         log::info!("eotn serve: {peer} refused: {max} viewers connected");
         close(ws, CloseCode::Again, &format!("eotn serve: {max} viewers connected, the most --max-clients allows; try again later")).await;
         return;
@@ -156,6 +156,17 @@ async fn connect_inner(inner: SocketAddr, subprotocol: &'static str) -> Result<I
         .map_err(|_| "timed out".to_owned())?
 }
 
+/// Adds what an outbox dropped since `before` to the gate's counts (as it happens: the counts
+/// are read while viewers are connected).
+fn count_dropped(counters: &super::Counters, before: Dropped, now: Dropped) {
+    counters
+        .dropped_frames
+        .fetch_add(now.frames - before.frames, Ordering::Relaxed);
+    counters
+        .dropped_messages
+        .fetch_add(now.messages - before.messages, Ordering::Relaxed);
+}
+
 /// Why a relay ended.
 enum End {
     /// The viewer closed or dropped the connection.
@@ -202,7 +213,14 @@ async fn relay(
                 Message::Close(_) => break,
                 _ => continue,
             };
-            if let Err(e) = lock(&outbox).push(m, kind, len) {
+            let pushed = {
+                let mut outbox = lock(&outbox);
+                let before = outbox.dropped();
+                let pushed = outbox.push(m, kind, len);
+                count_dropped(&shared.counters, before, outbox.dropped());
+                pushed
+            };
+            if let Err(e) = pushed {
                 return End::Overflow(e.to_string());
             }
             ready.notify_one();
@@ -230,12 +248,6 @@ async fn relay(
     };
     let dropped = lock(&outbox).dropped();
     let counters = &shared.counters;
-    counters
-        .dropped_frames
-        .fetch_add(dropped.frames, Ordering::Relaxed);
-    counters
-        .dropped_messages
-        .fetch_add(dropped.messages, Ordering::Relaxed);
     if dropped.messages > 0 {
         let line = format!(
             "eotn serve: viewer {peer} left; it read too slowly: {} frames ({} messages) dropped for it",
