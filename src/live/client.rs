@@ -374,7 +374,15 @@ fn connect(
     let mut attempt = tungstenite::client::client_with_config(request, stream, Some(config));
     loop {
         match attempt {
-            Ok((ws, _response)) => return Ok(ws),
+            Ok((ws, _response)) => {
+                // Reads keep their POLL timeout (the session looks at its stop flag and deadlines
+                // between them); a robot that takes longer than the handshake's deadline to take
+                // in a subscription or a ping is given up on.
+                ws.get_ref()
+                    .set_write_timeout(Some(limits.handshake_timeout))
+                    .map_err(ConnectError::Socket)?;
+                return Ok(ws);
+            }
             Err(tungstenite::HandshakeError::Failure(e)) => return Err(ConnectError::Handshake(e)),
             Err(tungstenite::HandshakeError::Interrupted(mid)) => {
                 if stop.load(Ordering::Relaxed) {

@@ -321,11 +321,14 @@ fn viewers_that_never_read_cost_bounded_memory_and_a_good_viewer_keeps_its_rate(
         "serve with 40 stalled viewers for {seconds} s: resident {peak_kb} kB at most (VmHWM {hwm} kB), CPU {:.0} % of a core; the good viewer {got:.1} fps of {fps:.1}",
         cpu * 100.0
     );
-    // Before the gate each stalled viewer cost about 68 MB (40: about 2.7 GB); measured about
-    // 100 MB for all 40 now.
-    assert!(peak_kb < 400_000, "serve held {peak_kb} kB");
+    // Before the gate each stalled viewer cost about 68 MB (40: about 2.7 GB); measured 87 to
+    // 107 MB for all 40 now.
+    assert!(peak_kb < 300_000, "serve held {peak_kb} kB");
+    // The good viewer loses no frame and keeps up (measured 27.9 to 29.9 fps of 30 on 2 shared
+    // cores; a machine loaded by other builds delays some past the window's end).
+    assert_eq!(lost, 0, "the good viewer lost frames");
     assert!(
-        got >= 0.8 * fps,
+        got >= 0.7 * fps,
         "the good viewer got {got:.1} fps of {fps:.1}"
     );
     // "eotn serve: sent N frames; …, D frames (M messages) dropped for slow viewers"

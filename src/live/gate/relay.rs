@@ -45,9 +45,10 @@ fn negotiate(request: &Request) -> Option<&'static str> {
         .find(|p| offered.iter().any(|o| o == p))
 }
 
-fn refusal(status: u16, text: &str) -> ErrorResponse {
+/// An HTTP 400 answer to a request the handshake cannot take.
+fn bad_request(text: &str) -> ErrorResponse {
     let mut response = ErrorResponse::new(Some(text.to_owned()));
-    *response.status_mut() = tungstenite::http::StatusCode::from_u16(status).unwrap_or_default();
+    *response.status_mut() = tungstenite::http::StatusCode::BAD_REQUEST;
     response
 }
 
@@ -68,8 +69,7 @@ pub(super) async fn viewer(
     )]
     let callback = |request: &Request, mut response: Response| {
         let Some(chosen) = negotiate(request) else {
-            return Err(refusal(
-                400,
+            return Err(bad_request(
                 "Missing expected sec-websocket-protocol header (foxglove.sdk.v1)",
             ));
         };
@@ -260,6 +260,20 @@ async fn relay(
         }
     }
     let _ = to_server.close().await;
+    if matches!(end, End::Server) {
+        // The server is stopping: what it sent last still goes out (within a second).
+        let until = tokio::time::Instant::now() + std::time::Duration::from_secs(1);
+        loop {
+            let next = lock(&outbox).pop();
+            let Some(m) = next else { break };
+            if !matches!(
+                tokio::time::timeout_at(until, to_viewer.send(m)).await,
+                Ok(Ok(()))
+            ) {
+                break;
+            }
+        }
+    }
     let mut viewer = match to_viewer.reunite(from_viewer) {
         Ok(v) => v,
         Err(_) => return,
