@@ -21,7 +21,10 @@ fuzz_target!(|data: &[u8]| {
         };
         let text = std::str::from_utf8(rest).unwrap_or_default();
         match what % 4 {
-            0 => traffic.from_viewer(text),
+            0 => {
+                traffic.from_viewer(text);
+                let _ = (traffic.pause_request(), traffic.resume_request());
+            }
             1 => {
                 traffic.from_server(text);
                 let _ = outbox.push(rest.len(), eotn::live::gate::outbox::Kind::Control, rest.len());

@@ -100,8 +100,8 @@ fn summary(f: &GateFigures, skipped: usize) -> String {
             .map(|(n, what)| format!("{n} {what}")),
     );
     parts.push(format!(
-        "{} frames ({} messages) dropped for slow viewers",
-        f.dropped_frames, f.dropped_messages
+        "{} frames dropped for slow viewers",
+        f.dropped_frames
     ));
     if skipped > 0 {
         parts.push(format!("{skipped} unreadable frames skipped"));

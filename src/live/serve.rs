@@ -12,7 +12,7 @@
 
 use std::collections::HashMap;
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
@@ -131,6 +131,8 @@ pub struct StandInRobot {
     context: Arc<Context>,
     handle: Option<foxglove::WebSocketServerHandle>,
     gate: Gate,
+    /// Frames sent so far (shared with the gate, which counts what slow viewers miss).
+    frames_sent: Arc<AtomicU64>,
     /// Frames skipped because they could not be read, in all passes.
     skipped: usize,
     image: Arc<RawChannel>,
@@ -205,7 +207,14 @@ impl StandInRobot {
             .block_on(server.start())
             .map_err(|e| listen_error(e.to_string()))?;
         let inner = SocketAddr::from(([127, 0, 0, 1], handle.port()));
-        let gate = match Gate::start(runtime.handle(), host, port, inner, options) {
+        let frames_sent = Arc::new(AtomicU64::new(0));
+        let gate = match Gate::start(
+            runtime.handle(),
+            (host, port),
+            inner,
+            Arc::clone(&frames_sent),
+            options,
+        ) {
             Ok(gate) => gate,
             Err(e) => {
                 drop(handle.stop());
@@ -217,6 +226,7 @@ impl StandInRobot {
             context,
             handle: Some(handle),
             gate,
+            frames_sent,
             skipped: 0,
             image,
             sensors,
@@ -266,6 +276,7 @@ impl StandInRobot {
         let meta = PartialMetadata::with_log_time(unix_time_ns());
         let log_time = meta.log_time.unwrap_or(0);
         self.image.log_with_meta(&self.buf, meta);
+        self.frames_sent.fetch_add(1, Ordering::Relaxed);
         if let Some(s) = &record.sensors {
             let json = serde_json::to_vec(&s.sanitised().0).map_err(|source| SendError::Json {
                 topic: SENSORS_TOPIC.to_owned(),

@@ -9,9 +9,10 @@
 //! closes a handshake that takes longer than its deadline (and the oldest unfinished handshake
 //! when too many are open, or descriptors run out), refuses clients past `--max-clients` with a
 //! close reason, keeps viewers and handshakes within the process's descriptor limit (with room
-//! for the `foxglove` server, whose `accept` must never see `EMFILE`), and relays each admitted viewer to the `foxglove` server on loopback through an
-//! [`outbox::Outbox`] of its own: a slow viewer's oldest frames are dropped and counted, and no
-//! other viewer waits for it ([`relay`]).
+//! for the `foxglove` server, whose `accept` must never see `EMFILE`), and relays each admitted
+//! viewer to the `foxglove` server on loopback through an [`outbox::Outbox`] of its own: a slow
+//! viewer's oldest frames are dropped and counted, its subscriptions held back until it reads
+//! again, and no other viewer waits for it ([`relay`]).
 
 pub mod outbox;
 mod relay;
@@ -72,10 +73,9 @@ pub struct GateFigures {
     pub accept_errors: u64,
     /// Viewers disconnected because they let control messages pile up.
     pub overflowed: u64,
-    /// Frames (images) dropped for slow viewers.
+    /// Frames dropped for slow viewers (with them their JSON): dropped from their outboxes, or
+    /// sent while their subscriptions were held back.
     pub dropped_frames: u64,
-    /// Message data dropped for slow viewers (frames and their JSON).
-    pub dropped_messages: u64,
 }
 
 /// Counters shared by the gate's tasks.
@@ -90,7 +90,6 @@ struct Counters {
     accept_errors: AtomicU64,
     overflowed: AtomicU64,
     dropped_frames: AtomicU64,
-    dropped_messages: AtomicU64,
     /// `EMFILE` has been logged (it is said once).
     said_out_of_descriptors: AtomicBool,
     /// A slow viewer has been logged (the first is a warning, the rest informational).
@@ -148,6 +147,9 @@ struct Shared {
     pending_cap: AtomicUsize,
     /// The `foxglove` server on loopback.
     inner: SocketAddr,
+    /// Frames the stand-in robot has sent so far (what a paused viewer misses is counted from
+    /// it).
+    frames_sent: Arc<AtomicU64>,
     counters: Counters,
     pending: Mutex<Pending>,
 }
@@ -227,7 +229,6 @@ impl Shared {
             accept_errors: get(&c.accept_errors),
             overflowed: get(&c.overflowed),
             dropped_frames: get(&c.dropped_frames),
-            dropped_messages: get(&c.dropped_messages),
         }
     }
 }
@@ -251,15 +252,15 @@ pub struct Gate {
 
 impl Gate {
     /// Listens on `host:port` (port 0: any free port) on `runtime`, relaying to the Foxglove
-    /// server at `inner`.
+    /// server at `inner`, whose frames `frames_sent` counts.
     ///
     /// # Errors
     /// The OS's error when the address cannot be listened on.
     pub fn start(
         runtime: &tokio::runtime::Handle,
-        host: &str,
-        port: u16,
+        (host, port): (&str, u16),
         inner: SocketAddr,
+        frames_sent: Arc<AtomicU64>,
         options: GateOptions,
     ) -> std::io::Result<Self> {
         let listener = runtime.block_on(TcpListener::bind((host, port)))?;
@@ -278,6 +279,7 @@ impl Gate {
             max_clients,
             pending_cap: AtomicUsize::new(max_pending),
             inner,
+            frames_sent,
             counters: Counters::default(),
             pending: Mutex::new(Pending::default()),
         });

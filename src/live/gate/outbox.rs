@@ -99,6 +99,12 @@ impl<M> Outbox<M> {
         self.bytes
     }
 
+    /// Data messages waiting.
+    #[must_use]
+    pub fn data(&self) -> usize {
+        self.data
+    }
+
     /// What was dropped so far.
     #[must_use]
     pub const fn dropped(&self) -> Dropped {

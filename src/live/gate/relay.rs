@@ -2,7 +2,9 @@
 //! deadline, closed early when the gate needs the room), admission, then the relay to the
 //! `foxglove` server: the viewer's messages go through as they come; the server's wait in the
 //! viewer's own [`Outbox`], so a viewer that does not read loses its oldest frames (counted)
-//! and holds up no one.
+//! and holds up no one. Once its outbox has had to drop, its subscriptions are held back at the
+//! server until it has read everything queued ([`Paused`]): a viewer that never reads costs
+//! the server no work, and the frames it missed meanwhile are counted too.
 
 use std::net::SocketAddr;
 use std::sync::atomic::Ordering;
@@ -10,7 +12,7 @@ use std::sync::{Arc, Mutex};
 
 use futures_util::{SinkExt, StreamExt};
 use tokio::net::TcpStream;
-use tokio::sync::{Notify, oneshot};
+use tokio::sync::{Notify, oneshot, watch};
 use tokio_tungstenite::tungstenite::Message;
 use tokio_tungstenite::tungstenite::handshake::server::{ErrorResponse, Request, Response};
 use tokio_tungstenite::tungstenite::protocol::WebSocketConfig;
@@ -19,7 +21,7 @@ use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
 use tokio_tungstenite::{WebSocketStream, tungstenite};
 
 use super::outbox::{Dropped, Kind, Outbox};
-use super::traffic::Traffic;
+use super::traffic::{Traffic, ViewerOp};
 use super::{Shared, lock};
 
 /// The Foxglove subprotocols the `foxglove` server speaks, newest first.
@@ -156,15 +158,12 @@ async fn connect_inner(inner: SocketAddr, subprotocol: &'static str) -> Result<I
         .map_err(|_| "timed out".to_owned())?
 }
 
-/// Adds what an outbox dropped since `before` to the gate's counts (as it happens: the counts
-/// are read while viewers are connected).
+/// Adds the images an outbox dropped since `before` to the gate's count (as it happens: the
+/// count is read while viewers are connected).
 fn count_dropped(counters: &super::Counters, before: Dropped, now: Dropped) {
     counters
         .dropped_frames
         .fetch_add(now.frames - before.frames, Ordering::Relaxed);
-    counters
-        .dropped_messages
-        .fetch_add(now.messages - before.messages, Ordering::Relaxed);
 }
 
 /// Why a relay ended.
@@ -175,6 +174,18 @@ enum End {
     Server,
     /// The viewer let control messages pile up.
     Overflow(String),
+}
+
+/// A viewer's subscriptions held back at the server while it does not read: from the moment
+/// its outbox had to drop message data until it has sent everything in it. Meanwhile the
+/// server sends it nothing (a viewer that never reads costs no work), and the frames sent to
+/// the others are counted as dropped for it.
+#[derive(Debug, Default)]
+struct Paused {
+    /// The frame count of the stand-in robot when the pause began; `None` while not paused.
+    since_frame: Option<u64>,
+    /// Frames the robot sent while this viewer was paused (and subscribed to images).
+    missed: u64,
 }
 
 /// Relays until either side ends; the viewer's outbox is the only queue.
@@ -189,6 +200,10 @@ async fn relay(
     let outbox = Mutex::new(Outbox::new(shared.options.queue));
     let traffic = Mutex::new(Traffic::new());
     let ready = Notify::new();
+    // The pause the outbox asks for (true: hold back, false: go on); applied by `viewer` below,
+    // the only one that writes to the server.
+    let (want_pause, mut pause_asked) = watch::channel(false);
+    let mut paused = Paused::default();
     let writer = async {
         loop {
             let next = lock(&outbox).pop();
@@ -198,7 +213,11 @@ async fn relay(
                         return End::Viewer;
                     }
                 }
-                None => ready.notified().await,
+                None => {
+                    // Everything sent: the viewer reads again.
+                    want_pause.send_if_modified(|p| std::mem::replace(p, false));
+                    ready.notified().await;
+                }
             }
         }
     };
@@ -213,45 +232,64 @@ async fn relay(
                 Message::Close(_) => break,
                 _ => continue,
             };
-            let pushed = {
+            let (pushed, dropped) = {
                 let mut outbox = lock(&outbox);
                 let before = outbox.dropped();
                 let pushed = outbox.push(m, kind, len);
                 count_dropped(&shared.counters, before, outbox.dropped());
-                pushed
+                (pushed, outbox.dropped() != before)
             };
             if let Err(e) = pushed {
                 return End::Overflow(e.to_string());
+            }
+            if dropped {
+                want_pause.send_if_modified(|p| !std::mem::replace(p, true));
             }
             ready.notify_one();
         }
         End::Server
     };
     let viewer = async {
-        while let Some(Ok(m)) = from_viewer.next().await {
-            match &m {
-                Message::Text(t) => lock(&traffic).from_viewer(t.as_str()),
-                Message::Binary(_) => {}
-                Message::Close(_) => break,
-                _ => continue,
-            }
-            if to_server.send(m).await.is_err() {
-                return End::Server;
+        loop {
+            tokio::select! {
+                m = from_viewer.next() => {
+                    let Some(Ok(m)) = m else { return End::Viewer };
+                    let op = match &m {
+                        Message::Text(t) => lock(&traffic).from_viewer(t.as_str()),
+                        Message::Binary(_) => ViewerOp::Other,
+                        Message::Close(_) => return End::Viewer,
+                        _ => continue,
+                    };
+                    // While paused, subscriptions are followed but reach the server on resume.
+                    let held = paused.since_frame.is_some() && op != ViewerOp::Other;
+                    if !held && to_server.send(m).await.is_err() {
+                        return End::Server;
+                    }
+                }
+                changed = pause_asked.changed() => {
+                    if changed.is_err() {
+                        return End::Server;
+                    }
+                    let pause = *pause_asked.borrow_and_update();
+                    if !apply_pause(pause, &mut paused, &traffic, &mut to_server, shared).await {
+                        return End::Server;
+                    }
+                }
             }
         }
-        End::Viewer
     };
     let end = tokio::select! {
         e = writer => e,
         e = server => e,
         e = viewer => e,
     };
-    let dropped = lock(&outbox).dropped();
+    let _ = apply_pause(false, &mut paused, &traffic, &mut to_server, shared).await;
+    let _ = to_server.close().await;
+    let dropped = lock(&outbox).dropped().frames + paused.missed;
     let counters = &shared.counters;
-    if dropped.messages > 0 {
+    if dropped > 0 {
         let line = format!(
-            "eotn serve: viewer {peer} left; it read too slowly: {} frames ({} messages) dropped for it",
-            dropped.frames, dropped.messages
+            "eotn serve: viewer {peer} left; it read too slowly: {dropped} frames dropped for it"
         );
         if counters.said_slow_viewer.swap(true, Ordering::Relaxed) {
             log::info!("{line}");
@@ -259,7 +297,6 @@ async fn relay(
             log::warn!("{line} (later slow viewers are counted in the summary)");
         }
     }
-    let _ = to_server.close().await;
     if matches!(end, End::Server) {
         // The server is stopping: what it sent last still goes out (within a second).
         let until = tokio::time::Instant::now() + std::time::Duration::from_secs(1);
@@ -292,4 +329,41 @@ async fn relay(
     };
     let _ =
         tokio::time::timeout(std::time::Duration::from_secs(1), viewer.close(Some(frame))).await;
+}
+
+/// Pauses (`pause`) or resumes the viewer's subscriptions at the server when that changes its
+/// state; frames sent meanwhile are counted as dropped for it. False when the server is gone.
+async fn apply_pause(
+    pause: bool,
+    paused: &mut Paused,
+    traffic: &Mutex<Traffic>,
+    to_server: &mut futures_util::stream::SplitSink<Inner, Message>,
+    shared: &Shared,
+) -> bool {
+    let frames = shared.frames_sent.load(Ordering::Relaxed);
+    let (request, images) = {
+        let traffic = lock(traffic);
+        let request = match (pause, paused.since_frame) {
+            (true, None) => traffic.pause_request(),
+            (false, Some(_)) => traffic.resume_request(),
+            _ => return true,
+        };
+        (request, traffic.has_image_subscription())
+    };
+    if pause {
+        paused.since_frame = Some(frames);
+    } else if let Some(since) = paused.since_frame.take()
+        && images
+    {
+        let missed = frames.saturating_sub(since);
+        paused.missed += missed;
+        shared
+            .counters
+            .dropped_frames
+            .fetch_add(missed, Ordering::Relaxed);
+    }
+    match request {
+        Some(text) => to_server.send(Message::text(text)).await.is_ok(),
+        None => true,
+    }
 }

@@ -5,18 +5,30 @@
 //! It follows the server's `advertise`/`unadvertise` (channel id → image channel or not) and
 //! the viewer's `subscribe`/`unsubscribe` (subscription id → channel id), each map at most
 //! [`MAX_TRACKED`] entries. Anything it does not understand is still relayed, untouched (the
-//! server answers it); it only counts as data that is not an image.
+//! server answers it); it only counts as data that is not an image. From the subscriptions it
+//! follows it writes the requests that pause a viewer that does not read, and resume it.
 
 use std::collections::{HashMap, HashSet};
 
 use serde::Deserialize;
 
 use super::outbox::Kind;
-use crate::live::protocol::OP_MESSAGE_DATA;
+use crate::live::protocol::{OP_MESSAGE_DATA, subscribe_request};
 use crate::streams::IMAGE_TOPIC;
 
 /// Channels and subscriptions followed, each at most (more are relayed, not followed).
 pub const MAX_TRACKED: usize = 4096;
+
+/// What a viewer's text message was, as far as its subscriptions go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ViewerOp {
+    /// `subscribe`.
+    Subscribe,
+    /// `unsubscribe`.
+    Unsubscribe,
+    /// Anything else (or nothing understood).
+    Other,
+}
 
 /// The channels and subscriptions of one viewer's connection.
 #[derive(Debug, Default)]
@@ -89,9 +101,9 @@ impl Traffic {
     }
 
     /// Takes note of a viewer's text message (`subscribe`, `unsubscribe`; others ignored).
-    pub fn from_viewer(&mut self, text: &str) {
+    pub fn from_viewer(&mut self, text: &str) -> ViewerOp {
         let Ok(op) = serde_json::from_str::<Op<'_>>(text) else {
-            return;
+            return ViewerOp::Other;
         };
         match op.op.as_ref() {
             "subscribe" => {
@@ -104,6 +116,7 @@ impl Traffic {
                         }
                     }
                 }
+                ViewerOp::Subscribe
             }
             "unsubscribe" => {
                 if let Ok(u) = serde_json::from_str::<Unsubscribe>(text) {
@@ -111,9 +124,36 @@ impl Traffic {
                         self.subscriptions.remove(&id);
                     }
                 }
+                ViewerOp::Unsubscribe
             }
-            _ => {}
+            _ => ViewerOp::Other,
         }
+    }
+
+    /// True when the viewer is subscribed to a camera image channel.
+    #[must_use]
+    pub fn has_image_subscription(&self) -> bool {
+        self.subscriptions
+            .values()
+            .any(|c| self.image_channels.contains(c))
+    }
+
+    /// The server message that ends every subscription followed (to pause a viewer that does
+    /// not read); `None` when there is none.
+    #[must_use]
+    pub fn pause_request(&self) -> Option<String> {
+        let mut ids: Vec<u32> = self.subscriptions.keys().copied().collect();
+        ids.sort_unstable();
+        (!ids.is_empty())
+            .then(|| serde_json::json!({"op": "unsubscribe", "subscriptionIds": ids}).to_string())
+    }
+
+    /// The server message that makes every subscription followed again (to resume it).
+    #[must_use]
+    pub fn resume_request(&self) -> Option<String> {
+        let mut subs: Vec<(u32, u32)> = self.subscriptions.iter().map(|(&s, &c)| (s, c)).collect();
+        subs.sort_unstable();
+        (!subs.is_empty()).then(|| subscribe_request(&subs))
     }
 
     /// Takes note of the server's text message (`advertise`, `unadvertise`; others ignored).
@@ -186,6 +226,7 @@ mod tests {
         assert_eq!(t.kind_of_binary(&[0x02, 0, 0]), Kind::Control);
         assert_eq!(t.kind_of_binary(&[0x01, 7]), Kind::Control);
         t.from_viewer(r#"{"op":"unsubscribe","subscriptionIds":[7]}"#);
+        assert!(!t.has_image_subscription());
         assert_eq!(
             t.kind_of_binary(&encode_message_data(7, 0, b"x")),
             Kind::Data { image: false }
