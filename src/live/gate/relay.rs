@@ -2,13 +2,15 @@
 //! deadline, closed early when the gate needs the room), admission, then the relay to the
 //! `foxglove` server: the viewer's messages go through as they come; the server's wait in the
 //! viewer's own [`Outbox`], so a viewer that does not read loses its oldest frames (counted)
-//! and holds up no one. Once its outbox has had to drop, its subscriptions are held back at the
-//! server until it has read everything queued ([`Paused`]): a viewer that never reads costs
-//! the server no work, and the frames it missed meanwhile are counted too.
+//! and holds up no one. Once its outbox has had to drop while it read nothing for half a
+//! second, its subscriptions are held back at the server until it has read everything queued
+//! ([`Paused`]): a viewer that never reads costs the server no work, and the frames it missed
+//! meanwhile are counted too.
 
 use std::net::SocketAddr;
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
+use std::time::Instant;
 
 use futures_util::{SinkExt, StreamExt};
 use tokio::net::TcpStream;
@@ -29,6 +31,10 @@ const SUBPROTOCOLS: [&str; 2] = ["foxglove.sdk.v1.1", "foxglove.sdk.v1"];
 
 /// Largest message a viewer may send, bytes: viewers send subscriptions, not data.
 const MAX_VIEWER_MESSAGE: usize = 1 << 20;
+
+/// A viewer whose outbox is full and that has not taken in one message for this long is held
+/// back (see [`Paused`]).
+const STALLED: std::time::Duration = std::time::Duration::from_millis(500);
 
 /// Time to open the connection to the `foxglove` server on loopback.
 const INNER_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
@@ -177,7 +183,8 @@ enum End {
 }
 
 /// A viewer's subscriptions held back at the server while it does not read: from the moment
-/// its outbox had to drop message data until it has sent everything in it. Meanwhile the
+/// its outbox had to drop message data while it had taken in nothing for [`STALLED`], until
+/// everything queued for it has gone out. Meanwhile the
 /// server sends it nothing (a viewer that never reads costs no work), and the frames sent to
 /// the others are counted as dropped for it.
 #[derive(Debug, Default)]
@@ -204,12 +211,17 @@ async fn relay(
     // the only one that writes to the server.
     let (want_pause, mut pause_asked) = watch::channel(false);
     let mut paused = Paused::default();
+    // When the send under way began: a viewer stuck on one send for STALLED reads nothing.
+    let sending_since: Mutex<Option<Instant>> = Mutex::new(None);
     let writer = async {
         loop {
             let next = lock(&outbox).pop();
             match next {
                 Some(m) => {
-                    if to_viewer.send(m).await.is_err() {
+                    *lock(&sending_since) = Some(Instant::now());
+                    let sent = to_viewer.send(m).await;
+                    *lock(&sending_since) = None;
+                    if sent.is_err() {
                         return End::Viewer;
                     }
                 }
@@ -242,7 +254,10 @@ async fn relay(
             if let Err(e) = pushed {
                 return End::Overflow(e.to_string());
             }
-            if dropped {
+            // A viewer that reads, only slowly, just loses its oldest; one that has read nothing
+            // for a while is held back.
+            let stalled = lock(&sending_since).is_some_and(|t| t.elapsed() >= STALLED);
+            if dropped && stalled {
                 want_pause.send_if_modified(|p| !std::mem::replace(p, true));
             }
             ready.notify_one();
