@@ -681,7 +681,7 @@ fn non_finite_negative_and_absurd_durations_and_counts_are_refused_with_one_line
 }
 
 /// Sends "{not json" after a proper start.
-fn garbage(stream: TcpStream, _: &AtomicBool) {
+pub fn garbage(stream: TcpStream, _: &AtomicBool) {
     let mut ws = handshake(stream);
     let info = serde_json::json!({"op": "serverInfo", "name": "garbage", "capabilities": []});
     if send_json(&mut ws, &info) {
