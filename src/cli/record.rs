@@ -252,6 +252,9 @@ fn finish(
 ) -> anyhow::Result<()> {
     let mut failed = Vec::new();
     let mut recorded = 0;
+    for (client, _) in &robots {
+        client.request_stop();
+    }
     for (client, rec) in robots {
         client.stop();
         let mut rec = lock(&rec);

@@ -206,6 +206,12 @@ impl RobotClient {
         &self.url
     }
 
+    /// Tells the thread to end, without waiting (to stop several clients at once before
+    /// [`RobotClient::stop`] waits for each).
+    pub fn request_stop(&self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+
     /// Closes the connection and waits for the thread to end, at most [`STOP_WAIT`] (a thread
     /// inside a TCP connect attempt ends when the attempt does, on its own). True when it ended.
     pub fn stop(mut self) -> bool {
