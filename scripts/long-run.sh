@@ -47,5 +47,5 @@ tail -1 "$WORK/app-rss.txt"
 # `eotn serve` with 40 viewers that never read beside a good one for SERVE_SECONDS (default 20):
 # its resident memory stays bounded and the good viewer keeps its rate (the test in
 # tests/it/serve_load.rs, which runs 5 s in the suite).
-EOTN_SERVE_LOAD_SECONDS=${SERVE_SECONDS:-20} cargo test --quiet --no-default-features --test it \
+EOTN_SERVE_LOAD_STALLED=40 EOTN_SERVE_LOAD_SECONDS=${SERVE_SECONDS:-20} cargo test --quiet --no-default-features --test it \
   -- --nocapture serve_load::viewers_that_never_read 2>&1 | grep -E "^serve with|test result"
