@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Fuzzes every parser of outside data (fuzz/fuzz_targets/: the live protocol, lookup tables in
-# all seven formats, B-Human logs, parameter/label/sensor text files, MCAP streams, frame files)
+# Fuzzes every parser of outside data (fuzz/fuzz_targets/: the live protocol as the client takes
+# it, viewers' and the server's messages as `eotn serve`'s gate takes them, lookup tables in all
+# seven formats, B-Human logs, parameter/label/sensor text files, MCAP streams, frame files)
 # with libFuzzer through cargo-fuzz, each for SECONDS (default 60), starting from the bundled
 # files as seeds. Prints executions and coverage per target; a crash stops the run, leaving its
 # input in fuzz/artifacts/TARGET/ (add it to fuzz/regressions/TARGET/ once fixed: CI replays
@@ -12,7 +13,7 @@ SECONDS_PER_TARGET=${1:-60}
 shift || true
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked --version 0.13.2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol lookup_tables bhuman_log text_files mcap_stream frame_files field_files)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol serve_viewer_messages lookup_tables bhuman_log text_files mcap_stream frame_files field_files)
 
 # Seeds: a real input or two of each kind, copied into a temporary corpus so fuzz/ stays clean
 # (inputs up to 1 MiB: -max_len below).
@@ -20,6 +21,8 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 seed() { mkdir -p "$WORK/$1"; cp "${@:2}" "$WORK/$1/" 2>/dev/null || true; }
 seed lookup_tables lookup_tables/bhuman2009.lut
+seed live_protocol fuzz/seeds/live_protocol/*
+seed serve_viewer_messages fuzz/seeds/serve_viewer_messages/*
 seed mcap_stream streams/sim-goalkeeper.mcap
 seed frame_files assets/screenshot.png
 seed text_files params/*.json streams/bhuman2009.labels.json

@@ -4,7 +4,8 @@
 # end to end by `eotn detect` (the CLI) and stepped end to end through the app's state
 # (examples/long_run.rs: the headless Workspace the window draws). Prints resident memory at the
 # start, after the first tenth and at its peak for each; fails when either grows by more than
-# 16 MiB after the first tenth (the frame cache and the pipeline's buffers are bounded).
+# 16 MiB after the first tenth (the frame cache and the pipeline's buffers are bounded). Then
+# `eotn serve` with 40 viewers that never read beside a good one for SERVE_SECONDS (default 20).
 #   scripts/long-run.sh [MINUTES]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -42,3 +43,9 @@ awk -v frames="$FRAMES" '
 # The app's state.
 "${CARGO_TARGET_DIR:-target}/release/examples/long_run" "$STREAM" lookup_tables/sim.lut 16 >"$WORK/app-rss.txt"
 tail -1 "$WORK/app-rss.txt"
+
+# `eotn serve` with 40 viewers that never read beside a good one for SERVE_SECONDS (default 20):
+# its resident memory stays bounded and the good viewer keeps its rate (the test in
+# tests/it/serve_load.rs, which runs 5 s in the suite).
+EOTN_SERVE_LOAD_STALLED=40 EOTN_SERVE_LOAD_SECONDS=${SERVE_SECONDS:-20} cargo test --quiet --no-default-features --test it \
+  -- --nocapture serve_load::viewers_that_never_read 2>&1 | grep -E "^serve with|test result"

@@ -1,6 +1,7 @@
 //! The robots window (Camera ▸ Connect to robot…): connect robots by address, several at once,
 //! and a list of them — name, connection state (with why a connection closed), frame rate,
-//! drops, latency, recording — where clicking a robot shows it. Every action is a [`Command`].
+//! drops, latency, recording, the robot's latest misbehaviour — where clicking a robot shows it.
+//! Every action is a [`Command`].
 //! [`live_controls_ui`] is the timeline's Live switch while a robot is shown.
 
 use std::path::PathBuf;
@@ -146,6 +147,12 @@ fn robot_row_ui(
             commands.push(RobotsCommand::DisconnectRobot(id).into());
         }
     });
+    if let Some(problem) = &row.stats.problem {
+        // One line per misbehaviour (garbage, a message too large, a limit reached), kept
+        // after the robot reconnects.
+        ui.colored_label(ui.visuals().warn_fg_color, problem)
+            .on_hover_text("what this robot last did wrong; hover its state for its log");
+    }
 }
 
 /// While a robot is shown: the Live switch (follow its newest frame, or hold the view to step

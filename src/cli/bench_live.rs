@@ -35,14 +35,14 @@ const APP_TICK: Duration = Duration::from_millis(16);
 /// Arguments of `eotn bench-live`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Robots sending at once.
-    #[arg(long, default_value_t = 4)]
-    pub robots: usize,
-    /// Frames per second each robot sends.
-    #[arg(long, default_value_t = 30.0)]
+    /// Robots sending at once (1 to 64).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u16).range(1..=64), allow_negative_numbers = true)]
+    pub robots: u16,
+    /// Frames per second each robot sends (above 0, at most 1000).
+    #[arg(long, default_value_t = 30.0, value_parser = super::bounds::rate_hz, allow_negative_numbers = true)]
     pub fps: f64,
-    /// Seconds measured.
-    #[arg(long, default_value_t = 10.0)]
+    /// Seconds measured (above 0, at most a week).
+    #[arg(long, default_value_t = 10.0, value_parser = super::bounds::seconds, allow_negative_numbers = true)]
     pub seconds: f64,
     /// Connect through the app's workspace (ticked as the window does), recording every robot.
     #[arg(long)]
@@ -346,7 +346,7 @@ fn report(
     }
     latencies.sort_unstable();
     LiveBenchJson {
-        robots: args.robots,
+        robots: usize::from(args.robots),
         fps: args.fps,
         width,
         height,

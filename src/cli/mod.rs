@@ -14,6 +14,7 @@ macro_rules! outln {
 mod bench;
 mod bench_live;
 mod blobs;
+mod bounds;
 mod classify;
 pub mod detect;
 mod eval;
@@ -24,6 +25,7 @@ mod import;
 mod import_bhuman;
 mod info;
 pub mod inputs;
+mod interrupt;
 mod lut;
 mod lut_from_labels;
 pub mod open;

@@ -1,4 +1,10 @@
 //! `eotn record`: record live robots into MCAP streams, every message bit-exact and in order.
+//!
+//! It runs until every robot has sent `--frames` frames, `--seconds` have passed, or Ctrl+C /
+//! SIGTERM; each recording is then finished (indexed) whatever the robots are doing: a robot
+//! stuck in a handshake cannot hold it. A robot's file is made when its first message arrives;
+//! one robot's failure (a name the file system refuses, a full disk) ends only its recording.
+//! Nothing recorded at all is a failure (exit status 1), as is any robot's failed recording.
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -7,7 +13,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 
-use crate::live::recorder::file_stem;
+use super::bounds::{MAX_FRAMES, seconds};
+use super::interrupt;
+use crate::live::recorder::{MAX_CHANNELS, Recorded, file_stem};
 use crate::live::{ClientOptions, LiveEvent, LiveRecorder, RobotClient, RobotUrl};
 use crate::streams::{IMAGE_TOPIC, StreamInfo};
 
@@ -21,23 +29,28 @@ pub struct Args {
     /// robot, named after its server name.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Stop once every robot has sent this many frames.
-    #[arg(long)]
-    pub frames: Option<usize>,
-    /// Stop after this many seconds.
-    #[arg(long)]
+    /// Stop once every robot has sent this many frames (1 to 100000000).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_FRAMES), allow_negative_numbers = true)]
+    pub frames: Option<u64>,
+    /// Stop after this many seconds (above 0, at most 604800: a week). Without `--frames` and
+    /// `--seconds`, record until Ctrl+C or SIGTERM.
+    #[arg(long, value_parser = seconds, allow_negative_numbers = true)]
     pub seconds: Option<f64>,
 }
 
 /// One robot's recording as the connection thread fills it.
 struct Recording {
     url: RobotUrl,
+    /// Its server name, once it said it.
     name: Option<String>,
     recorder: Option<LiveRecorder>,
-    frames: usize,
+    frames: u64,
     /// The frame limit was reached and the next frame began: nothing more is written.
     closed: bool,
+    /// Why its recording ended early.
     error: Option<String>,
+    /// The error was reported on stderr.
+    reported: bool,
 }
 
 /// Where each robot's file goes; file names given out so far.
@@ -67,26 +80,64 @@ impl Naming {
     }
 }
 
-fn on_event(rec: &mut Recording, naming: &Mutex<Naming>, limit: Option<usize>, event: LiveEvent) {
+impl Recording {
+    /// Writes one message, making the robot's file with its first.
+    fn write(
+        &mut self,
+        naming: &Mutex<Naming>,
+        channel: &Arc<crate::live::protocol::AdvertisedChannel>,
+        log_time_ns: u64,
+        payload: &[u8],
+    ) {
+        if self.error.is_some() {
+            return;
+        }
+        if self.recorder.is_none() {
+            let name = self.name.clone().unwrap_or_else(|| self.url.to_string());
+            let path = lock(naming).path_for(&name, &self.url);
+            let info = StreamInfo {
+                source: "robot".to_owned(),
+                description: format!("recorded live from {name} ({})", self.url),
+            };
+            match LiveRecorder::create(&path, &info) {
+                Ok(r) => self.recorder = Some(r),
+                Err(e) => {
+                    self.error = Some(e.to_string());
+                    return;
+                }
+            }
+        }
+        let Some(r) = self.recorder.as_mut() else {
+            return;
+        };
+        match r.message(channel, log_time_ns, payload) {
+            Ok(Recorded::Written) => {}
+            Ok(Recorded::OverChannelLimit) => {
+                if r.over_limit() == 1 {
+                    eprintln!(
+                        "{}: the recording holds {MAX_CHANNELS} channels: messages on later channels are not written",
+                        self.url
+                    );
+                }
+            }
+            Err(e) => self.error = Some(e.to_string()),
+        }
+    }
+}
+
+fn on_event(rec: &mut Recording, naming: &Mutex<Naming>, limit: Option<u64>, event: LiveEvent) {
     match event {
         LiveEvent::Connected { server_name } => {
             if rec.name.is_some() {
                 eprintln!("{}: reconnected ({server_name})", rec.url);
             } else {
                 eprintln!("{}: connected to '{server_name}'", rec.url);
-                let path = lock(naming).path_for(&server_name, &rec.url);
-                let info = StreamInfo {
-                    source: "robot".to_owned(),
-                    description: format!("recorded live from {server_name} ({})", rec.url),
-                };
-                match LiveRecorder::create(&path, &info) {
-                    Ok(r) => rec.recorder = Some(r),
-                    Err(e) => rec.error = Some(e.to_string()),
-                }
                 rec.name = Some(server_name);
             }
         }
-        LiveEvent::Disconnected { reason, retry_in } => {
+        LiveEvent::Disconnected {
+            reason, retry_in, ..
+        } => {
             eprintln!(
                 "{}: {reason}; reconnecting in {:.1} s",
                 rec.url,
@@ -94,6 +145,7 @@ fn on_event(rec: &mut Recording, naming: &Mutex<Naming>, limit: Option<usize>, e
             );
         }
         LiveEvent::Status(s) => eprintln!("{}: {s}", rec.url),
+        LiveEvent::Warning(w) => eprintln!("{}: {w}", rec.url),
         LiveEvent::Advertised(_) => {}
         LiveEvent::Message {
             channel,
@@ -112,20 +164,17 @@ fn on_event(rec: &mut Recording, naming: &Mutex<Naming>, limit: Option<usize>, e
             if is_image {
                 rec.frames += 1;
             }
-            if let Some(r) = rec.recorder.as_mut()
-                && let Err(e) = r.message(&channel, log_time_ns, &payload)
-            {
-                rec.error = Some(e.to_string());
-                rec.recorder = None;
-            }
+            rec.write(naming, &channel, log_time_ns, &payload);
         }
     }
 }
 
-/// Runs `eotn record` until every robot sent `--frames` frames or `--seconds` passed.
+/// Runs `eotn record` until every robot sent `--frames` frames, `--seconds` passed, or Ctrl+C /
+/// SIGTERM.
 ///
 /// # Errors
-/// A bad address, an output that cannot be written, or a recording that failed.
+/// A bad address, an output that cannot be written, a recording that failed, or nothing
+/// recorded.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let urls = args
         .urls
@@ -137,6 +186,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         std::fs::create_dir_all(&args.output)
             .with_context(|| format!("cannot create folder {}", args.output.display()))?;
     }
+    let interrupted = interrupt::catch("finishing the recordings")?;
     let naming = Arc::new(Mutex::new(Naming {
         output: args.output.clone(),
         single,
@@ -151,6 +201,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             frames: 0,
             closed: false,
             error: None,
+            reported: false,
         }));
         let client = RobotClient::spawn(url, ClientOptions::default(), {
             let (rec, naming, limit) = (Arc::clone(&rec), Arc::clone(&naming), args.frames);
@@ -159,53 +210,87 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         robots.push((client, rec));
     }
     let start = Instant::now();
-    let deadline = args
-        .seconds
-        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    let deadline = args.seconds.map(|s| start + Duration::from_secs_f64(s));
     loop {
         std::thread::sleep(Duration::from_millis(50));
-        let mut all_full = args.frames.is_some();
-        for (_, rec) in &robots {
-            let mut rec = lock(rec);
-            if let Some(r) = rec.recorder.as_mut()
-                && let Err(e) = r.tick()
-            {
-                rec.error = Some(e.to_string());
-                rec.recorder = None;
-            }
-            if let Some(e) = &rec.error {
-                anyhow::bail!("{}: recording failed: {e}", rec.url);
-            }
-            all_full &= args.frames.is_some_and(|n| rec.frames >= n);
+        if tick(&robots, args.frames) || deadline.is_some_and(|d| Instant::now() >= d) {
+            break;
         }
-        if all_full || deadline.is_some_and(|d| Instant::now() >= d) {
+        if interrupted.is_set() {
             break;
         }
     }
     finish(robots, start.elapsed())
 }
 
+/// Closes idle chunks and reports failed recordings; true when every robot has its frames (or
+/// has failed).
+fn tick(robots: &[(RobotClient, Arc<Mutex<Recording>>)], frames: Option<u64>) -> bool {
+    let mut all_full = frames.is_some();
+    for (_, rec) in robots {
+        let mut rec = lock(rec);
+        if let Some(r) = rec.recorder.as_mut()
+            && let Err(e) = r.tick()
+        {
+            rec.error = Some(e.to_string());
+        }
+        if let Some(e) = rec.error.clone()
+            && !rec.reported
+        {
+            eprintln!("{}: recording failed: {e}", rec.url);
+            rec.reported = true;
+        }
+        all_full &= rec.error.is_some() || frames.is_some_and(|n| rec.frames >= n);
+    }
+    all_full
+}
+
+/// Stops every connection (without waiting on any robot for long) and finishes each file.
 fn finish(
     robots: Vec<(RobotClient, Arc<Mutex<Recording>>)>,
     elapsed: Duration,
 ) -> anyhow::Result<()> {
+    let mut failed = Vec::new();
+    let mut recorded = 0;
+    for (client, _) in &robots {
+        client.request_stop();
+    }
     for (client, rec) in robots {
         client.stop();
         let mut rec = lock(&rec);
         let name = rec.name.clone().unwrap_or_else(|| rec.url.to_string());
-        match rec.recorder.take() {
-            Some(r) => {
-                let (frames, messages) = (r.frames(), r.messages());
-                let path = r.finish()?;
+        let result = rec
+            .recorder
+            .take()
+            .map(|r| (r.frames(), r.messages(), r.finish()));
+        match (result, rec.error.take()) {
+            (Some((frames, messages, Ok(path))), error) => {
+                recorded += 1;
                 println!(
                     "{name}: {frames} frames, {messages} messages in {:.1} s -> {}",
                     elapsed.as_secs_f64(),
                     display(&path)
                 );
+                if let Some(e) = error {
+                    failed.push(format!("{name}: {e}"));
+                }
             }
-            None => eprintln!("{name}: never connected; nothing recorded"),
+            (Some((.., Err(e))), _) => failed.push(format!("{name}: {e}")),
+            (None, Some(e)) => failed.push(format!("{name}: {e}")),
+            (None, None) if rec.name.is_some() => {
+                eprintln!("{name}: connected, but sent nothing; no file written");
+            }
+            (None, None) => eprintln!("{name}: never connected; nothing recorded"),
         }
     }
+    if !failed.is_empty() {
+        anyhow::bail!("recording failed: {}", failed.join("; "));
+    }
+    anyhow::ensure!(
+        recorded > 0,
+        "nothing was recorded: no robot sent a message in {:.1} s",
+        elapsed.as_secs_f64()
+    );
     Ok(())
 }
 

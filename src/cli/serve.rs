@@ -1,11 +1,16 @@
 //! `eotn serve`: a stand-in robot, a Foxglove WebSocket server playing a stream at its recorded
-//! rate, for the app, `eotn record` and Foxglove itself to connect to.
+//! rate, for the app, `eotn record` and Foxglove itself to connect to. It ends when the stream
+//! does (never with `--loop`) or on Ctrl+C / SIGTERM, saying what its gate did: viewers served
+//! and refused, handshakes closed, frames dropped for slow viewers.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::time::Duration;
 
 use anyhow::Context;
 
+use super::bounds::deadline_seconds;
+use super::interrupt;
+use crate::live::gate::{GateFigures, GateOptions};
 use crate::live::serve::StandInRobot;
 use crate::streams::StreamReader;
 
@@ -27,6 +32,12 @@ pub struct Args {
     /// Wait for the first viewer to subscribe before sending the first frame.
     #[arg(long)]
     pub wait: bool,
+    /// Viewers connected at once (1 to 4096); the next is refused with a close reason.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u16).range(1..=4096), allow_negative_numbers = true)]
+    pub max_clients: u16,
+    /// Seconds a new connection has to finish its WebSocket handshake (above 0, at most 600).
+    #[arg(long, default_value_t = 5.0, value_parser = deadline_seconds, allow_negative_numbers = true)]
+    pub handshake_timeout: f64,
 }
 
 /// Runs `eotn serve` until the stream ends (or forever with `--loop`).
@@ -45,18 +56,55 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .file_stem()
             .map_or_else(|| "eotn".to_owned(), |s| s.to_string_lossy().into_owned())
     });
-    let mut robot = StandInRobot::start(&name, host, port)?;
+    let options = GateOptions {
+        max_clients: usize::from(args.max_clients),
+        handshake_timeout: Duration::from_secs_f64(args.handshake_timeout),
+        ..GateOptions::default()
+    };
+    let mut robot = StandInRobot::start_with(&name, host, port, options)?;
     println!(
         "serving {} ({} frames) as '{name}' on ws://{host}:{}",
         args.stream.display(),
         reader.len(),
         robot.port()
     );
-    let stop = AtomicBool::new(false);
-    let sent = robot.play(&mut reader, args.looping, args.wait, &stop)?;
+    let interrupted = interrupt::catch("stopping")?;
+    let played = robot.play(&mut reader, args.looping, args.wait, interrupted.flag());
     // Let the last frames leave the server's queues before it closes.
-    std::thread::sleep(std::time::Duration::from_millis(300));
-    robot.stop();
-    eprintln!("eotn serve: sent {sent} frames");
+    std::thread::sleep(Duration::from_millis(300));
+    let skipped = robot.skipped();
+    let figures = robot.stop();
+    let sent = played?;
+    eprintln!(
+        "eotn serve: sent {sent} frames{}",
+        summary(&figures, skipped)
+    );
     Ok(())
+}
+
+/// What the gate did, for the last line.
+fn summary(f: &GateFigures, skipped: usize) -> String {
+    let mut parts = vec![format!("{} viewers served", f.served)];
+    let counts = [
+        (f.refused, "refused (--max-clients)"),
+        (f.handshake_timeouts, "handshakes timed out"),
+        (f.handshake_failures, "handshakes failed"),
+        (f.evicted, "unfinished handshakes closed for room"),
+        (f.overflowed, "viewers disconnected for not reading"),
+        (f.accept_errors, "accept errors (retried)"),
+    ];
+    parts.extend(
+        counts
+            .iter()
+            .filter(|(n, _)| *n > 0)
+            .map(|(n, what)| format!("{n} {what}")),
+    );
+    parts.push(format!(
+        "{} frames dropped for slow viewers",
+        f.dropped_frames
+    ));
+    if skipped > 0 {
+        parts.push(format!("{skipped} unreadable frames skipped"));
+    }
+    format!("; {}", parts.join(", "))
 }

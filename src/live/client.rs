@@ -4,8 +4,11 @@
 //! the owner's handler (on this thread), pings the robot when it is quiet, and reconnects with a
 //! growing back-off when the connection drops or the robot sends something malformed or
 //! oversized. One robot's faults never reach another's thread.
+//!
+//! Every wait has a deadline and every store a bound, both in [`Limits`]: the TCP connect, the
+//! whole handshake, the robot's first message, silence; channels, names, schemas, messages.
+//! [`RobotClient::stop`] waits at most half a second; dropping a client does not wait at all.
 
-use std::collections::HashMap;
 use std::io::ErrorKind;
 use std::net::{TcpStream, ToSocketAddrs};
 use std::sync::Arc;
@@ -17,22 +20,66 @@ use tungstenite::client::IntoClientRequest;
 use tungstenite::protocol::WebSocketConfig;
 use tungstenite::{Message, WebSocket};
 
+use super::channels::{Channels, cut};
 use super::protocol::{
     AdvertisedChannel, ServerMessage, parse_binary, parse_text, subscribe_request,
 };
 use super::{RobotUrl, SUBPROTOCOLS, unix_time_ns};
 
-/// How a [`RobotClient`] connects and when it gives up on a connection.
-#[derive(Debug, Clone)]
-pub struct ClientOptions {
-    /// Largest message accepted, bytes; a larger one closes the connection.
+/// Every bound the live client keeps, in one place: what a robot can make it hold in memory or
+/// wait for. A robot past a bound is dropped (a message too large, a deadline missed: the
+/// connection closes and is retried) or trimmed (channels and names: the excess is not
+/// subscribed, with a warning, and the rest goes on).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Limits {
+    /// Channels subscribed on one connection; later ones are refused with a warning.
+    pub max_channels: usize,
+    /// Longest topic, encoding or schema name of a channel, bytes (such a channel is refused),
+    /// and longest server name (cut to it).
+    pub max_name_bytes: usize,
+    /// Largest schema of a channel, bytes (such a channel is refused).
+    pub max_schema_bytes: usize,
+    /// Largest message, bytes; a larger one closes the connection.
     pub max_message_bytes: usize,
-    /// Time to open the TCP connection and finish the WebSocket handshake.
+    /// JSON messages held while they wait for their frame's image, at most this many…
+    pub queue_messages: usize,
+    /// …and at most this many bytes (older ones are let go first).
+    pub queue_bytes: usize,
+    /// Time to open the TCP connection (each address the name resolves to).
     pub connect_timeout: Duration,
+    /// Time for the whole WebSocket handshake, however slowly the robot answers.
+    pub handshake_timeout: Duration,
+    /// Time from the handshake to the robot's `serverInfo`, its first message.
+    pub first_message_timeout: Duration,
     /// A ping is sent after this long without hearing from the robot.
     pub ping_after: Duration,
     /// The connection is dropped after this long without hearing from the robot.
     pub silence_timeout: Duration,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            max_channels: 256,
+            max_name_bytes: 255,
+            max_schema_bytes: 256 << 10,
+            max_message_bytes: 64 << 20,
+            queue_messages: 64,
+            queue_bytes: 16 << 20,
+            connect_timeout: Duration::from_secs(3),
+            handshake_timeout: Duration::from_secs(3),
+            first_message_timeout: Duration::from_secs(5),
+            ping_after: Duration::from_secs(2),
+            silence_timeout: Duration::from_secs(10),
+        }
+    }
+}
+
+/// How a [`RobotClient`] connects: its [`Limits`] and how it retries.
+#[derive(Debug, Clone)]
+pub struct ClientOptions {
+    /// What a robot can make the client hold or wait for.
+    pub limits: Limits,
     /// First wait before reconnecting; doubled after each failed attempt.
     pub backoff_min: Duration,
     /// Longest wait between reconnection attempts.
@@ -42,10 +89,7 @@ pub struct ClientOptions {
 impl Default for ClientOptions {
     fn default() -> Self {
         Self {
-            max_message_bytes: 64 << 20,
-            connect_timeout: Duration::from_secs(3),
-            ping_after: Duration::from_secs(2),
-            silence_timeout: Duration::from_secs(10),
+            limits: Limits::default(),
             backoff_min: Duration::from_millis(100),
             backoff_max: Duration::from_secs(2),
         }
@@ -73,18 +117,58 @@ pub enum LiveEvent {
         /// The message bytes.
         payload: Vec<u8>,
     },
-    /// A status message from the robot.
+    /// A status message from the robot (cut to [`MAX_STATUS_BYTES`]).
     Status(String),
+    /// Something the robot did that the client trimmed or worked around (a limit reached, a
+    /// long name cut, a channel advertised again), in one line.
+    Warning(String),
     /// The connection failed or ended; the client retries after `retry_in`.
     Disconnected {
         /// Why, in one line.
         reason: String,
+        /// True when the robot misbehaved (garbage, a message too large, a deadline missed in
+        /// the handshake) rather than went away.
+        fault: bool,
         /// Wait before the next attempt.
         retry_in: Duration,
     },
 }
 
-/// A robot's connection thread; stops (and joins) when dropped or [`RobotClient::stop`]ped.
+/// Why a connection ended, in one line, and whether the robot was at fault.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Ending {
+    reason: String,
+    fault: bool,
+}
+
+impl Ending {
+    /// The robot misbehaved.
+    fn fault(reason: String) -> Self {
+        Self {
+            reason,
+            fault: true,
+        }
+    }
+
+    /// The robot went away or could not be reached.
+    fn ordinary(reason: String) -> Self {
+        Self {
+            reason,
+            fault: false,
+        }
+    }
+}
+
+/// Longest status message passed on, bytes (a robot's text is cut to it).
+pub const MAX_STATUS_BYTES: usize = 500;
+
+/// Longest [`RobotClient::stop`] waits for the thread to end; past it the thread is left to end
+/// on its own (it looks at its stop flag every [`POLL`], or after a TCP connect attempt).
+const STOP_WAIT: Duration = Duration::from_millis(500);
+
+/// A robot's connection thread. [`RobotClient::stop`] ends it, waiting at most [`STOP_WAIT`];
+/// dropping it only tells the thread to end and returns at once (the UI never waits on a
+/// socket).
 #[derive(Debug)]
 pub struct RobotClient {
     url: RobotUrl,
@@ -122,26 +206,40 @@ impl RobotClient {
         &self.url
     }
 
-    /// Closes the connection and waits for the thread to end (at most about 100 ms).
-    pub fn stop(mut self) {
-        self.shutdown();
+    /// Tells the thread to end, without waiting (to stop several clients at once before
+    /// [`RobotClient::stop`] waits for each).
+    pub fn request_stop(&self) {
+        self.stop.store(true, Ordering::Relaxed);
     }
 
-    fn shutdown(&mut self) {
+    /// Closes the connection and waits for the thread to end, at most [`STOP_WAIT`] (a thread
+    /// inside a TCP connect attempt ends when the attempt does, on its own). True when it ended.
+    pub fn stop(mut self) -> bool {
         self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
+        let Some(thread) = self.thread.take() else {
+            return true;
+        };
+        let until = Instant::now() + STOP_WAIT;
+        while !thread.is_finished() && Instant::now() < until {
+            std::thread::sleep(Duration::from_millis(2));
         }
+        let ended = thread.is_finished();
+        if ended {
+            let _ = thread.join();
+        }
+        ended
     }
 }
 
 impl Drop for RobotClient {
+    /// Tells the thread to end, without waiting for it.
     fn drop(&mut self) {
-        self.shutdown();
+        self.stop.store(true, Ordering::Relaxed);
     }
 }
 
-/// Read timeout of the socket: how often the thread looks at the stop flag and the ping timer.
+/// Read timeout of the socket: how often the thread looks at the stop flag, the deadlines and
+/// the ping timer.
 const POLL: Duration = Duration::from_millis(50);
 
 fn run(
@@ -153,21 +251,26 @@ fn run(
     let mut backoff = options.backoff_min;
     while !stop.load(Ordering::Relaxed) {
         let mut got_info = false;
-        let reason = match connect(url, options) {
+        let ending = match connect(url, &options.limits, stop) {
             Ok(mut ws) => {
-                let reason = session(&mut ws, options, stop, &mut handler, &mut got_info);
+                let ending = session(&mut ws, &options.limits, stop, &mut handler, &mut got_info);
                 let _ = ws.close(None);
                 let _ = ws.flush();
-                reason
+                ending
             }
-            Err(reason) => Some(reason.to_string()),
+            Err(ConnectError::Stopped) => None,
+            Err(e) if e.is_fault() => Some(Ending::fault(e.to_string())),
+            Err(e) => Some(Ending::ordinary(e.to_string())),
         };
-        let Some(reason) = reason else { return };
+        let Some(Ending { reason, fault }) = ending else {
+            return;
+        };
         if got_info {
             backoff = options.backoff_min;
         }
         handler(LiveEvent::Disconnected {
             reason,
+            fault,
             retry_in: backoff,
         });
         let until = Instant::now() + backoff;
@@ -211,11 +314,25 @@ enum ConnectError {
     #[error("handshake failed: {0}")]
     Handshake(#[source] tungstenite::Error),
     /// The robot did not finish the handshake in time.
-    #[error("handshake timed out")]
-    HandshakeTimeout,
+    #[error("no WebSocket handshake within {:.1} s", .0.as_secs_f64())]
+    HandshakeTimeout(Duration),
+    /// The client was told to stop.
+    #[error("stopped")]
+    Stopped,
 }
 
-fn connect(url: &RobotUrl, options: &ClientOptions) -> Result<WebSocket<TcpStream>, ConnectError> {
+impl ConnectError {
+    /// True when the robot answered but wrongly or too slowly (not when it was unreachable).
+    fn is_fault(&self) -> bool {
+        matches!(self, Self::Handshake(_) | Self::HandshakeTimeout(_))
+    }
+}
+
+fn connect(
+    url: &RobotUrl,
+    limits: &Limits,
+    stop: &AtomicBool,
+) -> Result<WebSocket<TcpStream>, ConnectError> {
     let addrs: Vec<_> = (url.host.as_str(), url.port)
         .to_socket_addrs()
         .map_err(|source| ConnectError::Resolve {
@@ -228,8 +345,9 @@ fn connect(url: &RobotUrl, options: &ClientOptions) -> Result<WebSocket<TcpStrea
     };
     let stream = addrs
         .iter()
+        .take_while(|_| !stop.load(Ordering::Relaxed))
         .find_map(
-            |a| match TcpStream::connect_timeout(a, options.connect_timeout) {
+            |a| match TcpStream::connect_timeout(a, limits.connect_timeout) {
                 Ok(s) => Some(s),
                 Err(e) => {
                     last = ConnectError::Connect(e);
@@ -239,11 +357,13 @@ fn connect(url: &RobotUrl, options: &ClientOptions) -> Result<WebSocket<TcpStrea
         )
         .ok_or(last)?;
     stream.set_nodelay(true).map_err(ConnectError::Socket)?;
+    // Short timeouts: the handshake below goes round in POLL steps, looking at the stop flag
+    // and its own deadline between them, so a robot answering byte by byte cannot hold it.
     stream
-        .set_read_timeout(Some(options.connect_timeout))
+        .set_read_timeout(Some(POLL))
         .map_err(ConnectError::Socket)?;
     stream
-        .set_write_timeout(Some(options.connect_timeout))
+        .set_write_timeout(Some(POLL))
         .map_err(ConnectError::Socket)?;
     let mut request = url
         .to_string()
@@ -254,28 +374,45 @@ fn connect(url: &RobotUrl, options: &ClientOptions) -> Result<WebSocket<TcpStrea
         tungstenite::http::HeaderValue::from_static(SUBPROTOCOLS),
     );
     let config = WebSocketConfig::default()
-        .max_message_size(Some(options.max_message_bytes))
-        .max_frame_size(Some(options.max_message_bytes));
-    let (ws, _response) = tungstenite::client::client_with_config(request, stream, Some(config))
-        .map_err(|e| match e {
-            tungstenite::HandshakeError::Failure(e) => ConnectError::Handshake(e),
-            tungstenite::HandshakeError::Interrupted(_) => ConnectError::HandshakeTimeout,
-        })?;
-    ws.get_ref()
-        .set_read_timeout(Some(POLL))
-        .map_err(ConnectError::Socket)?;
-    Ok(ws)
+        .max_message_size(Some(limits.max_message_bytes))
+        .max_frame_size(Some(limits.max_message_bytes));
+    let deadline = Instant::now() + limits.handshake_timeout;
+    let mut attempt = tungstenite::client::client_with_config(request, stream, Some(config));
+    loop {
+        match attempt {
+            Ok((ws, _response)) => {
+                // Reads keep their POLL timeout (the session looks at its stop flag and deadlines
+                // between them); a robot that takes longer than the handshake's deadline to take
+                // in a subscription or a ping is given up on.
+                ws.get_ref()
+                    .set_write_timeout(Some(limits.handshake_timeout))
+                    .map_err(ConnectError::Socket)?;
+                return Ok(ws);
+            }
+            Err(tungstenite::HandshakeError::Failure(e)) => return Err(ConnectError::Handshake(e)),
+            Err(tungstenite::HandshakeError::Interrupted(mid)) => {
+                if stop.load(Ordering::Relaxed) {
+                    return Err(ConnectError::Stopped);
+                }
+                if Instant::now() >= deadline {
+                    return Err(ConnectError::HandshakeTimeout(limits.handshake_timeout));
+                }
+                attempt = mid.handshake();
+            }
+        }
+    }
 }
 
 /// Runs one connection until it ends: `None` when stopped, otherwise why it ended.
 fn session(
     ws: &mut WebSocket<TcpStream>,
-    options: &ClientOptions,
+    limits: &Limits,
     stop: &AtomicBool,
     handler: &mut impl FnMut(LiveEvent),
     got_info: &mut bool,
-) -> Option<String> {
-    let mut channels = Channels::new();
+) -> Option<Ending> {
+    let mut channels = Channels::new(limits.clone());
+    let opened = Instant::now();
     let mut last_heard = Instant::now();
     let mut pinged = false;
     loop {
@@ -287,24 +424,33 @@ fn session(
             Err(tungstenite::Error::Io(e))
                 if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) =>
             {
-                let quiet = last_heard.elapsed();
-                if quiet > options.silence_timeout {
-                    return Some(format!("nothing heard for {:.1} s", quiet.as_secs_f64()));
+                if !*got_info && opened.elapsed() > limits.first_message_timeout {
+                    return Some(Ending::fault(format!(
+                        "connected, but no serverInfo within {:.1} s",
+                        limits.first_message_timeout.as_secs_f64()
+                    )));
                 }
-                if quiet > options.ping_after && !pinged {
+                let quiet = last_heard.elapsed();
+                if quiet > limits.silence_timeout {
+                    return Some(Ending::ordinary(format!(
+                        "nothing heard for {:.1} s",
+                        quiet.as_secs_f64()
+                    )));
+                }
+                if quiet > limits.ping_after && !pinged {
                     pinged = true;
                     if let Err(e) = ws.send(Message::Ping(Vec::new().into())) {
-                        return Some(describe(&e, options));
+                        return Some(describe(&e, limits));
                     }
                 }
                 continue;
             }
-            Err(e) => return Some(describe(&e, options)),
+            Err(e) => return Some(describe(&e, limits)),
         };
         let received_ns = unix_time_ns();
         last_heard = Instant::now();
         pinged = false;
-        let parsed = match parse_message(&message) {
+        let parsed = match parse_message(&message, limits.max_channels) {
             Ok(Some(p)) => p,
             Ok(None) => continue,
             Err(why) => return Some(why),
@@ -312,7 +458,7 @@ fn session(
         if matches!(parsed, ServerMessage::ServerInfo { .. }) {
             *got_info = true;
         }
-        if let Err(why) = channels.handle(parsed, received_ns, ws, options, handler) {
+        if let Err(why) = handle(&mut channels, parsed, received_ns, ws, limits, handler) {
             return Some(why);
         }
     }
@@ -320,123 +466,125 @@ fn session(
 
 /// A received message parsed: `None` for the WebSocket's own (ping, pong), `Err` with why the
 /// session ends for a close or a malformed message.
-fn parse_message(message: &Message) -> Result<Option<ServerMessage<'_>>, String> {
+fn parse_message(
+    message: &Message,
+    max_channels: usize,
+) -> Result<Option<ServerMessage<'_>>, Ending> {
     let parsed = match message {
-        Message::Text(t) => parse_text(t.as_str()),
+        Message::Text(t) => parse_text(t.as_str(), max_channels),
         Message::Binary(b) => parse_binary(b),
         Message::Close(frame) => {
-            return Err(match frame {
-                Some(f) if !f.reason.is_empty() => {
-                    format!("the robot closed the connection: {}", f.reason)
-                }
+            return Err(Ending::ordinary(match frame {
+                Some(f) if !f.reason.is_empty() => format!(
+                    "the robot closed the connection: {}",
+                    one_line(&f.reason, MAX_STATUS_BYTES)
+                ),
                 _ => "the robot closed the connection".to_owned(),
-            });
+            }));
         }
         Message::Ping(_) | Message::Pong(_) | Message::Frame(_) => return Ok(None),
     };
-    parsed
-        .map(Some)
-        .map_err(|e| format!("malformed message: {e}"))
+    parsed.map(Some).map_err(|e| {
+        Ending::fault(format!(
+            "malformed message: {}",
+            one_line(&e.to_string(), MAX_STATUS_BYTES)
+        ))
+    })
 }
 
-/// The channels one session has seen advertised and the subscriptions it made to them.
-struct Channels {
-    channels: HashMap<u32, Arc<AdvertisedChannel>>,
-    subscriptions: HashMap<u32, Arc<AdvertisedChannel>>,
-    next_subscription: u32,
+/// A robot's own text made one line: control characters (line breaks) become spaces, cut to
+/// `max` bytes.
+fn one_line(text: &str, max: usize) -> String {
+    let line: String = text
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    cut(&line, max)
 }
 
-impl Channels {
-    fn new() -> Self {
-        Self {
-            channels: HashMap::new(),
-            subscriptions: HashMap::new(),
-            next_subscription: 1,
+/// Acts on one server message: subscribes to new channels, forgets withdrawn ones, hands the
+/// rest to `handler`; `Err` with why the session ends when a subscription cannot be sent.
+fn handle(
+    channels: &mut Channels,
+    parsed: ServerMessage<'_>,
+    received_ns: u64,
+    ws: &mut WebSocket<TcpStream>,
+    limits: &Limits,
+    handler: &mut impl FnMut(LiveEvent),
+) -> Result<(), Ending> {
+    match parsed {
+        ServerMessage::ServerInfo { name } => {
+            let server_name = one_line(&name, limits.max_name_bytes);
+            if name.len() > limits.max_name_bytes {
+                handler(LiveEvent::Warning(format!(
+                    "the robot's name is {} bytes long: cut to {}",
+                    name.len(),
+                    limits.max_name_bytes
+                )));
+            }
+            handler(LiveEvent::Connected { server_name });
         }
-    }
-
-    /// Acts on one server message: subscribes to new channels, forgets withdrawn ones, hands
-    /// the rest to `handler`; `Err` with why the session ends when a subscription cannot be
-    /// sent.
-    fn handle(
-        &mut self,
-        parsed: ServerMessage<'_>,
-        received_ns: u64,
-        ws: &mut WebSocket<TcpStream>,
-        options: &ClientOptions,
-        handler: &mut impl FnMut(LiveEvent),
-    ) -> Result<(), String> {
-        match parsed {
-            ServerMessage::ServerInfo { name } => {
-                handler(LiveEvent::Connected { server_name: name });
+        ServerMessage::Advertise {
+            channels: list,
+            beyond,
+        } => {
+            let outcome = channels.advertise(list, beyond);
+            for w in outcome.warnings {
+                handler(LiveEvent::Warning(w));
             }
-            ServerMessage::Advertise(list) => {
-                let mut new = Vec::new();
-                let mut subs = Vec::new();
-                for c in list {
-                    let c = Arc::new(c);
-                    if self.channels.insert(c.id, Arc::clone(&c)).is_none() {
-                        subs.push((self.next_subscription, c.id));
-                        self.subscriptions
-                            .insert(self.next_subscription, Arc::clone(&c));
-                        self.next_subscription = self.next_subscription.wrapping_add(1);
-                        new.push(c);
-                    }
-                }
-                if !subs.is_empty()
-                    && let Err(e) = ws.send(Message::text(subscribe_request(&subs)))
-                {
-                    return Err(describe(&e, options));
-                }
-                handler(LiveEvent::Advertised(new));
+            if !outcome.subscribe.is_empty()
+                && let Err(e) = ws.send(Message::text(subscribe_request(&outcome.subscribe)))
+            {
+                return Err(describe(&e, limits));
             }
-            ServerMessage::Unadvertise(ids) => {
-                for id in ids {
-                    self.channels.remove(&id);
-                    self.subscriptions.retain(|_, c| c.id != id);
-                }
+            if !outcome.channels.is_empty() {
+                handler(LiveEvent::Advertised(outcome.channels));
             }
-            ServerMessage::MessageData {
-                subscription_id,
-                log_time_ns,
-                payload,
-            } => {
-                if let Some(channel) = self.subscriptions.get(&subscription_id) {
-                    handler(LiveEvent::Message {
-                        channel: Arc::clone(channel),
-                        log_time_ns,
-                        received_ns,
-                        payload: payload.to_vec(),
-                    });
-                }
-            }
-            ServerMessage::Status { level, message } => {
-                let kind = match level {
-                    0 => "info",
-                    1 => "warning",
-                    _ => "error",
-                };
-                handler(LiveEvent::Status(format!("{kind}: {message}")));
-            }
-            ServerMessage::Time(_) | ServerMessage::Other(_) => {}
         }
-        Ok(())
+        ServerMessage::Unadvertise(ids) => channels.unadvertise(&ids),
+        ServerMessage::MessageData {
+            subscription_id,
+            log_time_ns,
+            payload,
+        } => {
+            if let Some(channel) = channels.subscription(subscription_id) {
+                handler(LiveEvent::Message {
+                    channel: Arc::clone(channel),
+                    log_time_ns,
+                    received_ns,
+                    payload: payload.to_vec(),
+                });
+            }
+        }
+        ServerMessage::Status { level, message } => {
+            let kind = match level {
+                0 => "info",
+                1 => "warning",
+                _ => "error",
+            };
+            let text = one_line(&message, MAX_STATUS_BYTES);
+            handler(LiveEvent::Status(format!("{kind}: {text}")));
+        }
+        ServerMessage::Time(_) | ServerMessage::Other(_) => {}
     }
+    Ok(())
 }
 
-fn describe(e: &tungstenite::Error, options: &ClientOptions) -> String {
+fn describe(e: &tungstenite::Error, limits: &Limits) -> Ending {
     match e {
-        tungstenite::Error::Capacity(c) => format!(
+        tungstenite::Error::Capacity(c) => Ending::fault(format!(
             "message too large ({c}; the limit is {} MiB)",
-            options.max_message_bytes >> 20
-        ),
+            limits.max_message_bytes >> 20
+        )),
         tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed => {
-            "the connection closed".to_owned()
+            Ending::ordinary("the connection closed".to_owned())
         }
         tungstenite::Error::Io(io) if io.kind() == ErrorKind::UnexpectedEof => {
-            "the robot dropped the connection".to_owned()
+            Ending::ordinary("the robot dropped the connection".to_owned())
         }
-        tungstenite::Error::Protocol(p) => format!("the robot broke the WebSocket protocol: {p}"),
-        other => other.to_string(),
+        tungstenite::Error::Protocol(p) => {
+            Ending::fault(format!("the robot broke the WebSocket protocol: {p}"))
+        }
+        other => Ending::ordinary(other.to_string()),
     }
 }

@@ -3,12 +3,17 @@
 //! channel), so a robot that logs to Foxglove needs nothing new.
 //!
 //! [`protocol`] parses one server message (pure: bytes in, typed message or typed error out);
-//! [`client`] runs one robot's connection on its own thread with reconnection; [`robot`] turns
-//! its messages into frames with statistics and an optional bit-exact recording ([`recorder`]);
-//! [`serve`] plays a stream as a Foxglove WebSocket server (`eotn serve`, a stand-in robot);
+//! [`channels`] keeps one connection's channels within the client's [`Limits`]; [`client`] runs
+//! one robot's connection on its own thread with deadlines and reconnection; [`robot`] turns its
+//! messages into frames with statistics ([`gaps`]: lost frames) and an optional bit-exact
+//! recording ([`recorder`]); [`serve`] plays a stream as a Foxglove WebSocket server (`eotn
+//! serve`, a stand-in robot) behind a [`gate`] that bounds its viewers;
 //! [`source`] is a robot as a [`crate::sources::FrameSource`] for the workspace and the app.
 
+pub mod channels;
 pub mod client;
+pub mod gaps;
+pub mod gate;
 pub mod protocol;
 pub mod recorder;
 pub mod robot;
@@ -17,7 +22,7 @@ pub mod source;
 
 use std::fmt;
 
-pub use client::{ClientOptions, LiveEvent, RobotClient};
+pub use client::{ClientOptions, Limits, LiveEvent, RobotClient};
 pub use recorder::LiveRecorder;
 pub use robot::{Connection, LiveFrame, LiveRobot, RobotFrames, RobotStats};
 pub use source::NetworkSource;

@@ -5,8 +5,11 @@
 //! Only what a viewer needs is typed (`serverInfo`, `status`, `advertise`, `unadvertise`, message
 //! data, time); other operations are [`ServerMessage::Other`] and ignored by the client.
 
+use std::fmt;
+
 use base64::Engine as _;
 use serde::Deserialize;
+use serde::de::{DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
 
 /// Binary opcode of a message-data frame: subscription id (u32 LE), log time (u64 LE, ns), payload.
 pub const OP_MESSAGE_DATA: u8 = 0x01;
@@ -16,7 +19,7 @@ pub const OP_TIME: u8 = 0x02;
 const MESSAGE_DATA_HEADER: usize = 1 + 4 + 8;
 
 /// A channel the server advertised.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct AdvertisedChannel {
     /// Server-chosen channel id.
     pub id: u32,
@@ -48,8 +51,14 @@ pub enum ServerMessage<'a> {
         /// The text.
         message: String,
     },
-    /// New channels.
-    Advertise(Vec<AdvertisedChannel>),
+    /// New channels: at most the cap [`parse_text`] was given, the rest only counted (an
+    /// endless list costs no memory).
+    Advertise {
+        /// The channels kept, in the order they came.
+        channels: Vec<AdvertisedChannel>,
+        /// Channels in the message beyond the cap, not parsed into memory.
+        beyond: usize,
+    },
     /// Channels that are gone.
     Unadvertise(Vec<u32>),
     /// One message on a subscription.
@@ -132,9 +141,88 @@ struct ChannelJson {
     schema_encoding: Option<String>,
 }
 
-#[derive(Deserialize)]
-struct AdvertiseJson {
-    channels: Vec<ChannelJson>,
+/// An `advertise` message's channels, at most `cap` of them parsed; the rest are skipped over
+/// (counted in `beyond`), so a message listing a million channels allocates only `cap`.
+#[derive(Default)]
+struct CappedChannels {
+    kept: Vec<ChannelJson>,
+    beyond: usize,
+}
+
+/// Reads an `advertise` object (the `channels` field through [`ChannelsSeed`]; others skipped).
+struct AdvertiseSeed(usize);
+
+/// Reads a list of channels, keeping the first `.0`.
+struct ChannelsSeed(usize);
+
+impl<'de> DeserializeSeed<'de> for AdvertiseSeed {
+    type Value = CappedChannels;
+
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        d.deserialize_map(self)
+    }
+}
+
+impl<'de> Visitor<'de> for AdvertiseSeed {
+    type Value = CappedChannels;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("an advertise object")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        let mut channels = None;
+        while let Some(key) = map.next_key::<std::borrow::Cow<'de, str>>()? {
+            if key == "channels" {
+                channels = Some(map.next_value_seed(ChannelsSeed(self.0))?);
+            } else {
+                map.next_value::<IgnoredAny>()?;
+            }
+        }
+        channels.ok_or_else(|| serde::de::Error::missing_field("channels"))
+    }
+}
+
+impl<'de> DeserializeSeed<'de> for ChannelsSeed {
+    type Value = CappedChannels;
+
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        d.deserialize_seq(self)
+    }
+}
+
+impl<'de> Visitor<'de> for ChannelsSeed {
+    type Value = CappedChannels;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a list of channels")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let mut out = CappedChannels::default();
+        while out.kept.len() < self.0 {
+            match seq.next_element::<ChannelJson>()? {
+                Some(c) => out.kept.push(c),
+                None => return Ok(out),
+            }
+        }
+        while seq.next_element::<IgnoredAny>()?.is_some() {
+            out.beyond += 1;
+        }
+        Ok(out)
+    }
+}
+
+/// Parses an `advertise` message's channels, at most `cap`.
+fn advertise_fields(text: &str, cap: usize) -> Result<CappedChannels, ProtocolError> {
+    let bad = |e: serde_json::Error| ProtocolError::BadFields {
+        op: "advertise".to_owned(),
+        detail: e.to_string(),
+    };
+    let mut de = serde_json::Deserializer::from_str(text);
+    let channels = AdvertiseSeed(cap).deserialize(&mut de).map_err(bad)?;
+    de.end().map_err(bad)?;
+    Ok(channels)
 }
 
 #[derive(Deserialize)]
@@ -155,11 +243,15 @@ fn is_binary_schema(schema_encoding: &str) -> bool {
     matches!(schema_encoding, "protobuf" | "flatbuffer")
 }
 
-/// Parses one text (JSON) message from the server.
+/// Parses one text (JSON) message from the server; of an `advertise` message at most
+/// `max_channels` channels are parsed (the rest are counted in its `beyond`).
 ///
 /// # Errors
 /// [`ProtocolError`] saying what is wrong with it.
-pub fn parse_text(text: &str) -> Result<ServerMessage<'static>, ProtocolError> {
+pub fn parse_text(
+    text: &str,
+    max_channels: usize,
+) -> Result<ServerMessage<'static>, ProtocolError> {
     let op: Op = serde_json::from_str(text).map_err(|e| ProtocolError::BadJson(e.to_string()))?;
     Ok(match op.op.as_str() {
         "serverInfo" => ServerMessage::ServerInfo {
@@ -173,9 +265,9 @@ pub fn parse_text(text: &str) -> Result<ServerMessage<'static>, ProtocolError> {
             }
         }
         "advertise" => {
-            let a: AdvertiseJson = fields(&op.op, text)?;
-            let mut channels = Vec::with_capacity(a.channels.len());
-            for c in a.channels {
+            let a = advertise_fields(text, max_channels)?;
+            let mut channels = Vec::with_capacity(a.kept.len());
+            for c in a.kept {
                 let schema_encoding = c.schema_encoding.unwrap_or_default();
                 let schema = if is_binary_schema(&schema_encoding) {
                     base64::engine::general_purpose::STANDARD
@@ -196,7 +288,10 @@ pub fn parse_text(text: &str) -> Result<ServerMessage<'static>, ProtocolError> {
                     schema,
                 });
             }
-            ServerMessage::Advertise(channels)
+            ServerMessage::Advertise {
+                channels,
+                beyond: a.beyond,
+            }
         }
         "unadvertise" => {
             ServerMessage::Unadvertise(fields::<UnadvertiseJson>(&op.op, text)?.channel_ids)
@@ -303,8 +398,12 @@ mod tests {
         let text = r#"{"op":"advertise","channels":[
             {"id":1,"topic":"/camera/image","encoding":"protobuf","schemaName":"foxglove.RawImage","schema":"AAEC","schemaEncoding":"protobuf"},
             {"id":2,"topic":"/sensors","encoding":"json","schemaName":"eotn.SensorReadings","schema":"{\"type\":\"object\"}","schemaEncoding":"jsonschema"}]}"#;
-        let Ok(ServerMessage::Advertise(channels)) = parse_text(text) else {
-            panic!("not parsed as advertise: {:?}", parse_text(text));
+        let Ok(ServerMessage::Advertise {
+            channels,
+            beyond: 0,
+        }) = parse_text(text, 8)
+        else {
+            panic!("not parsed as advertise: {:?}", parse_text(text, 8));
         };
         assert_eq!(channels[0].schema, vec![0, 1, 2]);
         assert_eq!(channels[1].schema, br#"{"type":"object"}"#.to_vec());
@@ -312,21 +411,55 @@ mod tests {
     }
 
     #[test]
+    fn an_advertise_past_the_cap_keeps_the_first_channels_and_counts_the_rest() {
+        let channels: Vec<String> = (0..10)
+            .map(|i| {
+                format!(
+                    r#"{{"id":{i},"topic":"/t{i}","encoding":"json","schemaName":"s","schema":"{{}}"}}"#
+                )
+            })
+            .collect();
+        let text = format!(
+            r#"{{"op":"advertise","extra":[1,2],"channels":[{}]}}"#,
+            channels.join(",")
+        );
+        let Ok(ServerMessage::Advertise { channels, beyond }) = parse_text(&text, 3) else {
+            panic!("{:?}", parse_text(&text, 3));
+        };
+        assert_eq!(channels.len(), 3);
+        assert_eq!(channels[2].topic, "/t2");
+        assert_eq!(beyond, 7);
+        // A malformed channel within the cap makes the message malformed; past it, only its
+        // JSON syntax is read.
+        let bad = text.replace(r#""id":1,"#, r#""id":"one","#);
+        assert!(parse_text(&bad, 3).is_err());
+        let past = text.replace(r#""id":9,"#, r#""id":"nine","#);
+        assert!(parse_text(&past, 3).is_ok());
+        assert!(matches!(
+            parse_text(r#"{"op":"advertise"}"#, 3),
+            Err(ProtocolError::BadFields { .. })
+        ));
+    }
+
+    #[test]
     fn garbage_text_and_mistyped_fields_are_errors_and_unknown_ops_are_other() {
         assert!(matches!(
-            parse_text("not json"),
+            parse_text("not json", 8),
             Err(ProtocolError::BadJson(_))
         ));
         assert!(matches!(
-            parse_text(r#"{"op":"advertise","channels":5}"#),
+            parse_text(r#"{"op":"advertise","channels":5}"#, 8),
             Err(ProtocolError::BadFields { .. })
         ));
         assert_eq!(
-            parse_text(r#"{"op":"parameterValues","parameters":[]}"#),
+            parse_text(r#"{"op":"parameterValues","parameters":[]}"#, 8),
             Ok(ServerMessage::Other("parameterValues".to_owned()))
         );
         assert_eq!(
-            parse_text(r#"{"op":"serverInfo","name":"robot3","capabilities":[]}"#),
+            parse_text(
+                r#"{"op":"serverInfo","name":"robot3","capabilities":[]}"#,
+                8
+            ),
             Ok(ServerMessage::ServerInfo {
                 name: "robot3".to_owned()
             })

@@ -5,8 +5,9 @@
 //! next image arrives, or [`LiveRecorder::tick`] finds the robot quiet, so a recording cut off by
 //! a crash or `kill -9` is readable as `OUT.partial` up to its last frame or so.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::RobotUrl;
@@ -18,13 +19,39 @@ use crate::streams::{
 /// A chunk with messages in it is closed after this long without a new image.
 const QUIET_CLOSE: Duration = Duration::from_millis(200);
 
+/// Distinct channels one recording holds (a channel advertised again with another encoding or
+/// schema counts as another). Messages on channels past it are not written: a robot that
+/// advertises new channels without end (withdrawing each before the next) cannot grow the
+/// recorder's memory or the file's summary without bound.
+pub const MAX_CHANNELS: usize = 256;
+
+/// Longest file-name stem [`file_stem`] makes from a robot's name, bytes (file systems allow
+/// 255, and `-N.mcap.partial` follows it).
+pub const MAX_STEM_BYTES: usize = 100;
+
+/// What became of one message given to [`LiveRecorder::message`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Recorded {
+    /// Written.
+    Written,
+    /// Not written: its channel would be one more than [`MAX_CHANNELS`].
+    OverChannelLimit,
+}
+
 /// An open recording of one robot.
 #[derive(Debug)]
 pub struct LiveRecorder {
     path: PathBuf,
     writer: StreamWriter,
-    /// The writer's view of each channel, by (channel id, topic): ids change on reconnection.
-    specs: HashMap<(u32, String), RawChannelSpec>,
+    /// The channels written so far, as the writer knows them (topic, encodings, schema): a
+    /// channel advertised again differently is written as a new channel. At most
+    /// [`MAX_CHANNELS`].
+    written: HashSet<Arc<RawChannelSpec>>,
+    /// Each advertised channel (ids change on reconnection) → its entry of `written`; a cache of
+    /// at most [`MAX_CHANNELS`] entries, emptied when full.
+    specs: HashMap<Arc<AdvertisedChannel>, Arc<RawChannelSpec>>,
+    /// Messages not written because of [`MAX_CHANNELS`].
+    over_limit: u64,
     messages: u64,
     unflushed: bool,
     last_write: Instant,
@@ -45,7 +72,9 @@ impl LiveRecorder {
         Ok(Self {
             path: path.to_owned(),
             writer: StreamWriter::create_with(path, info, options)?,
+            written: HashSet::new(),
             specs: HashMap::new(),
+            over_limit: 0,
             messages: 0,
             unflushed: false,
             last_write: Instant::now(),
@@ -70,29 +99,50 @@ impl LiveRecorder {
         self.messages
     }
 
-    /// Appends one message exactly as it arrived.
+    /// Messages not written so far because the recording had [`MAX_CHANNELS`] channels.
+    #[must_use]
+    pub fn over_limit(&self) -> u64 {
+        self.over_limit
+    }
+
+    /// Appends one message exactly as it arrived (unless its channel would be one too many).
     ///
     /// # Errors
     /// I/O errors naming the file.
     pub fn message(
         &mut self,
-        channel: &AdvertisedChannel,
+        channel: &Arc<AdvertisedChannel>,
         log_time_ns: u64,
         payload: &[u8],
-    ) -> Result<(), StreamError> {
-        let key = (channel.id, channel.topic.clone());
-        let spec = self.specs.entry(key).or_insert_with(|| RawChannelSpec {
-            topic: channel.topic.clone(),
-            message_encoding: channel.encoding.clone(),
-            schema_name: channel.schema_name.clone(),
-            schema_encoding: channel.schema_encoding.clone(),
-            schema: channel.schema.clone(),
-        });
-        self.writer.write_raw(spec, log_time_ns, payload)?;
+    ) -> Result<Recorded, StreamError> {
+        let spec = match self.specs.get(channel) {
+            Some(spec) => Arc::clone(spec),
+            None => {
+                let spec = raw_spec(channel);
+                let spec = match self.written.get(&spec) {
+                    Some(known) => Arc::clone(known),
+                    None if self.written.len() >= MAX_CHANNELS => {
+                        self.over_limit += 1;
+                        return Ok(Recorded::OverChannelLimit);
+                    }
+                    None => {
+                        let spec = Arc::new(spec);
+                        self.written.insert(Arc::clone(&spec));
+                        spec
+                    }
+                };
+                if self.specs.len() >= MAX_CHANNELS {
+                    self.specs.clear();
+                }
+                self.specs.insert(Arc::clone(channel), Arc::clone(&spec));
+                spec
+            }
+        };
+        self.writer.write_raw(&spec, log_time_ns, payload)?;
         self.messages += 1;
         self.unflushed = true;
         self.last_write = Instant::now();
-        Ok(())
+        Ok(Recorded::Written)
     }
 
     /// Closes the open chunk when nothing has arrived for a while (call it now and then).
@@ -117,12 +167,24 @@ impl LiveRecorder {
     }
 }
 
+/// How the writer records a channel: as it was advertised.
+fn raw_spec(channel: &AdvertisedChannel) -> RawChannelSpec {
+    RawChannelSpec {
+        topic: channel.topic.clone(),
+        message_encoding: channel.encoding.clone(),
+        schema_name: channel.schema_name.clone(),
+        schema_encoding: channel.schema_encoding.clone(),
+        schema: channel.schema.clone(),
+    }
+}
+
 /// A recording's file name (without `.mcap`) from a robot's server name: letters, digits, `-`,
-/// `_`, `.` kept, the rest `_`; the address when nothing is left.
+/// `_`, `.` kept, the rest `_`, at most [`MAX_STEM_BYTES`]; the address when nothing is left.
 #[must_use]
 pub fn file_stem(name: &str, url: &RobotUrl) -> String {
     let stem: String = name
         .chars()
+        .take(MAX_STEM_BYTES)
         .map(|c| {
             if c.is_ascii_alphanumeric() || "-_.".contains(c) {
                 c

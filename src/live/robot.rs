@@ -12,8 +12,9 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use super::client::{ClientOptions, LiveEvent, RobotClient};
+use super::gaps::{FrameGaps, Gap};
 use super::protocol::AdvertisedChannel;
-use super::recorder::LiveRecorder;
+use super::recorder::{LiveRecorder, MAX_CHANNELS, Recorded};
 use super::{RobotUrl, unix_time_ns};
 use crate::sensors::SensorReadings;
 use crate::streams::schema::{decode_image_with_time, parse_json_lenient};
@@ -91,6 +92,16 @@ pub struct RobotStats {
     pub connections: usize,
     /// Frames written to the open recording, if any.
     pub recorded: Option<usize>,
+    /// The robot's latest misbehaviour, one line (garbage, a message too large, a deadline
+    /// missed, a limit reached), with how often it happened; kept after it reconnects.
+    pub problem: Option<String>,
+}
+
+/// A robot's latest misbehaviour and how many times in a row it was the same.
+#[derive(Debug, Clone, Default)]
+struct Problem {
+    text: String,
+    times: usize,
 }
 
 #[derive(Default)]
@@ -105,7 +116,12 @@ struct Inner {
     arrivals: VecDeque<Instant>,
     latencies: VecDeque<u64>,
     gaps: FrameGaps,
-    pending: Vec<(Arc<AdvertisedChannel>, u64, Vec<u8>)>,
+    /// JSON messages waiting for their frame's image, and their bytes (bounded by the client's
+    /// [`super::Limits`]: `queue`, messages and bytes).
+    pending: VecDeque<(Arc<AdvertisedChannel>, u64, Vec<u8>)>,
+    pending_bytes: usize,
+    queue: (usize, usize),
+    problem: Option<Problem>,
     recorder: Option<LiveRecorder>,
     log: VecDeque<String>,
     /// When the first frame arrived (the origin of the arrival times).
@@ -252,6 +268,7 @@ impl LiveRobot {
     ) -> std::io::Result<Self> {
         let shared = Arc::new(Mutex::new(Inner {
             connection: Some(Connection::Connecting),
+            queue: (options.limits.queue_messages, options.limits.queue_bytes),
             ..Inner::default()
         }));
         let client = RobotClient::spawn(url.clone(), options, {
@@ -393,10 +410,10 @@ impl LiveRobot {
 }
 
 impl Drop for LiveRobot {
+    /// Tells the connection thread to end (without waiting: the UI never waits on a socket) and
+    /// finishes the recording with what has arrived.
     fn drop(&mut self) {
-        if let Some(c) = self.client.take() {
-            c.stop();
-        }
+        drop(self.client.take());
         if let Ok(Some((path, _))) = self.stop_recording() {
             log::info!("recording finished: {}", path.display());
         }
@@ -437,6 +454,23 @@ impl Inner {
             latency_p99_ms: percentile(&sorted, 0.99),
             connections: self.connections,
             recorded: self.recorder.as_ref().map(LiveRecorder::frames),
+            problem: self.problem.as_ref().map(|p| match p.times {
+                1 => p.text.clone(),
+                n => format!("{} ({n} times)", p.text),
+            }),
+        }
+    }
+
+    /// Notes a misbehaviour: the robots list shows the latest.
+    fn problem(&mut self, text: &str) {
+        match &mut self.problem {
+            Some(p) if p.text == text => p.times += 1,
+            _ => {
+                self.problem = Some(Problem {
+                    text: text.to_owned(),
+                    times: 1,
+                });
+            }
         }
     }
 
@@ -480,13 +514,26 @@ impl Inner {
                 self.note(format!("robot says {s}"));
                 false
             }
-            LiveEvent::Disconnected { reason, retry_in } => {
+            LiveEvent::Warning(w) => {
+                self.problem(&w);
+                self.note(w);
+                false
+            }
+            LiveEvent::Disconnected {
+                reason,
+                fault,
+                retry_in,
+            } => {
+                if fault {
+                    self.problem(&reason);
+                }
                 if !matches!(&self.connection, Some(Connection::Disconnected { reason: r, .. }) if *r == reason)
                 {
                     self.note(format!("disconnected: {reason}; reconnecting"));
                 }
                 self.connection = Some(Connection::Disconnected { reason, retry_in });
                 self.pending.clear();
+                self.pending_bytes = 0;
                 if let Some(r) = self.recorder.as_mut()
                     && let Err(e) = r.tick()
                 {
@@ -500,11 +547,7 @@ impl Inner {
                 received_ns,
                 payload,
             } => {
-                if let Some(r) = self.recorder.as_mut()
-                    && let Err(e) = r.message(&channel, log_time_ns, &payload)
-                {
-                    self.recording_failed(&e);
-                }
+                self.record(&channel, log_time_ns, &payload);
                 if is_image(&channel) {
                     self.image(log_time_ns, received_ns, &payload, keep_bytes)
                 } else {
@@ -514,6 +557,26 @@ impl Inner {
                     false
                 }
             }
+        }
+    }
+
+    /// Writes one message to the recording, if one runs.
+    fn record(&mut self, channel: &Arc<AdvertisedChannel>, log_time_ns: u64, payload: &[u8]) {
+        let Some(r) = self.recorder.as_mut() else {
+            return;
+        };
+        match r.message(channel, log_time_ns, payload) {
+            Ok(Recorded::Written) => {}
+            Ok(Recorded::OverChannelLimit) => {
+                if r.over_limit() == 1 {
+                    let w = format!(
+                        "the recording holds {MAX_CHANNELS} channels: messages on later channels are not written"
+                    );
+                    self.problem(&w);
+                    self.note(w);
+                }
+            }
+            Err(e) => self.recording_failed(&e),
         }
     }
 
@@ -538,6 +601,7 @@ impl Inner {
             )),
         }
         let mut record = FrameRecord::new(log_time_ns, frame);
+        self.pending_bytes = 0;
         for (channel, time, bytes) in std::mem::take(&mut self.pending) {
             if time == log_time_ns
                 && let Some(n) = attach(&mut record, &channel, &bytes)
@@ -591,68 +655,16 @@ impl Inner {
             }
         } else {
             self.pending.retain(|(_, t, _)| *t == log_time_ns);
-            if self.pending.len() < 64 {
-                self.pending.push((channel, log_time_ns, payload));
+            self.pending.push_back((channel, log_time_ns, payload));
+            self.pending_bytes = self.pending.iter().map(|(_, _, p)| p.len()).sum();
+            let (messages, bytes) = self.queue;
+            while self.pending.len() > messages || self.pending_bytes > bytes {
+                let Some((_, _, old)) = self.pending.pop_front() else {
+                    break;
+                };
+                self.pending_bytes -= old.len();
             }
         }
-    }
-}
-
-/// A jump in frame times this large (forward) is a clock change, not a network outage.
-const CLOCK_JUMP_NS: u64 = 60_000_000_000;
-
-/// What one frame's capture time says about the frames before it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Gap {
-    /// The next frame, or the first one.
-    Regular,
-    /// This many frames were lost: the gap held them (more than 1.5 frame periods).
-    Missed(usize),
-    /// The times went backwards or leapt ahead by more than [`CLOCK_JUMP_NS`]: a looping or
-    /// restarted sender, or one that switched clocks. Nothing can be said about losses.
-    ClockJump {
-        /// From the previous frame's time to this one's, nanoseconds.
-        by_ns: i128,
-    },
-}
-
-/// Counts lost frames from the gaps between capture times, learning the frame period as it goes.
-#[derive(Debug, Default, Clone)]
-struct FrameGaps {
-    /// The shortest recent gap, slowly averaged: the camera's frame period, nanoseconds.
-    period_ns: Option<f64>,
-    /// The previous frame's capture time, nanoseconds.
-    last_ns: Option<u64>,
-}
-
-impl FrameGaps {
-    /// After a reconnection the next frame starts afresh (its gap says nothing).
-    fn forget_last(&mut self) {
-        self.last_ns = None;
-    }
-
-    fn observe(&mut self, capture_ns: u64) -> Gap {
-        let Some(last) = self.last_ns.replace(capture_ns) else {
-            return Gap::Regular;
-        };
-        if capture_ns < last || capture_ns - last > CLOCK_JUMP_NS {
-            return Gap::ClockJump {
-                by_ns: i128::from(capture_ns) - i128::from(last),
-            };
-        }
-        let gap = (capture_ns - last) as f64;
-        if gap == 0.0 {
-            return Gap::Regular;
-        }
-        let verdict = match self.period_ns {
-            Some(period) if gap > 1.5 * period => {
-                Gap::Missed(((gap / period).round() as usize).saturating_sub(1))
-            }
-            _ => Gap::Regular,
-        };
-        // Slow average so one gap does not make the next frames look late.
-        self.period_ns = Some(self.period_ns.map_or(gap, |p| p.min(0.9 * p + 0.1 * gap)));
-        verdict
     }
 }
 
@@ -679,70 +691,4 @@ fn attach(record: &mut FrameRecord, channel: &AdvertisedChannel, bytes: &[u8]) -
 /// failing that, any topic).
 fn is_image(c: &AdvertisedChannel) -> bool {
     c.encoding == "protobuf" && (c.schema_name == "foxglove.RawImage" || c.topic == IMAGE_TOPIC)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{CLOCK_JUMP_NS, FrameGaps, Gap};
-
-    const PERIOD: u64 = 33_333_333;
-
-    fn observe_all(gaps: &mut FrameGaps, times: impl IntoIterator<Item = u64>) -> Vec<Gap> {
-        times.into_iter().map(|t| gaps.observe(t)).collect()
-    }
-
-    #[test]
-    fn regular_frames_lose_nothing_and_a_gap_counts_the_frames_it_held() {
-        let mut gaps = FrameGaps::default();
-        let verdicts = observe_all(&mut gaps, (0..10).map(|i| 1_000 + i * PERIOD));
-        assert!(verdicts.iter().all(|v| *v == Gap::Regular), "{verdicts:?}");
-        // Frames 10, 11 and 12 never came.
-        assert_eq!(gaps.observe(1_000 + 13 * PERIOD), Gap::Missed(3));
-        assert_eq!(gaps.observe(1_000 + 14 * PERIOD), Gap::Regular);
-    }
-
-    #[test]
-    fn a_looping_sender_starting_over_is_a_clock_jump_not_a_loss() {
-        let mut gaps = FrameGaps::default();
-        let times = (0..30)
-            .map(|i| i * PERIOD)
-            .chain((0..30).map(|i| i * PERIOD));
-        let verdicts = observe_all(&mut gaps, times);
-        let jumps = verdicts
-            .iter()
-            .filter(|v| matches!(v, Gap::ClockJump { by_ns } if *by_ns < 0))
-            .count();
-        assert_eq!(jumps, 1, "{verdicts:?}");
-        assert!(!verdicts.iter().any(|v| matches!(v, Gap::Missed(_))));
-    }
-
-    #[test]
-    fn a_switch_from_stream_time_to_wall_clock_time_is_not_billions_of_drops() {
-        // A sender whose first image has no timestamp (its log time, the Unix clock, stands in),
-        // then stream times from 0, then the Unix clock again when it loops.
-        let unix = 1_796_000_000_000_000_000;
-        let mut gaps = FrameGaps::default();
-        let times = [unix]
-            .into_iter()
-            .chain((1..30).map(|i| i * PERIOD))
-            .chain([unix + 2_000_000_000]);
-        let verdicts = observe_all(&mut gaps, times);
-        assert!(
-            !verdicts.iter().any(|v| matches!(v, Gap::Missed(_))),
-            "{verdicts:?}"
-        );
-        assert!(
-            matches!(verdicts.last(), Some(Gap::ClockJump { by_ns }) if *by_ns > CLOCK_JUMP_NS.into())
-        );
-    }
-
-    #[test]
-    fn after_a_reconnection_the_first_gap_is_not_judged() {
-        let mut gaps = FrameGaps::default();
-        observe_all(&mut gaps, (0..10).map(|i| i * PERIOD));
-        gaps.forget_last();
-        // Twenty seconds later: the outage is the disconnection's, already reported.
-        assert_eq!(gaps.observe(20_000_000_000), Gap::Regular);
-        assert_eq!(gaps.observe(20_000_000_000 + PERIOD), Gap::Regular);
-    }
 }

@@ -1,19 +1,25 @@
 //! [`StandInRobot`]: a Foxglove WebSocket server (the SDK's own, the `foxglove` crate) that
 //! plays a stream's frames at their recorded rate, as a robot would send them: `eotn serve`.
 //!
+//! The `foxglove` server listens on loopback only; viewers connect to the [`Gate`] in front of
+//! it, which bounds clients, handshakes and each viewer's queue (see [`super::gate`]). A frame
+//! that cannot be read (a damaged chunk) is skipped with a warning, as `eotn detect` skips it.
+//!
 //! Each frame goes out as its `foxglove.RawImage` (encoding `yuyv`, the streams' default) on
 //! `/camera/image`, then its sensor readings on
 //! `/sensors` and its other JSON channels, all with the same log time: the moment it is sent
 //! (this machine's clock), so a viewer can measure its latency.
 
 use std::collections::HashMap;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use foxglove::websocket::{ChannelView, Client, ServerListener};
 use foxglove::{ChannelBuilder, Context, PartialMetadata, RawChannel, Schema, WebSocketServer};
 
+use super::gate::{Gate, GateFigures, GateOptions};
 use super::unix_time_ns;
 use crate::streams::schema::{
     EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, ImageEncoding, ImageMessageError,
@@ -47,6 +53,12 @@ pub enum ServeError {
     /// The stream could not be read.
     #[error(transparent)]
     Stream(#[from] StreamError),
+    /// No frame of the stream could be read or sent (every chunk damaged).
+    #[error("none of the stream's {frames} frames could be read")]
+    Unreadable {
+        /// Frames the stream has.
+        frames: usize,
+    },
     /// A frame could not be sent.
     #[error("frame {index}: {error}")]
     Frame {
@@ -93,10 +105,36 @@ impl ServerListener for ViewerFlag {
     }
 }
 
+/// Messages the `foxglove` server queues per viewer. Its queues feed the gate's relays, which
+/// drain them at once; the viewers' own bounds are the gate's [`super::gate::QueueBound`].
+const INNER_BACKLOG: usize = 64;
+
+/// The tokio runtime every stand-in robot of this process runs on (the gate's tasks and the
+/// `foxglove` server's), started with the first.
+fn runtime() -> Result<&'static tokio::runtime::Runtime, String> {
+    static RUNTIME: OnceLock<Result<tokio::runtime::Runtime, String>> = OnceLock::new();
+    RUNTIME
+        .get_or_init(|| {
+            tokio::runtime::Builder::new_multi_thread()
+                .worker_threads(2)
+                .thread_name("eotn-serve")
+                .enable_all()
+                .build()
+                .map_err(|e| e.to_string())
+        })
+        .as_ref()
+        .map_err(Clone::clone)
+}
+
 /// A running Foxglove WebSocket server with the stream's channels.
 pub struct StandInRobot {
     context: Arc<Context>,
     handle: Option<foxglove::WebSocketServerHandle>,
+    gate: Gate,
+    /// Frames sent so far (shared with the gate, which counts what slow viewers miss).
+    frames_sent: Arc<AtomicU64>,
+    /// Frames skipped because they could not be read, in all passes.
+    skipped: usize,
     image: Arc<RawChannel>,
     sensors: Arc<RawChannel>,
     json: HashMap<String, Arc<RawChannel>>,
@@ -114,11 +152,31 @@ impl std::fmt::Debug for StandInRobot {
 }
 
 impl StandInRobot {
-    /// Starts the server on `host:port` (port 0: any free port) under the server name `name`.
+    /// Starts the server on `host:port` (port 0: any free port) under the server name `name`,
+    /// with the gate's default bounds.
     ///
     /// # Errors
     /// [`ServeError::Listen`] when it cannot listen.
     pub fn start(name: &str, host: &str, port: u16) -> Result<Self, ServeError> {
+        Self::start_with(name, host, port, GateOptions::default())
+    }
+
+    /// Starts the server on `host:port` (port 0: any free port) under the server name `name`,
+    /// admitting viewers as `options` say.
+    ///
+    /// # Errors
+    /// [`ServeError::Listen`] when it cannot listen.
+    pub fn start_with(
+        name: &str,
+        host: &str,
+        port: u16,
+        options: GateOptions,
+    ) -> Result<Self, ServeError> {
+        let listen_error = |detail: String| ServeError::Listen {
+            addr: format!("{host}:{port}"),
+            detail,
+        };
+        let runtime = runtime().map_err(listen_error)?;
         let context = Context::new();
         let viewer = Arc::new(AtomicBool::new(false));
         let channel = |topic: &str, encoding: &str, schema: Option<Schema>| {
@@ -138,20 +196,38 @@ impl StandInRobot {
             "json",
             Some(json_schema(SENSORS_SCHEMA_NAME, &sensors_json_schema())),
         )?;
-        let handle = WebSocketServer::new()
+        let server = WebSocketServer::new()
             .name(name)
-            .bind(host, port)
+            .bind("127.0.0.1", 0)
             .context(&context)
-            .listener(Arc::new(ViewerFlag(Arc::clone(&viewer))))
-            .start_blocking()
-            .map_err(|e| ServeError::Listen {
-                addr: format!("{host}:{port}"),
-                detail: e.to_string(),
-            })?;
-        let port = handle.port();
+            .message_backlog_size(INNER_BACKLOG)
+            .listener(Arc::new(ViewerFlag(Arc::clone(&viewer))));
+        // Started inside our runtime, the server runs its tasks on it.
+        let handle = runtime
+            .block_on(server.start())
+            .map_err(|e| listen_error(e.to_string()))?;
+        let inner = SocketAddr::from(([127, 0, 0, 1], handle.port()));
+        let frames_sent = Arc::new(AtomicU64::new(0));
+        let gate = match Gate::start(
+            runtime.handle(),
+            (host, port),
+            inner,
+            Arc::clone(&frames_sent),
+            options,
+        ) {
+            Ok(gate) => gate,
+            Err(e) => {
+                drop(handle.stop());
+                return Err(listen_error(e.to_string()));
+            }
+        };
+        let port = gate.port();
         Ok(Self {
             context,
             handle: Some(handle),
+            gate,
+            frames_sent,
+            skipped: 0,
             image,
             sensors,
             json: HashMap::new(),
@@ -165,6 +241,18 @@ impl StandInRobot {
     #[must_use]
     pub fn port(&self) -> u16 {
         self.port
+    }
+
+    /// The gate's figures: viewers, refusals, frames dropped for slow viewers.
+    #[must_use]
+    pub fn figures(&self) -> GateFigures {
+        self.gate.figures()
+    }
+
+    /// Frames skipped so far because they could not be read (damaged chunks).
+    #[must_use]
+    pub const fn skipped(&self) -> usize {
+        self.skipped
     }
 
     /// True once a viewer has subscribed to the images.
@@ -188,6 +276,7 @@ impl StandInRobot {
         let meta = PartialMetadata::with_log_time(unix_time_ns());
         let log_time = meta.log_time.unwrap_or(0);
         self.image.log_with_meta(&self.buf, meta);
+        self.frames_sent.fetch_add(1, Ordering::Relaxed);
         if let Some(s) = &record.sensors {
             let json = serde_json::to_vec(&s.sanitised().0).map_err(|source| SendError::Json {
                 topic: SENSORS_TOPIC.to_owned(),
@@ -243,10 +332,12 @@ impl StandInRobot {
 
     /// Plays a stream at its recorded rate (again and again with `looping`) until it ends or
     /// `stop` is set; returns the frames sent. With `wait_for_viewer` nothing is sent before a
-    /// viewer has subscribed to the images.
+    /// viewer has subscribed to the images. A frame that cannot be read or encoded (a damaged
+    /// chunk) is skipped, with a warning naming the frames on the first pass.
     ///
     /// # Errors
-    /// [`ServeError`] when a frame cannot be read or encoded.
+    /// [`ServeError::Unreadable`] when no frame of a pass could be sent; [`ServeError::Frame`]
+    /// when a channel cannot be made.
     pub fn play(
         &mut self,
         reader: &mut StreamReader,
@@ -259,9 +350,12 @@ impl StandInRobot {
             std::thread::sleep(Duration::from_millis(10));
         }
         let mut sent = 0;
+        let mut first_pass = true;
         loop {
+            let mut skipped = SkippedRun::default();
             let start = Instant::now();
             let first = reader.time_ns(0).unwrap_or(0);
+            let mut sent_in_pass = 0;
             for index in 0..reader.len() {
                 let offset = reader.time_ns(index).unwrap_or(first).saturating_sub(first);
                 let due = start + Duration::from_nanos(offset);
@@ -275,10 +369,35 @@ impl StandInRobot {
                 if stopped() {
                     return Ok(sent);
                 }
-                let record = reader.read(index)?;
-                self.send(&record)
-                    .map_err(|error| ServeError::Frame { index, error })?;
-                sent += 1;
+                let sent_frame = match reader.read(index) {
+                    Ok(record) => match self.send(&record) {
+                        Ok(_) => Ok(()),
+                        Err(error @ SendError::Channel { .. }) => {
+                            return Err(ServeError::Frame { index, error });
+                        }
+                        Err(e) => Err(format!("{}: {e}", reader.path().display())),
+                    },
+                    Err(e) => Err(e.to_string()),
+                };
+                match sent_frame {
+                    Ok(()) => {
+                        sent += 1;
+                        sent_in_pass += 1;
+                    }
+                    Err(why) => {
+                        self.skipped += 1;
+                        if first_pass {
+                            skipped.note(index, why);
+                        }
+                    }
+                }
+            }
+            drop(skipped);
+            first_pass = false;
+            if sent_in_pass == 0 && !reader.is_empty() {
+                return Err(ServeError::Unreadable {
+                    frames: reader.len(),
+                });
             }
             if !looping || reader.is_empty() {
                 return Ok(sent);
@@ -291,11 +410,70 @@ impl StandInRobot {
         }
     }
 
-    /// Stops the server, letting queued messages go out first.
-    pub fn stop(mut self) {
+    /// Stops the server, letting queued messages go out first (waiting at most a second for
+    /// viewers that do not read); the gate's figures at the end.
+    pub fn stop(mut self) -> GateFigures {
+        self.shutdown(true);
+        self.gate.figures()
+    }
+
+    fn shutdown(&mut self, wait: bool) {
         if let Some(h) = self.handle.take() {
-            h.stop().wait_blocking();
+            let stopping = h.stop();
+            if wait {
+                stopping.wait_blocking();
+                // The relays pass on what is queued and close their viewers.
+                let until = Instant::now() + Duration::from_secs(1);
+                while self.gate.figures().clients > 0 && Instant::now() < until {
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+            } else {
+                stopping.detach_all();
+            }
         }
+        self.gate.stop();
+    }
+}
+
+impl Drop for StandInRobot {
+    /// Stops the server without waiting.
+    fn drop(&mut self) {
+        self.shutdown(false);
+    }
+}
+
+/// Consecutive skipped frames, said as one warning when the run ends (as `eotn detect` says
+/// them).
+#[derive(Default)]
+struct SkippedRun(Option<(usize, usize, String)>);
+
+impl SkippedRun {
+    fn note(&mut self, index: usize, why: String) {
+        if let Some((_, last, _)) = self.0.as_mut()
+            && *last + 1 == index
+        {
+            *last = index;
+            return;
+        }
+        self.flush();
+        self.0 = Some((index, index, why));
+    }
+
+    fn flush(&mut self) {
+        if let Some((first, last, why)) = self.0.take() {
+            let frames = if first == last {
+                format!("frame {first}")
+            } else {
+                format!("frames {first}–{last}")
+            };
+            log::warn!("eotn serve: {frames} skipped, unreadable: {why}");
+        }
+    }
+}
+
+impl Drop for SkippedRun {
+    fn drop(&mut self) {
+        self.flush();
     }
 }
 

@@ -67,13 +67,14 @@ pub struct StreamWriter {
     frames_in_chunk: usize,
     frames: u32,
     buf: Vec<u8>,
-    /// Channels of [`StreamWriter::write_raw`] by topic (other than the fixed two).
-    raw_channels: HashMap<String, u16>,
+    /// Channels of [`StreamWriter::write_raw`] (other than the fixed two) by their whole
+    /// description: a topic advertised again with another encoding or schema is a new channel.
+    raw_channels: HashMap<RawChannelSpec, u16>,
 }
 
 /// A channel whose messages are recorded as they arrive ([`StreamWriter::write_raw`]): a live
 /// robot's channel as its server advertised it.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct RawChannelSpec {
     /// Topic, e.g. `/camera/image`.
     pub topic: String,
@@ -416,7 +417,7 @@ impl StreamWriter {
             self.image_channel
         } else if spec.topic == SENSORS_TOPIC && spec.message_encoding == "json" {
             self.sensors_channel
-        } else if let Some(&id) = self.raw_channels.get(&spec.topic) {
+        } else if let Some(&id) = self.raw_channels.get(spec) {
             id
         } else {
             let schema = if spec.schema_name.is_empty() {
@@ -435,7 +436,7 @@ impl StreamWriter {
                     &BTreeMap::new(),
                 )
                 .map_err(self.mcap_err("cannot add a channel"))?;
-            self.raw_channels.insert(spec.topic.clone(), id);
+            self.raw_channels.insert(spec.clone(), id);
             id
         };
         self.put(channel, log_time_ns, data)?;

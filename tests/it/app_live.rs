@@ -2,6 +2,7 @@
 //! driven headlessly with egui_kittest; its frames arrive in the app state with their sensors.
 //! Camera ▸ Connect to robot…: two robots at once in the robots window, clicking one shows it,
 //! the Live switch holds the view while frames keep arriving, Record all writes one file each.
+//! A robot that sends garbage gets one orange line in the robots window.
 
 use std::time::Duration;
 
@@ -14,6 +15,7 @@ use eotn::workspace::Window;
 use crate::common::sim_stream;
 use crate::harness::{click_label, harness, harness_sized, run_steps_until, run_until};
 use crate::live::serve;
+use crate::live_peers::{Peer, garbage};
 
 /// How long a robot may take to deliver what a step waits for.
 const WITHIN: Duration = Duration::from_secs(30);
@@ -150,4 +152,40 @@ fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows
         let r = eotn::streams::StreamReader::open(&folder.join(format!("{name}.mcap"))).unwrap();
         assert!(r.len() >= 2, "{name}: {} frames", r.len());
     }
+}
+
+#[test]
+fn a_robot_that_sends_garbage_gets_one_line_in_the_robots_window_and_disconnects_at_once() {
+    let peer = Peer::start(garbage);
+    let mut h = harness_sized(Vec::new(), Vec2::new(1280.0, 800.0));
+    h.run_steps(4);
+    h.get_by_label("Camera").click();
+    h.run_steps(4);
+    h.get_by_label("Connect to robot…").click();
+    h.run_steps(4);
+    h.state_mut().robots.address.clear();
+    h.run_steps(4);
+    let field = h.get_by_label("address");
+    field.focus();
+    field.type_text(&peer.address());
+    h.run_steps(4);
+    h.get_by_label("Connect robot").click();
+    h.run_steps(4);
+    run_steps_until(&mut h, WITHIN, |a| {
+        a.state
+            .robots()
+            .first()
+            .is_some_and(|r| r.stats.problem.is_some())
+    });
+    // The robot gone, its line stays (and stops counting).
+    drop(peer);
+    std::thread::sleep(Duration::from_millis(300));
+    h.run_steps(4);
+    // One line, under the robot (its state line may say the same while it reconnects).
+    let problem = h.state().state.robots()[0].stats.problem.clone().unwrap();
+    assert!(!problem.contains('\n'), "{problem}");
+    assert_eq!(h.query_all_by_label(&problem).count(), 1, "{problem}");
+    h.get_by_label("Disconnect").click();
+    h.run_steps(2);
+    assert!(h.state().state.robots().is_empty());
 }

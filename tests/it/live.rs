@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use base64::Engine as _;
 use eotn::frame::{Frame, Yuv};
 use eotn::live::serve::StandInRobot;
-use eotn::live::{ClientOptions, LiveRobot, RobotUrl};
+use eotn::live::{ClientOptions, Limits, LiveRobot, RobotUrl};
 use eotn::sensors::SensorReadings;
 use eotn::streams::schema::{ImageEncoding, encode_image, raw_image_schema};
 use eotn::streams::{FrameRecord, StreamReader};
@@ -218,7 +218,10 @@ fn garbage_and_oversized_messages_close_only_their_own_robot() {
     });
     let mut good = StandInRobot::start("good", "127.0.0.1", 0).unwrap();
     let small_limit = ClientOptions {
-        max_message_bytes: 1 << 20,
+        limits: Limits {
+            max_message_bytes: 1 << 20,
+            ..Limits::default()
+        },
         ..fast_retry()
     };
     let bad_text = LiveRobot::connect(url(gport), fast_retry(), 1 << 20, None).unwrap();

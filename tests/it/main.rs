@@ -25,6 +25,7 @@ mod hardening;
 #[cfg(feature = "gui")]
 mod harness;
 mod live;
+mod live_peers;
 mod motion;
 mod overhead;
 mod patterns;
@@ -33,6 +34,7 @@ mod properties;
 mod real_data;
 mod recognition;
 mod robots;
+mod serve_load;
 mod sim;
 mod sim_table;
 mod snapshots;

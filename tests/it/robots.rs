@@ -199,6 +199,13 @@ fn stepping_back_holds_the_view_while_frames_arrive_and_are_recorded_and_live_re
     send_ticking(&mut w, &mut robot, 20..25);
     assert!(tick_until(&mut w, 5.0, |w| w.index() == 24));
     assert_eq!(w.frame(), Some(&frame(24)));
+    // A frame's sensors follow its image by a moment (through `eotn serve`'s relay, a little
+    // longer on a loaded machine): wait for the last one's.
+    assert!(tick_until(&mut w, 5.0, |w| {
+        w.robot_frames(id)
+            .and_then(|f| f.latest())
+            .is_some_and(|f| f.record.sensors.is_some())
+    }));
     // The sensor dialog's plots cover every frame that has arrived, with its readings.
     w.apply(Command::ShowWindow(Window::Sensors, true)).unwrap();
     assert!(tick_until(&mut w, 5.0, |w| w.sensor_series.points.len() == 25));
