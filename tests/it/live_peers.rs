@@ -289,7 +289,10 @@ fn a_silent_or_slow_peer_gives_a_deadline_line_and_cannot_hold_record_past_its_s
 fn disconnecting_a_robot_stuck_in_a_slow_handshake_is_immediate_and_ticks_never_wait() {
     let slow = Peer::start(slow_handshake);
     let mut w = Workspace::default();
-    w.apply(WsCommand::ConnectRobot(slow.address())).unwrap();
+    w.apply(WsCommand::from(
+        eotn::workspace::RobotsCommand::ConnectRobot(slow.address()),
+    ))
+    .unwrap();
     let id = w.robots()[0].id;
     let mut longest = Duration::ZERO;
     let until = Instant::now() + Duration::from_millis(800);
@@ -307,7 +310,10 @@ fn disconnecting_a_robot_stuck_in_a_slow_handshake_is_immediate_and_ticks_never_
         "a tick took {longest:?}"
     );
     let t = Instant::now();
-    w.apply(WsCommand::DisconnectRobot(id)).unwrap();
+    w.apply(WsCommand::from(
+        eotn::workspace::RobotsCommand::DisconnectRobot(id),
+    ))
+    .unwrap();
     let took = t.elapsed();
     eprintln!("Disconnect took {took:?}");
     // Measured 26 µs.
@@ -742,7 +748,10 @@ fn garbage_oversized_and_endless_advertisements_each_give_one_line_in_the_robots
     let flood = Peer::start(flood);
     let mut w = Workspace::default();
     for p in [&garbage, &big, &flood] {
-        w.apply(WsCommand::ConnectRobot(p.address())).unwrap();
+        w.apply(WsCommand::from(
+            eotn::workspace::RobotsCommand::ConnectRobot(p.address()),
+        ))
+        .unwrap();
     }
     let wanted = [
         "malformed message",
