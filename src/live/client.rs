@@ -166,7 +166,7 @@ pub const MAX_STATUS_BYTES: usize = 500;
 /// on its own (it looks at its stop flag every [`POLL`], or after a TCP connect attempt).
 const STOP_WAIT: Duration = Duration::from_millis(500);
 
-/// A robot's connection thread. [`RobotClient::stop`] ends it, waiting at most [`STOP_WAIT`];
+/// A robot's connection thread. [`RobotClient::stop`] ends it, waiting at most `STOP_WAIT`;
 /// dropping it only tells the thread to end and returns at once (the UI never waits on a
 /// socket).
 #[derive(Debug)]
@@ -212,7 +212,7 @@ impl RobotClient {
         self.stop.store(true, Ordering::Relaxed);
     }
 
-    /// Closes the connection and waits for the thread to end, at most [`STOP_WAIT`] (a thread
+    /// Closes the connection and waits for the thread to end, at most `STOP_WAIT` (a thread
     /// inside a TCP connect attempt ends when the attempt does, on its own). True when it ended.
     pub fn stop(mut self) -> bool {
         self.stop.store(true, Ordering::Relaxed);

@@ -12,7 +12,7 @@
 //! for the `foxglove` server, whose `accept` must never see `EMFILE`), and relays each admitted
 //! viewer to the `foxglove` server on loopback through an [`outbox::Outbox`] of its own: a slow
 //! viewer's oldest frames are dropped and counted, its subscriptions held back until it reads
-//! again, and no other viewer waits for it ([`relay`]).
+//! again, and no other viewer waits for it (`relay`).
 
 pub mod outbox;
 mod relay;
