@@ -24,6 +24,7 @@ mod hardening;
 #[cfg(feature = "gui")]
 mod harness;
 mod live;
+mod mcap_conformance;
 mod motion;
 mod overhead;
 mod patterns;

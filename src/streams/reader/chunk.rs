@@ -1,4 +1,5 @@
-//! A chunk record's body, read without copying: its schemas, channels and messages.
+//! A chunk record's body, read without copying: its schemas, channels and messages; and a run
+//! of message records outside chunks.
 
 use mcap::records::{Record, op};
 
@@ -6,7 +7,11 @@ use super::{MAX_CHUNK_BYTES, Msg};
 
 /// What the recovery scan needs from a chunk's records.
 pub(super) enum ChunkItem {
-    Schema(u16, String),
+    Schema {
+        id: u16,
+        name: String,
+        encoding: String,
+    },
     Channel(mcap::records::Channel),
     Message(u16, u64),
 }
@@ -17,7 +22,11 @@ pub(super) fn decode_chunk(
     mut each: impl FnMut(ChunkItem),
 ) -> Result<(), mcap::McapError> {
     for_each_chunk_record(body, |r| match r {
-        Record::Schema { header, .. } => each(ChunkItem::Schema(header.id, header.name)),
+        Record::Schema { header, .. } => each(ChunkItem::Schema {
+            id: header.id,
+            name: header.name,
+            encoding: header.encoding,
+        }),
         Record::Channel(c) => each(ChunkItem::Channel(c)),
         Record::Message { header, .. } => {
             each(ChunkItem::Message(header.channel_id, header.log_time));
@@ -39,6 +48,49 @@ pub(super) fn decode_chunk_messages(
             });
         }
     })
+}
+
+/// Parses a chunk record's body and calls `each` with every message's header and data.
+pub(super) fn for_each_chunk_message(
+    body: &[u8],
+    mut each: impl FnMut(&mcap::records::MessageHeader, &[u8]),
+) -> Result<(), mcap::McapError> {
+    for_each_chunk_record(body, |r| {
+        if let Record::Message { header, data } = r {
+            each(&header, &data);
+        }
+    })
+}
+
+/// Parses a run of whole records from the data section (outside chunks) into its messages;
+/// other records in the run are skipped.
+pub(super) fn decode_loose_messages(
+    mut bytes: &[u8],
+    out: &mut Vec<Msg>,
+) -> Result<(), mcap::McapError> {
+    while !bytes.is_empty() {
+        let (opcode, len) = match bytes.get(..9) {
+            Some(h) => (
+                h[0],
+                u64::from_le_bytes(h[1..9].try_into().unwrap_or([0xff; 8])),
+            ),
+            None => return Err(mcap::McapError::UnexpectedEof),
+        };
+        let body = usize::try_from(len)
+            .ok()
+            .and_then(|n| bytes.get(9..9usize.checked_add(n)?))
+            .ok_or(mcap::McapError::UnexpectedEof)?;
+        if opcode == op::MESSAGE
+            && let Record::Message { header, data } = mcap::parse_record(opcode, body)?
+        {
+            out.push(Msg {
+                channel: header.channel_id,
+                data: data.into_owned(),
+            });
+        }
+        bytes = &bytes[9 + body.len()..];
+    }
+    Ok(())
 }
 
 fn for_each_chunk_record(
