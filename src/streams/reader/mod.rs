@@ -32,6 +32,10 @@ mod summary;
 const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
 /// Largest chunk record read into memory, bytes (compressed or not); larger ones are corrupt.
 const MAX_CHUNK_BYTES: u64 = 1 << 30;
+/// The file's read buffer, bytes: small records read one after another come from it; reads
+/// at least this long bypass it. Each jump elsewhere (a message index, a frame's chunk) refills
+/// it, so it is kept small.
+const READ_BUFFER_BYTES: usize = 16 << 10;
 /// Largest summary-side record (message index, metadata) read, bytes.
 const MAX_INDEX_BYTES: u64 = 64 << 20;
 /// Warnings kept; later ones are only counted, so memory stays bounded on a bad file.
@@ -98,6 +102,8 @@ struct Msg {
 pub struct StreamReader {
     path: PathBuf,
     file: BufReader<File>,
+    /// Where `file` is, bytes; `None` after an I/O error (the next read seeks from the start).
+    pos: Option<u64>,
     file_len: u64,
     info: StreamInfo,
     /// The recognition parameter set the stream names (`eotn.recognition` metadata).
@@ -201,7 +207,8 @@ impl StreamReader {
         let file_len = meta.len();
         let mut reader = Self {
             path: path.to_owned(),
-            file: BufReader::with_capacity(64 << 10, file),
+            file: BufReader::with_capacity(READ_BUFFER_BYTES, file),
+            pos: None,
             file_len,
             info: StreamInfo::default(),
             param_set: None,
@@ -518,7 +525,18 @@ impl StreamReader {
             path: self.path.clone(),
             source,
         };
-        self.file.seek(SeekFrom::Start(offset)).map_err(io)?;
+        // A relative seek keeps the buffer when `offset` lies in it, so records read one after
+        // another (the data section walked, a record's body after its header) cost one read of
+        // the file, not one each; an absolute seek always drops it.
+        let delta = self
+            .pos
+            .take()
+            .and_then(|p| i64::try_from(i128::from(offset) - i128::from(p)).ok());
+        match delta {
+            Some(d) => self.file.seek_relative(d),
+            None => self.file.seek(SeekFrom::Start(offset)).map(drop),
+        }
+        .map_err(io)?;
         let mut got = 0;
         while got < buf.len() {
             match self.file.read(&mut buf[got..]) {
@@ -528,6 +546,7 @@ impl StreamReader {
                 Err(e) => return Err(io(e)),
             }
         }
+        self.pos = Some(offset + got as u64);
         Ok(got)
     }
 
