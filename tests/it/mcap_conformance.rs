@@ -378,3 +378,70 @@ fn frames_are_read_in_every_writer_layout() {
     }
     assert_eq!(layouts, 80);
 }
+
+/// Reads everything the reader offers of a damaged file: it opens or fails naming the file, and
+/// its frames and messages read or fail cleanly. Returns whether it opened with warnings.
+fn read_all_of_damaged(path: &Path) -> Option<bool> {
+    match StreamReader::open(path) {
+        Err(e) => {
+            assert!(e.to_string().contains("damaged.mcap"), "{e}");
+            None
+        }
+        Ok(mut r) => {
+            for i in 0..r.len() {
+                if let Err(e) = r.read(i) {
+                    assert!(e.to_string().contains("damaged.mcap"), "{e}");
+                }
+            }
+            if let Err(e) = r.for_each_message(|_| {}) {
+                assert!(e.to_string().contains("damaged.mcap"), "{e}");
+            }
+            Some(!r.warnings().is_empty())
+        }
+    }
+}
+
+/// A foreign file cut short anywhere, or with a byte changed anywhere, in the layouts that take
+/// each path (summary alone; the data section walked, messages outside chunks): never a panic;
+/// a cut file that opens says it was cut.
+#[test]
+fn damaged_foreign_files_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = Layout {
+        chunks: true,
+        statistics: true,
+        repeat_schemas: true,
+        repeat_channels: true,
+        message_indexes: true,
+        chunk_indexes: true,
+        summary_offsets: true,
+    };
+    let loose = Layout {
+        chunks: false,
+        message_indexes: false,
+        chunk_indexes: false,
+        ..full
+    };
+    let damaged = dir.path().join("damaged.mcap");
+    for layout in [full, loose] {
+        let p = dir.path().join("whole.mcap");
+        write_foreign(&p, layout, 8);
+        let bytes = std::fs::read(&p).unwrap();
+        for cut in (0..bytes.len()).step_by(5) {
+            std::fs::write(&damaged, &bytes[..cut]).unwrap();
+            if let Some(warned) = read_all_of_damaged(&damaged) {
+                assert!(
+                    warned,
+                    "{layout:?}: cut at {cut} of {} unreported",
+                    bytes.len()
+                );
+            }
+        }
+        for at in (0..bytes.len()).step_by(3) {
+            let mut changed = bytes.clone();
+            changed[at] ^= 0xa5;
+            std::fs::write(&damaged, &changed).unwrap();
+            read_all_of_damaged(&damaged);
+        }
+    }
+}

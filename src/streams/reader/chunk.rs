@@ -136,8 +136,61 @@ fn for_each_chunk_record(
                 }
                 reader.notify_read(n);
             }
-            LinearReadEvent::Record { data, opcode } => each(mcap::parse_record(opcode, data)?),
+            // Only the records the reader uses are parsed: mcap 0.26's parser panics on some
+            // others when damaged (an attachment too short for its CRC), and they are skipped.
+            LinearReadEvent::Record { data, opcode }
+                if matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE) =>
+            {
+                each(mcap::parse_record(opcode, data)?);
+            }
+            LinearReadEvent::Record { .. } => {}
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An uncompressed chunk record's body holding `records`, without a CRC.
+    fn chunk_body(records: &[u8]) -> Vec<u8> {
+        let mut b = Vec::new();
+        b.extend(0u64.to_le_bytes()); // message start time
+        b.extend(0u64.to_le_bytes()); // message end time
+        b.extend((records.len() as u64).to_le_bytes()); // uncompressed size
+        b.extend(0u32.to_le_bytes()); // uncompressed CRC: none
+        b.extend(0u32.to_le_bytes()); // compression: "" (none)
+        b.extend((records.len() as u64).to_le_bytes());
+        b.extend(records);
+        b
+    }
+
+    /// A record mcap's parser cannot take (an attachment too short for its CRC made it slice
+    /// backwards and panic) inside a chunk is skipped: only schemas, channels and messages are
+    /// parsed.
+    #[test]
+    fn records_the_reader_does_not_need_are_not_parsed() {
+        let mut attachment = Vec::new();
+        attachment.extend(1u64.to_le_bytes()); // log time
+        attachment.extend(1u64.to_le_bytes()); // create time
+        attachment.extend(0u32.to_le_bytes()); // name ""
+        attachment.extend(0u32.to_le_bytes()); // media type ""
+        attachment.extend(0u64.to_le_bytes()); // data length; no data, no CRC
+        let mut records = vec![op::ATTACHMENT];
+        records.extend((attachment.len() as u64).to_le_bytes());
+        records.extend(&attachment);
+        let mut message = vec![op::MESSAGE];
+        message.extend(23u64.to_le_bytes());
+        message.extend(7u16.to_le_bytes()); // channel
+        message.extend(0u32.to_le_bytes()); // sequence
+        message.extend(5u64.to_le_bytes()); // log time
+        message.extend(5u64.to_le_bytes()); // publish time
+        message.push(42); // data
+        records.extend(&message);
+        let mut out = Vec::new();
+        decode_chunk_messages(&chunk_body(&records), &mut out).unwrap();
+        assert_eq!(out.len(), 1);
+        assert_eq!((out[0].channel, out[0].data.as_slice()), (7, &[42u8][..]));
+    }
 }
