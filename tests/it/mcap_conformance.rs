@@ -166,7 +166,13 @@ fn check_file(path: &Path) -> Option<String> {
             want.channels
         ));
     }
-    if !r.is_empty() || !r.notes().iter().any(|n| n.contains("no camera frames")) {
+    let mut distinct = r.notes().to_vec();
+    distinct.sort();
+    distinct.dedup();
+    if !r.is_empty()
+        || !r.notes().iter().any(|n| n.contains("no camera frames"))
+        || distinct.len() != r.notes().len()
+    {
         problems.push(format!("{} frames, notes {:?}", r.len(), r.notes()));
     }
     let mut got = Vec::new();
@@ -350,6 +356,8 @@ fn frames_are_read_in_every_writer_layout() {
         write_foreign(&p, layout, frames);
         let mut r = StreamReader::open(&p).unwrap();
         assert!(r.warnings().is_empty(), "{layout:?}: {:?}", r.warnings());
+        let notes = r.notes().join("\n");
+        assert_eq!(notes.matches("not written by eotn").count(), 1, "{notes}");
         assert_eq!(r.len(), frames, "{layout:?}");
         let c = r.counts();
         assert_eq!(

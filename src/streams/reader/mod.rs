@@ -262,6 +262,7 @@ impl StreamReader {
             catalog = Catalog::default();
             reader.info = StreamInfo::default();
             reader.param_set = None;
+            reader.notes.clear();
             reader.blocks.clear();
             reader.frames.clear();
             reader.scan(&mut table, &mut catalog)?;
