@@ -1,6 +1,8 @@
 //! Criterion benchmarks of stream access: opening a stream (summary + message indexes) and
 //! reading a random frame (one chunk read and decompressed), on a 300-frame 640×480 stream of
-//! noisy synthetic frames with sensor readings, chunks chosen by the writer (2 frames each).
+//! noisy synthetic frames with sensor readings, chunks chosen by the writer (2 frames each);
+//! and opening the same frames written unchunked by the `mcap` crate (no summary indexes: the
+//! data section is walked record by record).
 
 use std::hint::black_box;
 
@@ -38,6 +40,14 @@ fn benches(c: &mut Criterion) {
         w.write(&r).expect("write");
     }
     w.finish().expect("finish");
+    let unchunked = dir.path().join("unchunked.mcap");
+    write_unchunked(&path, &unchunked);
+    let check = StreamReader::open(&unchunked).expect("open");
+    assert_eq!(
+        (check.len(), check.warnings().len()),
+        (FRAMES, 0),
+        "every frame, no warning"
+    );
 
     let mut group = c.benchmark_group("stream_640x480");
     group.sample_size(20);
@@ -60,7 +70,24 @@ fn benches(c: &mut Criterion) {
             reader.read(black_box(k)).expect("read")
         });
     });
+    group.bench_function("open_unchunked", |b| {
+        b.iter(|| StreamReader::open(black_box(&unchunked)).expect("open"));
+    });
     group.finish();
+}
+
+/// Every message of `from` rewritten into `to` outside chunks, by the `mcap` crate's writer.
+fn write_unchunked(from: &std::path::Path, to: &std::path::Path) {
+    let bytes = std::fs::read(from).expect("read");
+    let file = std::io::BufWriter::new(std::fs::File::create(to).expect("create"));
+    let mut w = mcap::WriteOptions::new()
+        .use_chunks(false)
+        .create(file)
+        .expect("writer");
+    for m in mcap::MessageStream::new(&bytes).expect("stream") {
+        w.write(&m.expect("message")).expect("write");
+    }
+    w.finish().expect("finish");
 }
 
 criterion_group!(streams, benches);

@@ -23,7 +23,11 @@ seed() { mkdir -p "$WORK/$1"; cp "${@:2}" "$WORK/$1/" 2>/dev/null || true; }
 seed lookup_tables lookup_tables/bhuman2009.lut
 seed live_protocol fuzz/seeds/live_protocol/*
 seed serve_viewer_messages fuzz/seeds/serve_viewer_messages/*
-seed mcap_stream streams/sim-goalkeeper.mcap
+seed mcap_stream streams/sim-goalkeeper.mcap \
+  tests/data/mcap-conformance/TenMessages/TenMessages-ch-chx-mx-pad-rch-rsh-st-sum.mcap \
+  tests/data/mcap-conformance/TenMessages/TenMessages-pad-rch-rsh-st-sum.mcap \
+  tests/data/mcap-conformance/OneMetadata/OneMetadata-mdx-pad-st-sum.mcap \
+  tests/data/mcap-conformance/OneAttachment/OneAttachment-ax-pad-st-sum.mcap
 seed frame_files assets/screenshot.png
 seed text_files params/*.json streams/bhuman2009.labels.json
 seed field_files params/fields/*.json

@@ -58,7 +58,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 /// A stream's description: source, frames, times, frame size, which channels the first readable
-/// frame has, and the reader's warnings.
+/// frame has, every channel of the file with its message count, record counts, and the
+/// reader's notes and warnings.
 fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
     let mut reader = StreamReader::open(path)?;
     let n = reader.len();
@@ -66,11 +67,27 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
         reader.time_ns(0),
         n.checked_sub(1).and_then(|i| reader.time_ns(i)),
     );
+    let counts = reader.counts();
+    let channels: Vec<serde_json::Value> = reader
+        .channels()
+        .iter()
+        .map(|c| {
+            serde_json::json!({
+                "topic": c.topic, "message_encoding": c.message_encoding,
+                "schema": c.schema.as_ref().map(|s| &s.name),
+                "schema_encoding": c.schema.as_ref().map(|s| &s.encoding),
+                "messages": c.message_count,
+            })
+        })
+        .collect();
     let mut value = serde_json::json!({
         "file": path.display().to_string(), "kind": "stream",
         "source": reader.info().source, "description": reader.info().description,
         "frames": n, "chunks": reader.chunk_count(),
         "first_time_ns": first, "last_time_ns": last,
+        "messages": counts.messages, "schemas": counts.schemas,
+        "attachments": counts.attachments, "metadata": counts.metadata,
+        "channels": channels,
     });
     if let (Some(a), Some(b)) = (first, last)
         && n > 1
@@ -119,6 +136,7 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
             )
         });
     }
+    value["notes"] = reader.notes().into();
     value["warnings"] = warnings.into();
     Ok(value)
 }
@@ -133,18 +151,45 @@ fn print_human(v: &serde_json::Value) {
     let Some(obj) = v.as_object() else { return };
     let file = obj.get("file").and_then(|f| f.as_str()).unwrap_or("?");
     outln!("{file}");
+    let text =
+        |val: &serde_json::Value| val.as_str().map_or_else(|| val.to_string(), str::to_owned);
     for (k, val) in obj.iter().filter(|(k, _)| k.as_str() != "file") {
-        match val.as_object() {
-            Some(inner) => {
+        if let Some(inner) = val.as_object() {
+            outln!("  {k}:");
+            for (ik, iv) in inner {
+                outln!("    {ik:<14} {iv}");
+            }
+        } else if k == "channels" {
+            outln!("  channels:");
+            for c in val.as_array().into_iter().flatten() {
+                outln!("    {}", channel_line(c));
+            }
+        } else if let Some(lines) = val.as_array().filter(|a| a.iter().all(|x| x.is_string())) {
+            // Notes and warnings: one per line (none: nothing).
+            if !lines.is_empty() {
                 outln!("  {k}:");
-                for (ik, iv) in inner {
-                    outln!("    {ik:<14} {iv}");
+                for line in lines {
+                    outln!("    {}", text(line));
                 }
             }
-            None => outln!(
-                "  {k}: {}",
-                val.as_str().map_or_else(|| val.to_string(), str::to_owned)
-            ),
+        } else {
+            outln!("  {k}: {}", text(val));
         }
     }
+}
+
+/// One channel of `eotn info`: `topic  N messages  encoding  schema (schema encoding)`.
+fn channel_line(c: &serde_json::Value) -> String {
+    let s = |k: &str| c[k].as_str().unwrap_or("").to_owned();
+    let schema = if c["schema"].is_string() {
+        format!("{} ({})", s("schema"), s("schema_encoding"))
+    } else {
+        "no schema".to_owned()
+    };
+    format!(
+        "{:<24} {:>8} messages  {:<10} {schema}",
+        s("topic"),
+        c["messages"],
+        s("message_encoding")
+    )
 }

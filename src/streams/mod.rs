@@ -14,7 +14,10 @@
 //! chunk indexes and the image channel's message indexes, and reads only the one chunk a frame is
 //! in (the last chunk stays cached), so memory stays flat however long the file is; when the
 //! summary is missing it recovers by scanning the complete chunks, and says so in
-//! [`StreamReader::warnings`].
+//! [`StreamReader::warnings`]. Any valid MCAP file opens (the MCAP conformance suite is a test):
+//! one whose summary does not describe it whole is read through its data section, messages
+//! outside chunks included; [`StreamReader::channels`] lists every channel with its message
+//! count, whatever it carries.
 
 mod reader;
 pub mod schema;
@@ -23,7 +26,7 @@ mod writer;
 
 use std::path::PathBuf;
 
-pub use reader::StreamReader;
+pub use reader::{ChannelSummary, RecordCounts, SchemaSummary, StreamMessage, StreamReader};
 pub use writer::{Compression, RawChannelSpec, StreamWriter, WriterOptions};
 
 use crate::frame::Frame;

@@ -26,6 +26,7 @@ mod hardening;
 mod harness;
 mod live;
 mod live_peers;
+mod mcap_conformance;
 mod motion;
 mod overhead;
 mod patterns;

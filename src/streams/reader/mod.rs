@@ -6,8 +6,7 @@ use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use foxglove::Decode as _;
-use mcap::records::{Record, op};
-use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
+use mcap::records::op;
 
 use super::schema::{decode_image, parse_json_lenient};
 use super::{
@@ -16,15 +15,27 @@ use super::{
     param_set_of_source,
 };
 use crate::sensors::SensorReadings;
-use chunk::decode_chunk_messages;
+use catalog::Catalog;
+use chunk::{decode_chunk_messages, decode_loose_messages};
+use summary::SummaryProblem;
 
+pub use catalog::{ChannelSummary, RecordCounts, SchemaSummary};
+pub use messages::StreamMessage;
+
+mod catalog;
 mod chunk;
+mod messages;
 mod recovery;
+mod summary;
 
 /// The MCAP magic bytes at both ends of a file.
 const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
 /// Largest chunk record read into memory, bytes (compressed or not); larger ones are corrupt.
 const MAX_CHUNK_BYTES: u64 = 1 << 30;
+/// The file's read buffer, bytes: small records read one after another come from it; reads
+/// at least this long bypass it. Each jump elsewhere (a message index, a frame's chunk) refills
+/// it, so it is kept small.
+const READ_BUFFER_BYTES: usize = 16 << 10;
 /// Largest summary-side record (message index, metadata) read, bytes.
 const MAX_INDEX_BYTES: u64 = 64 << 20;
 /// Warnings kept; later ones are only counted, so memory stays bounded on a bad file.
@@ -46,18 +57,28 @@ enum Role {
     Ignored,
 }
 
-/// Where a chunk record lies in the file (opcode and length prefix included), bytes.
-#[derive(Debug, Clone, Copy)]
-struct ChunkLoc {
-    offset: u64,
-    length: u64,
+/// What a block of the file is: one chunk record, or a run of records outside chunks (a frame's
+/// image message and the messages after it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum BlockKind {
+    Chunk,
+    Loose,
 }
 
-/// Where a frame is: its time, its chunk, and which image message of that chunk it is.
+/// Where a block of records holding frames lies in the file (opcodes and length prefixes
+/// included), bytes.
+#[derive(Debug, Clone, Copy)]
+struct BlockLoc {
+    offset: u64,
+    length: u64,
+    kind: BlockKind,
+}
+
+/// Where a frame is: its time, its block, and which image message of that block it is.
 #[derive(Debug, Clone, Copy)]
 struct FrameLoc {
     time_ns: u64,
-    chunk: u32,
+    block: u32,
     nth: u32,
 }
 
@@ -71,24 +92,36 @@ struct Msg {
 /// Reads a stream written by [`super::StreamWriter`] (or any MCAP file with `foxglove.RawImage`
 /// frames on [`IMAGE_TOPIC`]).
 ///
-/// Opening reads the summary and the image channel's message indexes (a few bytes per chunk);
-/// [`StreamReader::read`] then reads and decompresses only the chunk holding the frame and keeps
-/// that one chunk cached. Memory is this index (16 bytes a frame) plus one chunk, whatever the
-/// file's length.
+/// Opening reads the summary and the image channel's message indexes (a few bytes per chunk)
+/// when the summary describes the whole file (statistics matching its channels, schemas and
+/// indexes, as eotn and most writers write); any other valid MCAP file — unchunked, without a
+/// summary or statistics, channels repeated without their schemas — is read through its data
+/// section once. [`StreamReader::read`] then reads and decompresses only the chunk holding the
+/// frame and keeps that one chunk cached. Memory is this index (16 bytes a frame) plus one
+/// chunk, whatever the file's length.
 pub struct StreamReader {
     path: PathBuf,
     file: BufReader<File>,
+    /// Where `file` is, bytes; `None` after an I/O error (the next read seeks from the start).
+    pos: Option<u64>,
     file_len: u64,
     info: StreamInfo,
     /// The recognition parameter set the stream names (`eotn.recognition` metadata).
     param_set: Option<String>,
     roles: HashMap<u16, Role>,
-    chunks: Vec<ChunkLoc>,
+    /// Every channel of the file, by id.
+    channels: Vec<ChannelSummary>,
+    counts: RecordCounts,
+    /// Blocks holding frames, in file order.
+    blocks: Vec<BlockLoc>,
     frames: Vec<FrameLoc>,
     times_sorted: bool,
+    /// True when the index came from the summary alone (the data section was not read).
+    from_summary: bool,
     cache: Option<(u32, Vec<Msg>)>,
     warnings: Vec<String>,
     warnings_dropped: usize,
+    notes: Vec<String>,
 }
 
 impl std::fmt::Debug for StreamReader {
@@ -96,7 +129,7 @@ impl std::fmt::Debug for StreamReader {
         f.debug_struct("StreamReader")
             .field("path", &self.path)
             .field("frames", &self.frames.len())
-            .field("chunks", &self.chunks.len())
+            .field("chunks", &self.counts.chunks)
             .finish_non_exhaustive()
     }
 }
@@ -104,7 +137,6 @@ impl std::fmt::Debug for StreamReader {
 /// Schemas and channels seen so far, to give each channel its [`Role`].
 #[derive(Default)]
 struct ChannelTable {
-    schema_names: HashMap<u16, String>,
     image: Option<u16>,
     roles: HashMap<u16, Role>,
     notes: Vec<String>,
@@ -152,9 +184,10 @@ impl ChannelTable {
 }
 
 impl StreamReader {
-    /// Opens a stream. Files without a summary (a recording cut off by a crash) are recovered by
-    /// scanning their complete chunks; files without frames open with zero frames. Both say so
-    /// in [`StreamReader::warnings`].
+    /// Opens a stream, or any valid MCAP file. Files cut off before their footer (a recording
+    /// cut off by a crash) are recovered by scanning their complete chunks, and say so in
+    /// [`StreamReader::warnings`]; files without frames open with zero frames and say so in
+    /// [`StreamReader::notes`].
     ///
     /// # Errors
     /// [`StreamError`] naming the file when it cannot be read or is not MCAP at all.
@@ -174,17 +207,22 @@ impl StreamReader {
         let file_len = meta.len();
         let mut reader = Self {
             path: path.to_owned(),
-            file: BufReader::with_capacity(64 << 10, file),
+            file: BufReader::with_capacity(READ_BUFFER_BYTES, file),
+            pos: None,
             file_len,
             info: StreamInfo::default(),
             param_set: None,
             roles: HashMap::new(),
-            chunks: Vec::new(),
+            channels: Vec::new(),
+            counts: RecordCounts::default(),
+            blocks: Vec::new(),
             frames: Vec::new(),
             times_sorted: true,
+            from_summary: false,
             cache: None,
             warnings: Vec::new(),
             warnings_dropped: 0,
+            notes: Vec::new(),
         };
         let mut magic = [0u8; 8];
         let got = reader.read_up_to(0, &mut magic)?;
@@ -202,33 +240,41 @@ impl StreamReader {
             });
         }
         let mut table = ChannelTable::default();
-        let indexed = match reader.read_summary() {
-            Ok(Some(summary)) => reader.index_from_summary(&summary, &mut table)?,
-            Ok(None) => {
-                reader.warn("the file has no summary section; scanning its chunks".to_owned());
+        let mut catalog = Catalog::default();
+        reader.from_summary = match reader.read_summary()? {
+            Ok(summary) => reader.index_from_summary(&summary, &mut table, &mut catalog)?,
+            Err(SummaryProblem::NoFooter(why)) => {
+                reader.warn(format!(
+                    "no usable summary ({why}): the recording was probably cut off; scanning its complete chunks"
+                ));
                 false
             }
-            Err(e) => {
+            Err(SummaryProblem::Damaged(why)) => {
                 reader.warn(format!(
-                    "no usable summary ({e}): the recording was probably cut off; scanning its complete chunks"
+                    "the summary is damaged ({why}); reading the data section instead"
                 ));
                 false
             }
         };
-        if !indexed {
+        if !reader.from_summary {
+            // Whatever a summary that does not describe the whole file gave is read again.
             table = ChannelTable::default();
-            reader.chunks.clear();
+            catalog = Catalog::default();
+            reader.info = StreamInfo::default();
+            reader.param_set = None;
+            reader.notes.clear();
+            reader.blocks.clear();
             reader.frames.clear();
-            reader.scan(&mut table)?;
+            reader.scan(&mut table, &mut catalog)?;
         }
-        for note in std::mem::take(&mut table.notes) {
-            reader.warn(note);
-        }
+        reader.notes.append(&mut table.notes);
         if table.image.is_none() {
-            reader.warn(format!(
-                "no {IMAGE_TOPIC} (foxglove.RawImage) channel: the file holds no frames"
+            reader.notes.push(format!(
+                "no camera frames: no {IMAGE_TOPIC} channel and no foxglove.RawImage channel among its {} channels",
+                catalog.counts.channels
             ));
         }
+        (reader.channels, reader.counts) = catalog.into_channels();
         reader.roles = table.roles;
         reader.times_sorted = reader
             .frames
@@ -272,10 +318,24 @@ impl StreamReader {
         self.frames.is_empty()
     }
 
-    /// Number of chunks holding frames (or, after a recovery scan, the complete chunks found).
+    /// Number of chunk records in the file (after a recovery scan, the complete chunks found).
     #[must_use]
     pub fn chunk_count(&self) -> usize {
-        self.chunks.len()
+        usize::try_from(self.counts.chunks).unwrap_or(usize::MAX)
+    }
+
+    /// Every channel of the file by id — topic, encodings, schema, message count — whatever
+    /// it carries, frames or not.
+    #[must_use]
+    pub fn channels(&self) -> &[ChannelSummary] {
+        &self.channels
+    }
+
+    /// How many messages, schemas, channels, chunks, attachments and metadata records the file
+    /// holds.
+    #[must_use]
+    pub fn counts(&self) -> RecordCounts {
+        self.counts
     }
 
     /// Capture time of frame `index`, nanoseconds, or `None` past the end.
@@ -312,11 +372,18 @@ impl StreamReader {
         )
     }
 
-    /// Things the reader skipped or repaired: truncation, unknown channels, bad JSON, NaN
-    /// sensor values. Bounded: after 100 only a count is kept.
+    /// Things wrong with the file that the reader skipped or repaired: truncation, damage, bad
+    /// JSON, NaN sensor values. Bounded: after 100 only a count is kept.
     #[must_use]
     pub fn warnings(&self) -> &[String] {
         &self.warnings
+    }
+
+    /// Facts about a valid file worth a line: channels it does not read, frames on another
+    /// topic, no camera frames at all, not written by eotn.
+    #[must_use]
+    pub fn notes(&self) -> &[String] {
+        &self.notes
     }
 
     /// Reads frame `index` with all its data.
@@ -332,16 +399,16 @@ impl StreamReader {
                 index,
                 len: self.frames.len(),
             })?;
-        if self.cache.as_ref().is_none_or(|(c, _)| *c != loc.chunk) {
+        if self.cache.as_ref().is_none_or(|(c, _)| *c != loc.block) {
             self.cache = None;
-            let messages = self.load_chunk(loc.chunk)?;
-            self.cache = Some((loc.chunk, messages));
+            let messages = self.load_block(loc.block)?;
+            self.cache = Some((loc.block, messages));
         }
         let Some((_, messages)) = self.cache.take() else {
             return Err(self.corrupt(format!("frame {index}: its chunk could not be loaded")));
         };
         let result = self.assemble(index, loc, &messages);
-        self.cache = Some((loc.chunk, messages));
+        self.cache = Some((loc.block, messages));
         result
     }
 
@@ -459,7 +526,18 @@ impl StreamReader {
             path: self.path.clone(),
             source,
         };
-        self.file.seek(SeekFrom::Start(offset)).map_err(io)?;
+        // A relative seek keeps the buffer when `offset` lies in it, so records read one after
+        // another (the data section walked, a record's body after its header) cost one read of
+        // the file, not one each; an absolute seek always drops it.
+        let delta = self
+            .pos
+            .take()
+            .and_then(|p| i64::try_from(i128::from(offset) - i128::from(p)).ok());
+        match delta {
+            Some(d) => self.file.seek_relative(d),
+            None => self.file.seek(SeekFrom::Start(offset)).map(drop),
+        }
+        .map_err(io)?;
         let mut got = 0;
         while got < buf.len() {
             match self.file.read(&mut buf[got..]) {
@@ -469,6 +547,7 @@ impl StreamReader {
                 Err(e) => return Err(io(e)),
             }
         }
+        self.pos = Some(offset + got as u64);
         Ok(got)
     }
 
@@ -500,170 +579,27 @@ impl StreamReader {
         Ok((opcode, self.read_exact_at(offset + 9, len)?))
     }
 
-    fn read_summary(&mut self) -> Result<Option<mcap::Summary>, StreamError> {
-        let path = self.path.clone();
-        let io = |source| StreamError::Io {
-            path: path.clone(),
-            source,
-        };
-        let mut summary = SummaryReader::new_with_options(
-            SummaryReaderOptions::default()
-                .with_file_size(self.file_len)
-                .with_record_length_limit(256 << 20),
-        );
-        let mut steps = 0u64;
-        while let Some(event) = summary.next_event() {
-            steps += 1;
-            if steps > 100_000_000 {
-                return Err(self.corrupt("the summary section never ends".to_owned()));
-            }
-            match event.map_err(self.mcap_err("reading the summary".to_owned()))? {
-                SummaryReadEvent::ReadRequest(n) => {
-                    let got = self.file.read(summary.insert(n)).map_err(io)?;
-                    summary.notify_read(got);
-                }
-                SummaryReadEvent::SeekRequest(to) => {
-                    let pos = self.file.seek(to).map_err(io)?;
-                    summary.notify_seeked(pos);
-                }
-            }
-        }
-        Ok(summary.finish())
+    /// Adds a block holding frames; its number.
+    fn push_block(&mut self, loc: BlockLoc) -> Result<u32, StreamError> {
+        let block = u32::try_from(self.blocks.len())
+            .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
+        self.blocks.push(loc);
+        Ok(block)
     }
 
-    /// Builds the frame index from the summary; `false` when the summary cannot locate the
-    /// frames (no chunk indexes), so the caller scans instead.
-    fn index_from_summary(
-        &mut self,
-        summary: &mcap::Summary,
-        table: &mut ChannelTable,
-    ) -> Result<bool, StreamError> {
-        for index in &summary.metadata_indexes {
-            if index.name != METADATA_NAME && index.name != PARAMS_METADATA_NAME {
-                continue;
-            }
-            if index.length > MAX_INDEX_BYTES
-                || index.offset.saturating_add(index.length) > self.file_len
-            {
-                self.warn("the stream metadata index points outside the file".to_owned());
-                continue;
-            }
-            match self.read_record_at(index.offset, MAX_INDEX_BYTES) {
-                Ok((opcode, body)) => self.take_metadata(opcode, &body),
-                Err(e) => self.warn(format!("stream metadata unreadable: {e}")),
-            }
-        }
-        if self.info == StreamInfo::default() {
-            self.no_metadata();
-        }
-        let mut ids: Vec<u16> = summary.channels.keys().copied().collect();
-        ids.sort_unstable();
-        // Prefer the canonical image topic over any other RawImage channel.
-        ids.sort_by_key(|id| {
-            summary
-                .channels
-                .get(id)
-                .is_none_or(|c| c.topic != IMAGE_TOPIC)
-        });
-        for id in ids {
-            if let Some(c) = summary.channels.get(&id) {
-                let schema = c.schema.as_ref().map(|s| s.name.as_str());
-                table.add(id, &c.topic, &c.message_encoding, schema);
-            }
-        }
-        let messages = summary.stats.as_ref().map_or(1, |s| s.message_count);
-        if summary.chunk_indexes.is_empty() {
-            return Ok(messages == 0);
-        }
-        let Some(image) = table.image else {
-            return Ok(true);
-        };
-        let mut chunk_indexes: Vec<&mcap::records::ChunkIndex> =
-            summary.chunk_indexes.iter().collect();
-        chunk_indexes.sort_by_key(|c| c.chunk_start_offset);
-        for ci in chunk_indexes {
-            if ci.chunk_length > MAX_CHUNK_BYTES
-                || ci.chunk_start_offset.saturating_add(ci.chunk_length) > self.file_len
-            {
-                self.warn(format!(
-                    "chunk index points outside the file (offset {}, {} bytes); the summary is not trusted",
-                    ci.chunk_start_offset, ci.chunk_length
-                ));
-                return Ok(false);
-            }
-            let Some(&at) = ci.message_index_offsets.get(&image) else {
-                continue;
-            };
-            let entries = match self.read_record_at(at, MAX_INDEX_BYTES) {
-                Ok((op::MESSAGE_INDEX, body)) => match mcap::parse_record(op::MESSAGE_INDEX, &body)
-                {
-                    Ok(Record::MessageIndex(mi)) if mi.channel_id == image => mi.records,
-                    _ => {
-                        self.warn(format!(
-                            "message index at offset {at} is malformed; scanning instead"
-                        ));
-                        return Ok(false);
-                    }
-                },
-                Ok(_) | Err(_) => {
-                    self.warn(format!(
-                        "message index at offset {at} is unreadable; scanning instead"
-                    ));
-                    return Ok(false);
-                }
-            };
-            let chunk = u32::try_from(self.chunks.len())
-                .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
-            self.chunks.push(ChunkLoc {
-                offset: ci.chunk_start_offset,
-                length: ci.chunk_length,
-            });
-            let mut entries = entries;
-            entries.sort_by_key(|e| e.offset);
-            for (nth, e) in entries.iter().enumerate() {
-                self.frames.push(FrameLoc {
-                    time_ns: e.log_time,
-                    chunk,
-                    nth: u32::try_from(nth).unwrap_or(u32::MAX),
-                });
-            }
-        }
-        Ok(true)
-    }
-
-    fn no_metadata(&mut self) {
-        self.info = StreamInfo {
-            source: "unknown".to_owned(),
-            description: String::new(),
-        };
-        self.warn(format!(
-            "no {METADATA_NAME} metadata: not written by eotn, source unknown"
-        ));
-    }
-
-    fn take_metadata(&mut self, opcode: u8, body: &[u8]) {
-        match mcap::parse_record(opcode, body) {
-            Ok(Record::Metadata(m)) if m.name == METADATA_NAME => {
-                let get = |k: &str| m.metadata.get(k).cloned().unwrap_or_default();
-                self.info = StreamInfo {
-                    source: get("source"),
-                    description: get("description"),
-                };
-            }
-            Ok(Record::Metadata(m)) if m.name == PARAMS_METADATA_NAME => {
-                self.param_set = m.metadata.get("params").filter(|s| !s.is_empty()).cloned();
-            }
-            Ok(Record::Metadata(_)) => {}
-            _ => self.warn("a metadata record is malformed; ignored".to_owned()),
-        }
-    }
-
-    /// Reads and decompresses chunk `chunk` into its messages.
-    fn load_chunk(&mut self, chunk: u32) -> Result<Vec<Msg>, StreamError> {
+    /// Reads block `block` into its messages: a chunk decompressed, or records outside chunks.
+    fn load_block(&mut self, block: u32) -> Result<Vec<Msg>, StreamError> {
         let loc = *self
-            .chunks
-            .get(chunk as usize)
-            .ok_or_else(|| self.corrupt(format!("no chunk {chunk}")))?;
+            .blocks
+            .get(block as usize)
+            .ok_or_else(|| self.corrupt(format!("no chunk {block}")))?;
+        if loc.kind == BlockKind::Loose {
+            let bytes = self.read_exact_at(loc.offset, loc.length)?;
+            let mut messages = Vec::new();
+            decode_loose_messages(&bytes, &mut messages)
+                .map_err(self.mcap_err(format!("reading the messages at offset {}", loc.offset)))?;
+            return Ok(messages);
+        }
         let (opcode, body) = self.read_record_at(loc.offset, loc.length.saturating_sub(9))?;
         if opcode != op::CHUNK {
             return Err(self.corrupt(format!(
@@ -733,7 +669,8 @@ mod tests {
         let mut r = StreamReader::open(&p).unwrap();
         assert_eq!(r.len(), 4);
         assert_eq!(r.info().source, "unknown");
-        let joined = r.warnings().join("\n");
+        assert!(r.warnings().is_empty(), "{:?}", r.warnings());
+        let joined = r.notes().join("\n");
         assert!(
             joined.contains("/cam/front") && joined.contains("/tf"),
             "{joined}"
@@ -746,6 +683,26 @@ mod tests {
             assert_eq!(rec.frame.pixel(0, 0).unwrap().y, u8::try_from(i).unwrap());
             assert!(rec.sensors.is_none() && rec.extra.is_empty());
         }
+    }
+
+    /// A file whose summary describes it whole (eotn's own, the `mcap` crate's defaults) is
+    /// indexed from its summary alone, without reading the data section.
+    #[test]
+    fn a_complete_summary_is_enough() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.mcap");
+        foreign_file(&p, &[100, 300, 200, 400]);
+        let r = StreamReader::open(&p).unwrap();
+        assert!(r.from_summary);
+        let c = r.counts();
+        assert_eq!((c.messages, c.channels, c.schemas), (8, 2, 1));
+        let tf = &r.channels()[1];
+        assert_eq!((tf.topic.as_str(), tf.message_count), ("/tf", 4));
+        assert_eq!(tf.schema, None);
+        assert_eq!(
+            r.channels()[0].schema.as_ref().map(|s| s.encoding.as_str()),
+            Some("protobuf")
+        );
     }
 
     #[test]

@@ -1,74 +1,118 @@
-//! The recovery scan of a stream without a usable summary (cut off, or never finished): the
-//! data section walked record by record, each chunk decompressed once, up to the first record
-//! that is cut off or damaged.
+//! The data section read record by record: for a file whose summary does not describe it
+//! (none written, no statistics, channels repeated without their schemas, messages outside
+//! chunks), and as the recovery of a file cut off or never finished — up to its first record
+//! that is cut off or damaged. Each chunk is decompressed once; messages outside chunks are
+//! read in place.
 
 use mcap::records::{Record, op};
 
+use super::catalog::Catalog;
 use super::chunk::{ChunkItem, decode_chunk};
 use super::{
-    ChannelTable, ChunkLoc, FrameLoc, MAX_CHUNK_BYTES, MAX_INDEX_BYTES, StreamError, StreamInfo,
-    StreamReader,
+    BlockKind, BlockLoc, ChannelTable, FrameLoc, MAX_CHUNK_BYTES, MAX_INDEX_BYTES, StreamError,
+    StreamInfo, StreamReader,
 };
 
+/// Largest run of records outside chunks kept as one frame's block, bytes: a frame's image
+/// and the messages after it that belong to it.
+const MAX_LOOSE_BLOCK_BYTES: u64 = 64 << 20;
+/// Bytes of a message record's body before its data: channel, sequence, log and publish time.
+const MESSAGE_HEADER_BYTES: u64 = 2 + 4 + 8 + 8;
+
+/// How a walk of the data section ended.
+#[derive(Debug, PartialEq, Eq)]
+pub(super) enum WalkEnd {
+    /// At the Data End record (or the footer): the data section is whole.
+    Complete,
+    /// The visitor stopped it at damage it has reported.
+    Stopped,
+    /// The file ends at a record boundary, before any Data End record.
+    FileEnds,
+    /// The file ends inside a record: what is cut off.
+    CutOff(String),
+}
+
 impl StreamReader {
-    /// Recovery: walks the data section record by record, decompressing each chunk once, and
-    /// stops at the first record that is cut off or damaged.
-    pub(super) fn scan(&mut self, table: &mut ChannelTable) -> Result<(), StreamError> {
-        let mut offset = 8u64;
-        let mut loose_messages = 0u64;
-        let mut complete = false;
+    /// Walks the data section's records from the header on, calling `each` with the opcode,
+    /// offset and body length of every record that lies whole in the file, until the Data End
+    /// record, the end of the file, a record cut off, or `each` returns `false`.
+    pub(super) fn walk(
+        &mut self,
+        mut each: impl FnMut(&mut Self, u8, u64, u64) -> Result<bool, StreamError>,
+    ) -> Result<WalkEnd, StreamError> {
+        let mut offset = super::MAGIC.len() as u64;
         loop {
             let remaining = self.file_len.saturating_sub(offset);
             if remaining == 0 {
-                break;
+                return Ok(WalkEnd::FileEnds);
             }
             if remaining < 9 {
-                self.warn(format!(
+                return Ok(WalkEnd::CutOff(format!(
                     "the file ends inside a record header at offset {offset}"
-                ));
-                break;
+                )));
             }
             let head = self.read_exact_at(offset, 9)?;
             let opcode = head[0];
             let len = u64::from_le_bytes(head[1..9].try_into().unwrap_or([0xff; 8]));
             if opcode == op::DATA_END || opcode == op::FOOTER {
-                complete = true;
-                break;
+                return Ok(WalkEnd::Complete);
             }
             if len > remaining - 9 {
-                self.warn(format!(
+                return Ok(WalkEnd::CutOff(format!(
                     "record at offset {offset} (opcode {opcode:#04x}) needs {len} bytes but the file ends after {}: it was cut off; frames up to the last complete chunk are kept",
                     remaining - 9
-                ));
-                break;
+                )));
             }
-            let go_on = match opcode {
-                op::CHUNK => self.scan_chunk(offset, len, table)?,
-                op::SCHEMA | op::CHANNEL | op::METADATA => {
-                    self.scan_index_record(offset, opcode, len, table)?
-                }
-                op::MESSAGE => {
-                    loose_messages += 1;
-                    true
-                }
-                _ => true,
-            };
-            if !go_on {
-                break;
+            if !each(self, opcode, offset, len)? {
+                return Ok(WalkEnd::Stopped);
             }
             offset += 9 + len;
         }
-        self.finish_scan(loose_messages, complete);
+    }
+
+    /// Reads the data section into `table`, `catalog` and the frame index, and says what was
+    /// wrong with it, if anything: a file whose data section is whole reads without warnings.
+    pub(super) fn scan(
+        &mut self,
+        table: &mut ChannelTable,
+        catalog: &mut Catalog,
+    ) -> Result<(), StreamError> {
+        // The block of the last frame found outside chunks, while the records after it may
+        // still belong to that frame.
+        let mut loose: Option<u32> = None;
+        let end = self.walk(|r, opcode, offset, len| match opcode {
+            op::CHUNK => {
+                loose = None;
+                r.scan_chunk(offset, len, table, catalog)
+            }
+            op::MESSAGE => r.scan_message(offset, len, table, catalog, &mut loose),
+            _ => {
+                r.extend_loose(&mut loose, offset, len);
+                match opcode {
+                    op::SCHEMA | op::CHANNEL | op::METADATA => {
+                        r.scan_index_record(offset, opcode, len, table, catalog)
+                    }
+                    op::ATTACHMENT => {
+                        catalog.counts.attachments += 1;
+                        Ok(true)
+                    }
+                    // The header, message indexes, and records this reader does not know.
+                    _ => Ok(true),
+                }
+            }
+        })?;
+        self.finish_scan(end, catalog);
         Ok(())
     }
 
-    /// The chunk record at `offset` (body `len` bytes): its schemas and channels into `table`,
-    /// its images as frames. `false` when it is damaged and the scan stops.
+    /// The chunk record at `offset` (body `len` bytes): its schemas and channels, its message
+    /// counts, its images as frames. `false` when it is damaged and the scan stops.
     fn scan_chunk(
         &mut self,
         offset: u64,
         len: u64,
         table: &mut ChannelTable,
+        catalog: &mut Catalog,
     ) -> Result<bool, StreamError> {
         if len > MAX_CHUNK_BYTES {
             self.warn(format!(
@@ -84,20 +128,22 @@ impl StreamReader {
             ));
             return Ok(false);
         }
-        let chunk = u32::try_from(self.chunks.len())
+        catalog.counts.chunks += 1;
+        let block = u32::try_from(self.blocks.len())
             .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
         let mut nth = 0u32;
         for r in records {
             match r {
-                ChunkItem::Schema(id, name) => {
-                    table.schema_names.insert(id, name);
+                ChunkItem::Schema { id, name, encoding } => {
+                    catalog.add_schema(id, &name, &encoding)
                 }
-                ChunkItem::Channel(c) => add_channel(table, &c),
+                ChunkItem::Channel(c) => add_channel(table, catalog, &c),
                 ChunkItem::Message(channel, log_time) => {
+                    catalog.count_message(channel);
                     if Some(channel) == table.image {
                         self.frames.push(FrameLoc {
                             time_ns: log_time,
-                            chunk,
+                            block,
                             nth,
                         });
                         nth = nth.saturating_add(1);
@@ -105,11 +151,66 @@ impl StreamReader {
                 }
             }
         }
-        self.chunks.push(ChunkLoc {
+        if nth > 0 {
+            self.blocks.push(BlockLoc {
+                offset,
+                length: len + 9,
+                kind: BlockKind::Chunk,
+            });
+        }
+        Ok(true)
+    }
+
+    /// A message record outside chunks: counted; an image starts a new frame's block, any
+    /// other message joins the block of the frame before it. `false` when it is malformed.
+    fn scan_message(
+        &mut self,
+        offset: u64,
+        len: u64,
+        table: &ChannelTable,
+        catalog: &mut Catalog,
+        loose: &mut Option<u32>,
+    ) -> Result<bool, StreamError> {
+        if len < MESSAGE_HEADER_BYTES {
+            self.warn(format!(
+                "message record at offset {offset} is too short for its header; stopping"
+            ));
+            return Ok(false);
+        }
+        let head = self.read_exact_at(offset + 9, MESSAGE_HEADER_BYTES)?;
+        let channel = u16::from_le_bytes([head[0], head[1]]);
+        let log_time = u64::from_le_bytes(head[6..14].try_into().unwrap_or([0; 8]));
+        catalog.count_message(channel);
+        if Some(channel) != table.image {
+            self.extend_loose(loose, offset, len);
+            return Ok(true);
+        }
+        let block = self.push_block(BlockLoc {
             offset,
             length: len + 9,
+            kind: BlockKind::Loose,
+        })?;
+        self.frames.push(FrameLoc {
+            time_ns: log_time,
+            block,
+            nth: 0,
         });
+        *loose = Some(block);
         Ok(true)
+    }
+
+    /// Adds the record at `offset` to the open block of records outside chunks when it
+    /// follows that block directly and the block stays small; else closes the block.
+    fn extend_loose(&mut self, loose: &mut Option<u32>, offset: u64, len: u64) {
+        let Some(b) = loose.and_then(|b| self.blocks.get_mut(b as usize)) else {
+            return;
+        };
+        let grown = b.length + 9 + len;
+        if b.offset + b.length == offset && grown <= MAX_LOOSE_BLOCK_BYTES {
+            b.length = grown;
+        } else {
+            *loose = None;
+        }
     }
 
     /// A schema, channel or metadata record outside chunks. `false` when it is implausibly
@@ -120,6 +221,7 @@ impl StreamReader {
         opcode: u8,
         len: u64,
         table: &mut ChannelTable,
+        catalog: &mut Catalog,
     ) -> Result<bool, StreamError> {
         if len > MAX_INDEX_BYTES {
             self.warn(format!(
@@ -130,10 +232,13 @@ impl StreamReader {
         let body = self.read_exact_at(offset + 9, len)?;
         match mcap::parse_record(opcode, &body) {
             Ok(Record::Schema { header, .. }) => {
-                table.schema_names.insert(header.id, header.name);
+                catalog.add_schema(header.id, &header.name, &header.encoding);
             }
-            Ok(Record::Channel(c)) => add_channel(table, &c),
-            Ok(Record::Metadata(_)) => self.take_metadata(opcode, &body),
+            Ok(Record::Channel(c)) => add_channel(table, catalog, &c),
+            Ok(Record::Metadata(_)) => {
+                catalog.counts.metadata += 1;
+                self.take_metadata(opcode, &body);
+            }
             _ => {
                 self.warn(format!("record at offset {offset} is malformed; stopping"));
                 return Ok(false);
@@ -142,28 +247,42 @@ impl StreamReader {
         Ok(true)
     }
 
-    /// The warnings of a finished scan: no metadata, skipped loose messages, a recovered
-    /// (incomplete) file.
-    fn finish_scan(&mut self, loose_messages: u64, complete: bool) {
+    /// What a finished scan says: a note when the stream is not eotn's, warnings for messages
+    /// on undefined channels and for a data section that did not end whole.
+    fn finish_scan(&mut self, end: WalkEnd, catalog: &Catalog) {
         if self.info == StreamInfo::default() {
             self.no_metadata();
         }
-        if loose_messages > 0 {
+        if catalog.orphan_messages > 0 {
             self.warn(format!(
-                "{loose_messages} messages outside chunks were skipped (only chunked streams are read)"
+                "{} messages on channels the file never defines were skipped",
+                catalog.orphan_messages
             ));
         }
-        if !complete {
-            self.warn(format!(
-                "recovered {} frames from {} complete chunks",
-                self.frames.len(),
-                self.chunks.len()
-            ));
+        match end {
+            WalkEnd::Complete => return,
+            WalkEnd::CutOff(what) => self.warn(what),
+            WalkEnd::FileEnds => {
+                self.warn("the file ends without its Data End record".to_owned());
+            }
+            WalkEnd::Stopped => {}
         }
+        self.warn(format!(
+            "recovered {} frames from {} complete chunks",
+            self.frames.len(),
+            catalog.counts.chunks
+        ));
     }
 }
 
-fn add_channel(table: &mut ChannelTable, c: &mcap::records::Channel) {
-    let schema = table.schema_names.get(&c.schema_id).cloned();
-    table.add(c.id, &c.topic, &c.message_encoding, schema.as_deref());
+/// A channel from the data section: into the catalog and, when new, given its role.
+fn add_channel(table: &mut ChannelTable, catalog: &mut Catalog, c: &mcap::records::Channel) {
+    if catalog.add_channel(c) {
+        table.add(
+            c.id,
+            &c.topic,
+            &c.message_encoding,
+            catalog.schema_name(c.schema_id),
+        );
+    }
 }
