@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use eotn::eval::Percentiles;
+
 /// The `../shared/` folder beside the project (overridable with `EOTN_SHARED`).
 pub fn shared_dir() -> PathBuf {
     std::env::var_os("EOTN_SHARED").map_or_else(
@@ -157,3 +159,27 @@ pub const SHIPPED_ROBOT_SCENARIOS: [&str; 6] = [
     "orange-clutter",
     "beacon-tour",
 ];
+
+/// A percentile summary taken over at least `min_n` values, for a test to assert on: fails the
+/// test (naming `what`) when the sample is smaller or empty, so that no percentile assertion
+/// passes on too little data (an empty sample has no percentiles at all).
+#[track_caller]
+pub fn sampled(p: Option<Percentiles>, min_n: usize, what: &str) -> Percentiles {
+    let n = p.map_or(0, |p| p.n);
+    assert!(
+        n >= min_n,
+        "{what}: {n} values, the assertion needs at least {min_n}"
+    );
+    p.expect("a sample of at least one value")
+}
+
+/// The percentiles of `values` over at least `min_n` of them ([`sampled`]).
+#[track_caller]
+pub fn percentiles(values: &[f64], min_n: usize, what: &str) -> Percentiles {
+    sampled(Percentiles::of(values), min_n, what)
+}
+
+/// A summary's figure for printing: `pick` of it, or NaN without a sample.
+pub fn figure(p: Option<Percentiles>, pick: fn(&Percentiles) -> f64) -> f64 {
+    p.as_ref().map_or(f64::NAN, pick)
+}

@@ -16,7 +16,7 @@ use eotn::overhead::{
 };
 use eotn::sim::{Scenario, ScenarioKind, SimFrame, Simulator};
 
-use crate::common::{eotn_ok, sim_stream};
+use crate::common::{eotn_ok, sampled, sim_stream};
 
 fn overhead_truth(f: &SimFrame) -> &OverheadTruth {
     match &f.ground_truth {
@@ -138,18 +138,13 @@ fn calibrated_from_noisy_clicks_the_overhead_recogniser_meets_the_figures() {
         r.ball_found as f64 >= 0.95 * r.ball_eligible as f64,
         "{r:?}"
     );
-    assert!(
-        r.ball_error_cm.p50 < 3.0 && r.ball_error_cm.p95 < 8.0,
-        "{:?}",
-        r.ball_error_cm
-    );
-    assert!(
-        r.robot_error_cm.p50 < 3.0 && r.robot_error_cm.p95 < 8.0,
-        "{:?}",
-        r.robot_error_cm
-    );
+    let ball = sampled(r.ball_error_cm, 30, "overhead ball errors");
+    assert!(ball.p50 < 3.0 && ball.p95 < 8.0, "{ball:?}");
+    let robots = sampled(r.robot_error_cm, 100, "overhead robot errors");
+    assert!(robots.p50 < 3.0 && robots.p95 < 8.0, "{robots:?}");
     assert!(r.identity_rate.unwrap() >= 0.99, "{r:?}");
-    assert!(r.heading_error_deg.p50 < 3.0, "{:?}", r.heading_error_deg);
+    let heading = sampled(r.heading_error_deg, 100, "overhead headings");
+    assert!(heading.p50 < 3.0, "{heading:?}");
     assert!(r.robots_false <= frames.len() / 20, "{r:?}");
 }
 
@@ -284,15 +279,19 @@ fn the_overhead_command_line_calibrates_detects_and_evaluates() {
     // Each robot's world model against the overhead detection of its marker, not only the truth.
     let seen: Vec<&serde_json::Value> = models
         .iter()
-        .filter(|m| m["self_error_vs_overhead_cm"]["n"].as_u64().unwrap() > 0)
+        .filter(|m| m["self_error_vs_overhead_cm"]["n"].as_u64().unwrap_or(0) > 0)
         .collect();
     assert!(seen.len() >= 2, "{overhead}");
     for m in &seen {
         assert!(
-            m["heading_error_vs_overhead_deg"]["n"].as_u64().unwrap() > 0,
+            m["heading_error_vs_overhead_deg"]["n"].as_u64().unwrap_or(0) > 0,
             "{m}"
         );
     }
+    assert!(
+        overhead["robot_error_cm"]["n"].as_u64().unwrap_or(0) >= 8,
+        "{overhead}"
+    );
     assert!(
         overhead["robot_error_cm"]["p50"].as_f64().unwrap() < 5.0,
         "{overhead}"
