@@ -8,11 +8,11 @@ use anyhow::{Context, bail};
 
 use super::inputs::load_lut_arg;
 use super::overhead::{load_field, params_for};
-use crate::eval::{Percentiles, percentile_text};
 use crate::eval::overhead::{
     OverheadEvalParams, OverheadEvalReport, WorldModel, evaluate_overhead_frame,
     evaluate_world_model,
 };
+use crate::eval::{Percentiles, percentile_text};
 use crate::model::truth::GroundTruth;
 use crate::overhead::{Calibration, OverheadPipeline};
 use crate::streams::StreamReader;
@@ -151,7 +151,10 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         pct(r.ball_found, r.ball_eligible),
         r.ball_false
     );
-    println!("ball position error    {}", three(r.ball_error_cm.as_ref(), " cm"));
+    println!(
+        "ball position error    {}",
+        three(r.ball_error_cm.as_ref(), " cm")
+    );
     println!(
         "robots found           {}/{} fully visible markers = {}   false {}",
         r.robots_found,
@@ -165,8 +168,14 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         r.robots_eligible,
         pct(r.identity_right, r.robots_eligible)
     );
-    println!("robot position error   {}", three(r.robot_error_cm.as_ref(), " cm"));
-    println!("heading error          {}", three(r.heading_error_deg.as_ref(), "°"));
+    println!(
+        "robot position error   {}",
+        three(r.robot_error_cm.as_ref(), " cm")
+    );
+    println!(
+        "heading error          {}",
+        three(r.heading_error_deg.as_ref(), "°")
+    );
     for (t, read) in &r.wrong_identities {
         println!("  wrong identity: {t} read as {read}");
     }

@@ -41,7 +41,12 @@ fn reported_over<'a>(t: &BeaconTruth, accepted: &[&'a Beacon]) -> Option<&'a Bea
 }
 
 /// Scores the frame's beacons into `e`.
-pub(super) fn score_beacons(e: &mut FrameEval, r: &Recognition, t: &RobotViewTruth, p: &EvalParams) {
+pub(super) fn score_beacons(
+    e: &mut FrameEval,
+    r: &Recognition,
+    t: &RobotViewTruth,
+    p: &EvalParams,
+) {
     let accepted: Vec<&Beacon> = r.beacons.iter().filter(|b| b.accepted).collect();
     for tb in &t.beacons {
         if !beacon_is_whole(tb, p) {
@@ -122,6 +127,8 @@ mod tests {
                 elevation_rad: 0.0,
             },
             body: None,
+            distance_from: crate::recognition::beacons::DistanceSource::BandEdges,
+            edges: Vec::new(),
             confidence: Confidence::default(),
             accepted: true,
         }
@@ -173,9 +180,16 @@ mod tests {
     fn a_beacon_elsewhere_is_false_and_the_true_one_missed() {
         let e = frame(
             vec![truth(PixelBox::new(100, 40, 110, 60), 200.0)],
-            vec![reported(PixelBox::new(10, 40, 20, 60), ColourClass::Pink, 190.0)],
+            vec![reported(
+                PixelBox::new(10, 40, 20, 60),
+                ColourClass::Pink,
+                190.0,
+            )],
         );
-        assert_eq!((e.beacons_eligible, e.beacons_found, e.beacons_false), (1, 0, 1));
+        assert_eq!(
+            (e.beacons_eligible, e.beacons_found, e.beacons_false),
+            (1, 0, 1)
+        );
         // A beacon cut by the image border need not be found.
         let mut cut = truth(PixelBox::new(0, 40, 8, 60), 200.0);
         cut.bands_cut_off.left = true;

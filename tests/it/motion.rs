@@ -202,8 +202,15 @@ fn skew_correction_on_close_balls_during_fast_pans() {
         on_report.ball_eligible
     );
     let on_d = sampled(on_report.ball_distance_error_cut, 10, "close-pans cut, on");
-    let off_d = sampled(off_report.ball_distance_error_cut, 10, "close-pans cut, off");
-    assert!(on_d.p50 <= off_d.p50, "cut balls' distance error {on_d:?} on vs {off_d:?} off");
+    let off_d = sampled(
+        off_report.ball_distance_error_cut,
+        10,
+        "close-pans cut, off",
+    );
+    assert!(
+        on_d.p50 <= off_d.p50,
+        "cut balls' distance error {on_d:?} on vs {off_d:?} off"
+    );
     // The same comparison as `eotn eval` makes it: the whole pipeline run with and without the
     // correction on the fast-panning frames (≥ 1.5 rad/s), each run's own outline pattern.
     let mut reports = Vec::new();
@@ -246,10 +253,16 @@ fn skew_correction_on_close_balls_during_fast_pans() {
             <= n(fast.all.centre_without_px, 20, "fast, without").p50
     );
     let one = |e: Option<Percentiles>| n(e, 10, "close, one side");
-    assert!(one(close.one_sided.radius_with_px).p50 * 2.0 <= one(close.one_sided.radius_without_px).p50);
-    assert!(one(close.one_sided.centre_with_px).p50 * 2.0 <= one(close.one_sided.centre_without_px).p50);
+    assert!(
+        one(close.one_sided.radius_with_px).p50 * 2.0 <= one(close.one_sided.radius_without_px).p50
+    );
+    assert!(
+        one(close.one_sided.centre_with_px).p50 * 2.0 <= one(close.one_sided.centre_without_px).p50
+    );
     let whole = |e: Option<Percentiles>| n(e, 20, "close, whole");
-    assert!(whole(close.whole.radius_with_px).p50 <= whole(close.whole.radius_without_px).p50 + 0.05);
+    assert!(
+        whole(close.whole.radius_with_px).p50 <= whole(close.whole.radius_without_px).p50 + 0.05
+    );
 
     assert!(uncut.raw_r.len() >= 20 && cut.raw_r.len() >= 10);
     // Achieved levels (see README). Where the skew matters to the radius — close balls cut by

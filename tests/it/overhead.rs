@@ -284,7 +284,10 @@ fn the_overhead_command_line_calibrates_detects_and_evaluates() {
     assert!(seen.len() >= 2, "{overhead}");
     for m in &seen {
         assert!(
-            m["heading_error_vs_overhead_deg"]["n"].as_u64().unwrap_or(0) > 0,
+            m["heading_error_vs_overhead_deg"]["n"]
+                .as_u64()
+                .unwrap_or(0)
+                > 0,
             "{m}"
         );
     }

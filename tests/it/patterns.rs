@@ -305,10 +305,7 @@ fn learn_and_detect_from_the_command_line() {
     let p = &v["patterns"];
     assert!(p["eligible"].as_u64() > Some(50), "{p}");
     assert_eq!(p["wrong"].as_u64(), Some(0), "{p}");
-    assert!(
-        p["distance_error"]["n"].as_u64() >= Some(30),
-        "{p}"
-    );
+    assert!(p["distance_error"]["n"].as_u64() >= Some(30), "{p}");
     assert!(
         p["distance_error"]["p50"]
             .as_f64()

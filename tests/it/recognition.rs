@@ -11,7 +11,7 @@ use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
 use crate::common::{figure, sampled};
 
-const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
+pub(crate) const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
     ScenarioKind::WalkAndPan,
     ScenarioKind::BallEdge,
     ScenarioKind::Goalkeeper,
@@ -27,10 +27,15 @@ pub(crate) fn learnt_table() -> LookupTable {
 
 /// A table learnt from every 10th frame of `kinds` with seed 100 (test frames use seed 7).
 pub(crate) fn table_learnt_from(kinds: &[ScenarioKind]) -> LookupTable {
+    table_learnt_every(kinds, 10)
+}
+
+/// A table learnt from every `step`-th of the first 90 frames of `kinds` with seed 100.
+pub(crate) fn table_learnt_every(kinds: &[ScenarioKind], step: usize) -> LookupTable {
     let mut builder = TableBuilder::new(7).expect("7 bits");
     for &kind in kinds {
         let sim = Simulator::new(Scenario::new(kind, 100));
-        for i in (0..90).step_by(10) {
+        for i in (0..90).step_by(step) {
             let f = sim.frame(i).expect("frame");
             builder.add_frame(&f.frame, &f.labels).expect("labels fit");
         }
@@ -133,8 +138,10 @@ fn recognition_on_synthetic_scenarios() {
             r.ball_distance_bias
         );
     }
+    // Few balls are cut by the image edge on seed 7 (4 on ball-edge, 6 on walk-and-pan): the
+    // medians of so few say little, but none may be missing.
     for k in [ScenarioKind::BallEdge, ScenarioKind::WalkAndPan] {
-        let cut = sampled(report(k).ball_distance_error_cut, 5, k.name());
+        let cut = sampled(report(k).ball_distance_error_cut, 4, k.name());
         assert!(cut.p50 <= 0.04, "{}: cut balls {cut:?}", k.name());
     }
     let goals_eligible = sum(&|r| r.goals_eligible);
@@ -142,12 +149,51 @@ fn recognition_on_synthetic_scenarios() {
     eprintln!("goals found {goals_found}/{goals_eligible}");
     assert!(goals_eligible > 200, "scenarios must show goals");
     assert!(goals_found as f64 >= 0.97 * goals_eligible as f64);
-    // The yellow box among the off-field clutter is not a goal (width and ground-at-foot tests).
-    assert!(
-        clutter.goals_false <= 1,
+    // The yellow box among the off-field clutter is not a goal (width and ground-at-foot tests),
+    // nor is anything else in any scenario.
+    assert_eq!(
+        sum(&|r| r.goals_false),
+        0,
         "false goals in clutter frames {:?}",
         clutter.goal_false_frames
     );
+    // Beacons: every one whose bands the frame shows whole found with its colours, none false,
+    // the distance from the bands' edges (the issue's targets: median ≤ 3%, p90 ≤ 8%).
+    let (eligible, found) = (sum(&|r| r.beacons_eligible), sum(&|r| r.beacons_found));
+    eprintln!(
+        "beacons found {found}/{eligible}, colours right {}, false {}",
+        sum(&|r| r.beacons_colours_right),
+        sum(&|r| r.beacons_false)
+    );
+    // With this table (54 frames of seed 100) the far beacon of orange-clutter in the image's
+    // shaded corner (frames 28, 29, 34, 35, 2.6 m) has no sky-blue pixels to find: the
+    // classification, not the recogniser, misses it (a table learnt from every third frame
+    // classifies it, and `beacons.rs` finds every whole beacon with that one).
+    assert!(
+        eligible >= 100 && found * 100 >= eligible * 97,
+        "beacons {found}/{eligible}"
+    );
+    assert_eq!(sum(&|r| r.beacons_colours_right), found);
+    assert_eq!(sum(&|r| r.beacons_false), 0);
+    // Limits at 2–3× what seed 7 gives with this coarse table (median, p90); the issue's
+    // targets (≤ 3%, ≤ 8%) are asserted on held-out seeds in `beacons.rs`. Orange-clutter's far
+    // beacon in the shaded corner keeps few classified pixels here, hence its wider limits.
+    for (k, [p50, p90]) in [
+        (ScenarioKind::WalkAndPan, [0.07, 0.12]),
+        (ScenarioKind::FastPans, [0.04, 0.10]),
+        (ScenarioKind::OrangeClutter, [0.10, 0.25]),
+        (ScenarioKind::BeaconTour, [0.015, 0.04]),
+    ] {
+        let d = sampled(report(k).beacon_distance_error, 20, k.name());
+        eprintln!(
+            "{}: beacon distance error median {:.1}% p90 {:.1}% (n = {})",
+            k.name(),
+            100.0 * d.p50,
+            100.0 * d.p90,
+            d.n
+        );
+        assert!(d.p50 <= p50 && d.p90 <= p90, "{}: {d:?}", k.name());
+    }
     let keeper = report(ScenarioKind::Goalkeeper);
     let walk = report(ScenarioKind::WalkAndPan);
     let tour = report(ScenarioKind::BeaconTour);
@@ -208,8 +254,8 @@ fn recognition_on_synthetic_scenarios() {
         "correction must find more balls on fast pans"
     );
     let (raw, fixed) = skew_radius_comparison(&lut, params);
-    let [raw_r, raw_c, fixed_r, fixed_c] = [raw.0, raw.1, fixed.0, fixed.1]
-        .map(|p| sampled(p, 20, "fast pans, same balls refitted"));
+    let [raw_r, raw_c, fixed_r, fixed_c] =
+        [raw.0, raw.1, fixed.0, fixed.1].map(|p| sampled(p, 20, "fast pans, same balls refitted"));
     eprintln!(
         "fast pans, same balls refitted: radius error median {:.3} px with the outline unskewed, \
          {:.3} px without (n = {}); centre error {:.2} px vs {:.2} px",
@@ -243,12 +289,20 @@ fn recognition_on_synthetic_scenarios() {
             sampled(r.ball_distance_error, 10, k.name()),
             sampled(v.ball_distance_error, 10, k.name()),
         );
-        assert!(on_d.p50 <= off_d.p50 + 0.002, "{}: {on_d:?} vs {off_d:?}", k.name());
+        assert!(
+            on_d.p50 <= off_d.p50 + 0.002,
+            "{}: {on_d:?} vs {off_d:?}",
+            k.name()
+        );
         let (on_r, off_r) = (
             sampled(r.ball_radius_error_px, 10, k.name()),
             sampled(v.ball_radius_error_px, 10, k.name()),
         );
-        assert!(on_r.p50 <= off_r.p50 + 0.02, "{}: {on_r:?} vs {off_r:?}", k.name());
+        assert!(
+            on_r.p50 <= off_r.p50 + 0.02,
+            "{}: {on_r:?} vs {off_r:?}",
+            k.name()
+        );
     }
 }
 
@@ -259,8 +313,14 @@ fn skew_radius_comparison(
     lut: &LookupTable,
     params: PipelineParams,
 ) -> (
-    (Option<eotn::eval::Percentiles>, Option<eotn::eval::Percentiles>),
-    (Option<eotn::eval::Percentiles>, Option<eotn::eval::Percentiles>),
+    (
+        Option<eotn::eval::Percentiles>,
+        Option<eotn::eval::Percentiles>,
+    ),
+    (
+        Option<eotn::eval::Percentiles>,
+        Option<eotn::eval::Percentiles>,
+    ),
 ) {
     use eotn::recognition::fit::fit_circle_trimmed;
     use eotn::recognition::scan::edge_points;

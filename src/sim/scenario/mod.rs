@@ -131,7 +131,9 @@ impl ScenarioKind {
             }
             Self::RollingBall => "the ball rolls across a still camera at 1-3 m/s",
             Self::PatternTour => "a robot walks round the centre, panning past six pattern markers",
-            Self::BeaconEdges => "close to each beacon, the head circling it out of every image edge",
+            Self::BeaconEdges => {
+                "close to each beacon, the head circling it out of every image edge"
+            }
         }
     }
 }

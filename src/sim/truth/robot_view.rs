@@ -241,7 +241,9 @@ fn convex_hull_area(mut points: Vec<ImagePoint>) -> f64 {
             Box::new(points.iter().rev())
         };
         for p in ordered {
-            while hull.len() >= start + 2 && cross(&hull[hull.len() - 2], &hull[hull.len() - 1], p) <= 0.0 {
+            while hull.len() >= start + 2
+                && cross(&hull[hull.len() - 2], &hull[hull.len() - 1], p) <= 0.0
+            {
                 hull.pop();
             }
             hull.push(*p);
