@@ -576,6 +576,51 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
             .is_some_and(|n| n >= 5),
         "{report}"
     );
+    // Beacons against the truth (walk-and-pan shows them; seed 7's 60 frames: every whole one
+    // found, none false, median error 2.9% with this table — the limit is about 2.5× that).
+    let r = &report["report"];
+    let (eligible, found) = (
+        r["beacons_eligible"].as_u64().unwrap(),
+        r["beacons_found"].as_u64().unwrap(),
+    );
+    assert!(eligible >= 20 && found == eligible, "{r}");
+    assert_eq!(r["beacons_colours_right"], found, "{r}");
+    assert_eq!(r["beacons_false"], 0, "{r}");
+    let beacon_median = r["beacon_distance_error"]["p50"].as_f64().unwrap();
+    assert!(beacon_median <= 0.07, "{r}");
+    assert!(
+        r["beacon_distance_error"]["n"].as_u64().unwrap() >= 20,
+        "{r}"
+    );
+    // The text shows the same; a stream without beacons has no percentiles ("—"), not 0%.
+    let text = |streams: &[&std::path::Path]| {
+        let mut args: Vec<&std::ffi::OsStr> = vec!["eval".as_ref()];
+        args.extend(streams.iter().map(|s| s.as_os_str()));
+        args.extend(["--lut".as_ref(), lut.as_os_str()]);
+        let out = super::common::eotn(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let both = text(&[&walk, &stream]);
+    assert!(
+        both.contains(&format!(
+            "beacons found          {found}/{eligible} = 100.0%"
+        )) && both.contains(&format!(
+            "beacon distance error  median {:.1}%",
+            100.0 * beacon_median
+        )),
+        "{both}"
+    );
+    let keeper = text(&[&stream]);
+    assert!(
+        keeper.contains("beacons found          0/0 = —")
+            && keeper.contains("beacon distance error  median — p90 — (n=0)"),
+        "{keeper}"
+    );
     let fitted = report["goal_calibration"].as_array().unwrap();
     assert!(
         fitted
