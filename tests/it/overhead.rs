@@ -138,14 +138,17 @@ fn calibrated_from_noisy_clicks_the_overhead_recogniser_meets_the_figures() {
         r.ball_found as f64 >= 0.95 * r.ball_eligible as f64,
         "{r:?}"
     );
+    // Limits at about 2.5× what is achieved (2026-12-04: ball median 0.45 cm, p95 1.5 cm, n = 58;
+    // robots 0.27 cm, 0.54 cm, n = 363; headings 0.13°, n = 350; no false robot); the issue's
+    // targets (3 cm, 8 cm, 3°) are far above.
     let ball = sampled(r.ball_error_cm, 30, "overhead ball errors");
-    assert!(ball.p50 < 3.0 && ball.p95 < 8.0, "{ball:?}");
+    assert!(ball.p50 < 1.2 && ball.p95 < 4.0, "{ball:?}");
     let robots = sampled(r.robot_error_cm, 100, "overhead robot errors");
-    assert!(robots.p50 < 3.0 && robots.p95 < 8.0, "{robots:?}");
+    assert!(robots.p50 < 0.7 && robots.p95 < 1.4, "{robots:?}");
     assert!(r.identity_rate.unwrap() >= 0.99, "{r:?}");
     let heading = sampled(r.heading_error_deg, 100, "overhead headings");
-    assert!(heading.p50 < 3.0, "{heading:?}");
-    assert!(r.robots_false <= frames.len() / 20, "{r:?}");
+    assert!(heading.p50 < 0.35, "{heading:?}");
+    assert_eq!(r.robots_false, 0, "{r:?}");
 }
 
 #[test]
