@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::common::{eotn_ok, in_ci, test_python};
+use crate::common::{eotn_ok, test_python};
 
 /// The `rerun` command installed beside the tests' Python, or `None` with a "skipped" line
 /// outside CI. Under `CI=true` its absence fails the test.
@@ -23,11 +23,10 @@ fn rerun() -> Option<PathBuf> {
     if ok {
         return Some(candidate);
     }
-    assert!(
-        !in_ci(),
-        "rerun (rerun-sdk) is required under CI=true (scripts/deps.sh --test installs it into .venv/)"
+    crate::common::skipped(
+        "rerun not found; the Rerun import check did not run",
+        "scripts/deps.sh --test installs rerun-sdk into .venv/",
     );
-    eprintln!("SKIPPED: rerun not found; the Rerun import check did not run");
     None
 }
 
