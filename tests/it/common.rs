@@ -190,6 +190,19 @@ pub const SHIPPED_ROBOT_SCENARIOS: [&str; 6] = [
     "beacon-tour",
 ];
 
+/// The first frame of each shipped sim stream (`eotn sim --seed 1 --first N`): where in its
+/// scenario the stream shows what it is named for (README, "Sample streams").
+pub fn shipped_first_frame(scenario: &str) -> u64 {
+    match scenario {
+        "walk-and-pan" => 75,
+        "ball-edge" => 210,
+        "fast-pans" => 90,
+        "orange-clutter" => 45,
+        "beacon-tour" => 15,
+        _ => 0,
+    }
+}
+
 /// A percentile summary taken over at least `min_n` values, for a test to assert on: fails the
 /// test (naming `what`) when the sample is smaller or empty, so that no percentile assertion
 /// passes on too little data (an empty sample has no percentiles at all).
