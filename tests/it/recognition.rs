@@ -306,22 +306,19 @@ fn recognition_on_synthetic_scenarios() {
     }
 }
 
+/// Radius and centre error percentiles, pixels (`None`: no ball measured).
+type RadiusCentre = (
+    Option<eotn::eval::Percentiles>,
+    Option<eotn::eval::Percentiles>,
+);
+
 /// The skew correction on the fast pans measured on the same balls: every accepted ball's
 /// outline is scanned again and fitted once as read and once moved to the reference read-out
 /// time. Returns (radius error, centre error) percentiles in pixels, without and with.
 fn skew_radius_comparison(
     lut: &LookupTable,
     params: PipelineParams,
-) -> (
-    (
-        Option<eotn::eval::Percentiles>,
-        Option<eotn::eval::Percentiles>,
-    ),
-    (
-        Option<eotn::eval::Percentiles>,
-        Option<eotn::eval::Percentiles>,
-    ),
-) {
+) -> (RadiusCentre, RadiusCentre) {
     use eotn::recognition::fit::fit_circle_trimmed;
     use eotn::recognition::scan::edge_points;
     let b = params.recognition.ball;
