@@ -24,7 +24,8 @@ fn time_to_finish(args: &[&OsStr]) -> Duration {
     start.elapsed()
 }
 
-/// Starts eotn, kills it with SIGKILL after `after`; true when it had finished by then.
+/// Starts eotn, kills it with SIGKILL after `after`; true when it had finished by then (exited
+/// by itself, successfully).
 fn run_and_kill(args: &[&OsStr], after: Duration) -> bool {
     let mut child = Command::new(env!("CARGO_BIN_EXE_eotn"))
         .args(args)
@@ -33,10 +34,9 @@ fn run_and_kill(args: &[&OsStr], after: Duration) -> bool {
         .spawn()
         .unwrap();
     std::thread::sleep(after);
-    let finished = child.try_wait().unwrap().is_some();
     let _ = child.kill();
-    let _ = child.wait();
-    finished
+    // Finished when it exited by itself (a run can end between a check and the kill).
+    child.wait().unwrap().success()
 }
 
 /// The moments to kill at: spread evenly over a whole run.
