@@ -8,17 +8,20 @@
 //! cargo run --example debug_recognition --no-default-features -- posts      # each post against the renderer's corners
 //! cargo run --example debug_recognition --no-default-features -- post-profiles
 //! cargo run --example debug_recognition --no-default-features -- patterns   # places learnt and identified per table
+//! cargo run --example debug_recognition --no-default-features -- beacons    # true beacons and candidates per frame
 //! ```
 //!
 //! `EOTN_DEBUG_SCENARIO`, `EOTN_DEBUG_LUT`, `EOTN_DEBUG_SEED`, `EOTN_DEBUG_NFRAMES` and
 //! `EOTN_DEBUG_FRAMES` pick the scenario, table, seed, frame count and frames shown in full;
-//! `EOTN_BIAS_FRAMES` and `EOTN_BIAS_SEEDS` the bias table's.
+//! `EOTN_BIAS_FRAMES` and `EOTN_BIAS_SEEDS` the bias table's; `EOTN_DEBUG_LEARN_STEP` learns the
+//! table from every Nth frame (10).
 
 #![allow(
     clippy::unwrap_used,
     reason = "a debugging aid: a panic on a missing file names it"
 )]
 
+mod beacons;
 mod patterns;
 mod posts;
 mod scenario;
@@ -46,7 +49,11 @@ fn table_learnt_from(kinds: &[ScenarioKind]) -> LookupTable {
     let mut builder = TableBuilder::new(7).expect("7 bits");
     for &kind in kinds {
         let sim = Simulator::new(Scenario::new(kind, 100));
-        for i in (0..90).step_by(10) {
+        let step = std::env::var("EOTN_DEBUG_LEARN_STEP")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(10);
+        for i in (0..90).step_by(step) {
             let f = sim.frame(i).expect("frame");
             builder.add_frame(&f.frame, &f.labels).expect("labels fit");
         }
@@ -86,9 +93,10 @@ fn main() {
         "posts" => posts::debug_posts(),
         "post-profiles" => posts::debug_post_profiles(),
         "patterns" => patterns::debug_patterns(),
+        "beacons" => beacons::debug_beacons(),
         _ => {
             eprintln!(
-                "usage: debug_recognition scenario|bias|rim|posts|post-profiles|patterns \
+                "usage: debug_recognition scenario|bias|rim|posts|post-profiles|patterns|beacons \
                  (see the file's documentation)"
             );
             std::process::exit(2);

@@ -125,8 +125,8 @@ pub fn debug_patterns() {
             r.wrong,
             r.missed,
             r.false_identifications,
-            100.0 * r.distance_error.p50,
-            100.0 * r.distance_error.p90
+            100.0 * r.distance_error.map_or(f64::NAN, |p| p.p50),
+            100.0 * r.distance_error.map_or(f64::NAN, |p| p.p90)
         );
     }
 }

@@ -14,8 +14,8 @@ use super::inputs::load_lut_arg;
 use super::pct;
 use crate::eval::skew::{self, SkewReport};
 use crate::eval::{
-    EvalParams, EvalReport, FrameEval, evaluate_frame, fit_inverse_size,
-    fit_inverse_size_multiplier,
+    EvalParams, EvalReport, FrameEval, Percentiles, evaluate_frame, fit_inverse_size,
+    fit_inverse_size_multiplier, percentile_text, sample_size,
 };
 use crate::model::truth::{GroundTruth, RobotViewTruth};
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -482,6 +482,7 @@ fn print_summary(o: &EvalOutput) {
         print_skew_summary(s);
     }
     print_goal_summary(r);
+    print_beacon_summary(r);
     print_frame_lists(r);
     if let Some(c) = &o.compare {
         println!(
@@ -525,13 +526,16 @@ fn print_ball_summary(r: &EvalReport) {
         r.ball_false,
         pct(r.ball_false_rate)
     );
+    let share = |p: &Option<Percentiles>, pick: fn(&Percentiles) -> f64| {
+        percentile_text(p.as_ref(), pick, 100.0, 1, "%")
+    };
     println!(
-        "ball distance error    median {:.1}% p90 {:.1}% (n={}); cut off: median {:.1}% (n={})",
-        r.ball_distance_error.p50 * 100.0,
-        r.ball_distance_error.p90 * 100.0,
-        r.ball_distance_error.n,
-        r.ball_distance_error_cut.p50 * 100.0,
-        r.ball_distance_error_cut.n
+        "ball distance error    median {} p90 {} (n={}); cut off: median {} (n={})",
+        share(&r.ball_distance_error, |p| p.p50),
+        share(&r.ball_distance_error, |p| p.p90),
+        sample_size(r.ball_distance_error.as_ref()),
+        share(&r.ball_distance_error_cut, |p| p.p50),
+        sample_size(r.ball_distance_error_cut.as_ref())
     );
     let signed =
         |b: Option<f64>| b.map_or_else(|| "-".to_owned(), |v| format!("{:+.1}%", v * 100.0));
@@ -541,8 +545,10 @@ fn print_ball_summary(r: &EvalReport) {
         signed(r.ball_distance_bias_cut)
     );
     println!(
-        "ball bearing error     median {:.2}° p90 {:.2}°; radius error median {:.2} px",
-        r.ball_bearing_error_deg.p50, r.ball_bearing_error_deg.p90, r.ball_radius_error_px.p50
+        "ball bearing error     median {} p90 {}; radius error median {}",
+        percentile_text(r.ball_bearing_error_deg.as_ref(), |p| p.p50, 1.0, 2, "°"),
+        percentile_text(r.ball_bearing_error_deg.as_ref(), |p| p.p90, 1.0, 2, "°"),
+        percentile_text(r.ball_radius_error_px.as_ref(), |p| p.p50, 1.0, 2, " px")
     );
 }
 
@@ -557,17 +563,17 @@ fn print_skew_summary(s: &SkewReport) {
         ("seen from one side", &s.one_sided),
         ("whole outline", &s.whole),
     ] {
-        if e.radius_with_px.n == 0 {
+        let Some(n) = e.radius_with_px.map(|p| p.n) else {
             continue;
-        }
+        };
+        let px = |p: &Option<Percentiles>| percentile_text(p.as_ref(), |p| p.p50, 1.0, 2, " px");
         println!(
-            "  {name:<20} radius error median {:.2} px with, {:.2} without; centre {:.2} \
-             px with, {:.2} without (n={})",
-            e.radius_with_px.p50,
-            e.radius_without_px.p50,
-            e.centre_with_px.p50,
-            e.centre_without_px.p50,
-            e.radius_with_px.n
+            "  {name:<20} radius error median {} with, {} without; centre {} with, {} \
+             without (n={n})",
+            px(&e.radius_with_px),
+            px(&e.radius_without_px),
+            px(&e.centre_with_px),
+            px(&e.centre_without_px),
         );
     }
 }
@@ -575,24 +581,46 @@ fn print_skew_summary(s: &SkewReport) {
 /// The goals', posts' and gaps' lines of the summary.
 fn print_goal_summary(r: &EvalReport) {
     println!(
-        "goals found            {}/{} = {}   false {}; distance error median {:.1}%",
+        "goals found            {}/{} = {}   false {}; distance error median {} (n={})",
         r.goals_found,
         r.goals_eligible,
         pct(r.goal_found_rate),
         r.goals_false,
-        r.goal_distance_error.p50 * 100.0
+        percentile_text(r.goal_distance_error.as_ref(), |p| p.p50, 100.0, 1, "%"),
+        sample_size(r.goal_distance_error.as_ref())
     );
     println!(
-        "posts                  median {:.2} px, within 2 px {} (n={})",
-        r.post_error_px.p50,
+        "posts                  median {}, within 2 px {} (n={})",
+        percentile_text(r.post_error_px.as_ref(), |p| p.p50, 1.0, 2, " px"),
         pct(r.posts_within_2px),
-        r.post_error_px.n
+        sample_size(r.post_error_px.as_ref())
     );
     println!(
-        "gaps                   median {:.2} px, within 3 px {} (n={})",
-        r.gap_error_px.p50,
+        "gaps                   median {}, within 3 px {} (n={})",
+        percentile_text(r.gap_error_px.as_ref(), |p| p.p50, 1.0, 2, " px"),
         pct(r.gaps_within_3px),
-        r.gap_error_px.n
+        sample_size(r.gap_error_px.as_ref())
+    );
+}
+
+/// The beacons' lines of the summary.
+fn print_beacon_summary(r: &EvalReport) {
+    println!(
+        "beacons found          {}/{} = {}, colours right {}   false {}",
+        r.beacons_found,
+        r.beacons_eligible,
+        pct(r.beacon_found_rate),
+        r.beacons_colours_right,
+        r.beacons_false
+    );
+    let signed =
+        |b: Option<f64>| b.map_or_else(|| "—".to_owned(), |v| format!("{:+.1}%", v * 100.0));
+    println!(
+        "beacon distance error  median {} p90 {} (n={}); signed median {}",
+        percentile_text(r.beacon_distance_error.as_ref(), |p| p.p50, 100.0, 1, "%"),
+        percentile_text(r.beacon_distance_error.as_ref(), |p| p.p90, 100.0, 1, "%"),
+        sample_size(r.beacon_distance_error.as_ref()),
+        signed(r.beacon_distance_bias)
     );
 }
 
@@ -610,6 +638,12 @@ fn print_frame_lists(r: &EvalReport) {
     if !r.goal_false_frames.is_empty() {
         println!("false goal in frames   {:?}", r.goal_false_frames);
     }
+    if !r.beacon_misses.is_empty() {
+        println!("beacon missed, frames  {:?}", r.beacon_misses);
+    }
+    if !r.beacon_false_frames.is_empty() {
+        println!("false beacon in frames {:?}", r.beacon_false_frames);
+    }
 }
 
 /// The pink markers' lines of the summary.
@@ -624,12 +658,15 @@ fn print_pattern_summary(p: &crate::eval::patterns::PatternEvalReport) {
         p.missed,
         p.false_identifications
     );
+    let share = |pick: fn(&Percentiles) -> f64| {
+        percentile_text(p.distance_error.as_ref(), pick, 100.0, 1, "%")
+    };
     println!(
-        "marker distance error  median {:.1}% p90 {:.1}% p95 {:.1}% (n={}); signed median {}",
-        p.distance_error.p50 * 100.0,
-        p.distance_error.p90 * 100.0,
-        p.distance_error.p95 * 100.0,
-        p.distance_error.n,
+        "marker distance error  median {} p90 {} p95 {} (n={}); signed median {}",
+        share(|p| p.p50),
+        share(|p| p.p90),
+        share(|p| p.p95),
+        sample_size(p.distance_error.as_ref()),
         p.distance_bias_cm
             .map_or_else(|| "-".to_owned(), |b| format!("{b:+.1} cm"))
     );

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::pct;
 use crate::eval::labels::{LabelledFrameEval, Labels, LabelsReport, evaluate_labelled_frame};
-use crate::eval::{EvalParams, Percentiles};
+use crate::eval::{EvalParams, Percentiles, percentile_text, sample_size};
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recognition::RecognitionParams;
 use crate::streams::StreamReader;
@@ -37,7 +37,7 @@ pub struct LabelsOutput {
     /// The sums.
     pub report: LabelsReport,
     /// Found goals with both ends in the image: size-based / foot distance, percentiles.
-    pub goal_size_over_foot: Percentiles,
+    pub goal_size_over_foot: Option<Percentiles>,
     /// Every found goal's distances.
     pub goal_distances: Vec<GoalDistances>,
     /// Every labelled frame.
@@ -169,21 +169,24 @@ fn print_summary(o: &LabelsOutput) {
         pct(r.ball_false_rate),
         r.ball_absent
     );
+    let q = |p: &Option<Percentiles>, pick: fn(&Percentiles) -> f64| {
+        percentile_text(p.as_ref(), pick, 1.0, 2, " px")
+    };
     outln!(
-        "ball centre error      median {:.2} px p90 {:.2} px (n={}); cut: median {:.2} px (n={})",
-        r.ball_center_error_px.p50,
-        r.ball_center_error_px.p90,
-        r.ball_center_error_px.n,
-        r.ball_center_error_cut_px.p50,
-        r.ball_center_error_cut_px.n
+        "ball centre error      median {} p90 {} (n={}); cut: median {} (n={})",
+        q(&r.ball_center_error_px, |p| p.p50),
+        q(&r.ball_center_error_px, |p| p.p90),
+        sample_size(r.ball_center_error_px.as_ref()),
+        q(&r.ball_center_error_cut_px, |p| p.p50),
+        sample_size(r.ball_center_error_cut_px.as_ref())
     );
     outln!(
-        "ball radius error      median {:.2} px p90 {:.2} px, signed median {}; cut: median {:.2} px",
-        r.ball_radius_error_px.p50,
-        r.ball_radius_error_px.p90,
+        "ball radius error      median {} p90 {}, signed median {}; cut: median {}",
+        q(&r.ball_radius_error_px, |p| p.p50),
+        q(&r.ball_radius_error_px, |p| p.p90),
         r.ball_radius_bias_px
             .map_or_else(|| "—".to_owned(), |b| format!("{b:+.2} px")),
-        r.ball_radius_error_cut_px.p50
+        q(&r.ball_radius_error_cut_px, |p| p.p50)
     );
     if !r.ball_missed_frames.is_empty() {
         outln!("ball missed in frames  {:?}", r.ball_missed_frames);
@@ -210,12 +213,12 @@ fn print_summary(o: &LabelsOutput) {
             outln!("false goal in frames   {:?}", r.goal_false_frames);
         }
     }
-    if o.goal_size_over_foot.n > 0 {
+    if let Some(g) = &o.goal_size_over_foot {
         outln!(
             "goal distance          size / foot on the ground: median {:.2}, p90 {:.2} (n={})",
-            o.goal_size_over_foot.p50,
-            o.goal_size_over_foot.p90,
-            o.goal_size_over_foot.n
+            g.p50,
+            g.p90,
+            g.n
         );
     }
     if !o.unlabelled_frames.is_empty() {

@@ -12,6 +12,7 @@ use crate::eval::overhead::{
     OverheadEvalParams, OverheadEvalReport, WorldModel, evaluate_overhead_frame,
     evaluate_world_model,
 };
+use crate::eval::{Percentiles, percentile_text};
 use crate::model::truth::GroundTruth;
 use crate::overhead::{Calibration, OverheadPipeline};
 use crate::streams::StreamReader;
@@ -118,6 +119,19 @@ pub fn run(
     Ok(())
 }
 
+/// Median, p90 and p95 of a summary with its unit and sample size, or "—" without a sample.
+fn three(p: Option<&Percentiles>, unit: &str) -> String {
+    p.map_or_else(
+        || "— (n=0)".to_owned(),
+        |p| {
+            format!(
+                "median {:.2}{unit} p90 {:.2}{unit} p95 {:.2}{unit} (n={})",
+                p.p50, p.p90, p.p95, p.n
+            )
+        },
+    )
+}
+
 fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
     let pct = |n: usize, d: usize| {
         if d == 0 {
@@ -138,8 +152,8 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         r.ball_false
     );
     println!(
-        "ball position error    median {:.2} cm p90 {:.2} p95 {:.2} (n={})",
-        r.ball_error_cm.p50, r.ball_error_cm.p90, r.ball_error_cm.p95, r.ball_error_cm.n
+        "ball position error    {}",
+        three(r.ball_error_cm.as_ref(), " cm")
     );
     println!(
         "robots found           {}/{} fully visible markers = {}   false {}",
@@ -155,43 +169,41 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         pct(r.identity_right, r.robots_eligible)
     );
     println!(
-        "robot position error   median {:.2} cm p90 {:.2} p95 {:.2} (n={})",
-        r.robot_error_cm.p50, r.robot_error_cm.p90, r.robot_error_cm.p95, r.robot_error_cm.n
+        "robot position error   {}",
+        three(r.robot_error_cm.as_ref(), " cm")
     );
     println!(
-        "heading error          median {:.2}° p90 {:.2}° p95 {:.2}°",
-        r.heading_error_deg.p50, r.heading_error_deg.p90, r.heading_error_deg.p95
+        "heading error          {}",
+        three(r.heading_error_deg.as_ref(), "°")
     );
     for (t, read) in &r.wrong_identities {
         println!("  wrong identity: {t} read as {read}");
     }
     for m in &r.world_models {
+        let q = |p: &Option<Percentiles>, pick: fn(&Percentiles) -> f64, unit: &str| {
+            percentile_text(p.as_ref(), pick, 1.0, 1, unit)
+        };
         println!(
-            "world model robot{:<2}   vs truth: self median {:.1} cm p95 {:.1}, heading {:.1}°, \
-             ball {:.1} cm",
+            "world model robot{:<2}   vs truth: self median {} p95 {}, heading {}, ball {}",
             m.robot_id,
-            m.self_error_cm.p50,
-            m.self_error_cm.p95,
-            m.heading_error_deg.p50,
-            m.ball_error_cm.p50
+            q(&m.self_error_cm, |p| p.p50, " cm"),
+            q(&m.self_error_cm, |p| p.p95, " cm"),
+            q(&m.heading_error_deg, |p| p.p50, "°"),
+            q(&m.ball_error_cm, |p| p.p50, " cm"),
         );
-        let vs = &m.self_error_vs_overhead_cm;
-        if vs.n == 0 {
-            println!("                       vs overhead: not seen overhead");
-        } else {
+        if let Some(vs) = &m.self_error_vs_overhead_cm {
             println!(
                 "                       vs overhead: self median {:.1} cm p95 {:.1} (n={}), \
-                 heading {:.1}°, ball {}",
+                 heading {}, ball {}",
                 vs.p50,
                 vs.p95,
                 vs.n,
-                m.heading_error_vs_overhead_deg.p50,
-                if m.ball_error_vs_overhead_cm.n == 0 {
-                    "not seen".to_owned()
-                } else {
-                    format!("{:.1} cm", m.ball_error_vs_overhead_cm.p50)
-                }
+                q(&m.heading_error_vs_overhead_deg, |p| p.p50, "°"),
+                m.ball_error_vs_overhead_cm
+                    .map_or_else(|| "not seen".to_owned(), |b| format!("{:.1} cm", b.p50))
             );
+        } else {
+            println!("                       vs overhead: not seen overhead");
         }
     }
     if !skipped.is_empty() {

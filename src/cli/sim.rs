@@ -23,6 +23,10 @@ pub struct Args {
     /// Seed: the same seed gives the same stream.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Index of the first frame: a short stream from the middle of a scenario, where it shows
+    /// what it is named for (the stream's times still start at 0).
+    #[arg(long, default_value_t = 0)]
+    pub first: u64,
     /// Output stream (`.mcap`).
     #[arg(short, long, required_unless_present = "list")]
     pub output: Option<PathBuf>,
@@ -67,10 +71,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let info = StreamInfo {
         source: format!("sim:{}", kind.name()),
         description: format!(
-            "eotn sim --scenario {} --frames {} --seed {}{}: {}",
+            "eotn sim --scenario {} --frames {} --seed {}{}{}: {}",
             kind.name(),
             args.frames,
             args.seed,
+            if args.first > 0 {
+                format!(" --first {}", args.first)
+            } else {
+                String::new()
+            },
             if args.ideal { " --ideal" } else { "" },
             kind.description()
         ),
@@ -83,12 +92,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let bar = progress(usize::try_from(args.frames).unwrap_or(usize::MAX), "sim");
     let mut render_s = 0.0;
     let mut size = (0, 0);
-    for index in 0..args.frames {
+    let last = args
+        .first
+        .checked_add(args.frames)
+        .context("--first + --frames is beyond the last frame index")?;
+    let mut first_ns = None;
+    for index in args.first..last {
         let start = Instant::now();
         let f = sim.frame(index)?;
         render_s += start.elapsed().as_secs_f64();
         size = (f.frame.width(), f.frame.height());
-        let mut record = FrameRecord::new(f.time_ns, f.frame);
+        // The stream starts at 0 like any recording, whichever frame it starts at.
+        let first_ns = *first_ns.get_or_insert(f.time_ns);
+        let mut record = FrameRecord::new(f.time_ns.saturating_sub(first_ns), f.frame);
         record.sensors = f.sensors;
         record.ground_truth = Some(
             serde_json::to_value(&f.ground_truth).context("ground truth is not serialisable")?,

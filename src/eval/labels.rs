@@ -387,13 +387,13 @@ pub struct LabelsReport {
     /// Frames without a labelled ball.
     pub ball_absent: usize,
     /// Centre error of found balls not cut off, pixels.
-    pub ball_center_error_px: Percentiles,
+    pub ball_center_error_px: Option<Percentiles>,
     /// Centre error of found balls cut off by the image edge, pixels.
-    pub ball_center_error_cut_px: Percentiles,
+    pub ball_center_error_cut_px: Option<Percentiles>,
     /// |radius error| of found balls not cut off, pixels.
-    pub ball_radius_error_px: Percentiles,
+    pub ball_radius_error_px: Option<Percentiles>,
     /// |radius error| of found cut balls, pixels.
-    pub ball_radius_error_cut_px: Percentiles,
+    pub ball_radius_error_cut_px: Option<Percentiles>,
     /// Median signed radius error (reported − labelled) of found uncut balls, pixels.
     pub ball_radius_bias_px: Option<f64>,
     /// Frames whose labelled ball was not found (near misses included).
@@ -480,7 +480,7 @@ impl LabelsReport {
         r.ball_center_error_cut_px = Percentiles::of(&centre_cut);
         r.ball_radius_error_px = Percentiles::of(&radius);
         r.ball_radius_error_cut_px = Percentiles::of(&radius_cut);
-        r.ball_radius_bias_px = (!signed.is_empty()).then(|| Percentiles::of(&signed).p50);
+        r.ball_radius_bias_px = Percentiles::median_of(&signed);
         r.goal_found_rate = rate(r.goals_found, r.goals_visible);
         r
     }
@@ -615,7 +615,8 @@ mod tests {
         assert_eq!(report.ball_near_frames, vec![0]);
         assert_eq!(report.ball_false_frames, vec![2]);
         assert_eq!((report.ball_cut, report.ball_cut_found), (1, 1));
-        assert_eq!(report.ball_center_error_px.n, 1);
+        assert_eq!(report.ball_center_error_px.map(|p| p.n), Some(1));
+        assert_eq!(report.ball_center_error_cut_px.map(|p| p.n), Some(1));
         assert_eq!(report.ball_radius_bias_px, Some(1.0));
         // Frame 0 twice (two recognitions), and frame 2 with no goal.
         assert_eq!(

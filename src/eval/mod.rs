@@ -4,6 +4,7 @@
 //! Pure functions on [`Recognition`] and the renderer's [`RobotViewTruth`]; `eotn eval` reads
 //! streams and runs the pipeline, this module only compares.
 
+pub mod beacons;
 pub mod labels;
 pub mod overhead;
 pub mod patterns;
@@ -40,6 +41,11 @@ pub struct EvalParams {
     /// A goal's second largest open stretch is as good an answer as its largest when it is at
     /// most this much narrower, pixels (the gap target's tolerance).
     pub gap_tie_px: f64,
+    /// A beacon must be found when no image border cuts its two bands, at least this fraction
+    /// of them is in view ...
+    pub beacon_min_visible_fraction: f64,
+    /// ... and they show at least this many pixels.
+    pub beacon_min_band_pixels: usize,
 }
 
 impl Default for EvalParams {
@@ -52,6 +58,8 @@ impl Default for EvalParams {
             goal_min_mouth_fraction: 0.5,
             goal_min_pixels: 30,
             gap_tie_px: 3.0,
+            beacon_min_visible_fraction: 0.9,
+            beacon_min_band_pixels: 40,
         }
     }
 }
@@ -101,6 +109,16 @@ pub struct FrameEval {
     pub goal_detections: Vec<(f64, bool)>,
     /// Found goals with uncut top and bottom: true and reported distance and the height used.
     pub goal_distances_cm: Vec<GoalDistance>,
+    /// Beacons that had to be found ([`beacons::beacon_is_whole`]).
+    pub beacons_eligible: usize,
+    /// Of those, found where they are.
+    pub beacons_found: usize,
+    /// Of those found, with the right colours top and bottom.
+    pub beacons_colours_right: usize,
+    /// Accepted beacons over no beacon.
+    pub beacons_false: usize,
+    /// Each found eligible beacon's true and reported distance.
+    pub beacon_distances_cm: Vec<beacons::BeaconDistance>,
 }
 
 /// A found goal's distance against the truth (the data of plots and calibration).
@@ -169,6 +187,7 @@ pub fn evaluate_frame(
         ..FrameEval::default()
     };
     score_ball(&mut e, r, t, p);
+    beacons::score_beacons(&mut e, r, t, p);
     for tg in &t.goals {
         score_goal(&mut e, r, tg, width, height, p);
     }
@@ -312,10 +331,12 @@ fn post_error_px(post: &Post, tg: &GoalTruth, width: f64, height: f64) -> f64 {
         .map_or(f64::INFINITY, |(error, _)| error)
 }
 
-/// 50th, 90th and 95th percentiles and the count of a sample.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+/// 50th, 90th and 95th percentiles and the count of a sample that has at least one value. An
+/// empty sample has no percentiles: [`Percentiles::of`] gives `None` (`null` in JSON, "—" in
+/// text), never zeros that would read as "no error".
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Percentiles {
-    /// Number of values.
+    /// Number of values (at least 1).
     pub n: usize,
     /// Median.
     pub p50: f64,
@@ -326,22 +347,51 @@ pub struct Percentiles {
 }
 
 impl Percentiles {
-    /// Percentiles by nearest rank; all zero for an empty sample. NaN values are left out.
+    /// Percentiles by nearest rank; `None` for a sample without values. NaN values are left
+    /// out.
     #[must_use]
-    pub fn of(values: &[f64]) -> Self {
+    pub fn of(values: &[f64]) -> Option<Self> {
         let mut v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
         if v.is_empty() {
-            return Self::default();
+            return None;
         }
         v.sort_by(f64::total_cmp);
         let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
-        Self {
+        Some(Self {
             n: v.len(),
             p50: rank(0.5),
             p90: rank(0.9),
             p95: rank(0.95),
-        }
+        })
     }
+
+    /// The median by nearest rank, `None` for a sample without values.
+    #[must_use]
+    pub fn median_of(values: &[f64]) -> Option<f64> {
+        Self::of(values).map(|p| p.p50)
+    }
+}
+
+/// How many values a percentile summary was taken over: 0 when there were none.
+#[must_use]
+pub fn sample_size(p: Option<&Percentiles>) -> usize {
+    p.map_or(0, |p| p.n)
+}
+
+/// One figure of a percentile summary as text, `pick(p) × scale` with `decimals` decimals and
+/// `unit` after it, or "—" when the sample was empty.
+#[must_use]
+pub fn percentile_text(
+    p: Option<&Percentiles>,
+    pick: fn(&Percentiles) -> f64,
+    scale: f64,
+    decimals: usize,
+    unit: &str,
+) -> String {
+    p.map_or_else(
+        || "—".to_owned(),
+        |p| format!("{:.*}{unit}", decimals, pick(p) * scale),
+    )
 }
 
 fn rate(num: usize, den: usize) -> Option<f64> {
@@ -364,9 +414,9 @@ pub struct EvalReport {
     /// False balls / frames.
     pub ball_false_rate: Option<f64>,
     /// Relative distance errors, balls not cut off.
-    pub ball_distance_error: Percentiles,
+    pub ball_distance_error: Option<Percentiles>,
     /// Relative distance errors, balls cut off by the image edge.
-    pub ball_distance_error_cut: Percentiles,
+    pub ball_distance_error_cut: Option<Percentiles>,
     /// Median signed relative distance error (measured − true) / true of balls not cut off:
     /// positive when distances read long (a bias, which the absolute error hides).
     #[serde(default)]
@@ -375,9 +425,9 @@ pub struct EvalReport {
     #[serde(default)]
     pub ball_distance_bias_cut: Option<f64>,
     /// Bearing errors, degrees.
-    pub ball_bearing_error_deg: Percentiles,
+    pub ball_bearing_error_deg: Option<Percentiles>,
     /// Radius errors, pixels.
-    pub ball_radius_error_px: Percentiles,
+    pub ball_radius_error_px: Option<Percentiles>,
     /// Goals that had to be found.
     pub goals_eligible: usize,
     /// Of those, found.
@@ -387,13 +437,13 @@ pub struct EvalReport {
     /// Goals reported that are not in view.
     pub goals_false: usize,
     /// Goal distance errors (relative), uncut goals.
-    pub goal_distance_error: Percentiles,
+    pub goal_distance_error: Option<Percentiles>,
     /// Post errors, pixels.
-    pub post_error_px: Percentiles,
+    pub post_error_px: Option<Percentiles>,
     /// Share of posts within 2 px.
     pub posts_within_2px: Option<f64>,
     /// Gap end errors, pixels.
-    pub gap_error_px: Percentiles,
+    pub gap_error_px: Option<Percentiles>,
     /// Share of gaps with both ends within 3 px.
     pub gaps_within_3px: Option<f64>,
     /// Frames where an eligible ball was missed.
@@ -405,6 +455,33 @@ pub struct EvalReport {
     /// Frames with a goal reported that is not in view (a yellow or sky-blue thing taken for
     /// a goal).
     pub goal_false_frames: Vec<usize>,
+    /// Beacons that had to be found (both bands whole in the image).
+    #[serde(default)]
+    pub beacons_eligible: usize,
+    /// Of those, found where they are.
+    #[serde(default)]
+    pub beacons_found: usize,
+    /// Found / eligible.
+    #[serde(default)]
+    pub beacon_found_rate: Option<f64>,
+    /// Of those found, with the right colours top and bottom.
+    #[serde(default)]
+    pub beacons_colours_right: usize,
+    /// Accepted beacons over no beacon.
+    #[serde(default)]
+    pub beacons_false: usize,
+    /// Relative distance errors of found whole beacons.
+    #[serde(default)]
+    pub beacon_distance_error: Option<Percentiles>,
+    /// Median signed relative distance error of those (positive: reads long).
+    #[serde(default)]
+    pub beacon_distance_bias: Option<f64>,
+    /// Frames where a beacon that had to be found was not.
+    #[serde(default)]
+    pub beacon_misses: Vec<usize>,
+    /// Frames with a false beacon.
+    #[serde(default)]
+    pub beacon_false_frames: Vec<usize>,
 }
 
 impl EvalReport {
@@ -418,6 +495,7 @@ impl EvalReport {
         let (mut d, mut dc, mut b, mut rad, mut gd, mut posts, mut gaps) =
             (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
         let (mut s, mut sc) = (vec![], vec![]);
+        let (mut bd, mut bs) = (vec![], vec![]);
         for f in frames {
             if f.ball_eligible {
                 r.ball_eligible += 1;
@@ -449,6 +527,21 @@ impl EvalReport {
                 r.goal_false_frames.push(f.frame);
             }
             gd.extend(&f.goal_distance_errors);
+            r.beacons_eligible += f.beacons_eligible;
+            r.beacons_found += f.beacons_found;
+            r.beacons_colours_right += f.beacons_colours_right;
+            r.beacons_false += f.beacons_false;
+            if f.beacons_found < f.beacons_eligible {
+                r.beacon_misses.push(f.frame);
+            }
+            if f.beacons_false > 0 {
+                r.beacon_false_frames.push(f.frame);
+            }
+            for d in f.beacon_distances_cm.iter().filter(|d| d.true_cm > 0.0) {
+                let signed = (d.measured_cm - d.true_cm) / d.true_cm;
+                bd.push(signed.abs());
+                bs.push(signed);
+            }
             posts.extend(&f.post_errors_px);
             gaps.extend(&f.gap_errors_px);
         }
@@ -456,8 +549,8 @@ impl EvalReport {
         r.ball_false_rate = rate(r.ball_false, r.frames);
         r.ball_distance_error = Percentiles::of(&d);
         r.ball_distance_error_cut = Percentiles::of(&dc);
-        r.ball_distance_bias = (!s.is_empty()).then(|| Percentiles::of(&s).p50);
-        r.ball_distance_bias_cut = (!sc.is_empty()).then(|| Percentiles::of(&sc).p50);
+        r.ball_distance_bias = Percentiles::median_of(&s);
+        r.ball_distance_bias_cut = Percentiles::median_of(&sc);
         r.ball_bearing_error_deg = Percentiles::of(&b);
         r.ball_radius_error_px = Percentiles::of(&rad);
         r.goal_found_rate = rate(r.goals_found, r.goals_eligible);
@@ -466,6 +559,9 @@ impl EvalReport {
         r.posts_within_2px = rate(posts.iter().filter(|e| **e <= 2.0).count(), posts.len());
         r.gap_error_px = Percentiles::of(&gaps);
         r.gaps_within_3px = rate(gaps.iter().filter(|e| **e <= 3.0).count(), gaps.len());
+        r.beacon_found_rate = rate(r.beacons_found, r.beacons_eligible);
+        r.beacon_distance_error = Percentiles::of(&bd);
+        r.beacon_distance_bias = Percentiles::median_of(&bs);
         r
     }
 }
@@ -499,10 +595,22 @@ mod tests {
     #[test]
     fn percentiles_by_nearest_rank() {
         let v: Vec<f64> = (1..=100).map(f64::from).collect();
-        let p = Percentiles::of(&v);
+        let p = Percentiles::of(&v).expect("a sample");
         assert_eq!((p.n, p.p50, p.p90, p.p95), (100, 50.0, 90.0, 95.0));
-        assert_eq!(Percentiles::of(&[]).n, 0);
-        assert_eq!(Percentiles::of(&[f64::NAN, 3.0]).p50, 3.0);
+        assert_eq!(Percentiles::of(&[]), None, "no data, no percentiles");
+        assert_eq!(Percentiles::of(&[f64::NAN]), None);
+        assert_eq!(Percentiles::median_of(&[f64::NAN, 3.0]), Some(3.0));
+        assert_eq!(sample_size(None), 0);
+        assert_eq!(percentile_text(None, |p| p.p50, 100.0, 1, "%"), "—");
+        assert_eq!(
+            percentile_text(Some(&p), |p| p.p90, 0.5, 1, " px"),
+            "45.0 px"
+        );
+        // An empty summary is null in JSON, not zeros.
+        let r = EvalReport::from_frames(&[]);
+        let json = serde_json::to_value(&r).expect("json");
+        assert!(json["ball_distance_error"].is_null(), "{json}");
+        assert!(json["beacon_distance_error"].is_null(), "{json}");
     }
 
     #[test]
@@ -548,7 +656,8 @@ mod tests {
         assert_eq!(r.ball_misses, vec![1]);
         assert_eq!(r.ball_false_frames, vec![2]);
         assert_eq!(r.ball_found_rate, Some(0.5));
-        assert_eq!(r.ball_distance_error.p50, 0.02);
+        assert_eq!(r.ball_distance_error.map(|p| (p.n, p.p50)), Some((1, 0.02)));
+        assert_eq!(r.ball_distance_error_cut, None);
         assert_eq!(
             r.ball_distance_bias,
             Some(-0.02),

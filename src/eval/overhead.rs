@@ -233,17 +233,17 @@ pub struct WorldModelReport {
     /// Robot id.
     pub robot_id: u32,
     /// Self position error against the truth, centimetres.
-    pub self_error_cm: Percentiles,
+    pub self_error_cm: Option<Percentiles>,
     /// Heading error, degrees.
-    pub heading_error_deg: Percentiles,
+    pub heading_error_deg: Option<Percentiles>,
     /// Ball error, centimetres.
-    pub ball_error_cm: Percentiles,
+    pub ball_error_cm: Option<Percentiles>,
     /// Self position error against the overhead detection, centimetres.
-    pub self_error_vs_overhead_cm: Percentiles,
+    pub self_error_vs_overhead_cm: Option<Percentiles>,
     /// Heading error against the overhead detection, degrees.
-    pub heading_error_vs_overhead_deg: Percentiles,
+    pub heading_error_vs_overhead_deg: Option<Percentiles>,
     /// Ball error against the ball the overhead camera found, centimetres.
-    pub ball_error_vs_overhead_cm: Percentiles,
+    pub ball_error_vs_overhead_cm: Option<Percentiles>,
 }
 
 /// The whole overhead evaluation.
@@ -258,7 +258,7 @@ pub struct OverheadEvalReport {
     /// Frames with a false ball.
     pub ball_false: usize,
     /// Ball position error, centimetres.
-    pub ball_error_cm: Percentiles,
+    pub ball_error_cm: Option<Percentiles>,
     /// Robot markers fully visible (robot-frames).
     pub robots_eligible: usize,
     /// Of those, found.
@@ -268,9 +268,9 @@ pub struct OverheadEvalReport {
     /// `identity_right / robots_eligible`.
     pub identity_rate: Option<f64>,
     /// Robot position error, centimetres.
-    pub robot_error_cm: Percentiles,
+    pub robot_error_cm: Option<Percentiles>,
     /// Heading error, degrees.
-    pub heading_error_deg: Percentiles,
+    pub heading_error_deg: Option<Percentiles>,
     /// Detections matching no robot.
     pub robots_false: usize,
     /// The first few wrong identities: `(true, read)`.

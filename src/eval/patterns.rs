@@ -166,7 +166,7 @@ pub struct PatternEvalReport {
     /// Correct / eligible.
     pub correct_rate: Option<f64>,
     /// Relative distance errors of correct identifications.
-    pub distance_error: Percentiles,
+    pub distance_error: Option<Percentiles>,
     /// Median signed distance error, centimetres.
     pub distance_bias_cm: Option<f64>,
     /// Learnt places and the marker each stands for (`None`: no marker near it).
@@ -199,7 +199,7 @@ impl PatternEvalReport {
         }
         r.correct_rate = (r.eligible > 0).then(|| r.correct as f64 / r.eligible as f64);
         r.distance_error = Percentiles::of(&rel);
-        r.distance_bias_cm = (!cm.is_empty()).then(|| Percentiles::of(&cm).p50);
+        r.distance_bias_cm = Percentiles::median_of(&cm);
         r
     }
 }
@@ -232,7 +232,7 @@ mod tests {
         let r = PatternEvalReport::from_frames(&frames, vec![(0, Some(1))]);
         assert_eq!((r.eligible, r.correct, r.wrong, r.missed), (4, 3, 1, 0));
         assert_eq!(r.correct_rate, Some(0.75));
-        assert_eq!(r.distance_error.p50, 0.04);
+        assert_eq!(r.distance_error.map(|p| (p.n, p.p50)), Some((3, 0.04)));
         assert_eq!(r.distance_bias_cm, Some(5.0));
         assert_eq!(r.wrong_frames, vec![1]);
     }

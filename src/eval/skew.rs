@@ -206,13 +206,13 @@ pub fn compare_ball(
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct SkewErrors {
     /// Radius error with the correction, pixels.
-    pub radius_with_px: Percentiles,
+    pub radius_with_px: Option<Percentiles>,
     /// Radius error without it, pixels.
-    pub radius_without_px: Percentiles,
+    pub radius_without_px: Option<Percentiles>,
     /// Centre error with the correction, pixels.
-    pub centre_with_px: Percentiles,
+    pub centre_with_px: Option<Percentiles>,
     /// Centre error without it, pixels.
-    pub centre_without_px: Percentiles,
+    pub centre_without_px: Option<Percentiles>,
 }
 
 impl SkewErrors {
@@ -370,9 +370,9 @@ mod tests {
             &[s(true, 0.2, 1.0), s(false, 0.3, 0.3), s(true, 0.1, 0.8)],
         );
         assert_eq!((r.frames, r.compared), (5, 3));
-        assert_eq!(r.one_sided.radius_with_px.n, 2);
-        assert_eq!(r.whole.radius_without_px.p50, 0.3);
-        assert_eq!(r.one_sided.radius_without_px.p50, 0.8);
-        assert_eq!(r.all.centre_without_px.p50, 10.0);
+        assert_eq!(r.one_sided.radius_with_px.map(|p| p.n), Some(2));
+        assert_eq!(r.whole.radius_without_px.map(|p| p.p50), Some(0.3));
+        assert_eq!(r.one_sided.radius_without_px.map(|p| p.p50), Some(0.8));
+        assert_eq!(r.all.centre_without_px.map(|p| p.p50), Some(10.0));
     }
 }

@@ -16,6 +16,7 @@ use crate::geometry::{
     BodyPose, HeadJoints, Horizon, ImagePoint, MarkerIdentity, MarkerTeam, OverheadCamera,
     PoseRecord, RobotPose,
 };
+use crate::lut::ColourClass;
 use crate::model::scene::{GoalColour, Team};
 use crate::sensors::SensorReadings;
 
@@ -172,6 +173,23 @@ pub struct BeaconTruth {
     /// Box of those pixels.
     #[serde(with = "box_fields", default)]
     pub image_box: Option<PixelBox>,
+    /// The colour classes of its upper and lower band (`None` in streams made before they
+    /// were recorded).
+    #[serde(default)]
+    pub colours: Option<[ColourClass; 2]>,
+    /// Pixels that show its two coloured bands (the white base not counted).
+    #[serde(default)]
+    pub band_pixels: usize,
+    /// Band pixels over the area of the two bands' whole projection (0..1): less than 1 when
+    /// cut by the image border or hidden behind something.
+    #[serde(default)]
+    pub bands_visible_fraction: f64,
+    /// Image borders that cut the bands' projection.
+    #[serde(default)]
+    pub bands_cut_off: CutOff,
+    /// Box of the band pixels.
+    #[serde(with = "box_fields", default)]
+    pub bands_box: Option<PixelBox>,
 }
 
 /// A coloured-pattern marker in a robot's view.

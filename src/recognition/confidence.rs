@@ -62,6 +62,8 @@ pub enum TestName {
     CutSides,
     /// Goal: share of its box a recognised beacon covers.
     BeaconOverlap,
+    /// Goal cut off at the top: share of green (white not counted) below its foot.
+    GreenBelowCut,
     /// Goal: upright posts found on the sides in view.
     UprightPosts,
     /// Beacon: pink band width over the other band's.
@@ -70,8 +72,12 @@ pub enum TestName {
     Alignment,
     /// Beacon: gap between the two bands, pixels.
     Gap,
-    /// Beacon: height over width of both bands.
+    /// Beacon: height over width of both bands (of the one band, when it stands on its base).
     Aspect,
+    /// Beacon seen as one band on its base: share of white right below the band.
+    WhiteBase,
+    /// Beacon seen as one band on its base: share of white beside the base.
+    BaseFlanks,
     /// Coloured pattern: regions with a colour, of nine.
     ColouredRegions,
     /// Coloured pattern: regions agreeing with the closest place, of nine.
@@ -105,11 +111,14 @@ impl TestName {
             Self::GroundAtFoot => "ground_at_foot",
             Self::CutSides => "cut_sides",
             Self::BeaconOverlap => "beacon_overlap",
+            Self::GreenBelowCut => "green_below_cut",
             Self::UprightPosts => "upright_posts",
             Self::WidthRatio => "width_ratio",
             Self::Alignment => "alignment",
             Self::Gap => "gap",
             Self::Aspect => "aspect",
+            Self::WhiteBase => "white_base",
+            Self::BaseFlanks => "base_flanks",
             Self::ColouredRegions => "coloured_regions",
             Self::Agreement => "agreement",
             Self::Margin => "margin",

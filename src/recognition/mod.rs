@@ -146,7 +146,7 @@ pub fn recognise(
     params: &RecognitionParams,
     memory: Option<&patterns::PatternMemory>,
 ) -> Recognition {
-    let beacons = beacons::recognise_beacons(blobs, ctx, &params.beacons);
+    let beacons = beacons::recognise_beacons(img, blobs, ctx, &params.beacons);
     let beacon_boxes: Vec<crate::frame::PixelBox> = beacons
         .iter()
         .filter(|b| b.accepted)

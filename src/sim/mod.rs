@@ -233,6 +233,7 @@ impl Simulator {
             &pose,
             sensors,
             &out.objects,
+            &out.labels,
         );
         if let (Some(b), Some(v)) = (truth.ball.as_mut(), self.scenario.ball_velocity_cm_s(t)) {
             truth::add_ball_velocity(b, v, &robot, &pose);

@@ -15,12 +15,11 @@ fn first_streaming_camera() -> Option<CameraSource> {
             return Some(c);
         }
     }
-    eprintln!(
-        "SKIPPED: camera::a_real_v4l2_device_streams_with_increasing_times — {} (load `vivid` \
-         with `modprobe vivid` to run it)",
-        found
+    crate::common::skip_noted(
+        &found
             .camera_note
-            .unwrap_or_else(|| "no /dev/video* device delivers frames".to_owned())
+            .unwrap_or_else(|| "no /dev/video* device delivers frames".to_owned()),
+        "load the virtual camera with `sudo modprobe vivid`",
     );
     None
 }

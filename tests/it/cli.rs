@@ -154,9 +154,15 @@ fn classify_writes_png_and_raw_codes() {
     ]);
     let codes = std::fs::read(outdir.join("ball.uyvy.cls")).unwrap();
     assert_eq!(codes.len(), 208 * 160);
-    let orange = codes.iter().filter(|&&c| c == 1).count();
+    // Orange (code 1) exactly on the 18 × 20 patch of `ball_frame`, nowhere else; the JSON
+    // count says the same.
+    for (i, &c) in codes.iter().enumerate() {
+        let (x, y) = (i % 208, i / 208);
+        let inside = (92..110).contains(&x) && (70..90).contains(&y);
+        assert_eq!(c == 1, inside, "pixel ({x}, {y}) has code {c}");
+    }
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["pixels"]["orange"].as_u64(), Some(orange as u64));
+    assert_eq!(v["pixels"]["orange"].as_u64(), Some(18 * 20));
     assert!(outdir.join("ball.uyvy.classified.png").exists());
 }
 

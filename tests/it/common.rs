@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use eotn::eval::Percentiles;
+
 /// The `../shared/` folder beside the project (overridable with `EOTN_SHARED`).
 pub fn shared_dir() -> PathBuf {
     std::env::var_os("EOTN_SHARED").map_or_else(
@@ -16,6 +18,41 @@ pub fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true" || v == "1")
 }
 
+/// Says a test is skipped: a "SKIPPED" line on stderr (which the harness shows only for failing
+/// tests, unless `--nocapture`), and one line appended to the file `EOTN_SKIP_LOG` names —
+/// `scripts/test.sh` sets it and ends with a summary of every skip: the test, why, and how to
+/// get what it needs. Fails the test under `CI=true`, where nothing may skip.
+#[track_caller]
+pub fn skipped(reason: &str, remedy: &str) {
+    let thread = std::thread::current();
+    let test = thread.name().unwrap_or("(unnamed test)");
+    assert!(
+        !in_ci(),
+        "{test}: {reason}, and CI=true allows no skip ({remedy})"
+    );
+    skip_noted(reason, remedy);
+}
+
+/// [`skipped`] without the failure under CI: for what a CI container cannot have (a kernel
+/// module for a virtual camera), still listed in the summary.
+pub fn skip_noted(reason: &str, remedy: &str) {
+    let thread = std::thread::current();
+    let test = thread.name().unwrap_or("(unnamed test)");
+    eprintln!("SKIPPED: {test}: {reason} ({remedy})");
+    if let Some(log) = std::env::var_os("EOTN_SKIP_LOG") {
+        use std::io::Write as _;
+        let line = format!("{test}\t{reason}\t{remedy}\n").replace(['\r'], " ");
+        if let Ok(mut f) = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&log)
+        {
+            // One short write of one line: appends from parallel tests do not interleave.
+            let _ = f.write_all(line.as_bytes());
+        }
+    }
+}
+
 /// A file under `../shared/`, or `None` with a clear "skipped" line when it is absent outside CI.
 /// Under `CI=true` a missing file fails the test.
 pub fn shared_file(relative: &str) -> Option<PathBuf> {
@@ -23,14 +60,10 @@ pub fn shared_file(relative: &str) -> Option<PathBuf> {
     if p.exists() {
         return Some(p);
     }
-    assert!(
-        !in_ci(),
-        "{} is missing, and CI=true requires it",
-        p.display()
-    );
-    eprintln!(
-        "SKIPPED: {} is not here (the shared data folder is absent)",
-        p.display()
+    skipped(
+        &format!("{} is not here", p.display()),
+        "put the shared data folder beside the project as ../shared, or set EOTN_SHARED \
+         (../shared/data/README.md)",
     );
     None
 }
@@ -110,11 +143,10 @@ fn python_with(import_line: &str, packages: &str, check: &str) -> Option<PathBuf
     if ok {
         return Some(python);
     }
-    assert!(
-        !in_ci(),
-        "python3 with {packages} is required under CI=true (scripts/deps.sh --test installs them into .venv/)"
+    skipped(
+        &format!("python3 with {packages} not found; {check} did not run"),
+        "scripts/deps.sh --test installs them into .venv/",
     );
-    eprintln!("SKIPPED: python3 with {packages} not found; {check} did not run");
     None
 }
 
@@ -157,3 +189,40 @@ pub const SHIPPED_ROBOT_SCENARIOS: [&str; 6] = [
     "orange-clutter",
     "beacon-tour",
 ];
+
+/// The first frame of each shipped sim stream (`eotn sim --seed 1 --first N`): where in its
+/// scenario the stream shows what it is named for (README, "Sample streams").
+pub fn shipped_first_frame(scenario: &str) -> u64 {
+    match scenario {
+        "walk-and-pan" => 75,
+        "ball-edge" => 210,
+        "fast-pans" => 90,
+        "orange-clutter" => 45,
+        "beacon-tour" => 15,
+        _ => 0,
+    }
+}
+
+/// A percentile summary taken over at least `min_n` values, for a test to assert on: fails the
+/// test (naming `what`) when the sample is smaller or empty, so that no percentile assertion
+/// passes on too little data (an empty sample has no percentiles at all).
+#[track_caller]
+pub fn sampled(p: Option<Percentiles>, min_n: usize, what: &str) -> Percentiles {
+    let n = p.map_or(0, |p| p.n);
+    assert!(
+        n >= min_n,
+        "{what}: {n} values, the assertion needs at least {min_n}"
+    );
+    p.expect("a sample of at least one value")
+}
+
+/// The percentiles of `values` over at least `min_n` of them ([`sampled`]).
+#[track_caller]
+pub fn percentiles(values: &[f64], min_n: usize, what: &str) -> Percentiles {
+    sampled(Percentiles::of(values), min_n, what)
+}
+
+/// A summary's figure for printing: `pick` of it, or NaN without a sample.
+pub fn figure(p: Option<Percentiles>, pick: fn(&Percentiles) -> f64) -> f64 {
+    p.as_ref().map_or(f64::NAN, pick)
+}

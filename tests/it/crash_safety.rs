@@ -24,7 +24,8 @@ fn time_to_finish(args: &[&OsStr]) -> Duration {
     start.elapsed()
 }
 
-/// Starts eotn, kills it with SIGKILL after `after`; true when it had finished by then.
+/// Starts eotn, kills it with SIGKILL after `after`; true when it had finished by then (exited
+/// by itself, successfully).
 fn run_and_kill(args: &[&OsStr], after: Duration) -> bool {
     let mut child = Command::new(env!("CARGO_BIN_EXE_eotn"))
         .args(args)
@@ -33,10 +34,9 @@ fn run_and_kill(args: &[&OsStr], after: Duration) -> bool {
         .spawn()
         .unwrap();
     std::thread::sleep(after);
-    let finished = child.try_wait().unwrap().is_some();
     let _ = child.kill();
-    let _ = child.wait();
-    finished
+    // Finished when it exited by itself (a run can end between a check and the kill).
+    child.wait().unwrap().success()
 }
 
 /// The moments to kill at: spread evenly over a whole run.
@@ -94,6 +94,41 @@ fn a_table_written_while_killed_is_the_old_table_or_the_new_one() {
             now.len()
         );
     }
+    // One kill that lands mid-write for certain: as soon as the temporary appears (the spread
+    // kills above may all land before or after the write).
+    std::fs::write(&out, &old).unwrap();
+    let before = temporaries(dir.path());
+    let fresh = || {
+        temporaries(dir.path())
+            .into_iter()
+            .any(|t| !before.contains(&t))
+    };
+    let mut child = Command::new(env!("CARGO_BIN_EXE_eotn"))
+        .args(run_args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    let landed = loop {
+        if fresh() {
+            let _ = child.kill();
+            break true;
+        }
+        if child.try_wait().unwrap().is_some() || t0.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            break false;
+        }
+        std::thread::sleep(Duration::from_micros(100));
+    };
+    let _ = child.wait();
+    assert!(landed, "the run ended before its temporary was seen");
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        old,
+        "killed mid-write: robot.lut is still the old table"
+    );
+    assert!(fresh(), "the killed write left its temporary");
     // The next whole run writes the table and clears what the killed ones left.
     eotn_ok(&run_args);
     assert_eq!(std::fs::read(&out).unwrap(), new);

@@ -16,6 +16,7 @@ mod app_live;
 mod app_overhead;
 #[cfg(feature = "gui")]
 mod app_papercuts;
+mod beacons;
 mod camera;
 mod cli;
 mod common;

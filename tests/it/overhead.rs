@@ -16,7 +16,7 @@ use eotn::overhead::{
 };
 use eotn::sim::{Scenario, ScenarioKind, SimFrame, Simulator};
 
-use crate::common::{eotn_ok, sim_stream};
+use crate::common::{eotn_ok, sampled, sim_stream};
 
 fn overhead_truth(f: &SimFrame) -> &OverheadTruth {
     match &f.ground_truth {
@@ -138,19 +138,17 @@ fn calibrated_from_noisy_clicks_the_overhead_recogniser_meets_the_figures() {
         r.ball_found as f64 >= 0.95 * r.ball_eligible as f64,
         "{r:?}"
     );
-    assert!(
-        r.ball_error_cm.p50 < 3.0 && r.ball_error_cm.p95 < 8.0,
-        "{:?}",
-        r.ball_error_cm
-    );
-    assert!(
-        r.robot_error_cm.p50 < 3.0 && r.robot_error_cm.p95 < 8.0,
-        "{:?}",
-        r.robot_error_cm
-    );
+    // Limits at about 2.5× what is achieved (2026-12-04: ball median 0.45 cm, p95 1.5 cm, n = 58;
+    // robots 0.27 cm, 0.54 cm, n = 363; headings 0.13°, n = 350; no false robot); the issue's
+    // targets (3 cm, 8 cm, 3°) are far above.
+    let ball = sampled(r.ball_error_cm, 30, "overhead ball errors");
+    assert!(ball.p50 < 1.2 && ball.p95 < 4.0, "{ball:?}");
+    let robots = sampled(r.robot_error_cm, 100, "overhead robot errors");
+    assert!(robots.p50 < 0.7 && robots.p95 < 1.4, "{robots:?}");
     assert!(r.identity_rate.unwrap() >= 0.99, "{r:?}");
-    assert!(r.heading_error_deg.p50 < 3.0, "{:?}", r.heading_error_deg);
-    assert!(r.robots_false <= frames.len() / 20, "{r:?}");
+    let heading = sampled(r.heading_error_deg, 100, "overhead headings");
+    assert!(heading.p50 < 0.35, "{heading:?}");
+    assert_eq!(r.robots_false, 0, "{r:?}");
 }
 
 #[test]
@@ -284,15 +282,22 @@ fn the_overhead_command_line_calibrates_detects_and_evaluates() {
     // Each robot's world model against the overhead detection of its marker, not only the truth.
     let seen: Vec<&serde_json::Value> = models
         .iter()
-        .filter(|m| m["self_error_vs_overhead_cm"]["n"].as_u64().unwrap() > 0)
+        .filter(|m| m["self_error_vs_overhead_cm"]["n"].as_u64().unwrap_or(0) > 0)
         .collect();
     assert!(seen.len() >= 2, "{overhead}");
     for m in &seen {
         assert!(
-            m["heading_error_vs_overhead_deg"]["n"].as_u64().unwrap() > 0,
+            m["heading_error_vs_overhead_deg"]["n"]
+                .as_u64()
+                .unwrap_or(0)
+                > 0,
             "{m}"
         );
     }
+    assert!(
+        overhead["robot_error_cm"]["n"].as_u64().unwrap_or(0) >= 8,
+        "{overhead}"
+    );
     assert!(
         overhead["robot_error_cm"]["p50"].as_f64().unwrap() < 5.0,
         "{overhead}"

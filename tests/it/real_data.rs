@@ -13,7 +13,7 @@ use eotn::import::bhuman;
 use eotn::lut::convert::{Converted, SourceFormat, convert_file};
 use eotn::lut::{ColourClass, LookupTable};
 
-use crate::common::{repo_file, shared_file};
+use crate::common::{figure, repo_file, sampled, shared_file};
 
 fn convert(rel: &str, format: SourceFormat) -> Option<Converted> {
     let path = shared_file(rel)?;
@@ -397,8 +397,25 @@ fn import_bhuman_cli_writes_a_readable_stream() {
     assert_eq!(s.len(), 160);
     let shipped_80 = s.read(80).unwrap();
     assert_eq!(shipped_80.frame, rec.frame);
-    // ... with the current import's readings (camera pose, head angles at the image time).
-    assert_eq!(shipped_80.sensors, rec.sensors);
+    // ... with the current import's readings (camera pose, head angles at the image time), to
+    // the last bit but one: the shipped stream was written while serde_json parsed numbers to
+    // within an ulp (before `float_roundtrip`), and re-making it would add 15 MB to the history.
+    let as_json = |s: &Option<eotn::sensors::SensorReadings>| serde_json::to_value(s).unwrap();
+    let (old, new) = (as_json(&shipped_80.sensors), as_json(&rec.sensors));
+    let (old, new) = (old.as_object().unwrap(), new.as_object().unwrap());
+    assert_eq!(
+        old.keys().collect::<Vec<_>>(),
+        new.keys().collect::<Vec<_>>()
+    );
+    for (k, v) in old {
+        match (v.as_f64(), new[k].as_f64()) {
+            (Some(a), Some(b)) => assert!(
+                (a - b).abs() <= 4.0 * f64::EPSILON * a.abs().max(b.abs()),
+                "{k}: {a} shipped, {b} imported"
+            ),
+            _ => assert_eq!(v, &new[k], "{k}"),
+        }
+    }
     assert!(rec.sensors.unwrap().camera_height_cm.is_some());
 }
 
@@ -461,10 +478,17 @@ fn bhuman_camera_matrices_give_the_naos_pose_and_horizon() {
 }
 
 /// A file of this repository.
-/// Recognition on the shipped B-Human stream scored against its hand labels.
-fn bhuman_labels_report(
+/// Whether B-Human frame `i` is held out: its number ends in 7, 8 or 9 (48 of 160;
+/// `docs/recognition.md`, "Held-out frames"). No tuning looks at these frames.
+fn held_out(i: usize) -> bool {
+    i % 10 >= 7
+}
+
+/// Recognition on the shipped B-Human stream scored against its hand labels: all frames, and the
+/// held-out ones alone.
+fn bhuman_labels_reports(
     params: eotn::recognition::RecognitionParams,
-) -> eotn::eval::labels::LabelsReport {
+) -> [eotn::eval::labels::LabelsReport; 2] {
     use eotn::eval::labels::{Labels, LabelsReport, evaluate_labelled_frame};
     let labels = Labels::load(&repo_file("streams/bhuman2009.labels.json")).unwrap();
     let lut = LookupTable::load(&repo_file("lookup_tables/bhuman2009.lut")).unwrap();
@@ -486,7 +510,37 @@ fn bhuman_labels_report(
             evaluate_labelled_frame(r.recognition, label, 320.0, 240.0, &ep)
         })
         .collect();
-    LabelsReport::from_frames(&frames)
+    let kept: Vec<_> = frames
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| held_out(*i))
+        .map(|(_, f)| f.clone())
+        .collect();
+    [
+        LabelsReport::from_frames(&frames),
+        LabelsReport::from_frames(&kept),
+    ]
+}
+
+/// One line of a labels report.
+fn labels_line(what: &str, r: &eotn::eval::labels::LabelsReport) -> String {
+    format!(
+        "{what}: {} frames; ball {}/{} (cut {}/{}), false {}, centre error median {:.2} px p90 \
+         {:.2} (n = {}), radius error median {:.2} px; goals {}/{}, false {}",
+        r.frames,
+        r.ball_found,
+        r.ball_visible,
+        r.ball_cut_found,
+        r.ball_cut,
+        r.ball_false,
+        figure(r.ball_center_error_px, |p| p.p50),
+        figure(r.ball_center_error_px, |p| p.p90),
+        r.ball_center_error_px.map_or(0, |p| p.n),
+        figure(r.ball_radius_error_px, |p| p.p50),
+        r.goals_found,
+        r.goals_visible,
+        r.goals_false
+    )
 }
 
 #[test]
@@ -510,21 +564,17 @@ fn bhuman_stream_against_its_hand_labels() {
             None => assert_eq!(&used[section], values, "params/spl2009.json: {section}"),
         }
     }
-    let r = bhuman_labels_report(spl);
+    let [r, kept] = bhuman_labels_reports(spl);
     eprintln!(
-        "B-Human stream, spl2009 parameters: ball {}/{} (cut {}/{}), false {}, centre error \
-         median {:.2} px p90 {:.2}, radius error median {:.2} px; goals {}/{}, false {}",
-        r.ball_found,
-        r.ball_visible,
-        r.ball_cut_found,
-        r.ball_cut,
-        r.ball_false,
-        r.ball_center_error_px.p50,
-        r.ball_center_error_px.p90,
-        r.ball_radius_error_px.p50,
-        r.goals_found,
-        r.goals_visible,
-        r.goals_false
+        "{}",
+        labels_line("B-Human stream, spl2009 parameters, all", &r)
+    );
+    eprintln!(
+        "{}",
+        labels_line(
+            "B-Human stream, spl2009 parameters, held out (7, 8, 9)",
+            &kept
+        )
     );
     // Measured 2026-12-01: every labelled ball found (107, the 7 cut by the image edge
     // included), none false (the robot's own red toe at frame 113, its red arms at 28–38 and
@@ -533,32 +583,44 @@ fn bhuman_stream_against_its_hand_labels() {
     assert_eq!(r.ball_found, 107, "missed {:?}", r.ball_missed_frames);
     assert_eq!(r.ball_cut_found, r.ball_cut);
     assert_eq!(r.ball_false, 0, "false {:?}", r.ball_false_frames);
-    assert!(
-        r.ball_center_error_px.p50 < 0.5,
-        "{:?}",
-        r.ball_center_error_px
-    );
-    assert!(
-        r.ball_center_error_px.p90 < 1.5,
-        "{:?}",
-        r.ball_center_error_px
-    );
-    assert!(
-        r.ball_radius_error_px.p50 < 0.75,
-        "{:?}",
-        r.ball_radius_error_px
-    );
-    assert!(
-        r.ball_center_error_cut_px.p50 < 2.0,
-        "{:?}",
-        r.ball_center_error_cut_px
-    );
+    let centre = sampled(r.ball_center_error_px, 90, "B-Human ball centres");
+    assert!(centre.p50 < 0.5 && centre.p90 < 1.5, "{centre:?}");
+    let radius = sampled(r.ball_radius_error_px, 90, "B-Human ball radii");
+    assert!(radius.p50 < 0.75, "{radius:?}");
+    let cut = sampled(r.ball_center_error_cut_px, 5, "B-Human cut balls");
+    assert!(cut.p50 < 2.0, "{cut:?}");
     assert_eq!(r.goals_visible, 66);
     assert_eq!(r.goals_found, 66, "missed {:?}", r.goal_missed_frames);
     assert_eq!(r.goals_false, 0, "false {:?}", r.goal_false_frames);
+    // The held-out frames alone (numbers ending in 7, 8, 9), which no tuning from 2026-12-04 on
+    // looks at; `params/spl2009.json` and `field_below` were tuned on all 160 before the split.
+    assert_eq!(kept.frames, 48);
+    assert!(kept.ball_visible >= 25, "{}", kept.ball_visible);
+    assert_eq!(
+        kept.ball_found, kept.ball_visible,
+        "missed {:?}",
+        kept.ball_missed_frames
+    );
+    assert_eq!(kept.ball_false, 0, "false {:?}", kept.ball_false_frames);
+    let kept_centre = sampled(
+        kept.ball_center_error_px,
+        25,
+        "held-out B-Human ball centres",
+    );
+    assert!(
+        kept_centre.p50 < 0.75 && kept_centre.p90 < 3.0,
+        "{kept_centre:?}"
+    );
+    assert!(kept.goals_visible >= 15, "{}", kept.goals_visible);
+    assert_eq!(
+        kept.goals_found, kept.goals_visible,
+        "missed {:?}",
+        kept.goal_missed_frames
+    );
+    assert_eq!(kept.goals_false, 0, "false {:?}", kept.goal_false_frames);
     // The defaults (ERS-7 goals, a pose taken as exact): the three far balls right after the
     // kick, where the camera matrix is 4–6° off, fail the height test; still nothing false.
-    let d = bhuman_labels_report(eotn::recognition::RecognitionParams::default());
+    let [d, _] = bhuman_labels_reports(eotn::recognition::RecognitionParams::default());
     assert!(d.ball_found >= 104, "missed {:?}", d.ball_missed_frames);
     assert_eq!(d.ball_false, 0, "false {:?}", d.ball_false_frames);
 }

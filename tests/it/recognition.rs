@@ -9,7 +9,9 @@ use eotn::model::truth::GroundTruth;
 use eotn::pipeline::{Pipeline, PipelineParams};
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 
-const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
+use crate::common::{figure, sampled};
+
+pub(crate) const ROBOT_SCENARIOS: [ScenarioKind; 6] = [
     ScenarioKind::WalkAndPan,
     ScenarioKind::BallEdge,
     ScenarioKind::Goalkeeper,
@@ -25,10 +27,15 @@ pub(crate) fn learnt_table() -> LookupTable {
 
 /// A table learnt from every 10th frame of `kinds` with seed 100 (test frames use seed 7).
 pub(crate) fn table_learnt_from(kinds: &[ScenarioKind]) -> LookupTable {
+    table_learnt_every(kinds, 10)
+}
+
+/// A table learnt from every `step`-th of the first 90 frames of `kinds` with seed 100.
+pub(crate) fn table_learnt_every(kinds: &[ScenarioKind], step: usize) -> LookupTable {
     let mut builder = TableBuilder::new(7).expect("7 bits");
     for &kind in kinds {
         let sim = Simulator::new(Scenario::new(kind, 100));
-        for i in (0..90).step_by(10) {
+        for i in (0..90).step_by(step) {
             let f = sim.frame(i).expect("frame");
             builder.add_frame(&f.frame, &f.labels).expect("labels fit");
         }
@@ -115,19 +122,15 @@ fn recognition_on_synthetic_scenarios() {
             "{}: ball distance error median {:.1}% (n = {}), signed median {:+.1}%; cut off \
              {:.1}% (n = {}), signed {:+.1}%",
             k.name(),
-            100.0 * r.ball_distance_error.p50,
-            r.ball_distance_error.n,
+            100.0 * figure(r.ball_distance_error, |p| p.p50),
+            r.ball_distance_error.map_or(0, |p| p.n),
             100.0 * r.ball_distance_bias.unwrap_or(f64::NAN),
-            100.0 * r.ball_distance_error_cut.p50,
-            r.ball_distance_error_cut.n,
+            100.0 * figure(r.ball_distance_error_cut, |p| p.p50),
+            r.ball_distance_error_cut.map_or(0, |p| p.n),
             100.0 * r.ball_distance_bias_cut.unwrap_or(f64::NAN),
         );
-        assert!(
-            r.ball_distance_error.p50 <= 0.03,
-            "{}: {:?}",
-            k.name(),
-            r.ball_distance_error
-        );
+        let d = sampled(r.ball_distance_error, 10, k.name());
+        assert!(d.p50 <= 0.03, "{}: {d:?}", k.name());
         assert!(
             r.ball_distance_bias.is_some_and(|b| b.abs() <= 0.03),
             "{}: bias {:?}",
@@ -135,41 +138,82 @@ fn recognition_on_synthetic_scenarios() {
             r.ball_distance_bias
         );
     }
-    assert!(report(ScenarioKind::BallEdge).ball_distance_error_cut.p50 <= 0.04);
-    assert!(report(ScenarioKind::WalkAndPan).ball_distance_error_cut.p50 <= 0.04);
+    // Few balls are cut by the image edge on seed 7 (4 on ball-edge, 6 on walk-and-pan): the
+    // medians of so few say little, but none may be missing.
+    for k in [ScenarioKind::BallEdge, ScenarioKind::WalkAndPan] {
+        let cut = sampled(report(k).ball_distance_error_cut, 4, k.name());
+        assert!(cut.p50 <= 0.04, "{}: cut balls {cut:?}", k.name());
+    }
     let goals_eligible = sum(&|r| r.goals_eligible);
     let goals_found = sum(&|r| r.goals_found);
     eprintln!("goals found {goals_found}/{goals_eligible}");
     assert!(goals_eligible > 200, "scenarios must show goals");
     assert!(goals_found as f64 >= 0.97 * goals_eligible as f64);
-    // The yellow box among the off-field clutter is not a goal (width and ground-at-foot tests).
-    assert!(
-        clutter.goals_false <= 1,
+    // The yellow box among the off-field clutter is not a goal (width and ground-at-foot tests),
+    // nor is anything else in any scenario.
+    assert_eq!(
+        sum(&|r| r.goals_false),
+        0,
         "false goals in clutter frames {:?}",
         clutter.goal_false_frames
     );
+    // Beacons: every one whose bands the frame shows whole found with its colours, none false,
+    // the distance from the bands' edges (the issue's targets: median ≤ 3%, p90 ≤ 8%).
+    let (eligible, found) = (sum(&|r| r.beacons_eligible), sum(&|r| r.beacons_found));
+    eprintln!(
+        "beacons found {found}/{eligible}, colours right {}, false {}",
+        sum(&|r| r.beacons_colours_right),
+        sum(&|r| r.beacons_false)
+    );
+    // With this table (54 frames of seed 100) the far beacon of orange-clutter in the image's
+    // shaded corner (frames 28, 29, 34, 35, 2.6 m) has no sky-blue pixels to find: the
+    // classification, not the recogniser, misses it (a table learnt from every third frame
+    // classifies it, and `beacons.rs` finds every whole beacon with that one).
+    assert!(
+        eligible >= 100 && found * 100 >= eligible * 97,
+        "beacons {found}/{eligible}"
+    );
+    assert_eq!(sum(&|r| r.beacons_colours_right), found);
+    assert_eq!(sum(&|r| r.beacons_false), 0);
+    // Limits at 2–3× what seed 7 gives with this coarse table (median, p90); the issue's
+    // targets (≤ 3%, ≤ 8%) are asserted on held-out seeds in `beacons.rs`. Orange-clutter's far
+    // beacon in the shaded corner keeps few classified pixels here, hence its wider limits.
+    for (k, [p50, p90]) in [
+        (ScenarioKind::WalkAndPan, [0.07, 0.12]),
+        (ScenarioKind::FastPans, [0.04, 0.10]),
+        (ScenarioKind::OrangeClutter, [0.10, 0.25]),
+        (ScenarioKind::BeaconTour, [0.015, 0.04]),
+    ] {
+        let d = sampled(report(k).beacon_distance_error, 20, k.name());
+        eprintln!(
+            "{}: beacon distance error median {:.1}% p90 {:.1}% (n = {})",
+            k.name(),
+            100.0 * d.p50,
+            100.0 * d.p90,
+            d.n
+        );
+        assert!(d.p50 <= p50 && d.p90 <= p90, "{}: {d:?}", k.name());
+    }
     let keeper = report(ScenarioKind::Goalkeeper);
     let walk = report(ScenarioKind::WalkAndPan);
     let tour = report(ScenarioKind::BeaconTour);
+    let keeper_posts = sampled(keeper.post_error_px, 100, "goalkeeper posts");
     assert!(
-        keeper.posts_within_2px == Some(1.0) && keeper.post_error_px.p50 <= 0.6,
-        "{:?}",
-        keeper.post_error_px
+        keeper.posts_within_2px == Some(1.0) && keeper_posts.p50 <= 0.6,
+        "{keeper_posts:?}"
     );
+    let walk_posts = sampled(walk.post_error_px, 30, "walk-and-pan posts");
     assert!(
-        walk.posts_within_2px == Some(1.0) && walk.post_error_px.p50 <= 1.1,
-        "{:?}",
-        walk.post_error_px
+        walk.posts_within_2px == Some(1.0) && walk_posts.p50 <= 1.1,
+        "{walk_posts:?}"
     );
     // Beside the goal (beacon tour) the outline's edge is a side wall's back corner; the posts
     // are found on the front corners (`front_corner`) but for one whose front corner is at the
     // image edge: 7 of 8.
+    let tour_posts = sampled(tour.post_error_px, 8, "beacon-tour posts");
     assert!(
-        tour.post_error_px.n >= 8
-            && tour.posts_within_2px.is_some_and(|f| f >= 0.87)
-            && tour.post_error_px.p50 <= 1.0,
-        "{:?}",
-        tour.post_error_px
+        tour.posts_within_2px.is_some_and(|f| f >= 0.87) && tour_posts.p50 <= 1.0,
+        "{tour_posts:?}"
     );
     // Every gap's ends within 3 px of the true largest gap (or of a second one as wide within
     // 3 px), in every scenario that shows gaps.
@@ -181,19 +225,16 @@ fn recognition_on_synthetic_scenarios() {
         ScenarioKind::BeaconTour,
     ] {
         let r = report(k);
+        let gaps = sampled(r.gap_error_px, 10, k.name());
         assert!(
-            r.gap_error_px.n >= 10 && r.gaps_within_3px == Some(1.0) && r.gap_error_px.p50 <= 1.0,
-            "{}: {:?}",
-            k.name(),
-            r.gap_error_px
+            r.gaps_within_3px == Some(1.0) && gaps.p50 <= 1.0,
+            "{}: {gaps:?}",
+            k.name()
         );
     }
     for r in [keeper, walk] {
-        assert!(
-            r.goal_distance_error.n >= 30 && r.goal_distance_error.p50 <= 0.05,
-            "{:?}",
-            r.goal_distance_error
-        );
+        let d = sampled(r.goal_distance_error, 30, "goal distances");
+        assert!(d.p50 <= 0.05, "{d:?}");
     }
 
     // Skew correction on the fast pans: the radius error with it against without it.
@@ -203,8 +244,8 @@ fn recognition_on_synthetic_scenarios() {
     let with = report(ScenarioKind::FastPans);
     eprintln!(
         "fast pans: radius error median {:.3} px with skew correction, {:.3} px without; found {} vs {}",
-        with.ball_radius_error_px.p50,
-        without.ball_radius_error_px.p50,
+        figure(with.ball_radius_error_px, |p| p.p50),
+        figure(without.ball_radius_error_px, |p| p.p50),
         with.ball_found,
         without.ball_found
     );
@@ -213,12 +254,14 @@ fn recognition_on_synthetic_scenarios() {
         "correction must find more balls on fast pans"
     );
     let (raw, fixed) = skew_radius_comparison(&lut, params);
+    let [raw_r, raw_c, fixed_r, fixed_c] =
+        [raw.0, raw.1, fixed.0, fixed.1].map(|p| sampled(p, 20, "fast pans, same balls refitted"));
     eprintln!(
         "fast pans, same balls refitted: radius error median {:.3} px with the outline unskewed, \
          {:.3} px without (n = {}); centre error {:.2} px vs {:.2} px",
-        fixed.0.p50, raw.0.p50, fixed.0.n, fixed.1.p50, raw.1.p50
+        fixed_r.p50, raw_r.p50, fixed_r.n, fixed_c.p50, raw_c.p50
     );
-    assert!(fixed.0.n >= 20 && fixed.1.p50 * 2.0 < raw.1.p50);
+    assert!(fixed_c.p50 * 2.0 < raw_c.p50);
 
     // The vertical (tilt) part of the skew, on and off, where the head tilts while moving.
     let mut vertical = params;
@@ -232,15 +275,42 @@ fn recognition_on_synthetic_scenarios() {
             k.name(),
             v.ball_found,
             v.ball_eligible,
-            v.ball_distance_error.p50,
-            v.ball_radius_error_px.p50,
+            figure(v.ball_distance_error, |p| p.p50),
+            figure(v.ball_radius_error_px, |p| p.p50),
             r.ball_found,
             r.ball_eligible,
-            r.ball_distance_error.p50,
-            r.ball_radius_error_px.p50
+            figure(r.ball_distance_error, |p| p.p50),
+            figure(r.ball_radius_error_px, |p| p.p50)
+        );
+        // What the tilt's correction is for: no ball lost to it, and the balls' distances and
+        // radii no worse than without it (a little slack for the pixel noise of a refit).
+        assert!(r.ball_found >= v.ball_found, "{}: found", k.name());
+        let (on_d, off_d) = (
+            sampled(r.ball_distance_error, 10, k.name()),
+            sampled(v.ball_distance_error, 10, k.name()),
+        );
+        assert!(
+            on_d.p50 <= off_d.p50 + 0.002,
+            "{}: {on_d:?} vs {off_d:?}",
+            k.name()
+        );
+        let (on_r, off_r) = (
+            sampled(r.ball_radius_error_px, 10, k.name()),
+            sampled(v.ball_radius_error_px, 10, k.name()),
+        );
+        assert!(
+            on_r.p50 <= off_r.p50 + 0.02,
+            "{}: {on_r:?} vs {off_r:?}",
+            k.name()
         );
     }
 }
+
+/// Radius and centre error percentiles, pixels (`None`: no ball measured).
+type RadiusCentre = (
+    Option<eotn::eval::Percentiles>,
+    Option<eotn::eval::Percentiles>,
+);
 
 /// The skew correction on the fast pans measured on the same balls: every accepted ball's
 /// outline is scanned again and fitted once as read and once moved to the reference read-out
@@ -248,10 +318,7 @@ fn recognition_on_synthetic_scenarios() {
 fn skew_radius_comparison(
     lut: &LookupTable,
     params: PipelineParams,
-) -> (
-    (eotn::eval::Percentiles, eotn::eval::Percentiles),
-    (eotn::eval::Percentiles, eotn::eval::Percentiles),
-) {
+) -> (RadiusCentre, RadiusCentre) {
     use eotn::recognition::fit::fit_circle_trimmed;
     use eotn::recognition::scan::edge_points;
     let b = params.recognition.ball;
@@ -505,6 +572,51 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
             .as_u64()
             .is_some_and(|n| n >= 5),
         "{report}"
+    );
+    // Beacons against the truth (walk-and-pan shows them; seed 7's 60 frames: every whole one
+    // found, none false, median error 2.9% with this table — the limit is about 2.5× that).
+    let r = &report["report"];
+    let (eligible, found) = (
+        r["beacons_eligible"].as_u64().unwrap(),
+        r["beacons_found"].as_u64().unwrap(),
+    );
+    assert!(eligible >= 20 && found == eligible, "{r}");
+    assert_eq!(r["beacons_colours_right"], found, "{r}");
+    assert_eq!(r["beacons_false"], 0, "{r}");
+    let beacon_median = r["beacon_distance_error"]["p50"].as_f64().unwrap();
+    assert!(beacon_median <= 0.07, "{r}");
+    assert!(
+        r["beacon_distance_error"]["n"].as_u64().unwrap() >= 20,
+        "{r}"
+    );
+    // The text shows the same; a stream without beacons has no percentiles ("—"), not 0%.
+    let text = |streams: &[&std::path::Path]| {
+        let mut args: Vec<&std::ffi::OsStr> = vec!["eval".as_ref()];
+        args.extend(streams.iter().map(|s| s.as_os_str()));
+        args.extend(["--lut".as_ref(), lut.as_os_str()]);
+        let out = super::common::eotn(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let both = text(&[&walk, &stream]);
+    assert!(
+        both.contains(&format!(
+            "beacons found          {found}/{eligible} = 100.0%"
+        )) && both.contains(&format!(
+            "beacon distance error  median {:.1}%",
+            100.0 * beacon_median
+        )),
+        "{both}"
+    );
+    let keeper = text(&[&stream]);
+    assert!(
+        keeper.contains("beacons found          0/0 = —")
+            && keeper.contains("beacon distance error  median — p90 — (n=0)"),
+        "{keeper}"
     );
     let fitted = report["goal_calibration"].as_array().unwrap();
     assert!(

@@ -374,9 +374,12 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     for (k, id) in ids.iter().enumerate() {
         let r = row(&w, *id);
         assert_eq!((r.stats.frames, r.stats.drops), (frames, 0), "robot {k}");
+        // Keeping up: 99% of frames in before the next one is sent (one frame interval,
+        // 33 ms). Achieved 2026-12-04: p99 0.8–4.2 ms per robot; the limit leaves room for a
+        // machine busy with the other tests, which run beside this one.
         assert!(
-            r.stats.latency_p99_ms.is_some_and(|ms| ms < 1000.0),
-            "{:?}",
+            r.stats.latency_p99_ms.is_some_and(|ms| ms < 33.0),
+            "robot {k}: {:?}",
             r.stats
         );
         let view = w.robot_frames(*id).unwrap();
@@ -391,6 +394,13 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     }
     shown_latency_ms.sort_by(f64::total_cmp);
     let pick = |p: f64| shown_latency_ms[((shown_latency_ms.len() - 1) as f64 * p) as usize];
+    // Shown within a frame interval and a UI poll (33 + 16 ms) at the median; achieved 10 ms.
+    assert!(
+        shown_latency_ms.len() >= frames / 2,
+        "{} shown",
+        shown_latency_ms.len()
+    );
+    assert!(pick(0.5) < 49.0, "median {} ms", pick(0.5));
     println!(
         "four robots, {frames} frames each: sender's write to the frame shown in the workspace (UI polling every 16 ms): median {:.1} ms, p99 {:.1} ms over {} shown frames",
         pick(0.5),

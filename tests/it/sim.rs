@@ -9,7 +9,7 @@ use eotn::lut::{ColourClass, LookupTable};
 use eotn::sim::GroundTruth;
 use eotn::streams::StreamReader;
 
-use crate::common::{SHIPPED_ROBOT_SCENARIOS, eotn, eotn_ok};
+use crate::common::{SHIPPED_ROBOT_SCENARIOS, eotn, eotn_ok, shipped_first_frame};
 
 fn sim(dir: &Path, scenario: &str, frames: &str, seed: &str) -> std::path::PathBuf {
     let out = dir.join(format!("{scenario}-{seed}.mcap"));
@@ -210,13 +210,11 @@ fn shipped_sim_streams_classify_with_the_shipped_table() {
     );
 }
 
-/// The shipped sim streams are what `eotn sim` writes today (`--seed 1`, as the README says they
-/// were made): every frame's pixels, time, sensor readings and extra channels alike, and every
-/// ground-truth value they hold equal to rounding (1e-9 relative), so a change of the renderer,
-/// the scenarios or the ground truth shows here before the shipped streams and the figures
-/// measured on them go stale. Two known differences: the robot-camera streams predate a few truth
-/// fields (`eotn sim` adds them), and their goals' `largest_gap` was measured by an earlier gap
-/// scan whose ends lay a pixel to the side (the streams were not re-made for it).
+/// The shipped sim streams are what `eotn sim` writes today (`--seed 1 --first N`, as the README
+/// says they were made): every frame's pixels, time, sensor readings, extra channels and ground
+/// truth alike, so a change of the renderer, the scenarios or the ground truth shows here before
+/// the shipped streams and the figures measured on them go stale. And each shows its subject:
+/// the ball-named streams a ball in most frames, beacon-tour a beacon, goalkeeper a goal.
 #[test]
 fn shipped_sim_streams_are_what_eotn_sim_writes() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -224,9 +222,24 @@ fn shipped_sim_streams_are_what_eotn_sim_writes() {
     for scenario in SHIPPED_ROBOT_SCENARIOS.into_iter().chain(["overhead-game"]) {
         let mut shipped =
             StreamReader::open(&root.join(format!("streams/sim-{scenario}.mcap"))).unwrap();
-        let fresh = sim(dir.path(), scenario, &shipped.len().to_string(), "1");
-        let mut fresh = StreamReader::open(&fresh).unwrap();
+        let first = shipped_first_frame(scenario);
+        let out = dir.path().join(format!("{scenario}.mcap"));
+        eotn_ok(&[
+            OsStr::new("sim"),
+            OsStr::new("--scenario"),
+            OsStr::new(scenario),
+            OsStr::new("--frames"),
+            OsStr::new(&shipped.len().to_string()),
+            OsStr::new("--seed"),
+            OsStr::new("1"),
+            OsStr::new("--first"),
+            OsStr::new(&first.to_string()),
+            OsStr::new("-o"),
+            out.as_os_str(),
+        ]);
+        let mut fresh = StreamReader::open(&out).unwrap();
         assert_eq!(fresh.len(), shipped.len(), "{scenario}");
+        assert_eq!(fresh.info(), shipped.info(), "{scenario}");
         for i in 0..shipped.len() {
             let (a, b) = (shipped.read(i).unwrap(), fresh.read(i).unwrap());
             assert_eq!(a.time_ns, b.time_ns, "{scenario} frame {i}");
@@ -235,32 +248,45 @@ fn shipped_sim_streams_are_what_eotn_sim_writes() {
                 "{scenario} frame {i}: the pixels differ"
             );
             assert_eq!(a.sensors, b.sensors, "{scenario} frame {i}");
-            let (old, new) = (a.ground_truth.unwrap(), b.ground_truth.unwrap());
-            assert!(
-                json_within(&old, &new),
-                "{scenario} frame {i}: shipped truth {old}\n is not within today's {new}"
-            );
+            assert_eq!(a.ground_truth, b.ground_truth, "{scenario} frame {i}");
             assert_eq!(a.extra, b.extra, "{scenario} frame {i}");
         }
     }
 }
 
-/// Whether every value of `old` is in `new` where `old` has it (objects may gain keys), numbers
-/// to 1e-9 relative; `largest_gap` is passed over (see the test above).
-fn json_within(old: &serde_json::Value, new: &serde_json::Value) -> bool {
-    use serde_json::Value;
-    match (old, new) {
-        (Value::Object(a), Value::Object(b)) => a
-            .iter()
-            .filter(|(k, _)| k.as_str() != "largest_gap")
-            .all(|(k, v)| b.get(k).is_some_and(|w| json_within(v, w))),
-        (Value::Array(a), Value::Array(b)) => {
-            a.len() == b.len() && a.iter().zip(b).all(|(v, w)| json_within(v, w))
-        }
-        (Value::Number(a), Value::Number(b)) => match (a.as_f64(), b.as_f64()) {
-            (Some(x), Some(y)) => (x - y).abs() <= 1e-9 * x.abs().max(1.0),
-            _ => a == b,
-        },
-        _ => old == new,
+/// What the shipped robot streams show, counted in their ground truth: frames with the ball in
+/// view (any pixel), with a beacon's bands, with a goal.
+#[test]
+fn shipped_sim_streams_show_what_they_are_named_for() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let count = |scenario: &str, what: &dyn Fn(&eotn::model::truth::RobotViewTruth) -> bool| {
+        let mut r = StreamReader::open(&root.join(format!("streams/sim-{scenario}.mcap"))).unwrap();
+        (0..r.len())
+            .filter(|&i| {
+                let truth = r.read(i).unwrap().ground_truth.unwrap();
+                match serde_json::from_value(truth).unwrap() {
+                    GroundTruth::Robot(t) => what(&t),
+                    GroundTruth::Overhead(_) => panic!("{scenario}: a robot stream"),
+                }
+            })
+            .count()
+    };
+    let ball = |t: &eotn::model::truth::RobotViewTruth| {
+        t.ball.as_ref().is_some_and(|b| b.visible_pixels > 0)
+    };
+    let beacon =
+        |t: &eotn::model::truth::RobotViewTruth| t.beacons.iter().any(|b| b.band_pixels > 0);
+    let goal =
+        |t: &eotn::model::truth::RobotViewTruth| t.goals.iter().any(|g| g.visible_pixels > 0);
+    for scenario in ["ball-edge", "walk-and-pan", "orange-clutter"] {
+        let n = count(scenario, &ball);
+        assert!(n >= 9, "{scenario}: the ball in {n} of 15 frames");
     }
+    // Fast pans sweep past the ball: in view a third of the time.
+    let n = count("fast-pans", &ball);
+    assert!(n >= 5, "fast-pans: the ball in {n} of 15 frames");
+    let n = count("beacon-tour", &beacon);
+    assert!(n >= 12, "beacon-tour: a beacon in {n} of 15 frames");
+    let n = count("goalkeeper", &goal);
+    assert!(n >= 12, "goalkeeper: a goal in {n} of 15 frames");
 }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::common::{eotn_ok, in_ci, test_python};
+use crate::common::{eotn_ok, test_python};
 
 /// The `rerun` command installed beside the tests' Python, or `None` with a "skipped" line
 /// outside CI. Under `CI=true` its absence fails the test.
@@ -23,11 +23,10 @@ fn rerun() -> Option<PathBuf> {
     if ok {
         return Some(candidate);
     }
-    assert!(
-        !in_ci(),
-        "rerun (rerun-sdk) is required under CI=true (scripts/deps.sh --test installs it into .venv/)"
+    crate::common::skipped(
+        "rerun not found; the Rerun import check did not run",
+        "scripts/deps.sh --test installs rerun-sdk into .venv/",
     );
-    eprintln!("SKIPPED: rerun not found; the Rerun import check did not run");
     None
 }
 
@@ -220,12 +219,12 @@ fn detect_annotate_keeps_every_frame_and_circles_each_found_ball() {
                 ball["center_y"].as_f64().unwrap(),
             );
             let r = ball["radius_px"].as_f64().unwrap();
+            // The circle is drawn where the image shows the ball, and a second one where the
+            // skew correction puts it (the JSON's centre) when that is over 0.5 px away.
             assert!(
                 ann.circles.iter().any(|c| {
                     let p = c.position.unwrap();
-                    (p.x - x).abs() < 1e-9
-                        && (p.y - y).abs() < 1e-9
-                        && (c.diameter - 2.0 * r).abs() < 1e-9
+                    (p.x - x).hypot(p.y - y) <= 0.5 + 1e-9 && (c.diameter - 2.0 * r).abs() < 1e-9
                 }),
                 "frame {i}: no circle at the ball ({x}, {y}) r {r}"
             );
@@ -238,7 +237,8 @@ fn detect_annotate_keeps_every_frame_and_circles_each_found_ball() {
             assert!(ann.circles.is_empty(), "frame {i}: a circle without a ball");
         }
     }
-    assert!(circled > 0, "the walk-and-pan stream shows balls");
+    // The shipped walk-and-pan stream shows the ball in every frame, and detect finds it.
+    assert_eq!(circled, a.len(), "a circled ball in every frame");
     assert!(image_encodings(&out).iter().all(|e| e == "yuyv"));
 }
 

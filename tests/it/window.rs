@@ -7,8 +7,6 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::common::in_ci;
-
 /// An Xvfb display of our own, ended when dropped.
 struct VirtualDisplay {
     server: Child,
@@ -20,15 +18,17 @@ impl VirtualDisplay {
     /// CI) when Xvfb is not installed.
     fn start() -> Option<Self> {
         let have = Command::new("sh")
-            .args(["-c", "command -v Xvfb && command -v xwd"])
+            .args([
+                "-c",
+                "command -v Xvfb && command -v xwd && command -v convert",
+            ])
             .output()
             .is_ok_and(|o| o.status.success());
         if !have {
-            assert!(
-                !in_ci(),
-                "Xvfb and xwd are required under CI=true (scripts/deps.sh)"
+            crate::common::skipped(
+                "Xvfb, xwd or ImageMagick's convert not installed; the real-window test did not run",
+                "scripts/deps.sh installs xvfb, x11-apps and imagemagick",
             );
-            eprintln!("SKIPPED: Xvfb or xwd not installed; the real-window test did not run");
             return None;
         }
         let n = (140..400)

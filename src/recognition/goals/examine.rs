@@ -21,6 +21,8 @@ struct LevelShape {
     height_px: f64,
     /// The middle of the foot, image pixels.
     bottom_mid: ImagePoint,
+    /// The middle of the top, image pixels.
+    top_mid: ImagePoint,
 }
 
 pub(super) fn examine(
@@ -135,11 +137,14 @@ fn level_shape(
     }
     let bottom_mid =
         ImagePoint::new((e_all[0] + e_all[2]) / 2.0, e_all[3]).rotated_about(centre, -angle);
+    let top_mid =
+        ImagePoint::new((e_all[0] + e_all[2]) / 2.0, e_all[1]).rotated_about(centre, -angle);
     LevelShape {
         cut,
         e_all,
         height_px,
         bottom_mid,
+        top_mid,
     }
 }
 
@@ -266,6 +271,18 @@ fn ground_tests(
         ),
         None => confidence.skipped(TestName::GreenBelow, p.green_below),
     }
+    // With its top cut off, a yellow or sky-blue band standing on white is a beacon's lower band
+    // on its white base (its pink band above the image), which white alone below would pass
+    // as ground: a goal's foot has carpet below it beyond the goal line.
+    match below.ratio(|c| c == ColourClass::Green.code()) {
+        Some(r) if cut.top && !cut.bottom => confidence.range_test(
+            TestName::GreenBelowCut,
+            r,
+            p.green_below_cut,
+            TestWeight::new(0.0, p.green_below_cut_penalty),
+        ),
+        _ => confidence.skipped(TestName::GreenBelowCut, p.green_below_cut),
+    }
     let foot_band = (height_px * p.ground_at_foot_band).max(2.0);
     let at_foot = scan_rotated_rect(
         img,
@@ -309,12 +326,23 @@ fn distance_tests(
             None => confidence.skipped(TestName::BottomHeightCm, p.bottom_height_cm),
         }
     }
+    // Bottom cut off, top in view: the height gives only a maximum distance, which would let
+    // anything narrow pass as wide. The top, were it a goal's, lies on the plane of the goal's
+    // height: that distance (through the camera pose) sizes it. A beacon's upper band with its
+    // lower band below the image (its top 40 cm up, not 30) comes out a few centimetres wide.
+    let width_distance = if cut.bottom && !cut.top {
+        ctx.distance_to_plane(shape.top_mid, p.height_cm)
+            .filter(|d| d.is_finite() && *d > 0.0)
+            .map_or(distance, |d| d.min(distance))
+    } else {
+        distance
+    };
     if cut.left || cut.right {
         confidence.skipped(TestName::ApparentWidthCm, p.apparent_width_cm);
     } else {
         confidence.range_test(
             TestName::ApparentWidthCm,
-            (e_all[2] - e_all[0]) * distance / ctx.camera.focal_px,
+            (e_all[2] - e_all[0]) * width_distance / ctx.camera.focal_px,
             p.apparent_width_cm,
             p.apparent_width_weight,
         );

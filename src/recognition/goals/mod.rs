@@ -170,6 +170,11 @@ pub struct GoalParams {
     pub pose_skew_model: bool,
     /// Penalty for a candidate overlapping an accepted beacon (its yellow or sky-blue band).
     pub beacon_overlap_penalty: f64,
+    /// Accepted share of green (not white) below a candidate whose top is cut off and whose
+    /// foot is in view: a beacon's band over its white base has none.
+    pub green_below_cut: [f64; 2],
+    /// Penalty when that share is below the range.
+    pub green_below_cut_penalty: f64,
 }
 
 impl Default for GoalParams {
@@ -224,6 +229,8 @@ impl Default for GoalParams {
             skew_correction: true,
             pose_skew_model: true,
             beacon_overlap_penalty: 10.0,
+            green_below_cut: [0.1, 1.0],
+            green_below_cut_penalty: 3.0,
         }
     }
 }

@@ -69,11 +69,15 @@ pub enum ScenarioKind {
     /// A robot walks round the centre with its head panning past six coloured-pattern markers
     /// beside the field (two pairs that differ in only two tiles): the "almost SLAM" places.
     PatternTour,
+    /// A robot close to each beacon in turn, its head circling so that the beacon leaves the
+    /// image at every edge: a beacon cut by the image border (a yellow band on its white base
+    /// with the pink band above the image) is not a goal.
+    BeaconEdges,
 }
 
 impl ScenarioKind {
     /// Every scenario in documentation order.
-    pub const ALL: [Self; 10] = [
+    pub const ALL: [Self; 11] = [
         Self::WalkAndPan,
         Self::BallEdge,
         Self::Goalkeeper,
@@ -84,6 +88,7 @@ impl ScenarioKind {
         Self::ClosePans,
         Self::RollingBall,
         Self::PatternTour,
+        Self::BeaconEdges,
     ];
 
     /// The command-line name (`walk-and-pan`, …).
@@ -100,6 +105,7 @@ impl ScenarioKind {
             Self::ClosePans => "close-pans",
             Self::RollingBall => "rolling-ball",
             Self::PatternTour => "pattern-tour",
+            Self::BeaconEdges => "beacon-edges",
         }
     }
 
@@ -125,6 +131,9 @@ impl ScenarioKind {
             }
             Self::RollingBall => "the ball rolls across a still camera at 1-3 m/s",
             Self::PatternTour => "a robot walks round the centre, panning past six pattern markers",
+            Self::BeaconEdges => {
+                "close to each beacon, the head circling it out of every image edge"
+            }
         }
     }
 }
@@ -204,6 +213,7 @@ impl Scenario {
             ScenarioKind::ClosePans => scenes::close_pans(s, t_s, j, self.seed),
             ScenarioKind::RollingBall => scenes::rolling_ball(s, t_s, j),
             ScenarioKind::PatternTour => scenes::pattern_tour(s, t_s, j),
+            ScenarioKind::BeaconEdges => scenes::beacon_edges(s, t_s, j),
             ScenarioKind::OverheadGame => self.overhead_game(s, t_s),
         }
         scene

@@ -133,6 +133,55 @@ pub(super) fn beacon_tour(scene: &mut Scene, t_s: f64, j: [f64; 4]) {
         .push(standing(4, Team::Blue, 160.0, -100.0, 2.5));
 }
 
+/// A robot close to each beacon in turn (6 s each), on the field side of it and facing it, 55
+/// to 145 cm from its axis; its head circles the beacon twice a beacon — pan ±0.45 rad and tilt
+/// ±0.4 rad about looking at the bands' boundary, about half the image's field of view — so the
+/// beacon leaves the image at the left, top, right and bottom in turn, whole in between.
+pub(super) fn beacon_edges(scene: &mut Scene, t_s: f64, j: [f64; 4]) {
+    const EACH_S: f64 = 6.0;
+    // The switch to the next beacon falls between two frames' read-outs (each spans a frame
+    // interval about its time), so no frame shows two poses torn apart by the rolling shutter.
+    let k = ((t_s + crate::sim::FRAME_INTERVAL_S / 2.0) / EACH_S)
+        .floor()
+        .rem_euclid(4.0) as usize;
+    let Some(beacon) = scene.beacons.get(k).cloned() else {
+        return;
+    };
+    let phase = TAU * t_s / (EACH_S / 2.0) + PI * j[0];
+    let distance = 100.0 + 45.0 * (TAU * t_s / EACH_S + j[1]).sin();
+    // From the beacon towards the field's long axis (the beacons stand beyond the side lines),
+    // a little to one side by the seed.
+    let away = if beacon.y_cm > 0.0 {
+        -FRAC_PI_2
+    } else {
+        FRAC_PI_2
+    } + 0.3 * j[2];
+    let pose = RobotPose::new(
+        beacon.x_cm + (beacon.radius_cm + distance) * away.cos(),
+        beacon.y_cm + (beacon.radius_cm + distance) * away.sin(),
+        away + PI,
+    );
+    let body = BodyPose::ERS7_STANCE;
+    let boundary = beacon.base_height_cm + beacon.band_height_cm;
+    let mut joints = look_at(
+        &pose,
+        &body,
+        &Point::new(beacon.x_cm, beacon.y_cm, boundary),
+    );
+    joints.pan_rad += 0.45 * phase.cos();
+    // Up and down with the lower tilt (whose motion the readings carry, so the rolling
+    // shutter's skew can be removed), the nod holding the head up at the bands.
+    joints.tilt2_rad = 0.45;
+    joints.tilt1_rad = (-0.35 + 0.4 * phase.sin()).min(0.0);
+    scene
+        .robots
+        .push(robot(OBSERVER_ID, Team::Red, pose, body, joints));
+    scene.ball = Some(Ball::at(
+        pose.x_cm + 40.0 * away.cos(),
+        pose.y_cm + 40.0 * away.sin(),
+    ));
+}
+
 /// Fast head pans past a close ball.
 pub(super) fn close_pans(scene: &mut Scene, t_s: f64, j: [f64; 4], seed: u64) {
     // A new ball spot each pan cycle, switched while the head looks away (pan

@@ -57,8 +57,13 @@ struct Coverage {
 }
 
 fn coverage(objects: &[u16], width: usize, id: u16) -> Coverage {
+    coverage_where(objects, width, |k| objects[k] == id)
+}
+
+/// The pixels (by index into the row-major buffer of `width` columns) for which `counts` holds.
+fn coverage_where(objects: &[u16], width: usize, counts: impl Fn(usize) -> bool) -> Coverage {
     let mut c = Coverage::default();
-    for (k, _) in objects.iter().enumerate().filter(|(_, o)| **o == id) {
+    for k in (0..objects.len()).filter(|k| counts(*k)) {
         let (x, y) = (k % width, k / width);
         let (x, y) = (
             u32::try_from(x).unwrap_or(u32::MAX),

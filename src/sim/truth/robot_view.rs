@@ -3,12 +3,13 @@
 //! coloured-pattern markers, each relative to the observing robot.
 
 use super::super::render::object_id;
-use super::{coverage, covered_fraction};
+use super::{coverage, coverage_where, covered_fraction};
 use crate::frame::PixelBox;
 use crate::geometry::{
     BodyPose, CameraPose, Field, HeadJoints, ImagePoint, Point, PoseRecord, RobotPose,
 };
-use crate::model::scene::{GoalColour, Scene};
+use crate::lut::ColourClass;
+use crate::model::scene::{Beacon, GoalColour, Scene};
 use crate::model::truth::{
     BallTruth, BeaconTruth, CutOff, GoalGap, GoalTruth, MarkerTruth, PostTruth, Relative,
     RobotTruth, RobotViewTruth,
@@ -33,7 +34,7 @@ fn relative(pose: &CameraPose, robot: &RobotPose, p: &Point<Field>) -> Relative 
 }
 
 /// Builds the truth of a robot-camera frame from the scene, the camera pose at mid-readout and
-/// the rendered object buffer.
+/// the rendered object buffer and true colour classes (one per pixel, row-major).
 #[must_use]
 #[expect(
     clippy::too_many_arguments,
@@ -49,10 +50,11 @@ pub fn robot_view_truth(
     pose: &CameraPose,
     sensors: SensorReadings,
     objects: &[u16],
+    labels: &[u8],
 ) -> RobotViewTruth {
     let ball = ball_truth(scene, &robot_pose, pose, objects);
     let goals = goal_truths(scene, &robot_pose, pose, objects);
-    let beacons = beacon_truths(scene, &robot_pose, pose, objects);
+    let beacons = beacon_truths(scene, &robot_pose, pose, objects, labels);
     let robots = other_robot_truths(scene, observer_id, &robot_pose, pose, objects);
     RobotViewTruth {
         time_s,
@@ -146,14 +148,17 @@ fn goal_truths(
         .collect()
 }
 
-/// Every beacon's truth.
+/// Every beacon's truth: the whole beacon's pixels, and its two coloured bands' pixels (the
+/// object's pixels whose true class is not the white base's) against the bands' projection.
 fn beacon_truths(
     scene: &Scene,
     robot_pose: &RobotPose,
     pose: &CameraPose,
     objects: &[u16],
+    labels: &[u8],
 ) -> Vec<BeaconTruth> {
     let w = pose.camera.width_px;
+    let white = ColourClass::White.code();
     scene
         .beacons
         .iter()
@@ -161,15 +166,96 @@ fn beacon_truths(
         .map(|(i, b)| {
             let id = object_id::BEACON + u16::try_from(i).unwrap_or(0).min(89);
             let cov = coverage(objects, w, id);
+            let bands = coverage_where(objects, w, |k| {
+                objects[k] == id && labels.get(k).is_some_and(|c| *c != white)
+            });
             let boundary = Point::new(b.x_cm, b.y_cm, b.base_height_cm + b.band_height_cm);
+            let (area, bands_cut_off) = beacon_bands_projection(b, pose);
             BeaconTruth {
                 name: b.name.clone(),
                 relative: relative(pose, robot_pose, &boundary),
                 visible_pixels: cov.pixels,
                 image_box: cov.bbox,
+                colours: Some([b.top.class(), b.bottom.class()]),
+                band_pixels: bands.pixels,
+                bands_visible_fraction: covered_fraction(bands.pixels, area),
+                bands_cut_off,
+                bands_box: bands.bbox,
             }
         })
         .collect()
+}
+
+/// The image area (pixels²) of a beacon's two coloured bands as the camera at `pose` sees them
+/// whole — the convex hull of the projected circles bounding the bands, a cylinder's outline —
+/// and the image borders that hull crosses. Area 0 and every side cut when part of the bands
+/// is behind the camera.
+fn beacon_bands_projection(b: &Beacon, pose: &CameraPose) -> (f64, CutOff) {
+    let (bottom, top) = (b.base_height_cm, b.base_height_cm + 2.0 * b.band_height_cm);
+    let outline: Option<Vec<ImagePoint>> = [bottom, top]
+        .into_iter()
+        .flat_map(|z| {
+            (0..48).map(move |k| {
+                let a = f64::from(k) * std::f64::consts::TAU / 48.0;
+                Point::new(
+                    b.x_cm + b.radius_cm * a.cos(),
+                    b.y_cm + b.radius_cm * a.sin(),
+                    z,
+                )
+            })
+        })
+        .map(|p| pose.image_from_field(&p))
+        .collect();
+    let all = CutOff {
+        left: true,
+        right: true,
+        top: true,
+        bottom: true,
+    };
+    let Some(points) = outline else {
+        return (0.0, all);
+    };
+    let (w, h) = (pose.camera.width_px as f64, pose.camera.height_px as f64);
+    let cut = CutOff {
+        left: points.iter().any(|p| p.x_px < 0.0),
+        right: points.iter().any(|p| p.x_px > w),
+        top: points.iter().any(|p| p.y_px < 0.0),
+        bottom: points.iter().any(|p| p.y_px > h),
+    };
+    (convex_hull_area(points), cut)
+}
+
+/// The area of the convex hull of `points` (Andrew's monotone chain, then the shoelace
+/// formula), pixels².
+fn convex_hull_area(mut points: Vec<ImagePoint>) -> f64 {
+    points.sort_by(|a, b| a.x_px.total_cmp(&b.x_px).then(a.y_px.total_cmp(&b.y_px)));
+    let cross = |o: &ImagePoint, a: &ImagePoint, b: &ImagePoint| {
+        (a.x_px - o.x_px) * (b.y_px - o.y_px) - (a.y_px - o.y_px) * (b.x_px - o.x_px)
+    };
+    let mut hull: Vec<ImagePoint> = Vec::with_capacity(points.len() + 1);
+    for pass in 0..2 {
+        let start = hull.len();
+        let ordered: Box<dyn Iterator<Item = &ImagePoint>> = if pass == 0 {
+            Box::new(points.iter())
+        } else {
+            Box::new(points.iter().rev())
+        };
+        for p in ordered {
+            while hull.len() >= start + 2
+                && cross(&hull[hull.len() - 2], &hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(*p);
+        }
+        hull.pop();
+    }
+    let twice: f64 = hull
+        .iter()
+        .zip(hull.iter().cycle().skip(1))
+        .map(|(a, b)| a.x_px * b.y_px - b.x_px * a.y_px)
+        .sum();
+    twice.abs() / 2.0
 }
 
 /// The truth of every robot but the observer.
