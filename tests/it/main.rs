@@ -22,6 +22,7 @@ mod common;
 mod crash_safety;
 mod docs;
 mod hardening;
+mod kernels;
 #[cfg(feature = "gui")]
 mod harness;
 mod live;
