@@ -40,8 +40,12 @@ impl Floor {
     /// and writes `lut`'s cells where the program reads them.
     ///
     /// # Errors
-    /// A compiler that fails or is missing, or an unwritable temporary folder.
+    /// A missing source, a compiler that fails or is missing, or an unwritable temporary
+    /// folder.
     pub fn prepare(source: &Path, lut: &LookupTable) -> anyhow::Result<Self> {
+        if !source.is_file() {
+            bail!("the C floor {}: no such file", source.display());
+        }
         let dir = std::env::temp_dir().join(format!("eotn-floor-{}", std::process::id()));
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         let mut floor = Self {
