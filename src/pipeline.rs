@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::blobs::{BlobSet, Connectivity};
 use crate::classify::{ClassifiedImage, classify_into_with};
-use crate::kernels::{self, KernelSet};
 use crate::frame::Frame;
+use crate::kernels::{self, KernelSet};
 use crate::lut::LookupTable;
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::{Recognition, RecognitionParams, recognise};

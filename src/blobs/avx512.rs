@@ -8,7 +8,9 @@
 
 #![allow(unsafe_code)]
 
-use super::{RowRuns, Run};
+#[cfg(target_arch = "x86_64")]
+use super::RowRuns;
+use super::Run;
 
 /// Appends the runs of `row`; `false` (and nothing appended) when the CPU lacks AVX-512 F/BW,
 /// so the caller falls back to another scan.

@@ -1,4 +1,3 @@
-
 //! UYVY classification 16 pixels at a time with AVX2, in two kernels chosen at run time.
 //!
 //! Both turn 32 bytes of UYVY (16 pixels, 8 pairs) into 16 cell indices with vector shifts and
@@ -23,6 +22,7 @@ use std::arch::x86_64::{
 
 /// Whether the table fits the kernels: `bits` in 6..=8 and `1 << (3 * bits)` cells, so every
 /// index built from 8-bit Y, U, V is inside it.
+#[cfg(target_arch = "x86_64")]
 fn table_fits(table: &[u8], bits: u32) -> bool {
     (6..=8).contains(&bits) && table.len() == 1 << (3 * bits)
 }
@@ -75,7 +75,10 @@ fn cell_indices(block: &[u8; 32], bits: i32) -> (__m256i, __m256i) {
     let q = unsafe { _mm256_loadu_si256(block.as_ptr().cast::<__m256i>()) };
     // Each 32-bit lane is one pair U Y0 V Y1 (little-endian).
     let field = |at: i32| _mm256_and_si256(_mm256_srlv_epi32(q, count(at)), mask);
-    let uv = _mm256_or_si256(_mm256_sllv_epi32(field(shift), count(bits)), field(16 + shift));
+    let uv = _mm256_or_si256(
+        _mm256_sllv_epi32(field(shift), count(bits)),
+        field(16 + shift),
+    );
     let to_y = count(2 * bits);
     (
         _mm256_or_si256(_mm256_sllv_epi32(field(8 + shift), to_y), uv),
@@ -87,7 +90,10 @@ fn cell_indices(block: &[u8; 32], bits: i32) -> (__m256i, __m256i) {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn classify_uyvy_avx2_indexed(src: &[u8], table: &[u8], bits: u32, dst: &mut [u8]) -> usize {
-    use std::arch::x86_64::{_mm256_permute2x128_si256, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32, _mm256_storeu_si256};
+    use std::arch::x86_64::{
+        _mm256_permute2x128_si256, _mm256_storeu_si256, _mm256_unpackhi_epi32,
+        _mm256_unpacklo_epi32,
+    };
 
     let (blocks, _) = src.as_chunks::<32>();
     let (outs, _) = dst.as_chunks_mut::<16>();
@@ -106,7 +112,12 @@ fn classify_uyvy_avx2_indexed(src: &[u8], table: &[u8], bits: u32, dst: &mut [u8
             _mm256_storeu_si256(at, _mm256_permute2x128_si256::<0x20>(lo, hi));
             _mm256_storeu_si256(at.add(1), _mm256_permute2x128_si256::<0x31>(lo, hi));
         }
-        for (half, bytes) in index.as_chunks::<8>().0.iter().zip(out.as_chunks_mut::<8>().0) {
+        for (half, bytes) in index
+            .as_chunks::<8>()
+            .0
+            .iter()
+            .zip(out.as_chunks_mut::<8>().0)
+        {
             let mut word = 0u64;
             for (k, &i) in half.iter().enumerate() {
                 // SAFETY: every index is below `1 << (3 * bits)` = `table.len()` (`table_fits`).

@@ -68,8 +68,14 @@ fn classify_uyvy_avx512(src: &[u8], table: &[u8], bits: u32, dst: &mut [u8]) -> 
         // Each 32-bit lane is one pair U Y0 V Y1 (little-endian).
         let field = |at: i32| _mm512_and_si512(_mm512_srlv_epi32(q, count(at)), mask);
         let uv = _mm512_or_si512(_mm512_sllv_epi32(field(shift), to_u), field(16 + shift));
-        let first = lookup(_mm512_or_si512(_mm512_sllv_epi32(field(8 + shift), to_y), uv));
-        let second = lookup(_mm512_or_si512(_mm512_sllv_epi32(field(24 + shift), to_y), uv));
+        let first = lookup(_mm512_or_si512(
+            _mm512_sllv_epi32(field(8 + shift), to_y),
+            uv,
+        ));
+        let second = lookup(_mm512_or_si512(
+            _mm512_sllv_epi32(field(24 + shift), to_y),
+            uv,
+        ));
         // Lane k holds pixel 2k in its low byte and pixel 2k + 1 in the next; narrow to words.
         let pairs = _mm512_or_si512(first, _mm512_sllv_epi32(second, by_a_byte));
         // SAFETY: `out` is 32 bytes; the store is unaligned.

@@ -262,7 +262,9 @@ fn print_report(r: &BenchJson, floor_source: Option<PathBuf>, json: bool) -> any
     outln!("kernels        classify    blobs    total ns/pixel   ms/frame   vs C floor");
     for f in &r.sets {
         let mark = if f.kernels == r.kernels { "*" } else { " " };
-        let vs = f.vs_floor.map_or_else(|| "-".to_owned(), |v| format!("{v:.2}x"));
+        let vs = f
+            .vs_floor
+            .map_or_else(|| "-".to_owned(), |v| format!("{v:.2}x"));
         outln!(
             "{mark}{:<13} {:8.3} {:8.3} {:8.3}       {:8.4}   {vs:>8}",
             f.kernels,

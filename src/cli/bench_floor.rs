@@ -31,7 +31,8 @@ pub struct Floor {
 /// `../shared/bench/` (the project's layout).
 #[must_use]
 pub fn default_source() -> Option<PathBuf> {
-    let shared = std::env::var_os("EOTN_SHARED").map_or_else(|| PathBuf::from("../shared"), PathBuf::from);
+    let shared =
+        std::env::var_os("EOTN_SHARED").map_or_else(|| PathBuf::from("../shared"), PathBuf::from);
     Some(shared.join("bench/floors.c")).filter(|p| p.is_file())
 }
 
@@ -85,7 +86,8 @@ impl Floor {
             bail!("the C floor reads UYVY frames only");
         }
         let path = self.dir.join("frame.uyvy");
-        std::fs::write(&path, frame.data()).with_context(|| format!("writing {}", path.display()))?;
+        std::fs::write(&path, frame.data())
+            .with_context(|| format!("writing {}", path.display()))?;
         let out = Command::new(&self.program)
             .arg(&path)
             .arg(frame.width().to_string())
@@ -101,7 +103,8 @@ impl Floor {
                 String::from_utf8_lossy(&out.stderr).trim()
             );
         }
-        parse_floor(&text).with_context(|| format!("no `{FLOOR_LINE}` figure from {}", self.program.display()))
+        parse_floor(&text)
+            .with_context(|| format!("no `{FLOOR_LINE}` figure from {}", self.program.display()))
     }
 }
 
@@ -117,7 +120,11 @@ fn parse_floor(text: &str) -> Option<f64> {
     let line = text.lines().find(|l| l.starts_with(FLOOR_LINE))?;
     let words: Vec<&str> = line.split_whitespace().collect();
     let at = words.iter().position(|&w| w == "ns/pixel")?;
-    words.get(at.checked_sub(1)?)?.parse().ok().filter(|v: &f64| v.is_finite())
+    words
+        .get(at.checked_sub(1)?)?
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite())
 }
 
 #[cfg(test)]
@@ -129,8 +136,14 @@ mod tests {
         let out = "# 640x480 lut b=7\nclassify const b=7             0.1500 ms/frame   0.488 ns/pixel\n\
                    classify+cc8 simd-rle (pipeline)    0.2711 ms/frame   0.883 ns/pixel\n";
         assert_eq!(parse_floor(out), Some(0.883));
-        assert_eq!(parse_floor("classify+cc8 simd-rle (pipeline) x ms/frame nan ns/pixel"), None);
-        assert_eq!(parse_floor("classify+cc8 simd-rle (pipeline) 1 ms/frame"), None);
+        assert_eq!(
+            parse_floor("classify+cc8 simd-rle (pipeline) x ms/frame nan ns/pixel"),
+            None
+        );
+        assert_eq!(
+            parse_floor("classify+cc8 simd-rle (pipeline) 1 ms/frame"),
+            None
+        );
         assert_eq!(parse_floor(""), None);
     }
 }

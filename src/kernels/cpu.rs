@@ -49,9 +49,10 @@ impl CpuFeatures {
     /// This machine's CPU.
     #[must_use]
     pub fn detect() -> Self {
-        let mut cpu = Self::baseline(&model_name_from_os().unwrap_or_else(|| {
-            format!("unknown {} CPU", std::env::consts::ARCH)
-        }));
+        let mut cpu = Self::baseline(
+            &model_name_from_os()
+                .unwrap_or_else(|| format!("unknown {} CPU", std::env::consts::ARCH)),
+        );
         #[cfg(target_arch = "x86_64")]
         x86::fill(&mut cpu);
         cpu
@@ -84,7 +85,7 @@ fn model_name_from_os() -> Option<String> {
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::{CpuFeatures, Vendor};
-    use std::arch::x86_64::{CpuidResult, __cpuid};
+    use std::arch::x86_64::{__cpuid, CpuidResult};
 
     /// Vendor, family, model, brand string and instruction sets from CPUID.
     pub(super) fn fill(cpu: &mut CpuFeatures) {
@@ -115,7 +116,7 @@ mod x86 {
                 };
         }
         if __cpuid(0x8000_0000).eax >= 0x8000_0004 {
-            let words: Vec<CpuidResult> = (0x8000_0002..=0x8000_0004).map(|l| __cpuid(l)).collect();
+            let words: Vec<CpuidResult> = (0x8000_0002..=0x8000_0004).map(__cpuid).collect();
             let bytes: Vec<u8> = words
                 .iter()
                 .flat_map(|r| [r.eax, r.ebx, r.ecx, r.edx])

@@ -94,12 +94,8 @@ pub enum KernelsError {
 
 impl fmt::Display for KernelsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let names = |sets: &[KernelSet]| {
-            sets.iter()
-                .map(|s| s.name())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
+        let names =
+            |sets: &[KernelSet]| sets.iter().map(|s| s.name()).collect::<Vec<_>>().join(", ");
         match self {
             Self::Unknown(name) => write!(
                 f,

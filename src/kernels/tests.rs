@@ -22,14 +22,49 @@ fn the_rule_picks_no_gathers_and_avx512_only_at_full_clock() {
     let table = [
         // (what, vendor, family, model, instructions, expected)
         ("Zen 1 (Ryzen 1800X)", Amd, 0x17, 0x01, "avx2", Avx2),
-        ("Zen 2 (EPYC 7742): slow gathers", Amd, 0x17, 0x31, "avx2", Avx2),
+        (
+            "Zen 2 (EPYC 7742): slow gathers",
+            Amd,
+            0x17,
+            0x31,
+            "avx2",
+            Avx2,
+        ),
         ("Zen 3 (Ryzen 5950X)", Amd, 0x19, 0x21, "avx2", Avx2),
-        ("Zen 4 (EPYC 9004, this machine)", Amd, 0x19, 0x11, "avx2 avx512", Avx512),
-        ("Zen 4 (Ryzen 7950X)", Amd, 0x19, 0x61, "avx2 avx512", Avx512),
-        ("Zen 5 (Ryzen 9950X)", Amd, 0x1a, 0x44, "avx2 avx512", Avx512),
+        (
+            "Zen 4 (EPYC 9004, this machine)",
+            Amd,
+            0x19,
+            0x11,
+            "avx2 avx512",
+            Avx512,
+        ),
+        (
+            "Zen 4 (Ryzen 7950X)",
+            Amd,
+            0x19,
+            0x61,
+            "avx2 avx512",
+            Avx512,
+        ),
+        (
+            "Zen 5 (Ryzen 9950X)",
+            Amd,
+            0x1a,
+            0x44,
+            "avx2 avx512",
+            Avx512,
+        ),
         ("Zen 5, AVX-512 off", Amd, 0x1a, 0x44, "avx2", Avx2),
         ("Haswell (i7-4770)", Intel, 6, 0x3c, "avx2", Avx2),
-        ("Skylake-SP: 512-bit clocks down", Intel, 6, 0x55, "avx2 avx512", Avx2),
+        (
+            "Skylake-SP: 512-bit clocks down",
+            Intel,
+            6,
+            0x55,
+            "avx2 avx512",
+            Avx2,
+        ),
         ("Ice Lake server", Intel, 6, 0x6a, "avx2 avx512", Avx512),
         ("Sapphire Rapids", Intel, 6, 0x8f, "avx2 avx512", Avx512),
         ("Alder Lake", Intel, 6, 0x97, "avx2", Avx2),
@@ -51,7 +86,10 @@ fn runnable_sets_follow_the_instructions() {
         runnable(&zen2),
         [KernelSet::Portable, KernelSet::Avx2, KernelSet::Avx2Gather]
     );
-    assert_eq!(runnable(&CpuFeatures::baseline("arm")), [KernelSet::Portable]);
+    assert_eq!(
+        runnable(&CpuFeatures::baseline("arm")),
+        [KernelSet::Portable]
+    );
     assert_eq!(
         runnable(&cpu(Vendor::Amd, 0x19, 0x11, "avx2 avx512")),
         KernelSet::ALL
@@ -64,17 +102,28 @@ fn forced_names_are_checked_against_the_cpu() {
     for auto in [None, Some(""), Some("auto"), Some(" AUTO ")] {
         assert_eq!(resolve(auto, &zen2), Ok(KernelSet::Avx2), "{auto:?}");
     }
-    assert_eq!(resolve(Some("avx2-gather"), &zen2), Ok(KernelSet::Avx2Gather));
+    assert_eq!(
+        resolve(Some("avx2-gather"), &zen2),
+        Ok(KernelSet::Avx2Gather)
+    );
     assert_eq!(resolve(Some("Portable"), &zen2), Ok(KernelSet::Portable));
     let unknown = resolve(Some("sse9"), &zen2).unwrap_err();
     assert_eq!(unknown, KernelsError::Unknown("sse9".into()));
     let text = unknown.to_string();
-    assert!(text.contains("EOTN_KERNELS=\"sse9\"") && text.contains("avx512"), "{text}");
+    assert!(
+        text.contains("EOTN_KERNELS=\"sse9\"") && text.contains("avx512"),
+        "{text}"
+    );
     let unsupported = resolve(Some("avx512"), &zen2).unwrap_err();
     let text = unsupported.to_string();
     assert!(
-        matches!(unsupported, KernelsError::Unsupported { set: KernelSet::Avx512, .. })
-            && text.contains("cannot run")
+        matches!(
+            unsupported,
+            KernelsError::Unsupported {
+                set: KernelSet::Avx512,
+                ..
+            }
+        ) && text.contains("cannot run")
             && text.contains("portable, avx2, avx2-gather"),
         "{text}"
     );

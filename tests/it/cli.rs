@@ -107,7 +107,11 @@ fn bench_json_ends_with_medians() {
         .map(|a| a.iter().filter_map(|s| s["kernels"].as_str()).collect())
         .unwrap_or_default();
     let runnable = eotn::kernels::runnable(eotn::kernels::cpu());
-    assert_eq!(sets, runnable.iter().map(|s| s.name()).collect::<Vec<_>>(), "{last}");
+    assert_eq!(
+        sets,
+        runnable.iter().map(|s| s.name()).collect::<Vec<_>>(),
+        "{last}"
+    );
     assert!(sets.contains(&chosen), "{last}");
     assert!(text.contains("# cpu: "), "{text}");
 }

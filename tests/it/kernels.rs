@@ -44,7 +44,10 @@ fn assert_all_sets_agree(frame: &Frame, lut: &LookupTable, what: &str) -> usize 
     let (img, blobs) = run(KernelSet::Portable, frame, lut);
     for set in other_sets() {
         let (other_img, other_blobs) = run(set, frame, lut);
-        assert!(other_img == img, "{set}: classified image differs on {what}");
+        assert!(
+            other_img == img,
+            "{set}: classified image differs on {what}"
+        );
         for (a, b) in other_blobs.iter().zip(&blobs) {
             assert_eq!(a.runs(), b.runs(), "{set}: runs differ on {what}");
             assert_eq!(a.all(), b.all(), "{set}: blobs differ on {what}");
@@ -70,14 +73,18 @@ fn every_kernel_set_equals_the_portable_one_on_random_frames() {
         let mut t = LookupTable::new(bits).unwrap();
         // Blocky classes (as real tables) with speckle, so runs of every length occur.
         for i in 0..t.cells().len() {
-            let code = if next() % 8 == 0 { next() % 11 } else { (i as u64 >> 9) % 11 };
+            let code = if next().is_multiple_of(8) {
+                next() % 11
+            } else {
+                (i as u64 >> 9) % 11
+            };
             t.set(i, ColourClass::from_code(code as u8).unwrap());
         }
         for (w, h) in [(640, 480), (208, 160), (34, 3), (2, 5), (1922, 2), (130, 9)] {
             let mut data: Vec<u8> = (0..w * h * 2).map(|_| next() as u8).collect();
             // Smooth stretches as well as noise: copy pixel pairs forward at random.
             for i in 4..data.len() {
-                if next() % 4 != 0 {
+                if !next().is_multiple_of(4) {
                     data[i] = data[i - 4];
                 }
             }
@@ -105,7 +112,11 @@ fn check_stream(stream: &str, lut: &LookupTable, what: &str) -> usize {
 #[test]
 fn every_kernel_set_equals_the_portable_one_on_real_frames() {
     let bhuman = LookupTable::load(&repo_file("lookup_tables/bhuman2009.lut")).unwrap();
-    let blobs = check_stream("streams/bhuman2009.mcap", &bhuman, "B-Human log (6-bit table)");
+    let blobs = check_stream(
+        "streams/bhuman2009.mcap",
+        &bhuman,
+        "B-Human log (6-bit table)",
+    );
     assert!(blobs > 1000, "the Nao frames make blobs: {blobs}");
     let sample = LookupTable::load(&repo_file("lookup_tables/sample.lut")).unwrap();
     assert!(check_stream("streams/sample.mcap", &sample, "sample (7-bit)") > 0);

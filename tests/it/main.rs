@@ -22,9 +22,9 @@ mod common;
 mod crash_safety;
 mod docs;
 mod hardening;
-mod kernels;
 #[cfg(feature = "gui")]
 mod harness;
+mod kernels;
 mod live;
 mod live_peers;
 mod motion;
