@@ -38,7 +38,8 @@ pub struct Args {
     #[arg(long, default_value_t = 3)]
     pub rounds: usize,
     /// The C floor: `floors.c` (compiled with `$CC` or `cc -O3 -march=native`) or the compiled
-    /// program; by default `$EOTN_SHARED/bench/floors.c` or `../shared/bench/floors.c`.
+    /// program; by default `$EOTN_SHARED/bench/floors.c` or `../shared/bench/floors.c`. It runs
+    /// on the first 8 frames of each round.
     #[arg(long, value_name = "FLOORS")]
     pub floor: Option<PathBuf>,
     /// Do not run the C floor.
@@ -51,6 +52,10 @@ pub struct Args {
     #[arg(long)]
     pub json: bool,
 }
+
+/// Frames per round the floor runs on (the first ones): the floor times a dozen loops per frame,
+/// about half a second, which on a long stream would dwarf the bench itself.
+const FLOOR_FRAMES: usize = 8;
 
 /// The figures of one kernel set.
 #[derive(Debug, Serialize)]
@@ -199,7 +204,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     s.total_ms.push(t.total().as_secs_f64() * 1e3);
                 }
             }
-            if let Some(floor) = &floor {
+            if let Some(floor) = floor.as_ref().filter(|_| i < FLOOR_FRAMES) {
                 floor_figures.push(floor.measure(&frame)?);
             }
             bar.inc(1);
