@@ -49,12 +49,12 @@ impl CpuFeatures {
     /// This machine's CPU.
     #[must_use]
     pub fn detect() -> Self {
-        let mut cpu = Self::baseline(
+        let cpu = Self::baseline(
             &model_name_from_os()
                 .unwrap_or_else(|| format!("unknown {} CPU", std::env::consts::ARCH)),
         );
         #[cfg(target_arch = "x86_64")]
-        x86::fill(&mut cpu);
+        let cpu = x86::filled(cpu);
         cpu
     }
 
@@ -88,7 +88,7 @@ mod x86 {
     use std::arch::x86_64::{__cpuid, CpuidResult};
 
     /// Vendor, family, model, brand string and instruction sets from CPUID.
-    pub(super) fn fill(cpu: &mut CpuFeatures) {
+    pub(super) fn filled(mut cpu: CpuFeatures) -> CpuFeatures {
         let leaf0 = __cpuid(0);
         let vendor: Vec<u8> = [leaf0.ebx, leaf0.edx, leaf0.ecx]
             .iter()
@@ -131,5 +131,6 @@ mod x86 {
         cpu.avx2 = std::arch::is_x86_feature_detected!("avx2");
         cpu.avx512f = std::arch::is_x86_feature_detected!("avx512f");
         cpu.avx512bw = std::arch::is_x86_feature_detected!("avx512bw");
+        cpu
     }
 }
