@@ -154,29 +154,26 @@ fn benches(c: &mut Criterion) {
     }
 }
 
-/// The run-time-chosen AVX2 kernels against the portable safe-Rust loops they replace, on the
-/// same frame and table (the issue allows `std::arch` only where a benchmark shows the gain).
+/// Every kernel set this CPU can run against the portable safe-Rust loops, on the same frame
+/// and table (the issue allows `std::arch` only where a benchmark shows the gain).
 fn kernels(c: &mut Criterion) {
-    use eotn::blobs::RunSearch;
-    use eotn::classify::{classify_uyvy, classify_uyvy_portable};
+    use eotn::classify::classify_uyvy_with;
+    use eotn::kernels::{cpu, runnable};
     let t = table(7);
     for (w, h) in [(208, 160), (640, 480)] {
         let frame = scene(w, h);
         let mut group = c.benchmark_group(format!("kernels_{w}x{h}"));
         group.throughput(Throughput::Elements((w * h) as u64));
         let mut codes = vec![0u8; w * h];
-        group.bench_function("classify_b7/portable", |b| {
-            b.iter(|| classify_uyvy_portable(black_box(frame.data()), &t, &mut codes));
-        });
-        group.bench_function("classify_b7/fastest", |b| {
-            b.iter(|| classify_uyvy(black_box(frame.data()), &t, &mut codes));
-        });
         let img = ClassifiedImage::from_frame(&frame, &t);
-        for search in [RunSearch::Portable, RunSearch::Fastest] {
-            let mut set = BlobSet::default();
-            set.set_run_search(search);
-            group.bench_function(format!("blobs_conn8/{search:?}").to_lowercase(), |b| {
-                b.iter(|| set.find(black_box(&img), Connectivity::Eight));
+        for set in runnable(cpu()) {
+            group.bench_function(format!("classify_b7/{set}"), |b| {
+                b.iter(|| classify_uyvy_with(set, black_box(frame.data()), &t, &mut codes));
+            });
+            let mut blobs = BlobSet::default();
+            blobs.set_kernels(set);
+            group.bench_function(format!("blobs_conn8/{set}"), |b| {
+                b.iter(|| blobs.find(black_box(&img), Connectivity::Eight));
             });
         }
         group.finish();

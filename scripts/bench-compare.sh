@@ -22,7 +22,7 @@ for size in 208x160 640x480; do
   frame="$WORK/$size/sample_${size}_00.uyvy"
   : > "$WORK/$size.eotn"; : > "$WORK/$size.plain"; : > "$WORK/$size.avx2"; : > "$WORK/$size.peer"
   for _ in $(seq "$ROUNDS"); do
-    "$EOTN" bench "$frame" --lut "$WORK/sample_b7.lut" --reps 400 --json | tail -1 \
+    "$EOTN" bench "$frame" --lut "$WORK/sample_b7.lut" --reps 400 --rounds 1 --chosen-only --no-floor --json | tail -1 \
       | "$PYTHON" -c 'import json,sys; print(json.load(sys.stdin)["total_ns_per_px"])' >> "$WORK/$size.eotn"
     out=$("$WORK/floors" "$frame" "$w" "$h" "$WORK/sample_b7.lut")
     echo "$out" | awk '/^classify\+cc8 \(pipeline\)/{print $(NF-1)}' >> "$WORK/$size.plain"

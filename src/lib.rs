@@ -8,6 +8,7 @@
 //! | [`atomic_file`] | write-to-temporary, fsync, rename: how files the user cares about are saved |
 //! | [`input_file`] | reading the files a user names: regular files only, bounded in size |
 //! | [`stats`] | the median and the inverse-size least squares shared by recognition and evaluation |
+//! | [`kernels`] | which hot-loop kernels (portable, AVX2, AVX-512) this CPU runs: the choosing rule, `EOTN_KERNELS` |
 //! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
 //! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model, other teams' formats |
 //! | [`classify`] | frame + table → classified image |
@@ -43,6 +44,7 @@ pub mod frame;
 pub mod geometry;
 pub mod import;
 pub mod input_file;
+pub mod kernels;
 pub mod live;
 pub mod lut;
 pub mod model;

@@ -8,6 +8,10 @@ use eotn::cli::{Cli, report};
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
+    // A kernel set forced by name is checked before anything runs (unknown, or not on this CPU).
+    if let Err(e) = eotn::kernels::from_env() {
+        return report(&anyhow::Error::new(e));
+    }
     let result = match cli.command {
         #[cfg(feature = "gui")]
         Some(eotn::cli::Command::Open(args)) => eotn::app::run(args.run_options()),

@@ -10,8 +10,9 @@ use std::time::{Duration, Instant};
 use serde::{Deserialize, Serialize};
 
 use crate::blobs::{BlobSet, Connectivity};
-use crate::classify::{ClassifiedImage, classify_into};
+use crate::classify::{ClassifiedImage, classify_into_with};
 use crate::frame::Frame;
+use crate::kernels::{self, KernelSet};
 use crate::lut::LookupTable;
 use crate::recognition::patterns::PatternMemory;
 use crate::recognition::{Recognition, RecognitionParams, recognise};
@@ -74,6 +75,8 @@ pub struct Pipeline {
     recognition: Recognition,
     pattern_memory: Option<PatternMemory>,
     timings: StageTimings,
+    /// Classification's and the run search's kernels; `None`: those chosen for this CPU.
+    kernels: Option<KernelSet>,
 }
 
 impl Pipeline {
@@ -88,7 +91,15 @@ impl Pipeline {
             recognition: Recognition::default(),
             pattern_memory: None,
             timings: StageTimings::default(),
+            kernels: None,
         }
+    }
+
+    /// Runs classification and blobs with the kernels of `set` from now on (benchmarks compare
+    /// the sets; every set gives the same results). By default the set chosen for this CPU.
+    pub fn set_kernels(&mut self, set: KernelSet) {
+        self.kernels = Some(set);
+        self.blobs.set_kernels(set);
     }
 
     /// Runs every stage on a frame without sensor readings (recognition then has no camera
@@ -100,7 +111,8 @@ impl Pipeline {
     /// Runs every stage on `frame` with the robot's readings for it.
     pub fn process(&mut self, frame: &Frame, sensors: Option<&SensorReadings>) -> FrameResult<'_> {
         let t0 = Instant::now();
-        classify_into(frame, &self.lut, &mut self.classified);
+        let set = self.kernels.unwrap_or_else(kernels::active);
+        classify_into_with(set, frame, &self.lut, &mut self.classified);
         let t1 = Instant::now();
         self.blobs.find(&self.classified, self.params.connectivity);
         let t2 = Instant::now();

@@ -9,7 +9,9 @@
 
 #![allow(unsafe_code)]
 
-use super::{RowRuns, Run};
+#[cfg(target_arch = "x86_64")]
+use super::RowRuns;
+use super::Run;
 
 /// Appends the runs of `row` with the AVX2 scan; `false` (and nothing appended) when the CPU
 /// has no AVX2, so the caller falls back to the portable scan.

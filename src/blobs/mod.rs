@@ -5,8 +5,8 @@
 //! neighbours join; with [`Connectivity::Four`] only left/right/up/down neighbours do.
 //!
 //! The algorithm is CMVision's: run-length encode each row (runs are found a machine word at a
-//! time: a run of one colour is skipped 8 bytes per step, or 32 with AVX2 when the CPU has it —
-//! see [`RunSearch`]), join overlapping runs of equal colour
+//! time: a run of one colour is skipped 8 bytes per step, or 32 with AVX2 and 64 with AVX-512
+//! when the chosen [`KernelSet`] has them), join overlapping runs of equal colour
 //! in adjacent rows with union-find (the root is always the run first in raster order), then one
 //! pass over the runs accumulates each blob's box, pixel count and centroid sums. All buffers
 //! live in a [`BlobSet`] that is reused frame after frame.
@@ -15,11 +15,13 @@
 //! [`BlobSet::merge`] joins two blobs explicitly and [`BlobSet::active`] lists the survivors.
 
 mod avx2;
+mod avx512;
 
 use serde::{Deserialize, Serialize};
 
 use crate::classify::ClassifiedImage;
 use crate::frame::{ImagePoint, PixelBox};
+use crate::kernels::{self, KernelSet};
 use crate::lut::ColourClass;
 
 /// Which neighbours join a blob.
@@ -53,18 +55,6 @@ impl Connectivity {
             _ => None,
         }
     }
-}
-
-/// How rows are searched for run boundaries. Both give the same runs; the choice only exists so
-/// that benchmarks and tests can compare them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum RunSearch {
-    /// 32 pixels per step with AVX2 when the CPU has it (checked at run time), else as
-    /// [`RunSearch::Portable`].
-    #[default]
-    Fastest,
-    /// 8 pixels per step in a 64-bit word, on every CPU.
-    Portable,
 }
 
 /// A horizontal run of one colour: pixels `x0..x1` (end exclusive) of row `y`.
@@ -178,7 +168,8 @@ pub struct BlobSet {
     width: usize,
     height: usize,
     connectivity: Connectivity,
-    run_search: RunSearch,
+    /// The run search's kernels; `None`: those chosen for this CPU ([`kernels::active`]).
+    kernels: Option<KernelSet>,
     blobs: Vec<Blob>,
     /// For each blob: `None`, or the blob it was merged into.
     merged_into: Vec<Option<u32>>,
@@ -212,11 +203,12 @@ impl BlobSet {
         self.run_blob.clear();
         self.row_start.clear();
         let reach = u32::from(connectivity == Connectivity::Eight);
+        let set = self.kernels.unwrap_or_else(kernels::active);
 
         for y in 0..img.height() {
             let first = self.runs.len();
             self.row_start.push(u32_of(first));
-            encode_row(img.row(y), u16_of(y), &mut self.runs, self.run_search);
+            encode_row(img.row(y), u16_of(y), &mut self.runs, set);
             self.parent.extend(u32_of(first)..u32_of(self.runs.len()));
             if y > 0 {
                 let prev = u32_index(self.row_start[y - 1])..first;
@@ -227,10 +219,10 @@ impl BlobSet {
         self.collect_blobs();
     }
 
-    /// Chooses the run search for later [`BlobSet::find`] calls (the default is the fastest
-    /// this CPU offers).
-    pub fn set_run_search(&mut self, search: RunSearch) {
-        self.run_search = search;
+    /// Chooses the run search's kernels for later [`BlobSet::find`] calls (the default is the
+    /// set chosen for this CPU); every set finds the same runs.
+    pub fn set_kernels(&mut self, set: KernelSet) {
+        self.kernels = Some(set);
     }
 
     /// Unites each run of the current row (from `current`) with the runs of the previous row
@@ -409,11 +401,15 @@ impl BlobSet {
 /// compared with itself shifted by one byte (the byte before the word shifted in), and every
 /// non-zero byte of the difference is a place where the colour changes. Inside a long run a word
 /// costs one load, a shift and a compare.
-fn encode_row(row: &[u8], y: u16, runs: &mut Vec<Run>, search: RunSearch) {
-    if search == RunSearch::Fastest && avx2::encode_row(row, y, runs) {
-        return;
+fn encode_row(row: &[u8], y: u16, runs: &mut Vec<Run>, set: KernelSet) {
+    let done = match set {
+        KernelSet::Portable => false,
+        KernelSet::Avx2 | KernelSet::Avx2Gather => avx2::encode_row(row, y, runs),
+        KernelSet::Avx512 | KernelSet::Avx512Gather => avx512::encode_row(row, y, runs),
+    };
+    if !done {
+        encode_row_words(row, y, runs);
     }
-    encode_row_words(row, y, runs);
 }
 
 /// The runs of one row as its colour boundaries are found, shared by both run searches.
@@ -626,7 +622,7 @@ mod tests {
 
     #[test]
     fn word_at_a_time_runs_equal_a_plain_scan() {
-        // Rows of every length up to 100 (AVX2 blocks of 32 and their tails) with runs of random lengths, including 0x80-valued and
+        // Rows of every length up to 100 (AVX2 blocks of 32, AVX-512 of 64, and their tails) with runs of random lengths, including 0x80-valued and
         // adjacent equal-low-bit colours that naive zero-byte tricks get wrong.
         let mut state = 0x1234_5678_9abc_def0u64;
         let mut rand = move |n: u64| {
@@ -636,20 +632,7 @@ mod tests {
             state % n
         };
         let palette = [0u8, 1, 2, 3, 0x80, 0x81, 0xff];
-        // The AVX2 scan is called itself: on a CPU without AVX2 the `Fastest` search is the
-        // portable one and would be compared with itself, so that is a visible skip of that
-        // part (a failure under CI=true).
-        #[cfg(target_arch = "x86_64")]
-        let has_avx2 = std::arch::is_x86_feature_detected!("avx2");
-        #[cfg(target_arch = "x86_64")]
-        if !has_avx2 {
-            assert!(
-                !matches!(std::env::var("CI").as_deref(), Ok("true" | "1")),
-                "CI=true: this x86-64 CPU has no AVX2, so the AVX2 run search cannot be compared"
-            );
-            eprintln!("SKIPPED: no AVX2 on this CPU; the AVX2 run search was not compared");
-        }
-        for len in 1..100 {
+        for len in 1..150 {
             for _ in 0..50 {
                 let mut row = Vec::new();
                 while row.len() < len {
@@ -660,15 +643,11 @@ mod tests {
                 }
                 row.truncate(len);
                 let mut fast = Vec::new();
-                encode_row(&row, 3, &mut fast, RunSearch::Portable);
-                let mut fastest = Vec::new();
-                encode_row(&row, 3, &mut fastest, RunSearch::Fastest);
-                assert_eq!(fastest, fast, "row {row:?}");
-                #[cfg(target_arch = "x86_64")]
-                if has_avx2 {
-                    let mut wide = Vec::new();
-                    assert!(avx2::encode_row(&row, 3, &mut wide), "the AVX2 scan ran");
-                    assert_eq!(wide, fast, "AVX2, row {row:?}");
+                encode_row(&row, 3, &mut fast, KernelSet::Portable);
+                for set in KernelSet::ALL {
+                    let mut other = Vec::new();
+                    encode_row(&row, 3, &mut other, set);
+                    assert_eq!(other, fast, "{set}, row {row:?}");
                 }
                 let mut plain = Vec::new();
                 let mut x0 = 0;

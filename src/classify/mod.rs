@@ -4,12 +4,15 @@
 //! the frame is walked in 4-byte pixel pairs, the shared U/V part of the cell index is built once
 //! per pair, and the table is a fixed-size array per resolution so the compiler can prove every
 //! index in bounds (no checks in the loop). Output goes into a caller-owned
-//! [`ClassifiedImage`] reused frame after frame. On CPUs with AVX2 a gather kernel does 16
-//! pixels per step instead (see `classify/avx2.rs`).
+//! [`ClassifiedImage`] reused frame after frame. On x86 CPUs with AVX2 or AVX-512 faster
+//! kernels do 16 or 32 pixels per step instead (`avx2.rs`, `avx512.rs`); which runs is the
+//! [`KernelSet`] `crate::kernels` chooses for the CPU.
 
 mod avx2;
+mod avx512;
 
 use crate::frame::{Frame, PixelLayout};
+use crate::kernels::{self, KernelSet};
 use crate::lut::{ColourClass, LookupTable, code_display_rgb};
 
 /// One class code per pixel, row-major.
@@ -141,12 +144,23 @@ impl ClassifiedImage {
     }
 }
 
-/// Classifies `frame` with `lut` into `out`, resizing it to the frame.
+/// Classifies `frame` with `lut` into `out`, resizing it to the frame, with the kernels
+/// chosen for this CPU ([`kernels::active`]).
 pub fn classify_into(frame: &Frame, lut: &LookupTable, out: &mut ClassifiedImage) {
+    classify_into_with(kernels::active(), frame, lut, out);
+}
+
+/// [`classify_into`] with the kernels of `set` (the portable loop where the CPU lacks them).
+pub fn classify_into_with(
+    set: KernelSet,
+    frame: &Frame,
+    lut: &LookupTable,
+    out: &mut ClassifiedImage,
+) {
     out.resize(frame.width(), frame.height());
     let dst = &mut out.codes;
     match frame.layout() {
-        PixelLayout::Uyvy => classify_uyvy(frame.data(), lut, dst),
+        PixelLayout::Uyvy => classify_uyvy_with(set, frame.data(), lut, dst),
         PixelLayout::Yuv444Packed | PixelLayout::Yuv444Planar => {
             let w = frame.width();
             frame.for_each_pixel(|x, y, p| dst[y * w + x] = lut.classify(p));
@@ -155,28 +169,26 @@ pub fn classify_into(frame: &Frame, lut: &LookupTable, out: &mut ClassifiedImage
 }
 
 /// Classifies raw UYVY bytes into `dst` (one code per pixel); `dst.len()` must be half of
-/// `src.len()`, extra bytes of either are left alone.
-///
-/// Uses the AVX2 kernel when the CPU has it (checked at run time), else
-/// [`classify_uyvy_portable`]; both give the same codes.
+/// `src.len()`, extra bytes of either are left alone. Uses the kernels chosen for this CPU.
 pub fn classify_uyvy(src: &[u8], lut: &LookupTable, dst: &mut [u8]) {
-    let done = avx2::classify_uyvy(src, lut.cells(), u32::from(lut.bits()), dst);
+    classify_uyvy_with(kernels::active(), src, lut, dst);
+}
+
+/// [`classify_uyvy`] with the kernel of `set`; every set gives the same codes. A set the CPU
+/// cannot run falls back to [`classify_uyvy_portable`].
+pub fn classify_uyvy_with(set: KernelSet, src: &[u8], lut: &LookupTable, dst: &mut [u8]) {
+    let (cells, bits) = (lut.cells(), u32::from(lut.bits()));
+    let done = match set {
+        KernelSet::Portable => 0,
+        KernelSet::Avx2 | KernelSet::Avx512 => avx2::classify_uyvy_indexed(src, cells, bits, dst),
+        KernelSet::Avx2Gather => avx2::classify_uyvy_gather(src, cells, bits, dst),
+        KernelSet::Avx512Gather => avx512::classify_uyvy_gather(src, cells, bits, dst),
+    };
     let (src_rest, dst_rest) = (
         src.get(done * 2..).unwrap_or(&[]),
         dst.get_mut(done..).unwrap_or(&mut []),
     );
     classify_uyvy_portable(src_rest, lut, dst_rest);
-}
-
-/// The kernels [`classify_uyvy`] and blob formation use on this CPU: `"avx2"` or `"portable"`
-/// (`eotn bench` reports it, so figures from different machines can be told apart).
-#[must_use]
-pub fn active_kernels() -> &'static str {
-    if avx2::available() {
-        "avx2"
-    } else {
-        "portable"
-    }
 }
 
 /// [`classify_uyvy`] in safe portable Rust on every CPU (for comparison in benchmarks).
@@ -269,20 +281,19 @@ mod tests {
     }
 
     #[test]
-    fn fastest_kernel_equals_the_portable_loop() {
+    fn every_runnable_kernel_set_equals_the_portable_loop() {
         // Every length around the 16-pixel blocks, every resolution, cells with many codes and
-        // pixels that reach the table's last cells (the gather reads whole words). The AVX2
-        // kernel is called itself, and must have done every whole block: on a CPU without AVX2
-        // the dispatcher would compare the portable loop with itself, so that is a visible skip
-        // (a failure under CI=true).
+        // pixels that reach the table's last cells (the gather reads whole words). Each kernel
+        // set this CPU can run is called by name; an x86-64 CPU without AVX2 can compare none,
+        // which is a visible skip (a failure under CI=true).
+        let sets = crate::kernels::runnable(crate::kernels::cpu());
         #[cfg(target_arch = "x86_64")]
-        if !avx2::available() {
+        if !sets.contains(&KernelSet::Avx2) {
             assert!(
                 !matches!(std::env::var("CI").as_deref(), Ok("true" | "1")),
-                "CI=true: this x86-64 CPU has no AVX2, so the AVX2 kernel cannot be compared"
+                "CI=true: this x86-64 CPU has no AVX2, so the AVX2 kernels cannot be compared"
             );
-            eprintln!("SKIPPED: no AVX2 on this CPU; the AVX2 classify kernel was not compared");
-            return;
+            eprintln!("SKIPPED: no AVX2 on this CPU; only the portable classify loop was run");
         }
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut next = move || {
@@ -301,17 +312,13 @@ mod tests {
                 if let Some(q) = src.first_chunk_mut::<4>() {
                     *q = [255; 4];
                 }
-                let (mut fast, mut plain) = (vec![0u8; pairs * 2], vec![0u8; pairs * 2]);
-                let done = avx2::classify_uyvy(&src, t.cells(), u32::from(t.bits()), &mut fast);
-                #[cfg(target_arch = "x86_64")]
-                assert_eq!(
-                    done,
-                    pairs * 2 / 16 * 16,
-                    "the AVX2 kernel did the whole blocks"
-                );
-                classify_uyvy_portable(&src[done * 2..], &t, &mut fast[done..]);
+                let mut plain = vec![0u8; pairs * 2];
                 classify_uyvy_portable(&src, &t, &mut plain);
-                assert_eq!(fast, plain, "bits {bits}, {pairs} pairs");
+                for &set in &sets {
+                    let mut fast = vec![0u8; pairs * 2];
+                    classify_uyvy_with(set, &src, &t, &mut fast);
+                    assert_eq!(fast, plain, "{set}, bits {bits}, {pairs} pairs");
+                }
             }
         }
     }

@@ -12,6 +12,7 @@ macro_rules! outln {
 }
 
 mod bench;
+mod bench_floor;
 mod bench_live;
 mod blobs;
 mod bounds;

@@ -96,10 +96,24 @@ fn bench_json_ends_with_medians() {
             "{key} in {last}"
         );
     }
+    let chosen = last["kernels"].as_str().unwrap_or_default();
     assert!(
-        matches!(last["kernels"].as_str(), Some("avx2" | "portable")),
+        eotn::kernels::KernelSet::from_name(chosen).is_some(),
         "kernels in {last}"
     );
+    // Every set this CPU can run was measured, the chosen one among them, portable first.
+    let sets: Vec<&str> = last["sets"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|s| s["kernels"].as_str()).collect())
+        .unwrap_or_default();
+    let runnable = eotn::kernels::runnable(eotn::kernels::cpu());
+    assert_eq!(
+        sets,
+        runnable.iter().map(|s| s.name()).collect::<Vec<_>>(),
+        "{last}"
+    );
+    assert!(sets.contains(&chosen), "{last}");
+    assert!(text.contains("# cpu: "), "{text}");
 }
 
 #[test]

@@ -25,6 +25,7 @@ mod docs;
 mod hardening;
 #[cfg(feature = "gui")]
 mod harness;
+mod kernels;
 mod live;
 mod live_peers;
 mod mcap_conformance;
