@@ -5,7 +5,7 @@
 //!
 //! | module | role |
 //! |---|---|
-//! | [`atomic_file`] | write-to-temporary, fsync, rename: how files the user cares about are saved |
+//! | [`atomic_file`] | how every output is written: temporary + fsync + rename, devices and FIFOs in place, links kept, inputs never replaced |
 //! | [`stats`] | the median and the inverse-size least squares shared by recognition and evaluation |
 //! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
 //! | [`lut`] | the 3D YUV lookup table, colour classes, the editing model, other teams' formats |

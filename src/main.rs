@@ -2,18 +2,22 @@
 
 use std::process::ExitCode;
 
-use clap::Parser;
-use eotn::cli::{Cli, report};
+use eotn::cli::{Parsed, report};
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
+    // The command line, and the files it names as inputs: no output may replace them.
+    let Parsed {
+        cli,
+        inputs,
+        outputs,
+    } = eotn::cli::parse();
     let result = match cli.command {
         #[cfg(feature = "gui")]
         Some(eotn::cli::Command::Open(args)) => {
             eotn::app::run(eotn::app::RunOptions::from_args(&args))
         }
-        Some(command) => eotn::cli::run(command),
+        Some(command) => eotn::cli::run(command, &inputs, &outputs),
         #[cfg(feature = "gui")]
         None => eotn::app::run(eotn::app::RunOptions::default()),
         #[cfg(not(feature = "gui"))]

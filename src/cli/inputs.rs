@@ -258,21 +258,6 @@ impl FrameInputs {
         &self.items
     }
 
-    /// Every file read: frame files and stream files (each once), for [`refuse_overwriting`].
-    #[must_use]
-    pub fn files(&self) -> Vec<PathBuf> {
-        let mut out: Vec<PathBuf> = Vec::new();
-        for item in &self.items {
-            let p = match item {
-                FrameInput::File(p) | FrameInput::Stream { path: p, .. } => p,
-            };
-            if out.last() != Some(p) {
-                out.push(p.clone());
-            }
-        }
-        out
-    }
-
     /// The name of frame `i` (see [`FrameInput::name`]).
     #[must_use]
     pub fn name(&self, i: usize) -> String {
@@ -376,39 +361,6 @@ impl FrameInputs {
             }
         }
     }
-}
-
-/// Refuses an output that is one of the inputs (also through a symlink or another spelling of
-/// the path): a command never replaces what it reads. `inputs` are the files read, after
-/// folders are expanded; for an input frame its label mask (`NAME.cls`, `NAME.uyvy.cls`) counts
-/// too, since `lut-from-labels` reads it.
-///
-/// # Errors
-/// The output names an input.
-pub fn refuse_overwriting(output: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
-    // An output that does not exist yet cannot be an input; one that does is compared by what
-    // it resolves to.
-    let Ok(out) = output.canonicalize() else {
-        return Ok(());
-    };
-    let masks = inputs.iter().flat_map(|p| {
-        let mut beside = p.as_os_str().to_owned();
-        beside.push(".cls");
-        [p.with_extension("cls"), PathBuf::from(beside)]
-    });
-    let clash = inputs
-        .iter()
-        .cloned()
-        .chain(masks)
-        .find(|p| p.canonicalize().is_ok_and(|c| c == out));
-    if let Some(p) = clash {
-        bail!(
-            "{}: the output would replace the input {}; name another file",
-            output.display(),
-            p.display()
-        );
-    }
-    Ok(())
 }
 
 /// Loads one frame with the error naming the file.

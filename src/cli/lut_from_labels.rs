@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress, refuse_overwriting};
+use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
 use crate::frame::Frame;
 use crate::lut::ColourClass;
 use crate::lut::learn::{Accuracy, LearnParams, TableBuilder};
@@ -44,7 +44,7 @@ pub struct Args {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
     /// Where to write the table (`.lut`).
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Print the accuracy as one JSON line.
     #[arg(long)]
@@ -151,7 +151,6 @@ fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Resul
     } else {
         expand_frame_paths(&args.frames)?
     };
-    refuse_overwriting(&args.output, &paths)?;
     for path in &paths {
         let frame = load_frame_arg(path, args.size)?;
         let labels = load_mask(path, &frame)?;

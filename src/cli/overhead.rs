@@ -8,9 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Serialize;
 
-use super::inputs::{
-    FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress, refuse_overwriting,
-};
+use super::inputs::{FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress};
 use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
 use crate::overhead::OverheadPipeline;
 use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
@@ -59,7 +57,7 @@ pub struct MarkerArgs {
     #[arg(long)]
     pub all: bool,
     /// Output SVG (with `--all`, the folder).
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
 }
 
@@ -70,7 +68,7 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub points: PathBuf,
     /// Where to write the calibration (JSON).
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// A frame of the camera: refine along its field lines and write the lines projected over
     /// it as `CAL.lines.png` beside the calibration.
@@ -126,7 +124,7 @@ pub struct SimPointsArgs {
     #[arg(long)]
     pub field: Option<PathBuf>,
     /// Output points file.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
 }
 
@@ -182,7 +180,7 @@ pub fn marker_file_name(team: MarkerTeam, id: MarkerIdentity) -> String {
 
 /// Writes all 32 markers into `dir` (made if missing).
 fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot make", dir.display()))?;
+    crate::atomic_file::output_folder(dir).with_context(|| format!("{}", dir.display()))?;
     for team in [MarkerTeam::Blue, MarkerTeam::Yellow] {
         for value in 0..16 {
             let id = MarkerIdentity::new(value).context("identity in 0..16")?;
@@ -196,16 +194,8 @@ fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
 }
 
 fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
-    let png = a.output.with_extension("lines.png");
-    let inputs: Vec<PathBuf> = [Some(&a.points), a.image.as_ref(), a.field.as_ref()]
-        .into_iter()
-        .flatten()
-        .cloned()
-        .collect();
-    refuse_overwriting(&a.output, &inputs)?;
-    if a.image.is_some() {
-        refuse_overwriting(&png, &inputs)?;
-    }
+    // The lines over the image go beside the calibration (not beside a device or FIFO).
+    let png = crate::atomic_file::beside_output(&a.output, "lines.png");
     let field = load_field(a.field.as_deref())?;
     let points = PointsFile::load(&a.points)?;
     let frame = a
@@ -236,8 +226,8 @@ fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
         .with_context(|| format!("{}", a.points.display()))?;
     cal.save(&a.output)?;
     print_calibration(&cal);
-    if let Some(f) = &frame {
-        write_lines_png(&png, f, &field, &cal.camera)?;
+    if let (Some(f), Some(png)) = (&frame, &png) {
+        write_lines_png(png, f, &field, &cal.camera)?;
         println!("field lines over the image: {}", png.display());
     }
     Ok(())
@@ -477,7 +467,6 @@ fn run_sim_points(a: &SimPointsArgs) -> anyhow::Result<()> {
     if !(a.noise_px.is_finite() && a.noise_px >= 0.0) {
         bail!("--noise-px must be a non-negative number");
     }
-    refuse_overwriting(&a.output, std::slice::from_ref(&a.stream))?;
     let field = load_field(a.field.as_deref())?;
     let camera = stream_truth_camera(&a.stream)?;
     let file = simulated_clicks(&camera, &field, a.noise_px, a.seed);

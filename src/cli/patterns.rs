@@ -61,7 +61,7 @@ pub struct LearnArgs {
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// Start from this places file and add to it (it may be the output).
-    #[arg(long)]
+    #[arg(long, value_name = super::paths::UPDATED)]
     pub update: Option<PathBuf>,
     /// A place placed within this distance of a known object adds its pattern to it, cm.
     #[arg(long, default_value_t = LearnParams::default().same_object_cm)]
@@ -76,7 +76,7 @@ pub struct LearnArgs {
     #[arg(long, default_value_t = LearnParams::default().outlier_cm)]
     pub outlier_cm: f64,
     /// The places file to write.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Print what was learnt as one JSON object.
     #[arg(long)]

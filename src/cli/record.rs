@@ -19,7 +19,7 @@ pub struct Args {
     pub urls: Vec<String>,
     /// Output: the `.mcap` file for one robot; for several, a folder that gets one file per
     /// robot, named after its server name.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Stop once every robot has sent this many frames.
     #[arg(long)]
@@ -134,8 +134,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .collect::<Result<Vec<_>, _>>()?;
     let single = urls.len() == 1;
     if !single {
-        std::fs::create_dir_all(&args.output)
-            .with_context(|| format!("cannot create folder {}", args.output.display()))?;
+        crate::atomic_file::output_folder(&args.output)
+            .with_context(|| format!("{}", args.output.display()))?;
     }
     let naming = Arc::new(Mutex::new(Naming {
         output: args.output.clone(),

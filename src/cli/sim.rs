@@ -24,7 +24,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Output stream (`.mcap`).
-    #[arg(short, long, required_unless_present = "list")]
+    #[arg(short, long, required_unless_present = "list", value_name = super::paths::OUT)]
     pub output: Option<PathBuf>,
     /// Ideal frames: no noise, vignetting or rolling shutter.
     #[arg(long)]
