@@ -20,10 +20,13 @@ mod cli;
 mod common;
 mod crash_safety;
 mod hardening;
+mod hardening_files;
 #[cfg(feature = "gui")]
 mod harness;
 mod live;
 mod motion;
+#[cfg(unix)]
+mod outputs;
 mod overhead;
 mod patterns;
 mod peer;
