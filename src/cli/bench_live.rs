@@ -36,13 +36,13 @@ const APP_TICK: Duration = Duration::from_millis(16);
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Robots sending at once.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = super::values::whole_in::<usize>(1, 64))]
     pub robots: usize,
     /// Frames per second each robot sends.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = super::values::number_in(0.1, 1000.0))]
     pub fps: f64,
     /// Seconds measured.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = super::values::number_in(0.1, 86_400.0))]
     pub seconds: f64,
     /// Connect through the app's workspace (ticked as the window does), recording every robot.
     #[arg(long)]

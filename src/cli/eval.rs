@@ -43,7 +43,7 @@ pub struct Args {
     pub compare_params: Option<PathBuf>,
     /// Frames whose pan speed is at least this (rad/s) also run without skew correction, to
     /// measure what the correction gains.
-    #[arg(long, default_value_t = 1.5)]
+    #[arg(long, default_value_t = 1.5, value_parser = super::values::number_in(0.0, 100.0))]
     pub fast_pan_rad_per_s: f64,
     /// Fit distance = multiplier / height + offset for goals to the truth and write the result as
     /// a recognition-parameter JSON file.
@@ -51,7 +51,7 @@ pub struct Args {
     pub calibrate_goals: Option<PathBuf>,
     /// Multiplier and offset are both fitted only when the tallest goal is at least this many
     /// times the shortest (else the multiplier alone).
-    #[arg(long, default_value_t = 1.3)]
+    #[arg(long, default_value_t = 1.3, value_parser = super::values::number_in(1.0, 100.0))]
     pub calibration_min_spread: f64,
     /// Draw the evaluation as PNG charts into this folder (measured against true distance,
     /// error histograms, found rates per distance band, post errors).

@@ -61,7 +61,7 @@ pub struct Args {
     #[arg(long, default_value = "8", value_parser = parse_connectivity)]
     pub connectivity: Connectivity,
     /// Blobs view: leave out blobs with fewer pixels than this.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = super::values::whole_in::<u32>(0, super::values::MAX_PIXELS))]
     pub min_pixels: u32,
 }
 

@@ -45,7 +45,7 @@ pub struct Args {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
     /// Frames per second, for frame times when the sensor table has no `time_s` column.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = super::values::number_in(0.001, 10_000.0))]
     pub fps: f64,
     /// Kind of source stored in the stream's metadata (`robot`, `overhead`, `sim:NAME`, …).
     #[arg(long, default_value = "import")]
@@ -57,7 +57,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "zstd")]
     pub compression: CompressionArg,
     /// Frames per chunk (default: about 1 MiB of images per chunk).
-    #[arg(long)]
+    #[arg(long, value_parser = super::values::whole_in::<usize>(1, 100_000))]
     pub frames_per_chunk: Option<usize>,
     /// Byte order of the stored frames: `yuyv` (read by Foxglove and Rerun) or `uyvy` (read by
     /// Foxglove; the cameras' own order). The same samples either way.

@@ -35,6 +35,7 @@ mod render;
 mod serve;
 mod sim;
 mod sources;
+pub mod values;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

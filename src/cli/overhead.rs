@@ -115,10 +115,10 @@ pub struct SimPointsArgs {
     #[arg(long)]
     pub stream: PathBuf,
     /// Click noise, pixels (standard deviation per axis).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = super::values::number_in(0.0, 100.0))]
     pub noise_px: f64,
     /// Seed of the noise.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed())]
     pub seed: u64,
     /// Field description; the 2005 field by default.
     #[arg(long)]

@@ -77,11 +77,20 @@ pub fn parse() -> Parsed {
     parse_from(std::env::args_os())
 }
 
-/// Like [`parse`], from given arguments (the first is the program name).
+/// Like [`parse`], from given arguments (the first is the program name). A wrong command line
+/// is one line, `eotn: invalid value 'NaN' for '--fps <FPS>': …`, like every other error;
+/// `--help` and `--version` print as clap prints them.
 #[must_use]
 pub fn parse_from(args: impl IntoIterator<Item = OsString>) -> Parsed {
     let command = Cli::command();
-    let matches = command.clone().get_matches_from(args);
+    let matches = match command.clone().try_get_matches_from(args) {
+        Ok(m) => m,
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            eprintln!("eotn: {}", one_line(&e));
+            std::process::exit(e.exit_code());
+        }
+    };
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let (mut inputs, mut outputs) = (Vec::new(), Vec::new());
     collect(&command, &matches, &[PathRole::Input], &mut inputs);
@@ -96,6 +105,16 @@ pub fn parse_from(args: impl IntoIterator<Item = OsString>) -> Parsed {
         outputs,
         cli,
     }
+}
+
+/// A clap error as one line: its message without the `error:` prefix, the usage and the
+/// pointer to `--help`, folded onto one line.
+fn one_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let message = text.split("\n\n").next().unwrap_or_default();
+    let message = message.strip_prefix("error: ").unwrap_or(message);
+    let words: Vec<&str> = message.split_whitespace().collect();
+    format!("{} (--help says more)", words.join(" "))
 }
 
 /// The values of every path option of `command` (and of the subcommand chosen, recursively)

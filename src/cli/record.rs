@@ -22,10 +22,10 @@ pub struct Args {
     #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Stop once every robot has sent this many frames.
-    #[arg(long)]
+    #[arg(long, value_parser = super::values::whole_in::<usize>(1, super::values::MAX_FRAMES))]
     pub frames: Option<usize>,
     /// Stop after this many seconds.
-    #[arg(long)]
+    #[arg(long, value_parser = super::values::number_in(0.0, super::values::MAX_SECONDS))]
     pub seconds: Option<f64>,
 }
 

@@ -75,7 +75,7 @@ pub struct Args {
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub scale: u8,
     /// Smallest blob drawn by the `blobs` overlay, pixels.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = super::values::whole_in::<u32>(0, super::values::MAX_PIXELS))]
     pub min_blob_pixels: u32,
     /// A places file (`eotn patterns learn`): pink markers are identified and labelled with
     /// their place and distance by the `patterns` overlay.

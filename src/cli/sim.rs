@@ -18,10 +18,10 @@ pub struct Args {
     #[arg(long, required_unless_present = "list")]
     pub scenario: Option<String>,
     /// Number of frames (30 a second).
-    #[arg(long, default_value_t = 90)]
+    #[arg(long, default_value_t = 90, value_parser = super::values::whole_in::<u64>(1, super::values::MAX_FRAMES))]
     pub frames: u64,
     /// Seed: the same seed gives the same stream.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed())]
     pub seed: u64,
     /// Output stream (`.mcap`).
     #[arg(short, long, required_unless_present = "list", value_name = super::paths::OUT)]
