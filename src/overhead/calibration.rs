@@ -145,18 +145,48 @@ impl Calibration {
         median(&e).unwrap_or(f64::NAN)
     }
 
-    /// Writes the calibration atomically as JSON.
+    /// Every number of the calibration, for the check that none is NaN or infinite.
+    fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        let c = &self.camera;
+        [
+            c.focal_px,
+            c.centre.x_px,
+            c.centre.y_px,
+            c.k1,
+            c.k2,
+            c.pose.yaw_rad,
+            c.pose.pitch_rad,
+            c.pose.roll_rad,
+        ]
+        .into_iter()
+        .chain(c.pose.position_cm)
+        .chain(self.line_rms_px)
+        .chain(self.points.iter().flat_map(|p| {
+            p.image_px
+                .into_iter()
+                .chain(p.projected_px)
+                .chain([p.error_px])
+        }))
+    }
+
+    /// Writes the calibration atomically as JSON; one with a value that is not a number is
+    /// never written (it could not be read back).
     ///
     /// # Errors
-    /// [`CalibrationError::File`] when it cannot be written.
+    /// [`CalibrationError::File`] when it has a non-finite value or cannot be written.
     pub fn save(&self, path: &Path) -> Result<(), CalibrationError> {
-        let file = CalibrationFile {
-            format: FORMAT.into(),
-            calibration: self.clone(),
-        };
         let err = |what: String| CalibrationError::File {
             path: path.display().to_string(),
             what,
+        };
+        if !self.values().all(f64::is_finite) {
+            return Err(err(
+                "the calibration has a value that is not a number; not written".into(),
+            ));
+        }
+        let file = CalibrationFile {
+            format: FORMAT.into(),
+            calibration: self.clone(),
         };
         let mut text = serde_json::to_string_pretty(&file).map_err(|e| err(e.to_string()))?;
         text.push('\n');
@@ -166,44 +196,51 @@ impl Calibration {
     /// Reads a calibration file.
     ///
     /// # Errors
-    /// [`CalibrationError::File`] for a missing file, other JSON, or a camera with non-finite
-    /// or non-positive values.
+    /// [`CalibrationError::File`] for a missing, oversized or non-regular file, other JSON, a key
+    /// the format does not have (named), or a camera with non-finite or non-positive values.
     pub fn load(path: &Path) -> Result<Self, CalibrationError> {
         let err = |what: String| CalibrationError::File {
             path: path.display().to_string(),
             what,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
-        let file: CalibrationFile = serde_json::from_str(&text)
-            .map_err(|e| err(format!("not an overhead calibration: {e}")))?;
+        let text = crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SMALL_FILE_BYTES,
+            "an overhead calibration",
+        )
+        .map_err(|e| err(e.to_string()))?;
+        Self::from_json(&text).map_err(|what| err(what))
+    }
+
+    /// Parses and checks a calibration file's text.
+    ///
+    /// # Errors
+    /// What is wrong, as a message: not JSON of this format, an unknown key (hand edits must not
+    /// be silently ignored), a value that is not usable.
+    pub fn from_json(text: &str) -> Result<Self, String> {
+        let given: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format!("not an overhead calibration: {e}"))?;
+        let file: CalibrationFile = serde_json::from_value(given.clone())
+            .map_err(|e| format!("not an overhead calibration: {e}"))?;
         if file.format != FORMAT {
-            return Err(err(format!(
-                "format {:?}, expected {FORMAT:?}",
-                file.format
-            )));
+            return Err(format!("format {:?}, expected {FORMAT:?}", file.format));
         }
-        let c = &file.calibration.camera;
-        let values = [
-            c.focal_px,
-            c.centre.x_px,
-            c.centre.y_px,
-            c.k1,
-            c.k2,
-            c.pose.yaw_rad,
-            c.pose.pitch_rad,
-            c.pose.roll_rad,
-        ];
-        if !values
-            .iter()
-            .chain(&c.pose.position_cm)
-            .all(|v| v.is_finite())
+        let known = serde_json::to_value(&file).map_err(|e| e.to_string())?;
+        if let Some(key) = crate::input_file::unknown_keys(&given, &known).first() {
+            return Err(format!(
+                "unknown key '{key}' (an overhead calibration has format, camera, field, points, line_samples, line_rms_px)"
+            ));
+        }
+        let cal = file.calibration;
+        let c = &cal.camera;
+        if !cal.values().all(f64::is_finite)
             || c.focal_px <= 0.0
             || c.width_px == 0
             || c.height_px == 0
         {
-            return Err(err("the camera has a value that is not usable".into()));
+            return Err("the camera has a value that is not usable".into());
         }
-        Ok(file.calibration)
+        Ok(cal)
     }
 }
 
@@ -687,5 +724,40 @@ mod tests {
         std::fs::write(&path, r#"{"format": "something else"}"#).expect("write");
         let err = Calibration::load(&path).expect_err("not ours");
         assert!(err.to_string().contains("cal.json"), "{err}");
+    }
+
+    #[test]
+    fn a_calibration_with_nan_is_never_written_and_unknown_keys_are_refused() {
+        let field = FieldDescription::four_legged_2005();
+        let camera = OverheadCamera::above_field_2005();
+        let mut cal = calibrate(
+            &clicked(&camera, &field, 0.0),
+            &field,
+            None,
+            &CalibrationParams::default(),
+        )
+        .expect("fits");
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("cal.json");
+        cal.save(&path).expect("saves");
+        let good = std::fs::read(&path).expect("read");
+        // A point the camera does not see has no error: NaN.
+        cal.points[1].error_px = f64::NAN;
+        let err = cal.save(&path).expect_err("NaN");
+        assert!(err.to_string().contains("not a number"), "{err}");
+        assert_eq!(
+            std::fs::read(&path).expect("read"),
+            good,
+            "the old file stays"
+        );
+        // A hand edit with a typo is refused, naming the key.
+        let mut v: serde_json::Value = serde_json::from_slice(&good).expect("json");
+        v["camera"]["focal"] = serde_json::json!(500.0);
+        let err = Calibration::from_json(&v.to_string()).expect_err("a typo");
+        assert!(err.contains("'camera.focal'"), "{err}");
+        let mut v: serde_json::Value = serde_json::from_slice(&good).expect("json");
+        v["points"][0]["eror_px"] = serde_json::json!(0.5);
+        let err = Calibration::from_json(&v.to_string()).expect_err("a typo");
+        assert!(err.contains("'points[0].eror_px'"), "{err}");
     }
 }

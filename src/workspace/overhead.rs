@@ -387,7 +387,10 @@ impl Workspace {
                 self.reprocess();
             }
             OverheadCommand::OpenPoints(p) => {
-                let points = PointsFile::load(&p)?;
+                let (points, warnings) = PointsFile::load_with_warnings(&p)?;
+                for w in warnings {
+                    self.warn(w);
+                }
                 self.status = format!("opened {} points from {}", points.points.len(), p.display());
                 self.overhead.points = points;
                 self.overhead.points_path = Some(p);
