@@ -398,6 +398,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     } else if overhead > 0 {
         bail!("give overhead streams and robot-camera streams to separate `eotn eval` runs");
     }
+    if args.calibration.is_some() || args.field.is_some() {
+        super::overhead::refuse_robot_streams(&args.streams)
+            .context("--calibration and --field are for overhead streams")?;
+    }
     let lut = load_lut_arg(&args.lut)?;
     let rp = load_params(args.params.as_deref())?;
     if let Some(labels) = &args.labels {

@@ -147,6 +147,8 @@ pub struct FrameInputs {
     /// The streams among the inputs whose camera looks down at the field (their source kind
     /// says so): the robot camera's recogniser means nothing on them.
     overhead_streams: Vec<PathBuf>,
+    /// The other streams: robot cameras' (the overhead recogniser means nothing on them).
+    robot_streams: Vec<PathBuf>,
 }
 
 /// Runs of consecutive stream frames skipped as unreadable, warned about once per run (when the
@@ -195,7 +197,7 @@ impl FrameInputs {
     /// without frames (each naming the file).
     pub fn open(paths: &[PathBuf], range: Option<Range<usize>>) -> anyhow::Result<Self> {
         let mut items = Vec::new();
-        let mut overhead_streams = Vec::new();
+        let (mut overhead_streams, mut robot_streams) = (Vec::new(), Vec::new());
         for p in expand_frame_paths(paths)? {
             if is_stream_file(&p) {
                 let stream = StreamSource::open(&p)?;
@@ -203,6 +205,8 @@ impl FrameInputs {
                     == crate::sources::CameraKind::Overhead
                 {
                     overhead_streams.push(p.clone());
+                } else {
+                    robot_streams.push(p.clone());
                 }
                 for w in stream.warnings() {
                     log::warn!("{}: {w}", p.display());
@@ -231,6 +235,7 @@ impl FrameInputs {
             stream: None,
             skipped: SkippedFrames::default(),
             overhead_streams,
+            robot_streams,
         })
     }
 
@@ -238,6 +243,13 @@ impl FrameInputs {
     #[must_use]
     pub fn overhead_streams(&self) -> &[PathBuf] {
         &self.overhead_streams
+    }
+
+    /// The streams among the inputs recorded by a robot's camera (any stream whose source kind
+    /// does not name an overhead camera).
+    #[must_use]
+    pub fn robot_streams(&self) -> &[PathBuf] {
+        &self.robot_streams
     }
 
     /// Number of frames.

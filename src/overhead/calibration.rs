@@ -29,6 +29,7 @@ use thiserror::Error;
 use super::field::FieldDescription;
 use super::lines::{LineObservation, find_line_observations};
 use super::points::PointsFile;
+use super::review::{Finding, check_points, review};
 use crate::atomic_file::write_atomic;
 use crate::frame::Frame;
 use crate::geometry::{Camera, Field, ImagePoint, OverheadCamera, Point, PoseRecord, Transform};
@@ -74,12 +75,11 @@ impl Default for CalibrationParams {
 /// Why a calibration failed.
 #[derive(Debug, Error)]
 pub enum CalibrationError {
-    /// Too few points to solve eleven parameters.
-    #[error("{count} calibration points, at least 6 are needed (3 of them on the ground)")]
-    TooFewPoints {
-        /// Points given.
-        count: usize,
-    },
+    /// The points, or the camera solved from them, are refused by the checks of
+    /// [`super::review`] (too few, on one line, clicked twice, outside the image; a camera below
+    /// the field or one the points do not determine).
+    #[error(transparent)]
+    Refused(#[from] Finding),
     /// The ground points all lie on one line (or on one spot): no start can be made.
     #[error("the ground points lie on a line: click landmarks spread over the field")]
     Degenerate,
@@ -121,7 +121,8 @@ pub struct Calibration {
     pub field: String,
     /// Each clicked point's reprojection error.
     pub points: Vec<PointResidual>,
-    /// Line samples used in the last round of line refinement.
+    /// Line samples used in the last round of line refinement (0: no refinement: no image, or
+    /// fewer than [`MIN_LINE_SAMPLES`] found along the lines).
     pub line_samples: usize,
     /// Root-mean-square distance of those samples from their projected lines, pixels.
     pub line_rms_px: Option<f64>,
@@ -263,12 +264,7 @@ pub fn calibrate(
             image: p.image(),
         })
         .collect();
-    let ground = targets.iter().filter(|t| t.field.z() == 0.0).count();
-    if targets.len() < 6 || ground < 3 {
-        return Err(CalibrationError::TooFewPoints {
-            count: targets.len(),
-        });
-    }
+    check_points(points, field)?;
     let start = starting_camera(points.width, points.height, &targets, field)?;
     let prior = Priors {
         height_cm: field.camera_height_guess_cm,
@@ -292,15 +288,23 @@ pub fn calibrate(
         let samples = field.line_samples(params.line_step_cm);
         let margin = (5.0 * field.line_width_cm).max(10.0);
         let samples = super::lines::away_from_crossings(field, &samples, margin);
+        let mut refined = false;
         for _ in 0..params.line_rounds {
             let found = find_line_observations(frame, &camera, &samples, params.line_search_px);
             lines = reject_outliers(&camera, found);
-            if lines.len() < 10 {
+            if lines.len() < MIN_LINE_SAMPLES {
                 break;
             }
             camera = solve(camera, &targets, &lines, prior)?;
+            refined = true;
         }
-        lines = reject_outliers(&camera, lines);
+        // Samples that never took part in a solve say nothing about the fit: without a
+        // refinement there are none ([`Calibration::line_samples`] 0 says it was skipped).
+        lines = if refined {
+            reject_outliers(&camera, lines)
+        } else {
+            Vec::new()
+        };
     }
     let residuals = points
         .points
@@ -322,14 +326,59 @@ pub fn calibrate(
         let s: f64 = lines.iter().map(|l| l.distance_px(&camera).powi(2)).sum();
         (s / lines.len() as f64).sqrt()
     });
-    Ok(Calibration {
+    let conditioning = conditioning(camera, &targets, &lines, prior);
+    if !(conditioning >= MIN_CONDITIONING) {
+        return Err(Finding::NotDetermined { conditioning }.into());
+    }
+    let cal = Calibration {
         camera,
         field: field.name.clone(),
         points: residuals,
         line_samples: lines.len(),
         line_rms_px,
-    })
+    };
+    if let Some(refusal) = review(&cal).refusal() {
+        return Err(refusal.clone().into());
+    }
+    Ok(cal)
 }
+
+/// Below this, [`conditioning`] says the fit leaves some parameter free.
+const MIN_CONDITIONING: f64 = 1e-9;
+
+/// How well the residuals pin every parameter down at `camera`: the smallest over the largest
+/// singular value of the Jacobian with each parameter's column scaled to unit length (0 when a
+/// parameter, or a combination of them, changes nothing).
+fn conditioning(
+    camera: OverheadCamera,
+    targets: &[Target],
+    lines: &[LineObservation],
+    prior: Priors,
+) -> f64 {
+    let problem = Problem {
+        base: camera,
+        base_rotation: camera.field_from_camera().rotation(),
+        targets,
+        lines,
+        prior,
+        params: params_of(&camera),
+    };
+    let Some(mut j) = problem.jacobian() else {
+        return 0.0;
+    };
+    for mut column in j.column_iter_mut() {
+        let norm = column.norm();
+        if norm > 0.0 {
+            column /= norm;
+        }
+    }
+    let s = j.singular_values();
+    let (lo, hi) = (s.min(), s.max());
+    if hi > 0.0 { lo / hi } else { 0.0 }
+}
+
+/// Fewest line samples found along the projected lines for the lines to refine the fit.
+pub const MIN_LINE_SAMPLES: usize = 10;
 
 /// Keeps the line observations within three times the median distance (at least 1 px).
 fn reject_outliers(camera: &OverheadCamera, found: Vec<LineObservation>) -> Vec<LineObservation> {
@@ -685,21 +734,67 @@ mod tests {
         points.points.truncate(5);
         assert!(matches!(
             calibrate(&points, &field, None, &CalibrationParams::default()),
-            Err(CalibrationError::TooFewPoints { count: 5 })
+            Err(CalibrationError::Refused(Finding::TooFewPoints {
+                count: 5
+            }))
         ));
+        // Eight landmarks along the centre line, clicked where a camera would see them: the
+        // solver would fit them to 0.000 px with the camera's turn about that line free.
         let mut line = PointsFile::new(640, 480);
         for k in 0..8 {
+            let y = -150.0 + 40.0 * f64::from(k);
+            let q = camera
+                .image_from_field(&Point::new(0.0, y, 0.0))
+                .expect("seen");
             line.points.push(CalibrationPoint {
                 name: format!("p{k}"),
-                field_cm: [0.0, 0.0],
+                field_cm: [0.0, y],
                 height_cm: 0.0,
-                image_px: [320.0, 240.0],
+                image_px: [q.x_px, q.y_px],
             });
         }
-        assert!(matches!(
-            calibrate(&line, &field, None, &CalibrationParams::default()),
-            Err(CalibrationError::Degenerate)
-        ));
+        let err =
+            calibrate(&line, &field, None, &CalibrationParams::default()).expect_err("collinear");
+        assert!(
+            matches!(err, CalibrationError::Refused(Finding::Collinear { .. })),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains("lie on one line"), "{err}");
+    }
+
+    #[test]
+    fn a_well_spread_fit_is_determined_and_points_on_one_spot_are_not() {
+        let field = FieldDescription::four_legged_2005();
+        let camera = OverheadCamera::above_field_2005();
+        let points = clicked(&camera, &field, 0.3);
+        let targets: Vec<Target> = points
+            .points
+            .iter()
+            .map(|p| Target {
+                field: Point::new(p.field_cm[0], p.field_cm[1], p.height_cm),
+                image: p.image(),
+            })
+            .collect();
+        let prior = Priors {
+            height_cm: 350.0,
+            height_sd_cm: 50.0,
+            centre: camera.centre,
+            centre_sd_px: 32.0,
+            distortion_sd: 0.3,
+        };
+        let good = conditioning(camera, &targets, &[], prior);
+        assert!(good > 1e3 * MIN_CONDITIONING, "{good:e}");
+        // Every point on one spot: the turn and the focal length are free.
+        let spot: Vec<Target> = targets
+            .iter()
+            .map(|_| Target {
+                field: targets[0].field,
+                image: targets[0].image,
+            })
+            .collect();
+        let bad = conditioning(camera, &spot, &[], prior);
+        eprintln!("conditioning: spread {good:e}, one spot {bad:e}");
+        assert!(bad < MIN_CONDITIONING, "{bad:e}");
     }
 
     #[test]

@@ -26,7 +26,7 @@ use crate::recognition::Recognition;
 use crate::sources::SourceFrame;
 
 /// Fewest picked points the solver is asked to work with (pose, focal, centre, k1, k2).
-pub const MIN_CALIBRATION_POINTS: usize = 6;
+pub const MIN_CALIBRATION_POINTS: usize = crate::overhead::review::MIN_POINTS;
 
 /// One robot as the overhead camera identifies it: team colour and marker identity. The one
 /// robot selection of the workspace (field view, image overlays) is one of these.
@@ -341,6 +341,13 @@ impl Workspace {
         match command {
             OverheadCommand::OpenCalibration(p) => {
                 let cal = Calibration::load(&p)?;
+                let review = crate::overhead::review::review(&cal);
+                if let Some(refusal) = review.refusal() {
+                    anyhow::bail!("{}: not usable: {refusal}", p.display());
+                }
+                for f in &review.findings {
+                    self.warn(format!("{}: {f}", p.display()));
+                }
                 self.status = format!(
                     "opened calibration {}: {} points, median error {:.2} px",
                     p.display(),
@@ -533,12 +540,24 @@ impl Workspace {
         let frame = frame.filter(|f| {
             (f.width(), f.height()) == (self.overhead.points.width, self.overhead.points.height)
         });
+        let notes =
+            crate::overhead::review::check_points(&self.overhead.points, &self.overhead.field)?;
         let cal = calibrate(
             &self.overhead.points,
             &self.overhead.field,
             frame.as_ref(),
             &CalibrationParams::default(),
         )?;
+        let review = crate::overhead::review::review(&cal);
+        for f in notes.iter().chain(&review.findings) {
+            self.warn(format!("calibration: {f}"));
+        }
+        if frame.is_some() && cal.line_samples == 0 {
+            self.warn(format!(
+                "calibration: line refinement skipped: fewer than {} samples of the field lines found in the frame",
+                crate::overhead::calibration::MIN_LINE_SAMPLES
+            ));
+        }
         self.status = format!(
             "calibrated from {n} points: median error {:.2} px{}",
             cal.median_point_error_px(),
