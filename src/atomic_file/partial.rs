@@ -230,6 +230,20 @@ impl PartialFile {
     }
 }
 
+impl PartialFile {
+    /// Stops writing and removes the partial file: nothing reaches the output (written in
+    /// place, what was written stays written).
+    ///
+    /// # Errors
+    /// The partial file cannot be removed.
+    pub fn discard(self) -> io::Result<()> {
+        match self.partial {
+            Some(p) => fs::remove_file(p),
+            None => Ok(()),
+        }
+    }
+}
+
 impl Write for PartialFile {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
         let n = self.file.write(buf)?;

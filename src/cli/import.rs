@@ -217,6 +217,15 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
         }
     }
     bar.finish_and_clear();
+    if written == 0 {
+        writer.discard()?;
+        bail!(
+            "{}: none of its {} frames could be read; nothing written to {}",
+            input.display(),
+            skipped.len(),
+            args.output.display()
+        );
+    }
     writer.finish()?;
     eprintln!(
         "eotn: wrote {written} frames to {} ({} skipped)",

@@ -476,6 +476,27 @@ impl StreamWriter {
             .map_err(self.mcap_err("cannot finish a chunk"))
     }
 
+    /// Stops without a stream: the `.partial` file is removed and the output left as it was
+    /// (for a command that found nothing to write).
+    ///
+    /// # Errors
+    /// The partial file cannot be removed.
+    pub fn discard(self) -> Result<(), StreamError> {
+        let partial = self.partial.clone();
+        let file = self
+            .mcap
+            .into_inner()
+            .into_inner()
+            .map_err(|e| StreamError::Io {
+                path: partial.clone(),
+                source: e.into_error(),
+            })?;
+        file.discard().map_err(|source| StreamError::Io {
+            path: partial,
+            source,
+        })
+    }
+
     /// Writes the summary (indexes, statistics), syncs the file and renames it into place.
     ///
     /// # Errors
