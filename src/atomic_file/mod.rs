@@ -65,6 +65,30 @@ pub fn write_atomic_with(
     out.commit()
 }
 
+/// Appends `bytes` to the file at `path` (made when missing) and syncs them to the disk: the
+/// edit journal's one line at a time. Links are followed as any append follows them; a device
+/// or FIFO is written to as it is (nothing is renamed anyway); a folder is an error.
+///
+/// # Errors
+/// A folder, or what the OS says.
+pub fn append_synced(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    if fs::metadata(path).is_ok_and(|m| m.is_dir()) {
+        return Err(io::Error::new(
+            io::ErrorKind::IsADirectory,
+            "is a folder; name a file",
+        ));
+    }
+    let mut file = fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)?;
+    file.write_all(bytes)?;
+    if file.metadata()?.is_file() {
+        file.sync_data()?;
+    }
+    Ok(())
+}
+
 /// Makes `path` a folder that outputs can be written into: made with its parents when missing,
 /// a link to a folder followed.
 ///
