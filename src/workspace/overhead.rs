@@ -106,6 +106,9 @@ pub struct Overhead {
     empty_recognition: Recognition,
     /// The field view's model: trails, world models, errors over time.
     pub field_model: FieldModel,
+    /// The calibration's and the frame's size last warned about (the warning is said once a
+    /// pair, not once a frame).
+    size_warned: Option<((usize, usize), (usize, usize))>,
 }
 
 impl Default for Overhead {
@@ -133,6 +136,7 @@ impl Default for Overhead {
             view_map: None,
             empty_recognition: Recognition::default(),
             field_model: FieldModel::default(),
+            size_warned: None,
         }
     }
 }
@@ -289,6 +293,28 @@ impl Workspace {
         }
     }
 
+    /// Whether `camera` (the calibration in use) can place objects on `frame`: a frame of
+    /// another size with the same shape is scaled to (with a warning), one of another shape
+    /// is not (with a warning: the calibration was made for another camera or view). Each
+    /// pair of sizes is warned about once.
+    fn frame_fits(&mut self, camera: &OverheadCamera, frame: &crate::frame::Frame) -> bool {
+        use crate::overhead::pipeline::{FrameFit, frame_fit};
+        let fit = frame_fit(camera, frame.width(), frame.height());
+        let key = (
+            (camera.width_px, camera.height_px),
+            (frame.width(), frame.height()),
+        );
+        if fit != FrameFit::Same && self.overhead.size_warned != Some(key) {
+            self.overhead.size_warned = Some(key);
+            let what = match fit {
+                FrameFit::Mismatch { .. } => format!("{fit}; nothing is placed on these frames"),
+                _ => fit.to_string(),
+            };
+            self.warn(format!("overhead calibration: {what}"));
+        }
+        !matches!(fit, FrameFit::Mismatch { .. })
+    }
+
     /// Runs the overhead pipeline on an overhead frame with the table in use and the
     /// calibration in use; returns the stage timings in the robot pipeline's shape.
     pub(super) fn run_overhead(&mut self, loaded: &SourceFrame) -> crate::pipeline::StageTimings {
@@ -301,12 +327,15 @@ impl Workspace {
         if let Some(c) = camera {
             self.overhead.pipeline.set_camera(c);
         }
+        let fits = camera.is_none_or(|c| self.frame_fits(&c, &loaded.frame));
         self.overhead.pipeline.process(&loaded.frame);
         self.overhead.active = true;
         if (self.overhead.points.width, self.overhead.points.height) == (0, 0) {
             self.overhead.points = PointsFile::new(loaded.frame.width(), loaded.frame.height());
         }
-        self.overhead.detections = camera.map(|_| self.overhead.pipeline.detections().clone());
+        self.overhead.detections = camera
+            .filter(|_| fits)
+            .map(|_| self.overhead.pipeline.detections().clone());
         self.refresh_view_map((loaded.frame.width(), loaded.frame.height()));
         self.primitives.clear();
         self.accepted_owners.clear();
