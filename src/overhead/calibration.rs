@@ -210,7 +210,7 @@ impl Calibration {
             "an overhead calibration",
         )
         .map_err(|e| err(e.to_string()))?;
-        Self::from_json(&text).map_err(|what| err(what))
+        Self::from_json(&text).map_err(err)
     }
 
     /// Parses and checks a calibration file's text.
@@ -327,7 +327,7 @@ pub fn calibrate(
         (s / lines.len() as f64).sqrt()
     });
     let conditioning = conditioning(camera, &targets, &lines, prior);
-    if !(conditioning >= MIN_CONDITIONING) {
+    if conditioning.is_nan() || conditioning < MIN_CONDITIONING {
         return Err(Finding::NotDetermined { conditioning }.into());
     }
     let cal = Calibration {

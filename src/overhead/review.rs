@@ -328,7 +328,7 @@ pub fn review(cal: &Calibration) -> Review {
 pub fn review_camera(c: &OverheadCamera) -> Vec<Finding> {
     let mut findings = Vec::new();
     let height_cm = c.pose.position_cm[2];
-    if !(height_cm > 0.0) {
+    if height_cm.is_nan() || height_cm <= 0.0 {
         findings.push(Finding::CameraBelowField { height_cm });
     } else if !(HEIGHT_RANGE_CM.0..=HEIGHT_RANGE_CM.1).contains(&height_cm) {
         findings.push(Finding::Height {
@@ -352,7 +352,7 @@ pub fn review_camera(c: &OverheadCamera) -> Vec<Finding> {
             height: c.height_px,
         });
     }
-    if !(c.k1.abs() <= MAX_K1) {
+    if c.k1.is_nan() || c.k1.abs() > MAX_K1 {
         findings.push(Finding::Distortion { k1: c.k1 });
     }
     findings

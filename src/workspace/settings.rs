@@ -396,10 +396,12 @@ mod tests {
     fn settings_round_trip_through_their_file() {
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join(SETTINGS_FILE_NAME);
-        let mut s = Settings::default();
-        s.speed = 4.0;
+        let mut s = Settings {
+            speed: 4.0,
+            recent: vec![PathBuf::from("/x/a.mcap")],
+            ..Settings::default()
+        };
         s.overlays.opacity = 0.25;
-        s.recent = vec![PathBuf::from("/x/a.mcap")];
         s.save(&path).expect("saves");
         assert_eq!(Settings::load(&path), (s, vec![]));
         assert_eq!(
