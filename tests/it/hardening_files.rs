@@ -445,3 +445,38 @@ fn info_reports_every_frame_size_of_a_stream_that_mixes_them() {
     let v: serde_json::Value = serde_json::from_slice(&one.stdout).unwrap();
     assert!(v.get("sizes").is_none(), "{v}");
 }
+
+#[test]
+fn overhead_calibrate_says_when_the_image_gives_no_lines_to_refine_along() {
+    let dir = tempfile::tempdir().unwrap();
+    let (points, _) = overhead_points(dir.path());
+    // A grey frame of the right size: no painted line anywhere.
+    let grey = dir.path().join("grey.png");
+    image::RgbImage::from_pixel(640, 480, image::Rgb([90, 90, 90]))
+        .save(&grey)
+        .unwrap();
+    let out = dir.path().join("cal.json");
+    let o = calibrate(&points, &out, &["--image", grey.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("line refinement skipped"), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    assert_eq!(v["line_samples"], 0, "{v}");
+    // With the stream's own frame the lines are found and nothing is said.
+    let frames = dir.path().join("frames");
+    eotn_ok(&[
+        "export".as_ref(),
+        repo_file("streams/sim-overhead-game.mcap").as_os_str(),
+        "--frames".as_ref(),
+        "0".as_ref(),
+        "-o".as_ref(),
+        frames.as_os_str(),
+    ]);
+    let frame = frames.join("sim-overhead-game_000000.raw.png");
+    let o = calibrate(&points, &out, &["--image", frame.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains("line refinement skipped"), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    assert!(v["line_samples"].as_u64().unwrap() >= 10, "{v}");
+}
