@@ -480,3 +480,38 @@ fn overhead_calibrate_says_when_the_image_gives_no_lines_to_refine_along() {
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
     assert!(v["line_samples"].as_u64().unwrap() >= 10, "{v}");
 }
+
+/// Whole-table edits in the app: the undo history stays within its bound, the oldest steps go
+/// with a note, and undoing as far as it reaches gives the table as it was after the last
+/// dropped step.
+#[test]
+fn whole_table_edits_drop_the_oldest_undo_steps_with_a_note() {
+    use eotn::lut::ColourClass;
+    use eotn::lut::edit::MAX_HISTORY_BYTES;
+    use eotn::workspace::{Command, Workspace};
+    let mut s = Workspace::default();
+    s.apply(Command::NewTable(6)).unwrap();
+    let all: Vec<usize> = (0..s.lut().cells().len()).collect();
+    let class = |i: usize| [ColourClass::Orange, ColourClass::Green][i % 2];
+    // 6 MiB a step (old codes and the cell list): 50 steps would hold 300 MiB.
+    for i in 0..50 {
+        s.apply(Command::SetClass(class(i))).unwrap();
+        s.apply(Command::SelectCells(all.clone())).unwrap();
+        s.apply(Command::Commit).unwrap();
+    }
+    let h = s.history();
+    let (kept, dropped) = (h.undo_len(), h.dropped());
+    assert!(h.held_bytes() <= MAX_HISTORY_BYTES, "{}", h.held_bytes());
+    assert!(dropped > 0 && kept + dropped == 50, "{kept} + {dropped}");
+    let said = s.warnings().join("\n");
+    assert!(said.contains("can no longer be undone"), "{said}");
+    for _ in 0..kept {
+        s.apply(Command::Undo).unwrap();
+    }
+    assert!(s.apply(Command::Undo).is_err(), "nothing older to undo");
+    let last_dropped = class(dropped - 1);
+    assert_eq!(
+        s.lut().class_counts()[usize::from(last_dropped.code())],
+        all.len()
+    );
+}
