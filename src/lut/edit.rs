@@ -104,6 +104,18 @@ impl Region {
         }
     }
 
+    /// The box of cells an `AroundSample` region covers in `lut`; `None` for picked cells.
+    fn select_cells(&self, lut: &LookupTable) -> Option<CellBox> {
+        match self {
+            // Not through `select`: for picked cells it makes a flag per table cell.
+            Self::Cells { .. } => None,
+            Self::AroundSample { .. } => match self.select(lut) {
+                Selection::Box(b) => Some(b),
+                Selection::Set(_) => None,
+            },
+        }
+    }
+
     /// Resolves the region for a table of this resolution.
     #[must_use]
     pub fn select(&self, lut: &LookupTable) -> Selection {
@@ -245,24 +257,42 @@ impl LookupTable {
     /// Writes an edit into the table and returns what it changed (for undo).
     pub fn apply(&mut self, record: EditRecord) -> AppliedEdit {
         let code = record.class.code();
-        let indices: Vec<usize> = match &record.region {
+        let mut previous = Vec::new();
+        let mut change = |lut: &mut Self, i: usize| {
+            if let Some(old) = lut.get(i).filter(|&old| old != code) {
+                previous.push((i, old));
+                lut.set(i, record.class);
+            }
+        };
+        match record.region.select_cells(self) {
             // Picked cells directly (sorted, once each, inside the table): resolving them to a
             // flag per cell would cost the whole table for every small edit (20,000 such edits
             // took 30 s to replay on a 7-bit table).
-            Region::Cells { indices } => {
+            None => {
                 let len = self.cells().len();
-                let mut v: Vec<usize> = indices.iter().copied().filter(|&i| i < len).collect();
+                let mut v: Vec<usize> = match &record.region {
+                    Region::Cells { indices } => {
+                        indices.iter().copied().filter(|&i| i < len).collect()
+                    }
+                    Region::AroundSample { .. } => Vec::new(),
+                };
                 v.sort_unstable();
                 v.dedup();
-                v
+                for i in v {
+                    change(self, i);
+                }
             }
-            Region::AroundSample { .. } => record.region.select(self).indices(self).collect(),
-        };
-        let mut previous = Vec::new();
-        for i in indices {
-            if let Some(old) = self.get(i).filter(|&old| old != code) {
-                previous.push((i, old));
-                self.set(i, record.class);
+            // A box, walked in index order without listing it first (a whole 8-bit table would
+            // be a 128 MiB list).
+            Some(b) => {
+                for y in b.min[0]..=b.max[0] {
+                    for u in b.min[1]..=b.max[1] {
+                        for v in b.min[2]..=b.max[2] {
+                            let i = self.index_of_cell([y, u, v]);
+                            change(self, i);
+                        }
+                    }
+                }
             }
         }
         AppliedEdit { record, previous }
