@@ -5,7 +5,7 @@
 //!
 //! | module | role |
 //! |---|---|
-//! | [`atomic_file`] | write-to-temporary, fsync, rename: how files the user cares about are saved |
+//! | [`atomic_file`] | how every output is written: temporary + fsync + rename, devices and FIFOs in place, links kept, inputs never replaced |
 //! | [`input_file`] | reading the files a user names: regular files only, bounded in size |
 //! | [`stats`] | the median and the inverse-size least squares shared by recognition and evaluation |
 //! | [`kernels`] | which hot-loop kernels (portable, AVX2, AVX-512) this CPU runs: the choosing rule, `EOTN_KERNELS` |

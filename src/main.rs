@@ -2,12 +2,16 @@
 
 use std::process::ExitCode;
 
-use clap::Parser;
-use eotn::cli::{Cli, report};
+use eotn::cli::{Parsed, report};
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
+    // The command line, and the files it names as inputs: no output may replace them.
+    let Parsed {
+        cli,
+        inputs,
+        outputs,
+    } = eotn::cli::parse();
     // A kernel set forced by name is checked before anything runs (unknown, or not on this CPU).
     if let Err(e) = eotn::kernels::from_env() {
         return report(&anyhow::Error::new(e));
@@ -15,7 +19,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         #[cfg(feature = "gui")]
         Some(eotn::cli::Command::Open(args)) => eotn::app::run(args.run_options()),
-        Some(command) => eotn::cli::run(command),
+        Some(command) => eotn::cli::run(command, &inputs, &outputs),
         #[cfg(feature = "gui")]
         None => eotn::app::run(eotn::app_options::RunOptions::default()),
         #[cfg(not(feature = "gui"))]

@@ -72,7 +72,7 @@ use crate::workspace::{PixelInfo, median};
 use overlays::ImageTransform;
 use textures::Textures;
 
-/// Key of the persisted [`Settings`] in eframe's storage.
+/// Key of the [`Settings`] in eframe's storage, where versions before 2026-12-04 kept them.
 pub const SETTINGS_KEY: &str = "eotn-settings";
 
 /// What draws the window, for the status bar and the About window.
@@ -202,6 +202,9 @@ pub struct EotnApp {
     /// before it would count the window's first, slow frame (fonts, shaders, first uploads:
     /// about 100 ms on a software renderer) as two or three dropped frames.
     play_when_shown: Option<f32>,
+    /// The settings file (`settings.json` in eframe's storage folder); `None` when the app
+    /// runs without storage (tests).
+    settings_file: Option<PathBuf>,
 }
 
 impl EotnApp {
@@ -209,11 +212,22 @@ impl EotnApp {
     /// when there are none).
     #[must_use]
     pub fn new(cc: &eframe::CreationContext<'_>, paths: Vec<PathBuf>) -> Self {
-        let settings = cc
+        // Settings live in their own file (written through `atomic_file`); versions before
+        // 2026-12-04 kept them in eframe's storage, read when there is no file yet.
+        let settings_file = cc
             .storage
-            .and_then(|s| eframe::get_value::<Settings>(s, SETTINGS_KEY))
-            .unwrap_or_default();
-        let mut app = Self::with_state(Workspace::new(settings));
+            .and_then(|_| eframe::storage_dir("eotn"))
+            .map(|d| d.join(crate::workspace::SETTINGS_FILE_NAME));
+        let state = match &settings_file {
+            Some(p) if std::fs::symlink_metadata(p).is_ok() => Workspace::with_settings_file(p),
+            _ => Workspace::new(
+                cc.storage
+                    .and_then(|s| eframe::get_value::<Settings>(s, SETTINGS_KEY))
+                    .unwrap_or_default(),
+            ),
+        };
+        let mut app = Self::with_state(state);
+        app.settings_file = settings_file;
         // A shown robot's new frame repaints at once (no waiting for the next look).
         let ctx = cc.egui_ctx.clone();
         app.state
@@ -252,6 +266,7 @@ impl EotnApp {
             show_about: false,
             quit_at: None,
             play_when_shown: None,
+            settings_file: None,
         }
     }
 
@@ -451,8 +466,17 @@ impl eframe::App for EotnApp {
         self.after_commands(&ctx, now, cpu);
     }
 
-    fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, SETTINGS_KEY, &self.state.settings);
+    fn save(&mut self, _storage: &mut dyn eframe::Storage) {
+        let Some(path) = &self.settings_file else {
+            return;
+        };
+        let written = path
+            .parent()
+            .map_or(Ok(()), std::fs::create_dir_all)
+            .and_then(|()| self.state.settings.save(path));
+        if let Err(e) = written {
+            log::warn!("{}: the settings are not saved: {e}", path.display());
+        }
     }
 
     fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {

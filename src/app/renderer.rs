@@ -163,7 +163,7 @@ fn setting_path() -> Option<PathBuf> {
 #[must_use]
 pub fn saved_setting() -> RendererSetting {
     setting_path()
-        .and_then(|p| std::fs::read_to_string(p).ok())
+        .and_then(|p| crate::input_file::read_text_bounded(&p, 1024, "a renderer setting").ok())
         .and_then(|s| s.trim().parse().ok())
         .unwrap_or(RendererSetting::Auto)
 }

@@ -29,10 +29,10 @@ pub struct Args {
     #[arg(long, default_value = "8", value_parser = parse_connectivity)]
     pub connectivity: Connectivity,
     /// Timed repetitions per frame, kernel set and round.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200, value_parser = super::values::whole_in::<usize>(1, 100_000))]
     pub reps: usize,
     /// Untimed repetitions per frame first (caches, branch predictors).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = super::values::whole_in::<usize>(0, 100_000))]
     pub warmup: usize,
     /// Rounds; each runs every kernel set and the floor once per frame, interleaved.
     #[arg(long, default_value_t = 3)]

@@ -19,7 +19,7 @@ pub struct Args {
     #[arg(long, default_value = "8", value_parser = parse_connectivity)]
     pub connectivity: Connectivity,
     /// Leave out blobs with fewer pixels than this.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::whole_in::<u32>(0, super::values::MAX_PIXELS))]
     pub min_pixels: u32,
     /// One JSON object per frame per line (the shape of `peer_pipeline.py --json`).
     #[arg(long)]

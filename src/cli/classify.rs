@@ -19,7 +19,7 @@ pub struct Args {
     pub input: InputArgs,
     /// Folder for the outputs (`NAME.classified.png`, and `NAME.cls` with `--raw`); created if
     /// missing. Without it nothing is written (useful with `--json`).
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT_DIR)]
     pub output: Option<PathBuf>,
     /// Also write the raw class codes, one byte per pixel, row-major (`NAME.cls`).
     #[arg(long)]
@@ -37,13 +37,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let (lut, mut inputs) = args.input.open()?;
 
     if let Some(dir) = &args.output {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create folder", dir.display()))?;
+        crate::atomic_file::output_folder(dir).with_context(|| format!("{}", dir.display()))?;
     }
     let mut img = ClassifiedImage::default();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    let files = inputs.files();
     let bar = progress(inputs.len(), "classify");
     for i in 0..inputs.len() {
         let Some(frame) = inputs
@@ -57,11 +55,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let name = inputs.name(i);
         if let Some(dir) = &args.output {
             let png = dir.join(format!("{name}.classified.png"));
-            super::inputs::refuse_overwriting(&png, &files)?;
             save_rgb_png(&png, img.width(), img.height(), &img.to_rgb())?;
             if args.raw {
                 let cls = dir.join(format!("{name}.cls"));
-                super::inputs::refuse_overwriting(&cls, &files)?;
                 crate::atomic_file::write_atomic(&cls, img.codes())
                     .with_context(|| format!("{}: cannot write", cls.display()))?;
             }

@@ -40,7 +40,7 @@ pub struct Args {
     /// Also write the frames with their recognition to this MCAP stream: each frame with the
     /// channels it came with, `/recognition` (the JSON line) and `/camera/annotations`
     /// (`foxglove.ImageAnnotations`), so Foxglove and Rerun draw what eotn found.
-    #[arg(long, value_name = "OUT.mcap")]
+    #[arg(long, value_name = super::paths::OUT)]
     pub annotate: Option<PathBuf>,
     /// A places file (`eotn patterns learn`): identify the pink markers' coloured patterns;
     /// `--json` then lists them as `patterns`.
@@ -513,12 +513,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The writer of `--annotate OUT`, refusing to replace one of the inputs.
+/// The writer of `--annotate OUT` (which never replaces an input: see [`super::paths`]).
 fn annotated_writer(
     path: &std::path::Path,
     inputs: &[PathBuf],
 ) -> anyhow::Result<crate::streams::StreamWriter> {
-    super::inputs::refuse_overwriting(path, &super::inputs::expand_frame_paths(inputs)?)?;
     // A stream's own source kind is kept (it says which camera the frames came from).
     let source = inputs
         .iter()

@@ -43,19 +43,19 @@ pub struct Args {
     pub compare_params: Option<PathBuf>,
     /// Frames whose pan speed is at least this (rad/s) also run without skew correction, to
     /// measure what the correction gains.
-    #[arg(long, default_value_t = 1.5)]
+    #[arg(long, default_value_t = 1.5, value_parser = super::values::number_in(0.0, 100.0))]
     pub fast_pan_rad_per_s: f64,
     /// Fit distance = multiplier / height + offset for goals to the truth and write the result as
     /// a recognition-parameter JSON file.
-    #[arg(long)]
+    #[arg(long, value_name = super::paths::OUT)]
     pub calibrate_goals: Option<PathBuf>,
     /// Multiplier and offset are both fitted only when the tallest goal is at least this many
     /// times the shortest (else the multiplier alone).
-    #[arg(long, default_value_t = 1.3)]
+    #[arg(long, default_value_t = 1.3, value_parser = super::values::number_in(1.0, 100.0))]
     pub calibration_min_spread: f64,
     /// Draw the evaluation as PNG charts into this folder (measured against true distance,
     /// error histograms, found rates per distance band, post errors).
-    #[arg(long)]
+    #[arg(long, value_name = super::paths::OUT_DIR)]
     pub plots: Option<PathBuf>,
     /// Score a real stream against hand labels instead of ground truth (a labels JSON file,
     /// see the README's "Hand labels"): ball found/missed/false, centre and radius errors,
@@ -361,15 +361,19 @@ fn calibrate_goals(
     p.goals.distance_multiplier = m;
     p.goals.distance_offset_cm = o;
     let json = serde_json::to_vec_pretty(&p)?;
+    // The plot goes beside the calibration (not beside a device or FIFO).
+    let plot = crate::atomic_file::beside_output(out, "png");
     crate::atomic_file::write_atomic(out, &json)
         .with_context(|| format!("{}: cannot write", out.display()))?;
-    crate::eval::plots::write_calibration_plot(
-        &out.with_extension("png"),
-        samples,
-        (m, o),
-        (rp.goals.distance_multiplier, rp.goals.distance_offset_cm),
-    )
-    .context("calibration plot")?;
+    if let Some(plot) = plot {
+        crate::eval::plots::write_calibration_plot(
+            &plot,
+            samples,
+            (m, o),
+            (rp.goals.distance_multiplier, rp.goals.distance_offset_cm),
+        )
+        .context("calibration plot")?;
+    }
     Ok((m, o))
 }
 
@@ -393,6 +397,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     } else if overhead > 0 {
         bail!("give overhead streams and robot-camera streams to separate `eotn eval` runs");
+    }
+    if args.calibration.is_some() || args.field.is_some() {
+        super::overhead::refuse_robot_streams(&args.streams)
+            .context("--calibration and --field are for overhead streams")?;
     }
     let lut = load_lut_arg(&args.lut)?;
     let rp = load_params(args.params.as_deref())?;

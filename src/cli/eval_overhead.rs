@@ -14,7 +14,7 @@ use crate::eval::overhead::{
 };
 use crate::eval::{Percentiles, percentile_text};
 use crate::model::truth::GroundTruth;
-use crate::overhead::{Calibration, OverheadPipeline};
+use crate::overhead::OverheadPipeline;
 use crate::streams::StreamReader;
 
 /// Whether the first frame of a stream carries overhead ground truth.
@@ -43,7 +43,10 @@ pub fn run(
 ) -> anyhow::Result<()> {
     let lut = load_lut_arg(lut)?;
     let field = load_field(field)?;
-    let cal = calibration.map(Calibration::load).transpose()?;
+    let cal = calibration
+        .map(super::overhead::load_usable_calibration)
+        .transpose()?;
+    let mut sizes = super::overhead::SizeCheck::default();
     let ep = OverheadEvalParams::default();
     let (mut frames, mut models, mut skipped) = (Vec::new(), Vec::new(), Vec::<String>::new());
     let mut global = 0usize;
@@ -79,6 +82,10 @@ pub fn run(
                     continue;
                 }
             };
+            if let Some(c) = &cal {
+                let (w, h) = (record.frame.width(), record.frame.height());
+                sizes.check(&c.camera, &format!("{name}#{i}"), w, h)?;
+            }
             let p = pipeline.get_or_insert_with(|| {
                 let camera = cal.as_ref().map_or(truth.camera, |c| c.camera);
                 OverheadPipeline::new(lut.clone(), camera, params_for(&field))

@@ -49,7 +49,7 @@ pub struct Args {
     pub view: View,
     /// Folder for the PNGs (`NAME.VIEW.png`; a stream's frames are named `STEM_NNNNNN`); created
     /// if missing.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT_DIR)]
     pub output: PathBuf,
     /// Frames of each stream to export: `A..B` (B excluded), `A..=B`, `A..`, `..B` or `A`.
     #[arg(long, value_parser = parse_frame_range)]
@@ -61,7 +61,7 @@ pub struct Args {
     #[arg(long, default_value = "8", value_parser = parse_connectivity)]
     pub connectivity: Connectivity,
     /// Blobs view: leave out blobs with fewer pixels than this.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = super::values::whole_in::<u32>(0, super::values::MAX_PIXELS))]
     pub min_pixels: u32,
 }
 
@@ -77,12 +77,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (None, view) => bail!("--view {} needs --lut TABLE", view.suffix()),
     };
     let mut inputs = FrameInputs::open(&args.inputs, args.frames.clone())?;
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
+    crate::atomic_file::output_folder(&args.output)
+        .with_context(|| format!("{}", args.output.display()))?;
     let mut classified = ClassifiedImage::default();
     let mut blobs = BlobSet::default();
     let mut rgb = Vec::new();
-    let files = inputs.files();
     let bar = progress(inputs.len(), "export");
     for i in 0..inputs.len() {
         let Some(frame) = inputs.load_record_or_skip(i, args.size)?.map(|r| r.frame) else {
@@ -114,7 +113,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let png = args
             .output
             .join(format!("{}.{}.png", inputs.name(i), args.view.suffix()));
-        super::inputs::refuse_overwriting(&png, &files)?;
         save_rgb_png(&png, w, h, &rgb)?;
         bar.inc(1);
     }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 
-use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress, refuse_overwriting};
+use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
 use crate::sensors::SensorReadings;
 use crate::streams::schema::ImageEncoding;
 use crate::streams::sensor_table::SensorTable;
@@ -45,7 +45,7 @@ pub struct Args {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
     /// Frames per second, for frame times when the sensor table has no `time_s` column.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = super::values::number_in(0.001, 10_000.0))]
     pub fps: f64,
     /// Kind of source stored in the stream's metadata (`robot`, `overhead`, `sim:NAME`, …).
     #[arg(long, default_value = "import")]
@@ -57,14 +57,14 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "zstd")]
     pub compression: CompressionArg,
     /// Frames per chunk (default: about 1 MiB of images per chunk).
-    #[arg(long)]
+    #[arg(long, value_parser = super::values::whole_in::<usize>(1, 100_000))]
     pub frames_per_chunk: Option<usize>,
     /// Byte order of the stored frames: `yuyv` (read by Foxglove and Rerun) or `uyvy` (read by
     /// Foxglove; the cameras' own order). The same samples either way.
     #[arg(long, default_value = "yuyv")]
     pub image_encoding: ImageEncoding,
     /// The stream to write (`.mcap`); written as `OUT.partial` and renamed when complete.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
 }
 
@@ -90,7 +90,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         return rewrite_stream(stream, args);
     }
     let paths = expand_frame_paths(&args.frames)?;
-    refuse_overwriting(&args.output, &paths)?;
     if let Some(stream) = paths.iter().find(|p| is_stream_file(p)) {
         bail!(
             "{}: import reads frame files, or one stream to rewrite on its own",
@@ -194,28 +193,6 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
     if args.sensors.is_some() || args.size.is_some() {
         bail!("--sensors and --size are for frame files; a stream keeps its own readings");
     }
-    refuse_overwriting(&args.output, &[input.to_owned()])?;
-    // The writer writes OUT.partial first: that must not be the input either (finishing
-    // `rec.mcap.partial` as `rec.mcap` would truncate what it reads).
-    let mut partial = args.output.as_os_str().to_owned();
-    partial.push(".partial");
-    let same_partial = match (
-        std::path::Path::new(&partial).canonicalize(),
-        input.canonicalize(),
-    ) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
-    if same_partial {
-        bail!(
-            "{}: writing it goes through {}, the stream being read; finish it into another name (e.g. -o {}-recovered.mcap)",
-            args.output.display(),
-            input.display(),
-            args.output
-                .file_stem()
-                .map_or_else(|| "stream".into(), |s| s.to_string_lossy())
-        );
-    }
     let mut reader = StreamReader::open(input)?;
     for w in reader.warnings() {
         log::warn!("{}: {w}", input.display());
@@ -240,6 +217,15 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
         }
     }
     bar.finish_and_clear();
+    if written == 0 {
+        writer.discard()?;
+        bail!(
+            "{}: none of its {} frames could be read; nothing written to {}",
+            input.display(),
+            skipped.len(),
+            args.output.display()
+        );
+    }
     writer.finish()?;
     eprintln!(
         "eotn: wrote {written} frames to {} ({} skipped)",

@@ -124,6 +124,15 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
         }
         channels.extend(r.extra.iter().map(|(t, _)| t.clone()));
         value["frame0_channels"] = channels.into();
+        // Every frame's size: streams imported from frames of several cameras mix them.
+        let sizes = frame_sizes(&mut reader, i);
+        if sizes.len() > 1 {
+            value["sizes"] = sizes
+                .iter()
+                .map(|((w, h), n)| (format!("{w}x{h}"), serde_json::Value::from(*n)))
+                .collect::<serde_json::Map<_, _>>()
+                .into();
+        }
     }
     let mut warnings = reader.warnings().to_vec();
     if let (Some(first), Some(last)) = (unreadable.first(), unreadable.last()) {
@@ -139,6 +148,22 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
     value["notes"] = reader.notes().into();
     value["warnings"] = warnings.into();
     Ok(value)
+}
+
+/// How many readable frames from `first` on have each size (width, height).
+fn frame_sizes(
+    reader: &mut StreamReader,
+    first: usize,
+) -> std::collections::BTreeMap<(usize, usize), usize> {
+    let mut sizes = std::collections::BTreeMap::new();
+    for i in first..reader.len() {
+        if let Ok(r) = reader.read(i) {
+            *sizes
+                .entry((r.frame.width(), r.frame.height()))
+                .or_insert(0) += 1;
+        }
+    }
+    sizes
 }
 
 /// Seconds spanned by `span_ns` and frames per second for `n` frames over it.

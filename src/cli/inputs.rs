@@ -147,6 +147,8 @@ pub struct FrameInputs {
     /// The streams among the inputs whose camera looks down at the field (their source kind
     /// says so): the robot camera's recogniser means nothing on them.
     overhead_streams: Vec<PathBuf>,
+    /// The other streams: robot cameras' (the overhead recogniser means nothing on them).
+    robot_streams: Vec<PathBuf>,
 }
 
 /// Runs of consecutive stream frames skipped as unreadable, warned about once per run (when the
@@ -195,7 +197,7 @@ impl FrameInputs {
     /// without frames (each naming the file).
     pub fn open(paths: &[PathBuf], range: Option<Range<usize>>) -> anyhow::Result<Self> {
         let mut items = Vec::new();
-        let mut overhead_streams = Vec::new();
+        let (mut overhead_streams, mut robot_streams) = (Vec::new(), Vec::new());
         for p in expand_frame_paths(paths)? {
             if is_stream_file(&p) {
                 let stream = StreamSource::open(&p)?;
@@ -203,6 +205,8 @@ impl FrameInputs {
                     == crate::sources::CameraKind::Overhead
                 {
                     overhead_streams.push(p.clone());
+                } else {
+                    robot_streams.push(p.clone());
                 }
                 for w in stream.warnings() {
                     log::warn!("{}: {w}", p.display());
@@ -231,6 +235,7 @@ impl FrameInputs {
             stream: None,
             skipped: SkippedFrames::default(),
             overhead_streams,
+            robot_streams,
         })
     }
 
@@ -238,6 +243,13 @@ impl FrameInputs {
     #[must_use]
     pub fn overhead_streams(&self) -> &[PathBuf] {
         &self.overhead_streams
+    }
+
+    /// The streams among the inputs recorded by a robot's camera (any stream whose source kind
+    /// does not name an overhead camera).
+    #[must_use]
+    pub fn robot_streams(&self) -> &[PathBuf] {
+        &self.robot_streams
     }
 
     /// Number of frames.
@@ -256,21 +268,6 @@ impl FrameInputs {
     #[must_use]
     pub fn items(&self) -> &[FrameInput] {
         &self.items
-    }
-
-    /// Every file read: frame files and stream files (each once), for [`refuse_overwriting`].
-    #[must_use]
-    pub fn files(&self) -> Vec<PathBuf> {
-        let mut out: Vec<PathBuf> = Vec::new();
-        for item in &self.items {
-            let p = match item {
-                FrameInput::File(p) | FrameInput::Stream { path: p, .. } => p,
-            };
-            if out.last() != Some(p) {
-                out.push(p.clone());
-            }
-        }
-        out
     }
 
     /// The name of frame `i` (see [`FrameInput::name`]).
@@ -376,39 +373,6 @@ impl FrameInputs {
             }
         }
     }
-}
-
-/// Refuses an output that is one of the inputs (also through a symlink or another spelling of
-/// the path): a command never replaces what it reads. `inputs` are the files read, after
-/// folders are expanded; for an input frame its label mask (`NAME.cls`, `NAME.uyvy.cls`) counts
-/// too, since `lut-from-labels` reads it.
-///
-/// # Errors
-/// The output names an input.
-pub fn refuse_overwriting(output: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
-    // An output that does not exist yet cannot be an input; one that does is compared by what
-    // it resolves to.
-    let Ok(out) = output.canonicalize() else {
-        return Ok(());
-    };
-    let masks = inputs.iter().flat_map(|p| {
-        let mut beside = p.as_os_str().to_owned();
-        beside.push(".cls");
-        [p.with_extension("cls"), PathBuf::from(beside)]
-    });
-    let clash = inputs
-        .iter()
-        .cloned()
-        .chain(masks)
-        .find(|p| p.canonicalize().is_ok_and(|c| c == out));
-    if let Some(p) = clash {
-        bail!(
-            "{}: the output would replace the input {}; name another file",
-            output.display(),
-            p.display()
-        );
-    }
-    Ok(())
 }
 
 /// Loads one frame with the error naming the file.

@@ -36,7 +36,7 @@ pub struct ConvertArgs {
     #[arg(long)]
     pub col: Option<PathBuf>,
     /// The table to write (`.lut`, raw FORMATS.md cells), written atomically.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Print one JSON object instead of the table of classes.
     #[arg(long)]

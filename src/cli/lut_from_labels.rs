@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress, refuse_overwriting};
+use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
 use crate::frame::Frame;
 use crate::lut::ColourClass;
 use crate::lut::learn::{Accuracy, LearnParams, TableBuilder};
@@ -20,31 +20,31 @@ pub struct Args {
     #[arg(long = "sim")]
     pub scenarios: Vec<String>,
     /// Frames rendered per scenario.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_parser = super::values::whole_in::<u64>(1, 100_000))]
     pub frames_per_scenario: u64,
     /// Seed for rendered frames.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed())]
     pub seed: u64,
     /// Hold back every Kth frame (from building) to score the table on.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u64).range(2..))]
+    #[arg(long, default_value_t = 4, value_parser = super::values::whole_in::<u64>(2, 1_000_000))]
     pub holdout_every: u64,
     /// Table resolution, bits per channel (6, 7 or 8).
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = 7, value_parser = super::values::whole_in::<u8>(6, 8))]
     pub bits: u8,
     /// Cells each class grows into unseen neighbouring colours.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = 2, value_parser = super::values::whole_in::<usize>(0, 64))]
     pub margin: usize,
     /// Fewest labelled pixels of the winning class for a cell to take it.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = 2, value_parser = super::values::whole_in::<u32>(1, super::values::MAX_PIXELS))]
     pub min_pixels: u32,
     /// Smallest share of a cell's pixels the winning class needs (0..1).
-    #[arg(long, default_value_t = 0.6)]
+    #[arg(long, default_value_t = 0.6, value_parser = super::values::number_in(0.0, 1.0))]
     pub min_purity: f64,
     /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
     /// Where to write the table (`.lut`).
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Print the accuracy as one JSON line.
     #[arg(long)]
@@ -151,7 +151,6 @@ fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Resul
     } else {
         expand_frame_paths(&args.frames)?
     };
-    refuse_overwriting(&args.output, &paths)?;
     for path in &paths {
         let frame = load_frame_arg(path, args.size)?;
         let labels = load_mask(path, &frame)?;

@@ -31,16 +31,22 @@ mod lut;
 mod lut_from_labels;
 pub mod open;
 pub mod overhead;
+pub mod paths;
 pub mod patterns;
 mod record;
 mod render;
 mod serve;
 mod sim;
 mod sources;
+pub mod values;
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
+use anyhow::Context as _;
 use clap::{Parser, Subcommand};
+
+pub use paths::{Parsed, parse};
 
 /// A rate as a percentage with one decimal, or a dash when there was nothing to rate.
 pub(crate) fn pct(r: Option<f64>) -> String {
@@ -106,11 +112,17 @@ pub enum Command {
     Open(open::Args),
 }
 
-/// Runs a headless subcommand.
+/// Runs a headless subcommand; no output it writes may replace one of `inputs` (the files its
+/// arguments name, [`paths::Parsed::inputs`]) or an output it wrote before. The `outputs` its
+/// arguments name are checked before it starts.
 ///
 /// # Errors
-/// Whatever the subcommand reports, with context naming the file.
-pub fn run(command: Command) -> anyhow::Result<()> {
+/// An output that is an input; whatever the subcommand reports, with context naming the file.
+pub fn run(command: Command, inputs: &[PathBuf], outputs: &[PathBuf]) -> anyhow::Result<()> {
+    let _guard = crate::atomic_file::guard_command(inputs);
+    for out in outputs {
+        crate::atomic_file::refuse_inputs(out).with_context(|| format!("{}", out.display()))?;
+    }
     match command {
         Command::Info(a) => info::run(&a),
         Command::Classify(a) => classify::run(&a),

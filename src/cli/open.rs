@@ -30,7 +30,7 @@ pub struct Args {
     #[arg(long)]
     pub all_overlays: bool,
     /// Close the window after this many seconds (for demos, scripts and benchmarks).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", value_parser = super::values::number_in(0.0, super::values::MAX_SECONDS))]
     pub quit_after: Option<f64>,
 }
 

@@ -8,18 +8,18 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Serialize;
 
-use super::inputs::{
-    FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress, refuse_overwriting,
-};
+use super::inputs::{FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress};
 use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
 use crate::model::GroundTruth;
 use crate::overhead::OverheadPipeline;
-use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
+use crate::overhead::calibration::{Calibration, CalibrationParams, MIN_LINE_SAMPLES, calibrate};
 use crate::overhead::drawing::marker_svg;
 use crate::overhead::field::FieldDescription;
 use crate::overhead::lines::projected_field_lines;
+use crate::overhead::pipeline::{FrameFit, frame_fit};
 use crate::overhead::points::{CalibrationPoint, PointsFile};
 use crate::overhead::recognise::{OverheadDetections, OverheadParams};
+use crate::overhead::review::{Severity, check_points, review};
 use crate::sim::SimRng;
 use crate::streams::StreamReader;
 
@@ -60,7 +60,7 @@ pub struct MarkerArgs {
     #[arg(long)]
     pub all: bool,
     /// Output SVG (with `--all`, the folder).
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
 }
 
@@ -71,7 +71,7 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub points: PathBuf,
     /// Where to write the calibration (JSON).
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// A frame of the camera: refine along its field lines and write the lines projected over
     /// it as `CAL.lines.png` beside the calibration.
@@ -86,6 +86,11 @@ pub struct CalibrateArgs {
     /// Do not refine along the lines even with `--image`.
     #[arg(long)]
     pub no_lines: bool,
+    /// Write the calibration even when it is doubtful (a large residual, a focal length,
+    /// principal point, distortion or height unlike a real overhead camera): without it such a
+    /// calibration is reported and not written, and the command fails.
+    #[arg(long)]
+    pub accept: bool,
 }
 
 /// Arguments of `eotn overhead detect`.
@@ -118,16 +123,16 @@ pub struct SimPointsArgs {
     #[arg(long)]
     pub stream: PathBuf,
     /// Click noise, pixels (standard deviation per axis).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = super::values::number_in(0.0, 100.0))]
     pub noise_px: f64,
     /// Seed of the noise.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed())]
     pub seed: u64,
     /// Field description; the 2005 field by default.
     #[arg(long)]
     pub field: Option<PathBuf>,
     /// Output points file.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
 }
 
@@ -183,7 +188,7 @@ pub fn marker_file_name(team: MarkerTeam, id: MarkerIdentity) -> String {
 
 /// Writes all 32 markers into `dir` (made if missing).
 fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot make", dir.display()))?;
+    crate::atomic_file::output_folder(dir).with_context(|| format!("{}", dir.display()))?;
     for team in [MarkerTeam::Blue, MarkerTeam::Yellow] {
         for value in 0..16 {
             let id = MarkerIdentity::new(value).context("identity in 0..16")?;
@@ -197,16 +202,8 @@ fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
 }
 
 fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
-    let png = a.output.with_extension("lines.png");
-    let inputs: Vec<PathBuf> = [Some(&a.points), a.image.as_ref(), a.field.as_ref()]
-        .into_iter()
-        .flatten()
-        .cloned()
-        .collect();
-    refuse_overwriting(&a.output, &inputs)?;
-    if a.image.is_some() {
-        refuse_overwriting(&png, &inputs)?;
-    }
+    // The lines over the image go beside the calibration (not beside a device or FIFO).
+    let png = crate::atomic_file::beside_output(&a.output, "lines.png");
     let field = load_field(a.field.as_deref())?;
     let points = PointsFile::load(&a.points)?;
     let frame = a
@@ -229,16 +226,34 @@ fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
             points.height
         );
     }
+    let notes = check_points(&points, &field)
+        .map_err(|f| anyhow::anyhow!("{}: {f}", a.points.display()))?;
     let params = CalibrationParams {
         refine_lines: !a.no_lines,
         ..CalibrationParams::default()
     };
     let cal = calibrate(&points, &field, frame.as_ref(), &params)
         .with_context(|| format!("{}", a.points.display()))?;
-    cal.save(&a.output)?;
     print_calibration(&cal);
-    if let Some(f) = &frame {
-        write_lines_png(&png, f, &field, &cal.camera)?;
+    let review = review(&cal);
+    for f in notes.iter().chain(&review.findings) {
+        log::warn!("{}: {f}", a.points.display());
+    }
+    if frame.is_some() && !a.no_lines && cal.line_samples == 0 {
+        log::warn!(
+            "line refinement skipped: fewer than {MIN_LINE_SAMPLES} samples of the field lines were found in the image (is it this camera's frame?); the fit rests on the clicked points alone"
+        );
+    }
+    if review.doubtful() && !a.accept {
+        bail!(
+            "{}: not written: the calibration is doubtful ({} warnings above); check the clicks, the field description and its units, or give --accept to keep it",
+            a.output.display(),
+            review.of(Severity::Doubt).count()
+        );
+    }
+    cal.save(&a.output)?;
+    if let (Some(f), Some(png)) = (&frame, &png) {
+        write_lines_png(png, f, &field, &cal.camera)?;
         println!("field lines over the image: {}", png.display());
     }
     Ok(())
@@ -379,17 +394,84 @@ pub fn params_for(field: &FieldDescription) -> OverheadParams {
     }
 }
 
+/// The calibration of `--calibration`: refused when [`review`] refuses it, its doubts warned
+/// about.
+///
+/// # Errors
+/// The loader's error, or the refusal, naming the file.
+pub fn load_usable_calibration(path: &Path) -> anyhow::Result<Calibration> {
+    let cal = Calibration::load(path)?;
+    let review = review(&cal);
+    if let Some(refusal) = review.refusal() {
+        bail!("{}: not a usable calibration: {refusal}", path.display());
+    }
+    for f in &review.findings {
+        log::warn!("{}: {f}", path.display());
+    }
+    Ok(cal)
+}
+
+/// Frame sizes against the calibration's: another shape stops the command, another size of
+/// the same shape is warned about once.
+#[derive(Debug, Default)]
+pub struct SizeCheck {
+    warned: Vec<(usize, usize)>,
+}
+
+impl SizeCheck {
+    /// Checks a frame of `name`.
+    ///
+    /// # Errors
+    /// A frame of another shape than the calibration's.
+    pub fn check(
+        &mut self,
+        camera: &OverheadCamera,
+        name: &str,
+        w: usize,
+        h: usize,
+    ) -> anyhow::Result<()> {
+        match frame_fit(camera, w, h) {
+            FrameFit::Same => Ok(()),
+            fit @ FrameFit::Mismatch { .. } => bail!("{name}: {fit}"),
+            fit @ FrameFit::Scaled { .. } => {
+                if !self.warned.contains(&(w, h)) {
+                    self.warned.push((w, h));
+                    log::warn!("{name}: {fit}");
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Refuses robot-camera streams given to an overhead command.
+///
+/// # Errors
+/// The first such stream, named.
+pub fn refuse_robot_streams(streams: &[PathBuf]) -> anyhow::Result<()> {
+    if let Some(p) = streams.first() {
+        bail!(
+            "{}: a robot camera's stream (its source kind does not say overhead); overhead commands read overhead cameras' streams (`eotn import --source overhead` marks imported ones)",
+            p.display()
+        );
+    }
+    Ok(())
+}
+
 fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     let lut = load_lut_arg(&a.lut)?;
-    let cal = Calibration::load(&a.calibration)?;
+    let cal = load_usable_calibration(&a.calibration)?;
     let field = load_field(a.field.as_deref())?;
     let mut pipeline = OverheadPipeline::new(lut, cal.camera, params_for(&field));
     let mut inputs = FrameInputs::open(&a.frames, None)?;
+    refuse_robot_streams(inputs.robot_streams())?;
+    let mut sizes = SizeCheck::default();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "overhead detect");
     for i in 0..inputs.len() {
         let frame = inputs.load(i, a.size)?;
+        sizes.check(&cal.camera, &inputs.name(i), frame.width(), frame.height())?;
         pipeline.process(&frame);
         let us = pipeline.timings().total().as_secs_f64() * 1e6;
         let line = overhead_json(inputs.name(i), pipeline.detections(), us);
@@ -478,7 +560,6 @@ fn run_sim_points(a: &SimPointsArgs) -> anyhow::Result<()> {
     if !(a.noise_px.is_finite() && a.noise_px >= 0.0) {
         bail!("--noise-px must be a non-negative number");
     }
-    refuse_overwriting(&a.output, std::slice::from_ref(&a.stream))?;
     let field = load_field(a.field.as_deref())?;
     let camera = stream_truth_camera(&a.stream)?;
     let file = simulated_clicks(&camera, &field, a.noise_px, a.seed);

@@ -61,22 +61,22 @@ pub struct LearnArgs {
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// Start from this places file and add to it (it may be the output).
-    #[arg(long)]
+    #[arg(long, value_name = super::paths::UPDATED)]
     pub update: Option<PathBuf>,
     /// A place placed within this distance of a known object adds its pattern to it, cm.
-    #[arg(long, default_value_t = LearnParams::default().same_object_cm)]
+    #[arg(long, default_value_t = LearnParams::default().same_object_cm, value_parser = super::values::number_in(0.0, 10_000.0))]
     pub same_object_cm: f64,
     /// Views a marker needs to be learnt.
-    #[arg(long, default_value_t = LearnParams::default().min_views)]
+    #[arg(long, default_value_t = LearnParams::default().min_views, value_parser = super::values::whole_in::<usize>(1, 100_000))]
     pub min_views: usize,
     /// Smallest spread of bearings for triangulation, degrees.
-    #[arg(long, default_value_t = LearnParams::default().min_spread_deg)]
+    #[arg(long, default_value_t = LearnParams::default().min_spread_deg, value_parser = super::values::number_in(0.0, 180.0))]
     pub min_spread_deg: f64,
     /// Rays passing farther than this from a triangulated marker are outliers, cm.
-    #[arg(long, default_value_t = LearnParams::default().outlier_cm)]
+    #[arg(long, default_value_t = LearnParams::default().outlier_cm, value_parser = super::values::number_in(0.0, 10_000.0))]
     pub outlier_cm: f64,
     /// The places file to write.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Print what was learnt as one JSON object.
     #[arg(long)]

@@ -27,7 +27,7 @@ pub struct Args {
     pub urls: Vec<String>,
     /// Output: the `.mcap` file for one robot; for several, a folder that gets one file per
     /// robot, named after its server name.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
     /// Stop once every robot has sent this many frames (1 to 100000000).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_FRAMES), allow_negative_numbers = true)]
@@ -183,8 +183,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .collect::<Result<Vec<_>, _>>()?;
     let single = urls.len() == 1;
     if !single {
-        std::fs::create_dir_all(&args.output)
-            .with_context(|| format!("cannot create folder {}", args.output.display()))?;
+        crate::atomic_file::output_folder(&args.output)
+            .with_context(|| format!("{}", args.output.display()))?;
     }
     let interrupted = interrupt::catch("finishing the recordings")?;
     let naming = Arc::new(Mutex::new(Naming {

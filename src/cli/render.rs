@@ -57,7 +57,7 @@ pub struct Args {
     #[command(flatten)]
     pub input: InputArgs,
     /// Output folder; one PNG per frame, named after it.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = super::paths::OUT_DIR)]
     pub output: PathBuf,
     /// Sensor readings JSON (as for `eotn detect`).
     #[arg(long)]
@@ -75,7 +75,7 @@ pub struct Args {
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub scale: u8,
     /// Smallest blob drawn by the `blobs` overlay, pixels.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = super::values::whole_in::<u32>(0, super::values::MAX_PIXELS))]
     pub min_blob_pixels: u32,
     /// A places file (`eotn patterns learn`): pink markers are identified and labelled with
     /// their place and distance by the `patterns` overlay.
@@ -112,13 +112,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         recognition: load_params(args.params.as_deref())?,
         ..PipelineParams::default()
     };
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
+    crate::atomic_file::output_folder(&args.output)
+        .with_context(|| format!("{}", args.output.display()))?;
     let mut pipeline = Pipeline::new(lut, params);
     if let Some(p) = &args.patterns {
         pipeline.set_pattern_memory(Some(crate::recognition::patterns::PatternMemory::load(p)?));
     }
-    let files = inputs.files();
     for i in 0..inputs.len() {
         let Some(record) = inputs.load_record_or_skip(i, args.input.size)? else {
             continue;
@@ -169,7 +168,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let name = inputs.name(i);
         let stem = name.rsplit_once('.').map_or(name.as_str(), |(s, _)| s);
         let out = args.output.join(format!("{stem}.png"));
-        super::inputs::refuse_overwriting(&out, &files)?;
         save_rgb_png(&out, canvas.width, canvas.height, &canvas.rgb)?;
     }
     Ok(())

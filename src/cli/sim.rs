@@ -18,17 +18,17 @@ pub struct Args {
     #[arg(long, required_unless_present = "list")]
     pub scenario: Option<String>,
     /// Number of frames (30 a second).
-    #[arg(long, default_value_t = 90)]
+    #[arg(long, default_value_t = 90, value_parser = super::values::whole_in::<u64>(1, super::values::MAX_FRAMES))]
     pub frames: u64,
     /// Seed: the same seed gives the same stream.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::values::seed())]
     pub seed: u64,
     /// Index of the first frame: a short stream from the middle of a scenario, where it shows
     /// what it is named for (the stream's times still start at 0).
     #[arg(long, default_value_t = 0)]
     pub first: u64,
     /// Output stream (`.mcap`).
-    #[arg(short, long, required_unless_present = "list")]
+    #[arg(short, long, required_unless_present = "list", value_name = super::paths::OUT)]
     pub output: Option<PathBuf>,
     /// Ideal frames: no noise, vignetting or rolling shutter.
     #[arg(long)]

@@ -386,7 +386,7 @@ fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3
 /// # Errors
 /// The folder or a file cannot be written (the message names it).
 pub fn write_eval_plots(dir: &Path, frames: &[FrameEval]) -> io::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
+    crate::atomic_file::output_folder(dir)
         .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
     let charts = EvalSeries::from_frames(frames).charts();
     let mut written = Vec::new();

@@ -63,6 +63,26 @@ pub enum FrameFileError {
         /// The decoder's error.
         source: image::ImageError,
     },
+    /// A JPEG that stops before its end (a cut-off copy or download): the decoder would fill
+    /// the missing part with grey or with the first scans' blur and call it a whole frame.
+    #[error("{path}: the JPEG is cut off (no end-of-image marker after its last scan)")]
+    TruncatedJpeg {
+        /// The file.
+        path: PathBuf,
+    },
+}
+
+/// True when JPEG `bytes` end their last scan with an end-of-image marker (`FF D9`). Inside a
+/// scan's coded data a 0xFF byte is always followed by 0x00 or a restart marker, so the last
+/// `FF DA` (start of scan) is the last scan header, and a whole file has `FF D9` after it; an
+/// earlier `FF D9` (an embedded thumbnail's) does not count.
+#[must_use]
+pub fn jpeg_is_complete(bytes: &[u8]) -> bool {
+    let marker = |m: u8| move |w: &[u8]| w == [0xFF, m];
+    let Some(last_scan) = bytes.windows(2).rposition(marker(0xDA)) else {
+        return false;
+    };
+    bytes[last_scan..].windows(2).any(marker(0xD9))
 }
 
 /// A file's name without its folders, for messages, labels and the JSON `frame` field; the whole
@@ -160,7 +180,13 @@ fn decode_image_file(path: &Path) -> Result<image::DynamicImage, FrameFileError>
             path: path.to_owned(),
             source,
         })?;
+    let format = reader.format();
     let (w, h) = reader.into_dimensions().map_err(image_err)?;
+    if format == Some(image::ImageFormat::Jpeg) && !jpeg_is_complete(&bytes) {
+        return Err(FrameFileError::TruncatedJpeg {
+            path: path.to_owned(),
+        });
+    }
     if w > MAX_FRAME_SIDE || h > MAX_FRAME_SIDE || u64::from(w) * u64::from(h) > MAX_FRAME_PIXELS {
         return Err(FrameFileError::TooLarge {
             path: path.to_owned(),
@@ -224,6 +250,29 @@ pub fn save_rgb_png(
 mod tests {
     use super::*;
     use crate::frame::{Yuv, yuv_to_rgb};
+
+    /// A progressive JPEG of 96×64 noise, ten scans (`convert -size 96x64 xc: +noise Random
+    /// -interlace JPEG -quality 85`, ImageMagick).
+    const PROGRESSIVE: &[u8] = include_bytes!("../../tests/data/progressive-96x64.jpg");
+
+    #[test]
+    fn a_cut_off_progressive_jpeg_is_refused_and_a_whole_one_loads() {
+        let dir = tempfile::tempdir().unwrap();
+        let whole = dir.path().join("whole.jpg");
+        std::fs::write(&whole, PROGRESSIVE).unwrap();
+        let f = load_frame(&whole, None).unwrap();
+        assert_eq!((f.width(), f.height()), (96, 64));
+        for cut in [PROGRESSIVE.len() * 6 / 10, PROGRESSIVE.len() - 2] {
+            let p = dir.path().join(format!("cut{cut}.jpg"));
+            std::fs::write(&p, &PROGRESSIVE[..cut]).unwrap();
+            let err = load_frame(&p, None).expect_err("cut off");
+            assert!(
+                matches!(err, FrameFileError::TruncatedJpeg { .. }),
+                "{cut}: {err}"
+            );
+            assert!(err.to_string().contains("cut off"), "{err}");
+        }
+    }
 
     #[test]
     fn raw_sizes_are_inferred_for_the_two_cameras() {

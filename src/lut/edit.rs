@@ -5,7 +5,7 @@
 //! which pixels it would classify, then write it. Here every change is an [`EditRecord`] (class,
 //! region, time): records can be saved in a journal, replayed to rebuild a table, and tested.
 //! Applying a record yields an [`AppliedEdit`] holding exactly the cells it changed and their old
-//! codes, which is what undo needs. [`EditHistory`] keeps a bounded undo stack and a redo stack.
+//! codes, which is what undo needs. [`EditHistory`] keeps an undo stack bounded by the memory it holds, and a redo stack.
 
 use std::collections::VecDeque;
 
@@ -101,6 +101,18 @@ impl Region {
         match self {
             Self::AroundSample { .. } => self.select(lut).contains_index(lut, index),
             Self::Cells { indices } => indices.contains(&index),
+        }
+    }
+
+    /// The box of cells an `AroundSample` region covers in `lut`; `None` for picked cells.
+    fn select_cells(&self, lut: &LookupTable) -> Option<CellBox> {
+        match self {
+            // Not through `select`: for picked cells it makes a flag per table cell.
+            Self::Cells { .. } => None,
+            Self::AroundSample { .. } => match self.select(lut) {
+                Selection::Box(b) => Some(b),
+                Selection::Set(_) => None,
+            },
         }
     }
 
@@ -244,14 +256,43 @@ impl AppliedEdit {
 impl LookupTable {
     /// Writes an edit into the table and returns what it changed (for undo).
     pub fn apply(&mut self, record: EditRecord) -> AppliedEdit {
-        let selection = record.region.select(self);
         let code = record.class.code();
-        let indices: Vec<usize> = selection.indices(self).collect();
         let mut previous = Vec::new();
-        for i in indices {
-            if let Some(old) = self.get(i).filter(|&old| old != code) {
+        let mut change = |lut: &mut Self, i: usize| {
+            if let Some(old) = lut.get(i).filter(|&old| old != code) {
                 previous.push((i, old));
-                self.set(i, record.class);
+                lut.set(i, record.class);
+            }
+        };
+        match record.region.select_cells(self) {
+            // Picked cells directly (sorted, once each, inside the table): resolving them to a
+            // flag per cell would cost the whole table for every small edit (20,000 such edits
+            // took 30 s to replay on a 7-bit table).
+            None => {
+                let len = self.cells().len();
+                let mut v: Vec<usize> = match &record.region {
+                    Region::Cells { indices } => {
+                        indices.iter().copied().filter(|&i| i < len).collect()
+                    }
+                    Region::AroundSample { .. } => Vec::new(),
+                };
+                v.sort_unstable();
+                v.dedup();
+                for i in v {
+                    change(self, i);
+                }
+            }
+            // A box, walked in index order without listing it first (a whole 8-bit table would
+            // be a 128 MiB list).
+            Some(b) => {
+                for y in b.min[0]..=b.max[0] {
+                    for u in b.min[1]..=b.max[1] {
+                        for v in b.min[2]..=b.max[2] {
+                            let i = self.index_of_cell([y, u, v]);
+                            change(self, i);
+                        }
+                    }
+                }
             }
         }
         AppliedEdit { record, previous }
@@ -267,28 +308,54 @@ impl LookupTable {
     }
 }
 
-/// Bounded undo and redo over applied edits.
+/// Most memory the undo and redo steps of an [`EditHistory`] hold together, bytes (256 MiB):
+/// about 16 million changed cells, one whole-table edit of an 8-bit table. Beyond it the oldest
+/// undo steps are dropped (the journal keeps them).
+pub const MAX_HISTORY_BYTES: usize = 256 << 20;
+
+impl AppliedEdit {
+    /// Memory the edit holds, bytes: its changed cells' old codes and its region's cell list.
+    #[must_use]
+    pub fn held_bytes(&self) -> usize {
+        let cells = match &self.record.region {
+            Region::Cells { indices } => indices.len() * size_of::<usize>(),
+            Region::AroundSample { .. } => 0,
+        };
+        size_of::<Self>() + self.previous.len() * size_of::<(usize, u8)>() + cells
+    }
+}
+
+/// Undo and redo over applied edits, bounded by the memory they hold: the oldest undo steps
+/// are dropped when the steps together hold more than the limit (the newest is always kept).
 #[derive(Debug, Clone)]
 pub struct EditHistory {
     undo: VecDeque<AppliedEdit>,
     redo: Vec<AppliedEdit>,
-    limit: usize,
+    /// Most bytes held ([`AppliedEdit::held_bytes`] over both stacks).
+    max_bytes: usize,
+    /// Bytes held now.
+    bytes: usize,
+    /// Undo steps dropped so far to stay within `max_bytes`.
+    dropped: usize,
 }
 
 impl Default for EditHistory {
     fn default() -> Self {
-        Self::new(256)
+        Self::new(MAX_HISTORY_BYTES)
     }
 }
 
 impl EditHistory {
-    /// A history that keeps at most `limit` undo steps (at least 1).
+    /// A history holding at most `max_bytes` bytes of steps (the newest step is kept whatever
+    /// its size).
     #[must_use]
-    pub fn new(limit: usize) -> Self {
+    pub fn new(max_bytes: usize) -> Self {
         Self {
             undo: VecDeque::new(),
             redo: Vec::new(),
-            limit: limit.max(1),
+            max_bytes,
+            bytes: 0,
+            dropped: 0,
         }
     }
 
@@ -297,12 +364,36 @@ impl EditHistory {
     pub fn commit(&mut self, lut: &mut LookupTable, record: EditRecord) -> usize {
         let applied = lut.apply(record);
         let changed = applied.changed_cells();
-        self.redo.clear();
-        self.undo.push_back(applied);
-        while self.undo.len() > self.limit {
-            self.undo.pop_front();
+        for e in self.redo.drain(..) {
+            self.bytes -= e.held_bytes();
         }
+        self.push_undo(applied);
         changed
+    }
+
+    /// Puts an applied edit on the undo stack, dropping the oldest steps beyond the limit.
+    fn push_undo(&mut self, applied: AppliedEdit) {
+        self.bytes += applied.held_bytes();
+        self.undo.push_back(applied);
+        while self.bytes > self.max_bytes && self.undo.len() > 1 {
+            if let Some(old) = self.undo.pop_front() {
+                self.bytes -= old.held_bytes();
+                self.dropped += 1;
+            }
+        }
+    }
+
+    /// Undo steps dropped so far because the history held too much (a caller compares it
+    /// before and after a commit to say so).
+    #[must_use]
+    pub const fn dropped(&self) -> usize {
+        self.dropped
+    }
+
+    /// Bytes the steps hold now.
+    #[must_use]
+    pub const fn held_bytes(&self) -> usize {
+        self.bytes
     }
 
     /// Undoes the latest edit; returns its record, or `None` when there is nothing to undo.
@@ -316,8 +407,9 @@ impl EditHistory {
     /// Redoes the latest undone edit; returns its record, or `None` when there is none.
     pub fn redo(&mut self, lut: &mut LookupTable) -> Option<&EditRecord> {
         let edit = self.redo.pop()?;
+        self.bytes -= edit.held_bytes();
         let applied = lut.apply(edit.record);
-        self.undo.push_back(applied);
+        self.push_undo(applied);
         self.undo.back().map(|e| &e.record)
     }
 
@@ -342,6 +434,7 @@ impl EditHistory {
     pub fn clear(&mut self) {
         self.undo.clear();
         self.redo.clear();
+        self.bytes = 0;
     }
 }
 
@@ -405,7 +498,7 @@ mod tests {
     #[test]
     fn commit_undo_redo_restore_exact_tables() {
         let mut lut = LookupTable::new(6).unwrap();
-        let mut history = EditHistory::new(10);
+        let mut history = EditHistory::default();
         let empty = lut.clone();
         let changed = history.commit(
             &mut lut,
@@ -442,16 +535,17 @@ mod tests {
     }
 
     #[test]
-    fn new_commit_clears_redo_and_history_is_bounded() {
+    fn new_commit_clears_redo_and_history_is_bounded_by_bytes() {
         let mut lut = LookupTable::new(6).unwrap();
-        let mut history = EditHistory::new(3);
+        let one = |i: u8| EditRecord::now(ColourClass::Pink, around(i * 40, 10, 10, 0));
+        // Room for three one-cell steps.
+        let step = lut.clone().apply(one(0)).held_bytes();
+        let mut history = EditHistory::new(3 * step);
         for i in 0..5u8 {
-            history.commit(
-                &mut lut,
-                EditRecord::now(ColourClass::Pink, around(i * 40, 10, 10, 0)),
-            );
+            history.commit(&mut lut, one(i));
         }
-        assert_eq!(history.undo_len(), 3);
+        assert_eq!((history.undo_len(), history.dropped()), (3, 2));
+        assert!(history.held_bytes() <= 3 * step);
         history.undo(&mut lut);
         assert_eq!(history.redo_len(), 1);
         history.commit(
@@ -459,6 +553,31 @@ mod tests {
             EditRecord::now(ColourClass::White, around(250, 128, 128, 0)),
         );
         assert_eq!(history.redo_len(), 0);
+        assert_eq!(
+            history.held_bytes(),
+            3 * step,
+            "the redo step's bytes are freed"
+        );
+        // A step larger than the whole limit is still kept, alone: it can be undone.
+        let whole = EditRecord::now(ColourClass::Green, around(128, 128, 128, 63));
+        history.commit(&mut lut, whole);
+        assert_eq!((history.undo_len(), history.dropped()), (1, 5));
+        history.undo(&mut lut);
+        assert_eq!(lut.class_counts()[5], 0);
+    }
+
+    #[test]
+    fn picked_cells_apply_like_their_selection() {
+        let indices = vec![900, 5, 9, 5, 1 << 30];
+        let region = Region::Cells {
+            indices: indices.clone(),
+        };
+        let mut direct = LookupTable::new(6).unwrap();
+        let applied = direct.apply(EditRecord::now(ColourClass::Yellow, region.clone()));
+        let expected: Vec<usize> = region.select(&direct).indices(&direct).collect();
+        assert_eq!(expected, [5, 9, 900]);
+        let changed: Vec<usize> = applied.previous.iter().map(|&(i, _)| i).collect();
+        assert_eq!(changed, expected, "sorted, once each, inside the table");
     }
 
     #[test]

@@ -29,6 +29,7 @@ use thiserror::Error;
 use super::field::FieldDescription;
 use super::lines::{LineObservation, find_line_observations};
 use super::points::PointsFile;
+use super::review::{Finding, check_points, review};
 use crate::atomic_file::write_atomic;
 use crate::frame::Frame;
 use crate::geometry::{Camera, Field, ImagePoint, OverheadCamera, Point, PoseRecord, Transform};
@@ -74,12 +75,11 @@ impl Default for CalibrationParams {
 /// Why a calibration failed.
 #[derive(Debug, Error)]
 pub enum CalibrationError {
-    /// Too few points to solve eleven parameters.
-    #[error("{count} calibration points, at least 6 are needed (3 of them on the ground)")]
-    TooFewPoints {
-        /// Points given.
-        count: usize,
-    },
+    /// The points, or the camera solved from them, are refused by the checks of
+    /// [`super::review`] (too few, on one line, clicked twice, outside the image; a camera below
+    /// the field or one the points do not determine).
+    #[error(transparent)]
+    Refused(#[from] Finding),
     /// The ground points all lie on one line (or on one spot): no start can be made.
     #[error("the ground points lie on a line: click landmarks spread over the field")]
     Degenerate,
@@ -121,7 +121,8 @@ pub struct Calibration {
     pub field: String,
     /// Each clicked point's reprojection error.
     pub points: Vec<PointResidual>,
-    /// Line samples used in the last round of line refinement.
+    /// Line samples used in the last round of line refinement (0: no refinement: no image, or
+    /// fewer than [`MIN_LINE_SAMPLES`] found along the lines).
     pub line_samples: usize,
     /// Root-mean-square distance of those samples from their projected lines, pixels.
     pub line_rms_px: Option<f64>,
@@ -145,18 +146,48 @@ impl Calibration {
         median(&e).unwrap_or(f64::NAN)
     }
 
-    /// Writes the calibration atomically as JSON.
+    /// Every number of the calibration, for the check that none is NaN or infinite.
+    fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        let c = &self.camera;
+        [
+            c.focal_px,
+            c.centre.x_px,
+            c.centre.y_px,
+            c.k1,
+            c.k2,
+            c.pose.yaw_rad,
+            c.pose.pitch_rad,
+            c.pose.roll_rad,
+        ]
+        .into_iter()
+        .chain(c.pose.position_cm)
+        .chain(self.line_rms_px)
+        .chain(self.points.iter().flat_map(|p| {
+            p.image_px
+                .into_iter()
+                .chain(p.projected_px)
+                .chain([p.error_px])
+        }))
+    }
+
+    /// Writes the calibration atomically as JSON; one with a value that is not a number is
+    /// never written (it could not be read back).
     ///
     /// # Errors
-    /// [`CalibrationError::File`] when it cannot be written.
+    /// [`CalibrationError::File`] when it has a non-finite value or cannot be written.
     pub fn save(&self, path: &Path) -> Result<(), CalibrationError> {
-        let file = CalibrationFile {
-            format: FORMAT.into(),
-            calibration: self.clone(),
-        };
         let err = |what: String| CalibrationError::File {
             path: path.display().to_string(),
             what,
+        };
+        if !self.values().all(f64::is_finite) {
+            return Err(err(
+                "the calibration has a value that is not a number; not written".into(),
+            ));
+        }
+        let file = CalibrationFile {
+            format: FORMAT.into(),
+            calibration: self.clone(),
         };
         let mut text = serde_json::to_string_pretty(&file).map_err(|e| err(e.to_string()))?;
         text.push('\n');
@@ -166,44 +197,51 @@ impl Calibration {
     /// Reads a calibration file.
     ///
     /// # Errors
-    /// [`CalibrationError::File`] for a missing file, other JSON, or a camera with non-finite
-    /// or non-positive values.
+    /// [`CalibrationError::File`] for a missing, oversized or non-regular file, other JSON, a key
+    /// the format does not have (named), or a camera with non-finite or non-positive values.
     pub fn load(path: &Path) -> Result<Self, CalibrationError> {
         let err = |what: String| CalibrationError::File {
             path: path.display().to_string(),
             what,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
-        let file: CalibrationFile = serde_json::from_str(&text)
-            .map_err(|e| err(format!("not an overhead calibration: {e}")))?;
+        let text = crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SMALL_FILE_BYTES,
+            "an overhead calibration",
+        )
+        .map_err(|e| err(e.to_string()))?;
+        Self::from_json(&text).map_err(err)
+    }
+
+    /// Parses and checks a calibration file's text.
+    ///
+    /// # Errors
+    /// What is wrong, as a message: not JSON of this format, an unknown key (hand edits must not
+    /// be silently ignored), a value that is not usable.
+    pub fn from_json(text: &str) -> Result<Self, String> {
+        let given: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| format!("not an overhead calibration: {e}"))?;
+        let file: CalibrationFile = serde_json::from_value(given.clone())
+            .map_err(|e| format!("not an overhead calibration: {e}"))?;
         if file.format != FORMAT {
-            return Err(err(format!(
-                "format {:?}, expected {FORMAT:?}",
-                file.format
-            )));
+            return Err(format!("format {:?}, expected {FORMAT:?}", file.format));
         }
-        let c = &file.calibration.camera;
-        let values = [
-            c.focal_px,
-            c.centre.x_px,
-            c.centre.y_px,
-            c.k1,
-            c.k2,
-            c.pose.yaw_rad,
-            c.pose.pitch_rad,
-            c.pose.roll_rad,
-        ];
-        if !values
-            .iter()
-            .chain(&c.pose.position_cm)
-            .all(|v| v.is_finite())
+        let known = serde_json::to_value(&file).map_err(|e| e.to_string())?;
+        if let Some(key) = crate::input_file::unknown_keys(&given, &known).first() {
+            return Err(format!(
+                "unknown key '{key}' (an overhead calibration has format, camera, field, points, line_samples, line_rms_px)"
+            ));
+        }
+        let cal = file.calibration;
+        let c = &cal.camera;
+        if !cal.values().all(f64::is_finite)
             || c.focal_px <= 0.0
             || c.width_px == 0
             || c.height_px == 0
         {
-            return Err(err("the camera has a value that is not usable".into()));
+            return Err("the camera has a value that is not usable".into());
         }
-        Ok(file.calibration)
+        Ok(cal)
     }
 }
 
@@ -226,12 +264,7 @@ pub fn calibrate(
             image: p.image(),
         })
         .collect();
-    let ground = targets.iter().filter(|t| t.field.z() == 0.0).count();
-    if targets.len() < 6 || ground < 3 {
-        return Err(CalibrationError::TooFewPoints {
-            count: targets.len(),
-        });
-    }
+    check_points(points, field)?;
     let start = starting_camera(points.width, points.height, &targets, field)?;
     let prior = Priors {
         height_cm: field.camera_height_guess_cm,
@@ -255,15 +288,23 @@ pub fn calibrate(
         let samples = field.line_samples(params.line_step_cm);
         let margin = (5.0 * field.line_width_cm).max(10.0);
         let samples = super::lines::away_from_crossings(field, &samples, margin);
+        let mut refined = false;
         for _ in 0..params.line_rounds {
             let found = find_line_observations(frame, &camera, &samples, params.line_search_px);
             lines = reject_outliers(&camera, found);
-            if lines.len() < 10 {
+            if lines.len() < MIN_LINE_SAMPLES {
                 break;
             }
             camera = solve(camera, &targets, &lines, prior)?;
+            refined = true;
         }
-        lines = reject_outliers(&camera, lines);
+        // Samples that never took part in a solve say nothing about the fit: without a
+        // refinement there are none ([`Calibration::line_samples`] 0 says it was skipped).
+        lines = if refined {
+            reject_outliers(&camera, lines)
+        } else {
+            Vec::new()
+        };
     }
     let residuals = points
         .points
@@ -285,14 +326,59 @@ pub fn calibrate(
         let s: f64 = lines.iter().map(|l| l.distance_px(&camera).powi(2)).sum();
         (s / lines.len() as f64).sqrt()
     });
-    Ok(Calibration {
+    let conditioning = conditioning(camera, &targets, &lines, prior);
+    if conditioning.is_nan() || conditioning < MIN_CONDITIONING {
+        return Err(Finding::NotDetermined { conditioning }.into());
+    }
+    let cal = Calibration {
         camera,
         field: field.name.clone(),
         points: residuals,
         line_samples: lines.len(),
         line_rms_px,
-    })
+    };
+    if let Some(refusal) = review(&cal).refusal() {
+        return Err(refusal.clone().into());
+    }
+    Ok(cal)
 }
+
+/// Below this, [`conditioning`] says the fit leaves some parameter free.
+const MIN_CONDITIONING: f64 = 1e-9;
+
+/// How well the residuals pin every parameter down at `camera`: the smallest over the largest
+/// singular value of the Jacobian with each parameter's column scaled to unit length (0 when a
+/// parameter, or a combination of them, changes nothing).
+fn conditioning(
+    camera: OverheadCamera,
+    targets: &[Target],
+    lines: &[LineObservation],
+    prior: Priors,
+) -> f64 {
+    let problem = Problem {
+        base: camera,
+        base_rotation: camera.field_from_camera().rotation(),
+        targets,
+        lines,
+        prior,
+        params: params_of(&camera),
+    };
+    let Some(mut j) = problem.jacobian() else {
+        return 0.0;
+    };
+    for mut column in j.column_iter_mut() {
+        let norm = column.norm();
+        if norm > 0.0 {
+            column /= norm;
+        }
+    }
+    let s = j.singular_values();
+    let (lo, hi) = (s.min(), s.max());
+    if hi > 0.0 { lo / hi } else { 0.0 }
+}
+
+/// Fewest line samples found along the projected lines for the lines to refine the fit.
+pub const MIN_LINE_SAMPLES: usize = 10;
 
 /// Keeps the line observations within three times the median distance (at least 1 px).
 fn reject_outliers(camera: &OverheadCamera, found: Vec<LineObservation>) -> Vec<LineObservation> {
@@ -566,124 +652,4 @@ fn solve(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::overhead::points::CalibrationPoint;
-    use crate::sim::SimRng;
-
-    fn clicked(camera: &OverheadCamera, field: &FieldDescription, noise_px: f64) -> PointsFile {
-        let mut rng = SimRng::derived(5, 9);
-        let mut file = PointsFile::new(camera.width_px, camera.height_px);
-        for l in &field.landmarks {
-            let p = Point::new(l.field_cm[0], l.field_cm[1], l.height_cm);
-            if let Some(q) = camera.image_from_field(&p)
-                && q.x_px > 0.0
-                && q.y_px > 0.0
-                && q.x_px < 640.0
-                && q.y_px < 480.0
-            {
-                file.points.push(CalibrationPoint {
-                    name: l.name.clone(),
-                    field_cm: l.field_cm,
-                    height_cm: l.height_cm,
-                    image_px: [
-                        q.x_px + noise_px * rng.normal(),
-                        q.y_px + noise_px * rng.normal(),
-                    ],
-                });
-            }
-        }
-        file
-    }
-
-    #[test]
-    fn a_negative_focal_length_is_the_camera_turned_half_round() {
-        let mut flipped = OverheadCamera::above_field_2005();
-        flipped.focal_px = -flipped.focal_px;
-        let fixed = with_positive_focal(flipped);
-        assert!(fixed.focal_px > 0.0);
-        for p in [
-            Point::new(0.0, 0.0, 0.0),
-            Point::new(120.0, -80.0, 0.0),
-            Point::new(-200.0, 90.0, 22.5),
-        ] {
-            let a = flipped.image_from_field(&p).expect("in front");
-            let b = fixed.image_from_field(&p).expect("in front");
-            assert!(a.distance_to(&b) < 1e-6, "{a:?} {b:?}");
-        }
-    }
-
-    #[test]
-    fn exact_clicks_give_back_the_camera() {
-        let truth =
-            crate::sim::Scenario::new(crate::sim::ScenarioKind::OverheadGame, 3).overhead_camera();
-        let field = FieldDescription::four_legged_2005();
-        let points = clicked(&truth, &field, 0.0);
-        assert!(points.points.len() >= 20, "{}", points.points.len());
-        let cal = calibrate(&points, &field, None, &CalibrationParams::default()).expect("fits");
-        assert!(cal.median_point_error_px() < 0.05, "{cal:?}");
-        for (x, y) in [(0.0, 0.0), (250.0, 170.0), (-200.0, 100.0)] {
-            let p = Point::new(x, y, 22.5);
-            let a = truth.image_from_field(&p).expect("seen");
-            let b = cal.camera.image_from_field(&p).expect("seen");
-            assert!(a.distance_to(&b) < 0.1, "({x}, {y}): {a:?} vs {b:?}");
-        }
-    }
-
-    #[test]
-    fn a_turned_camera_is_found_without_a_turn_guess() {
-        let mut truth = OverheadCamera::above_field_2005();
-        truth.pose.yaw_rad += 2.0;
-        let field = FieldDescription::four_legged_2005();
-        let points = clicked(&truth, &field, 0.3);
-        let cal = calibrate(&points, &field, None, &CalibrationParams::default()).expect("fits");
-        assert!(cal.median_point_error_px() < 0.6, "{cal:?}");
-    }
-
-    #[test]
-    fn too_few_or_collinear_points_are_refused() {
-        let field = FieldDescription::four_legged_2005();
-        let camera = OverheadCamera::above_field_2005();
-        let mut points = clicked(&camera, &field, 0.0);
-        points.points.truncate(5);
-        assert!(matches!(
-            calibrate(&points, &field, None, &CalibrationParams::default()),
-            Err(CalibrationError::TooFewPoints { count: 5 })
-        ));
-        let mut line = PointsFile::new(640, 480);
-        for k in 0..8 {
-            line.points.push(CalibrationPoint {
-                name: format!("p{k}"),
-                field_cm: [0.0, 0.0],
-                height_cm: 0.0,
-                image_px: [320.0, 240.0],
-            });
-        }
-        assert!(matches!(
-            calibrate(&line, &field, None, &CalibrationParams::default()),
-            Err(CalibrationError::Degenerate)
-        ));
-    }
-
-    #[test]
-    fn a_saved_calibration_loads_back_and_other_json_is_refused() {
-        let field = FieldDescription::four_legged_2005();
-        let camera = OverheadCamera::above_field_2005();
-        let cal = calibrate(
-            &clicked(&camera, &field, 0.0),
-            &field,
-            None,
-            &CalibrationParams::default(),
-        )
-        .expect("fits");
-        let dir = tempfile::tempdir().expect("tempdir");
-        let path = dir.path().join("cal.json");
-        cal.save(&path).expect("saves");
-        let back = Calibration::load(&path).expect("loads");
-        // Every field, bit for bit (serde_json's `float_roundtrip`).
-        assert_eq!(back, cal);
-        std::fs::write(&path, r#"{"format": "something else"}"#).expect("write");
-        let err = Calibration::load(&path).expect_err("not ours");
-        assert!(err.to_string().contains("cal.json"), "{err}");
-    }
-}
+mod tests;

@@ -6,6 +6,11 @@
 //! Size League field of 2008 (the real overhead frame of `../shared/data/ssl2008/`). Field
 //! coordinates follow `FORMATS.md`: centimetres, origin at the centre spot, x towards the yellow
 //! goal, y left. Lines are given along their painted centres.
+//!
+//! Descriptions are written by hand: a key the format does not have is refused, naming it (a
+//! typo `heigth_cm` would otherwise put a goal top on the ground). Every coordinate lies within
+//! [`MAX_FIELD_CM`] of the centre (a field in millimetres or a line a kilometre long is refused,
+//! not sampled into gigabytes), and the line samples drawn from it are bounded in number.
 
 use std::path::Path;
 
@@ -15,8 +20,19 @@ use thiserror::Error;
 use crate::geometry::marker::DEFAULT_PLATE_HEIGHT_CM;
 use crate::model::scene::FieldSpec;
 
+/// Farthest any coordinate of a field description lies from the centre spot, centimetres (100 m:
+/// every RoboCup field fits with room to spare).
+pub const MAX_FIELD_CM: f64 = 10_000.0;
+/// Most landmarks, and most lines and arcs together, a description may have.
+pub const MAX_FIELD_ITEMS: usize = 1000;
+/// Most line samples [`FieldDescription::line_samples`] gives (the step widens beyond it).
+pub const MAX_LINE_SAMPLES: usize = 20_000;
+/// Largest size (line width, ball radius) a description may give, centimetres.
+const MAX_SIZE_CM: f64 = 100.0;
+
 /// A named point of the field that a user can click.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Landmark {
     /// Its name, as offered in the app and written into points files.
     pub name: String,
@@ -33,6 +49,7 @@ fn is_zero(v: &f64) -> bool {
 
 /// A straight painted line between two field points (its centre line), centimetres.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LineSegment {
     /// One end `[x, y]`, centimetres.
     pub from_cm: [f64; 2],
@@ -42,6 +59,7 @@ pub struct LineSegment {
 
 /// A painted circular arc (its centre line), counter-clockwise from `from_rad` to `to_rad`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Arc {
     /// Centre `[x, y]`, centimetres.
     pub centre_cm: [f64; 2],
@@ -55,6 +73,7 @@ pub struct Arc {
 
 /// What overhead calibration and recognition need to know about a field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FieldDescription {
     /// A human name, e.g. "RoboCup 2005 Four-Legged League".
     pub name: String,
@@ -80,6 +99,19 @@ pub struct FieldDescription {
 
 fn default_plate_height() -> f64 {
     DEFAULT_PLATE_HEIGHT_CM
+}
+
+impl FieldError {
+    /// The same error naming the file `path`.
+    #[must_use]
+    pub fn at(self, path: &str) -> Self {
+        let path = path.to_owned();
+        match self {
+            Self::Io { source, .. } => Self::Io { path, source },
+            Self::Parse { source, .. } => Self::Parse { path, source },
+            Self::Invalid { problem, .. } => Self::Invalid { path, problem },
+        }
+    }
 }
 
 /// Why a field description could not be read.
@@ -126,6 +158,30 @@ pub enum FieldProblem {
         /// Its value.
         value: f64,
     },
+    /// A coordinate, radius or size beyond what a field can have (units? millimetres?).
+    #[error("{what} is {value}, more than a field can have (at most {limit}; centimetres?)")]
+    TooFar {
+        /// Which value, e.g. `lines[3].to_cm`.
+        what: String,
+        /// Its value.
+        value: f64,
+        /// The largest allowed.
+        limit: f64,
+    },
+    /// More landmarks, lines or arcs than a field has.
+    #[error("{count} {what}, more than a field description may have ({MAX_FIELD_ITEMS})")]
+    TooMany {
+        /// Which list.
+        what: &'static str,
+        /// How many were given.
+        count: usize,
+    },
+    /// An arc that does not run counter-clockwise by at most one full turn.
+    #[error("arcs[{index}]: to_rad must lie above from_rad by at most one turn (2π)")]
+    BadArc {
+        /// The arc's place in the list.
+        index: usize,
+    },
 }
 
 impl FieldDescription {
@@ -136,22 +192,47 @@ impl FieldDescription {
     /// non-positive sizes.
     pub fn load(path: &Path) -> Result<Self, FieldError> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| FieldError::Io {
+        let text = crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SMALL_FILE_BYTES,
+            "a field description",
+        )
+        .map_err(|source| FieldError::Io {
             path: name.clone(),
             source,
         })?;
-        let field: Self = serde_json::from_str(&text).map_err(|source| FieldError::Parse {
-            path: name.clone(),
+        Self::from_json(&text).map_err(|e| e.at(&name))
+    }
+
+    /// Parses and checks a description's text (errors name no file until [`FieldError::at`]).
+    ///
+    /// # Errors
+    /// [`FieldError::Parse`] (an unknown key among them, named) or [`FieldError::Invalid`].
+    pub fn from_json(text: &str) -> Result<Self, FieldError> {
+        let field: Self = serde_json::from_str(text).map_err(|source| FieldError::Parse {
+            path: String::new(),
             source,
         })?;
         field.check().map_err(|problem| FieldError::Invalid {
-            path: name,
+            path: String::new(),
             problem,
         })?;
         Ok(field)
     }
 
     fn check(&self) -> Result<(), FieldProblem> {
+        if self.landmarks.len() > MAX_FIELD_ITEMS {
+            return Err(FieldProblem::TooMany {
+                what: "landmarks",
+                count: self.landmarks.len(),
+            });
+        }
+        if self.lines.len() + self.arcs.len() > MAX_FIELD_ITEMS {
+            return Err(FieldProblem::TooMany {
+                what: "lines and arcs",
+                count: self.lines.len() + self.arcs.len(),
+            });
+        }
         let finite = self
             .landmarks
             .iter()
@@ -184,7 +265,74 @@ impl FieldDescription {
                 return Err(FieldProblem::NotPositive { key, value });
             }
         }
-        Ok(())
+        self.check_extent()
+    }
+
+    /// Every coordinate within [`MAX_FIELD_CM`] of the centre, sizes within reason, arcs at
+    /// most one turn.
+    fn check_extent(&self) -> Result<(), FieldProblem> {
+        let too_far = |what: String, value: f64, limit: f64| {
+            (value.abs() > limit).then_some(FieldProblem::TooFar { what, value, limit })
+        };
+        let named = |list: &str, i: usize, key: &str| format!("{list}[{i}].{key}");
+        let mut values: Vec<(String, f64, f64)> = Vec::new();
+        for (i, l) in self.landmarks.iter().enumerate() {
+            values.extend(
+                l.field_cm
+                    .map(|v| (named("landmarks", i, "field_cm"), v, MAX_FIELD_CM)),
+            );
+            values.push((
+                named("landmarks", i, "height_cm"),
+                l.height_cm,
+                MAX_FIELD_CM,
+            ));
+        }
+        for (i, l) in self.lines.iter().enumerate() {
+            values.extend(
+                l.from_cm
+                    .map(|v| (named("lines", i, "from_cm"), v, MAX_FIELD_CM)),
+            );
+            values.extend(
+                l.to_cm
+                    .map(|v| (named("lines", i, "to_cm"), v, MAX_FIELD_CM)),
+            );
+        }
+        for (i, a) in self.arcs.iter().enumerate() {
+            values.extend(
+                a.centre_cm
+                    .map(|v| (named("arcs", i, "centre_cm"), v, MAX_FIELD_CM)),
+            );
+            values.push((named("arcs", i, "radius_cm"), a.radius_cm, MAX_FIELD_CM));
+            let sweep = a.to_rad - a.from_rad;
+            if !(sweep > 0.0 && sweep <= std::f64::consts::TAU + 1e-9) || a.from_rad.abs() > 100.0 {
+                return Err(FieldProblem::BadArc { index: i });
+            }
+        }
+        values.extend([
+            ("line_width_cm".to_owned(), self.line_width_cm, MAX_SIZE_CM),
+            (
+                "ball_radius_cm".to_owned(),
+                self.ball_radius_cm,
+                MAX_SIZE_CM,
+            ),
+            (
+                "plate_height_cm".to_owned(),
+                self.plate_height_cm,
+                MAX_FIELD_CM,
+            ),
+            (
+                "camera_height_guess_cm".to_owned(),
+                self.camera_height_guess_cm,
+                MAX_FIELD_CM,
+            ),
+        ]);
+        match values
+            .into_iter()
+            .find_map(|(what, value, limit)| too_far(what, value, limit))
+        {
+            Some(problem) => Err(problem),
+            None => Ok(()),
+        }
     }
 
     /// The landmark with this name.
@@ -193,11 +341,26 @@ impl FieldDescription {
         self.landmarks.iter().find(|l| l.name == name)
     }
 
-    /// Points along every painted line and arc, about `step_cm` apart, with the unit direction
-    /// of the line there (field `[x, y]`, centimetres): where the calibration looks for lines.
+    /// Points along every painted line and arc, about `step_cm` apart (farther when that would
+    /// give more than [`MAX_LINE_SAMPLES`]), with the unit direction of the line there (field
+    /// `[x, y]`, centimetres): where the calibration looks for lines.
     #[must_use]
     pub fn line_samples(&self, step_cm: f64) -> Vec<LineSample> {
-        let step = step_cm.max(0.5);
+        let total_cm: f64 = self
+            .lines
+            .iter()
+            .map(|l| (l.to_cm[0] - l.from_cm[0]).hypot(l.to_cm[1] - l.from_cm[1]))
+            .chain(
+                self.arcs
+                    .iter()
+                    .map(|a| (a.to_rad - a.from_rad).abs() * a.radius_cm),
+            )
+            .filter(|v| v.is_finite())
+            .sum();
+        let step = step_cm
+            .max(0.5)
+            .max(total_cm / MAX_LINE_SAMPLES as f64)
+            .max(f64::MIN_POSITIVE);
         let mut out = Vec::new();
         for l in &self.lines {
             let (dx, dy) = (l.to_cm[0] - l.from_cm[0], l.to_cm[1] - l.from_cm[1]);
@@ -378,6 +541,70 @@ mod tests {
             .filter(|s| (s.field_cm[0].hypot(s.field_cm[1]) - 18.0).abs() < 1e-9)
             .collect();
         assert!(circle.len() >= 10);
+    }
+
+    #[test]
+    fn an_unknown_key_is_refused_naming_it() {
+        let mut v = serde_json::to_value(FieldDescription::four_legged_2005()).expect("json");
+        v["landmarks"][3]["heigth_cm"] = serde_json::json!(22.5);
+        let err = FieldDescription::from_json(&v.to_string()).expect_err("a typo");
+        assert!(
+            err.to_string().contains("unknown field `heigth_cm`"),
+            "{err}"
+        );
+        let mut v = serde_json::to_value(FieldDescription::four_legged_2005()).expect("json");
+        v["ball_radius"] = serde_json::json!(4.0);
+        let err = FieldDescription::from_json(&v.to_string()).expect_err("a typo");
+        assert!(
+            err.to_string().contains("unknown field `ball_radius`"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_line_a_kilometre_long_or_a_field_in_millimetres_is_refused() {
+        let mut f = FieldDescription::four_legged_2005();
+        f.lines[0].to_cm = [100_000.0, 0.0];
+        let err = FieldDescription::from_json(&serde_json::to_string(&f).expect("json"))
+            .expect_err("1 km");
+        assert!(
+            err.to_string().contains("lines[0].to_cm is 100000"),
+            "{err}"
+        );
+        let mut f = FieldDescription::four_legged_2005();
+        for l in &mut f.landmarks {
+            l.field_cm = l.field_cm.map(|v| v * 10.0);
+        }
+        for l in &mut f.lines {
+            l.from_cm = l.from_cm.map(|v| v * 10.0);
+            l.to_cm = l.to_cm.map(|v| v * 10.0);
+        }
+        // The 2005 field in millimetres is 5.4 m wide: still within bounds (the calibration
+        // warns of such points); ten times that is not a field.
+        assert!(FieldDescription::from_json(&serde_json::to_string(&f).expect("json")).is_ok());
+        let mut f = FieldDescription::four_legged_2005();
+        f.arcs[0].to_rad = 1e9;
+        let err = FieldDescription::from_json(&serde_json::to_string(&f).expect("json"))
+            .expect_err("an arc of a billion radians");
+        assert!(err.to_string().contains("arcs[0]"), "{err}");
+    }
+
+    #[test]
+    fn line_samples_are_bounded_in_number() {
+        // Built in code, not read: no bounds were checked.
+        let mut f = FieldDescription::four_legged_2005();
+        f.lines.push(LineSegment {
+            from_cm: [0.0, 0.0],
+            to_cm: [1e8, 0.0],
+        });
+        let n = f.line_samples(0.5).len();
+        assert!(n <= MAX_LINE_SAMPLES, "{n}");
+        let curves = crate::overhead::lines::projected_field_lines(
+            &f,
+            &crate::geometry::OverheadCamera::above_field_2005(),
+        );
+        let points: usize = curves.iter().map(Vec::len).sum();
+        assert!(points < 100_000, "{points}");
     }
 
     #[test]

@@ -214,6 +214,9 @@ pub fn find_line_observations(
         .collect()
 }
 
+/// Most points a projected line or arc is drawn with.
+const MAX_CURVE_POINTS: f64 = 4096.0;
+
 /// Every painted line and arc as image polylines through `camera` (about 2 cm steps), split
 /// where the camera does not see them or they leave the image by more than a margin: what the
 /// app and `eotn overhead calibrate --image` draw to judge a calibration.
@@ -228,7 +231,8 @@ pub fn projected_field_lines(
     let mut curves: Vec<Vec<[f64; 2]>> = Vec::new();
     for l in &field.lines {
         let len = (l.to_cm[0] - l.from_cm[0]).hypot(l.to_cm[1] - l.from_cm[1]);
-        let n = (len / 2.0).ceil().max(1.0) as usize;
+        // A point every 2 cm, at most MAX_CURVE_POINTS a line (the image is never finer).
+        let n = (len / 2.0).ceil().clamp(1.0, MAX_CURVE_POINTS) as usize;
         curves.push(
             (0..=n)
                 .map(|k| {
@@ -243,7 +247,9 @@ pub fn projected_field_lines(
     }
     for a in &field.arcs {
         let sweep = a.to_rad - a.from_rad;
-        let n = (sweep.abs() * a.radius_cm / 2.0).ceil().max(8.0) as usize;
+        let n = (sweep.abs() * a.radius_cm / 2.0)
+            .ceil()
+            .clamp(8.0, MAX_CURVE_POINTS) as usize;
         curves.push(
             (0..=n)
                 .map(|k| {

@@ -5,7 +5,7 @@
 //! - [`points`]: calibration points files (`*.points.json`, `FORMATS.md`).
 //! - [`calibration`]: camera pose, focal length, principal point and radial distortion by
 //!   Levenberg–Marquardt from clicked points, refined along the lines ([`lines`]); saved as a
-//!   file.
+//!   file; [`review`]: whether a calibration can be trusted (refusals, doubts, notes).
 //! - [`recognise`]: ball and robot markers in a classified image → field coordinates;
 //!   [`pipeline`] runs classification, blobs and it on a frame.
 //! - [`undistort`]: the undistorted view; [`drawing`]: the printable marker (SVG).
@@ -20,6 +20,7 @@ pub mod lines;
 pub mod pipeline;
 pub mod points;
 pub mod recognise;
+pub mod review;
 pub mod undistort;
 
 pub use calibration::{Calibration, CalibrationError, CalibrationParams, calibrate};

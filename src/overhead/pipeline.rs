@@ -43,6 +43,67 @@ pub struct OverheadPipeline {
     timings: OverheadTimings,
 }
 
+/// How a calibration made for one image size fits a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameFit {
+    /// The size it was made for.
+    Same,
+    /// Another size of the same shape (within 1 %): the camera is scaled to it.
+    Scaled {
+        /// The calibration's size, pixels.
+        from: (usize, usize),
+        /// The frame's size, pixels.
+        to: (usize, usize),
+    },
+    /// Another shape: not this camera's view.
+    Mismatch {
+        /// The calibration's size, pixels.
+        calibrated: (usize, usize),
+        /// The frame's size, pixels.
+        frame: (usize, usize),
+    },
+}
+
+impl std::fmt::Display for FrameFit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Same => write!(f, "the calibration's own frame size"),
+            Self::Scaled { from, to } => write!(
+                f,
+                "the calibration is for {}x{} frames, these are {}x{} (the same shape): the camera is scaled to them",
+                from.0, from.1, to.0, to.1
+            ),
+            Self::Mismatch { calibrated, frame } => write!(
+                f,
+                "the calibration is for {}x{} frames, this one is {}x{}: another shape, so another camera or view; calibrate for it",
+                calibrated.0, calibrated.1, frame.0, frame.1
+            ),
+        }
+    }
+}
+
+/// How `camera` (a calibration) fits a frame of `width`×`height` pixels.
+#[must_use]
+pub fn frame_fit(camera: &OverheadCamera, width: usize, height: usize) -> FrameFit {
+    let calibrated = (camera.width_px, camera.height_px);
+    if calibrated == (width, height) {
+        return FrameFit::Same;
+    }
+    let sx = width as f64 / camera.width_px.max(1) as f64;
+    let sy = height as f64 / camera.height_px.max(1) as f64;
+    if (sx / sy - 1.0).abs() <= 0.01 {
+        FrameFit::Scaled {
+            from: calibrated,
+            to: (width, height),
+        }
+    } else {
+        FrameFit::Mismatch {
+            calibrated,
+            frame: (width, height),
+        }
+    }
+}
+
 impl OverheadPipeline {
     /// A pipeline classifying with `lut` and placing objects through `camera`.
     #[must_use]
@@ -65,8 +126,12 @@ impl OverheadPipeline {
         let t1 = Instant::now();
         self.blobs.find(&self.classified, Connectivity::Eight);
         let t2 = Instant::now();
-        let camera = self.camera_for(frame);
-        self.detections = recognise_overhead(&self.classified, &self.blobs, &camera, &self.params);
+        self.detections = match self.camera_for(frame) {
+            Some(camera) => {
+                recognise_overhead(&self.classified, &self.blobs, &camera, &self.params)
+            }
+            None => OverheadDetections::default(),
+        };
         self.timings = OverheadTimings {
             classify: t1 - t0,
             blobs: t2 - t1,
@@ -75,20 +140,25 @@ impl OverheadPipeline {
         &self.detections
     }
 
-    /// The camera, rescaled when a frame's size differs from the calibration's.
-    fn camera_for(&self, frame: &Frame) -> OverheadCamera {
+    /// The camera for a frame: the calibration's, scaled to a frame of another size with the
+    /// same shape; `None` for a frame of another shape (nothing is placed then: the calibration
+    /// was made for another camera or view).
+    fn camera_for(&self, frame: &Frame) -> Option<OverheadCamera> {
         let (w, h) = (frame.width(), frame.height());
-        if (w, h) == (self.camera.width_px, self.camera.height_px) {
-            return self.camera;
+        match frame_fit(&self.camera, w, h) {
+            FrameFit::Same => Some(self.camera),
+            FrameFit::Mismatch { .. } => None,
+            FrameFit::Scaled { .. } => {
+                let s = w as f64 / self.camera.width_px.max(1) as f64;
+                let mut c = self.camera;
+                c.width_px = w;
+                c.height_px = h;
+                c.focal_px *= s;
+                c.centre.x_px *= s;
+                c.centre.y_px *= h as f64 / self.camera.height_px.max(1) as f64;
+                Some(c)
+            }
         }
-        let s = w as f64 / self.camera.width_px.max(1) as f64;
-        let mut c = self.camera;
-        c.width_px = w;
-        c.height_px = h;
-        c.focal_px *= s;
-        c.centre.x_px *= s;
-        c.centre.y_px *= h as f64 / self.camera.height_px.max(1) as f64;
-        c
     }
 
     /// The last frame's classified image.

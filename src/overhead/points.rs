@@ -6,7 +6,11 @@
 //! distorted image as the camera delivers it (pixel centres at +0.5). The project adds one
 //! optional key per point, `height_cm`, for landmarks above the ground (goal-post tops): other
 //! readers ignore it, and without it the point is on the ground as the format says.
+//!
+//! The format is an interchange format, so keys it does not have (another tool's) are not an
+//! error: each is named in a warning and the rest is read.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
@@ -52,6 +56,28 @@ pub struct PointsFile {
     pub points: Vec<CalibrationPoint>,
 }
 
+/// A points file as read: the format's keys and whatever else it holds.
+#[derive(Deserialize)]
+struct PointsRead {
+    width: usize,
+    height: usize,
+    points: Vec<PointRead>,
+    #[serde(flatten)]
+    other: BTreeMap<String, serde_json::Value>,
+}
+
+/// A point as read.
+#[derive(Deserialize)]
+struct PointRead {
+    name: String,
+    field_cm: [f64; 2],
+    #[serde(default)]
+    height_cm: f64,
+    image_px: [f64; 2],
+    #[serde(flatten)]
+    other: BTreeMap<String, serde_json::Value>,
+}
+
 /// Why a points file could not be read or written.
 #[derive(Debug, Error)]
 pub enum PointsError {
@@ -80,6 +106,19 @@ pub enum PointsError {
         #[source]
         problem: PointsProblem,
     },
+}
+
+impl PointsError {
+    /// The same error naming the file `path`.
+    #[must_use]
+    pub fn at(self, path: &str) -> Self {
+        let path = path.to_owned();
+        match self {
+            Self::Io { source, .. } => Self::Io { path, source },
+            Self::Parse { source, .. } => Self::Parse { path, source },
+            Self::Invalid { problem, .. } => Self::Invalid { path, problem },
+        }
+    }
 }
 
 /// What makes a points file of the right shape unusable.
@@ -112,25 +151,76 @@ impl PointsFile {
         }
     }
 
-    /// Reads and checks a points file.
+    /// Reads and checks a points file; keys the format does not have are named in warnings
+    /// (logged) and ignored.
     ///
     /// # Errors
-    /// [`PointsError`] for a missing file, bad JSON, a zero image size or a non-finite value.
+    /// [`PointsError`] for a missing, oversized or non-regular file, bad JSON, a zero image size
+    /// or a non-finite value.
     pub fn load(path: &Path) -> Result<Self, PointsError> {
+        let (file, warnings) = Self::load_with_warnings(path)?;
+        for w in warnings {
+            log::warn!("{w}");
+        }
+        Ok(file)
+    }
+
+    /// Like [`PointsFile::load`], with the warnings (unknown keys, naming the file) returned.
+    ///
+    /// # Errors
+    /// As [`PointsFile::load`].
+    pub fn load_with_warnings(path: &Path) -> Result<(Self, Vec<String>), PointsError> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| PointsError::Io {
+        let text = crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SMALL_FILE_BYTES,
+            "a calibration points file",
+        )
+        .map_err(|source| PointsError::Io {
             path: name.clone(),
             source,
         })?;
-        let file: Self = serde_json::from_str(&text).map_err(|source| PointsError::Parse {
-            path: name.clone(),
+        let (file, unknown) = Self::from_json(&text).map_err(|e| e.at(&name))?;
+        let warnings = unknown
+            .into_iter()
+            .map(|key| {
+                format!("{name}: unknown key '{key}' ignored (not part of the points format)")
+            })
+            .collect();
+        Ok((file, warnings))
+    }
+
+    /// Parses and checks a points file's text; also gives the keys the format does not have
+    /// (errors name no file until [`PointsError::at`]).
+    ///
+    /// # Errors
+    /// [`PointsError::Parse`] or [`PointsError::Invalid`].
+    pub fn from_json(text: &str) -> Result<(Self, Vec<String>), PointsError> {
+        let read: PointsRead = serde_json::from_str(text).map_err(|source| PointsError::Parse {
+            path: String::new(),
             source,
         })?;
+        let mut unknown: Vec<String> = read.other.into_keys().collect();
+        let mut points = Vec::with_capacity(read.points.len());
+        for (i, p) in read.points.into_iter().enumerate() {
+            unknown.extend(p.other.into_keys().map(|k| format!("points[{i}].{k}")));
+            points.push(CalibrationPoint {
+                name: p.name,
+                field_cm: p.field_cm,
+                height_cm: p.height_cm,
+                image_px: p.image_px,
+            });
+        }
+        let file = Self {
+            width: read.width,
+            height: read.height,
+            points,
+        };
         file.check().map_err(|problem| PointsError::Invalid {
-            path: name,
+            path: String::new(),
             problem,
         })?;
-        Ok(file)
+        Ok((file, unknown))
     }
 
     fn check(&self) -> Result<(), PointsProblem> {
@@ -211,6 +301,27 @@ mod tests {
             "ground points stay in the fixed format"
         );
         assert_eq!(PointsFile::load(&out).expect("loads"), file);
+    }
+
+    #[test]
+    fn unknown_keys_are_named_in_warnings_and_the_rest_is_read() {
+        let text = r#"{"width": 640, "height": 480, "camera": "ssl-1", "points": [{"name": "goal top",
+            "field_cm": [0, 0], "heigth_cm": 22.5, "image_px": [321.4, 238.0]}]}"#;
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("typo.points.json");
+        std::fs::write(&path, text).expect("write");
+        let (file, warnings) = PointsFile::load_with_warnings(&path).expect("loads");
+        assert_eq!(file.points.len(), 1);
+        assert_eq!(file.points[0].image_px, [321.4, 238.0]);
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        assert!(
+            warnings[0].contains("typo.points.json") && warnings[0].contains("'camera'"),
+            "{warnings:?}"
+        );
+        assert!(
+            warnings[1].contains("'points[0].heigth_cm'"),
+            "{warnings:?}"
+        );
     }
 
     #[test]

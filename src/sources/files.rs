@@ -201,7 +201,12 @@ pub fn sensor_side_file(frame: &Path) -> PathBuf {
 /// An unreadable file, text that is not JSON, or JSON that is not a sensor reading, naming the
 /// file.
 pub fn load_side_sensors(path: &Path) -> anyhow::Result<(SensorReadings, Vec<String>)> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let bytes = crate::input_file::read_bounded(
+        path,
+        crate::input_file::MAX_SMALL_FILE_BYTES,
+        "a sensor side file",
+    )
+    .with_context(|| format!("{}: cannot read", path.display()))?;
     let (value, replaced) = crate::streams::schema::parse_json_lenient(&bytes)
         .map_err(|e| anyhow::anyhow!("{}: not JSON ({e})", path.display()))?;
     let mut dropped: Vec<String> = if replaced {

@@ -164,7 +164,7 @@ pub enum StreamError {
 }
 
 /// True when the path looks like an MCAP stream (`.mcap`, or `.mcap.partial` as a killed writer
-/// leaves it; any case).
+/// leaves it, or `.mcap.partial.N` as the next writer moved it aside; any case).
 #[must_use]
 pub fn is_stream_file(path: &std::path::Path) -> bool {
     let name = path
@@ -172,5 +172,8 @@ pub fn is_stream_file(path: &std::path::Path) -> bool {
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     // `NAME.mcap.partial` is a stream whose writer was killed: readable to its last chunk.
-    name.ends_with(".mcap") || name.ends_with(".mcap.partial")
+    name.ends_with(".mcap")
+        || name.rsplit_once(".mcap.partial").is_some_and(|(_, rest)| {
+            crate::atomic_file::is_partial_name(&format!(".partial{rest}"))
+        })
 }

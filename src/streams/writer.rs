@@ -1,12 +1,13 @@
 //! [`StreamWriter`]: frames and their data into a chunked, indexed MCAP file.
 
 use std::collections::{BTreeMap, HashMap};
-use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use foxglove::Encode as _;
 use mcap::records::MessageHeader;
+
+use crate::atomic_file::{OutputTarget, PartialFile};
 
 use super::schema::{
     EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, ImageEncoding, RECOGNITION_SCHEMA_NAME,
@@ -50,14 +51,19 @@ const MAX_FRAMES_PER_CHUNK: usize = 16;
 
 /// Writes a stream: one [`FrameRecord`] at a time, each frame's messages in one chunk.
 ///
-/// The file is written as `PATH.partial` and renamed to `PATH` by [`StreamWriter::finish`], so an
-/// existing stream is never replaced by a half-written one. Each finished chunk is flushed to the
-/// `.partial` file: after a crash it is readable (by [`super::StreamReader`]) up to its last
-/// complete chunk.
+/// The file is written through [`crate::atomic_file`]'s [`PartialFile`]: as `PATH.partial`,
+/// locked against a second writer, renamed to `PATH` by [`StreamWriter::finish`], so an existing
+/// stream is never replaced by a half-written one and an earlier crashed `PATH.partial` is moved
+/// aside rather than truncated; a device or FIFO is written front to back in place. Each finished
+/// chunk is flushed to the `.partial` file: after a crash it is readable (by
+/// [`super::StreamReader`]) up to its last complete chunk.
 pub struct StreamWriter {
     path: PathBuf,
+    /// The file written until [`StreamWriter::finish`] (the device itself when written in place).
     partial: PathBuf,
-    mcap: mcap::Writer<BufWriter<File>>,
+    /// Where an earlier unfinished `PATH.partial` was moved.
+    moved_aside: Option<PathBuf>,
+    mcap: mcap::Writer<BufWriter<PartialFile>>,
     image_channel: u16,
     sensors_channel: u16,
     lazy_channels: HashMap<String, u16>,
@@ -125,13 +131,16 @@ impl StreamWriter {
         info: &StreamInfo,
         options: WriterOptions,
     ) -> Result<Self, StreamError> {
-        let mut partial = path.as_os_str().to_owned();
-        partial.push(".partial");
-        let partial = PathBuf::from(partial);
-        let file = File::create(&partial).map_err(|source| StreamError::Io {
-            path: partial.clone(),
+        let io = |source| StreamError::Io {
+            path: path.to_owned(),
             source,
-        })?;
+        };
+        let file = OutputTarget::open(path)
+            .and_then(|t| t.create_partial())
+            .map_err(io)?;
+        let partial = file.partial().unwrap_or(file.path()).to_owned();
+        let moved_aside = file.moved_aside().map(Path::to_owned);
+        let seekable = file.seekable();
         let mcap_err = |context: &str| {
             let path = partial.clone();
             let context = context.to_owned();
@@ -152,6 +161,8 @@ impl StreamWriter {
             .compression_threads(1)
             .profile("")
             .library(concat!("eotn ", env!("CARGO_PKG_VERSION")))
+            // A device or FIFO is written front to back: chunks are assembled in memory.
+            .disable_seeking(!seekable)
             .create(BufWriter::with_capacity(1 << 20, file))
             .map_err(mcap_err("cannot start the MCAP file"))?;
         let metadata = mcap::records::Metadata {
@@ -195,6 +206,7 @@ impl StreamWriter {
         Ok(Self {
             path: path.to_owned(),
             partial,
+            moved_aside,
             mcap,
             image_channel,
             sensors_channel,
@@ -207,6 +219,13 @@ impl StreamWriter {
             buf: Vec::new(),
             raw_channels: HashMap::new(),
         })
+    }
+
+    /// Where an earlier unfinished `PATH.partial` (a crashed recording) was moved when this
+    /// writer started (a warning said so too).
+    #[must_use]
+    pub fn moved_aside(&self) -> Option<&Path> {
+        self.moved_aside.as_deref()
     }
 
     /// Number of frames written so far.
@@ -458,6 +477,27 @@ impl StreamWriter {
             .map_err(self.mcap_err("cannot finish a chunk"))
     }
 
+    /// Stops without a stream: the `.partial` file is removed and the output left as it was
+    /// (for a command that found nothing to write).
+    ///
+    /// # Errors
+    /// The partial file cannot be removed.
+    pub fn discard(self) -> Result<(), StreamError> {
+        let partial = self.partial.clone();
+        let file = self
+            .mcap
+            .into_inner()
+            .into_inner()
+            .map_err(|e| StreamError::Io {
+                path: partial.clone(),
+                source: e.into_error(),
+            })?;
+        file.discard().map_err(|source| StreamError::Io {
+            path: partial,
+            source,
+        })
+    }
+
     /// Writes the summary (indexes, statistics), syncs the file and renames it into place.
     ///
     /// # Errors
@@ -478,9 +518,7 @@ impl StreamWriter {
                 path: self.partial.clone(),
                 source: e.into_error(),
             })?;
-        file.sync_all().map_err(io(&self.partial))?;
-        drop(file);
-        std::fs::rename(&self.partial, &self.path).map_err(io(&self.path))?;
+        file.finish().map_err(io(&self.path))?;
         Ok(())
     }
 }

@@ -7,7 +7,6 @@
 //! so a crash loses at most the line being written; a torn last line is skipped with a warning.
 //! No egui here: the journal is plain data so tests can replay it.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
@@ -92,13 +91,7 @@ pub fn append(
         lines.push_str(&serde_json::to_string(e)?);
         lines.push('\n');
     }
-    let mut file = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&path)
-        .with_context(|| format!("{}: cannot open the edit journal", path.display()))?;
-    file.write_all(lines.as_bytes())
-        .and_then(|()| file.sync_data())
+    crate::atomic_file::append_synced(&path, lines.as_bytes())
         .with_context(|| format!("{}: cannot write the edit journal", path.display()))
 }
 
@@ -107,22 +100,21 @@ pub fn append(
 pub struct Replay {
     /// The rebuilt table.
     pub table: LookupTable,
-    /// Its undo/redo history, as if the edits had been made in this session.
+    /// Its undo/redo history, as if the edits had been made in this session (bounded by
+    /// [`crate::lut::edit::MAX_HISTORY_BYTES`]: the oldest steps of a long journal are not
+    /// kept, see [`EditHistory::dropped`]).
     pub history: EditHistory,
     /// Commits replayed.
     pub commits: usize,
-    /// Lines skipped (torn or unknown), with the reason.
+    /// Lines skipped (torn or unknown), with the reason; a note when old undo steps were
+    /// dropped.
     pub warnings: Vec<String>,
 }
 
-/// Reads the journal of `table` and replays it onto its starting table.
-///
-/// # Errors
-/// The journal cannot be read, has no start line, or its base copy is missing or not a table.
-pub fn replay(table: &Path) -> anyhow::Result<Replay> {
-    let path = journal_path(table);
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("{}: cannot read the edit journal", path.display()))?;
+/// Parses a journal's text into entries; lines that are not entries are skipped, each with a
+/// warning naming `name` and the line number.
+#[must_use]
+pub fn parse(text: &str, name: &str) -> (Vec<JournalEntry>, Vec<String>) {
     let mut warnings = Vec::new();
     let mut entries = Vec::new();
     for (n, line) in text.lines().enumerate() {
@@ -131,46 +123,164 @@ pub fn replay(table: &Path) -> anyhow::Result<Replay> {
         }
         match serde_json::from_str::<JournalEntry>(line) {
             Ok(e) => entries.push(e),
-            Err(e) => warnings.push(format!("{} line {}: skipped ({e})", path.display(), n + 1)),
+            Err(e) => warnings.push(format!("{name} line {}: skipped ({e})", n + 1)),
         }
     }
+    (entries, warnings)
+}
+
+/// What [`replay_onto`] gives: the history, commits replayed and warnings.
+#[derive(Debug)]
+pub struct Replayed {
+    /// The undo/redo history rebuilt.
+    pub history: EditHistory,
+    /// Commits replayed.
+    pub commits: usize,
+    /// A second start line, old undo steps dropped: each said once, naming `name`.
+    pub warnings: Vec<String>,
+}
+
+/// Replays journal entries (after the start line) onto `lut`, rebuilding the undo history.
+#[must_use]
+pub fn replay_onto(
+    lut: &mut LookupTable,
+    entries: impl IntoIterator<Item = JournalEntry>,
+    name: &str,
+) -> Replayed {
+    let mut history = EditHistory::default();
+    let (mut commits, mut warnings) = (0, Vec::new());
+    for e in entries {
+        match e {
+            JournalEntry::Commit { record } => {
+                history.commit(lut, record);
+                commits += 1;
+            }
+            JournalEntry::Undo { .. } => {
+                history.undo(lut);
+            }
+            JournalEntry::Redo { .. } => {
+                history.redo(lut);
+            }
+            JournalEntry::Start { .. } => {
+                warnings.push(format!("{name}: a second start line, ignored"));
+            }
+        }
+    }
+    if history.dropped() > 0 {
+        warnings.push(format!(
+            "{name}: the oldest {} edits cannot be undone (the undo history keeps at most {} MiB); the journal keeps them",
+            history.dropped(),
+            crate::lut::edit::MAX_HISTORY_BYTES >> 20
+        ));
+    }
+    Replayed {
+        history,
+        commits,
+        warnings,
+    }
+}
+
+/// Reads the journal of `table` and replays it onto its starting table.
+///
+/// # Errors
+/// The journal cannot be read (also: not a regular file, over
+/// [`crate::input_file::MAX_SIDE_FILE_BYTES`]), has no start line, or its base copy is missing
+/// or not a table.
+pub fn replay(table: &Path) -> anyhow::Result<Replay> {
+    let path = journal_path(table);
+    let text = crate::input_file::read_text_bounded(
+        &path,
+        crate::input_file::MAX_SIDE_FILE_BYTES,
+        "an edit journal",
+    )
+    .with_context(|| format!("{}: cannot read the edit journal", path.display()))?;
+    let name = path.display().to_string();
+    let (entries, mut warnings) = parse(&text, &name);
     let Some(JournalEntry::Start { bits, base, .. }) = entries.first().cloned() else {
-        anyhow::bail!("{}: the journal has no start line", path.display());
+        anyhow::bail!("{name}: the journal has no start line");
     };
     let mut lut = if base {
         LookupTable::load(&base_path(table))?
     } else {
-        LookupTable::new(bits).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
+        LookupTable::new(bits).map_err(|e| anyhow::anyhow!("{name}: {e}"))?
     };
     anyhow::ensure!(
         lut.bits() == bits,
-        "{}: the base table has {} bits, the journal says {bits}",
-        path.display(),
+        "{name}: the base table has {} bits, the journal says {bits}",
         lut.bits()
     );
-    let mut history = EditHistory::default();
-    let mut commits = 0;
-    for e in entries.into_iter().skip(1) {
-        match e {
-            JournalEntry::Commit { record } => {
-                history.commit(&mut lut, record);
-                commits += 1;
-            }
-            JournalEntry::Undo { .. } => {
-                history.undo(&mut lut);
-            }
-            JournalEntry::Redo { .. } => {
-                history.redo(&mut lut);
-            }
-            JournalEntry::Start { .. } => {
-                warnings.push(format!("{}: a second start line, ignored", path.display()));
-            }
-        }
-    }
+    let replayed = replay_onto(&mut lut, entries.into_iter().skip(1), &name);
+    warnings.extend(replayed.warnings);
     Ok(Replay {
         table: lut,
-        history,
-        commits,
+        history: replayed.history,
+        commits: replayed.commits,
         warnings,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Yuv;
+    use crate::lut::edit::MAX_HISTORY_BYTES;
+    use crate::lut::{ColourClass, Region, Sensitivity};
+
+    fn whole_table(class: ColourClass) -> JournalEntry {
+        JournalEntry::Commit {
+            record: EditRecord {
+                class,
+                region: Region::AroundSample {
+                    sample: Yuv::new(128, 128, 128),
+                    sensitivity: Sensitivity::uniform(255),
+                },
+                time_unix_ms: 0,
+                sampled_at: None,
+            },
+        }
+    }
+
+    #[test]
+    fn a_journal_of_whole_table_edits_keeps_the_undo_history_within_its_bound() {
+        // 40 whole-table edits of a 7-bit table: 32 MiB of old codes each, 1.3 GiB unbounded.
+        let dir = tempfile::tempdir().expect("tempdir");
+        let table = dir.path().join("t.lut");
+        let mut text = serde_json::to_string(&JournalEntry::Start {
+            bits: 7,
+            base: false,
+            time_unix_ms: 0,
+        })
+        .expect("json");
+        let classes = [ColourClass::Orange, ColourClass::Green];
+        for i in 0..40 {
+            text.push('\n');
+            text.push_str(&serde_json::to_string(&whole_table(classes[i % 2])).expect("json"));
+        }
+        std::fs::write(journal_path(&table), text).expect("write");
+        let r = replay(&table).expect("replays");
+        assert_eq!(r.commits, 40);
+        assert!(
+            r.history.held_bytes() <= MAX_HISTORY_BYTES,
+            "{}",
+            r.history.held_bytes()
+        );
+        assert!(r.history.undo_len() >= 2, "{}", r.history.undo_len());
+        assert_eq!(r.history.undo_len() + r.history.dropped(), 40);
+        let note = r.warnings.join("\n");
+        assert!(note.contains("edits cannot be undone"), "{note}");
+        // The table is the last edit's, whatever was dropped.
+        assert_eq!(
+            r.table.class_counts()[ColourClass::Green.code() as usize],
+            r.table.cells().len()
+        );
+    }
+
+    #[test]
+    fn torn_lines_are_skipped_with_their_line_number() {
+        let text = "{\"event\":\"start\",\"bits\":6,\"base\":false,\"time_unix_ms\":0}\n\n{\"event\":\"undo\",\"ti";
+        let (entries, warnings) = parse(text, "j");
+        assert_eq!(entries.len(), 1);
+        assert_eq!(warnings.len(), 1);
+        assert!(warnings[0].starts_with("j line 3: skipped"), "{warnings:?}");
+    }
 }

@@ -65,8 +65,8 @@ pub use params::{ParamsOffer, ParamsSlot, TryParams, TryParamsRow};
 pub use player::Player;
 pub use robots::{RobotId, RobotRow, Wake};
 pub use settings::{
-    MAX_RECENT, MAX_WARNINGS, OverheadView, Overlays, SPEEDS, Settings, ViewKind, ViewTransform,
-    ZOOM_PRESETS, ZOOM_RANGE,
+    MAX_RECENT, MAX_WARNINGS, OverheadView, Overlays, SETTINGS_FILE_NAME, SPEEDS, Settings,
+    ViewKind, ViewTransform, ZOOM_PRESETS, ZOOM_RANGE,
 };
 pub use source::Source;
 pub use stream_scan::StreamScan;
@@ -233,6 +233,18 @@ impl Workspace {
             params: ParamsSlot::default(),
             saved_undo_len: Some(0),
         }
+    }
+
+    /// A workspace with the settings of the settings file at `path` (see [`Settings::load`]):
+    /// what it cannot read is in [`Workspace::warnings`].
+    #[must_use]
+    pub fn with_settings_file(path: &Path) -> Self {
+        let (settings, warnings) = Settings::load(path);
+        let mut w = Self::new(settings);
+        for warning in warnings {
+            w.warn(warning);
+        }
+        w
     }
 
     /// Reopens what the settings name (last table, last stream or frames), reporting failures

@@ -26,7 +26,7 @@ use crate::recognition::Recognition;
 use crate::sources::SourceFrame;
 
 /// Fewest picked points the solver is asked to work with (pose, focal, centre, k1, k2).
-pub const MIN_CALIBRATION_POINTS: usize = 6;
+pub const MIN_CALIBRATION_POINTS: usize = crate::overhead::review::MIN_POINTS;
 
 /// One robot as the overhead camera identifies it: team colour and marker identity. The one
 /// robot selection of the workspace (field view, image overlays) is one of these.
@@ -106,6 +106,9 @@ pub struct Overhead {
     empty_recognition: Recognition,
     /// The field view's model: trails, world models, errors over time.
     pub field_model: FieldModel,
+    /// The calibration's and the frame's size last warned about (the warning is said once a
+    /// pair, not once a frame).
+    size_warned: Option<((usize, usize), (usize, usize))>,
 }
 
 impl Default for Overhead {
@@ -133,6 +136,7 @@ impl Default for Overhead {
             view_map: None,
             empty_recognition: Recognition::default(),
             field_model: FieldModel::default(),
+            size_warned: None,
         }
     }
 }
@@ -289,6 +293,28 @@ impl Workspace {
         }
     }
 
+    /// Whether `camera` (the calibration in use) can place objects on `frame`: a frame of
+    /// another size with the same shape is scaled to (with a warning), one of another shape
+    /// is not (with a warning: the calibration was made for another camera or view). Each
+    /// pair of sizes is warned about once.
+    fn frame_fits(&mut self, camera: &OverheadCamera, frame: &crate::frame::Frame) -> bool {
+        use crate::overhead::pipeline::{FrameFit, frame_fit};
+        let fit = frame_fit(camera, frame.width(), frame.height());
+        let key = (
+            (camera.width_px, camera.height_px),
+            (frame.width(), frame.height()),
+        );
+        if fit != FrameFit::Same && self.overhead.size_warned != Some(key) {
+            self.overhead.size_warned = Some(key);
+            let what = match fit {
+                FrameFit::Mismatch { .. } => format!("{fit}; nothing is placed on these frames"),
+                _ => fit.to_string(),
+            };
+            self.warn(format!("overhead calibration: {what}"));
+        }
+        !matches!(fit, FrameFit::Mismatch { .. })
+    }
+
     /// Runs the overhead pipeline on an overhead frame with the table in use and the
     /// calibration in use; returns the stage timings in the robot pipeline's shape.
     pub(super) fn run_overhead(&mut self, loaded: &SourceFrame) -> crate::pipeline::StageTimings {
@@ -301,12 +327,15 @@ impl Workspace {
         if let Some(c) = camera {
             self.overhead.pipeline.set_camera(c);
         }
+        let fits = camera.is_none_or(|c| self.frame_fits(&c, &loaded.frame));
         self.overhead.pipeline.process(&loaded.frame);
         self.overhead.active = true;
         if (self.overhead.points.width, self.overhead.points.height) == (0, 0) {
             self.overhead.points = PointsFile::new(loaded.frame.width(), loaded.frame.height());
         }
-        self.overhead.detections = camera.map(|_| self.overhead.pipeline.detections().clone());
+        self.overhead.detections = camera
+            .filter(|_| fits)
+            .map(|_| self.overhead.pipeline.detections().clone());
         self.refresh_view_map((loaded.frame.width(), loaded.frame.height()));
         self.primitives.clear();
         self.accepted_owners.clear();
@@ -341,6 +370,13 @@ impl Workspace {
         match command {
             OverheadCommand::OpenCalibration(p) => {
                 let cal = Calibration::load(&p)?;
+                let review = crate::overhead::review::review(&cal);
+                if let Some(refusal) = review.refusal() {
+                    anyhow::bail!("{}: not usable: {refusal}", p.display());
+                }
+                for f in &review.findings {
+                    self.warn(format!("{}: {f}", p.display()));
+                }
                 self.status = format!(
                     "opened calibration {}: {} points, median error {:.2} px",
                     p.display(),
@@ -387,7 +423,10 @@ impl Workspace {
                 self.reprocess();
             }
             OverheadCommand::OpenPoints(p) => {
-                let points = PointsFile::load(&p)?;
+                let (points, warnings) = PointsFile::load_with_warnings(&p)?;
+                for w in warnings {
+                    self.warn(w);
+                }
                 self.status = format!("opened {} points from {}", points.points.len(), p.display());
                 self.overhead.points = points;
                 self.overhead.points_path = Some(p);
@@ -530,12 +569,24 @@ impl Workspace {
         let frame = frame.filter(|f| {
             (f.width(), f.height()) == (self.overhead.points.width, self.overhead.points.height)
         });
+        let notes =
+            crate::overhead::review::check_points(&self.overhead.points, &self.overhead.field)?;
         let cal = calibrate(
             &self.overhead.points,
             &self.overhead.field,
             frame.as_ref(),
             &CalibrationParams::default(),
         )?;
+        let review = crate::overhead::review::review(&cal);
+        for f in notes.iter().chain(&review.findings) {
+            self.warn(format!("calibration: {f}"));
+        }
+        if frame.is_some() && cal.line_samples == 0 {
+            self.warn(format!(
+                "calibration: line refinement skipped: fewer than {} samples of the field lines found in the frame",
+                crate::overhead::calibration::MIN_LINE_SAMPLES
+            ));
+        }
         self.status = format!(
             "calibrated from {n} points: median error {:.2} px{}",
             cal.median_point_error_px(),

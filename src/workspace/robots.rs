@@ -276,8 +276,8 @@ impl Workspace {
     /// Records every robot not recording yet into `folder`, one file per robot named after it.
     pub(super) fn record_all_robots(&mut self, folder: &Path) -> anyhow::Result<()> {
         anyhow::ensure!(!self.robots.entries.is_empty(), "no robot connected");
-        std::fs::create_dir_all(folder)
-            .with_context(|| format!("cannot make the folder {}", folder.display()))?;
+        crate::atomic_file::output_folder(folder)
+            .with_context(|| format!("{}", folder.display()))?;
         let mut started = 0;
         let ids: Vec<RobotId> = self
             .robots

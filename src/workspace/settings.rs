@@ -1,7 +1,12 @@
 //! What persists between runs and what the views are: the settings, the four views, the
 //! overlay switches, zoom and pan.
+//!
+//! The settings file (`settings.json` in the app's storage folder) is read and written by this
+//! version of eotn and by others: a key it does not know is named in a warning and the rest is
+//! kept, a key whose value it cannot read keeps its default (also with a warning), and the file
+//! is written through [`crate::atomic_file`] like every other output.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -289,5 +294,159 @@ impl Default for Settings {
             show_coverage: false,
             show_bookmarks: false,
         }
+    }
+}
+
+/// The settings file's name in the app's storage folder.
+pub const SETTINGS_FILE_NAME: &str = "settings.json";
+
+impl Settings {
+    /// Settings from a settings file's text, with warnings: keys this version does not know are
+    /// named and ignored, a key whose value it cannot read keeps its default, text that is not
+    /// a JSON object gives the defaults.
+    #[must_use]
+    pub fn from_json(text: &str) -> (Self, Vec<String>) {
+        let given: serde_json::Value = match serde_json::from_str(text) {
+            Ok(v @ serde_json::Value::Object(_)) => v,
+            Ok(_) => {
+                return (
+                    Self::default(),
+                    vec!["not a JSON object; defaults used".into()],
+                );
+            }
+            Err(e) => {
+                return (
+                    Self::default(),
+                    vec![format!("not JSON ({e}); defaults used")],
+                );
+            }
+        };
+        let mut warnings = Vec::new();
+        let mut merged = serde_json::to_value(Self::default()).unwrap_or_default();
+        if let (Some(keys), Some(target)) = (given.as_object(), merged.as_object_mut()) {
+            for (key, value) in keys {
+                let before = target.insert(key.clone(), value.clone());
+                let readable =
+                    serde_json::from_value::<Self>(serde_json::Value::Object(target.clone()))
+                        .is_ok();
+                if !readable {
+                    warnings.push(format!(
+                        "setting '{key}' has a value this version cannot read; its default is kept"
+                    ));
+                    match before {
+                        Some(b) => target.insert(key.clone(), b),
+                        None => target.remove(key),
+                    };
+                }
+            }
+        }
+        let settings: Self = serde_json::from_value(merged).unwrap_or_default();
+        let known = serde_json::to_value(&settings).unwrap_or_default();
+        warnings.extend(
+            crate::input_file::unknown_keys(&given, &known)
+                .into_iter()
+                .map(|k| format!("unknown setting '{k}' ignored (from another version of eotn?)")),
+        );
+        (settings, warnings)
+    }
+
+    /// Reads the settings file at `path`; a missing file gives the defaults quietly, one that
+    /// cannot be read (not a regular file, too large, not JSON) the defaults with a warning.
+    /// Every warning names the file.
+    #[must_use]
+    pub fn load(path: &Path) -> (Self, Vec<String>) {
+        let text = match crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SMALL_FILE_BYTES,
+            "a settings file",
+        ) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return (Self::default(), vec![]),
+            Err(e) => {
+                return (
+                    Self::default(),
+                    vec![format!("{}: {e}; defaults used", path.display())],
+                );
+            }
+        };
+        let (settings, warnings) = Self::from_json(&text);
+        let warnings = warnings
+            .into_iter()
+            .map(|w| format!("{}: {w}", path.display()))
+            .collect();
+        (settings, warnings)
+    }
+
+    /// Writes the settings file (pretty JSON, through [`crate::atomic_file`]).
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn save(&self, path: &Path) -> std::io::Result<()> {
+        let mut text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        text.push('\n');
+        crate::atomic_file::write_atomic(path, text.as_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_round_trip_through_their_file() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join(SETTINGS_FILE_NAME);
+        let mut s = Settings {
+            speed: 4.0,
+            recent: vec![PathBuf::from("/x/a.mcap")],
+            ..Settings::default()
+        };
+        s.overlays.opacity = 0.25;
+        s.save(&path).expect("saves");
+        assert_eq!(Settings::load(&path), (s, vec![]));
+        assert_eq!(
+            Settings::load(&dir.path().join("none.json")),
+            (Settings::default(), vec![])
+        );
+    }
+
+    #[test]
+    fn another_version_s_settings_keep_what_this_one_reads() {
+        let text = r#"{"speed": 2.0, "main_view": "Blobs", "dark_mode": true,
+            "overlays": {"opacity": 0.3, "glow": 1}, "min_blob_pixels": "many"}"#;
+        let (s, warnings) = Settings::from_json(text);
+        assert_eq!(s.speed, 2.0);
+        assert_eq!(s.main_view, ViewKind::Blobs);
+        assert_eq!(s.overlays.opacity, 0.3);
+        assert_eq!(s.min_blob_pixels, Settings::default().min_blob_pixels);
+        let all = warnings.join("\n");
+        assert!(all.contains("'min_blob_pixels' has a value"), "{all}");
+        assert!(all.contains("unknown setting 'dark_mode'"), "{all}");
+        assert!(all.contains("unknown setting 'overlays.glow'"), "{all}");
+        assert_eq!(warnings.len(), 3, "{all}");
+        let (s, warnings) = Settings::from_json("[1, 2]");
+        assert_eq!((s, warnings.len()), (Settings::default(), 1));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_as_the_settings_file_gives_the_defaults_without_waiting() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let fifo = dir.path().join(SETTINGS_FILE_NAME);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success());
+        if !made {
+            assert!(
+                !std::env::var("CI").is_ok_and(|v| v == "true" || v == "1"),
+                "mkfifo failed, and CI=true requires the FIFO case"
+            );
+            eprintln!("SKIPPED: mkfifo failed: the FIFO case is not tested");
+            return;
+        }
+        let (s, warnings) = Settings::load(&fifo);
+        assert_eq!(s, Settings::default());
+        assert!(warnings[0].contains("not a regular file"), "{warnings:?}");
     }
 }

@@ -76,6 +76,9 @@ impl Workspace {
         if journal::journal_path(path).exists() {
             match journal::replay(path) {
                 Ok(r) if &r.table == self.pipeline.lut() => {
+                    for w in r.warnings {
+                        self.warn(w);
+                    }
                     let n = r.history.undo_len();
                     self.history = r.history;
                     self.saved_undo_len = Some(n);
@@ -176,13 +179,28 @@ impl Workspace {
             // The saved state was undone and is now replaced: no undo leads back to it.
             self.saved_undo_len = None;
         }
+        let dropped_before = self.history.dropped();
         let changed = self.history.commit(self.pipeline.lut_mut(), record.clone());
+        self.note_dropped_steps(self.history.dropped() - dropped_before);
         self.journal(&JournalEntry::Commit { record });
         self.dirty = true;
         self.selection = None;
         self.table_changed();
         self.status = format!("{changed} cells set to {}", self.settings.class.name());
         Ok(())
+    }
+
+    /// After `n` old undo steps were dropped to keep the history within its memory bound: the
+    /// saved state is that many steps nearer (or out of reach), and the user is told once.
+    fn note_dropped_steps(&mut self, n: usize) {
+        if n == 0 {
+            return;
+        }
+        self.saved_undo_len = self.saved_undo_len.and_then(|s| s.checked_sub(n));
+        self.warn(format!(
+            "the oldest {n} edit(s) can no longer be undone: the undo history keeps at most {} MiB (the journal keeps every edit)",
+            crate::lut::edit::MAX_HISTORY_BYTES >> 20
+        ));
     }
 
     pub(super) fn set_sensitivity(&mut self, s: Sensitivity) {

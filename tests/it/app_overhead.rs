@@ -197,6 +197,48 @@ fn without_a_calibration_nothing_is_placed_and_the_status_says_so_until_one_is_o
         w.overhead_detections().is_some(),
         "a failed open changes nothing"
     );
+    // The same camera calibrated on frames of twice the size (the same shape): scaled to these
+    // frames, with one warning, and it places the ball where the true camera does.
+    let ball = w
+        .overhead_detections()
+        .and_then(|d| d.ball)
+        .map(|b| b.field_cm);
+    let open_as = |w: &mut Workspace, name: &str, f: &dyn Fn(&mut Calibration)| {
+        let mut c = cal.clone();
+        f(&mut c);
+        let p = dir.path().join(name);
+        c.save(&p).unwrap();
+        w.apply(Command::Overhead(OverheadCommand::OpenCalibration(p)))
+            .unwrap();
+    };
+    open_as(&mut w, "double.json", &|c| {
+        (c.camera.width_px, c.camera.height_px) = (1280, 960);
+        c.camera.focal_px *= 2.0;
+        c.camera.centre.x_px *= 2.0;
+        c.camera.centre.y_px *= 2.0;
+    });
+    let scaled = w
+        .overhead_detections()
+        .and_then(|d| d.ball)
+        .map(|b| b.field_cm);
+    let (a, b) = (
+        ball.expect("ball"),
+        scaled.expect("ball through the scaled camera"),
+    );
+    assert!(dist(a, b) < 1.0, "{a:?} {b:?}");
+    let said = w.warnings().join("\n");
+    assert!(
+        said.contains("is for 1280x960 frames, these are 640x480"),
+        "{said}"
+    );
+    // Made for another shape: nothing placed, and said.
+    open_as(&mut w, "wide.json", &|c| c.camera.height_px = 360);
+    assert!(w.overhead_detections().is_none());
+    let said = w.warnings().join("\n");
+    assert!(
+        said.contains("another shape") && said.contains("nothing is placed"),
+        "{said}"
+    );
 }
 
 /// Where the true camera puts each of the field's landmarks that it sees (pixel centres).

@@ -202,3 +202,71 @@ fn sources_lists_cameras_or_says_there_are_none_in_one_line_and_every_scenario()
         assert!(text.contains(k.name()), "{} missing: {text}", k.name());
     }
 }
+
+/// Every numeric option of the command line, found by walking its clap definition, refuses NaN,
+/// infinities and absurd sizes before any work (`eotn::cli::values`): a number option added
+/// later without a range fails here.
+#[test]
+fn every_numeric_option_refuses_nan_infinity_and_absurd_values() {
+    use std::any::TypeId;
+    fn walk(cmd: &clap::Command, path: &str, checked: &mut usize) {
+        for arg in cmd.get_arguments() {
+            let parser = arg.get_value_parser();
+            let id = parser.type_id();
+            let float = id == TypeId::of::<f64>() || id == TypeId::of::<f32>();
+            let whole = [
+                TypeId::of::<u8>(),
+                TypeId::of::<u16>(),
+                TypeId::of::<u32>(),
+                TypeId::of::<u64>(),
+                TypeId::of::<usize>(),
+                TypeId::of::<i32>(),
+                TypeId::of::<i64>(),
+            ]
+            .iter()
+            .any(|t| id == *t);
+            if !float && !whole {
+                continue;
+            }
+            let name = format!("{path} --{}", arg.get_long().unwrap_or_default());
+            // The option's own value parser, alone on a probe command (its relations to other
+            // options left out).
+            let probe = clap::Command::new("probe").arg(
+                clap::Arg::new("v")
+                    .long("v")
+                    .value_parser(parser.clone())
+                    .allow_hyphen_values(true),
+            );
+            let accepts = |v: &str| {
+                probe
+                    .clone()
+                    .try_get_matches_from(["probe", "--v", v])
+                    .is_ok()
+            };
+            for bad in ["NaN", "nan", "inf", "-inf", "1e300", "-1"] {
+                assert!(!accepts(bad), "{name} accepts {bad}");
+            }
+            // Any seed is a seed; every other count has a ceiling.
+            if arg.get_long() != Some("seed") {
+                assert!(!accepts("18446744073709551615"), "{name} accepts 2^64 - 1");
+            }
+            if let Some(default) = arg.get_default_values().first() {
+                assert!(
+                    accepts(&default.to_string_lossy()),
+                    "{name} refuses its own default {default:?}"
+                );
+            }
+            *checked += 1;
+        }
+        for sub in cmd.get_subcommands() {
+            walk(sub, &format!("{path} {}", sub.get_name()), checked);
+        }
+    }
+    let mut checked = 0;
+    walk(
+        &<eotn::cli::Cli as clap::CommandFactory>::command(),
+        "eotn",
+        &mut checked,
+    );
+    assert!(checked >= 25, "only {checked} numeric options found");
+}

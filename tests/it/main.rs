@@ -23,6 +23,7 @@ mod common;
 mod crash_safety;
 mod docs;
 mod hardening;
+mod hardening_files;
 #[cfg(feature = "gui")]
 mod harness;
 mod kernels;
@@ -30,6 +31,8 @@ mod live;
 mod live_peers;
 mod mcap_conformance;
 mod motion;
+#[cfg(unix)]
+mod outputs;
 mod overhead;
 mod patterns;
 mod peer;

@@ -196,15 +196,8 @@ impl StreamReader {
             path: path.to_owned(),
             source,
         };
-        let file = File::open(path).map_err(io)?;
-        let meta = file.metadata().map_err(io)?;
-        if !meta.is_file() {
-            return Err(io(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "not a regular file, so it cannot be a stream",
-            )));
-        }
-        let file_len = meta.len();
+        // Looked at before it is opened: a FIFO would hang the open.
+        let (file, file_len) = crate::input_file::open_regular(path, "a stream").map_err(io)?;
         let mut reader = Self {
             path: path.to_owned(),
             file: BufReader::with_capacity(READ_BUFFER_BYTES, file),
