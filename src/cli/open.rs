@@ -86,7 +86,7 @@ mod tests {
     }
 
     #[test]
-    fn run_options_take_the_speed_only_with_play_and_a_sane_quit_time() {
+    fn run_options_take_the_speed_only_with_play_and_a_quit_time_in_range() {
         let o = options(&["a.mcap", "--renderer", "gl", "--all-overlays"]);
         assert_eq!(o.files, vec![PathBuf::from("a.mcap")]);
         assert_eq!(o.renderer, Some(RendererSetting::Gl));
@@ -107,7 +107,11 @@ mod tests {
             options(&["a.mcap", "--play"]).play,
             Some(PlaySpeed::Times(1.0))
         );
-        assert_eq!(options(&["a.mcap", "--quit-after=-1"]).quit_after, None);
-        assert_eq!(options(&["a.mcap", "--quit-after", "NaN"]).quit_after, None);
+        // A quit time outside its range is refused when the line is parsed, naming the range.
+        for bad in ["--quit-after=-1", "--quit-after=NaN"] {
+            let refused = Open::try_parse_from(["open", "a.mcap", bad]).err();
+            let said = refused.map(|e| e.to_string()).unwrap_or_default();
+            assert!(said.contains("must be a number from 0"), "{bad}: {said}");
+        }
     }
 }
