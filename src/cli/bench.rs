@@ -35,7 +35,7 @@ pub struct Args {
     #[arg(long, default_value_t = 10, value_parser = super::values::whole_in::<usize>(0, 100_000))]
     pub warmup: usize,
     /// Rounds; each runs every kernel set and the floor once per frame, interleaved.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = super::values::whole_in::<usize>(1, 1000))]
     pub rounds: usize,
     /// The C floor: `floors.c` (compiled with `$CC` or `cc -O3 -march=native`) or the compiled
     /// program; by default `$EOTN_SHARED/bench/floors.c` or `../shared/bench/floors.c`. It runs

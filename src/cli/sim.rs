@@ -25,7 +25,7 @@ pub struct Args {
     pub seed: u64,
     /// Index of the first frame: a short stream from the middle of a scenario, where it shows
     /// what it is named for (the stream's times still start at 0).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = super::values::whole_in::<u64>(0, super::values::MAX_FRAMES))]
     pub first: u64,
     /// Output stream (`.mcap`).
     #[arg(short, long, required_unless_present = "list", value_name = super::paths::OUT)]
