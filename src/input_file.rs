@@ -136,6 +136,24 @@ pub fn human_bytes(n: u64) -> String {
     }
 }
 
+/// Makes a FIFO at `path` for a test; `false` (a visible skip, a failure under `CI=true`) when
+/// `mkfifo` cannot.
+#[cfg(all(test, unix))]
+pub(crate) fn make_fifo(path: &Path) -> bool {
+    let made = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .is_ok_and(|s| s.success());
+    if !made {
+        assert!(
+            !std::env::var("CI").is_ok_and(|v| v == "true" || v == "1"),
+            "mkfifo failed, and CI=true requires the FIFO case"
+        );
+        eprintln!("SKIPPED: mkfifo failed: the FIFO case is not tested");
+    }
+    made
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -152,16 +170,7 @@ mod tests {
     fn a_fifo_is_refused_without_waiting_for_a_writer() {
         let dir = tempfile::tempdir().unwrap();
         let fifo = dir.path().join("fifo");
-        let made = std::process::Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .is_ok_and(|s| s.success());
-        if !made {
-            assert!(
-                !std::env::var("CI").is_ok_and(|v| v == "true" || v == "1"),
-                "mkfifo failed, and CI=true requires the FIFO case"
-            );
-            eprintln!("SKIPPED: mkfifo failed: the FIFO case is not tested");
+        if !make_fifo(&fifo) {
             return;
         }
         // Opening it would wait for ever: the test would hang, not fail.
