@@ -15,6 +15,7 @@
 //! | [`geometry`] | camera models, the ERS-7 body-to-camera chain, horizon, overhead camera |
 //! | [`sim`] | synthetic frames with ground truth: scenes, renderer, scenarios |
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
+//! | [`formats`] | one decoder per message type (ROS 2 CDR, Foxglove protobuf): images, camera info, joints, TF |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
 //! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
 //! | [`overhead`] | overhead camera: field descriptions, calibration, ball and robot markers |
@@ -35,6 +36,7 @@ pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
 pub mod eval;
+pub mod formats;
 pub mod frame;
 pub mod geometry;
 pub mod import;

@@ -298,6 +298,46 @@ pub fn decode_raw_as(
     Ok(frame)
 }
 
+/// [`decode_raw_as`] taking the message's pixel buffer: unpadded 4:2:2 data becomes the frame
+/// without another copy (YUYV reordered in place); everything else is converted from it.
+///
+/// # Errors
+/// As [`decode_raw`].
+pub fn decode_raw_owned(
+    encoding: PixelEncoding,
+    width: usize,
+    height: usize,
+    step: usize,
+    mut data: Vec<u8>,
+) -> Result<Frame, RawImageError> {
+    let row = encoding.row_bytes(width);
+    let is_422 = matches!(encoding, PixelEncoding::Uyvy | PixelEncoding::Yuyv);
+    let fits = width % 2 == 0
+        && (step == row || step == 0)
+        && row.checked_mul(height).is_some_and(|n| n <= data.len());
+    if !is_422 || !fits || width == 0 || height == 0 {
+        let image = RawImage {
+            width,
+            height,
+            encoding: encoding.name(),
+            step,
+            data: &data,
+        };
+        return decode_raw_as(encoding, &image);
+    }
+    data.truncate(row * height);
+    if encoding == PixelEncoding::Yuyv {
+        for q in data.chunks_exact_mut(4) {
+            q.swap(0, 1);
+            q.swap(2, 3);
+        }
+    }
+    if (width as u64) * (height as u64) > MAX_FRAME_PIXELS {
+        return Err(RawImageError::BadSize { width, height });
+    }
+    Ok(Frame::from_uyvy(width, height, data)?)
+}
+
 /// A grey level (0 black .. 255 white) as studio-range luma, as [`super::rgb_to_yuv`] gives it
 /// for R = G = B.
 fn grey_luma(g: u8) -> u8 {
@@ -530,6 +570,18 @@ mod tests {
             let f = decode_raw(&raw(2, 2, name, step, &data)).unwrap();
             let flat = decode_raw(&raw(2, 2, name, row, &vec![100; row * 2])).unwrap();
             assert_eq!(f, flat, "{name}");
+        }
+    }
+
+    #[test]
+    fn owned_buffers_give_the_same_frames() {
+        let data: Vec<u8> = (0..24).collect();
+        for (enc, step) in [("uyvy", 8), ("yuyv", 8), ("yuyv", 12), ("rgb8", 12)] {
+            let e = PixelEncoding::from_name(enc).unwrap();
+            let h = 24 / step;
+            let borrowed = decode_raw(&raw(4, h, enc, step, &data)).unwrap();
+            let owned = decode_raw_owned(e, 4, h, step, data.clone()).unwrap();
+            assert_eq!(borrowed, owned, "{enc} {step}");
         }
     }
 

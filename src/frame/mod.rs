@@ -22,7 +22,7 @@ mod io;
 mod pixel_box;
 
 pub use compressed::{CompressedFormat, CompressedImageError, decode_compressed, decode_jpeg};
-pub use encodings::{PixelEncoding, RawImage, RawImageError, decode_raw};
+pub use encodings::{PixelEncoding, RawImage, RawImageError, decode_raw, decode_raw_owned};
 pub use image_point::{ImagePoint, xy_array};
 pub use io::{
     FrameFileError, MAX_FRAME_PIXELS, MAX_FRAME_SIDE, display_name, infer_uyvy_size, is_image_file,
