@@ -15,15 +15,21 @@
 //! in (the last chunk stays cached), so memory stays flat however long the file is; when the
 //! summary is missing it recovers by scanning the complete chunks, and says so in
 //! [`StreamReader::warnings`].
+//!
+//! [`StreamReader`] reads other recordings too: MCAP files of other writers and ROS 2 bags
+//! ([`rosbag2`]: folders with `metadata.yaml`, SQLite or MCAP storage), their images in any
+//! encoding through [`crate::formats`].
 
 mod reader;
+pub mod rosbag2;
 pub mod schema;
 pub mod sensor_table;
 mod writer;
 
 use std::path::PathBuf;
 
-pub use reader::StreamReader;
+pub use reader::{ImageTopic, StreamReader};
+pub use rosbag2::{is_bag_folder, is_recording};
 pub use writer::{Compression, RawChannelSpec, StreamWriter, WriterOptions};
 
 use crate::frame::Frame;
@@ -161,7 +167,8 @@ pub enum StreamError {
 }
 
 /// True when the path looks like an MCAP stream (`.mcap`, or `.mcap.partial` as a killed writer
-/// leaves it; any case).
+/// leaves it; any case): what eotn writes. Inputs are told by [`is_recording`], which also takes
+/// rosbag2 bags.
 #[must_use]
 pub fn is_stream_file(path: &std::path::Path) -> bool {
     let name = path

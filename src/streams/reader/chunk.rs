@@ -2,7 +2,7 @@
 
 use mcap::records::{Record, op};
 
-use super::{MAX_CHUNK_BYTES, Msg};
+use super::mcap_file::{MAX_CHUNK_BYTES, Msg};
 
 /// What the recovery scan needs from a chunk's records.
 pub(super) enum ChunkItem {
@@ -35,6 +35,7 @@ pub(super) fn decode_chunk_messages(
         if let Record::Message { header, data } = r {
             out.push(Msg {
                 channel: header.channel_id,
+                log_time: header.log_time,
                 data: data.into_owned(),
             });
         }

@@ -1,240 +1,258 @@
-//! [`StreamReader`]: random access to the frames of an MCAP stream, by index and by time.
+//! [`StreamReader`]: random access to the frames of a recording, by index and by time: an MCAP
+//! file (eotn's streams and any other writer's), a rosbag2 bag (folder, `metadata.yaml`, or one
+//! storage file, SQLite or MCAP, split or zstd-compressed), read as one sequence of frames.
+//!
+//! Each storage gives a frame's raw messages ([`RawFrame`]: `mcap_file`, `rosbag2::db3`);
+//! `assemble` decodes them the same way for all (`crate::formats`).
 
-use std::collections::HashMap;
-use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
-use foxglove::Decode as _;
-use mcap::records::{Record, op};
-use mcap::sans_io::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
+use super::rosbag2::db3::Db3File;
+use super::rosbag2::{Layout, StorageKind, StoragePart, layout_of};
+use super::{FrameRecord, StreamError, StreamInfo, param_set_of_source};
+use crate::formats::tf::TfTree;
+use crate::formats::{ImageMessage, MessageKind, ros2};
+pub use channels::ImageTopic;
+use channels::Role;
+use mcap_file::McapFile;
 
-use super::schema::{decode_image, parse_json_lenient};
-use super::{
-    ANNOTATIONS_TOPIC, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME,
-    PARAMS_METADATA_NAME, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
-    param_set_of_source,
-};
-use crate::sensors::SensorReadings;
-use chunk::decode_chunk_messages;
-
+mod assemble;
+pub(crate) mod channels;
 mod chunk;
+mod mcap_file;
 mod recovery;
 
-/// The MCAP magic bytes at both ends of a file.
-const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
-/// Largest chunk record read into memory, bytes (compressed or not); larger ones are corrupt.
-const MAX_CHUNK_BYTES: u64 = 1 << 30;
-/// Largest summary-side record (message index, metadata) read, bytes.
-const MAX_INDEX_BYTES: u64 = 64 << 20;
 /// Warnings kept; later ones are only counted, so memory stays bounded on a bad file.
 const MAX_WARNINGS: usize = 100;
-/// Name of the schema of frame images from other writers.
-const RAW_IMAGE_SCHEMA: &str = "foxglove.RawImage";
-/// Name of the schema of image overlays (`eotn detect --annotate`, or other tools').
-const ANNOTATIONS_SCHEMA: &str = "foxglove.ImageAnnotations";
+/// Largest storage file decompressed from `.zstd`, bytes.
+const MAX_DECOMPRESSED_FILE: u64 = 64 << 30;
 
-/// What a channel's messages are to a frame.
-#[derive(Debug, Clone, PartialEq, Eq)]
-enum Role {
-    Image,
-    Sensors,
-    GroundTruth,
-    Recognition,
-    Annotations,
-    Extra(String),
-    Ignored,
+/// One frame's messages as stored: the image's bytes and, of the other channels read, those
+/// that go with it (borrowed from a cached chunk, or owned).
+pub(crate) struct RawFrame<'a> {
+    /// The frame's time (its image's log time), nanoseconds.
+    pub(crate) time_ns: u64,
+    /// The image's message type.
+    pub(crate) kind: MessageKind,
+    /// The image message's bytes.
+    pub(crate) image: Cow<'a, [u8]>,
+    /// The other messages.
+    pub(crate) others: Vec<RawMsg<'a>>,
 }
 
-/// Where a chunk record lies in the file (opcode and length prefix included), bytes.
-#[derive(Debug, Clone, Copy)]
-struct ChunkLoc {
-    offset: u64,
-    length: u64,
+/// One message that goes with a frame.
+pub(crate) struct RawMsg<'a> {
+    /// What it is.
+    pub(crate) role: Role,
+    /// Its bytes.
+    pub(crate) data: Cow<'a, [u8]>,
 }
 
-/// Where a frame is: its time, its chunk, and which image message of that chunk it is.
-#[derive(Debug, Clone, Copy)]
-struct FrameLoc {
-    time_ns: u64,
-    chunk: u32,
-    nth: u32,
+/// One storage file of a recording.
+enum Part {
+    Mcap(McapFile),
+    Db3(Db3File),
 }
 
-/// One message of a decoded chunk.
-#[derive(Debug)]
-struct Msg {
-    channel: u16,
-    data: Vec<u8>,
+impl Part {
+    fn len(&self) -> usize {
+        match self {
+            Self::Mcap(m) => m.frames.len(),
+            Self::Db3(d) => d.len(),
+        }
+    }
+
+    fn time_ns(&self, i: usize) -> Option<u64> {
+        match self {
+            Self::Mcap(m) => m.frames.get(i).map(|f| f.time_ns),
+            Self::Db3(d) => d.time_ns(i),
+        }
+    }
+
+    fn read_raw(&mut self, i: usize) -> Result<RawFrame<'_>, StreamError> {
+        match self {
+            Self::Mcap(m) => m.read_raw(i),
+            Self::Db3(d) => d.read_raw(i),
+        }
+    }
+
+    fn take_warnings(&mut self) -> Vec<String> {
+        match self {
+            Self::Mcap(m) => std::mem::take(&mut m.warnings),
+            Self::Db3(d) => std::mem::take(&mut d.warnings),
+        }
+    }
+
+    fn image_topics(&self) -> &[ImageTopic] {
+        match self {
+            Self::Mcap(m) => &m.image_topics,
+            Self::Db3(d) => &d.image_topics,
+        }
+    }
+
+    fn static_transforms(&mut self) -> Vec<Vec<u8>> {
+        match self {
+            Self::Mcap(m) => m.static_transforms(),
+            Self::Db3(d) => d.static_transforms(),
+        }
+    }
 }
 
-/// Reads a stream written by [`super::StreamWriter`] (or any MCAP file with `foxglove.RawImage`
-/// frames on [`IMAGE_TOPIC`]).
+/// Reads a recording: an MCAP stream written by [`super::StreamWriter`] or another tool, or a
+/// rosbag2 bag.
 ///
-/// Opening reads the summary and the image channel's message indexes (a few bytes per chunk);
-/// [`StreamReader::read`] then reads and decompresses only the chunk holding the frame and keeps
-/// that one chunk cached. Memory is this index (16 bytes a frame) plus one chunk, whatever the
-/// file's length.
+/// Opening reads the indexes only; [`StreamReader::read`] reads one frame (for MCAP, the one
+/// chunk it is in, which stays cached). Memory is the index (about 24 bytes a frame) plus one
+/// chunk, whatever the recording's length.
 pub struct StreamReader {
     path: PathBuf,
-    file: BufReader<File>,
-    file_len: u64,
-    info: StreamInfo,
-    /// The recognition parameter set the stream names (`eotn.recognition` metadata).
-    param_set: Option<String>,
-    roles: HashMap<u16, Role>,
-    chunks: Vec<ChunkLoc>,
-    frames: Vec<FrameLoc>,
+    parts: Vec<Part>,
+    /// The first frame of each part.
+    starts: Vec<usize>,
+    times: Vec<u64>,
     times_sorted: bool,
-    cache: Option<(u32, Vec<Msg>)>,
+    info: StreamInfo,
+    param_set: Option<String>,
+    chunk_count: usize,
+    zstd_messages: bool,
+    image_topics: Vec<ImageTopic>,
+    tf_static: TfTree,
     warnings: Vec<String>,
     warnings_dropped: usize,
+    grey_noted: bool,
+    /// Decompressed copies of `.zstd` storage files, removed when the reader is dropped.
+    _decompressed: Vec<tempfile::TempPath>,
 }
 
 impl std::fmt::Debug for StreamReader {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("StreamReader")
             .field("path", &self.path)
-            .field("frames", &self.frames.len())
-            .field("chunks", &self.chunks.len())
+            .field("frames", &self.times.len())
+            .field("parts", &self.parts.len())
             .finish_non_exhaustive()
     }
 }
 
-/// Schemas and channels seen so far, to give each channel its [`Role`].
-#[derive(Default)]
-struct ChannelTable {
-    schema_names: HashMap<u16, String>,
-    image: Option<u16>,
-    roles: HashMap<u16, Role>,
-    notes: Vec<String>,
-}
-
-impl ChannelTable {
-    fn add(&mut self, id: u16, topic: &str, encoding: &str, schema_name: Option<&str>) {
-        if self.roles.contains_key(&id) {
-            return;
-        }
-        let is_raw_image = schema_name == Some(RAW_IMAGE_SCHEMA) && encoding == "protobuf";
-        let role = if (topic == IMAGE_TOPIC || is_raw_image) && self.image.is_none() {
-            if !is_raw_image {
-                self.notes.push(format!(
-                    "channel {topic} is not a protobuf foxglove.RawImage (schema {}, encoding {encoding}); its frames will not decode",
-                    schema_name.unwrap_or("none")
-                ));
-            } else if topic != IMAGE_TOPIC {
-                self.notes.push(format!(
-                    "no {IMAGE_TOPIC} channel yet; frames are read from {topic}"
-                ));
-            }
-            self.image = Some(id);
-            Role::Image
-        } else if topic == ANNOTATIONS_TOPIC
-            && schema_name == Some(ANNOTATIONS_SCHEMA)
-            && encoding == "protobuf"
-        {
-            Role::Annotations
-        } else if encoding != "json" {
-            self.notes.push(format!(
-                "channel {topic} ({encoding}) is not read: only {IMAGE_TOPIC} and JSON channels are"
-            ));
-            Role::Ignored
-        } else {
-            match topic {
-                SENSORS_TOPIC => Role::Sensors,
-                GROUND_TRUTH_TOPIC => Role::GroundTruth,
-                RECOGNITION_TOPIC => Role::Recognition,
-                _ => Role::Extra(topic.to_owned()),
-            }
-        };
-        self.roles.insert(id, role);
-    }
-}
-
 impl StreamReader {
-    /// Opens a stream. Files without a summary (a recording cut off by a crash) are recovered by
-    /// scanning their complete chunks; files without frames open with zero frames. Both say so
-    /// in [`StreamReader::warnings`].
+    /// Opens a recording: an MCAP file, a rosbag2 folder (or its `metadata.yaml`), or one storage
+    /// file (`.mcap`, `.db3`, with or without `metadata.yaml` beside it). MCAP files without a
+    /// summary (a recording cut off by a crash) are recovered by scanning their complete chunks;
+    /// recordings without frames open with zero frames. Both say so in
+    /// [`StreamReader::warnings`].
     ///
     /// # Errors
-    /// [`StreamError`] naming the file when it cannot be read or is not MCAP at all.
+    /// [`StreamError`] naming the file when it cannot be read, is not MCAP or SQLite, or is a
+    /// folder that is not a bag.
     pub fn open(path: &Path) -> Result<Self, StreamError> {
-        let io = |source| StreamError::Io {
-            path: path.to_owned(),
-            source,
-        };
-        let file = File::open(path).map_err(io)?;
-        let meta = file.metadata().map_err(io)?;
-        if !meta.is_file() {
-            return Err(io(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "not a regular file, so it cannot be a stream",
-            )));
-        }
-        let file_len = meta.len();
+        let layout = layout_of(path)?;
         let mut reader = Self {
             path: path.to_owned(),
-            file: BufReader::with_capacity(64 << 10, file),
-            file_len,
+            parts: Vec::new(),
+            starts: Vec::new(),
+            times: Vec::new(),
+            times_sorted: true,
             info: StreamInfo::default(),
             param_set: None,
-            roles: HashMap::new(),
-            chunks: Vec::new(),
-            frames: Vec::new(),
-            times_sorted: true,
-            cache: None,
+            chunk_count: 0,
+            zstd_messages: layout.zstd_messages,
+            image_topics: Vec::new(),
+            tf_static: TfTree::default(),
             warnings: Vec::new(),
             warnings_dropped: 0,
+            grey_noted: false,
+            _decompressed: Vec::new(),
         };
-        let mut magic = [0u8; 8];
-        let got = reader.read_up_to(0, &mut magic)?;
-        if got < magic.len() || &magic != MAGIC {
-            let detail = if file_len == 0 {
-                "the file is empty".to_owned()
-            } else if got < magic.len() {
-                format!("only {file_len} bytes, no MCAP header")
-            } else {
-                "it does not start with the MCAP magic bytes".to_owned()
-            };
-            return Err(StreamError::NotMcap {
-                path: path.to_owned(),
-                detail,
-            });
-        }
-        let mut table = ChannelTable::default();
-        let indexed = match reader.read_summary() {
-            Ok(Some(summary)) => reader.index_from_summary(&summary, &mut table)?,
-            Ok(None) => {
-                reader.warn("the file has no summary section; scanning its chunks".to_owned());
-                false
-            }
-            Err(e) => {
-                reader.warn(format!(
-                    "no usable summary ({e}): the recording was probably cut off; scanning its complete chunks"
-                ));
-                false
-            }
-        };
-        if !indexed {
-            table = ChannelTable::default();
-            reader.chunks.clear();
-            reader.frames.clear();
-            reader.scan(&mut table)?;
-        }
-        for note in std::mem::take(&mut table.notes) {
-            reader.warn(note);
-        }
-        if table.image.is_none() {
-            reader.warn(format!(
-                "no {IMAGE_TOPIC} (foxglove.RawImage) channel: the file holds no frames"
-            ));
-        }
-        reader.roles = table.roles;
-        reader.times_sorted = reader
-            .frames
-            .windows(2)
-            .all(|w| w[0].time_ns <= w[1].time_ns);
+        reader.open_parts(&layout)?;
         Ok(reader)
+    }
+
+    fn open_parts(&mut self, layout: &Layout) -> Result<(), StreamError> {
+        if let Some(meta) = &layout.metadata {
+            for w in &meta.warnings {
+                self.warn(format!("metadata.yaml: {w}"));
+            }
+        }
+        let several = layout.parts.len() > 1;
+        let mut wanted = layout.image_topic.clone();
+        for (i, part) in layout.parts.iter().enumerate() {
+            let opened = self.open_part(part, wanted.clone());
+            let mut part_reader = match opened {
+                Ok(p) => p,
+                // One damaged file of a split bag costs its frames, not the bag.
+                Err(e) if several && i > 0 => {
+                    self.warn(format!("{e}; its frames are not read"));
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
+            let name = crate::frame::display_name(&part.path);
+            for w in part_reader.take_warnings() {
+                if several {
+                    self.warn(format!("{name}: {w}"));
+                } else {
+                    self.warn(w);
+                }
+            }
+            if wanted.is_none() {
+                wanted = part_reader.image_topics().first().map(|t| t.topic.clone());
+            }
+            for t in part_reader.image_topics() {
+                if !self.image_topics.iter().any(|k| k.topic == t.topic) {
+                    self.image_topics.push(t.clone());
+                }
+            }
+            for bytes in part_reader.static_transforms() {
+                let bytes = if self.zstd_messages {
+                    match assemble_unzstd(&bytes) {
+                        Ok(b) => b,
+                        Err(_) => continue,
+                    }
+                } else {
+                    bytes
+                };
+                if let Ok(msg) = ros2::decode::<ros2::TfMessage>(&bytes) {
+                    self.tf_static.add(&msg);
+                }
+            }
+            if let Part::Mcap(m) = &part_reader {
+                if i == 0 {
+                    self.info = m.info.clone();
+                    self.param_set = m.param_set.clone();
+                }
+                self.chunk_count += m.chunk_count();
+            }
+            self.starts.push(self.times.len());
+            for f in 0..part_reader.len() {
+                self.times.push(part_reader.time_ns(f).unwrap_or(0));
+            }
+            self.parts.push(part_reader);
+        }
+        if self.info == StreamInfo::default() {
+            self.info.source = "unknown".to_owned();
+        }
+        self.times_sorted = self.times.windows(2).all(|w| w[0] <= w[1]);
+        Ok(())
+    }
+
+    fn open_part(
+        &mut self,
+        part: &StoragePart,
+        wanted: Option<String>,
+    ) -> Result<Part, StreamError> {
+        let path = if part.zstd_file {
+            let temp = decompress_to_temp(&part.path)?;
+            let p = temp.to_path_buf();
+            self._decompressed.push(temp);
+            p
+        } else {
+            part.path.clone()
+        };
+        Ok(match part.kind {
+            StorageKind::Mcap => Part::Mcap(McapFile::open(&path, wanted)?),
+            StorageKind::Sqlite => Part::Db3(Db3File::open(&path, wanted)?),
+        })
     }
 
     /// What the stream is (from its `eotn.stream` metadata; source `"unknown"` without it).
@@ -244,7 +262,7 @@ impl StreamReader {
     }
 
     /// The recognition parameter set the stream is meant for (`"spl2009"`): its
-    /// [`PARAMS_METADATA_NAME`] metadata record, else the set known for its source kind
+    /// [`super::PARAMS_METADATA_NAME`] metadata record, else the set known for its source kind
     /// ([`param_set_of_source`]: B-Human streams imported before the record existed); `None`
     /// for the built-in defaults.
     #[must_use]
@@ -254,7 +272,7 @@ impl StreamReader {
             .or_else(|| param_set_of_source(&self.info.source))
     }
 
-    /// The file this reader reads.
+    /// The file or folder this reader reads.
     #[must_use]
     pub fn path(&self) -> &Path {
         &self.path
@@ -263,25 +281,32 @@ impl StreamReader {
     /// Number of frames.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.frames.len()
+        self.times.len()
     }
 
     /// True when the stream holds no frames.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.frames.is_empty()
+        self.times.is_empty()
     }
 
-    /// Number of chunks holding frames (or, after a recovery scan, the complete chunks found).
+    /// Number of MCAP chunks holding frames (or, after a recovery scan, the complete chunks
+    /// found); 0 for SQLite storage.
     #[must_use]
     pub fn chunk_count(&self) -> usize {
-        self.chunks.len()
+        self.chunk_count
+    }
+
+    /// Every camera image topic of the recording with its message type, the one read first.
+    #[must_use]
+    pub fn image_topics(&self) -> &[ImageTopic] {
+        &self.image_topics
     }
 
     /// Capture time of frame `index`, nanoseconds, or `None` past the end.
     #[must_use]
     pub fn time_ns(&self, index: usize) -> Option<u64> {
-        self.frames.get(index).map(|f| f.time_ns)
+        self.times.get(index).copied()
     }
 
     /// The frame at or before `time_ns` (the latest such; the first frame when all are later,
@@ -290,22 +315,22 @@ impl StreamReader {
     pub fn index_at_time(&self, time_ns: u64) -> usize {
         if self.times_sorted {
             return self
-                .frames
-                .partition_point(|f| f.time_ns <= time_ns)
+                .times
+                .partition_point(|&t| t <= time_ns)
                 .saturating_sub(1);
         }
         let mut best: Option<(u64, usize)> = None;
-        for (i, f) in self.frames.iter().enumerate() {
-            if f.time_ns <= time_ns && best.is_none_or(|(t, _)| f.time_ns >= t) {
-                best = Some((f.time_ns, i));
+        for (i, &t) in self.times.iter().enumerate() {
+            if t <= time_ns && best.is_none_or(|(b, _)| t >= b) {
+                best = Some((t, i));
             }
         }
         best.map_or_else(
             || {
-                self.frames
+                self.times
                     .iter()
                     .enumerate()
-                    .min_by_key(|(_, f)| f.time_ns)
+                    .min_by_key(|(_, t)| **t)
                     .map_or(0, |(i, _)| i)
             },
             |(_, i)| i,
@@ -322,105 +347,80 @@ impl StreamReader {
     /// Reads frame `index` with all its data.
     ///
     /// # Errors
-    /// [`StreamError::NoSuchFrame`] past the end; I/O or corruption errors naming the file.
+    /// [`StreamError::NoSuchFrame`] past the end; I/O or corruption errors naming the file; an
+    /// image that does not decode (that frame only).
     pub fn read(&mut self, index: usize) -> Result<FrameRecord, StreamError> {
-        let loc = *self
-            .frames
-            .get(index)
-            .ok_or_else(|| StreamError::NoSuchFrame {
-                path: self.path.clone(),
-                index,
-                len: self.frames.len(),
-            })?;
-        if self.cache.as_ref().is_none_or(|(c, _)| *c != loc.chunk) {
-            self.cache = None;
-            let messages = self.load_chunk(loc.chunk)?;
-            self.cache = Some((loc.chunk, messages));
-        }
-        let Some((_, messages)) = self.cache.take() else {
-            return Err(self.corrupt(format!("frame {index}: its chunk could not be loaded")));
-        };
-        let result = self.assemble(index, loc, &messages);
-        self.cache = Some((loc.chunk, messages));
-        result
+        Ok(self.read_frame(index, false)?.0)
     }
 
-    fn assemble(
+    /// Reads frame `index` and its image message as it was stored (for `eotn import`, which
+    /// keeps it unchanged).
+    ///
+    /// # Errors
+    /// As [`StreamReader::read`].
+    pub fn read_with_image(
         &mut self,
         index: usize,
-        loc: FrameLoc,
-        messages: &[Msg],
-    ) -> Result<FrameRecord, StreamError> {
-        let mut images = messages
-            .iter()
-            .enumerate()
-            .filter(|(_, m)| self.roles.get(&m.channel) == Some(&Role::Image));
-        let Some((at, image)) = images.nth(loc.nth as usize) else {
-            return Err(self.corrupt(format!(
-                "frame {index}: its chunk does not hold the indexed image"
-            )));
+    ) -> Result<(FrameRecord, ImageMessage), StreamError> {
+        let (record, image) = self.read_frame(index, true)?;
+        let image = image.ok_or_else(|| StreamError::Corrupt {
+            path: self.path.clone(),
+            detail: format!("frame {index}: its image message was not kept"),
+        })?;
+        Ok((record, image))
+    }
+
+    fn read_frame(
+        &mut self,
+        index: usize,
+        keep_image: bool,
+    ) -> Result<(FrameRecord, Option<ImageMessage>), StreamError> {
+        let len = self.times.len();
+        let no_such = |path: &Path| StreamError::NoSuchFrame {
+            path: path.to_owned(),
+            index,
+            len,
         };
-        let frame = decode_image(&image.data)
-            .map_err(|detail| self.corrupt(format!("frame {index}: {detail}")))?;
-        let mut record = FrameRecord::new(loc.time_ns, frame);
-        for m in messages.iter().skip(at + 1) {
-            let role = self.roles.get(&m.channel).cloned().unwrap_or(Role::Ignored);
-            if role == Role::Image {
-                break;
-            }
-            if role == Role::Ignored {
-                continue;
-            }
-            if role == Role::Annotations {
-                match foxglove::messages::ImageAnnotations::decode(m.data.as_slice()) {
-                    Ok(a) => record.annotations = Some(a),
-                    Err(e) => self.warn(format!(
-                        "frame {index}: {ANNOTATIONS_TOPIC} is not a foxglove.ImageAnnotations ({e}); skipped"
-                    )),
-                }
-                continue;
-            }
-            let value = match parse_json_lenient(&m.data) {
-                Ok((v, replaced)) => {
-                    if replaced {
-                        self.warn(format!(
-                            "frame {index}: {} has NaN/Infinity values; read as missing",
-                            topic_of(&role)
-                        ));
-                    }
-                    v
-                }
-                Err(e) => {
-                    self.warn(format!(
-                        "frame {index}: {} is not valid JSON ({e}); skipped",
-                        topic_of(&role)
-                    ));
-                    continue;
-                }
-            };
-            match role {
-                Role::Sensors => match serde_json::from_value::<SensorReadings>(value) {
-                    Ok(s) => {
-                        let (clean, dropped) = s.sanitised();
-                        if !dropped.is_empty() {
-                            self.warn(format!(
-                                "frame {index}: non-finite or impossible sensor values dropped: {}",
-                                dropped.join(", ")
-                            ));
-                        }
-                        record.sensors = Some(clean);
-                    }
-                    Err(e) => self.warn(format!(
-                        "frame {index}: {SENSORS_TOPIC} does not match the sensor schema ({e}); skipped"
-                    )),
-                },
-                Role::GroundTruth => record.ground_truth = Some(value),
-                Role::Recognition => record.recognition = Some(value),
-                Role::Extra(topic) => record.extra.push((topic, value)),
-                Role::Image | Role::Annotations | Role::Ignored => {}
-            }
+        if index >= len {
+            return Err(no_such(&self.path));
         }
-        Ok(record)
+        let p = self
+            .starts
+            .partition_point(|&s| s <= index)
+            .saturating_sub(1);
+        let local = index - self.starts.get(p).copied().unwrap_or(0);
+        let Self {
+            parts,
+            tf_static,
+            zstd_messages,
+            path,
+            ..
+        } = self;
+        let Some(part) = parts.get_mut(p) else {
+            return Err(no_such(path));
+        };
+        let raw = part.read_raw(local)?;
+        let assembled = assemble::assemble(index, raw, tf_static, *zstd_messages, keep_image)
+            .map_err(|detail| StreamError::Corrupt {
+                path: path.clone(),
+                detail: format!("frame {index}: {detail}"),
+            });
+        let part_warnings = part.take_warnings();
+        for w in part_warnings {
+            self.warn(w);
+        }
+        let assembled = assembled?;
+        for w in assembled.warnings {
+            self.warn(w);
+        }
+        if assembled.grey && !self.grey_noted {
+            self.grey_noted = true;
+            self.warn(
+                "the frames are mono8 (grey): they show and step, but a colour table cannot classify them"
+                    .to_owned(),
+            );
+        }
+        Ok((assembled.record, assembled.image))
     }
 
     fn warn(&mut self, text: String) {
@@ -436,258 +436,51 @@ impl StreamReader {
             *last = note;
         }
     }
-
-    fn corrupt(&self, detail: String) -> StreamError {
-        StreamError::Corrupt {
-            path: self.path.clone(),
-            detail,
-        }
-    }
-
-    fn mcap_err(&self, context: String) -> impl FnOnce(mcap::McapError) -> StreamError {
-        let path = self.path.clone();
-        move |source| StreamError::Mcap {
-            path,
-            context,
-            source,
-        }
-    }
-
-    /// Reads as many bytes as the file has at `offset`, up to `buf.len()`.
-    fn read_up_to(&mut self, offset: u64, buf: &mut [u8]) -> Result<usize, StreamError> {
-        let io = |source| StreamError::Io {
-            path: self.path.clone(),
-            source,
-        };
-        self.file.seek(SeekFrom::Start(offset)).map_err(io)?;
-        let mut got = 0;
-        while got < buf.len() {
-            match self.file.read(&mut buf[got..]) {
-                Ok(0) => break,
-                Ok(n) => got += n,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                Err(e) => return Err(io(e)),
-            }
-        }
-        Ok(got)
-    }
-
-    /// Reads `len` bytes at `offset`, which the caller has checked lie inside the file.
-    fn read_exact_at(&mut self, offset: u64, len: u64) -> Result<Vec<u8>, StreamError> {
-        let n = usize::try_from(len).map_err(|_| self.corrupt(format!("{len} bytes too large")))?;
-        let mut buf = vec![0u8; n];
-        let got = self.read_up_to(offset, &mut buf)?;
-        if got < n {
-            return Err(self.corrupt(format!(
-                "the file ends {got} bytes into a {n}-byte record at offset {offset}"
-            )));
-        }
-        Ok(buf)
-    }
-
-    /// Reads one record (opcode, length, body) at `offset` whose total length must not exceed
-    /// `limit` bytes.
-    fn read_record_at(&mut self, offset: u64, limit: u64) -> Result<(u8, Vec<u8>), StreamError> {
-        let head = self.read_exact_at(offset, 9)?;
-        let opcode = head[0];
-        let len = u64::from_le_bytes(head[1..9].try_into().unwrap_or([0xff; 8]));
-        let end = offset.saturating_add(9).saturating_add(len);
-        if len > limit || end > self.file_len {
-            return Err(self.corrupt(format!(
-                "record at offset {offset} claims {len} bytes, beyond the file or any sane size"
-            )));
-        }
-        Ok((opcode, self.read_exact_at(offset + 9, len)?))
-    }
-
-    fn read_summary(&mut self) -> Result<Option<mcap::Summary>, StreamError> {
-        let path = self.path.clone();
-        let io = |source| StreamError::Io {
-            path: path.clone(),
-            source,
-        };
-        let mut summary = SummaryReader::new_with_options(
-            SummaryReaderOptions::default()
-                .with_file_size(self.file_len)
-                .with_record_length_limit(256 << 20),
-        );
-        let mut steps = 0u64;
-        while let Some(event) = summary.next_event() {
-            steps += 1;
-            if steps > 100_000_000 {
-                return Err(self.corrupt("the summary section never ends".to_owned()));
-            }
-            match event.map_err(self.mcap_err("reading the summary".to_owned()))? {
-                SummaryReadEvent::ReadRequest(n) => {
-                    let got = self.file.read(summary.insert(n)).map_err(io)?;
-                    summary.notify_read(got);
-                }
-                SummaryReadEvent::SeekRequest(to) => {
-                    let pos = self.file.seek(to).map_err(io)?;
-                    summary.notify_seeked(pos);
-                }
-            }
-        }
-        Ok(summary.finish())
-    }
-
-    /// Builds the frame index from the summary; `false` when the summary cannot locate the
-    /// frames (no chunk indexes), so the caller scans instead.
-    fn index_from_summary(
-        &mut self,
-        summary: &mcap::Summary,
-        table: &mut ChannelTable,
-    ) -> Result<bool, StreamError> {
-        for index in &summary.metadata_indexes {
-            if index.name != METADATA_NAME && index.name != PARAMS_METADATA_NAME {
-                continue;
-            }
-            if index.length > MAX_INDEX_BYTES
-                || index.offset.saturating_add(index.length) > self.file_len
-            {
-                self.warn("the stream metadata index points outside the file".to_owned());
-                continue;
-            }
-            match self.read_record_at(index.offset, MAX_INDEX_BYTES) {
-                Ok((opcode, body)) => self.take_metadata(opcode, &body),
-                Err(e) => self.warn(format!("stream metadata unreadable: {e}")),
-            }
-        }
-        if self.info == StreamInfo::default() {
-            self.no_metadata();
-        }
-        let mut ids: Vec<u16> = summary.channels.keys().copied().collect();
-        ids.sort_unstable();
-        // Prefer the canonical image topic over any other RawImage channel.
-        ids.sort_by_key(|id| {
-            summary
-                .channels
-                .get(id)
-                .is_none_or(|c| c.topic != IMAGE_TOPIC)
-        });
-        for id in ids {
-            if let Some(c) = summary.channels.get(&id) {
-                let schema = c.schema.as_ref().map(|s| s.name.as_str());
-                table.add(id, &c.topic, &c.message_encoding, schema);
-            }
-        }
-        let messages = summary.stats.as_ref().map_or(1, |s| s.message_count);
-        if summary.chunk_indexes.is_empty() {
-            return Ok(messages == 0);
-        }
-        let Some(image) = table.image else {
-            return Ok(true);
-        };
-        let mut chunk_indexes: Vec<&mcap::records::ChunkIndex> =
-            summary.chunk_indexes.iter().collect();
-        chunk_indexes.sort_by_key(|c| c.chunk_start_offset);
-        for ci in chunk_indexes {
-            if ci.chunk_length > MAX_CHUNK_BYTES
-                || ci.chunk_start_offset.saturating_add(ci.chunk_length) > self.file_len
-            {
-                self.warn(format!(
-                    "chunk index points outside the file (offset {}, {} bytes); the summary is not trusted",
-                    ci.chunk_start_offset, ci.chunk_length
-                ));
-                return Ok(false);
-            }
-            let Some(&at) = ci.message_index_offsets.get(&image) else {
-                continue;
-            };
-            let entries = match self.read_record_at(at, MAX_INDEX_BYTES) {
-                Ok((op::MESSAGE_INDEX, body)) => match mcap::parse_record(op::MESSAGE_INDEX, &body)
-                {
-                    Ok(Record::MessageIndex(mi)) if mi.channel_id == image => mi.records,
-                    _ => {
-                        self.warn(format!(
-                            "message index at offset {at} is malformed; scanning instead"
-                        ));
-                        return Ok(false);
-                    }
-                },
-                Ok(_) | Err(_) => {
-                    self.warn(format!(
-                        "message index at offset {at} is unreadable; scanning instead"
-                    ));
-                    return Ok(false);
-                }
-            };
-            let chunk = u32::try_from(self.chunks.len())
-                .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
-            self.chunks.push(ChunkLoc {
-                offset: ci.chunk_start_offset,
-                length: ci.chunk_length,
-            });
-            let mut entries = entries;
-            entries.sort_by_key(|e| e.offset);
-            for (nth, e) in entries.iter().enumerate() {
-                self.frames.push(FrameLoc {
-                    time_ns: e.log_time,
-                    chunk,
-                    nth: u32::try_from(nth).unwrap_or(u32::MAX),
-                });
-            }
-        }
-        Ok(true)
-    }
-
-    fn no_metadata(&mut self) {
-        self.info = StreamInfo {
-            source: "unknown".to_owned(),
-            description: String::new(),
-        };
-        self.warn(format!(
-            "no {METADATA_NAME} metadata: not written by eotn, source unknown"
-        ));
-    }
-
-    fn take_metadata(&mut self, opcode: u8, body: &[u8]) {
-        match mcap::parse_record(opcode, body) {
-            Ok(Record::Metadata(m)) if m.name == METADATA_NAME => {
-                let get = |k: &str| m.metadata.get(k).cloned().unwrap_or_default();
-                self.info = StreamInfo {
-                    source: get("source"),
-                    description: get("description"),
-                };
-            }
-            Ok(Record::Metadata(m)) if m.name == PARAMS_METADATA_NAME => {
-                self.param_set = m.metadata.get("params").filter(|s| !s.is_empty()).cloned();
-            }
-            Ok(Record::Metadata(_)) => {}
-            _ => self.warn("a metadata record is malformed; ignored".to_owned()),
-        }
-    }
-
-    /// Reads and decompresses chunk `chunk` into its messages.
-    fn load_chunk(&mut self, chunk: u32) -> Result<Vec<Msg>, StreamError> {
-        let loc = *self
-            .chunks
-            .get(chunk as usize)
-            .ok_or_else(|| self.corrupt(format!("no chunk {chunk}")))?;
-        let (opcode, body) = self.read_record_at(loc.offset, loc.length.saturating_sub(9))?;
-        if opcode != op::CHUNK {
-            return Err(self.corrupt(format!(
-                "the chunk index points at offset {} which holds no chunk",
-                loc.offset
-            )));
-        }
-        let mut messages = Vec::new();
-        decode_chunk_messages(&body, &mut messages)
-            .map_err(self.mcap_err(format!("reading the chunk at offset {}", loc.offset)))?;
-        Ok(messages)
-    }
 }
 
-fn topic_of(role: &Role) -> &str {
-    match role {
-        Role::Image => IMAGE_TOPIC,
-        Role::Sensors => SENSORS_TOPIC,
-        Role::GroundTruth => GROUND_TRUTH_TOPIC,
-        Role::Recognition => RECOGNITION_TOPIC,
-        Role::Annotations => ANNOTATIONS_TOPIC,
-        Role::Extra(t) => t,
-        Role::Ignored => "an ignored channel",
+fn assemble_unzstd(data: &[u8]) -> Result<Vec<u8>, String> {
+    use std::io::Read as _;
+    let mut out = Vec::new();
+    zstd::stream::read::Decoder::new(data)
+        .map_err(|e| e.to_string())?
+        .take(64 << 20)
+        .read_to_end(&mut out)
+        .map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
+/// A `.zstd` storage file decompressed into a temporary file (removed when dropped).
+fn decompress_to_temp(path: &Path) -> Result<tempfile::TempPath, StreamError> {
+    use std::io::{Read as _, Write as _};
+    let io = |source| StreamError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let input = std::fs::File::open(path).map_err(io)?;
+    if !input.metadata().map_err(io)?.is_file() {
+        return Err(io(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file",
+        )));
     }
+    let mut out = tempfile::NamedTempFile::new().map_err(io)?;
+    let decoder = zstd::stream::read::Decoder::new(input).map_err(io)?;
+    let copied = std::io::copy(
+        &mut decoder.take(MAX_DECOMPRESSED_FILE + 1),
+        out.as_file_mut(),
+    )
+    .map_err(|e| StreamError::Corrupt {
+        path: path.to_owned(),
+        detail: format!("zstd: {e}"),
+    })?;
+    if copied > MAX_DECOMPRESSED_FILE {
+        return Err(StreamError::Corrupt {
+            path: path.to_owned(),
+            detail: "decompresses to more than 64 GiB".to_owned(),
+        });
+    }
+    out.flush().map_err(io)?;
+    Ok(out.into_temp_path())
 }
 
 #[cfg(test)]
@@ -699,7 +492,7 @@ mod tests {
     /// A file from another writer: frames on another topic, times out of order, default
     /// chunking, no eotn metadata.
     fn foreign_file(path: &Path, times: &[u64]) {
-        let file = std::io::BufWriter::new(File::create(path).unwrap());
+        let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
         let mut w = mcap::Writer::new(file).unwrap();
         let s = raw_image_schema().unwrap();
         let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();

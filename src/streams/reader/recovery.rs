@@ -4,13 +4,12 @@
 
 use mcap::records::{Record, op};
 
+use super::super::{StreamError, StreamInfo};
+use super::channels::{ChannelTable, Role};
 use super::chunk::{ChunkItem, decode_chunk};
-use super::{
-    ChannelTable, ChunkLoc, FrameLoc, MAX_CHUNK_BYTES, MAX_INDEX_BYTES, StreamError, StreamInfo,
-    StreamReader,
-};
+use super::mcap_file::{ChunkLoc, FrameLoc, MAX_CHUNK_BYTES, MAX_INDEX_BYTES, McapFile};
 
-impl StreamReader {
+impl McapFile {
     /// Recovery: walks the data section record by record, decompressing each chunk once, and
     /// stops at the first record that is cut off or damaged.
     pub(super) fn scan(&mut self, table: &mut ChannelTable) -> Result<(), StreamError> {
@@ -87,6 +86,7 @@ impl StreamReader {
         let chunk = u32::try_from(self.chunks.len())
             .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
         let mut nth = 0u32;
+        let mut has_static = false;
         for r in records {
             match r {
                 ChunkItem::Schema(id, name) => {
@@ -94,6 +94,7 @@ impl StreamReader {
                 }
                 ChunkItem::Channel(c) => add_channel(table, &c),
                 ChunkItem::Message(channel, log_time) => {
+                    has_static |= table.roles.get(&channel) == Some(&Role::Tf(true));
                     if Some(channel) == table.image {
                         self.frames.push(FrameLoc {
                             time_ns: log_time,
@@ -105,10 +106,14 @@ impl StreamReader {
                 }
             }
         }
-        self.chunks.push(ChunkLoc {
+        let loc = ChunkLoc {
             offset,
             length: len + 9,
-        });
+        };
+        if has_static {
+            self.note_static_chunk(loc);
+        }
+        self.chunks.push(loc);
         Ok(true)
     }
 
