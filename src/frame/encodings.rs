@@ -3,7 +3,8 @@
 //! The 4:2:2 orders stay 4:2:2 (UYVY, the pipeline's own layout: YUYV is reordered, nothing is
 //! lost). Everything else becomes a 4:4:4 frame: RGB and BGR (with or without alpha) through the
 //! one RGB → YUV conversion ([`super::colour::RgbToYuv`]), `nv12` with its chroma up-sampled
-//! bilinearly, 8-bit Bayer demosaiced bilinearly, `mono8` as grey (U = V = 128: it shows and
+//! bilinearly, 8-bit Bayer demosaiced linearly (bilinear with Malvar–He–Cutler's gradient
+//! correction), `mono8` as grey (U = V = 128: it shows and
 //! steps, but a colour table cannot classify it). `step` (bytes a row, padding included) is
 //! honoured for every encoding.
 
@@ -436,8 +437,29 @@ fn from_nv12(w: usize, h: usize, rows: &Rows<'_>) -> Result<Frame, FrameError> {
     Frame::new(w, h, PixelLayout::Yuv444Packed, data)
 }
 
-/// An 8-bit Bayer mosaic demosaiced bilinearly (each missing colour the mean of the nearest
-/// photosites of that colour, edges mirrored) into a 4:4:4 frame.
+/// Malvar–He–Cutler kernels (×16, 5×5, row-major) for one missing colour: bilinear
+/// interpolation corrected by the photosite's own Laplacian, which keeps edges from growing
+/// colour fringes. Green at a red or blue photosite:
+const MHC_GREEN: [i32; 25] = [
+    0, 0, -2, 0, 0, 0, 0, 4, 0, 0, -2, 4, 8, 4, -2, 0, 0, 4, 0, 0, 0, 0, -2, 0, 0,
+];
+/// At a green photosite, the colour whose neighbours lie left and right.
+const MHC_ROW: [i32; 25] = [
+    0, 0, 1, 0, 0, 0, -2, 0, -2, 0, -2, 8, 10, 8, -2, 0, -2, 0, -2, 0, 0, 0, 1, 0, 0,
+];
+/// At a green photosite, the colour whose neighbours lie above and below.
+const MHC_COLUMN: [i32; 25] = [
+    0, 0, -2, 0, 0, 0, -2, 8, -2, 0, 1, 0, 10, 0, 1, 0, -2, 8, -2, 0, 0, 0, -2, 0, 0,
+];
+/// Red at a blue photosite, or blue at a red one.
+const MHC_DIAGONAL: [i32; 25] = [
+    0, 0, -3, 0, 0, 0, 4, 0, 4, 0, -3, 0, 12, 0, -3, 0, 4, 0, 4, 0, 0, 0, -3, 0, 0,
+];
+
+/// An 8-bit Bayer mosaic demosaiced linearly into a 4:4:4 frame: each missing colour from the
+/// nearest photosites of that colour (bilinear), corrected by the local gradient
+/// (Malvar, He and Cutler 2004: "High-quality linear interpolation for demosaicing of
+/// Bayer-patterned color images"); edges mirrored.
 fn from_bayer(w: usize, h: usize, rows: &Rows<'_>, order: BayerOrder) -> Result<Frame, FrameError> {
     let t = RgbToYuv::get();
     // Mirrored neighbour index: -1 → 1, n → n - 2 (keeps the colour of the photosite).
@@ -452,37 +474,37 @@ fn from_bayer(w: usize, h: usize, rows: &Rows<'_>, order: BayerOrder) -> Result<
         };
         usize::try_from(m.clamp(0, (n - 1).max(0))).unwrap_or(0)
     };
-    let at = |x: isize, y: isize| -> u16 {
+    let at = |x: isize, y: isize| -> i32 {
         let row = rows.get(mirror(y, h));
-        u16::from(row.get(mirror(x, w)).copied().unwrap_or(0))
+        i32::from(row.get(mirror(x, w)).copied().unwrap_or(0))
+    };
+    let apply = |kernel: &[i32; 25], x: isize, y: isize| -> i32 {
+        let mut sum = 0;
+        for (k, &c) in kernel.iter().enumerate() {
+            if c != 0 {
+                let (dx, dy) = ((k % 5) as isize - 2, (k / 5) as isize - 2);
+                sum += c * at(x + dx, y + dy);
+            }
+        }
+        (sum + 8) >> 4
     };
     let mut data = Vec::with_capacity(w * h * 3);
     for y in 0..h {
         for x in 0..w {
             let (xi, yi) = (x as isize, y as isize);
             let here = order.colour_at(x, y);
-            let own = at(xi, yi);
-            let cross = (at(xi - 1, yi) + at(xi + 1, yi) + at(xi, yi - 1) + at(xi, yi + 1) + 2) / 4;
-            let diag = (at(xi - 1, yi - 1)
-                + at(xi + 1, yi - 1)
-                + at(xi - 1, yi + 1)
-                + at(xi + 1, yi + 1)
-                + 2)
-                / 4;
-            let horiz = (at(xi - 1, yi) + at(xi + 1, yi) + 1) / 2;
-            let vert = (at(xi, yi - 1) + at(xi, yi + 1) + 1) / 2;
-            let mut rgb = [0u16; 3];
-            rgb[here] = own;
+            let mut rgb = [0i32; 3];
+            rgb[here] = at(xi, yi);
             if here == 1 {
-                // Green: red and blue lie left/right on one row and above/below on the other.
+                // Green: one colour lies left and right on this row, the other above and below.
                 let row_colour = order.colour_at(x + 1, y);
-                rgb[row_colour] = horiz;
-                rgb[2 - row_colour] = vert;
+                rgb[row_colour] = apply(&MHC_ROW, xi, yi);
+                rgb[2 - row_colour] = apply(&MHC_COLUMN, xi, yi);
             } else {
-                rgb[1] = cross;
-                rgb[2 - here] = diag;
+                rgb[1] = apply(&MHC_GREEN, xi, yi);
+                rgb[2 - here] = apply(&MHC_DIAGONAL, xi, yi);
             }
-            let c = |v: u16| u8::try_from(v.min(255)).unwrap_or(u8::MAX);
+            let c = |v: i32| u8::try_from(v.clamp(0, 255)).unwrap_or(u8::MAX);
             let yuv = t.convert(c(rgb[0]), c(rgb[1]), c(rgb[2]));
             data.extend_from_slice(&[yuv.y, yuv.u, yuv.v]);
         }

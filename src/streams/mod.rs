@@ -1,8 +1,10 @@
 //! Recorded streams: camera frames with the robot's sensor readings, ground truth and recognition
 //! results, in one MCAP file that Foxglove and other MCAP tools open.
 //!
-//! One frame is one message on [`IMAGE_TOPIC`] (`foxglove.RawImage`, protobuf, encoding `uyvy`,
-//! `step` = 2 × width bytes). The frame's other data are JSON messages with the image's log time,
+//! One frame is one message on [`IMAGE_TOPIC`] (`foxglove.RawImage`, protobuf; frames eotn makes
+//! are `yuyv` or `uyvy` with `step` = 2 × width bytes; images imported from other recordings keep
+//! their own encoding and step) or, for images that came compressed, on
+//! [`COMPRESSED_IMAGE_TOPIC`] (`foxglove.CompressedImage`, JPEG or PNG, unchanged). The frame's other data are JSON messages with the image's log time,
 //! written right after it in the same chunk: [`SENSORS_TOPIC`] (a [`SensorReadings`]),
 //! [`GROUND_TRUTH_TOPIC`], [`RECOGNITION_TOPIC`] and any extra JSON channels (for example
 //! `/world_model/robot3`). Every JSON channel has a `jsonschema` schema. The stream's
@@ -37,6 +39,9 @@ use crate::sensors::SensorReadings;
 
 /// Topic of the camera image channel (`foxglove.RawImage`, protobuf).
 pub const IMAGE_TOPIC: &str = "/camera/image";
+/// Topic of camera images stored compressed, as they came (`foxglove.CompressedImage`, JPEG or
+/// PNG, written by `eotn import` from recordings that hold them).
+pub const COMPRESSED_IMAGE_TOPIC: &str = "/camera/image/compressed";
 /// Topic of the sensor readings channel (JSON, schema `eotn.SensorReadings`).
 pub const SENSORS_TOPIC: &str = "/sensors";
 /// Topic of the ground-truth channel (JSON object, free form; written by renderers/simulators).

@@ -30,6 +30,7 @@ mod peer;
 mod properties;
 mod real_data;
 mod recognition;
+mod recordings;
 mod robots;
 mod sim;
 mod sim_table;

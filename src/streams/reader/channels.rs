@@ -78,6 +78,8 @@ pub(crate) struct ChannelTable {
     /// Every image channel, in the order met.
     pub(crate) image_topics: Vec<ImageTopic>,
     pub(crate) notes: Vec<String>,
+    /// Channels of types eotn does not read, named once in the notes.
+    unread: Vec<String>,
 }
 
 impl ChannelTable {
@@ -124,10 +126,9 @@ impl ChannelTable {
                 _ => Role::Extra(topic.to_owned()),
             },
             _ => {
-                self.notes.push(format!(
-                    "channel {topic} ({} in {encoding}) is not read: eotn reads {}",
-                    schema_name.filter(|s| !s.is_empty()).unwrap_or("no schema"),
-                    MessageKind::NAMES
+                self.unread.push(format!(
+                    "{topic} ({}, {encoding})",
+                    schema_name.filter(|s| !s.is_empty()).unwrap_or("no schema")
                 ));
                 Role::Ignored
             }
@@ -158,8 +159,17 @@ impl ChannelTable {
         }
     }
 
-    /// The notes of a finished table: the other cameras, by name.
+    /// The notes of a finished table: the channels not read and the other cameras, by name.
     pub(crate) fn note_other_cameras(&mut self) {
+        if !self.unread.is_empty() {
+            self.notes.push(format!(
+                "{} channels are not read: {} (eotn reads {})",
+                self.unread.len(),
+                self.unread.join(", "),
+                MessageKind::NAMES
+            ));
+            self.unread.clear();
+        }
         let Some(chosen) = self.image_topic.clone() else {
             return;
         };
