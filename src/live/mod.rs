@@ -9,6 +9,7 @@
 //! [`source`] is a robot as a [`crate::sources::FrameSource`] for the workspace and the app.
 
 pub mod client;
+mod gaps;
 pub mod protocol;
 pub mod recorder;
 pub mod robot;

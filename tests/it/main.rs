@@ -20,6 +20,7 @@ mod cli;
 mod common;
 mod crash_safety;
 mod hardening;
+mod jpeg_colour;
 #[cfg(feature = "gui")]
 mod harness;
 mod live;

@@ -443,50 +443,7 @@ impl McapFile {
         if self.info == StreamInfo::default() {
             self.no_metadata();
         }
-        let mut ids: Vec<u16> = summary.channels.keys().copied().collect();
-        ids.sort_unstable();
-        // Prefer the canonical image topic over any other RawImage channel.
-        ids.sort_by_key(|id| {
-            summary
-                .channels
-                .get(id)
-                .is_none_or(|c| c.topic != IMAGE_TOPIC)
-        });
-        // A channel no chunk holds messages of is never chosen as the camera.
-        let with_messages: HashSet<u16> = if summary.chunk_indexes.is_empty() {
-            summary.stats.as_ref().map_or_else(
-                || ids.iter().copied().collect(),
-                |s| {
-                    s.channel_message_counts
-                        .iter()
-                        .filter(|(_, n)| **n > 0)
-                        .map(|(id, _)| *id)
-                        .collect()
-                },
-            )
-        } else {
-            summary
-                .chunk_indexes
-                .iter()
-                .flat_map(|c| c.message_index_offsets.keys().copied())
-                .collect()
-        };
-        table.empty = ids
-            .iter()
-            .copied()
-            .filter(|id| !with_messages.contains(id))
-            .collect();
-        for &id in &ids {
-            if let Some(c) = summary.channels.get(&id) {
-                let schema = c.schema.as_ref().map(|s| s.name.as_str());
-                table.add(id, &c.topic, &c.message_encoding, schema);
-            }
-        }
-        let statics: HashSet<u16> = ids
-            .iter()
-            .copied()
-            .filter(|id| table.roles.get(id) == Some(&Role::Tf(true)))
-            .collect();
+        let statics = channels_from_summary(summary, table);
         let messages = summary.stats.as_ref().map_or(1, |s| s.message_count);
         if summary.chunk_indexes.is_empty() {
             return Ok(messages == 0);
@@ -604,4 +561,52 @@ impl McapFile {
             .map_err(self.mcap_err(format!("reading the chunk at offset {}", loc.offset)))?;
         Ok(messages)
     }
+}
+
+/// Gives every channel of the summary its role (the canonical image topic first, channels
+/// without messages never the camera); returns the `/tf_static` channels.
+fn channels_from_summary(summary: &mcap::Summary, table: &mut ChannelTable) -> HashSet<u16> {
+    let mut ids: Vec<u16> = summary.channels.keys().copied().collect();
+    ids.sort_unstable();
+    // Prefer the canonical image topic over any other RawImage channel.
+    ids.sort_by_key(|id| {
+        summary
+            .channels
+            .get(id)
+            .is_none_or(|c| c.topic != IMAGE_TOPIC)
+    });
+    // A channel no chunk holds messages of is never chosen as the camera.
+    let with_messages: HashSet<u16> = if summary.chunk_indexes.is_empty() {
+        summary.stats.as_ref().map_or_else(
+            || ids.iter().copied().collect(),
+            |s| {
+                s.channel_message_counts
+                    .iter()
+                    .filter(|(_, n)| **n > 0)
+                    .map(|(id, _)| *id)
+                    .collect()
+            },
+        )
+    } else {
+        summary
+            .chunk_indexes
+            .iter()
+            .flat_map(|c| c.message_index_offsets.keys().copied())
+            .collect()
+    };
+    table.empty = ids
+        .iter()
+        .copied()
+        .filter(|id| !with_messages.contains(id))
+        .collect();
+    for &id in &ids {
+        if let Some(c) = summary.channels.get(&id) {
+            let schema = c.schema.as_ref().map(|s| s.name.as_str());
+            table.add(id, &c.topic, &c.message_encoding, schema);
+        }
+    }
+    ids.iter()
+        .copied()
+        .filter(|id| table.roles.get(id) == Some(&Role::Tf(true)))
+        .collect()
 }
