@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use eotn::app::{palette, view_images};
-use eotn::sim::{Scenario, ScenarioKind, Simulator};
 use eotn::formats::{ImageBody, ImageMessage};
+use eotn::sim::{Scenario, ScenarioKind, Simulator};
 use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
 use eotn::workspace::{Command, Workspace};
 

@@ -20,9 +20,9 @@ mod cli;
 mod common;
 mod crash_safety;
 mod hardening;
-mod jpeg_colour;
 #[cfg(feature = "gui")]
 mod harness;
+mod jpeg_colour;
 mod live;
 mod motion;
 mod overhead;
