@@ -313,7 +313,7 @@ pub fn decode_raw_owned(
 ) -> Result<Frame, RawImageError> {
     let row = encoding.row_bytes(width);
     let is_422 = matches!(encoding, PixelEncoding::Uyvy | PixelEncoding::Yuyv);
-    let fits = width % 2 == 0
+    let fits = width.is_multiple_of(2)
         && (step == row || step == 0)
         && row.checked_mul(height).is_some_and(|n| n <= data.len());
     if !is_422 || !fits || width == 0 || height == 0 {
