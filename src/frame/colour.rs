@@ -107,13 +107,39 @@ pub fn studio_maps() -> &'static ([u8; 256], [u8; 256]) {
     })
 }
 
-/// Converts interleaved full-range YCbCr (3 bytes a pixel) to studio range in place.
+/// Full-range luma → studio range in 16.16 fixed point: `16 + 219·Y/255`, rounded (equal to
+/// [`full_to_studio_luma`] for every value; tested).
+#[inline]
+fn luma_fixed(y: u8) -> u8 {
+    let v = 16 + ((u32::from(y) * 56_284 + 32_768) >> 16);
+    u8::try_from(v).unwrap_or(u8::MAX)
+}
+
+/// Full-range chroma → studio range in 16.16 fixed point: `224·C/255 + 128·31/255`, rounded
+/// (equal to [`full_to_studio_chroma`] for every value; tested).
+#[inline]
+fn chroma_fixed(c: u8) -> u8 {
+    let v = (u32::from(c) * 57_569 + 1_019_799 + 32_768) >> 16;
+    u8::try_from(v).unwrap_or(u8::MAX)
+}
+
+/// Converts interleaved full-range YCbCr (3 bytes a pixel) to studio range in place: 16 pixels
+/// at a time with the channel of each byte known, so the compiler keeps it in registers.
 pub fn full_to_studio_in_place(ycbcr: &mut [u8]) {
-    let (luma, chroma) = studio_maps();
-    for p in ycbcr.chunks_exact_mut(3) {
-        p[0] = luma[usize::from(p[0])];
-        p[1] = chroma[usize::from(p[1])];
-        p[2] = chroma[usize::from(p[2])];
+    let mut blocks = ycbcr.chunks_exact_mut(48);
+    for block in &mut blocks {
+        for (k, b) in block.iter_mut().enumerate() {
+            *b = if k % 3 == 0 {
+                luma_fixed(*b)
+            } else {
+                chroma_fixed(*b)
+            };
+        }
+    }
+    for p in blocks.into_remainder().chunks_exact_mut(3) {
+        p[0] = luma_fixed(p[0]);
+        p[1] = chroma_fixed(p[1]);
+        p[2] = chroma_fixed(p[2]);
     }
 }
 
@@ -143,6 +169,28 @@ mod tests {
             }
         }
         assert!(differ * 10_000 < total, "{differ} of {total} differ");
+    }
+
+    #[test]
+    fn fixed_point_maps_equal_the_rounded_formula() {
+        for v in 0..=255u8 {
+            assert_eq!(luma_fixed(v), full_to_studio_luma(v), "luma {v}");
+            assert_eq!(chroma_fixed(v), full_to_studio_chroma(v), "chroma {v}");
+        }
+        let mut long: Vec<u8> = (0..300u32).map(|i| (i * 7 % 256) as u8).collect();
+        let want: Vec<u8> = long
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                if i % 3 == 0 {
+                    full_to_studio_luma(v)
+                } else {
+                    full_to_studio_chroma(v)
+                }
+            })
+            .collect();
+        full_to_studio_in_place(&mut long);
+        assert_eq!(long, want);
     }
 
     #[test]

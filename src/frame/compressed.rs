@@ -121,10 +121,12 @@ pub fn decode_jpeg(data: &[u8]) -> Result<Frame, CompressedImageError> {
         |e: zune_jpeg::errors::DecodeErrors| CompressedImageError::Jpeg(format!("{e:?}"));
     let options = DecoderOptions::default()
         .set_max_width(MAX_FRAME_SIDE as usize)
-        .set_max_height(MAX_FRAME_SIDE as usize);
-    let mut probe = zune_jpeg::JpegDecoder::new_with_options(std::io::Cursor::new(data), options);
-    probe.decode_headers().map_err(jpeg_err)?;
-    let info = probe
+        .set_max_height(MAX_FRAME_SIDE as usize)
+        .jpeg_set_out_colorspace(ColorSpace::YCbCr);
+    // One decoder: the headers first (size and components), then the pixels.
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(std::io::Cursor::new(data), options);
+    decoder.decode_headers().map_err(jpeg_err)?;
+    let info = decoder
         .info()
         .ok_or_else(|| CompressedImageError::Jpeg("no image size in the header".to_owned()))?;
     let (w, h) = (usize::from(info.width), usize::from(info.height));
@@ -134,17 +136,14 @@ pub fn decode_jpeg(data: &[u8]) -> Result<Frame, CompressedImageError> {
             height: h as u64,
         });
     }
-    let input = probe.input_colorspace();
-    let out_space = match input {
+    let out_space = match decoder.input_colorspace() {
         Some(ColorSpace::Luma) => ColorSpace::Luma,
         Some(ColorSpace::YCbCr) => ColorSpace::YCbCr,
         _ => ColorSpace::RGB,
     };
-    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(
-        std::io::Cursor::new(data),
-        options.jpeg_set_out_colorspace(out_space),
-    );
-    decoder.decode_headers().map_err(jpeg_err)?;
+    if out_space != ColorSpace::YCbCr {
+        decoder.set_options(options.jpeg_set_out_colorspace(out_space));
+    }
     let len = w * h * out_space.num_components();
     if decoder.output_buffer_size() != Some(len) {
         return Err(CompressedImageError::Jpeg(format!(
