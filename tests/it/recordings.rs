@@ -332,3 +332,84 @@ fn a_ros2_bridge_sending_cdr_is_watched_and_recorded_bit_exact() {
     assert_eq!(reread.len(), recorded.len());
     assert!(bag_frames.contains(&reread.read(0).unwrap().frame));
 }
+
+/// Real bags written by the C++ rosbag2 (its own test bags, `tests/data/rosbag2/`: SQLite and
+/// MCAP storage, `metadata.yaml` versions 4 to 6), given as a user would — the folder, its
+/// `metadata.yaml`, its storage file alone — to `info`, `detect`, `eval`, `import` and the app's
+/// Open: each is read as a bag whose topics are named (they hold no images, so each says that it
+/// has no camera image topic), never as a folder of frames or a lookup table.
+#[test]
+fn real_rosbag2_bags_open_as_recordings_in_every_command() {
+    let bags = root().join("tests/data/rosbag2");
+    let lut = root().join("lookup_tables/sample.lut");
+    let not_as = |what: &str, text: &str| {
+        for wrong in ["lookup table", "lookup-table", "frame file", "no frames found"] {
+            assert!(!text.contains(wrong), "{what} read as {wrong}: {text}");
+        }
+    };
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&bags).unwrap() {
+        let folder = entry.unwrap().path();
+        if !folder.is_dir() {
+            continue;
+        }
+        let storage = std::fs::read_dir(&folder)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|e| e == "db3" || e == "mcap"))
+            .unwrap();
+        let meta = std::fs::read_to_string(folder.join("metadata.yaml")).unwrap();
+        for given in [folder.clone(), folder.join("metadata.yaml"), storage] {
+            let what = given.display().to_string();
+            // info: a stream of 0 frames, its topics named, the missing image said.
+            let i = info(&given);
+            assert_eq!(i["kind"], "stream", "{what}: {i}");
+            assert_eq!(i["frames"], 0, "{what}: {i}");
+            let warnings = i["warnings"].to_string();
+            assert!(warnings.contains("no camera image"), "{what}: {warnings}");
+            let first_topic = meta
+                .lines()
+                .find_map(|l| l.trim().strip_prefix("name: "))
+                .unwrap();
+            assert!(warnings.contains(first_topic), "{what}: {warnings}");
+            not_as(&what, &warnings);
+            // detect and eval: a clear refusal about frames.
+            for args in [
+                vec!["detect".as_ref(), "--lut".as_ref(), lut.as_os_str(), given.as_os_str()],
+                vec!["eval".as_ref(), "--lut".as_ref(), lut.as_os_str(), given.as_os_str()],
+            ] {
+                let out = eotn(&args);
+                let err = String::from_utf8_lossy(&out.stderr);
+                assert!(!out.status.success(), "{args:?}: {err}");
+                assert!(
+                    err.contains("no camera frames") || err.contains("no frame with"),
+                    "{args:?}: {err}"
+                );
+                not_as(&what, &err);
+            }
+            // import: the bag read, its missing image said, nothing invented.
+            let out_dir = tempfile::tempdir().unwrap();
+            let imported = out_dir.path().join("out.mcap");
+            let out = eotn_ok(&[
+                "import".as_ref(),
+                given.as_os_str(),
+                "-o".as_ref(),
+                imported.as_os_str(),
+            ]);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(err.contains("wrote 0 frames"), "{what}: {err}");
+            assert!(err.contains("no camera image"), "{what}: {err}");
+            not_as(&what, &err);
+            // The app's Open reads it as a stream and says it has no frames.
+            let mut state = eotn::workspace::Workspace::default();
+            let err = state
+                .apply(eotn::workspace::Command::Open(vec![given.clone()]))
+                .expect_err("a bag without images opens no source");
+            let err = format!("{err:#}");
+            assert!(err.contains("holds no camera frames"), "{what}: {err}");
+            not_as(&what, &err);
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 12, "four bags, three ways each");
+}
