@@ -23,6 +23,7 @@ use crate::frame::{
     CompressedImageError, Frame, PixelEncoding, RawImage, RawImageError, decode_compressed,
     decode_raw_owned,
 };
+use crate::sensors::SensorReadings;
 
 /// What a channel carries, told by its schema name and message encoding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -419,6 +420,33 @@ impl CameraIntrinsics {
             "fx": self.fx, "fy": self.fy, "cx": self.cx, "cy": self.cy,
         })
     }
+
+    /// Puts this calibration into the readings of a `width`×`height` frame (focal length and
+    /// optical centre, scaled when the calibration was made at another size), where the readings
+    /// have none of their own; recognition then uses this camera. False when the calibration
+    /// gives no usable focal length.
+    pub fn fill_readings(&self, width: usize, height: usize, s: &mut SensorReadings) -> bool {
+        if s.camera_focal_px.is_some() {
+            return false;
+        }
+        let scale = |frame: usize, calibrated: u32| {
+            if calibrated == 0 {
+                1.0
+            } else {
+                frame as f64 / f64::from(calibrated)
+            }
+        };
+        let (sx, sy) = (scale(width, self.width), scale(height, self.height));
+        let focal = self.fx * sx;
+        if !(focal.is_finite() && focal > 0.0 && focal <= 1e5) {
+            return false;
+        }
+        let centre = |c: f64, s: f64| Some(c * s).filter(|v| v.is_finite() && v.abs() <= 1e5);
+        s.camera_focal_px = Some(focal);
+        s.camera_centre_x_px = centre(self.cx, sx);
+        s.camera_centre_y_px = centre(self.cy, sy);
+        true
+    }
 }
 
 /// A `sensor_msgs/msg/JointState` as JSON: `{"NAME": position, …}` (radians, or metres for
@@ -540,5 +568,38 @@ mod tests {
             CameraIntrinsics::decode(MessageKind::RosCameraInfo, &empty).unwrap(),
             None
         );
+    }
+
+    #[test]
+    fn a_calibration_fills_the_readings_scaled_to_the_frame() {
+        let k = CameraIntrinsics {
+            width: 640,
+            height: 480,
+            fx: 500.0,
+            fy: 501.0,
+            cx: 330.0,
+            cy: 250.0,
+        };
+        let mut s = SensorReadings::default();
+        assert!(k.fill_readings(320, 240, &mut s));
+        assert_eq!(s.camera_focal_px, Some(250.0));
+        assert_eq!(
+            (s.camera_centre_x_px, s.camera_centre_y_px),
+            (Some(165.0), Some(125.0))
+        );
+        // Readings with a calibration of their own keep it.
+        let mut own = SensorReadings {
+            camera_focal_px: Some(100.0),
+            ..SensorReadings::default()
+        };
+        assert!(!k.fill_readings(640, 480, &mut own));
+        assert_eq!(own.camera_focal_px, Some(100.0));
+        // A calibration without a usable focal length leaves the readings alone.
+        let bad = CameraIntrinsics { fx: -1.0, ..k };
+        let mut s = SensorReadings::default();
+        assert!(!bad.fill_readings(640, 480, &mut s));
+        assert_eq!(s, SensorReadings::default());
+        let nan = CameraIntrinsics { fx: f64::NAN, ..k };
+        assert!(!nan.fill_readings(640, 480, &mut s));
     }
 }

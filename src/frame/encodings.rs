@@ -462,7 +462,12 @@ const MHC_DIAGONAL: [i32; 25] = [
 /// Bayer-patterned color images"); edges mirrored.
 fn from_bayer(w: usize, h: usize, rows: &Rows<'_>, order: BayerOrder) -> Result<Frame, FrameError> {
     let t = RgbToYuv::get();
-    // Mirrored neighbour index: -1 → 1, n → n - 2 (keeps the colour of the photosite).
+    let mut data = Vec::with_capacity(w * h * 3);
+    if w == 0 || h == 0 {
+        return Frame::new(w, h, PixelLayout::Yuv444Packed, data);
+    }
+    // The mosaic with a mirrored border of 2 photosites (-1 → 1, n → n - 2: keeps each
+    // photosite's colour), so the 5×5 kernels index it directly.
     let mirror = |i: isize, n: usize| -> usize {
         let n = n as isize;
         let m = if i < 0 {
@@ -472,37 +477,48 @@ fn from_bayer(w: usize, h: usize, rows: &Rows<'_>, order: BayerOrder) -> Result<
         } else {
             i
         };
-        usize::try_from(m.clamp(0, (n - 1).max(0))).unwrap_or(0)
+        usize::try_from(m.clamp(0, n - 1)).unwrap_or(0)
     };
-    let at = |x: isize, y: isize| -> i32 {
-        let row = rows.get(mirror(y, h));
-        i32::from(row.get(mirror(x, w)).copied().unwrap_or(0))
-    };
-    let apply = |kernel: &[i32; 25], x: isize, y: isize| -> i32 {
-        let mut sum = 0;
-        for (k, &c) in kernel.iter().enumerate() {
-            if c != 0 {
-                let (dx, dy) = ((k % 5) as isize - 2, (k / 5) as isize - 2);
-                sum += c * at(x + dx, y + dy);
-            }
+    let pw = w + 4;
+    let mut padded = Vec::with_capacity(pw * (h + 4));
+    for py in 0..h + 4 {
+        let row = rows.get(mirror(py as isize - 2, h));
+        for px in 0..pw {
+            padded.push(i32::from(
+                row.get(mirror(px as isize - 2, w)).copied().unwrap_or(0),
+            ));
         }
+    }
+    // Each kernel as (offset into `padded`, weight) of its non-zero taps.
+    let taps = |kernel: &[i32; 25]| -> Vec<(usize, i32)> {
+        kernel
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| **c != 0)
+            .map(|(k, &c)| ((k / 5) * pw + k % 5, c))
+            .collect()
+    };
+    let [green, along_row, along_column, diagonal] =
+        [&MHC_GREEN, &MHC_ROW, &MHC_COLUMN, &MHC_DIAGONAL].map(taps);
+    // `corner`: index of the 5×5 window's top-left photosite.
+    let apply = |taps: &[(usize, i32)], corner: usize| -> i32 {
+        let sum: i32 = taps.iter().map(|&(o, c)| c * padded[corner + o]).sum();
         (sum + 8) >> 4
     };
-    let mut data = Vec::with_capacity(w * h * 3);
     for y in 0..h {
         for x in 0..w {
-            let (xi, yi) = (x as isize, y as isize);
+            let corner = y * pw + x;
             let here = order.colour_at(x, y);
             let mut rgb = [0i32; 3];
-            rgb[here] = at(xi, yi);
+            rgb[here] = padded[corner + 2 * pw + 2];
             if here == 1 {
                 // Green: one colour lies left and right on this row, the other above and below.
                 let row_colour = order.colour_at(x + 1, y);
-                rgb[row_colour] = apply(&MHC_ROW, xi, yi);
-                rgb[2 - row_colour] = apply(&MHC_COLUMN, xi, yi);
+                rgb[row_colour] = apply(&along_row, corner);
+                rgb[2 - row_colour] = apply(&along_column, corner);
             } else {
-                rgb[1] = apply(&MHC_GREEN, xi, yi);
-                rgb[2 - here] = apply(&MHC_DIAGONAL, xi, yi);
+                rgb[1] = apply(&green, corner);
+                rgb[2 - here] = apply(&diagonal, corner);
             }
             let c = |v: i32| u8::try_from(v.clamp(0, 255)).unwrap_or(u8::MAX);
             let yuv = t.convert(c(rgb[0]), c(rgb[1]), c(rgb[2]));
@@ -655,6 +671,64 @@ mod tests {
                 .collect();
             let f = decode_raw(&raw(w, h, name, 0, &mosaic)).unwrap();
             f.for_each_pixel(|x, y, p| assert_eq!(p, rgb_to_yuv(c), "{name} at {x},{y}"));
+        }
+    }
+
+    /// Malvar–He–Cutler written out per photosite, edges mirrored: what the padded, tap-list
+    /// form must equal on a mosaic with edges and noise, for every order, odd sizes and 1×1.
+    #[test]
+    fn bayer_equals_the_kernels_applied_photosite_by_photosite() {
+        let mirror = |i: isize, n: usize| {
+            let n = n as isize;
+            let m = if i < 0 {
+                -i
+            } else if i >= n {
+                2 * (n - 1) - i
+            } else {
+                i
+            };
+            m.clamp(0, n - 1) as usize
+        };
+        for (w, h) in [(7, 5), (1, 1), (2, 3)] {
+            let mosaic: Vec<u8> = (0..w * h)
+                .map(|i| ((i * 97 + i / w * 31) % 256) as u8)
+                .collect();
+            for order in [
+                BayerOrder::Rggb,
+                BayerOrder::Bggr,
+                BayerOrder::Gbrg,
+                BayerOrder::Grbg,
+            ] {
+                let at = |x: isize, y: isize| i32::from(mosaic[mirror(y, h) * w + mirror(x, w)]);
+                let apply = |k: &[i32; 25], x: usize, y: usize| {
+                    let sum: i32 = (0..25)
+                        .map(|i| {
+                            k[i] * at(
+                                x as isize + i as isize % 5 - 2,
+                                y as isize + i as isize / 5 - 2,
+                            )
+                        })
+                        .sum();
+                    (sum + 8) >> 4
+                };
+                let f =
+                    decode_raw(&raw(w, h, PixelEncoding::Bayer(order).name(), 0, &mosaic)).unwrap();
+                f.for_each_pixel(|x, y, p| {
+                    let here = order.colour_at(x, y);
+                    let mut rgb = [0i32; 3];
+                    rgb[here] = at(x as isize, y as isize);
+                    if here == 1 {
+                        let row = order.colour_at(x + 1, y);
+                        rgb[row] = apply(&MHC_ROW, x, y);
+                        rgb[2 - row] = apply(&MHC_COLUMN, x, y);
+                    } else {
+                        rgb[1] = apply(&MHC_GREEN, x, y);
+                        rgb[2 - here] = apply(&MHC_DIAGONAL, x, y);
+                    }
+                    let c = rgb.map(|v| v.clamp(0, 255) as u8);
+                    assert_eq!(p, rgb_to_yuv(c), "{order:?} {w}x{h} at {x},{y}");
+                });
+            }
         }
     }
 

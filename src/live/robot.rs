@@ -714,6 +714,10 @@ fn attach(
                 Ok(k) => {
                     if let Some(k) = k {
                         record.extra.push((topic.to_owned(), k.to_json()));
+                        let mut s = record.sensors.unwrap_or_default();
+                        if k.fill_readings(record.frame.width(), record.frame.height(), &mut s) {
+                            record.sensors = Some(s);
+                        }
                     }
                     None
                 }

@@ -162,7 +162,7 @@ fn every_recording_opens_and_recognition_matches_the_original_frames() {
 }
 
 #[test]
-fn a_camera_pose_from_tf_static_reaches_the_readings() {
+fn a_camera_pose_from_tf_static_and_the_calibration_reach_the_readings() {
     let Some((_, list)) = recordings() else {
         return;
     };
@@ -184,6 +184,8 @@ fn a_camera_pose_from_tf_static_reaches_the_readings() {
             "{}: {s:?}",
             r.name
         );
+        // recordings.py: CameraInfo with fx = 200 px, calibrated at the frame's size.
+        assert_eq!(s.camera_focal_px, Some(200.0), "{}: {s:?}", r.name);
     }
 }
 
@@ -305,6 +307,11 @@ fn a_ros2_bridge_sending_cdr_is_watched_and_recorded_bit_exact() {
         "{:?}",
         live.record.extra
     );
+    // The bridge's CameraInfo reaches the readings recognition uses.
+    assert_eq!(
+        live.record.sensors.and_then(|s| s.camera_focal_px),
+        Some(200.0)
+    );
     // Bit-exact: every recorded image payload is one the bag's writer serialised.
     let payloads = |p: &Path, topic: &str| -> Vec<Vec<u8>> {
         let bytes = std::fs::read(p).unwrap();
@@ -343,7 +350,12 @@ fn real_rosbag2_bags_open_as_recordings_in_every_command() {
     let bags = root().join("tests/data/rosbag2");
     let lut = root().join("lookup_tables/sample.lut");
     let not_as = |what: &str, text: &str| {
-        for wrong in ["lookup table", "lookup-table", "frame file", "no frames found"] {
+        for wrong in [
+            "lookup table",
+            "lookup-table",
+            "frame file",
+            "no frames found",
+        ] {
             assert!(!text.contains(wrong), "{what} read as {wrong}: {text}");
         }
     };
@@ -375,8 +387,18 @@ fn real_rosbag2_bags_open_as_recordings_in_every_command() {
             not_as(&what, &warnings);
             // detect and eval: a clear refusal about frames.
             for args in [
-                vec!["detect".as_ref(), "--lut".as_ref(), lut.as_os_str(), given.as_os_str()],
-                vec!["eval".as_ref(), "--lut".as_ref(), lut.as_os_str(), given.as_os_str()],
+                vec![
+                    "detect".as_ref(),
+                    "--lut".as_ref(),
+                    lut.as_os_str(),
+                    given.as_os_str(),
+                ],
+                vec![
+                    "eval".as_ref(),
+                    "--lut".as_ref(),
+                    lut.as_os_str(),
+                    given.as_os_str(),
+                ],
             ] {
                 let out = eotn(&args);
                 let err = String::from_utf8_lossy(&out.stderr);

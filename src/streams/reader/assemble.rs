@@ -75,6 +75,7 @@ pub(super) fn assemble(
     let mut record = FrameRecord::new(raw.time_ns, frame);
     let mut warnings = Vec::new();
     let mut tree: Option<TfTree> = None;
+    let mut calibration: Option<CameraIntrinsics> = None;
     for m in &raw.others {
         let data = match bytes(&m.data, zstd_messages) {
             Ok(d) => d,
@@ -83,7 +84,14 @@ pub(super) fn assemble(
                 continue;
             }
         };
-        if let Err(e) = take(&mut record, m, &data, tf_static, &mut tree) {
+        if let Err(e) = take(
+            &mut record,
+            m,
+            &data,
+            tf_static,
+            &mut tree,
+            &mut calibration,
+        ) {
             warnings.push(format!("frame {index}: {e}"));
         }
     }
@@ -94,6 +102,12 @@ pub(super) fn assemble(
         let mut s = record.sensors.unwrap_or_default();
         fill_camera_pose(&mut s, &pose);
         record.sensors = Some(s);
+    }
+    if let Some(k) = calibration {
+        let mut s = record.sensors.unwrap_or_default();
+        if k.fill_readings(record.frame.width(), record.frame.height(), &mut s) {
+            record.sensors = Some(s);
+        }
     }
     Ok(Assembled {
         record,
@@ -116,13 +130,15 @@ fn fill_camera_pose(s: &mut SensorReadings, pose: &SensorReadings) {
     s.camera_yaw_rad = pose.camera_yaw_rad;
 }
 
-/// One message into the record; `Err` names what was skipped and why.
+/// One message into the record (a camera calibration also into `calibration`, for the
+/// readings); `Err` names what was skipped and why.
 fn take(
     record: &mut FrameRecord,
     m: &RawMsg<'_>,
     data: &[u8],
     tf_static: &TfTree,
     tree: &mut Option<TfTree>,
+    calibration: &mut Option<CameraIntrinsics>,
 ) -> Result<(), String> {
     let topic = m.role.topic();
     match &m.role {
@@ -137,6 +153,7 @@ fn take(
                 .map_err(|e| format!("{topic}: {e}; skipped"))?
             {
                 record.extra.push((topic.clone(), k.to_json()));
+                *calibration = Some(k);
             }
         }
         Role::Joints(topic) => {
