@@ -435,3 +435,87 @@ fn real_rosbag2_bags_open_as_recordings_in_every_command() {
     }
     assert_eq!(checked, 12, "four bags, three ways each");
 }
+
+/// A bag written by `rosbags` with one image message cut short and one joint-state message
+/// turned to garbage: the cut image costs its frame only, with one warning naming it; the
+/// garbage costs its reading only; every other frame reads as before.
+#[test]
+fn a_damaged_message_costs_its_frame_only() {
+    let Some((dir, list)) = recordings() else {
+        return;
+    };
+    let original = list
+        .iter()
+        .find(|r| r.name == "rosbag2 sqlite sensor_msgs/Image uyvy step+0")
+        .unwrap();
+    let damaged = dir.path().join("damaged_uyvy");
+    std::fs::create_dir_all(&damaged).unwrap();
+    for e in std::fs::read_dir(&original.path).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(&p, damaged.join(p.file_name().unwrap())).unwrap();
+    }
+    let db3 = std::fs::read_dir(&damaged)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "db3"))
+        .unwrap();
+    let nth_of = |conn: &rusqlite::Connection, topic: &str, n: i64| -> i64 {
+        conn.query_row(
+            "SELECT m.id FROM messages m JOIN topics t ON t.id = m.topic_id \
+             WHERE t.name = ?1 ORDER BY m.timestamp, m.id LIMIT 1 OFFSET ?2",
+            rusqlite::params![topic, n],
+            |r| r.get(0),
+        )
+        .unwrap()
+    };
+    {
+        let conn = rusqlite::Connection::open(&db3).unwrap();
+        let image = nth_of(&conn, "/camera/image_raw", 5);
+        conn.execute(
+            "UPDATE messages SET data = substr(data, 1, 60) WHERE id = ?1",
+            [image],
+        )
+        .unwrap();
+        let joints = nth_of(&conn, "/joint_states", 9);
+        conn.execute(
+            "UPDATE messages SET data = X'00010000FFFFFFFF' WHERE id = ?1",
+            [joints],
+        )
+        .unwrap();
+    }
+    let mut good = StreamReader::open(&original.path).unwrap();
+    let mut bad = StreamReader::open(&damaged).unwrap();
+    assert_eq!(bad.len(), FRAMES);
+    for i in 0..FRAMES {
+        let want = good.read(i).unwrap();
+        match bad.read(i) {
+            Err(e) => assert_eq!(i, 5, "frame {i} lost: {e}"),
+            Ok(got) => {
+                assert_ne!(i, 5, "the cut image read");
+                assert_eq!(got.frame, want.frame, "frame {i}");
+                let joints = |r: &eotn::streams::FrameRecord| {
+                    r.extra.iter().any(|(t, _)| t == "/joint_states")
+                };
+                assert_eq!(joints(&got), i != 9, "frame {i}: {:?}", got.extra);
+            }
+        }
+    }
+    // detect: 23 frames and the lost one named once.
+    let out = eotn(&[
+        "detect".as_ref(),
+        "--json".as_ref(),
+        "--lut".as_ref(),
+        root().join("lookup_tables/bhuman2009.lut").as_os_str(),
+        damaged.as_os_str(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines = String::from_utf8_lossy(&out.stdout).lines().count();
+    assert_eq!(lines, FRAMES - 1);
+    let err = String::from_utf8_lossy(&out.stderr);
+    let named = err.lines().filter(|l| l.contains("frame 5")).count();
+    assert_eq!(named, 1, "{err}");
+}
