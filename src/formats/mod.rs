@@ -570,6 +570,31 @@ mod tests {
         );
     }
 
+    /// Found by the `ros2_messages` fuzz target (an out-of-memory abort): a message whose
+    /// claimed sizes exceed its bytes is refused by every decoder without a large allocation.
+    #[test]
+    fn the_fuzzers_oversized_message_is_refused_cheaply() {
+        let bytes = include_bytes!("../../fuzz/regressions/ros2_messages/oom-image-claims.cdr");
+        for kind in [
+            MessageKind::RosImage,
+            MessageKind::RosCompressedImage,
+            MessageKind::FoxgloveRawImage,
+            MessageKind::FoxgloveCompressedImage,
+        ] {
+            if let Ok(m) = ImageMessage::decode(kind, bytes) {
+                assert!(m.into_frame().is_err(), "{kind:?} made a frame of it");
+            }
+        }
+        assert!(matches!(
+            ros2::decode_compressed_image(bytes),
+            Err(ros2::CdrError::Truncated { .. })
+        ));
+        let _ = CameraIntrinsics::decode(MessageKind::RosCameraInfo, bytes);
+        let _ = CameraIntrinsics::decode(MessageKind::FoxgloveCameraCalibration, bytes);
+        let _ = joint_positions(bytes);
+        let _ = ros2::decode::<ros2::TfMessage>(bytes);
+    }
+
     #[test]
     fn a_calibration_fills_the_readings_scaled_to_the_frame() {
         let k = CameraIntrinsics {

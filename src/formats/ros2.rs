@@ -97,7 +97,8 @@ pub struct Header {
     pub frame_id: CdrString,
 }
 
-/// The fields of `sensor_msgs/msg/Image` before its `data`.
+/// The fields of `sensor_msgs/msg/Image` up to its `data`'s claimed length, read by the same
+/// deserialiser (so strings without their NUL or with invalid UTF-8 cannot shift it).
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ImageHead {
     /// Header.
@@ -112,6 +113,8 @@ pub struct ImageHead {
     pub is_bigendian: u8,
     /// Bytes a row, padding included.
     pub step: u32,
+    /// How many pixel bytes the message claims to hold.
+    pub data_len: u32,
 }
 
 /// `sensor_msgs/msg/Image` (CDR has no field names, so [`ImageHead`]'s fields are repeated here
@@ -135,13 +138,15 @@ pub struct Image {
     pub data: Vec<u8>,
 }
 
-/// The fields of `sensor_msgs/msg/CompressedImage` before its `data`.
+/// The fields of `sensor_msgs/msg/CompressedImage` up to its `data`'s claimed length.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct CompressedImageHead {
     /// Header.
     pub header: Header,
     /// `jpeg`, `png`, or image_transport's `bgr8; jpeg compressed bgr8`.
     pub format: CdrString,
+    /// How many compressed bytes the message claims to hold.
+    pub data_len: u32,
 }
 
 /// `sensor_msgs/msg/CompressedImage`.
@@ -281,34 +286,10 @@ fn check_header(bytes: &[u8]) -> Result<bool, CdrError> {
     }
 }
 
-/// Checks the length of the byte array that follows `head` in `bytes` (a message whose fields
-/// before that array are `head`) against what the message holds.
-fn check_trailing_bytes<H: Serialize>(
-    bytes: &[u8],
-    head: &H,
-    field: &'static str,
-) -> Result<(), CdrError> {
-    let little = check_header(bytes)?;
-    // The head's serialised size is where the array's length field starts (4-aligned after it).
-    let at = usize::try_from(cdr::calc_serialized_size(head))
-        .unwrap_or(usize::MAX)
-        .saturating_sub(4)
-        .next_multiple_of(4)
-        .saturating_add(4);
-    let Some(len) = bytes.get(at..at.saturating_add(4)) else {
-        return Err(CdrError::Truncated {
-            field,
-            claimed: 4,
-            available: bytes.len().saturating_sub(at) as u64,
-        });
-    };
-    let len = [len[0], len[1], len[2], len[3]];
-    let claimed = if little {
-        u32::from_le_bytes(len)
-    } else {
-        u32::from_be_bytes(len)
-    };
-    let available = bytes.len().saturating_sub(at + 4) as u64;
+/// Checks a byte array's claimed length against the message's size before the array is read
+/// (the `cdr` crate allocates a claimed length before reading it).
+fn check_claimed_bytes(bytes: &[u8], claimed: u32, field: &'static str) -> Result<(), CdrError> {
+    let available = bytes.len().saturating_sub(4) as u64;
     if u64::from(claimed) > available {
         return Err(CdrError::Truncated {
             field,
@@ -325,7 +306,7 @@ fn check_trailing_bytes<H: Serialize>(
 /// [`CdrError`] when the bytes are not such a message.
 pub fn decode_image(bytes: &[u8]) -> Result<Image, CdrError> {
     let head: ImageHead = decode(bytes)?;
-    check_trailing_bytes(bytes, &head, "data")?;
+    check_claimed_bytes(bytes, head.data_len, "data")?;
     decode(bytes)
 }
 
@@ -335,7 +316,7 @@ pub fn decode_image(bytes: &[u8]) -> Result<Image, CdrError> {
 /// [`CdrError`] when the bytes are not such a message.
 pub fn decode_compressed_image(bytes: &[u8]) -> Result<CompressedImage, CdrError> {
     let head: CompressedImageHead = decode(bytes)?;
-    check_trailing_bytes(bytes, &head, "data")?;
+    check_claimed_bytes(bytes, head.data_len, "data")?;
     decode(bytes)
 }
 
@@ -454,6 +435,24 @@ mod tests {
         for cut in 0..good.len() {
             assert!(decode_image(&good[..cut]).is_err(), "cut at {cut}");
         }
+        // A frame_id without its NUL: the data length is still the one the message claims
+        // (the fuzzer's case: a re-serialised head put the length 4 bytes further on).
+        let no_nul = CompressedImage {
+            header: Header {
+                stamp: Time { sec: 1, nanosec: 2 },
+                frame_id: CdrString("cam".into()),
+            },
+            format: CdrString("\u{4}".into()),
+            data: vec![7; 8],
+        };
+        let mut b = encode(&no_nul).unwrap();
+        b[19] = 8; // "cam\0" → "cam\x08"
+        let at = b.len() - 12;
+        b[at..at + 4].copy_from_slice(&0xff00_0005_u32.to_le_bytes());
+        assert!(matches!(
+            decode_compressed_image(&b),
+            Err(CdrError::Truncated { .. })
+        ));
         assert!(matches!(
             decode_image(b"\x00\x07\x00\x00"),
             Err(CdrError::Header(_))
