@@ -29,8 +29,7 @@ impl Workspace {
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default();
-            let partial_stream = p.to_string_lossy().ends_with(".mcap.partial");
-            let opened = if ext == "mcap" || partial_stream {
+            let opened = if crate::streams::is_recording(&p) {
                 streams.push(p);
                 Ok(())
             } else if ext == "json" {

@@ -25,6 +25,7 @@ mod docs;
 mod hardening;
 #[cfg(feature = "gui")]
 mod harness;
+mod jpeg_colour;
 mod kernels;
 mod live;
 mod live_peers;
@@ -36,6 +37,7 @@ mod peer;
 mod properties;
 mod real_data;
 mod recognition;
+mod recordings;
 mod robots;
 mod serve_load;
 mod sim;
