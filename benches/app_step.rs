@@ -5,13 +5,15 @@
 //!
 //! Streams: a 640×480 stream rendered by the simulator (overhead game: robots, ball, goals,
 //! beacons) written to a temporary file at start, and the bundled 208×160 robot-camera stream
-//! `streams/sim-walk-and-pan.mcap`; both classified with `lookup_tables/sim.lut`.
+//! `streams/sim-walk-and-pan.mcap`; both classified with `lookup_tables/sim.lut`. And the 640×480
+//! frames stored as JPEG (`foxglove.CompressedImage`): each step decodes a JPEG (issue 27).
 
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use eotn::app::{palette, view_images};
+use eotn::formats::{ImageBody, ImageMessage};
 use eotn::sim::{Scenario, ScenarioKind, Simulator};
 use eotn::streams::{FrameRecord, StreamInfo, StreamWriter};
 use eotn::workspace::{Command, PlaybackCommand, Workspace};
@@ -33,6 +35,35 @@ fn overhead_stream(dir: &Path) -> PathBuf {
         let mut r = FrameRecord::new(f.time_ns, f.frame);
         r.sensors = f.sensors;
         w.write(&r).expect("write");
+    }
+    w.finish().expect("finish");
+    path
+}
+
+/// The same overhead frames stored as JPEG (`foxglove.CompressedImage`, quality 90), as a camera
+/// that compresses would record them: each step decodes a JPEG.
+fn jpeg_stream(dir: &Path) -> PathBuf {
+    let path = dir.join("overhead-640x480-jpeg.mcap");
+    let sim = Simulator::new(Scenario::new(ScenarioKind::OverheadGame, 1));
+    let mut w = StreamWriter::create(&path, &StreamInfo::default()).expect("create");
+    for i in 0..FRAMES {
+        let f = sim.frame(i as u64).expect("render");
+        let img = image::RgbImage::from_raw(640, 480, f.frame.to_rgb()).expect("size");
+        let mut jpeg = Vec::new();
+        image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 90)
+            .encode_image(&img)
+            .expect("encode");
+        let message = ImageMessage {
+            timestamp_ns: Some(f.time_ns),
+            frame_id: "camera".to_owned(),
+            body: ImageBody::Compressed {
+                format: "jpeg".to_owned(),
+                data: jpeg,
+            },
+        };
+        let mut r = FrameRecord::new(f.time_ns, f.frame);
+        r.sensors = f.sensors;
+        w.write_with_image(&r, Some(&message)).expect("write");
     }
     w.finish().expect("finish");
     path
@@ -65,6 +96,7 @@ fn bench_stream(c: &mut Criterion, name: &str, stream: PathBuf) {
 fn app_step(c: &mut Criterion) {
     let dir = tempfile::tempdir().expect("temporary folder");
     bench_stream(c, "app_step_640x480", overhead_stream(dir.path()));
+    bench_stream(c, "app_step_640x480_jpeg", jpeg_stream(dir.path()));
     bench_stream(c, "app_step_208x160", repo("streams/sim-walk-and-pan.mcap"));
 }
 

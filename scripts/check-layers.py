@@ -13,7 +13,7 @@ import sys
 # Data-flow order: frames in, results out, front ends last (STYLE.md, ARCHITECTURE.md).
 ORDER = [
     "atomic_file", "input_file", "stats", "kernels", "frame", "lut", "classify", "blobs", "sensors", "geometry",
-    "model", "sim", "import",
+    "model", "sim", "import", "formats",
     "recognition", "overhead", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
     "live", "workspace", "app_options", "cli", "app",
 ]

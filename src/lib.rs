@@ -18,6 +18,7 @@
 //! | [`model`] | the world described (field, materials, teams, goals) and per-frame ground truth |
 //! | [`sim`] | synthetic frames with ground truth: renders the model, scenarios over time |
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
+//! | [`formats`] | one decoder per message type (ROS 2 CDR, Foxglove protobuf): images, camera info, joints, TF |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
 //! | [`overhead`] | overhead camera: field descriptions, calibration, ball and robot markers |
 //! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
@@ -40,6 +41,7 @@ pub mod atomic_file;
 pub mod blobs;
 pub mod classify;
 pub mod eval;
+pub mod formats;
 pub mod frame;
 pub mod geometry;
 pub mod import;

@@ -68,6 +68,17 @@ pub struct SensorReadings {
     /// Camera yaw relative to the robot's forward direction, radians, positive left; the
     /// rotation is yaw · pitch · roll (about z, then the turned y, then the optical axis).
     pub camera_yaw_rad: Option<f64>,
+    /// The camera's calibrated focal length, pixels of this frame (ROS `CameraInfo`'s `fx`,
+    /// scaled to the frame's width): with it recognition uses this camera instead of the
+    /// parameters' field of view. Absent from the JSON when unknown.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_focal_px: Option<f64>,
+    /// Where the optical axis meets the image, pixels from the left edge (`CameraInfo`'s `cx`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_centre_x_px: Option<f64>,
+    /// Where the optical axis meets the image, pixels from the top edge (`CameraInfo`'s `cy`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_centre_y_px: Option<f64>,
 }
 
 /// One field of [`SensorReadings`]: its name, unit and value, for tables and plots.
@@ -84,7 +95,8 @@ pub struct SensorField {
 /// Whether `v` can be a reading of the field `name` in `unit`: finite, and within what any
 /// robot can report (angles within ±8π rad, lengths within ±1 km and heights and ranges not
 /// below the ground, durations from 0 to an hour, duty cycles within ±1, accelerations within
-/// ±1000 m/s², the battery within 0–100 %, temperatures within −100 to 200 °C).
+/// ±1000 m/s², the battery within 0–100 %, temperatures within −100 to 200 °C, pixel positions
+/// within ±100,000 and focal lengths positive).
 #[must_use]
 pub fn plausible(name: &str, unit: &str, v: f64) -> bool {
     if !v.is_finite() {
@@ -100,6 +112,8 @@ pub fn plausible(name: &str, unit: &str, v: f64) -> bool {
         "m/s²" => v.abs() <= 1000.0,
         "%" => (0.0..=100.0).contains(&v),
         "°C" => (-100.0..=200.0).contains(&v),
+        "px" if name.contains("focal") => v > 0.0 && v <= 1e5,
+        "px" => v.abs() <= 1e5,
         _ => true,
     }
 }
@@ -156,6 +170,9 @@ sensor_fields! {
     camera_roll_rad: "rad",
     camera_pitch_rad: "rad",
     camera_yaw_rad: "rad",
+    camera_focal_px: "px",
+    camera_centre_x_px: "px",
+    camera_centre_y_px: "px",
 }
 
 impl SensorReadings {
@@ -243,12 +260,26 @@ mod tests {
     #[test]
     fn fields_lists_every_reading_with_units() {
         let fields = SensorReadings::default().fields();
-        assert_eq!(fields.len(), 24);
+        assert_eq!(fields.len(), 27);
         assert!(
             fields
                 .iter()
                 .any(|f| f.name == "pan_pwm" && f.unit == "duty")
         );
         assert!(fields.iter().all(|f| f.value.is_none()));
+    }
+
+    #[test]
+    fn a_calibration_is_written_only_when_known_and_must_be_possible() {
+        let json = serde_json::to_string(&SensorReadings::default()).expect("serialise");
+        assert!(!json.contains("camera_focal_px"), "{json}");
+        let r = SensorReadings {
+            camera_focal_px: Some(-3.0),
+            camera_centre_x_px: Some(-20.0),
+            ..SensorReadings::default()
+        };
+        let (clean, dropped) = r.sanitised();
+        assert_eq!(dropped, vec!["camera_focal_px"]);
+        assert_eq!(clean.camera_centre_x_px, Some(-20.0));
     }
 }

@@ -521,7 +521,7 @@ fn annotated_writer(
     // A stream's own source kind is kept (it says which camera the frames came from).
     let source = inputs
         .iter()
-        .find(|p| crate::streams::is_stream_file(p))
+        .find(|p| crate::streams::is_recording(p))
         .and_then(|p| crate::streams::StreamReader::open(p).ok())
         .map_or_else(|| "import".to_owned(), |r| r.info().source.clone());
     let info = crate::streams::StreamInfo {

@@ -10,7 +10,7 @@ use crate::sensors::SensorReadings;
 use crate::streams::schema::ImageEncoding;
 use crate::streams::sensor_table::SensorTable;
 use crate::streams::{
-    Compression, FrameRecord, StreamInfo, StreamReader, StreamWriter, WriterOptions, is_stream_file,
+    Compression, FrameRecord, StreamInfo, StreamReader, StreamWriter, WriterOptions, is_recording,
 };
 
 /// Chunk compression on the command line.
@@ -28,8 +28,10 @@ pub enum CompressionArg {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Frames (`.uyvy`, `.png`, `.jpg`) or folders of them; a folder's frames are taken in name
-    /// order. PNG/JPEG frames are stored as UYVY. One stream (`.mcap`) instead is rewritten in
-    /// today's layout (image encoding, compression), every channel kept.
+    /// order. PNG/JPEG frames are stored as UYVY. One recording instead — an MCAP stream, another
+    /// tool's MCAP, a ROS 2 bag (its folder or its `.db3`/`.mcap` file) — becomes an eotn stream:
+    /// every frame with its readings and channels, images stored as they came (any encoding,
+    /// JPEG/PNG unchanged; eotn's own 4:2:2 frames in `--image-encoding`).
     #[arg(required_unless_present = "bhuman")]
     pub frames: Vec<PathBuf>,
     /// Import a B-Human 2009 Nao log (`logfile.log`) instead of frame files: its camera images
@@ -85,12 +87,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     if let [stream] = args.frames.as_slice()
-        && is_stream_file(stream)
+        && is_recording(stream)
     {
         return rewrite_stream(stream, args);
     }
     let paths = expand_frame_paths(&args.frames)?;
-    if let Some(stream) = paths.iter().find(|p| is_stream_file(p)) {
+    if let Some(stream) = paths.iter().find(|p| is_recording(p)) {
         bail!(
             "{}: import reads frame files, or one stream to rewrite on its own",
             stream.display()
@@ -186,9 +188,19 @@ fn frame_time_ns(
     })
 }
 
-/// `eotn import OLD.mcap -o NEW.mcap`: the stream rewritten in today's layout and the chosen
-/// options (image encoding, compression, chunking), every frame with all its channels. Frames
-/// that cannot be read are skipped with a warning naming them.
+/// True for an unpadded UYVY or YUYV image: eotn's own frames, rewritten in the chosen order.
+fn is_plain_422(image: &crate::formats::ImageMessage) -> bool {
+    use crate::frame::PixelEncoding;
+    matches!(&image.body, crate::formats::ImageBody::Raw { width, encoding, step, .. }
+        if matches!(PixelEncoding::from_name(encoding), Some(PixelEncoding::Uyvy | PixelEncoding::Yuyv))
+            && u64::from(*step) == 2 * u64::from(*width))
+}
+
+/// `eotn import REC -o NEW.mcap`: a recording (an eotn stream, another tool's MCAP, a ROS 2 bag)
+/// as an eotn stream in the chosen options (compression, chunking; eotn's own 4:2:2 frames in the
+/// chosen byte order), every frame with its channels; images in any other encoding, and
+/// compressed ones, are stored unchanged. Frames that cannot be read are skipped with a warning
+/// naming them.
 fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
     if args.sensors.is_some() || args.size.is_some() {
         bail!("--sensors and --size are for frame files; a stream keeps its own readings");
@@ -197,16 +209,39 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
     for w in reader.warnings() {
         log::warn!("{}: {w}", input.display());
     }
-    let info = reader.info().clone();
+    for n in reader.notes() {
+        log::warn!("{}: note: {n}", input.display());
+    }
+    if reader.is_empty() {
+        // The notes above say why (no image channel, one in an encoding eotn does not read).
+        bail!(
+            "{}: no camera frames to import; nothing written to {}",
+            input.display(),
+            args.output.display()
+        );
+    }
+    let mut info = reader.info().clone();
+    if info.source == "unknown" {
+        // Another tool's recording: the import's own source kind and a note of where from.
+        info.source.clone_from(&args.source);
+        info.description = if args.description.is_empty() {
+            format!("imported from {}", input.display())
+        } else {
+            args.description.clone()
+        };
+    }
     let mut writer = StreamWriter::create_with(&args.output, &info, writer_options(args))?;
     let bar = progress(reader.len(), "import");
     let (mut written, mut skipped) = (0usize, Vec::new());
     for index in 0..reader.len() {
         bar.inc(1);
-        match reader.read(index) {
-            Ok(record) => {
+        match reader.read_with_image(index) {
+            Ok((record, image)) => {
+                // eotn's own 4:2:2 frames take the chosen byte order; every other image is
+                // stored as the message it came in (converted only when read).
+                let keep = (!is_plain_422(&image)).then_some(&image);
                 writer
-                    .write(&record)
+                    .write_with_image(&record, keep)
                     .with_context(|| format!("{}: frame {index}", args.output.display()))?;
                 written += 1;
             }

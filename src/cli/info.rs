@@ -1,15 +1,16 @@
-//! `eotn info`: what a file is — lookup table, frame, or MCAP stream.
+//! `eotn info`: what a file is — lookup table, frame, or recording (MCAP stream, ROS 2 bag).
 
 use std::path::PathBuf;
 
 use super::inputs::{is_frame_file, load_frame_arg, parse_size};
 use crate::lut::{ColourClass, LookupTable};
-use crate::streams::{StreamReader, is_stream_file};
+use crate::streams::{StreamReader, is_recording};
 
 /// Arguments of `eotn info`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Lookup tables (`.lut`), frames (`.uyvy`, `.png`, `.jpg`) and streams (`.mcap`).
+    /// Lookup tables (`.lut`), frames (`.uyvy`, `.png`, `.jpg`) and recordings: MCAP streams
+    /// (`.mcap`), ROS 2 bags (a folder with `metadata.yaml`, or its `.db3`/`.mcap` file).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred.
@@ -26,7 +27,8 @@ pub struct Args {
 /// An unreadable or malformed file, naming it.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     for path in &args.files {
-        let value = if is_stream_file(path) {
+        let value = if is_recording(path) || path.is_dir() {
+            // A folder is a ROS 2 bag or nothing `info` describes: the reader says which.
             stream_info(path)?
         } else if is_frame_file(path) {
             let f = load_frame_arg(path, args.size)?;
@@ -99,8 +101,17 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
     }
     // The first readable frame: a damaged first chunk costs its frames, not the description.
     let mut unreadable = Vec::new();
-    let first_readable = (0..n).find_map(|i| match reader.read(i) {
-        Ok(r) => Some((i, r)),
+    let topics: Vec<serde_json::Value> = reader
+        .image_topics()
+        .iter()
+        .map(|t| serde_json::json!({"topic": t.topic, "type": t.kind.schema_name()}))
+        .collect();
+    value["image_topics"] = topics.into();
+    let first_readable = (0..n).find_map(|i| match reader.read_with_image(i) {
+        Ok((r, image)) => {
+            value["image_encoding"] = image.encoding().into();
+            Some((i, r))
+        }
         Err(e) => {
             unreadable.push(format!("frame {i}: {e}"));
             None

@@ -15,7 +15,7 @@ use crate::lut::LookupTable;
 use crate::sources::{
     FileSource, NOMINAL_FRAME_INTERVAL_NS, RecordedSource, SourceFrame, StreamSource,
 };
-use crate::streams::is_stream_file;
+use crate::streams::is_recording;
 
 /// Parses `WxH` (e.g. `208x160`).
 ///
@@ -81,9 +81,9 @@ pub fn parse_frame_range(text: &str) -> anyhow::Result<Range<usize>> {
 pub enum FrameInput {
     /// A `.uyvy`/PNG/JPEG file.
     File(PathBuf),
-    /// Frame `index` of the MCAP stream at `path`.
+    /// Frame `index` of the recording at `path` (an MCAP stream or a ROS 2 bag).
     Stream {
-        /// The stream file.
+        /// The recording: a file, or a bag's folder.
         path: PathBuf,
         /// Frame index within the stream.
         index: usize,
@@ -111,8 +111,9 @@ impl FrameInput {
 /// `render`), flattened into each command's own arguments.
 #[derive(Debug, clap::Args)]
 pub struct InputArgs {
-    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams (`.mcap`, which carry
-    /// their own sensor readings).
+    /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or recordings (which carry their own
+    /// sensor readings): MCAP streams (`.mcap`), ROS 2 bags (a folder with `metadata.yaml`, or
+    /// its `.db3`/`.mcap` file).
     #[arg(required = true)]
     pub frames: Vec<PathBuf>,
     /// Lookup table (`.lut`, 6, 7 or 8 bits per channel).
@@ -199,7 +200,7 @@ impl FrameInputs {
         let mut items = Vec::new();
         let (mut overhead_streams, mut robot_streams) = (Vec::new(), Vec::new());
         for p in expand_frame_paths(paths)? {
-            if is_stream_file(&p) {
+            if is_recording(&p) {
                 let stream = StreamSource::open(&p)?;
                 if crate::sources::FrameSource::info(&stream).camera
                     == crate::sources::CameraKind::Overhead

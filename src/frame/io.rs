@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use super::{AIBO_SIZE, Frame, FrameError, OVERHEAD_SIZE, PixelLayout, rgb_to_yuv};
+use super::compressed::{CompressedFormat, decode_compressed};
+use super::{AIBO_SIZE, Frame, FrameError, OVERHEAD_SIZE, PixelLayout};
 
 /// Most pixels a frame may have: 4096 × 4096 (16.8 Mpx; 50 MiB as 4:4:4), far beyond the
 /// cameras' 208×160 to 1920×1080. Larger images are refused before they are decoded.
@@ -43,19 +44,15 @@ pub enum FrameFileError {
         /// The frame error.
         source: FrameError,
     },
-    /// The image is larger than any frame eotn takes ([`MAX_FRAME_PIXELS`]).
-    #[error(
-        "{path}: {width}×{height} is larger than the frames eotn takes (at most 4096×4096 pixels)"
-    )]
-    TooLarge {
+    /// The image does not decode, or is too large.
+    #[error("{path}: {source}")]
+    Compressed {
         /// The file.
         path: PathBuf,
-        /// Its width, pixels.
-        width: u64,
-        /// Its height, pixels.
-        height: u64,
+        /// The decoder's error.
+        source: super::compressed::CompressedImageError,
     },
-    /// The image decoder or encoder failed.
+    /// The image encoder failed.
     #[error("{path}: {source}")]
     Image {
         /// The file.
@@ -139,8 +136,8 @@ pub fn is_image_file(path: &Path) -> bool {
     )
 }
 
-/// Reads a frame: PNG and JPEG through the `image` crate (converted with
-/// [`rgb_to_yuv`] into a 4:4:4 frame), anything else as raw UYVY.
+/// Reads a frame: JPEG through its own YCbCr and PNG through RGB, both into the tables' YUV
+/// ([`super::colour`]) as 4:4:4 frames; anything else as raw UYVY.
 ///
 /// # Errors
 /// [`FrameFileError`] naming the file.
@@ -148,64 +145,30 @@ pub fn load_frame(path: &Path, size: Option<(usize, usize)>) -> Result<Frame, Fr
     if !is_image_file(path) {
         return load_raw_uyvy(path, size);
     }
-    let img = decode_image_file(path)?.into_rgb8();
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    Frame::yuv444_from_fn(w, h, |x, y| {
-        // x < w and y < h, so get_pixel_checked always answers.
-        let p = img
-            .get_pixel_checked(u32::try_from(x).unwrap_or(0), u32::try_from(y).unwrap_or(0))
-            .map_or([0, 0, 0], |p| p.0);
-        rgb_to_yuv(p)
-    })
-    .map_err(|source| FrameFileError::Frame {
-        path: path.to_owned(),
-        source,
-    })
-}
-
-/// Decodes a PNG or JPEG after checking from its header that it is no larger than a frame may be.
-fn decode_image_file(path: &Path) -> Result<image::DynamicImage, FrameFileError> {
-    let image_err = |source| FrameFileError::Image {
-        path: path.to_owned(),
-        source,
-    };
     let bytes = crate::input_file::read_bounded(path, MAX_IMAGE_FILE_BYTES, "an image frame")
         .map_err(|source| FrameFileError::Io {
             path: path.to_owned(),
             source,
         })?;
-    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
-        .with_guessed_format()
-        .map_err(|source| FrameFileError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-    let format = reader.format();
-    let (w, h) = reader.into_dimensions().map_err(image_err)?;
-    if format == Some(image::ImageFormat::Jpeg) && !jpeg_is_complete(&bytes) {
+    // The content decides (a `.jpg` that is a PNG opens too); the extension when it says nothing.
+    let sniffed = CompressedFormat::sniff(&bytes);
+    if sniffed == Some(CompressedFormat::Jpeg) && !jpeg_is_complete(&bytes) {
         return Err(FrameFileError::TruncatedJpeg {
             path: path.to_owned(),
         });
     }
-    if w > MAX_FRAME_SIDE || h > MAX_FRAME_SIDE || u64::from(w) * u64::from(h) > MAX_FRAME_PIXELS {
-        return Err(FrameFileError::TooLarge {
-            path: path.to_owned(),
-            width: u64::from(w),
-            height: u64::from(h),
-        });
-    }
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
-        .with_guessed_format()
-        .map_err(|source| FrameFileError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(MAX_FRAME_SIDE);
-    limits.max_image_height = Some(MAX_FRAME_SIDE);
-    limits.max_alloc = Some(MAX_FRAME_PIXELS * 8);
-    reader.limits(limits);
-    reader.decode().map_err(image_err)
+    let format = sniffed.map_or_else(
+        || {
+            path.extension()
+                .map(|e| e.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        },
+        |f| f.name().to_owned(),
+    );
+    decode_compressed(&format, &bytes).map_err(|source| FrameFileError::Compressed {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 /// Writes packed RGB (3 bytes a pixel) as a PNG, atomically.

@@ -6,19 +6,27 @@
 //! classification loop reads the raw bytes ([`Frame::data`]) directly.
 //!
 //! Display conversion to RGB uses the exact integer BT.601 formula of `FORMATS.md`
-//! ([`yuv_to_rgb`]); loading PNG/JPEG goes the other way with [`rgb_to_yuv`].
+//! ([`yuv_to_rgb`]); everything else comes in through one conversion into the tables' studio-range
+//! YUV ([`colour`]: [`rgb_to_yuv`] for RGB, JPEG's own YCbCr mapped without RGB), from image
+//! files ([`load_frame`]), compressed images ([`compressed`]) and raw message encodings
+//! ([`encodings`]: YUYV, RGB/BGR, mono, NV12, Bayer).
 //!
 //! Positions in a frame are [`ImagePoint`]s (pixels, sub-pixel) and [`PixelBox`]es (whole
 //! pixels), shared by every later stage.
 
+pub mod colour;
+pub mod compressed;
+pub mod encodings;
 mod image_point;
 mod io;
 mod pixel_box;
 
+pub use compressed::{CompressedFormat, CompressedImageError, decode_compressed, decode_jpeg};
+pub use encodings::{PixelEncoding, RawImage, RawImageError, decode_raw, decode_raw_owned};
 pub use image_point::{ImagePoint, xy_array};
 pub use io::{
-    FrameFileError, MAX_FRAME_PIXELS, display_name, infer_uyvy_size, is_image_file, load_frame,
-    load_raw_uyvy, save_rgb_png,
+    FrameFileError, MAX_FRAME_PIXELS, MAX_FRAME_SIDE, display_name, infer_uyvy_size, is_image_file,
+    load_frame, load_raw_uyvy, save_rgb_png,
 };
 pub use pixel_box::{CutOff, PixelBox};
 

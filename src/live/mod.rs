@@ -10,6 +10,7 @@
 //! serve`, a stand-in robot) behind a [`gate`] that bounds its viewers;
 //! [`source`] is a robot as a [`crate::sources::FrameSource`] for the workspace and the app.
 
+mod attach;
 pub mod channels;
 pub mod client;
 pub mod gaps;

@@ -11,17 +11,16 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
+use super::attach::{attach, image_kind};
 use super::client::{ClientOptions, LiveEvent, RobotClient};
 use super::gaps::{FrameGaps, Gap};
 use super::protocol::AdvertisedChannel;
 use super::recorder::{LiveRecorder, MAX_CHANNELS, Recorded};
 use super::{RobotUrl, unix_time_ns};
+use crate::formats::tf::TfTree;
+use crate::formats::{ImageMessage, MessageKind, ros2};
 use crate::sensors::SensorReadings;
-use crate::streams::schema::{decode_image_with_time, parse_json_lenient};
-use crate::streams::{
-    FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError,
-    StreamInfo,
-};
+use crate::streams::{FrameRecord, IMAGE_TOPIC, StreamError, StreamInfo};
 
 /// Frame bytes kept in memory per robot unless told otherwise (about 2,000 ERS-7 frames).
 pub const DEFAULT_KEEP_BYTES: usize = 128 << 20;
@@ -129,6 +128,12 @@ struct Inner {
     /// Every frame's arrival, nanoseconds after the first frame's, by index (8 bytes a frame,
     /// kept for frames no longer in memory too, so the timeline's times never change).
     arrival_offsets_ns: Vec<u64>,
+    /// The image topic shown (the first camera advertised; the others are recorded only).
+    camera: Option<String>,
+    /// The robot's transform tree (`/tf`, `/tf_static`), for the camera's pose.
+    tf: TfTree,
+    /// The "grey frames" note was given.
+    grey_noted: bool,
 }
 
 /// Called after each new frame (the app passes its repaint request).
@@ -500,11 +505,15 @@ impl Inner {
                 false
             }
             LiveEvent::Advertised(channels) => {
+                self.choose_camera(&channels);
                 for c in channels {
-                    if !is_image(&c) && c.encoding != "json" {
+                    let read = MessageKind::of(&c.schema_name, &c.encoding).is_some();
+                    let shown =
+                        image_kind(&c).is_some() && self.camera.as_deref() == Some(&c.topic);
+                    if (!read && c.encoding != "json") || (image_kind(&c).is_some() && !shown) {
                         self.note(format!(
-                            "channel {} ({}) is recorded, not shown",
-                            c.topic, c.encoding
+                            "channel {} ({} {}) is recorded, not shown",
+                            c.topic, c.schema_name, c.encoding
                         ));
                     }
                 }
@@ -548,13 +557,29 @@ impl Inner {
                 payload,
             } => {
                 self.record(&channel, log_time_ns, &payload);
-                if is_image(&channel) {
-                    self.image(log_time_ns, received_ns, &payload, keep_bytes)
-                } else {
-                    if channel.encoding == "json" {
-                        self.json(channel, log_time_ns, payload);
+                match image_kind(&channel) {
+                    Some(kind) if self.camera.as_deref() == Some(&channel.topic) => {
+                        self.image(kind, log_time_ns, received_ns, &payload, keep_bytes)
                     }
-                    false
+                    Some(_) => false,
+                    None if MessageKind::of(&channel.schema_name, &channel.encoding)
+                        == Some(MessageKind::RosTf) =>
+                    {
+                        // Transforms hold until replaced: into the tree whenever they come.
+                        match ros2::decode::<ros2::TfMessage>(&payload) {
+                            Ok(m) => self.tf.add(&m),
+                            Err(e) => {
+                                self.note(format!("{}: not a TFMessage ({e})", channel.topic))
+                            }
+                        }
+                        false
+                    }
+                    None => {
+                        if channel.encoding == "json" || channel.encoding == "cdr" {
+                            self.json(channel, log_time_ns, payload);
+                        }
+                        false
+                    }
                 }
             }
         }
@@ -580,8 +605,44 @@ impl Inner {
         }
     }
 
-    fn image(&mut self, log_time_ns: u64, received_ns: u64, payload: &[u8], keep: usize) -> bool {
-        let (frame, capture_ns) = match decode_image_with_time(payload) {
+    /// Chooses the camera shown among the advertised image channels (once: the canonical
+    /// topic, else the first); the others are recorded, not shown.
+    fn choose_camera(&mut self, channels: &[Arc<AdvertisedChannel>]) {
+        if self.camera.is_some() {
+            return;
+        }
+        let images: Vec<&Arc<AdvertisedChannel>> = channels
+            .iter()
+            .filter(|c| image_kind(c).is_some())
+            .collect();
+        let chosen = images
+            .iter()
+            .find(|c| c.topic == IMAGE_TOPIC)
+            .or_else(|| images.first());
+        if let Some(c) = chosen {
+            self.camera = Some(c.topic.clone());
+            if c.topic != IMAGE_TOPIC {
+                self.note(format!(
+                    "frames are shown from {} ({} {})",
+                    c.topic, c.schema_name, c.encoding
+                ));
+            }
+        }
+    }
+
+    fn image(
+        &mut self,
+        kind: MessageKind,
+        log_time_ns: u64,
+        received_ns: u64,
+        payload: &[u8],
+        keep: usize,
+    ) -> bool {
+        let decoded = ImageMessage::decode(kind, payload).and_then(|m| {
+            let (time, frame_id, grey) = (m.timestamp_ns, m.frame_id.clone(), m.is_grey());
+            m.into_frame().map(|f| (f, time, frame_id, grey))
+        });
+        let (frame, capture_ns, frame_id, grey) = match decoded {
             Ok(f) => f,
             Err(e) => {
                 self.drops += 1;
@@ -589,6 +650,13 @@ impl Inner {
                 return false;
             }
         };
+        if grey && !self.grey_noted {
+            self.grey_noted = true;
+            self.note(
+                "frames are mono8 (grey): they show, but a colour table cannot classify them"
+                    .to_owned(),
+            );
+        }
         // Gaps are judged on the camera's capture times (regular), not on when the sender got
         // round to writing (jittery); images without a timestamp use their log time.
         let capture_ns = capture_ns.filter(|&t| t > 0).unwrap_or(log_time_ns);
@@ -604,9 +672,20 @@ impl Inner {
         self.pending_bytes = 0;
         for (channel, time, bytes) in std::mem::take(&mut self.pending) {
             if time == log_time_ns
-                && let Some(n) = attach(&mut record, &channel, &bytes)
+                && let Some(n) = attach(&mut record, &channel, &bytes, &mut self.tf)
             {
                 self.note(n);
+            }
+        }
+        if let Some(pose) = self.tf.camera_pose(&frame_id) {
+            let s = record.sensors.get_or_insert_with(SensorReadings::default);
+            if s.camera_height_cm.is_none() && s.camera_pitch_rad.is_none() {
+                s.camera_x_cm = pose.camera_x_cm;
+                s.camera_y_cm = pose.camera_y_cm;
+                s.camera_height_cm = pose.camera_height_cm;
+                s.camera_roll_rad = pose.camera_roll_rad;
+                s.camera_pitch_rad = pose.camera_pitch_rad;
+                s.camera_yaw_rad = pose.camera_yaw_rad;
             }
         }
         let bytes = record.frame.data().len();
@@ -643,13 +722,22 @@ impl Inner {
         true
     }
 
+    /// Attaches a JSON or CDR message to its frame: eotn's senders give a frame's messages the
+    /// image's log time; a ROS bridge stamps each message when it came, so its `cdr` messages go
+    /// with the latest frame.
     fn json(&mut self, channel: Arc<AdvertisedChannel>, log_time_ns: u64, payload: Vec<u8>) {
+        let by_arrival = channel.encoding == "cdr";
         let latest = self
             .frames
             .back_mut()
-            .filter(|f| f.record.time_ns == log_time_ns);
+            .filter(|f| by_arrival || f.record.time_ns == log_time_ns);
         if let Some(latest) = latest {
-            let note = attach(&mut Arc::make_mut(latest).record, &channel, &payload);
+            let note = attach(
+                &mut Arc::make_mut(latest).record,
+                &channel,
+                &payload,
+                &mut self.tf,
+            );
             if let Some(n) = note {
                 self.note(n);
             }
@@ -666,29 +754,4 @@ impl Inner {
             }
         }
     }
-}
-
-/// Attaches one JSON message to its frame; a note when it had to be skipped.
-fn attach(record: &mut FrameRecord, channel: &AdvertisedChannel, bytes: &[u8]) -> Option<String> {
-    let topic = channel.topic.as_str();
-    let value = match parse_json_lenient(bytes) {
-        Ok((v, _)) => v,
-        Err(e) => return Some(format!("{topic}: not JSON ({e}); skipped")),
-    };
-    match topic {
-        SENSORS_TOPIC => match serde_json::from_value::<SensorReadings>(value) {
-            Ok(s) => record.sensors = Some(s.sanitised().0),
-            Err(e) => return Some(format!("{topic}: not sensor readings ({e}); skipped")),
-        },
-        GROUND_TRUTH_TOPIC => record.ground_truth = Some(value),
-        RECOGNITION_TOPIC => record.recognition = Some(value),
-        _ => record.extra.push((topic.to_owned(), value)),
-    }
-    None
-}
-
-/// True for a camera image channel: `foxglove.RawImage` in protobuf (on `/camera/image` or,
-/// failing that, any topic).
-fn is_image(c: &AdvertisedChannel) -> bool {
-    c.encoding == "protobuf" && (c.schema_name == "foxglove.RawImage" || c.topic == IMAGE_TOPIC)
 }

@@ -628,4 +628,27 @@ mod tests {
         let ers7 = params.context_for(208, 160, Some(&joints_only));
         assert_eq!(ers7.pose_source, Some(PoseSource::Ers7Joints));
     }
+
+    #[test]
+    fn a_calibrated_camera_in_the_readings_replaces_the_parameters_field_of_view() {
+        let params = super::super::RecognitionParams::default();
+        let default = params.context_for(320, 240, None).camera;
+        let calibrated = SensorReadings {
+            camera_focal_px: Some(250.0),
+            camera_centre_x_px: Some(165.0),
+            ..SensorReadings::default()
+        };
+        let ctx = params.context_for(320, 240, Some(&calibrated));
+        assert_relative_eq!(ctx.camera.focal_px, 250.0);
+        assert_relative_eq!(ctx.camera.centre.x_px, 165.0);
+        assert_relative_eq!(ctx.camera.centre.y_px, 120.0);
+        assert!((default.focal_px - 250.0).abs() > 50.0, "{default:?}");
+        // Without a focal length the parameters' camera stays.
+        let centre_only = SensorReadings {
+            camera_focal_px: None,
+            ..calibrated
+        };
+        let ctx = params.context_for(320, 240, Some(&centre_only));
+        assert_eq!(ctx.camera, default);
+    }
 }

@@ -100,7 +100,9 @@ impl RecognitionParams {
         height: usize,
         sensors: Option<&SensorReadings>,
     ) -> ViewContext {
-        let camera = self.camera_for(width, height);
+        let camera = sensors
+            .and_then(|s| calibrated_camera(width, height, s))
+            .unwrap_or_else(|| self.camera_for(width, height));
         match sensors {
             Some(s) => {
                 let ctx = ViewContext::from_sensors_with_readout(
@@ -118,6 +120,23 @@ impl RecognitionParams {
             None => ViewContext::without_pose(camera),
         }
     }
+}
+
+/// The camera as calibrated (`camera_focal_px` and the optical centre in the readings, from a
+/// ROS `CameraInfo`), when the readings carry a positive focal length; the centre defaults to
+/// the image's middle.
+fn calibrated_camera(width: usize, height: usize, s: &SensorReadings) -> Option<PinholeCamera> {
+    let focal_px = s.camera_focal_px.filter(|f| f.is_finite() && *f > 0.0)?;
+    let (w, h) = (width as f64, height as f64);
+    Some(PinholeCamera {
+        width_px: width,
+        height_px: height,
+        focal_px,
+        centre: crate::geometry::ImagePoint::new(
+            s.camera_centre_x_px.unwrap_or(w / 2.0),
+            s.camera_centre_y_px.unwrap_or(h / 2.0),
+        ),
+    })
 }
 
 /// Everything recognised in one frame.

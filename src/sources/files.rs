@@ -24,15 +24,18 @@ pub fn is_frame_file(path: &Path) -> bool {
             .is_some_and(|e| RAW_EXTENSIONS.iter().any(|r| e.eq_ignore_ascii_case(r)))
 }
 
-/// Expands the arguments: files (frames and `.mcap` streams) stay, folders give their frame files
-/// sorted by name.
+/// Expands the arguments: files (frames and recordings) and rosbag2 folders (with
+/// `metadata.yaml`) stay, other folders give their frame files sorted by name.
 ///
 /// # Errors
 /// A path that does not exist, or a folder without frames.
 pub fn expand_frame_paths(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for p in paths {
-        if p.is_dir() {
+        // A rosbag2 bag is a folder too: it stays one recording, never a folder of frames.
+        if crate::streams::is_bag_folder(p) {
+            out.push(p.clone());
+        } else if p.is_dir() {
             let mut found: Vec<PathBuf> = std::fs::read_dir(p)
                 .with_context(|| format!("{}: cannot list folder", p.display()))?
                 .filter_map(Result::ok)
@@ -41,7 +44,7 @@ pub fn expand_frame_paths(paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
                 .collect();
             anyhow::ensure!(
                 !found.is_empty(),
-                "{}: no frame files (.uyvy, .yuv, .raw, .png, .jpg) in folder",
+                "{}: no frame files (.uyvy, .yuv, .raw, .png, .jpg) in folder, and no metadata.yaml, so not a rosbag2 bag either",
                 p.display()
             );
             found.sort();

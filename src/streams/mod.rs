@@ -1,8 +1,10 @@
 //! Recorded streams: camera frames with the robot's sensor readings, ground truth and recognition
 //! results, in one MCAP file that Foxglove and other MCAP tools open.
 //!
-//! One frame is one message on [`IMAGE_TOPIC`] (`foxglove.RawImage`, protobuf, encoding `uyvy`,
-//! `step` = 2 × width bytes). The frame's other data are JSON messages with the image's log time,
+//! One frame is one message on [`IMAGE_TOPIC`] (`foxglove.RawImage`, protobuf; frames eotn makes
+//! are `yuyv` or `uyvy` with `step` = 2 × width bytes; images imported from other recordings keep
+//! their own encoding and step) or, for images that came compressed, on
+//! [`COMPRESSED_IMAGE_TOPIC`] (`foxglove.CompressedImage`, JPEG or PNG, unchanged). The frame's other data are JSON messages with the image's log time,
 //! written right after it in the same chunk: [`SENSORS_TOPIC`] (a [`SensorReadings`]),
 //! [`GROUND_TRUTH_TOPIC`], [`RECOGNITION_TOPIC`] and any extra JSON channels (for example
 //! `/world_model/robot3`). Every JSON channel has a `jsonschema` schema. The stream's
@@ -18,15 +20,23 @@
 //! one whose summary does not describe it whole is read through its data section, messages
 //! outside chunks included; [`StreamReader::channels`] lists every channel with its message
 //! count, whatever it carries.
+//!
+//! [`StreamReader`] reads other recordings too: MCAP files of other writers and ROS 2 bags
+//! ([`rosbag2`]: folders with `metadata.yaml`, SQLite or MCAP storage), their images in any
+//! encoding through [`crate::formats`].
 
 mod reader;
+pub mod rosbag2;
 pub mod schema;
 pub mod sensor_table;
 mod writer;
 
 use std::path::PathBuf;
 
-pub use reader::{ChannelSummary, RecordCounts, SchemaSummary, StreamMessage, StreamReader};
+pub use reader::{
+    ChannelSummary, ImageTopic, RecordCounts, SchemaSummary, StreamMessage, StreamReader,
+};
+pub use rosbag2::{is_bag_folder, is_recording};
 pub use writer::{Compression, RawChannelSpec, StreamWriter, WriterOptions};
 
 use crate::frame::Frame;
@@ -34,6 +44,9 @@ use crate::sensors::SensorReadings;
 
 /// Topic of the camera image channel (`foxglove.RawImage`, protobuf).
 pub const IMAGE_TOPIC: &str = "/camera/image";
+/// Topic of camera images stored compressed, as they came (`foxglove.CompressedImage`, JPEG or
+/// PNG, written by `eotn import` from recordings that hold them).
+pub const COMPRESSED_IMAGE_TOPIC: &str = "/camera/image/compressed";
 /// Topic of the sensor readings channel (JSON, schema `eotn.SensorReadings`).
 pub const SENSORS_TOPIC: &str = "/sensors";
 /// Topic of the ground-truth channel (JSON object, free form; written by renderers/simulators).
@@ -164,7 +177,9 @@ pub enum StreamError {
 }
 
 /// True when the path looks like an MCAP stream (`.mcap`, or `.mcap.partial` as a killed writer
-/// leaves it, or `.mcap.partial.N` as the next writer moved it aside; any case).
+/// leaves it, or `.mcap.partial.N` as the next writer moved it aside; any case): what eotn
+/// writes. Inputs are told by [`is_recording`], which also takes
+/// rosbag2 bags.
 #[must_use]
 pub fn is_stream_file(path: &std::path::Path) -> bool {
     let name = path

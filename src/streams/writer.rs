@@ -8,6 +8,7 @@ use foxglove::Encode as _;
 use mcap::records::MessageHeader;
 
 use crate::atomic_file::{OutputTarget, PartialFile};
+use crate::formats::{ImageMessage, MessageKind};
 
 use super::schema::{
     EXTRA_SCHEMA_NAME, GROUND_TRUTH_SCHEMA_NAME, ImageEncoding, RECOGNITION_SCHEMA_NAME,
@@ -15,8 +16,9 @@ use super::schema::{
     sensors_json_schema,
 };
 use super::{
-    ANNOTATIONS_TOPIC, FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, METADATA_NAME,
-    PARAMS_METADATA_NAME, RECOGNITION_TOPIC, SENSORS_TOPIC, StreamError, StreamInfo,
+    ANNOTATIONS_TOPIC, COMPRESSED_IMAGE_TOPIC, FORMAT_VERSION, FrameRecord, GROUND_TRUTH_TOPIC,
+    IMAGE_TOPIC, METADATA_NAME, PARAMS_METADATA_NAME, RECOGNITION_TOPIC, SENSORS_TOPIC,
+    StreamError, StreamInfo,
 };
 
 /// How chunks are compressed.
@@ -68,6 +70,7 @@ pub struct StreamWriter {
     sensors_channel: u16,
     lazy_channels: HashMap<String, u16>,
     annotations_channel: Option<u16>,
+    compressed_channel: Option<u16>,
     frames_per_chunk: Option<usize>,
     image_encoding: ImageEncoding,
     frames_in_chunk: usize,
@@ -101,6 +104,14 @@ impl RawChannelSpec {
         self.topic == IMAGE_TOPIC
             && self.message_encoding == "protobuf"
             && self.schema_name == "foxglove.RawImage"
+    }
+
+    /// True for any camera image channel eotn reads (`foxglove.RawImage`, `CompressedImage`,
+    /// `sensor_msgs/msg/Image`, …, see [`MessageKind`]): its messages are frames.
+    #[must_use]
+    pub fn is_frame(&self) -> bool {
+        MessageKind::of(&self.schema_name, &self.message_encoding)
+            .is_some_and(MessageKind::is_image)
     }
 }
 
@@ -212,6 +223,7 @@ impl StreamWriter {
             sensors_channel,
             lazy_channels: HashMap::new(),
             annotations_channel: None,
+            compressed_channel: None,
             frames_per_chunk: options.frames_per_chunk.map(|n| n.max(1)),
             image_encoding: options.image_encoding,
             frames_in_chunk: 0,
@@ -242,6 +254,34 @@ impl StreamWriter {
             context,
             source,
         }
+    }
+
+    /// The `foxglove.CompressedImage` channel, added with the first compressed frame.
+    fn compressed_channel(&mut self) -> Result<u16, StreamError> {
+        if let Some(id) = self.compressed_channel {
+            return Ok(id);
+        }
+        let schema = foxglove::messages::CompressedImage::get_schema().ok_or_else(|| {
+            StreamError::Corrupt {
+                path: self.partial.clone(),
+                detail: "the foxglove.CompressedImage schema is not available".to_owned(),
+            }
+        })?;
+        let schema_id = self
+            .mcap
+            .add_schema(&schema.name, &schema.encoding, &schema.data)
+            .map_err(self.mcap_err("cannot add the compressed image schema"))?;
+        let id = self
+            .mcap
+            .add_channel(
+                schema_id,
+                COMPRESSED_IMAGE_TOPIC,
+                "protobuf",
+                &BTreeMap::new(),
+            )
+            .map_err(self.mcap_err("cannot add the compressed image channel"))?;
+        self.compressed_channel = Some(id);
+        Ok(id)
     }
 
     /// The channel for a JSON topic other than the sensors, added on first use.
@@ -339,6 +379,21 @@ impl StreamWriter {
     /// [`StreamError::BadRecord`] for an image that cannot be UYVY (odd width) or a reserved
     /// extra topic; I/O errors naming the file.
     pub fn write(&mut self, record: &FrameRecord) -> Result<(), StreamError> {
+        self.write_with_image(record, None)
+    }
+
+    /// Appends one frame with its data, its image stored as the message it came in when `image`
+    /// is given: raw pixels as a `foxglove.RawImage` on [`IMAGE_TOPIC`] in their own encoding,
+    /// step and bytes; compressed ones as a `foxglove.CompressedImage` on
+    /// [`COMPRESSED_IMAGE_TOPIC`], bytes unchanged. Readers convert them when they read.
+    ///
+    /// # Errors
+    /// As [`StreamWriter::write`].
+    pub fn write_with_image(
+        &mut self,
+        record: &FrameRecord,
+        image: Option<&ImageMessage>,
+    ) -> Result<(), StreamError> {
         let path = self.path.clone();
         let bad = |detail: String| StreamError::BadRecord {
             path: path.clone(),
@@ -348,6 +403,7 @@ impl StreamWriter {
         for (topic, _) in &record.extra {
             if [
                 IMAGE_TOPIC,
+                COMPRESSED_IMAGE_TOPIC,
                 SENSORS_TOPIC,
                 GROUND_TRUTH_TOPIC,
                 RECOGNITION_TOPIC,
@@ -361,16 +417,28 @@ impl StreamWriter {
                 )));
             }
         }
-        let mut image = std::mem::take(&mut self.buf);
-        encode_image(
-            record.time_ns,
-            &record.frame,
-            self.image_encoding,
-            &mut image,
-        )
-        .map_err(|e| bad(e.to_string()))?;
-        let written = self.put(self.image_channel, record.time_ns, &image);
-        self.buf = image;
+        let mut bytes = std::mem::take(&mut self.buf);
+        let channel = match image {
+            Some(message) => {
+                bytes.clear();
+                match message.encode_foxglove(&mut bytes).map_err(&bad)? {
+                    MessageKind::FoxgloveCompressedImage => self.compressed_channel()?,
+                    _ => self.image_channel,
+                }
+            }
+            None => {
+                encode_image(
+                    record.time_ns,
+                    &record.frame,
+                    self.image_encoding,
+                    &mut bytes,
+                )
+                .map_err(|e| bad(e.to_string()))?;
+                self.image_channel
+            }
+        };
+        let written = self.put(channel, record.time_ns, &bytes);
+        self.buf = bytes;
         written?;
         if let Some(s) = &record.sensors {
             let (clean, _) = s.sanitised();
@@ -425,14 +493,14 @@ impl StreamWriter {
         log_time_ns: u64,
         data: &[u8],
     ) -> Result<(), StreamError> {
-        let is_image = spec.is_image();
-        let channel = if is_image {
-            let per_chunk = self.frames_per_chunk.unwrap_or_else(|| {
-                (TARGET_CHUNK_BYTES / data.len().max(1)).clamp(1, MAX_FRAMES_PER_CHUNK)
-            });
-            if self.frames_in_chunk >= per_chunk {
-                self.close_chunk()?;
-            }
+        let is_frame = spec.is_frame();
+        if is_frame && !spec.is_image() {
+            // Another writer's camera (ROS `cdr`, a compressed image): its own channel, but its
+            // messages make frames and chunks as ours do.
+            self.close_chunk_if_full(data.len())?;
+        }
+        let channel = if spec.is_image() {
+            self.close_chunk_if_full(data.len())?;
             self.image_channel
         } else if spec.topic == SENSORS_TOPIC && spec.message_encoding == "json" {
             self.sensors_channel
@@ -459,9 +527,19 @@ impl StreamWriter {
             id
         };
         self.put(channel, log_time_ns, data)?;
-        if is_image {
+        if is_frame {
             self.frames = self.frames.saturating_add(1);
             self.frames_in_chunk += 1;
+        }
+        Ok(())
+    }
+
+    fn close_chunk_if_full(&mut self, image_bytes: usize) -> Result<(), StreamError> {
+        let per_chunk = self.frames_per_chunk.unwrap_or_else(|| {
+            (TARGET_CHUNK_BYTES / image_bytes.max(1)).clamp(1, MAX_FRAMES_PER_CHUNK)
+        });
+        if self.frames_in_chunk >= per_chunk {
+            self.close_chunk()?;
         }
         Ok(())
     }

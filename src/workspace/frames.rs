@@ -29,7 +29,7 @@ impl Workspace {
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default();
-            let opened = if crate::streams::is_stream_file(&p) {
+            let opened = if crate::streams::is_recording(&p) {
                 streams.push(p);
                 Ok(())
             } else if ext == "json" {

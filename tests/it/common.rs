@@ -134,7 +134,7 @@ pub fn test_python() -> PathBuf {
 
 /// [`test_python`] when `import_line` runs in it; else fails under CI and skips with a line saying
 /// which `check` did not run.
-fn python_with(import_line: &str, packages: &str, check: &str) -> Option<PathBuf> {
+pub fn python_with(import_line: &str, packages: &str, check: &str) -> Option<PathBuf> {
     let python = test_python();
     let ok = Command::new(&python)
         .args(["-c", import_line])

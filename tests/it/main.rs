@@ -26,6 +26,7 @@ mod hardening;
 mod hardening_files;
 #[cfg(feature = "gui")]
 mod harness;
+mod jpeg_colour;
 mod kernels;
 mod live;
 mod live_peers;
@@ -39,6 +40,7 @@ mod peer;
 mod properties;
 mod real_data;
 mod recognition;
+mod recordings;
 mod robots;
 mod serve_load;
 mod sim;

@@ -50,7 +50,7 @@ fn overhead_stream(dir: &Path, jpg: &Path) -> PathBuf {
 }
 
 /// The frame open in the app's workspace, classified by replaying the clicks.
-fn classified_workspace(stream: &Path) -> Workspace {
+pub fn classified_workspace(stream: &Path) -> Workspace {
     let mut ws = Workspace::default();
     ws.apply(Command::Open(vec![stream.to_owned()])).unwrap();
     let clicks = clicks::Clicks::load(&repo("params/overhead/ssl-field-2008.clicks.json")).unwrap();

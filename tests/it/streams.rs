@@ -232,8 +232,11 @@ fn damaged_chunk_fails_only_its_frames() {
     let p = dir.path().join("s.mcap");
     let records = write_stream(&p, 6, 2);
     let mut bytes = std::fs::read(&p).unwrap();
-    // Flip bytes in the middle of the file: inside the second chunk's compressed data.
-    let mid = bytes.len() / 2;
+    // Flip bytes inside the second chunk's compressed data (its middle, found through the
+    // summary's chunk index, so the damage lands there whatever the schemas' sizes).
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let chunk = &summary.chunk_indexes[1];
+    let mid = usize::try_from(chunk.chunk_start_offset + chunk.chunk_length / 2).unwrap();
     for b in &mut bytes[mid..mid + 16] {
         *b ^= 0x5a;
     }

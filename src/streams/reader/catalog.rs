@@ -46,6 +46,18 @@ pub struct RecordCounts {
     pub metadata: u64,
 }
 
+impl RecordCounts {
+    /// Adds another file's counts (the files of a split bag).
+    pub(super) fn add(&mut self, other: Self) {
+        self.messages += other.messages;
+        self.schemas += other.schemas;
+        self.channels += other.channels;
+        self.chunks += other.chunks;
+        self.attachments += other.attachments;
+        self.metadata += other.metadata;
+    }
+}
+
 /// The schemas and channels seen so far, with message counts: a summary's, or a data section's
 /// as it is walked.
 #[derive(Debug, Default)]

@@ -3,7 +3,7 @@
 
 use mcap::records::{Record, op};
 
-use super::{MAX_CHUNK_BYTES, Msg};
+use super::mcap_file::{MAX_CHUNK_BYTES, Msg};
 
 /// What the recovery scan needs from a chunk's records.
 pub(super) enum ChunkItem {
@@ -44,6 +44,7 @@ pub(super) fn decode_chunk_messages(
         if let Record::Message { header, data } = r {
             out.push(Msg {
                 channel: header.channel_id,
+                log_time: header.log_time,
                 data: data.into_owned(),
             });
         }
@@ -85,6 +86,7 @@ pub(super) fn decode_loose_messages(
         {
             out.push(Msg {
                 channel: header.channel_id,
+                log_time: header.log_time,
                 data: data.into_owned(),
             });
         }

@@ -3,9 +3,10 @@
 
 use mcap::records::{MessageHeader, Record, op};
 
+use super::super::StreamError;
 use super::chunk::for_each_chunk_message;
+use super::mcap_file::{MAX_CHUNK_BYTES, McapFile};
 use super::recovery::WalkEnd;
-use super::{MAX_CHUNK_BYTES, StreamError, StreamReader};
 
 /// One message as stored: its channel, sequence number, times and undecoded data.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,7 +35,7 @@ impl<'a> StreamMessage<'a> {
     }
 }
 
-impl StreamReader {
+impl McapFile {
     /// Calls `each` with every message of the file in the order it is stored, inside chunks
     /// and outside them. Memory is one chunk at a time.
     ///

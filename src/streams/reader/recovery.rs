@@ -6,11 +6,12 @@
 
 use mcap::records::{Record, op};
 
+use super::super::{StreamError, StreamInfo};
 use super::catalog::Catalog;
+use super::channels::{ChannelTable, Role};
 use super::chunk::{ChunkItem, decode_chunk};
-use super::{
-    BlockKind, BlockLoc, ChannelTable, FrameLoc, MAX_CHUNK_BYTES, MAX_INDEX_BYTES, StreamError,
-    StreamInfo, StreamReader,
+use super::mcap_file::{
+    BlockKind, BlockLoc, FrameLoc, MAGIC, MAX_CHUNK_BYTES, MAX_INDEX_BYTES, McapFile,
 };
 
 /// Largest run of records outside chunks kept as one frame's block, bytes: a frame's image
@@ -32,7 +33,7 @@ pub(super) enum WalkEnd {
     CutOff(String),
 }
 
-impl StreamReader {
+impl McapFile {
     /// Walks the data section's records from the header on, calling `each` with the opcode,
     /// offset and body length of every record that lies whole in the file, until the Data End
     /// record, the end of the file, a record cut off, or `each` returns `false`.
@@ -40,7 +41,7 @@ impl StreamReader {
         &mut self,
         mut each: impl FnMut(&mut Self, u8, u64, u64) -> Result<bool, StreamError>,
     ) -> Result<WalkEnd, StreamError> {
-        let mut offset = super::MAGIC.len() as u64;
+        let mut offset = MAGIC.len() as u64;
         loop {
             let remaining = self.file_len.saturating_sub(offset);
             if remaining == 0 {
@@ -132,6 +133,7 @@ impl StreamReader {
         let block = u32::try_from(self.blocks.len())
             .map_err(|_| self.corrupt("more than 2³² chunks".to_owned()))?;
         let mut nth = 0u32;
+        let mut has_static = false;
         for r in records {
             match r {
                 ChunkItem::Schema { id, name, encoding } => {
@@ -140,6 +142,7 @@ impl StreamReader {
                 ChunkItem::Channel(c) => add_channel(table, catalog, &c),
                 ChunkItem::Message(channel, log_time) => {
                     catalog.count_message(channel);
+                    has_static |= table.roles.get(&channel) == Some(&Role::Tf(true));
                     if Some(channel) == table.image {
                         self.frames.push(FrameLoc {
                             time_ns: log_time,
@@ -151,12 +154,16 @@ impl StreamReader {
                 }
             }
         }
+        let loc = BlockLoc {
+            offset,
+            length: len + 9,
+            kind: BlockKind::Chunk,
+        };
+        if has_static {
+            self.note_static_block(loc);
+        }
         if nth > 0 {
-            self.blocks.push(BlockLoc {
-                offset,
-                length: len + 9,
-                kind: BlockKind::Chunk,
-            });
+            self.blocks.push(loc);
         }
         Ok(true)
     }
@@ -181,6 +188,13 @@ impl StreamReader {
         let channel = u16::from_le_bytes([head[0], head[1]]);
         let log_time = u64::from_le_bytes(head[6..14].try_into().unwrap_or([0; 8]));
         catalog.count_message(channel);
+        if table.roles.get(&channel) == Some(&Role::Tf(true)) {
+            self.note_static_block(BlockLoc {
+                offset,
+                length: len + 9,
+                kind: BlockKind::Loose,
+            });
+        }
         if Some(channel) != table.image {
             self.extend_loose(loose, offset, len);
             return Ok(true);

@@ -7,10 +7,11 @@
 
 use mcap::records::{Channel, ChunkIndex, MetadataIndex, Record, Statistics, op};
 
+use super::super::{IMAGE_TOPIC, METADATA_NAME, PARAMS_METADATA_NAME, StreamError, StreamInfo};
 use super::catalog::Catalog;
-use super::{
-    BlockKind, BlockLoc, ChannelTable, FrameLoc, IMAGE_TOPIC, MAGIC, MAX_CHUNK_BYTES,
-    MAX_INDEX_BYTES, METADATA_NAME, PARAMS_METADATA_NAME, StreamError, StreamInfo, StreamReader,
+use super::channels::ChannelTable;
+use super::mcap_file::{
+    BlockKind, BlockLoc, FrameLoc, MAGIC, MAX_CHUNK_BYTES, MAX_INDEX_BYTES, McapFile,
 };
 
 /// The footer record (opcode, length, 20-byte body) and the closing magic, bytes.
@@ -39,7 +40,7 @@ pub(super) enum SummaryProblem {
     Damaged(String),
 }
 
-impl StreamReader {
+impl McapFile {
     /// Reads the footer and the summary section it points at.
     ///
     /// # Errors
@@ -128,6 +129,13 @@ impl StreamReader {
         if self.info == StreamInfo::default() {
             self.no_metadata();
         }
+        // A channel without messages is never chosen as the camera.
+        table.empty = summary
+            .channels
+            .iter()
+            .map(|c| c.id)
+            .filter(|id| stats.channel_message_counts.get(id).is_none_or(|n| *n == 0))
+            .collect();
         let mut channels: Vec<&Channel> = summary.channels.iter().collect();
         // Prefer the canonical image topic over any other RawImage channel.
         channels.sort_by_key(|c| (c.topic != IMAGE_TOPIC, c.id));
@@ -139,6 +147,7 @@ impl StreamReader {
                 catalog.schema_name(c.schema_id),
             );
         }
+        self.static_blocks_from_indexes(&summary.chunk_indexes, table);
         let Some(image) = table.image else {
             return Ok(true);
         };
@@ -151,6 +160,32 @@ impl StreamReader {
         }
         // Fewer indexed frames than the statistics count: some are outside chunks.
         Ok(Some(self.frames.len() as u64) == frames)
+    }
+
+    /// The chunks holding `/tf_static` messages, through the chunk indexes.
+    fn static_blocks_from_indexes(&mut self, chunk_indexes: &[ChunkIndex], table: &ChannelTable) {
+        let statics = McapFile::static_channels(&table.roles);
+        if statics.is_empty() {
+            return;
+        }
+        let mut sorted: Vec<&ChunkIndex> = chunk_indexes.iter().collect();
+        sorted.sort_by_key(|c| c.chunk_start_offset);
+        for ci in sorted {
+            let inside = ci.chunk_length <= MAX_CHUNK_BYTES
+                && ci.chunk_start_offset.saturating_add(ci.chunk_length) <= self.file_len;
+            if inside
+                && ci
+                    .message_index_offsets
+                    .keys()
+                    .any(|id| statics.contains(id))
+            {
+                self.note_static_block(BlockLoc {
+                    offset: ci.chunk_start_offset,
+                    length: ci.chunk_length,
+                    kind: BlockKind::Chunk,
+                });
+            }
+        }
     }
 
     /// The image channel's frames through each chunk's message index. `false` when a chunk has
@@ -261,6 +296,7 @@ impl StreamReader {
     pub(super) fn take_metadata(&mut self, opcode: u8, body: &[u8]) {
         match mcap::parse_record(opcode, body) {
             Ok(Record::Metadata(m)) if m.name == METADATA_NAME => {
+                self.written_by_eotn = true;
                 let get = |k: &str| m.metadata.get(k).cloned().unwrap_or_default();
                 self.info = StreamInfo {
                     source: get("source"),
