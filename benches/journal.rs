@@ -3,6 +3,9 @@
 //! the work the app does before it shows a table at start. Two kinds of small edit, alternating:
 //! a sample pixel with ±1 cell (27 cells), and two cells picked in the U–V plane.
 //!
+//! And the worst a small journal can ask: 40 whole-table edits of an 8-bit table (a 7.9 KB
+//! journal, 670 million cell writes), replayed with the undo history bounded by its bytes.
+//!
 //!     cargo bench --bench journal
 
 use std::hint::black_box;
@@ -74,7 +77,40 @@ fn benches(c: &mut Criterion) {
             r
         });
     });
+    let whole = dir.path().join("whole.lut");
+    std::fs::write(journal::journal_path(&whole), whole_table_journal()).expect("write");
+    group.bench_function("replay_40_whole_table_edits_8bit", |b| {
+        b.iter(|| {
+            let r = journal::replay(black_box(&whole)).expect("replays");
+            assert_eq!(r.commits, 40);
+            r
+        });
+    });
     group.finish();
+}
+
+/// A journal of 40 edits, each of the whole 8-bit table, alternating two classes.
+fn whole_table_journal() -> String {
+    let start = JournalEntry::Start {
+        bits: 8,
+        base: false,
+        time_unix_ms: 0,
+    };
+    let mut text = serde_json::to_string(&start).expect("json");
+    for i in 0..40 {
+        let record = EditRecord {
+            class: [ColourClass::Orange, ColourClass::Green][i % 2],
+            region: Region::AroundSample {
+                sample: Yuv::new(128, 128, 128),
+                sensitivity: Sensitivity::uniform(255),
+            },
+            time_unix_ms: i as u64,
+            sampled_at: None,
+        };
+        text.push('\n');
+        text.push_str(&serde_json::to_string(&JournalEntry::Commit { record }).expect("json"));
+    }
+    text
 }
 
 criterion_group!(journal_benches, benches);

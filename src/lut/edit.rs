@@ -236,20 +236,53 @@ pub fn now_unix_ms() -> u64 {
         .map_or(0, |d| u64::try_from(d.as_millis()).unwrap_or(u64::MAX))
 }
 
-/// An edit that was applied: the record and the old code of every cell it changed.
+/// An edit that was applied: the record and the old codes it overwrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct AppliedEdit {
     /// What was done.
     pub record: EditRecord,
-    /// (cell index, previous code) for every cell whose code changed.
-    pub previous: Vec<(usize, u8)>,
+    /// The old codes, for undo.
+    pub previous: PreviousCodes,
+    /// Number of cells whose class changed.
+    changed: usize,
+}
+
+/// The codes an edit overwrote, kept compactly: a whole 8-bit table's box is 16 MiB (one byte a
+/// cell), not a list of 16 million (index, code) pairs, so the undo history holds 16 such edits
+/// and a journal of whole-table edits replays at memory speed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PreviousCodes {
+    /// Picked cells: the index and old code of each cell that changed, in index order.
+    Cells {
+        /// Cell indices (a table has at most 2^24 cells).
+        indices: Vec<u32>,
+        /// Their old codes, one per index.
+        codes: Vec<u8>,
+    },
+    /// A box: the old code of every cell in it, row by row (V fastest, then U, then Y).
+    Box {
+        /// The cells covered.
+        cells: CellBox,
+        /// One old code per cell of the box.
+        codes: Vec<u8>,
+    },
+}
+
+impl PreviousCodes {
+    /// Bytes the codes hold.
+    fn held_bytes(&self) -> usize {
+        match self {
+            Self::Cells { indices, codes } => indices.len() * size_of::<u32>() + codes.len(),
+            Self::Box { codes, .. } => codes.len(),
+        }
+    }
 }
 
 impl AppliedEdit {
     /// Number of cells whose class changed.
     #[must_use]
-    pub fn changed_cells(&self) -> usize {
-        self.previous.len()
+    pub const fn changed_cells(&self) -> usize {
+        self.changed
     }
 }
 
@@ -257,52 +290,87 @@ impl LookupTable {
     /// Writes an edit into the table and returns what it changed (for undo).
     pub fn apply(&mut self, record: EditRecord) -> AppliedEdit {
         let code = record.class.code();
-        let mut previous = Vec::new();
-        let mut change = |lut: &mut Self, i: usize| {
-            if let Some(old) = lut.get(i).filter(|&old| old != code) {
-                previous.push((i, old));
-                lut.set(i, record.class);
-            }
-        };
-        match record.region.select_cells(self) {
+        let (previous, changed) = match record.region.select_cells(self) {
             // Picked cells directly (sorted, once each, inside the table): resolving them to a
             // flag per cell would cost the whole table for every small edit (20,000 such edits
             // took 30 s to replay on a 7-bit table).
-            None => {
-                let len = self.cells().len();
-                let mut v: Vec<usize> = match &record.region {
-                    Region::Cells { indices } => {
-                        indices.iter().copied().filter(|&i| i < len).collect()
-                    }
-                    Region::AroundSample { .. } => Vec::new(),
-                };
-                v.sort_unstable();
-                v.dedup();
-                for i in v {
-                    change(self, i);
-                }
-            }
-            // A box, walked in index order without listing it first (a whole 8-bit table would
-            // be a 128 MiB list).
-            Some(b) => {
-                for y in b.min[0]..=b.max[0] {
-                    for u in b.min[1]..=b.max[1] {
-                        for v in b.min[2]..=b.max[2] {
-                            let i = self.index_of_cell([y, u, v]);
-                            change(self, i);
-                        }
-                    }
-                }
+            None => self.apply_to_cells(&record.region, code),
+            // A box, row by row (a row of V is contiguous), without listing its cells.
+            Some(b) => self.apply_to_box(b, code),
+        };
+        AppliedEdit {
+            record,
+            previous,
+            changed,
+        }
+    }
+
+    /// The rows of V of a box: (first index, length) of each.
+    fn box_rows(&self, b: CellBox) -> impl Iterator<Item = (usize, usize)> + use<> {
+        let side = self.side();
+        let row_len = b.max[2] + 1 - b.min[2];
+        (b.min[0]..=b.max[0]).flat_map(move |y| {
+            (b.min[1]..=b.max[1]).map(move |u| ((y * side + u) * side + b.min[2], row_len))
+        })
+    }
+
+    fn apply_to_box(&mut self, b: CellBox, code: u8) -> (PreviousCodes, usize) {
+        let mut codes = Vec::with_capacity(b.len());
+        let mut changed = 0;
+        for (start, len) in self.box_rows(b) {
+            if let Some(row) = self.cells.get_mut(start..start + len) {
+                codes.extend_from_slice(row);
+                changed += row.iter().filter(|&&c| c != code).count();
+                row.fill(code);
             }
         }
-        AppliedEdit { record, previous }
+        (PreviousCodes::Box { cells: b, codes }, changed)
+    }
+
+    fn apply_to_cells(&mut self, region: &Region, code: u8) -> (PreviousCodes, usize) {
+        let len = self.cells.len();
+        let mut picked: Vec<usize> = match region {
+            Region::Cells { indices } => indices.iter().copied().filter(|&i| i < len).collect(),
+            Region::AroundSample { .. } => Vec::new(),
+        };
+        picked.sort_unstable();
+        picked.dedup();
+        let (mut indices, mut codes) = (Vec::new(), Vec::new());
+        for i in picked {
+            let (Some(cell), Ok(index)) = (self.cells.get_mut(i), u32::try_from(i)) else {
+                continue;
+            };
+            if *cell != code {
+                indices.push(index);
+                codes.push(std::mem::replace(cell, code));
+            }
+        }
+        let changed = indices.len();
+        (PreviousCodes::Cells { indices, codes }, changed)
     }
 
     /// Puts back the cells an applied edit changed.
     pub fn revert(&mut self, edit: &AppliedEdit) {
-        for &(i, old) in edit.previous.iter().rev() {
-            if let Some(class) = ColourClass::from_code(old) {
-                self.set(i, class);
+        match &edit.previous {
+            PreviousCodes::Cells { indices, codes } => {
+                for (&i, &old) in indices.iter().zip(codes) {
+                    if let Some(cell) = self.cells.get_mut(i as usize) {
+                        *cell = old;
+                    }
+                }
+            }
+            PreviousCodes::Box { cells, codes } => {
+                let mut rest = codes.as_slice();
+                for (start, len) in self.box_rows(*cells) {
+                    let (Some(row), Some((old, tail))) = (
+                        self.cells.get_mut(start..start + len),
+                        rest.split_at_checked(len),
+                    ) else {
+                        return;
+                    };
+                    row.copy_from_slice(old);
+                    rest = tail;
+                }
             }
         }
     }
@@ -321,7 +389,7 @@ impl AppliedEdit {
             Region::Cells { indices } => indices.len() * size_of::<usize>(),
             Region::AroundSample { .. } => 0,
         };
-        size_of::<Self>() + self.previous.len() * size_of::<(usize, u8)>() + cells
+        size_of::<Self>() + self.previous.held_bytes() + cells
     }
 }
 
@@ -576,7 +644,10 @@ mod tests {
         let applied = direct.apply(EditRecord::now(ColourClass::Yellow, region.clone()));
         let expected: Vec<usize> = region.select(&direct).indices(&direct).collect();
         assert_eq!(expected, [5, 9, 900]);
-        let changed: Vec<usize> = applied.previous.iter().map(|&(i, _)| i).collect();
+        let PreviousCodes::Cells { indices, .. } = &applied.previous else {
+            panic!("picked cells keep a list");
+        };
+        let changed: Vec<usize> = indices.iter().map(|&i| i as usize).collect();
         assert_eq!(changed, expected, "sorted, once each, inside the table");
     }
 

@@ -242,11 +242,12 @@ mod tests {
 
     #[test]
     fn a_journal_of_whole_table_edits_keeps_the_undo_history_within_its_bound() {
-        // 40 whole-table edits of a 7-bit table: 32 MiB of old codes each, 1.3 GiB unbounded.
+        // 40 whole-table edits of an 8-bit table: 16 MiB of old codes each, 640 MiB unbounded
+        // (and 5.5 GB when each changed cell was an (index, code) pair).
         let dir = tempfile::tempdir().expect("tempdir");
         let table = dir.path().join("t.lut");
         let mut text = serde_json::to_string(&JournalEntry::Start {
-            bits: 7,
+            bits: 8,
             base: false,
             time_unix_ms: 0,
         })
