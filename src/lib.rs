@@ -20,6 +20,7 @@
 //! | [`import`] | other teams' recordings (the B-Human 2009 Nao log) into frames and readings |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
 //! | [`overhead`] | overhead camera: field descriptions, calibration, ball and robot markers |
+//! | [`session`] | the session file: a field, its overhead cameras (each its table and calibration), robots |
 //! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
 //! | [`overlay`] | recognition's drawing primitives on RGB images (`eotn render`) |
 //! | [`annotate`] | those primitives as Foxglove image annotations (`eotn detect --annotate`) |
@@ -53,6 +54,7 @@ pub mod overlay;
 pub mod pipeline;
 pub mod recognition;
 pub mod sensors;
+pub mod session;
 pub mod sim;
 pub mod sources;
 pub mod stats;
