@@ -37,6 +37,7 @@ mod record;
 mod render;
 mod serve;
 mod sim;
+mod sim_field;
 mod sources;
 pub mod values;
 

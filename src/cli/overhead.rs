@@ -44,6 +44,10 @@ pub enum OverheadCommand {
     /// Write a points file from a synthetic overhead stream's true camera: every visible
     /// landmark "clicked" with Gaussian noise (for tests and figures).
     SimPoints(SimPointsArgs),
+    /// Render N overhead cameras over one field (overlapping views, each its own pose, lens and
+    /// clock; up to 1920x1200): one recording with truth, table and calibration per camera, and
+    /// the `SESSION.json` naming them.
+    SimField(super::sim_field::SimFieldArgs),
 }
 
 /// Arguments of `eotn overhead marker`.
@@ -146,6 +150,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         OverheadCommand::Calibrate(a) => run_calibrate(a),
         OverheadCommand::Detect(a) => run_detect(a),
         OverheadCommand::SimPoints(a) => run_sim_points(a),
+        OverheadCommand::SimField(a) => super::sim_field::run(a),
     }
 }
 
