@@ -11,7 +11,6 @@
 #[cfg(test)]
 mod tests;
 
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
@@ -22,16 +21,7 @@ use crate::geometry::{MarkerIdentity, MarkerTeam};
 use crate::input_file::{MAX_SMALL_FILE_BYTES, read_text_bounded};
 use crate::overhead::FieldDescription;
 
-/// The SSL `camera_id` of an overhead camera, 0–255: how detections name the cameras that saw
-/// them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize)]
-pub struct CameraId(pub u8);
-
-impl fmt::Display for CameraId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.0)
-    }
-}
+pub use crate::overhead::merge::CameraId;
 
 /// Where a camera's or robot's frames come from.
 #[derive(Debug, Clone, PartialEq, Eq)]
