@@ -14,7 +14,7 @@ import sys
 ORDER = [
     "atomic_file", "input_file", "stats", "kernels", "frame", "lut", "classify", "blobs", "sensors", "geometry",
     "model", "sim", "import", "formats",
-    "recognition", "overhead", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
+    "recognition", "overhead", "session", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
     "live", "workspace", "app_options", "cli", "app",
 ]
 

@@ -21,6 +21,7 @@
 //! | [`formats`] | one decoder per message type (ROS 2 CDR, Foxglove protobuf): images, camera info, joints, TF |
 //! | [`recognition`] | classified image + blobs + view → ball, goals, beacons, coloured patterns |
 //! | [`overhead`] | overhead camera: field descriptions, calibration, ball and robot markers |
+//! | [`session`] | the session file: a field, its overhead cameras (each its table and calibration), robots |
 //! | [`pipeline`] | one frame through classification, blobs and recognition, with timings |
 //! | [`overlay`] | recognition's drawing primitives on RGB images (`eotn render`) |
 //! | [`annotate`] | those primitives as Foxglove image annotations (`eotn detect --annotate`) |
@@ -55,6 +56,7 @@ pub mod overlay;
 pub mod pipeline;
 pub mod recognition;
 pub mod sensors;
+pub mod session;
 pub mod sim;
 pub mod sources;
 pub mod stats;

@@ -44,6 +44,13 @@ pub enum OverheadCommand {
     /// Write a points file from a synthetic overhead stream's true camera: every visible
     /// landmark "clicked" with Gaussian noise (for tests and figures).
     SimPoints(SimPointsArgs),
+    /// Render N overhead cameras over one field (overlapping views, each its own pose, lens and
+    /// clock; up to 1920x1200): one recording with truth, table and calibration per camera, and
+    /// the `SESSION.json` naming them.
+    SimField(super::sim_field::SimFieldArgs),
+    /// Throughput of the overhead pipeline on frames held in memory, on N threads beside one:
+    /// one camera's frames, or a whole field's (`--session`), checked against the truth.
+    Bench(super::overhead_bench::BenchArgs),
 }
 
 /// Arguments of `eotn overhead marker`.
@@ -97,14 +104,20 @@ pub struct CalibrateArgs {
 #[derive(Debug, clap::Args)]
 pub struct DetectArgs {
     /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams.
-    #[arg(required = true)]
+    #[arg(required_unless_present = "session", conflicts_with = "session")]
     pub frames: Vec<PathBuf>,
     /// Lookup table of the overhead camera.
-    #[arg(long)]
-    pub lut: PathBuf,
+    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    pub lut: Option<PathBuf>,
     /// Calibration (`eotn overhead calibrate`).
+    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    pub calibration: Option<PathBuf>,
+    /// A session file (docs/formats.md): every overhead camera through its own table and
+    /// calibration, merged into one field picture per frame of the first (reference) camera;
+    /// with `--json` one line per field frame with `time_ns`, `ball`, `robots` (each with
+    /// `camera_ids`) and `cameras` (each merged frame's `id` and `time_ns`).
     #[arg(long)]
-    pub calibration: PathBuf,
+    pub session: Option<PathBuf>,
     /// Field description for the ball radius and plate height; the 2005 field by default.
     #[arg(long)]
     pub field: Option<PathBuf>,
@@ -146,6 +159,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         OverheadCommand::Calibrate(a) => run_calibrate(a),
         OverheadCommand::Detect(a) => run_detect(a),
         OverheadCommand::SimPoints(a) => run_sim_points(a),
+        OverheadCommand::SimField(a) => super::sim_field::run(a),
+        OverheadCommand::Bench(a) => super::overhead_bench::run(a),
     }
 }
 
@@ -459,8 +474,14 @@ pub fn refuse_robot_streams(streams: &[PathBuf]) -> anyhow::Result<()> {
 }
 
 fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
-    let lut = load_lut_arg(&a.lut)?;
-    let cal = load_usable_calibration(&a.calibration)?;
+    if let Some(session) = &a.session {
+        return super::detect_field::run(session, a.json);
+    }
+    let (Some(lut), Some(cal)) = (&a.lut, &a.calibration) else {
+        bail!("--lut and --calibration are needed with frames (or give --session)");
+    };
+    let lut = load_lut_arg(lut)?;
+    let cal = load_usable_calibration(cal)?;
     let field = load_field(a.field.as_deref())?;
     let mut pipeline = OverheadPipeline::new(lut, cal.camera, params_for(&field));
     let mut inputs = FrameInputs::open(&a.frames, None)?;

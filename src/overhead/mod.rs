@@ -8,6 +8,8 @@
 //!   file; [`review`]: whether a calibration can be trusted (refusals, doubts, notes).
 //! - [`recognise`]: ball and robot markers in a classified image → field coordinates;
 //!   [`pipeline`] runs classification, blobs and it on a frame.
+//! - [`merge`]: several cameras' detections of one instant → one field picture (robots by
+//!   identity, the ball by confidence), and which frames form one field frame.
 //! - [`undistort`]: the undistorted view; [`drawing`]: the printable marker (SVG).
 //!
 //! The marker's layout itself is a geometry type (`geometry::marker`) because the simulator
@@ -17,6 +19,7 @@ pub mod calibration;
 pub mod drawing;
 pub mod field;
 pub mod lines;
+pub mod merge;
 pub mod pipeline;
 pub mod points;
 pub mod recognise;

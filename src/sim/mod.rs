@@ -9,6 +9,7 @@
 //! frames are made in.
 
 mod effects;
+pub mod field_rig;
 pub mod render;
 pub mod rng;
 pub mod scenario;

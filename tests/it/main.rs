@@ -22,6 +22,7 @@ mod cli;
 mod common;
 mod crash_safety;
 mod docs;
+mod field;
 mod hardening;
 mod hardening_files;
 #[cfg(feature = "gui")]

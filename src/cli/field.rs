@@ -1,0 +1,139 @@
+//! A session's overhead cameras opened for the command line: each camera's pipeline (its own
+//! table, calibration, recogniser settings) and its recording, shared by `eotn overhead bench
+//! --session` and `eotn overhead detect --session`.
+
+use std::path::Path;
+
+use anyhow::{Context, bail};
+
+use super::inputs::load_lut_arg;
+use super::overhead::{load_usable_calibration, params_for};
+use crate::model::GroundTruth;
+use crate::model::truth::OverheadTruth;
+use crate::overhead::recognise::OverheadParams;
+use crate::overhead::{FieldDescription, OverheadPipeline};
+use crate::session::{CameraId, OverheadEntry, Session, SessionSource};
+use crate::streams::StreamReader;
+
+/// One overhead camera of a session, ready to run.
+#[derive(Debug)]
+pub struct FieldCamera {
+    /// Its session id.
+    pub id: CameraId,
+    /// Its pipeline: its own table, calibration and settings.
+    pub pipeline: OverheadPipeline,
+    /// Its recording.
+    pub reader: StreamReader,
+    /// The recording's path, for messages.
+    pub name: String,
+}
+
+/// A frame read from a camera's recording, with its truth when the recording has one.
+#[derive(Debug, Clone)]
+pub struct FieldFrame {
+    /// Capture time, nanoseconds on the recording's clock.
+    pub time_ns: u64,
+    /// The frame.
+    pub frame: crate::frame::Frame,
+    /// The overhead truth (simulated recordings).
+    pub truth: Option<OverheadTruth>,
+}
+
+/// Opens every overhead camera of `session`, in session order (the reference first).
+///
+/// # Errors
+/// A camera whose source is not a recording (live and device sources are not read here), an
+/// unreadable table, calibration, parameter file or recording: each named with the camera.
+pub fn open_cameras(session: &Session) -> anyhow::Result<(FieldDescription, Vec<FieldCamera>)> {
+    let field = session
+        .field
+        .load()
+        .with_context(|| format!("{}: field", session.path.display()))?;
+    let cameras = session
+        .overhead
+        .iter()
+        .map(|e| {
+            open_camera(e, &field)
+                .with_context(|| format!("{}: camera {}", session.path.display(), e.id))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok((field, cameras))
+}
+
+fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<FieldCamera> {
+    let SessionSource::Recording(path) = &e.source else {
+        bail!(
+            "source {:?}: this command reads recorded cameras; live servers and devices are read by the app",
+            e.source
+        );
+    };
+    if let Some(topic) = &e.camera {
+        log::warn!(
+            "camera {}: topic {topic:?} given; the recording's image channel is read",
+            e.id
+        );
+    }
+    let lut = load_lut_arg(&e.lut)?;
+    let cal = load_usable_calibration(&e.calibration)?;
+    let params = match &e.params {
+        Some(p) => load_params(p)?,
+        None => params_for(field),
+    };
+    let reader = StreamReader::open(path)?;
+    Ok(FieldCamera {
+        id: e.id,
+        pipeline: OverheadPipeline::new(lut, cal.camera, params),
+        reader,
+        name: crate::frame::display_name(path),
+    })
+}
+
+/// The overhead recogniser's settings from a JSON file; unknown keys refused.
+fn load_params(path: &Path) -> anyhow::Result<OverheadParams> {
+    let text = crate::input_file::read_text_bounded(
+        path,
+        crate::input_file::MAX_SMALL_FILE_BYTES,
+        "overhead parameters",
+    )
+    .with_context(|| format!("{}", path.display()))?;
+    let given: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let params: OverheadParams = serde_json::from_value(given.clone())
+        .with_context(|| format!("{}: not overhead parameters", path.display()))?;
+    let known = serde_json::to_value(params)?;
+    if let Some(key) = crate::input_file::unknown_keys(&given, &known).first() {
+        bail!("{}: unknown key '{key}'", path.display());
+    }
+    Ok(params)
+}
+
+impl FieldCamera {
+    /// Number of frames in its recording.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.reader.len()
+    }
+
+    /// Frame `i` of its recording, with its overhead truth when it has one.
+    ///
+    /// # Errors
+    /// An unreadable frame, naming the recording.
+    pub fn read(&mut self, i: usize) -> anyhow::Result<FieldFrame> {
+        let record = self
+            .reader
+            .read(i)
+            .with_context(|| format!("{} frame {i}", self.name))?;
+        let truth = record
+            .ground_truth
+            .and_then(|t| serde_json::from_value::<GroundTruth>(t).ok())
+            .and_then(|t| match t {
+                GroundTruth::Overhead(o) => Some(o),
+                GroundTruth::Robot(_) => None,
+            });
+        Ok(FieldFrame {
+            time_ns: record.time_ns,
+            frame: record.frame,
+            truth,
+        })
+    }
+}

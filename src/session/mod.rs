@@ -1,0 +1,378 @@
+//! The session file (`SESSION.json`, docs/formats.md): one field watched by several overhead
+//! cameras, each with its own table and calibration, and any number of robots sending their
+//! world models.
+//!
+//! Plain data in and out: [`Session::load`] reads the file, resolves every path against the
+//! session file's folder, and checks what can be checked without opening anything heavy —
+//! unknown keys, ids in range and unique, the files named exist and are files. Each error names
+//! the entry (`overhead[2] (id 5)`) and the key. The calibration's `intrinsics` is a path that
+//! is carried, not read (the lens models are the calibration's business).
+
+#[cfg(test)]
+mod tests;
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use serde_json::Value;
+use thiserror::Error;
+
+use crate::geometry::{MarkerIdentity, MarkerTeam};
+use crate::input_file::{MAX_SMALL_FILE_BYTES, read_text_bounded};
+use crate::overhead::FieldDescription;
+
+pub use crate::overhead::merge::CameraId;
+
+/// Where a camera's or robot's frames come from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SessionSource {
+    /// A recording eotn reads (MCAP stream, frame file, folder), resolved against the session
+    /// file's folder.
+    Recording(PathBuf),
+    /// A `ws://` or `wss://` robot or overhead server.
+    Live(String),
+    /// A camera device as `eotn sources` names it (`/dev/videoN`).
+    Device(PathBuf),
+}
+
+/// The field of a session.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FieldRef {
+    /// A field description file, resolved against the session file's folder.
+    File(PathBuf),
+    /// A field description shipped with eotn, by name ([`SHIPPED_FIELDS`]).
+    Shipped(&'static str),
+}
+
+/// The field descriptions shipped with eotn (`params/fields/NAME.json`), by name.
+pub const SHIPPED_FIELDS: [(&str, &str); 2] = [
+    (
+        "four-legged-2005",
+        include_str!("../../params/fields/four-legged-2005.json"),
+    ),
+    (
+        "ssl-2008",
+        include_str!("../../params/fields/ssl-2008.json"),
+    ),
+];
+
+impl FieldRef {
+    /// The field description.
+    ///
+    /// # Errors
+    /// The field file's loader error, naming it.
+    pub fn load(&self) -> anyhow::Result<FieldDescription> {
+        match self {
+            Self::File(p) => Ok(FieldDescription::load(p)?),
+            Self::Shipped(name) => {
+                let text = SHIPPED_FIELDS
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, t)| *t)
+                    .ok_or_else(|| anyhow::anyhow!("no shipped field {name:?}"))?;
+                Ok(FieldDescription::from_json(text)
+                    .map_err(|e| anyhow::anyhow!("shipped field {name}: {e}"))?)
+            }
+        }
+    }
+}
+
+/// One overhead camera of the session.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OverheadEntry {
+    /// Its SSL camera id.
+    pub id: CameraId,
+    /// Its frames.
+    pub source: SessionSource,
+    /// The topic of its frames when the source has several.
+    pub camera: Option<String>,
+    /// Its lookup table.
+    pub lut: PathBuf,
+    /// Its calibration (`eotn overhead calibrate`).
+    pub calibration: PathBuf,
+    /// Its lens intrinsics (ROS `camera_info` YAML), carried for the calibration.
+    pub intrinsics: Option<PathBuf>,
+    /// Its overhead recogniser parameters.
+    pub params: Option<PathBuf>,
+}
+
+/// One robot of the session, named by the marker it wears.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RobotEntry {
+    /// The marker's team.
+    pub team: MarkerTeam,
+    /// The marker's identity.
+    pub robot_id: MarkerIdentity,
+    /// Its world models (and camera frames).
+    pub source: SessionSource,
+    /// The topic of its camera frames when the source has several.
+    pub camera: Option<String>,
+    /// Its camera's table, when its frames are to be recognised.
+    pub lut: Option<PathBuf>,
+    /// Its recognition parameters.
+    pub params: Option<PathBuf>,
+}
+
+/// A session file, read and checked, its paths resolved.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Session {
+    /// The file it was read from.
+    pub path: PathBuf,
+    /// The field.
+    pub field: FieldRef,
+    /// The overhead cameras, in file order; the first is the reference camera.
+    pub overhead: Vec<OverheadEntry>,
+    /// The robots, in file order.
+    pub robots: Vec<RobotEntry>,
+}
+
+/// Why a session file cannot be used.
+#[derive(Debug, Error)]
+pub enum SessionError {
+    /// The file cannot be read.
+    #[error("{path}: cannot read the session file: {source}")]
+    Read {
+        /// The session file.
+        path: PathBuf,
+        /// The reason.
+        source: std::io::Error,
+    },
+    /// The file or one entry is not what the format says.
+    #[error("{path}: {entry}: {message}")]
+    Entry {
+        /// The session file.
+        path: PathBuf,
+        /// Which entry (`overhead[1] (id 3)`, `field`, the top level).
+        entry: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The file's top level, its entries left as JSON so each is read (and named) on its own.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSession {
+    field: String,
+    #[serde(default)]
+    overhead: Vec<Value>,
+    #[serde(default)]
+    robots: Vec<Value>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOverhead {
+    id: u8,
+    source: String,
+    camera: Option<String>,
+    lut: PathBuf,
+    calibration: PathBuf,
+    intrinsics: Option<PathBuf>,
+    params: Option<PathBuf>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRobot {
+    team: String,
+    robot_id: u8,
+    source: String,
+    camera: Option<String>,
+    lut: Option<PathBuf>,
+    params: Option<PathBuf>,
+}
+
+impl Session {
+    /// Reads and checks a session file.
+    ///
+    /// # Errors
+    /// [`SessionError`], naming the file and the entry.
+    pub fn load(path: &Path) -> Result<Self, SessionError> {
+        let text =
+            read_text_bounded(path, MAX_SMALL_FILE_BYTES, "a session file").map_err(|source| {
+                SessionError::Read {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
+        let base = path.parent().unwrap_or_else(|| Path::new("")).to_path_buf();
+        Self::from_json(&text, path, &base)
+    }
+
+    /// Reads a session from JSON text; `path` names it in errors, `base` is the folder its
+    /// relative paths start from.
+    ///
+    /// # Errors
+    /// [`SessionError::Entry`], naming the entry.
+    pub fn from_json(text: &str, path: &Path, base: &Path) -> Result<Self, SessionError> {
+        let err = |entry: String, message: String| SessionError::Entry {
+            path: path.to_path_buf(),
+            entry,
+            message,
+        };
+        let raw: RawSession =
+            serde_json::from_str(text).map_err(|e| err("the session".into(), format!("{e}")))?;
+        let ctx = Resolver { base };
+        let field = ctx.field(&raw.field).map_err(|m| err("field".into(), m))?;
+        if raw.overhead.is_empty() {
+            return Err(err(
+                "overhead".into(),
+                "no overhead camera: a session needs at least one".into(),
+            ));
+        }
+        let mut overhead: Vec<OverheadEntry> = Vec::new();
+        for (i, value) in raw.overhead.iter().enumerate() {
+            let name = entry_name("overhead", i, value, "id");
+            let e = ctx.overhead(value).map_err(|m| err(name.clone(), m))?;
+            if let Some(j) = overhead.iter().position(|o| o.id == e.id) {
+                return Err(err(
+                    name,
+                    format!(
+                        "camera id {} is also overhead[{j}]'s: each camera needs its own id",
+                        e.id
+                    ),
+                ));
+            }
+            overhead.push(e);
+        }
+        let mut robots: Vec<RobotEntry> = Vec::new();
+        for (i, value) in raw.robots.iter().enumerate() {
+            let name = entry_name("robots", i, value, "robot_id");
+            let r = ctx.robot(value).map_err(|m| err(name.clone(), m))?;
+            if let Some(j) = robots
+                .iter()
+                .position(|o| (o.team, o.robot_id) == (r.team, r.robot_id))
+            {
+                return Err(err(
+                    name,
+                    format!(
+                        "robot {} {} is also robots[{j}]: each robot wears its own marker",
+                        r.team.name(),
+                        r.robot_id
+                    ),
+                ));
+            }
+            robots.push(r);
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            field,
+            overhead,
+            robots,
+        })
+    }
+
+    /// The camera with `id`.
+    #[must_use]
+    pub fn camera(&self, id: CameraId) -> Option<&OverheadEntry> {
+        self.overhead.iter().find(|o| o.id == id)
+    }
+}
+
+/// `overhead[2] (id 5)`: an entry named by its place and, when it has one, its id.
+fn entry_name(list: &str, i: usize, value: &Value, id_key: &str) -> String {
+    match value.get(id_key).and_then(Value::as_u64) {
+        Some(id) => format!("{list}[{i}] ({id_key} {id})"),
+        None => format!("{list}[{i}]"),
+    }
+}
+
+/// Resolves an entry's paths against the session file's folder and checks them.
+struct Resolver<'a> {
+    base: &'a Path,
+}
+
+impl Resolver<'_> {
+    fn field(&self, name: &str) -> Result<FieldRef, String> {
+        if let Some((n, _)) = SHIPPED_FIELDS.iter().find(|(n, _)| *n == name) {
+            return Ok(FieldRef::Shipped(n));
+        }
+        let p = self.base.join(name);
+        if p.is_file() {
+            return Ok(FieldRef::File(p));
+        }
+        let shipped: Vec<&str> = SHIPPED_FIELDS.iter().map(|(n, _)| *n).collect();
+        Err(format!(
+            "{}: no such field file, and {name:?} is not a shipped field ({})",
+            p.display(),
+            shipped.join(", ")
+        ))
+    }
+
+    fn overhead(&self, value: &Value) -> Result<OverheadEntry, String> {
+        let raw: RawOverhead = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
+        Ok(OverheadEntry {
+            id: CameraId(raw.id),
+            source: self.source(&raw.source)?,
+            camera: raw.camera,
+            lut: self.file("lut", "lookup table", &raw.lut)?,
+            calibration: self.file("calibration", "calibration", &raw.calibration)?,
+            intrinsics: raw
+                .intrinsics
+                .map(|p| self.file("intrinsics", "intrinsics file", &p))
+                .transpose()?,
+            params: raw
+                .params
+                .map(|p| self.file("params", "parameter file", &p))
+                .transpose()?,
+        })
+    }
+
+    fn robot(&self, value: &Value) -> Result<RobotEntry, String> {
+        let raw: RawRobot = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
+        let team = MarkerTeam::from_name(&raw.team)
+            .ok_or_else(|| format!("team {:?}: must be blue or yellow", raw.team))?;
+        let robot_id = MarkerIdentity::new(raw.robot_id).ok_or_else(|| {
+            format!(
+                "robot_id {}: must be 0-15 (the marker's identity)",
+                raw.robot_id
+            )
+        })?;
+        Ok(RobotEntry {
+            team,
+            robot_id,
+            source: self.source(&raw.source)?,
+            camera: raw.camera,
+            lut: raw
+                .lut
+                .map(|p| self.file("lut", "lookup table", &p))
+                .transpose()?,
+            params: raw
+                .params
+                .map(|p| self.file("params", "parameter file", &p))
+                .transpose()?,
+        })
+    }
+
+    fn source(&self, s: &str) -> Result<SessionSource, String> {
+        if s.starts_with("ws://") || s.starts_with("wss://") {
+            return Ok(SessionSource::Live(s.to_owned()));
+        }
+        if s.starts_with("/dev/") {
+            return Ok(SessionSource::Device(PathBuf::from(s)));
+        }
+        let p = self.base.join(s);
+        if p.exists() {
+            Ok(SessionSource::Recording(p))
+        } else {
+            Err(format!(
+                "source {}: no such recording (a source is a recording, a ws:// server or a /dev/video device)",
+                p.display()
+            ))
+        }
+    }
+
+    /// `key`'s file, which must exist and be a regular file.
+    fn file(&self, key: &str, what: &str, p: &Path) -> Result<PathBuf, String> {
+        let full = self.base.join(p);
+        match std::fs::metadata(&full) {
+            Ok(m) if m.is_file() => Ok(full),
+            Ok(_) => Err(format!(
+                "{key} {}: not a file, so not a {what}",
+                full.display()
+            )),
+            Err(e) => Err(format!("{key} {}: no {what} there ({e})", full.display())),
+        }
+    }
+}
