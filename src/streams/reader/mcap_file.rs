@@ -466,3 +466,104 @@ impl McapFile {
             .map_err(self.mcap_err(format!("reading the chunk at offset {}", loc.offset)))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{Frame, Yuv};
+    use crate::streams::schema::{ImageEncoding, encode_image, raw_image_schema};
+
+    /// Another writer's file of `n` 4×2 frames on `/cam`, one uncompressed chunk each (with
+    /// its CRC), and a complete summary: statistics, chunk and message indexes.
+    fn chunked_file(path: &Path, n: u8) {
+        let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+        let mut w = mcap::WriteOptions::new()
+            .compression(None)
+            .create(file)
+            .unwrap();
+        let s = raw_image_schema().unwrap();
+        let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+        let ch = w
+            .add_channel(sid, "/cam", "protobuf", &Default::default())
+            .unwrap();
+        let mut buf = Vec::new();
+        for i in 0..n {
+            let t = 100 * u64::from(i) + 100;
+            let f = Frame::filled_uyvy(4, 2, Yuv::new(i, 128, 128)).unwrap();
+            encode_image(t, &f, ImageEncoding::Uyvy, &mut buf).unwrap();
+            let header = mcap::records::MessageHeader {
+                channel_id: ch,
+                sequence: 0,
+                log_time: t,
+                publish_time: t,
+            };
+            w.write_to_known_channel(&header, &buf).unwrap();
+            // Ends the chunk: one chunk a frame.
+            w.flush().unwrap();
+        }
+        w.finish().unwrap();
+    }
+
+    /// A file whose summary is complete opens from the summary alone: the chunk of frame 1 is
+    /// damaged (a byte of its records flipped, so its CRC fails), and opening neither sees nor
+    /// warns about it — a walk of the data section would (`from_summary` is what decides) —,
+    /// while reading that frame finds the damage and the other frames read.
+    #[test]
+    fn a_complete_summary_is_enough() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.mcap");
+        chunked_file(&p, 3);
+        let mut bytes = std::fs::read(&p).unwrap();
+        let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+        assert_eq!(summary.chunk_indexes.len(), 3, "one chunk a frame");
+        let second = &summary.chunk_indexes[1];
+        let last_record_byte = second.chunk_start_offset + second.chunk_length - 1;
+        bytes[usize::try_from(last_record_byte).unwrap()] ^= 0xff;
+        std::fs::write(&p, &bytes).unwrap();
+
+        let mut f = McapFile::open(&p, None).unwrap();
+        assert!(
+            f.from_summary,
+            "a complete summary: the data section is not read"
+        );
+        assert!(f.warnings.is_empty(), "{:?}", f.warnings);
+        assert_eq!(f.frames.len(), 3);
+        assert_eq!(f.chunk_count(), 3);
+        let e = f.read_raw(1).err().unwrap().to_string();
+        assert!(e.contains("CRC"), "{e}");
+        for i in [0, 2] {
+            let raw = f.read_raw(i).unwrap();
+            assert_eq!(raw.time_ns, 100 * i as u64 + 100);
+        }
+
+        // Without its statistics the summary does not say it describes the whole file: the data
+        // section is walked, and the damaged chunk is found at opening.
+        let mut bare = mcap::WriteOptions::new()
+            .compression(None)
+            .emit_statistics(false)
+            .create(std::io::BufWriter::new(
+                std::fs::File::create(dir.path().join("g.mcap")).unwrap(),
+            ))
+            .unwrap();
+        let s = raw_image_schema().unwrap();
+        let sid = bare.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+        let ch = bare
+            .add_channel(sid, "/cam", "protobuf", &Default::default())
+            .unwrap();
+        let mut buf = Vec::new();
+        let f0 = Frame::filled_uyvy(4, 2, Yuv::new(9, 128, 128)).unwrap();
+        encode_image(5, &f0, ImageEncoding::Uyvy, &mut buf).unwrap();
+        let header = mcap::records::MessageHeader {
+            channel_id: ch,
+            sequence: 0,
+            log_time: 5,
+            publish_time: 5,
+        };
+        bare.write_to_known_channel(&header, &buf).unwrap();
+        bare.finish().unwrap();
+        drop(bare);
+        let g = McapFile::open(&dir.path().join("g.mcap"), None).unwrap();
+        assert!(!g.from_summary, "no statistics: the data section is walked");
+        assert_eq!(g.frames.len(), 1);
+    }
+}
