@@ -50,6 +50,7 @@ fn writers_python() -> Option<PathBuf> {
 /// A rosbag2 folder written by `rosbags` (MCAP storage, `rgb8` images) with
 /// `sensor_msgs/msg/JointState` (`HeadYaw` 0.1, `HeadPitch` 0.2 rad) on `/joint_states` with
 /// every frame; `None` (a skip line) without the writers, outside CI.
+#[cfg(feature = "gui")]
 pub(crate) fn joint_state_bag() -> Option<PathBuf> {
     let (_, list) = recordings()?;
     list.iter()
