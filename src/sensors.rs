@@ -189,6 +189,23 @@ impl SensorReadings {
     }
 }
 
+/// The numeric readings another channel carries with a frame: its per-frame JSON when that is a
+/// flat object of numbers (nulls left out) — as a ROS `sensor_msgs/msg/JointState` is read,
+/// joint name → position (rad) —, by name; empty for anything else.
+#[must_use]
+pub fn channel_readings(value: &serde_json::Value) -> Vec<(&str, f64)> {
+    let Some(object) = value.as_object() else {
+        return Vec::new();
+    };
+    if !object.values().all(|v| v.is_number() || v.is_null()) {
+        return Vec::new();
+    }
+    object
+        .iter()
+        .filter_map(|(name, v)| v.as_f64().map(|x| (name.as_str(), x)))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -281,5 +298,22 @@ mod tests {
         let (clean, dropped) = r.sanitised();
         assert_eq!(dropped, vec!["camera_focal_px"]);
         assert_eq!(clean.camera_centre_x_px, Some(-20.0));
+    }
+
+    #[test]
+    fn flat_objects_of_numbers_are_readings_and_nothing_else() {
+        let joints = serde_json::json!({"HeadYaw": 0.1, "HeadPitch": -0.2, "LHand": null});
+        assert_eq!(
+            channel_readings(&joints),
+            vec![("HeadPitch", -0.2), ("HeadYaw", 0.1)]
+        );
+        for other in [
+            serde_json::json!({"ball": {"x": 1.0}}),
+            serde_json::json!({"name": "x", "v": 1.0}),
+            serde_json::json!([1.0, 2.0]),
+            serde_json::json!(3.0),
+        ] {
+            assert!(channel_readings(&other).is_empty(), "{other}");
+        }
     }
 }

@@ -1,11 +1,12 @@
 //! The sensor dialog: every reading of the current frame with its unit, live during playback,
-//! and plots of head pan, pan velocity and the pan motor's PWM over the stream with a cursor at
-//! the current frame.
+//! the numeric readings of other channels (a ROS `JointState`'s joints), and plots of head pan,
+//! pan velocity, the pan motor's PWM and those channels over the stream with a cursor at the
+//! current frame.
 
 use egui::{Color32, Id};
 use egui_plot::{Legend, Line, Plot, VLine};
 
-use crate::sensors::SensorReadings;
+use crate::sensors::{SensorReadings, channel_readings};
 use crate::workspace::Workspace;
 
 /// The Sensors window's contents: every reading of the shown frame with units, plots over
@@ -26,11 +27,18 @@ pub fn sensors_ui(ui: &mut egui::Ui, state: &Workspace) {
         }
         Some(r) => readings_grid_ui(ui, r),
     }
-    if !current.extra.is_empty() {
+    let (readings, others): (Vec<_>, Vec<_>) = current
+        .extra
+        .iter()
+        .partition(|(_, value)| !channel_readings(value).is_empty());
+    for (channel, value) in readings {
+        channel_grid_ui(ui, channel, &channel_readings(value));
+    }
+    if !others.is_empty() {
         egui::CollapsingHeader::new("Other channels")
             .default_open(false)
             .show(ui, |ui| {
-                for (channel, value) in &current.extra {
+                for (channel, value) in others {
                     ui.monospace(format!("{channel}: {value}"));
                 }
             });
@@ -60,6 +68,21 @@ fn readings_grid_ui(ui: &mut egui::Ui, r: &SensorReadings) {
             };
             ui.label("rad/s");
             ui.end_row();
+        });
+}
+
+/// One channel's numeric readings (a `JointState`'s joints: name, position in rad).
+fn channel_grid_ui(ui: &mut egui::Ui, channel: &str, readings: &[(&str, f64)]) {
+    ui.strong(channel);
+    egui::Grid::new(("channel_readings", channel))
+        .striped(true)
+        .num_columns(2)
+        .show(ui, |ui| {
+            for (name, v) in readings {
+                ui.label(*name);
+                ui.monospace(format!("{v:>10.4}"));
+                ui.end_row();
+            }
         });
 }
 
@@ -106,6 +129,19 @@ fn series_plots_ui(ui: &mut egui::Ui, state: &Workspace, now_s: f64) {
             .y_axis_label(unit)
             .show(ui, |p| {
                 p.line(Line::new(format!("{name} ({unit})"), points).color(colour));
+                p.vline(VLine::new("current frame", now_s).color(Color32::WHITE));
+            });
+    }
+    if !series.channels.is_empty() {
+        Plot::new("other channels")
+            .height(140.0)
+            .legend(Legend::default())
+            .link_axis(link, [true, false])
+            .link_cursor(link, [true, false])
+            .show(ui, |p| {
+                for (name, points) in &series.channels {
+                    p.line(Line::new(name.clone(), points.clone()));
+                }
                 p.vline(VLine::new("current frame", now_s).color(Color32::WHITE));
             });
     }

@@ -107,33 +107,64 @@ pub fn studio_maps() -> &'static ([u8; 256], [u8; 256]) {
     })
 }
 
-/// Full-range luma → studio range in 16.16 fixed point: `16 + 219·Y/255`, rounded (equal to
-/// [`full_to_studio_luma`] for every value; tested).
+/// The full→studio maps in 16-bit fixed point, one form for both channels:
+/// `16 + ((256·x + c) · m) >> 24`, with `(c, m)` = (148, 56 285) for luma (`16 + 219·x/255`) and
+/// (14, 57 575) for chroma (`128 + 224·(x − 128)/255`), rounded. Found by search over all 256
+/// values and equal to [`full_to_studio_luma`] and [`full_to_studio_chroma`] for every value
+/// (tested). `256·x + c` fits 16 bits, and `(… · m) >> 16` is a 16-bit high multiply, so the
+/// loop below runs 8 or 16 lanes at a time on plain SSE2.
+const LUMA_FIXED: (u16, u16) = (148, 56_285);
+/// See [`LUMA_FIXED`].
+const CHROMA_FIXED: (u16, u16) = (14, 57_575);
+
+#[inline]
+fn map_fixed(x: u8, (c, m): (u16, u16)) -> u8 {
+    let t = (u16::from(x) << 8) | c;
+    let high = (u32::from(t) * u32::from(m)) >> 16;
+    // high < 2^16, so high >> 8 ≤ 224 (chroma) or 219 (luma): no overflow adding 16.
+    16 + (high >> 8) as u8
+}
+
+/// Full-range luma → studio range (equal to [`full_to_studio_luma`] for every value; tested).
 #[inline]
 fn luma_fixed(y: u8) -> u8 {
-    let v = 16 + ((u32::from(y) * 56_284 + 32_768) >> 16);
-    u8::try_from(v).unwrap_or(u8::MAX)
+    map_fixed(y, LUMA_FIXED)
 }
 
-/// Full-range chroma → studio range in 16.16 fixed point: `224·C/255 + 128·31/255`, rounded
-/// (equal to [`full_to_studio_chroma`] for every value; tested).
+/// Full-range chroma → studio range (equal to [`full_to_studio_chroma`] for every value;
+/// tested).
 #[inline]
 fn chroma_fixed(c: u8) -> u8 {
-    let v = (u32::from(c) * 57_569 + 1_019_799 + 32_768) >> 16;
-    u8::try_from(v).unwrap_or(u8::MAX)
+    map_fixed(c, CHROMA_FIXED)
 }
 
+/// Pixels of a block of [`full_to_studio_in_place`]: 16 pixels, 48 bytes, whole vectors.
+const BLOCK_PIXELS: usize = 16;
+
+/// Each byte's `(c, m)` in a block of interleaved Y, Cb, Cr: the channel of every lane is fixed,
+/// so the loop is the same arithmetic on every lane and vectorises.
+const BLOCK_CONSTANTS: ([u16; 3 * BLOCK_PIXELS], [u16; 3 * BLOCK_PIXELS]) = {
+    let mut c = [0u16; 3 * BLOCK_PIXELS];
+    let mut m = [0u16; 3 * BLOCK_PIXELS];
+    let mut k = 0;
+    while k < 3 * BLOCK_PIXELS {
+        let (ck, mk) = if k % 3 == 0 { LUMA_FIXED } else { CHROMA_FIXED };
+        c[k] = ck;
+        m[k] = mk;
+        k += 1;
+    }
+    (c, m)
+};
+
 /// Converts interleaved full-range YCbCr (3 bytes a pixel) to studio range in place: 16 pixels
-/// at a time with the channel of each byte known, so the compiler keeps it in registers.
+/// at a time with every lane's constants known, so the compiler vectorises it (16-bit high
+/// multiplies); the last pixels one by one.
 pub fn full_to_studio_in_place(ycbcr: &mut [u8]) {
-    let mut blocks = ycbcr.chunks_exact_mut(48);
+    let (cs, ms) = &BLOCK_CONSTANTS;
+    let mut blocks = ycbcr.chunks_exact_mut(3 * BLOCK_PIXELS);
     for block in &mut blocks {
-        for (k, b) in block.iter_mut().enumerate() {
-            *b = if k % 3 == 0 {
-                luma_fixed(*b)
-            } else {
-                chroma_fixed(*b)
-            };
+        for ((b, &c), &m) in block.iter_mut().zip(cs).zip(ms) {
+            *b = map_fixed(*b, (c, m));
         }
     }
     for p in blocks.into_remainder().chunks_exact_mut(3) {
@@ -191,6 +222,18 @@ mod tests {
             .collect();
         full_to_studio_in_place(&mut long);
         assert_eq!(long, want);
+        // Every value in every lane of a block: 256 blocks, lane k of block v holding v.
+        let mut every: Vec<u8> = (0..=255u8).flat_map(|v| [v; 3 * BLOCK_PIXELS]).collect();
+        full_to_studio_in_place(&mut every);
+        for (i, &got) in every.iter().enumerate() {
+            let (v, lane) = ((i / (3 * BLOCK_PIXELS)) as u8, i % (3 * BLOCK_PIXELS));
+            let want = if lane % 3 == 0 {
+                full_to_studio_luma(v)
+            } else {
+                full_to_studio_chroma(v)
+            };
+            assert_eq!(got, want, "value {v} in lane {lane}");
+        }
     }
 
     #[test]

@@ -141,6 +141,7 @@ impl Workspace {
             let warnings = src.warnings();
             self.sensor_series = SensorSeries {
                 points: Vec::new(),
+                channels: std::collections::BTreeMap::new(),
                 total: if src.is_stream() { n } else { 0 },
             };
             for w in warnings {
@@ -267,7 +268,17 @@ impl Workspace {
         {
             let i = self.sensor_series.points.len();
             let t = src.time_ns(i) as f64 / 1e9;
-            let r = src.read_uncached(i).ok().and_then(|f| f.sensors);
+            let frame = src.read_uncached(i).ok();
+            for (topic, value) in frame.iter().flat_map(|f| &f.extra) {
+                for (name, v) in crate::sensors::channel_readings(value) {
+                    self.sensor_series
+                        .channels
+                        .entry(format!("{topic} {name}"))
+                        .or_default()
+                        .push([t, v]);
+                }
+            }
+            let r = frame.and_then(|f| f.sensors);
             self.sensor_series.points.push((t, r));
         }
     }

@@ -118,6 +118,10 @@ pub struct PendingSelection {
 pub struct SensorSeries {
     /// (time in seconds, readings) per frame read so far, in frame order.
     pub points: Vec<(f64, Option<SensorReadings>)>,
+    /// The numeric readings of other channels ([`crate::sensors::channel_readings`]: joint
+    /// positions of a ROS `JointState`, …), keyed `"topic name"` (`"/joint_states HeadYaw"`):
+    /// (time in seconds, value) of the frames read so far that carry it.
+    pub channels: std::collections::BTreeMap<String, Vec<[f64; 2]>>,
     /// Frames in the source.
     pub total: usize,
 }

@@ -835,3 +835,46 @@ fn inspector_shows_a_pattern_match_from_a_places_file() {
     click_label(&mut h, "Classification");
     assert!(h.query_by_label("Open places…").is_some());
 }
+
+/// A ROS 2 bag written by `rosbags` with `sensor_msgs/JointState` beside its images: the Sensors
+/// window shows the joints of the shown frame with their positions, and the series it plots
+/// holds every frame's joint positions.
+#[test]
+fn joint_states_are_shown_and_plotted_in_the_sensors_window() {
+    let Some(bag) = crate::recordings::joint_state_bag() else {
+        return;
+    };
+    let mut h = harness(vec![bag]);
+    // The window reads the series a few frames per UI frame, repainting until it has them all.
+    h.state_mut()
+        .state
+        .run(Command::ShowWindow(Window::Sensors, true));
+    let frames = workspace(&h).source().unwrap().len();
+    assert_eq!(frames, 24);
+    crate::harness::run_steps_until(&mut h, std::time::Duration::from_secs(120), |app| {
+        app.state.sensor_series.points.len() == frames
+    });
+    h.run();
+    h.get_by_label("/joint_states");
+    h.get_by_label("HeadYaw");
+    h.get_by_label("HeadPitch");
+    for value in ["0.1000", "0.2000"] {
+        assert!(
+            h.query_by_label_contains(value).is_some(),
+            "the joint position {value} is shown"
+        );
+    }
+    let series = &workspace(&h).sensor_series.channels;
+    for (joint, position) in [("HeadYaw", 0.1), ("HeadPitch", 0.2)] {
+        let points = &series[&format!("/joint_states {joint}")];
+        assert_eq!(points.len(), frames, "{joint}: a point per frame");
+        assert!(
+            points.iter().all(|p| (p[1] - position).abs() < 1e-12),
+            "{joint}"
+        );
+        assert!(
+            points.windows(2).all(|w| w[0][0] < w[1][0]),
+            "{joint}: in time order"
+        );
+    }
+}

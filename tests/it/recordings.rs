@@ -19,9 +19,9 @@ use crate::live::{free_port, wait_for};
 const FRAMES: usize = 24;
 
 #[derive(Debug, Clone)]
-struct Recording {
-    name: String,
-    path: PathBuf,
+pub(crate) struct Recording {
+    pub(crate) name: String,
+    pub(crate) path: PathBuf,
     /// What its frames must match: exact, jpeg, nv12, bayer, grey, pose.
     matches: String,
 }
@@ -45,6 +45,17 @@ fn writers_python() -> Option<PathBuf> {
         "rosbags, mcap-ros2-support, foxglove-sdk and opencv-python-headless",
         "the third-party recordings tests",
     )
+}
+
+/// A rosbag2 folder written by `rosbags` (MCAP storage, `rgb8` images) with
+/// `sensor_msgs/msg/JointState` (`HeadYaw` 0.1, `HeadPitch` 0.2 rad) on `/joint_states` with
+/// every frame; `None` (a skip line) without the writers, outside CI.
+#[cfg(feature = "gui")]
+pub(crate) fn joint_state_bag() -> Option<PathBuf> {
+    let (_, list) = recordings()?;
+    list.iter()
+        .find(|r| r.name == "rosbag2 mcap sensor_msgs/Image rgb8 step+0")
+        .map(|r| r.path.clone())
 }
 
 /// The recordings, written once for all tests of this file.
@@ -521,4 +532,43 @@ fn a_damaged_message_costs_its_frame_only() {
     let err = String::from_utf8_lossy(&out.stderr);
     let named = err.lines().filter(|l| l.contains("frame 5")).count();
     assert_eq!(named, 1, "{err}");
+}
+
+/// A split bag's channels are those of all its files (each topic's messages summed over both),
+/// and every message of it is given in stored order, SQLite storage included, with channel ids
+/// of that list.
+#[test]
+fn a_split_bag_lists_the_channels_and_messages_of_all_its_files() {
+    let Some((_, list)) = recordings() else {
+        return;
+    };
+    let split: Vec<&Recording> = list
+        .iter()
+        .filter(|r| r.name.starts_with("split rosbag2"))
+        .collect();
+    assert_eq!(split.len(), 2, "the mcap and sqlite split bags");
+    for r in split {
+        let mut reader = StreamReader::open(&r.path).unwrap();
+        let channels = reader.channels().to_vec();
+        for topic in ["/camera/image_raw", "/joint_states", "/camera/camera_info"] {
+            let c: Vec<_> = channels.iter().filter(|c| c.topic == topic).collect();
+            assert_eq!(c.len(), 1, "{}: {topic} in {channels:?}", r.name);
+            assert_eq!(
+                c[0].message_count, FRAMES as u64,
+                "{}: {topic}: both files' messages",
+                r.name
+            );
+            assert_eq!(c[0].message_encoding, "cdr");
+        }
+        let mut per_channel = std::collections::BTreeMap::<u16, u64>::new();
+        reader
+            .for_each_message(|m| *per_channel.entry(m.channel).or_default() += 1)
+            .unwrap_or_else(|e| panic!("{}: {e}", r.name));
+        let listed: std::collections::BTreeMap<u16, u64> = channels
+            .iter()
+            .map(|c| (c.id, c.message_count))
+            .filter(|(_, n)| *n > 0)
+            .collect();
+        assert_eq!(per_channel, listed, "{}", r.name);
+    }
 }

@@ -29,6 +29,36 @@ pub struct ChannelSummary {
     pub message_count: u64,
 }
 
+/// Adds a further storage file's channels to a split bag's list: a channel with the topic,
+/// message encoding and schema of one listed adds its messages to it; any other is appended,
+/// keeping its id unless the list has that id already (then it gets the next free one). Returns
+/// the file's channel ids → the list's.
+pub(super) fn merge_channels(
+    into: &mut Vec<ChannelSummary>,
+    more: &[ChannelSummary],
+) -> HashMap<u16, u16> {
+    let mut ids = HashMap::new();
+    for c in more {
+        let same = into.iter_mut().find(|k| {
+            k.topic == c.topic && k.message_encoding == c.message_encoding && k.schema == c.schema
+        });
+        if let Some(k) = same {
+            k.message_count = k.message_count.saturating_add(c.message_count);
+            ids.insert(c.id, k.id);
+            continue;
+        }
+        let taken = |id: u16| into.iter().any(|k| k.id == id);
+        let id = if taken(c.id) {
+            (0..=u16::MAX).find(|&id| !taken(id)).unwrap_or(c.id)
+        } else {
+            c.id
+        };
+        ids.insert(c.id, id);
+        into.push(ChannelSummary { id, ..c.clone() });
+    }
+    ids
+}
+
 /// How many records of each kind the file holds (the MCAP statistics, checked or counted).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct RecordCounts {

@@ -14,7 +14,7 @@ use mcap::records::op;
 use super::super::{IMAGE_TOPIC, StreamError, StreamInfo};
 use super::catalog::{Catalog, ChannelSummary, RecordCounts};
 use super::channels::{ChannelTable, ImageTopic, Role};
-use super::chunk::{decode_chunk_messages, decode_loose_messages};
+use super::chunk::{Block, Msg, decode_chunk_block, decode_loose_block};
 use super::summary::SummaryProblem;
 use super::{RawFrame, RawMsg};
 use crate::formats::MessageKind;
@@ -59,14 +59,6 @@ pub(super) struct FrameLoc {
     pub(super) nth: u32,
 }
 
-/// One message of a decoded block.
-#[derive(Debug)]
-pub(super) struct Msg {
-    pub(super) channel: u16,
-    pub(super) log_time: u64,
-    pub(super) data: Vec<u8>,
-}
-
 /// One MCAP file of a recording (an eotn stream, another writer's MCAP, or one storage file of
 /// a rosbag2 bag).
 ///
@@ -102,7 +94,8 @@ pub(super) struct McapFile {
     static_blocks: Vec<BlockLoc>,
     /// True when the index came from the summary alone (the data section was not read).
     pub(super) from_summary: bool,
-    cache: Option<(u32, Vec<Msg>)>,
+    /// The block last read, by number: its records and where its messages lie in them.
+    cache: Option<(u32, Block)>,
     /// Warnings not yet taken by the reader.
     pub(super) warnings: Vec<String>,
     /// Facts about the file worth a line (not problems with it).
@@ -251,11 +244,12 @@ impl McapFile {
             let messages = self.load_block(loc.block)?;
             self.cache = Some((loc.block, messages));
         }
-        let (Some((_, messages)), Some(image), Some(kind)) =
+        let (Some((_, block)), Some(image), Some(kind)) =
             (self.cache.as_ref(), self.image_channel, self.image_kind)
         else {
             return Err(self.corrupt(format!("frame {index}: its chunk could not be loaded")));
         };
+        let messages = &block.messages;
         let images: Vec<usize> = messages
             .iter()
             .enumerate()
@@ -273,13 +267,13 @@ impl McapFile {
         let others = if self.written_by_eotn {
             messages[at + 1..end]
                 .iter()
-                .filter_map(|m| self.raw_msg(m))
+                .filter_map(|m| self.raw_msg(block, m))
                 .collect()
         } else {
             let t = messages[at].log_time;
             let mut nearest: HashMap<u16, usize> = HashMap::new();
             for (i, m) in messages.iter().enumerate().take(end).skip(start) {
-                if i == at || self.raw_msg(m).is_none() {
+                if i == at || self.raw_msg(block, m).is_none() {
                     continue;
                 }
                 let better = nearest
@@ -293,24 +287,24 @@ impl McapFile {
             picked.sort_unstable();
             picked
                 .into_iter()
-                .filter_map(|i| self.raw_msg(&messages[i]))
+                .filter_map(|i| self.raw_msg(block, &messages[i]))
                 .collect()
         };
         Ok(RawFrame {
             time_ns: loc.time_ns,
             kind,
-            image: Cow::Borrowed(messages[at].data.as_slice()),
+            image: Cow::Borrowed(block.data(&messages[at])),
             others,
         })
     }
 
     /// A message that goes with a frame, when its channel is read and is not the camera.
-    fn raw_msg<'a>(&self, m: &'a Msg) -> Option<RawMsg<'a>> {
+    fn raw_msg<'a>(&self, block: &'a Block, m: &Msg) -> Option<RawMsg<'a>> {
         match self.roles.get(&m.channel) {
             None | Some(Role::Ignored | Role::Image(_)) => None,
             Some(role) => Some(RawMsg {
                 role: role.clone(),
-                data: Cow::Borrowed(m.data.as_slice()),
+                data: Cow::Borrowed(block.data(m)),
             }),
         }
     }
@@ -330,12 +324,13 @@ impl McapFile {
         let statics = Self::static_channels(&self.roles);
         let mut out = Vec::new();
         for loc in std::mem::take(&mut self.static_blocks) {
-            if let Ok(messages) = self.load_loc(loc) {
+            if let Ok(block) = self.load_loc(loc) {
                 out.extend(
-                    messages
-                        .into_iter()
+                    block
+                        .messages
+                        .iter()
                         .filter(|m| statics.contains(&m.channel))
-                        .map(|m| m.data),
+                        .map(|m| block.data(m).to_vec()),
                 );
             }
         }
@@ -444,7 +439,7 @@ impl McapFile {
     }
 
     /// Reads block `block` into its messages: a chunk decompressed, or records outside chunks.
-    fn load_block(&mut self, block: u32) -> Result<Vec<Msg>, StreamError> {
+    fn load_block(&mut self, block: u32) -> Result<Block, StreamError> {
         let loc = *self
             .blocks
             .get(block as usize)
@@ -452,14 +447,13 @@ impl McapFile {
         self.load_loc(loc)
     }
 
-    /// Reads the block at `loc` into its messages.
-    fn load_loc(&mut self, loc: BlockLoc) -> Result<Vec<Msg>, StreamError> {
+    /// Reads the block at `loc`: its records as read (decompressed when compressed), and where
+    /// its messages lie in them.
+    fn load_loc(&mut self, loc: BlockLoc) -> Result<Block, StreamError> {
         if loc.kind == BlockKind::Loose {
             let bytes = self.read_exact_at(loc.offset, loc.length)?;
-            let mut messages = Vec::new();
-            decode_loose_messages(&bytes, &mut messages)
-                .map_err(self.mcap_err(format!("reading the messages at offset {}", loc.offset)))?;
-            return Ok(messages);
+            return decode_loose_block(bytes)
+                .map_err(self.mcap_err(format!("reading the messages at offset {}", loc.offset)));
         }
         let (opcode, body) = self.read_record_at(loc.offset, loc.length.saturating_sub(9))?;
         if opcode != op::CHUNK {
@@ -468,9 +462,108 @@ impl McapFile {
                 loc.offset
             )));
         }
-        let mut messages = Vec::new();
-        decode_chunk_messages(&body, &mut messages)
-            .map_err(self.mcap_err(format!("reading the chunk at offset {}", loc.offset)))?;
-        Ok(messages)
+        decode_chunk_block(body)
+            .map_err(self.mcap_err(format!("reading the chunk at offset {}", loc.offset)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{Frame, Yuv};
+    use crate::streams::schema::{ImageEncoding, encode_image, raw_image_schema};
+
+    /// Another writer's file of `n` 4×2 frames on `/cam`, one uncompressed chunk each (with
+    /// its CRC), and a complete summary: statistics, chunk and message indexes.
+    fn chunked_file(path: &Path, n: u8) {
+        let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+        let mut w = mcap::WriteOptions::new()
+            .compression(None)
+            .create(file)
+            .unwrap();
+        let s = raw_image_schema().unwrap();
+        let sid = w.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+        let ch = w
+            .add_channel(sid, "/cam", "protobuf", &Default::default())
+            .unwrap();
+        let mut buf = Vec::new();
+        for i in 0..n {
+            let t = 100 * u64::from(i) + 100;
+            let f = Frame::filled_uyvy(4, 2, Yuv::new(i, 128, 128)).unwrap();
+            encode_image(t, &f, ImageEncoding::Uyvy, &mut buf).unwrap();
+            let header = mcap::records::MessageHeader {
+                channel_id: ch,
+                sequence: 0,
+                log_time: t,
+                publish_time: t,
+            };
+            w.write_to_known_channel(&header, &buf).unwrap();
+            // Ends the chunk: one chunk a frame.
+            w.flush().unwrap();
+        }
+        w.finish().unwrap();
+    }
+
+    /// A file whose summary is complete opens from the summary alone: the chunk of frame 1 is
+    /// damaged (a byte of its records flipped, so its CRC fails), and opening neither sees nor
+    /// warns about it — a walk of the data section would (`from_summary` is what decides) —,
+    /// while reading that frame finds the damage and the other frames read.
+    #[test]
+    fn a_complete_summary_is_enough() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.mcap");
+        chunked_file(&p, 3);
+        let mut bytes = std::fs::read(&p).unwrap();
+        let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+        assert_eq!(summary.chunk_indexes.len(), 3, "one chunk a frame");
+        let second = &summary.chunk_indexes[1];
+        let last_record_byte = second.chunk_start_offset + second.chunk_length - 1;
+        bytes[usize::try_from(last_record_byte).unwrap()] ^= 0xff;
+        std::fs::write(&p, &bytes).unwrap();
+
+        let mut f = McapFile::open(&p, None).unwrap();
+        assert!(
+            f.from_summary,
+            "a complete summary: the data section is not read"
+        );
+        assert!(f.warnings.is_empty(), "{:?}", f.warnings);
+        assert_eq!(f.frames.len(), 3);
+        assert_eq!(f.chunk_count(), 3);
+        let e = f.read_raw(1).err().unwrap().to_string();
+        assert!(e.contains("CRC"), "{e}");
+        for i in [0, 2] {
+            let raw = f.read_raw(i).unwrap();
+            assert_eq!(raw.time_ns, 100 * i as u64 + 100);
+        }
+
+        // Without its statistics the summary does not say it describes the whole file: the data
+        // section is walked, and the damaged chunk is found at opening.
+        let mut bare = mcap::WriteOptions::new()
+            .compression(None)
+            .emit_statistics(false)
+            .create(std::io::BufWriter::new(
+                std::fs::File::create(dir.path().join("g.mcap")).unwrap(),
+            ))
+            .unwrap();
+        let s = raw_image_schema().unwrap();
+        let sid = bare.add_schema(&s.name, &s.encoding, &s.data).unwrap();
+        let ch = bare
+            .add_channel(sid, "/cam", "protobuf", &Default::default())
+            .unwrap();
+        let mut buf = Vec::new();
+        let f0 = Frame::filled_uyvy(4, 2, Yuv::new(9, 128, 128)).unwrap();
+        encode_image(5, &f0, ImageEncoding::Uyvy, &mut buf).unwrap();
+        let header = mcap::records::MessageHeader {
+            channel_id: ch,
+            sequence: 0,
+            log_time: 5,
+            publish_time: 5,
+        };
+        bare.write_to_known_channel(&header, &buf).unwrap();
+        bare.finish().unwrap();
+        drop(bare);
+        let g = McapFile::open(&dir.path().join("g.mcap"), None).unwrap();
+        assert!(!g.from_summary, "no statistics: the data section is walked");
+        assert_eq!(g.frames.len(), 1);
     }
 }

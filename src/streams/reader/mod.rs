@@ -9,6 +9,7 @@
 //! and channels, `messages` gives every message in file order.
 
 use std::borrow::Cow;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use super::rosbag2::db3::Db3File;
@@ -99,6 +100,13 @@ impl Part {
         }
     }
 
+    fn channels(&self) -> &[ChannelSummary] {
+        match self {
+            Self::Mcap(m) => &m.channels,
+            Self::Db3(d) => &d.channels,
+        }
+    }
+
     fn static_transforms(&mut self) -> Vec<Vec<u8>> {
         match self {
             Self::Mcap(m) => m.static_transforms(),
@@ -123,8 +131,11 @@ pub struct StreamReader {
     info: StreamInfo,
     param_set: Option<String>,
     chunk_count: usize,
-    /// Every channel of the first MCAP storage file, by id.
+    /// Every channel of the storage files: the first file's by id, then those of later files
+    /// (a split bag) that it does not have.
     channels: Vec<ChannelSummary>,
+    /// For each part, its channel ids → those of `channels`.
+    channel_ids: Vec<HashMap<u16, u16>>,
     /// The records of the MCAP storage files, summed.
     counts: RecordCounts,
     zstd_messages: bool,
@@ -170,6 +181,7 @@ impl StreamReader {
             param_set: None,
             chunk_count: 0,
             channels: Vec::new(),
+            channel_ids: Vec::new(),
             counts: RecordCounts::default(),
             zstd_messages: layout.zstd_messages,
             image_topics: Vec::new(),
@@ -232,11 +244,14 @@ impl StreamReader {
                     self.tf_static.add(&msg);
                 }
             }
+            self.channel_ids.push(catalog::merge_channels(
+                &mut self.channels,
+                part_reader.channels(),
+            ));
             if let Part::Mcap(m) = &mut part_reader {
                 if i == 0 {
                     self.info = m.info.clone();
                     self.param_set = m.param_set.clone();
-                    self.channels = m.channels.clone();
                 }
                 self.chunk_count += m.chunk_count();
                 self.counts.add(m.counts);
@@ -325,8 +340,11 @@ impl StreamReader {
         self.chunk_count
     }
 
-    /// Every channel of the (first) MCAP storage file by id — topic, encodings, schema, message
-    /// count — whatever it carries, frames or not; empty for SQLite storage.
+    /// Every channel of the recording — topic, encodings, schema, message count — whatever it
+    /// carries, frames or not. A split bag's files are summed: a channel of a later file with the
+    /// topic, encoding and schema of one listed adds its messages to it, any other is listed
+    /// after the first file's (renumbered if its id is taken). SQLite storage lists its topics
+    /// (id: the place in the `topics` table; schema: the type's name, without an encoding).
     #[must_use]
     pub fn channels(&self) -> &[ChannelSummary] {
         &self.channels
@@ -346,26 +364,25 @@ impl StreamReader {
         &self.notes
     }
 
-    /// Calls `each` with every message of an MCAP recording in the order it is stored, inside
-    /// chunks and outside them (of each storage file in turn). Memory is one chunk at a time.
+    /// Calls `each` with every message of the recording in the order it is stored (of each
+    /// storage file in turn): MCAP inside chunks and outside them, SQLite by row. Channel ids are
+    /// those of [`StreamReader::channels`]. Memory is one chunk (one SQLite row) at a time.
     ///
     /// # Errors
     /// I/O errors, [`StreamError::Corrupt`] at the first damaged or cut-off record (the messages
-    /// before it have been given to `each`), and for SQLite storage, which this does not read.
+    /// before it have been given to `each`).
     pub fn for_each_message(
         &mut self,
         mut each: impl FnMut(&StreamMessage<'_>),
     ) -> Result<(), StreamError> {
-        for part in &mut self.parts {
+        for (part, ids) in self.parts.iter_mut().zip(&self.channel_ids) {
+            let mut renumbered = |m: &StreamMessage<'_>| {
+                let channel = ids.get(&m.channel).copied().unwrap_or(m.channel);
+                each(&StreamMessage { channel, ..*m });
+            };
             match part {
-                Part::Mcap(m) => m.for_each_message(&mut each)?,
-                Part::Db3(_) => {
-                    return Err(StreamError::Corrupt {
-                        path: self.path.clone(),
-                        detail: "every message in file order is read from MCAP storage only"
-                            .to_owned(),
-                    });
-                }
+                Part::Mcap(m) => m.for_each_message(&mut renumbered)?,
+                Part::Db3(d) => d.for_each_message(&mut renumbered)?,
             }
         }
         Ok(())

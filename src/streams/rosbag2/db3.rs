@@ -13,7 +13,7 @@ use rusqlite::{Connection, OpenFlags, OptionalExtension as _};
 
 use super::super::StreamError;
 use super::super::reader::channels::{ChannelTable, ImageTopic, Role};
-use super::super::reader::{RawFrame, RawMsg};
+use super::super::reader::{ChannelSummary, RawFrame, RawMsg, SchemaSummary, StreamMessage};
 use crate::formats::MessageKind;
 
 /// Largest message read, bytes (a 4096×4096 RGBA frame is 64 MiB).
@@ -32,6 +32,8 @@ pub(crate) struct Db3File {
     path: PathBuf,
     conn: Connection,
     topics: Vec<Topic>,
+    /// Every topic as a channel (id: its place in the `topics` table), with its message count.
+    pub(crate) channels: Vec<ChannelSummary>,
     roles: HashMap<i64, Role>,
     image_topic: Option<i64>,
     pub(crate) image_kind: Option<MessageKind>,
@@ -97,6 +99,7 @@ impl Db3File {
             path: path.to_owned(),
             conn,
             topics: Vec::new(),
+            channels: Vec::new(),
             roles: HashMap::new(),
             image_topic: None,
             image_kind: None,
@@ -143,6 +146,7 @@ impl Db3File {
             table.add(channel, name, format, Some(type_name));
         }
         drop(counts);
+        self.channels = self.channel_summaries(&listed)?;
         table.note_other_cameras();
         self.warnings.append(&mut table.notes);
         for (i, (id, ..)) in listed.into_iter().enumerate() {
@@ -188,6 +192,92 @@ impl Db3File {
             self.warnings.push(format!(
                 "{negative} images have negative timestamps; read as 0"
             ));
+        }
+        Ok(())
+    }
+
+    /// The topics as channels: id (the topic's place in the table, as the frames' channel
+    /// table numbers them), name, serialization format, type (the schema's name; SQLite storage
+    /// keeps no schema text, so its encoding is empty), and message count.
+    fn channel_summaries(
+        &self,
+        listed: &[(i64, String, String, String)],
+    ) -> rusqlite::Result<Vec<ChannelSummary>> {
+        let mut stmt = self
+            .conn
+            .prepare("SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id")?;
+        let counts: HashMap<i64, i64> = stmt
+            .query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, i64>(1)?)))?
+            .collect::<rusqlite::Result<_>>()?;
+        Ok(listed
+            .iter()
+            .zip(0..=u16::MAX)
+            .map(|((id, name, type_name, format), channel)| ChannelSummary {
+                id: channel,
+                topic: name.clone(),
+                message_encoding: format.clone(),
+                schema: Some(SchemaSummary {
+                    name: type_name.clone(),
+                    encoding: String::new(),
+                }),
+                message_count: counts.get(id).map_or(0, |&n| u64::try_from(n).unwrap_or(0)),
+            })
+            .collect())
+    }
+
+    /// Calls `each` with every message of the file in the order it was stored (row id), its
+    /// channel numbered as in [`Db3File::channels`]; sequence 0 and the timestamp as both times
+    /// (the table keeps one).
+    ///
+    /// # Errors
+    /// [`StreamError::Corrupt`] at the first row that cannot be read or is larger than any
+    /// message eotn reads (the messages before it have been given to `each`).
+    pub(crate) fn for_each_message(
+        &self,
+        mut each: impl FnMut(&StreamMessage<'_>),
+    ) -> Result<(), StreamError> {
+        let sql = |e: rusqlite::Error| self.corrupt(format!("reading the messages: {e}"));
+        let channel_of: HashMap<i64, u16> =
+            self.topics.iter().map(|t| t.id).zip(0..=u16::MAX).collect();
+        // Oversized rows come back without their data, so they are refused, not loaded.
+        let mut stmt = self
+            .conn
+            .prepare(
+                "SELECT id, topic_id, timestamp, length(data), \
+                 CASE WHEN length(data) <= ?1 THEN data END FROM messages ORDER BY id",
+            )
+            .map_err(sql)?;
+        let mut rows = stmt.query([MAX_MESSAGE_BYTES]).map_err(sql)?;
+        while let Some(row) = rows.next().map_err(sql)? {
+            let id: i64 = row.get(0).map_err(sql)?;
+            let topic: i64 = row.get(1).map_err(sql)?;
+            let time = u64::try_from(row.get::<_, i64>(2).map_err(sql)?).unwrap_or(0);
+            let Some(data) = row
+                .get_ref(4)
+                .map_err(sql)?
+                .as_blob_or_null()
+                .map_err(|e| self.corrupt(format!("message {id}: {e}")))?
+            else {
+                let len: Option<i64> = row.get(3).map_err(sql)?;
+                return Err(self.corrupt(match len {
+                    Some(n) => {
+                        format!("message {id} holds {n} bytes, more than any message eotn reads")
+                    }
+                    None => format!("message {id} has no data"),
+                }));
+            };
+            let Some(&channel) = channel_of.get(&topic) else {
+                return Err(self.corrupt(format!(
+                    "message {id} is on topic {topic}, which the topics table does not list"
+                )));
+            };
+            each(&StreamMessage {
+                channel,
+                sequence: 0,
+                log_time_ns: time,
+                publish_time_ns: time,
+                data,
+            });
         }
         Ok(())
     }
