@@ -31,6 +31,7 @@ mod lut;
 mod lut_from_labels;
 pub mod open;
 pub mod overhead;
+pub mod overhead_calibrate;
 pub mod paths;
 pub mod patterns;
 mod record;

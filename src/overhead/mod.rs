@@ -16,6 +16,7 @@
 pub mod calibration;
 pub mod drawing;
 pub mod field;
+pub mod intrinsics;
 pub mod lines;
 pub mod pipeline;
 pub mod points;
