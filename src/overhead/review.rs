@@ -12,7 +12,7 @@
 //! ([`Severity::Doubt`]: the command line writes such a calibration only with `--accept`), and
 //! so are the points not determining the camera: without intrinsics, clicks spanning less than
 //! half the image's width or height ([`MIN_COVERAGE`]); any fit whose camera position has a
-//! standard deviation over 10 cm, focal length over 3 %, or principal point over 3 % of the
+//! standard deviation over 25 cm, focal length over 6 %, or principal point over 3 % of the
 //! image width (from the fit's covariance, [`Uncertainty`]); and points whose coordinates are
 //! not those of the field description's landmark of that name (points for another field).
 //! Fewer points than the fitted parameters need (five residuals to spare) refuse. Points more
@@ -43,10 +43,14 @@ pub const HEIGHT_RANGE_CM: (f64, f64) = (50.0, 1500.0);
 /// seen only where points are.
 pub const MIN_COVERAGE: f64 = 0.5;
 /// A camera position whose standard deviation (the largest of x, y, z) exceeds this is not
-/// determined by the clicks, centimetres.
-pub const MAX_POSITION_SD_CM: f64 = 10.0;
-/// A focal length whose standard deviation exceeds this fraction of it is not determined.
-pub const MAX_FOCAL_SD_FRACTION: f64 = 0.03;
+/// determined by the clicks, centimetres. About twice what every landmark of the 2005 field
+/// clicked with 1 px of noise gives the simulator's camera looking straight down (13 cm, its
+/// height, which ground points cannot tell from the focal length): the two click sets
+/// gave cameras 42 cm apart.
+pub const MAX_POSITION_SD_CM: f64 = 25.0;
+/// A focal length whose standard deviation exceeds this fraction of it is not determined
+/// (the same clicks: 3.6 %; the two fits: 492 and 408 px).
+pub const MAX_FOCAL_SD_FRACTION: f64 = 0.06;
 /// A principal point whose standard deviation (x or y) exceeds this fraction of the image
 /// width is not determined (the weak prior alone holds it: 5 % of the width).
 pub const MAX_CENTRE_SD_FRACTION: f64 = 0.03;
@@ -681,6 +685,58 @@ mod tests {
         assert_eq!(with(|c| c.focal_px = 2500.0), ["Focal"]);
         assert_eq!(with(|c| c.centre.x_px = 500.0), ["PrincipalPoint"]);
         assert_eq!(with(|c| c.centre.y_px = 50.0), ["PrincipalPoint"]);
+    }
+
+    #[test]
+    fn parameters_the_clicks_leave_uncertain_are_doubted_each_by_name() {
+        let camera = OverheadCamera::above_field_2005();
+        let sure = Uncertainty {
+            residual_sd_px: 0.8,
+            position_cm: [2.0, 3.0, 13.0],
+            rotation_deg: [0.2, 0.2, 0.1],
+            focal_px: Some(0.035 * camera.focal_px),
+            centre_px: Some([10.0, 12.0]),
+            k1: Some(0.01),
+            k2: Some(0.01),
+        };
+        assert!(uncertain(&sure, &camera, false).is_empty());
+        // The fits: cameras 42 cm apart, focal 492 vs 408 px, principal points 100 px.
+        let unsure = Uncertainty {
+            position_cm: [30.0, 12.0, 20.0],
+            focal_px: Some(45.0),
+            centre_px: Some([60.0, 20.0]),
+            ..sure
+        };
+        let found = uncertain(&unsure, &camera, false);
+        assert_eq!(kinds(&found), ["Uncertain", "Uncertain", "Uncertain"]);
+        let text: Vec<String> = found.iter().map(ToString::to_string).collect();
+        assert!(
+            text[0].contains("camera position: standard deviation 30.00 cm (limit 25.00 cm)"),
+            "{text:?}"
+        );
+        assert!(
+            text[1].contains("focal length") && text[2].contains("principal point"),
+            "{text:?}"
+        );
+        assert!(text.iter().all(|t| t.contains("--intrinsics")), "{text:?}");
+        assert!(found.iter().all(|f| f.severity() == Severity::Doubt));
+        // With intrinsics there is only the pose; the hint is not repeated.
+        let pose_only = Uncertainty {
+            focal_px: None,
+            centre_px: None,
+            k1: None,
+            k2: None,
+            ..unsure
+        };
+        let found = uncertain(&pose_only, &camera, true);
+        assert_eq!(kinds(&found), ["Uncertain"]);
+        assert!(!found[0].to_string().contains("--intrinsics"), "{found:?}");
+        // A standard deviation that is not a number is not a determined parameter.
+        let nan = Uncertainty {
+            position_cm: [f64::NAN, 1.0, 1.0],
+            ..sure
+        };
+        assert_eq!(kinds(&uncertain(&nan, &camera, false)), ["Uncertain"]);
     }
 
     #[test]

@@ -52,9 +52,13 @@ impl Uncertainty {
         }
     }
 
-    /// The largest of the position's three standard deviations, centimetres.
+    /// The largest of the position's three standard deviations, centimetres (NaN when one
+    /// is).
     #[must_use]
     pub fn position_sd_cm(&self) -> f64 {
+        if self.position_cm.iter().any(|v| v.is_nan()) {
+            return f64::NAN;
+        }
         self.position_cm.into_iter().fold(0.0, f64::max)
     }
 
