@@ -413,25 +413,8 @@ impl Workspace {
                 self.reprocess();
                 self.status = self.overhead.calibration_status();
             }
-            OverheadCommand::OpenIntrinsics(p) => {
-                let mut i = Intrinsics::load(&p)?;
-                if i.camera_name.is_empty() {
-                    i.camera_name = p.display().to_string();
-                }
-                self.status = format!(
-                    "intrinsics {}: {}x{}, fx {:.1} px, {}; Calibrate fits only the pose",
-                    p.display(),
-                    i.width_px,
-                    i.height_px,
-                    i.fx,
-                    i.lens.ros_name()
-                );
-                self.overhead.intrinsics = Some((i, p));
-            }
-            OverheadCommand::CloseIntrinsics => {
-                self.overhead.intrinsics = None;
-                self.status = "no intrinsics: Calibrate fits the lens too".into();
-            }
+            OverheadCommand::OpenIntrinsics(p) => self.open_intrinsics(Some(p))?,
+            OverheadCommand::CloseIntrinsics => self.open_intrinsics(None)?,
             OverheadCommand::OpenField(p) => {
                 let field = FieldDescription::resolve(&p.to_string_lossy())?;
                 self.overhead.pipeline = OverheadPipeline::new(
@@ -490,6 +473,29 @@ impl Workspace {
                 self.frame_generation += 1;
             }
         }
+        Ok(())
+    }
+
+    /// Uses the intrinsics of `p` for Calibrate, or none.
+    fn open_intrinsics(&mut self, p: Option<PathBuf>) -> anyhow::Result<()> {
+        let Some(p) = p else {
+            self.overhead.intrinsics = None;
+            self.status = "no intrinsics: Calibrate fits the lens too".into();
+            return Ok(());
+        };
+        let mut i = Intrinsics::load(&p)?;
+        if i.camera_name.is_empty() {
+            i.camera_name = p.display().to_string();
+        }
+        self.status = format!(
+            "intrinsics {}: {}x{}, fx {:.1} px, {}; Calibrate fits only the pose",
+            p.display(),
+            i.width_px,
+            i.height_px,
+            i.fx,
+            i.lens.ros_name()
+        );
+        self.overhead.intrinsics = Some((i, p));
         Ok(())
     }
 
