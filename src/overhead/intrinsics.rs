@@ -237,7 +237,10 @@ impl Intrinsics {
     pub fn for_frame(&self, width: usize, height: usize) -> Result<Self, IntrinsicsError> {
         let (iw, ih) = (self.width_px, self.height_px);
         let whole = |big: usize, small: usize, big2: usize, small2: usize| {
-            small > 0 && big % small == 0 && big / small >= 2 && big2 == (big / small) * small2
+            small > 0
+                && big.is_multiple_of(small)
+                && big / small >= 2
+                && big2 == (big / small) * small2
         };
         let scale = if (width, height) == (iw, ih) {
             1.0

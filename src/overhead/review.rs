@@ -443,16 +443,15 @@ fn coverage(cal: &Calibration) -> Option<Finding> {
     }
     let (w, h) = (cal.camera.width_px as f64, cal.camera.height_px as f64);
     let (fx, fy) = ((hi[0] - lo[0]) / w.max(1.0), (hi[1] - lo[1]) / h.max(1.0));
-    (!(fx >= MIN_COVERAGE && fy >= MIN_COVERAGE) && !cal.points.is_empty()).then_some(
-        Finding::Clustered {
-            x_pct: 100.0 * fx,
-            y_pct: 100.0 * fy,
-            x0: lo[0],
-            x1: hi[0],
-            y0: lo[1],
-            y1: hi[1],
-        },
-    )
+    let covered = fx >= MIN_COVERAGE && fy >= MIN_COVERAGE;
+    (!covered && !cal.points.is_empty()).then_some(Finding::Clustered {
+        x_pct: 100.0 * fx,
+        y_pct: 100.0 * fy,
+        x0: lo[0],
+        x1: hi[0],
+        y0: lo[1],
+        y1: hi[1],
+    })
 }
 
 /// The fitted parameters whose standard deviations exceed their limits.

@@ -741,7 +741,7 @@ fn stream_camera(loaded: &SourceFrame) -> Option<OverheadCamera> {
 pub(super) fn truth_of(loaded: &SourceFrame) -> Option<crate::model::truth::OverheadTruth> {
     let value = loaded.channel(crate::streams::GROUND_TRUTH_TOPIC)?;
     match serde_json::from_value::<crate::model::truth::GroundTruth>(value.clone()) {
-        Ok(crate::model::truth::GroundTruth::Overhead(t)) => Some(t),
+        Ok(crate::model::truth::GroundTruth::Overhead(t)) => Some(*t),
         _ => None,
     }
 }

@@ -54,7 +54,7 @@ fn fixture() -> (&'static PathBuf, &'static PathBuf) {
 fn truth(stream: &Path, index: usize) -> OverheadTruth {
     let record = StreamReader::open(stream).unwrap().read(index).unwrap();
     match serde_json::from_value(record.ground_truth.unwrap()).unwrap() {
-        GroundTruth::Overhead(t) => t,
+        GroundTruth::Overhead(t) => *t,
         GroundTruth::Robot(_) => panic!("an overhead stream"),
     }
 }

@@ -104,7 +104,7 @@ pub(super) fn camera_from_homography(
         .sum::<f64>()
         / n)
         .sqrt();
-    if !(spread > 1e-6) {
+    if spread.is_nan() || spread <= 1e-6 {
         return None;
     }
     let mut a = DMatrix::<f64>::zeros(2 * pairs.len(), 9);
