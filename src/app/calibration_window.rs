@@ -18,8 +18,10 @@ pub struct OverheadPaths {
     pub calibration: String,
     /// Points file (`*.points.json`).
     pub points: String,
-    /// Field description (`params/fields/*.json`).
+    /// Field description (`params/fields/*.json`, or a shipped field's name).
     pub field: String,
+    /// The lens's intrinsics (a ROS `camera_info` YAML file).
+    pub intrinsics: String,
 }
 
 /// The window's contents.
@@ -83,13 +85,37 @@ fn files_ui(
     ui.label(format!("Field: {}", overhead.field().name));
     if path_row(
         ui,
-        "field file",
-        "params/fields/ssl-2008.json",
+        "field file or name",
+        "spl-2020",
         &mut paths.field,
         &[("Open field", true)],
     ) == Some(0)
     {
         commands.push(OverheadCommand::OpenField(path(&paths.field)).into());
+    }
+    ui.label(match overhead.intrinsics() {
+        Some((i, p)) => format!(
+            "Intrinsics: {} ({}x{}, {}): Calibrate fits only the pose",
+            p.display(),
+            i.width_px,
+            i.height_px,
+            i.lens.ros_name()
+        ),
+        None => "Intrinsics: none (Calibrate fits the lens too)".to_owned(),
+    });
+    let has_intrinsics = overhead.intrinsics().is_some();
+    if path_row(
+        ui,
+        "intrinsics",
+        "camera_info.yaml",
+        &mut paths.intrinsics,
+        &[("Open intrinsics", true)],
+    ) == Some(0)
+    {
+        commands.push(OverheadCommand::OpenIntrinsics(path(&paths.intrinsics)).into());
+    }
+    if has_intrinsics && ui.button("Close intrinsics").clicked() {
+        commands.push(OverheadCommand::CloseIntrinsics.into());
     }
     let has_cal = overhead.calibration().is_some();
     match path_row(

@@ -127,7 +127,7 @@ impl FieldCamera {
             .ground_truth
             .and_then(|t| serde_json::from_value::<GroundTruth>(t).ok())
             .and_then(|t| match t {
-                GroundTruth::Overhead(o) => Some(o),
+                GroundTruth::Overhead(o) => Some(*o),
                 GroundTruth::Robot(_) => None,
             });
         Ok(FieldFrame {

@@ -34,6 +34,7 @@ mod lut_from_labels;
 pub mod open;
 pub mod overhead;
 mod overhead_bench;
+pub mod overhead_calibrate;
 pub mod paths;
 pub mod patterns;
 mod record;

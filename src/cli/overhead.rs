@@ -8,18 +8,17 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Serialize;
 
-use super::inputs::{FrameInputs, load_frame_arg, load_lut_arg, parse_size, progress};
+use super::inputs::{FrameInputs, load_lut_arg, parse_size, progress};
 use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera, Point};
 use crate::model::GroundTruth;
 use crate::overhead::OverheadPipeline;
-use crate::overhead::calibration::{Calibration, CalibrationParams, MIN_LINE_SAMPLES, calibrate};
+use crate::overhead::calibration::Calibration;
 use crate::overhead::drawing::marker_svg;
 use crate::overhead::field::FieldDescription;
-use crate::overhead::lines::projected_field_lines;
 use crate::overhead::pipeline::{FrameFit, frame_fit};
 use crate::overhead::points::{CalibrationPoint, PointsFile};
 use crate::overhead::recognise::{OverheadDetections, OverheadParams};
-use crate::overhead::review::{Severity, check_points, review};
+use crate::overhead::review::review;
 use crate::sim::SimRng;
 use crate::streams::StreamReader;
 
@@ -36,8 +35,9 @@ pub struct Args {
 pub enum OverheadCommand {
     /// Write the printable robot marker of a team and identity as SVG at real size.
     Marker(MarkerArgs),
-    /// Fit the camera (pose, focal, principal point, k1, k2) to a points file; print the
-    /// parameters and each point's reprojection error.
+    /// Fit the camera (pose, focal, principal point, k1, k2; only the pose with --intrinsics)
+    /// to a points file; print the parameters with their standard deviations and each point's
+    /// reprojection error.
     Calibrate(CalibrateArgs),
     /// Find ball and robots in overhead frames: one JSON line per frame with `--json`.
     Detect(DetectArgs),
@@ -84,18 +84,31 @@ pub struct CalibrateArgs {
     /// it as `CAL.lines.png` beside the calibration.
     #[arg(long)]
     pub image: Option<PathBuf>,
-    /// Field description (landmarks, lines, heights); the 2005 Four-Legged field by default.
-    #[arg(long)]
+    /// Field description (landmarks, lines, heights): a file, or a shipped field's name
+    /// (four-legged-2005, ssl-2008, spl-2020, ssl-div-a, ssl-div-b); four-legged-2005 by
+    /// default.
+    #[arg(long, value_name = "FIELD")]
     pub field: Option<PathBuf>,
     /// Frame size of a raw `--image`, WxH.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
+    /// The lens's intrinsics from a checkerboard calibration: a ROS `camera_info` YAML file as
+    /// `camera_calibration` writes it (plumb_bob, rational_polynomial or equidistant); then only
+    /// the camera's pose is fitted. Intrinsics made at a whole multiple or fraction of the
+    /// points' frame size are scaled.
+    #[arg(long)]
+    pub intrinsics: Option<PathBuf>,
     /// Do not refine along the lines even with `--image`.
     #[arg(long)]
     pub no_lines: bool,
-    /// Write the calibration even when it is doubtful (a large residual, a focal length,
-    /// principal point, distortion or height unlike a real overhead camera): without it such a
-    /// calibration is reported and not written, and the command fails.
+    /// Print the result as one JSON object (the calibration, each parameter's standard
+    /// deviation, the findings) instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the calibration even when it is doubtful (a large residual; a focal length,
+    /// principal point, distortion or height unlike a real overhead camera; clicks in one part
+    /// of the image or parameters they leave uncertain; points made for another field): without
+    /// it such a calibration is reported and not written, and the command fails.
     #[arg(long)]
     pub accept: bool,
 }
@@ -118,8 +131,9 @@ pub struct DetectArgs {
     /// `camera_ids`) and `cameras` (each merged frame's `id` and `time_ns`).
     #[arg(long)]
     pub session: Option<PathBuf>,
-    /// Field description for the ball radius and plate height; the 2005 field by default.
-    #[arg(long)]
+    /// Field description for the ball radius and plate height: a file or a shipped field's
+    /// name (as `overhead calibrate --field`); four-legged-2005 by default.
+    #[arg(long, value_name = "FIELD")]
     pub field: Option<PathBuf>,
     /// Frame size of raw files, WxH.
     #[arg(long, value_parser = parse_size)]
@@ -141,8 +155,9 @@ pub struct SimPointsArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 1, value_parser = super::values::seed())]
     pub seed: u64,
-    /// Field description; the 2005 field by default.
-    #[arg(long)]
+    /// Field description: a file or a shipped field's name (as `overhead calibrate --field`);
+    /// four-legged-2005 by default.
+    #[arg(long, value_name = "FIELD")]
     pub field: Option<PathBuf>,
     /// Output points file.
     #[arg(short, long, value_name = super::paths::OUT)]
@@ -156,7 +171,7 @@ pub struct SimPointsArgs {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     match &args.command {
         OverheadCommand::Marker(a) => run_marker(a),
-        OverheadCommand::Calibrate(a) => run_calibrate(a),
+        OverheadCommand::Calibrate(a) => super::overhead_calibrate::run(a),
         OverheadCommand::Detect(a) => run_detect(a),
         OverheadCommand::SimPoints(a) => run_sim_points(a),
         OverheadCommand::SimField(a) => super::sim_field::run(a),
@@ -164,13 +179,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 }
 
-/// The field description of `--field`, or the 2005 field.
+/// The field description `--field` names (a file or a shipped field's name), or the 2005
+/// field.
 ///
 /// # Errors
-/// The loader's error, naming the file.
+/// The loader's error naming the file, or an unknown name with the shipped names listed.
 pub fn load_field(path: Option<&Path>) -> anyhow::Result<FieldDescription> {
     Ok(match path {
-        Some(p) => FieldDescription::load(p)?,
+        Some(p) => FieldDescription::resolve(&p.to_string_lossy())?,
         None => FieldDescription::four_legged_2005(),
     })
 }
@@ -213,116 +229,6 @@ fn write_all_markers(dir: &Path) -> anyhow::Result<()> {
         }
     }
     eprintln!("{}: 32 markers (blue and yellow, 0-15)", dir.display());
-    Ok(())
-}
-
-fn run_calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
-    // The lines over the image go beside the calibration (not beside a device or FIFO).
-    let png = crate::atomic_file::beside_output(&a.output, "lines.png");
-    let field = load_field(a.field.as_deref())?;
-    let points = PointsFile::load(&a.points)?;
-    let frame = a
-        .image
-        .as_deref()
-        .map(|p| load_frame_arg(p, a.size))
-        .transpose()?;
-    if let Some(f) = &frame
-        && (f.width(), f.height()) != (points.width, points.height)
-    {
-        bail!(
-            "{}: the frame is {}x{}, the points are for {}x{}",
-            a.image
-                .as_deref()
-                .map(|p| p.display().to_string())
-                .unwrap_or_default(),
-            f.width(),
-            f.height(),
-            points.width,
-            points.height
-        );
-    }
-    let notes = check_points(&points, &field)
-        .map_err(|f| anyhow::anyhow!("{}: {f}", a.points.display()))?;
-    let params = CalibrationParams {
-        refine_lines: !a.no_lines,
-        ..CalibrationParams::default()
-    };
-    let cal = calibrate(&points, &field, frame.as_ref(), &params)
-        .with_context(|| format!("{}", a.points.display()))?;
-    print_calibration(&cal);
-    let review = review(&cal);
-    for f in notes.iter().chain(&review.findings) {
-        log::warn!("{}: {f}", a.points.display());
-    }
-    if frame.is_some() && !a.no_lines && cal.line_samples == 0 {
-        log::warn!(
-            "line refinement skipped: fewer than {MIN_LINE_SAMPLES} samples of the field lines were found in the image (is it this camera's frame?); the fit rests on the clicked points alone"
-        );
-    }
-    if review.doubtful() && !a.accept {
-        bail!(
-            "{}: not written: the calibration is doubtful ({} warnings above); check the clicks, the field description and its units, or give --accept to keep it",
-            a.output.display(),
-            review.of(Severity::Doubt).count()
-        );
-    }
-    cal.save(&a.output)?;
-    if let (Some(f), Some(png)) = (&frame, &png) {
-        write_lines_png(png, f, &field, &cal.camera)?;
-        println!("field lines over the image: {}", png.display());
-    }
-    Ok(())
-}
-
-fn print_calibration(cal: &Calibration) {
-    let c = &cal.camera;
-    let [x, y, z] = c.pose.position_cm;
-    println!(
-        "camera at ({x:.1}, {y:.1}, {z:.1}) cm, yaw {:.2}° pitch {:.2}° roll {:.2}°",
-        c.pose.yaw_rad.to_degrees(),
-        c.pose.pitch_rad.to_degrees(),
-        c.pose.roll_rad.to_degrees()
-    );
-    println!(
-        "focal {:.2} px, principal point ({:.2}, {:.2}) px, k1 {:.5}, k2 {:.5}",
-        c.focal_px, c.centre.x_px, c.centre.y_px, c.k1, c.k2
-    );
-    println!("reprojection error per point:");
-    for p in &cal.points {
-        println!(
-            "  {:<42} {:6.2} px  (clicked {:.1}, {:.1})",
-            p.name, p.error_px, p.image_px[0], p.image_px[1]
-        );
-    }
-    println!(
-        "median {:.3} px over {} points",
-        cal.median_point_error_px(),
-        cal.points.len()
-    );
-    if let Some(rms) = cal.line_rms_px {
-        println!(
-            "line refinement: {} samples, rms {rms:.3} px",
-            cal.line_samples
-        );
-    }
-}
-
-/// The frame with the field lines projected through `camera` drawn over it, as a PNG.
-fn write_lines_png(
-    path: &Path,
-    frame: &crate::frame::Frame,
-    field: &FieldDescription,
-    camera: &OverheadCamera,
-) -> anyhow::Result<()> {
-    let mut canvas =
-        crate::overlay::Canvas::from_rgb(frame.width(), frame.height(), &frame.to_rgb(), 1)
-            .context("frame size")?;
-    for curve in projected_field_lines(field, camera) {
-        for pair in curve.windows(2) {
-            canvas.line(pair[0], pair[1], [255, 40, 200]);
-        }
-    }
-    crate::frame::save_rgb_png(path, canvas.width, canvas.height, &canvas.rgb)?;
     Ok(())
 }
 

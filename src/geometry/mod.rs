@@ -25,6 +25,7 @@
 pub mod camera;
 pub mod horizon;
 pub mod kinematics;
+pub mod lens;
 pub mod marker;
 pub mod overhead;
 
@@ -39,6 +40,7 @@ pub use horizon::Horizon;
 pub use kinematics::{
     BodyPose, Ers7Dimensions, HeadJoints, RobotPose, camera_pose_from_readings, write_camera_pose,
 };
+pub use lens::{LensError, LensModel};
 pub use marker::{MarkerIdentity, MarkerTeam, RobotMarker};
 pub use overhead::OverheadCamera;
 

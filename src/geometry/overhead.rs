@@ -7,11 +7,15 @@
 //! `(u, v)·(1 + k1·r² + k2·r⁴)`, and the pixel is `centre + focal·(u_d, v_d)`. Barrel
 //! distortion has `k1 < 0`. Going back (image → ray) solves the radial polynomial by Newton's
 //! method, which converges in a handful of steps wherever the mapping is monotonic.
+//!
+//! A camera whose intrinsics come from a checkerboard (ROS `camera_info`) carries its
+//! [`LensModel`] instead of k1/k2 and may have a vertical focal length of its own (`fy`).
 
 use nalgebra::{Matrix3, Point3, Rotation3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::camera::ImagePoint;
+use super::lens::LensModel;
 use super::{Camera, Field, Point, PoseRecord, Transform, Vector};
 
 /// A distorted overhead camera and its pose above the field.
@@ -31,6 +35,14 @@ pub struct OverheadCamera {
     pub k2: f64,
     /// The camera's pose in the field (position in cm, yaw/pitch/roll in radians).
     pub pose: PoseRecord,
+    /// The vertical focal length when it differs from `focal_px` (a checkerboard calibration's
+    /// `fy`), pixels; `None`: square pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub focal_y_px: Option<f64>,
+    /// A checkerboard-calibrated lens (ROS's `distortion_model`) in place of `k1`/`k2` (which
+    /// are then 0 and unused); `None`: the radial k1/k2 model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lens: Option<LensModel>,
 }
 
 impl OverheadCamera {
@@ -72,6 +84,25 @@ impl OverheadCamera {
             k1,
             k2,
             pose: PoseRecord::from_transform(&t),
+            focal_y_px: None,
+            lens: None,
+        }
+    }
+
+    /// The same camera for a frame of `width`×`height` pixels (the same view resampled): focal
+    /// lengths and principal point scaled with the frame (pixel edges at whole numbers, so a
+    /// pure scale; square pixels stay square), the lens unchanged (it works in normalised coordinates).
+    #[must_use]
+    pub fn scaled_to(&self, width: usize, height: usize) -> Self {
+        let sx = width as f64 / self.width_px.max(1) as f64;
+        let sy = height as f64 / self.height_px.max(1) as f64;
+        Self {
+            width_px: width,
+            height_px: height,
+            focal_px: self.focal_px * sx,
+            focal_y_px: self.focal_y_px.map(|f| f * sy),
+            centre: ImagePoint::new(self.centre.x_px * sx, self.centre.y_px * sy),
+            ..*self
         }
     }
 
@@ -81,9 +112,18 @@ impl OverheadCamera {
         self.pose.to_transform()
     }
 
+    /// The vertical focal length, pixels (`focal_px` unless the intrinsics give another).
+    #[must_use]
+    pub fn focal_y(&self) -> f64 {
+        self.focal_y_px.unwrap_or(self.focal_px)
+    }
+
     /// Applies the lens: undistorted normalised coordinates → distorted ones.
     #[must_use]
     pub fn distort(&self, u: f64, v: f64) -> (f64, f64) {
+        if let Some(lens) = &self.lens {
+            return lens.distort(u, v);
+        }
         let r2 = u * u + v * v;
         let f = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
         (u * f, v * f)
@@ -94,6 +134,9 @@ impl OverheadCamera {
     /// converge.
     #[must_use]
     pub fn undistort(&self, ud: f64, vd: f64) -> Option<(f64, f64)> {
+        if let Some(lens) = &self.lens {
+            return lens.undistort(ud, vd).ok();
+        }
         let rd = ud.hypot(vd);
         if !rd.is_finite() {
             return None;
@@ -135,7 +178,7 @@ impl OverheadCamera {
         let (ud, vd) = self.distort(-c.y() / c.x(), -c.z() / c.x());
         Some(ImagePoint::new(
             self.centre.x_px + self.focal_px * ud,
-            self.centre.y_px + self.focal_px * vd,
+            self.centre.y_px + self.focal_y() * vd,
         ))
     }
 
@@ -144,7 +187,7 @@ impl OverheadCamera {
     pub fn camera_ray(&self, p: ImagePoint) -> Option<Vector<Camera>> {
         let (u, v) = self.undistort(
             (p.x_px - self.centre.x_px) / self.focal_px,
-            (p.y_px - self.centre.y_px) / self.focal_px,
+            (p.y_px - self.centre.y_px) / self.focal_y(),
         )?;
         Vector::new(1.0, -u, -v).normalized()
     }

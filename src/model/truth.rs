@@ -27,7 +27,7 @@ pub enum GroundTruth {
     /// A frame from a robot's head camera.
     Robot(Box<RobotViewTruth>),
     /// A frame from the overhead camera.
-    Overhead(OverheadTruth),
+    Overhead(Box<OverheadTruth>),
 }
 
 /// Truth of a robot-camera frame.

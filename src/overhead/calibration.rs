@@ -17,23 +17,35 @@
 //! first, then all eleven parameters, with weak priors holding the principal point near the
 //! image centre and k1, k2 near 0 where the clicks alone cannot place them (a half field seen
 //! by a wide lens: the real SSL 2008 frame ran off to a folded lens without them).
+//!
+//! With a checkerboard's intrinsics ([`super::intrinsics`]: focal lengths, principal point and
+//! a plumb_bob, rational_polynomial or equidistant lens) only the six pose parameters are
+//! solved, from the pose of the homography between the field plane and the undistorted clicks
+//! ([`start`]). Either way the fit's covariance at the solution gives each parameter's standard
+//! deviation ([`Uncertainty`]), which [`super::review`] holds against its limits.
 
 use std::path::Path;
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
-use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::field::FieldDescription;
+use super::intrinsics::{Intrinsics, IntrinsicsError};
 use super::lines::{LineObservation, find_line_observations};
 use super::points::PointsFile;
 use super::review::{Finding, check_points, review};
 use crate::atomic_file::write_atomic;
 use crate::frame::Frame;
-use crate::geometry::{Camera, Field, ImagePoint, OverheadCamera, Point, PoseRecord, Transform};
+use crate::geometry::{Field, ImagePoint, OverheadCamera, Point};
 use crate::stats::median;
+
+mod solver;
+mod start;
+mod uncertainty;
+
+use solver::{Free, MIN_CONDITIONING, conditioning, covariance, solve};
+use start::{camera_from_homography, starting_camera};
+pub use uncertainty::{CLICK_SD_FLOOR_PX, Uncertainty};
 
 /// Settings of the calibration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -83,6 +95,9 @@ pub enum CalibrationError {
     /// The ground points all lie on one line (or on one spot): no start can be made.
     #[error("the ground points lie on a line: click landmarks spread over the field")]
     Degenerate,
+    /// The intrinsics are for another frame size.
+    #[error(transparent)]
+    Intrinsics(#[from] IntrinsicsError),
     /// The solver ended without a usable camera.
     #[error("the solver found no camera that fits ({reason})")]
     NoFit {
@@ -126,6 +141,14 @@ pub struct Calibration {
     pub line_samples: usize,
     /// Root-mean-square distance of those samples from their projected lines, pixels.
     pub line_rms_px: Option<f64>,
+    /// Each fitted parameter's standard deviation (absent in calibrations written before it
+    /// was computed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<Uncertainty>,
+    /// The intrinsics the lens came from (their `camera_name` or file), when only the pose was
+    /// fitted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub intrinsics: Option<String>,
 }
 
 /// The file format's tag, so that other JSON is refused clearly.
@@ -161,6 +184,9 @@ impl Calibration {
         ]
         .into_iter()
         .chain(c.pose.position_cm)
+        .chain(c.focal_y_px)
+        .chain(c.lens.iter().flat_map(|l| l.coefficients()))
+        .chain(self.uncertainty.iter().flat_map(Uncertainty::values))
         .chain(self.line_rms_px)
         .chain(self.points.iter().flat_map(|p| {
             p.image_px
@@ -229,7 +255,7 @@ impl Calibration {
         let known = serde_json::to_value(&file).map_err(|e| e.to_string())?;
         if let Some(key) = crate::input_file::unknown_keys(&given, &known).first() {
             return Err(format!(
-                "unknown key '{key}' (an overhead calibration has format, camera, field, points, line_samples, line_rms_px)"
+                "unknown key '{key}' (an overhead calibration has format, camera, field, points, line_samples, line_rms_px, uncertainty, intrinsics)"
             ));
         }
         let cal = file.calibration;
@@ -246,7 +272,8 @@ impl Calibration {
 }
 
 /// Calibrates an overhead camera from a points file, refined along the lines of `image` when
-/// one is given.
+/// one is given: pose, focal length, principal point and k1/k2 ([`calibrate_with`] without
+/// intrinsics).
 ///
 /// # Errors
 /// [`CalibrationError`] when there are too few or degenerate points or the solver fails.
@@ -255,6 +282,23 @@ pub fn calibrate(
     field: &FieldDescription,
     image: Option<&Frame>,
     params: &CalibrationParams,
+) -> Result<Calibration, CalibrationError> {
+    calibrate_with(points, field, image, params, None)
+}
+
+/// Calibrates an overhead camera; with a checkerboard's `intrinsics` (scaled to the points'
+/// frame size when it is a whole factor of theirs) only the pose is fitted. The result carries
+/// each fitted parameter's standard deviation ([`Uncertainty`]).
+///
+/// # Errors
+/// [`CalibrationError`] when there are too few points for the parameters, degenerate points,
+/// intrinsics for another frame size, or the solver fails.
+pub fn calibrate_with(
+    points: &PointsFile,
+    field: &FieldDescription,
+    image: Option<&Frame>,
+    params: &CalibrationParams,
+    intrinsics: Option<&Intrinsics>,
 ) -> Result<Calibration, CalibrationError> {
     let targets: Vec<Target> = points
         .points
@@ -265,7 +309,102 @@ pub fn calibrate(
         })
         .collect();
     check_points(points, field)?;
-    let start = starting_camera(points.width, points.height, &targets, field)?;
+    let free = if intrinsics.is_some() {
+        Free::Pose
+    } else {
+        Free::All
+    };
+    let needed = min_points_for(free);
+    if points.points.len() < needed {
+        return Err(Finding::TooFewForParameters {
+            count: points.points.len(),
+            needed,
+            parameters: free.indices().len(),
+        }
+        .into());
+    }
+    let intrinsics = intrinsics
+        .map(|i| i.for_frame(points.width, points.height))
+        .transpose()?;
+    let (mut camera, prior) = match &intrinsics {
+        None => first_fit(points, &targets, field, params)?,
+        Some(i) => {
+            let start = match camera_from_homography(i, &targets) {
+                Some(c) => c,
+                None => i.applied_to(starting_camera(
+                    points.width,
+                    points.height,
+                    &targets,
+                    field,
+                )?),
+            };
+            let prior = Priors::none();
+            (solve(start, &targets, &[], prior, free)?, prior)
+        }
+    };
+    let mut lines: Vec<LineObservation> = Vec::new();
+    if let (Some(frame), true) = (image, params.refine_lines) {
+        (camera, lines) = refine_along_lines(frame, field, params, camera, &targets, prior, free)?;
+    }
+    let residuals = point_residuals(points, &targets, &camera);
+    let line_rms_px = (!lines.is_empty()).then(|| {
+        let s: f64 = lines.iter().map(|l| l.distance_px(&camera).powi(2)).sum();
+        (s / lines.len() as f64).sqrt()
+    });
+    let conditioning = conditioning(camera, &targets, &lines, prior, free);
+    if conditioning.is_nan() || conditioning < MIN_CONDITIONING {
+        return Err(Finding::NotDetermined { conditioning }.into());
+    }
+    let uncertainty = covariance(camera, &targets, &lines, prior, free, CLICK_SD_FLOOR_PX)
+        .map(|(cov, sigma)| Uncertainty::from_covariance(&cov, sigma, free))
+        .ok_or(Finding::NotDetermined { conditioning: 0.0 })?;
+    let cal = Calibration {
+        camera,
+        field: field.name.clone(),
+        points: residuals,
+        line_samples: lines.len(),
+        line_rms_px,
+        uncertainty: Some(uncertainty),
+        intrinsics: intrinsics.map(|i| i.camera_name.clone()),
+    };
+    if let Some(refusal) = review(&cal).refusal() {
+        return Err(refusal.clone().into());
+    }
+    Ok(cal)
+}
+
+/// Fewest points for a fit of these parameters: two residuals each, at least five more
+/// residuals than parameters (so that the residuals say how well the parameters fit), and at
+/// least [`super::review::MIN_POINTS`].
+#[must_use]
+fn min_points_for(free: Free) -> usize {
+    (free.indices().len() + 5)
+        .div_ceil(2)
+        .max(super::review::MIN_POINTS)
+}
+
+/// Fewest points a calibration without intrinsics needs (pose, focal length, principal point,
+/// k1, k2), and with them (the pose).
+#[must_use]
+pub fn min_points(with_intrinsics: bool) -> usize {
+    min_points_for(if with_intrinsics {
+        Free::Pose
+    } else {
+        Free::All
+    })
+}
+
+/// The fit without intrinsics: a straight-down start, a pinhole with its principal point at
+/// the image centre (pose and focal length only), then everything from there — eleven free
+/// parameters from a straight-down start can run off to a folded lens on clicks over half a
+/// field.
+fn first_fit(
+    points: &PointsFile,
+    targets: &[Target],
+    field: &FieldDescription,
+    params: &CalibrationParams,
+) -> Result<(OverheadCamera, Priors), CalibrationError> {
+    let start = starting_camera(points.width, points.height, targets, field)?;
     let prior = Priors {
         height_cm: field.camera_height_guess_cm,
         height_sd_cm: params.height_prior_fraction * field.camera_height_guess_cm,
@@ -273,43 +412,60 @@ pub fn calibrate(
         centre_sd_px: params.principal_point_prior_fraction * points.width as f64,
         distortion_sd: params.distortion_prior_sd,
     };
-    // First a pinhole with its principal point at the image centre (pose and focal length
-    // only), then everything from there: eleven free parameters from a straight-down start can
-    // run off to a folded lens on clicks over half a field.
     let pinhole = Priors {
         centre_sd_px: 1e-3,
         distortion_sd: 1e-6,
         ..prior
     };
-    let camera = solve(start, &targets, &[], pinhole)?;
-    let mut camera = solve(camera, &targets, &[], prior)?;
-    let mut lines: Vec<LineObservation> = Vec::new();
-    if let (Some(frame), true) = (image, params.refine_lines) {
-        let samples = field.line_samples(params.line_step_cm);
-        let margin = (5.0 * field.line_width_cm).max(10.0);
-        let samples = super::lines::away_from_crossings(field, &samples, margin);
-        let mut refined = false;
-        for _ in 0..params.line_rounds {
-            let found = find_line_observations(frame, &camera, &samples, params.line_search_px);
-            lines = reject_outliers(&camera, found);
-            if lines.len() < MIN_LINE_SAMPLES {
-                break;
-            }
-            camera = solve(camera, &targets, &lines, prior)?;
-            refined = true;
+    let camera = solve(start, targets, &[], pinhole, Free::All)?;
+    Ok((solve(camera, targets, &[], prior, Free::All)?, prior))
+}
+
+/// Rounds of "find the lines near where the camera puts them, solve again"; the line samples
+/// of the last solve (none when too few were found to refine).
+fn refine_along_lines(
+    frame: &Frame,
+    field: &FieldDescription,
+    params: &CalibrationParams,
+    mut camera: OverheadCamera,
+    targets: &[Target],
+    prior: Priors,
+    free: Free,
+) -> Result<(OverheadCamera, Vec<LineObservation>), CalibrationError> {
+    let samples = field.line_samples(params.line_step_cm);
+    let margin = (5.0 * field.line_width_cm).max(10.0);
+    let samples = super::lines::away_from_crossings(field, &samples, margin);
+    let mut refined = false;
+    let mut lines = Vec::new();
+    for _ in 0..params.line_rounds {
+        let found = find_line_observations(frame, &camera, &samples, params.line_search_px);
+        lines = reject_outliers(&camera, found);
+        if lines.len() < MIN_LINE_SAMPLES {
+            break;
         }
-        // Samples that never took part in a solve say nothing about the fit: without a
-        // refinement there are none ([`Calibration::line_samples`] 0 says it was skipped).
-        lines = if refined {
-            reject_outliers(&camera, lines)
-        } else {
-            Vec::new()
-        };
+        camera = solve(camera, targets, &lines, prior, free)?;
+        refined = true;
     }
-    let residuals = points
+    // Samples that never took part in a solve say nothing about the fit: without a
+    // refinement there are none ([`Calibration::line_samples`] 0 says it was skipped).
+    let lines = if refined {
+        reject_outliers(&camera, lines)
+    } else {
+        Vec::new()
+    };
+    Ok((camera, lines))
+}
+
+/// Each clicked point's reprojection through `camera`.
+fn point_residuals(
+    points: &PointsFile,
+    targets: &[Target],
+    camera: &OverheadCamera,
+) -> Vec<PointResidual> {
+    points
         .points
         .iter()
-        .zip(&targets)
+        .zip(targets)
         .map(|(p, t)| {
             let projected = camera
                 .image_from_field(&t.field)
@@ -321,60 +477,7 @@ pub fn calibrate(
                 error_px: projected.distance_to(&t.image),
             }
         })
-        .collect();
-    let line_rms_px = (!lines.is_empty()).then(|| {
-        let s: f64 = lines.iter().map(|l| l.distance_px(&camera).powi(2)).sum();
-        (s / lines.len() as f64).sqrt()
-    });
-    let conditioning = conditioning(camera, &targets, &lines, prior);
-    if conditioning.is_nan() || conditioning < MIN_CONDITIONING {
-        return Err(Finding::NotDetermined { conditioning }.into());
-    }
-    let cal = Calibration {
-        camera,
-        field: field.name.clone(),
-        points: residuals,
-        line_samples: lines.len(),
-        line_rms_px,
-    };
-    if let Some(refusal) = review(&cal).refusal() {
-        return Err(refusal.clone().into());
-    }
-    Ok(cal)
-}
-
-/// Below this, [`conditioning`] says the fit leaves some parameter free.
-const MIN_CONDITIONING: f64 = 1e-9;
-
-/// How well the residuals pin every parameter down at `camera`: the smallest over the largest
-/// singular value of the Jacobian with each parameter's column scaled to unit length (0 when a
-/// parameter, or a combination of them, changes nothing).
-fn conditioning(
-    camera: OverheadCamera,
-    targets: &[Target],
-    lines: &[LineObservation],
-    prior: Priors,
-) -> f64 {
-    let problem = Problem {
-        base: camera,
-        base_rotation: camera.field_from_camera().rotation(),
-        targets,
-        lines,
-        prior,
-        params: params_of(&camera),
-    };
-    let Some(mut j) = problem.jacobian() else {
-        return 0.0;
-    };
-    for mut column in j.column_iter_mut() {
-        let norm = column.norm();
-        if norm > 0.0 {
-            column /= norm;
-        }
-    }
-    let s = j.singular_values();
-    let (lo, hi) = (s.min(), s.max());
-    if hi > 0.0 { lo / hi } else { 0.0 }
+        .collect()
 }
 
 /// Fewest line samples found along the projected lines for the lines to refine the fit.
@@ -412,243 +515,17 @@ struct Priors {
     distortion_sd: f64,
 }
 
-/// A camera looking straight down from the similarity that best maps the ground points to the
-/// image: `w = a·z + b` in complex numbers, field `z = x + iy`, image `w = u − iv` (image y
-/// points down, so the image is the field seen in a mirror).
-fn starting_camera(
-    width: usize,
-    height: usize,
-    targets: &[Target],
-    field: &FieldDescription,
-) -> Result<OverheadCamera, CalibrationError> {
-    let ground: Vec<&Target> = targets.iter().filter(|t| t.field.z() == 0.0).collect();
-    let n = ground.len() as f64;
-    let (zx, zy) = ground.iter().fold((0.0, 0.0), |(a, b), t| {
-        (a + t.field.x() / n, b + t.field.y() / n)
-    });
-    let (wx, wy) = ground.iter().fold((0.0, 0.0), |(a, b), t| {
-        (a + t.image.x_px / n, b - t.image.y_px / n)
-    });
-    // a = Σ conj(z − z̄)(w − w̄) / Σ |z − z̄|².
-    let (mut re, mut im, mut norm) = (0.0, 0.0, 0.0);
-    for t in &ground {
-        let (dx, dy) = (t.field.x() - zx, t.field.y() - zy);
-        let (du, dv) = (t.image.x_px - wx, -t.image.y_px - wy);
-        re += dx * du + dy * dv;
-        im += dx * dv - dy * du;
-        norm += dx * dx + dy * dy;
-    }
-    let scale = re.hypot(im) / norm.max(f64::MIN_POSITIVE);
-    if norm < 1.0 || !scale.is_finite() || scale <= 0.0 {
-        return Err(CalibrationError::Degenerate);
-    }
-    let theta = im.atan2(re);
-    let (ar, ai) = (scale * theta.cos(), scale * theta.sin());
-    // The field point under the image centre: z0 = (w_c − b)/a with b = w̄ − a·z̄.
-    let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
-    let (br, bi) = (wx - (ar * zx - ai * zy), wy - (ar * zy + ai * zx));
-    let (nr, ni) = (cx - br, -cy - bi);
-    let d = ar * ar + ai * ai;
-    let (x0, y0) = ((nr * ar + ni * ai) / d, (ni * ar - nr * ai) / d);
-    let h = field.camera_height_guess_cm;
-    // Camera axes in the field: optical axis down; image right is e^{−iθ}, image up i·e^{−iθ}.
-    let (s, c) = theta.sin_cos();
-    let m = Matrix3::from_columns(&[
-        Vector3::new(0.0, 0.0, -1.0),
-        Vector3::new(-c, s, 0.0),
-        Vector3::new(s, c, 0.0),
-    ]);
-    let rotation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
-    let t: Transform<Field, Camera> = Transform::new(Vector3::new(x0, y0, h), rotation);
-    Ok(OverheadCamera {
-        width_px: width,
-        height_px: height,
-        focal_px: scale * h,
-        centre: ImagePoint::new(cx, cy),
-        k1: 0.0,
-        k2: 0.0,
-        pose: PoseRecord::from_transform(&t),
-    })
-}
-
-/// Number of camera parameters.
-const PARAMS: usize = 11;
-
-/// The least-squares problem: parameters `[x, y, z, ωx, ωy, ωz, f, cx, cy, k1, k2]` with the
-/// rotation `exp(ω)·R0`.
-struct Problem<'a> {
-    base: OverheadCamera,
-    base_rotation: UnitQuaternion<f64>,
-    targets: &'a [Target],
-    lines: &'a [LineObservation],
-    prior: Priors,
-    params: [f64; PARAMS],
-}
-
-/// Residual of a point the camera cannot see, pixels: large, so the solver moves away, but
-/// finite, so it keeps going.
-const UNSEEN_PX: f64 = 1000.0;
-
-impl Problem<'_> {
-    /// The camera of a parameter vector, and its `field_from_camera` built directly (the
-    /// camera's pose record goes through Euler angles, which lose digits near straight down).
-    fn model(&self, p: &[f64; PARAMS]) -> (OverheadCamera, Transform<Field, Camera>) {
-        let rotation =
-            UnitQuaternion::from_scaled_axis(Vector3::new(p[3], p[4], p[5])) * self.base_rotation;
-        let t: Transform<Field, Camera> = Transform::new(Vector3::new(p[0], p[1], p[2]), rotation);
-        let camera = OverheadCamera {
-            focal_px: p[6],
-            centre: ImagePoint::new(p[7], p[8]),
-            k1: p[9],
-            k2: p[10],
-            pose: PoseRecord::from_transform(&t),
-            ..self.base
-        };
-        (camera, t)
-    }
-
-    fn camera(&self, p: &[f64; PARAMS]) -> OverheadCamera {
-        self.model(p).0
-    }
-
-    fn residuals_at(&self, p: &[f64; PARAMS]) -> Vec<f64> {
-        let len = 2 * self.targets.len() + self.lines.len() + 5;
-        let (camera, field_from_camera) = self.model(p);
-        let camera_from_field = field_from_camera.inverse();
-        let mut r = Vec::with_capacity(len);
-        for t in self.targets {
-            match camera.image_from_camera(&(camera_from_field * t.field)) {
-                Some(q) => {
-                    r.push(q.x_px - t.image.x_px);
-                    r.push(q.y_px - t.image.y_px);
-                }
-                None => r.extend([UNSEEN_PX, UNSEEN_PX]),
-            }
-        }
-        for l in self.lines {
-            let d = l.distance_px_with(&camera, &camera_from_field);
-            r.push(if d.is_finite() { d } else { UNSEEN_PX });
-        }
-        // The priors in pixel-like units: one "pixel" per standard deviation.
-        let q = &self.prior;
-        r.push((p[2] - q.height_cm) / q.height_sd_cm.max(1e-6));
-        r.push((p[7] - q.centre.x_px) / q.centre_sd_px.max(1e-9));
-        r.push((p[8] - q.centre.y_px) / q.centre_sd_px.max(1e-9));
-        r.push(p[9] / q.distortion_sd.max(1e-12));
-        r.push(p[10] / q.distortion_sd.max(1e-12));
-        r
-    }
-}
-
-fn params_of(camera: &OverheadCamera) -> [f64; PARAMS] {
-    let o = camera.pose.position_cm;
-    [
-        o[0],
-        o[1],
-        o[2],
-        0.0,
-        0.0,
-        0.0,
-        camera.focal_px,
-        camera.centre.x_px,
-        camera.centre.y_px,
-        camera.k1,
-        camera.k2,
-    ]
-}
-
-/// Finite-difference steps per parameter: small against each one's scale.
-const STEPS: [f64; PARAMS] = [
-    1e-3, 1e-3, 1e-3, 1e-6, 1e-6, 1e-6, 1e-3, 1e-3, 1e-3, 1e-6, 1e-6,
-];
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        for (p, v) in self.params.iter_mut().zip(x.iter()) {
-            *p = *v;
+impl Priors {
+    /// No priors (every residual 0): the pose fit with known intrinsics.
+    const fn none() -> Self {
+        Self {
+            height_cm: 0.0,
+            height_sd_cm: f64::INFINITY,
+            centre: ImagePoint::new(0.0, 0.0),
+            centre_sd_px: f64::INFINITY,
+            distortion_sd: f64::INFINITY,
         }
     }
-
-    fn params(&self) -> DVector<f64> {
-        DVector::from_column_slice(&self.params)
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let r = self.residuals_at(&self.params);
-        r.iter()
-            .all(|v| v.is_finite())
-            .then(|| DVector::from_vec(r))
-    }
-
-    /// Central differences: the projection through the lens has no tidy closed-form
-    /// derivative, and eleven parameters make this cheap.
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let rows = self.residuals_at(&self.params).len();
-        let mut j = DMatrix::zeros(rows, PARAMS);
-        for k in 0..PARAMS {
-            let (mut hi, mut lo) = (self.params, self.params);
-            hi[k] += STEPS[k];
-            lo[k] -= STEPS[k];
-            let (a, b) = (self.residuals_at(&hi), self.residuals_at(&lo));
-            for (row, (x, y)) in a.iter().zip(&b).enumerate() {
-                j[(row, k)] = (x - y) / (2.0 * STEPS[k]);
-            }
-        }
-        j.iter().all(|v| v.is_finite()).then_some(j)
-    }
-}
-
-/// The same camera with a positive focal length: a negative one (which the solver can step
-/// into, as it did on the real SSL 2008 frame) turns the image half round about the principal
-/// point, which is the camera turned half round about its optical axis. The radial lens
-/// model is the same either way, so every projection is unchanged.
-fn with_positive_focal(camera: OverheadCamera) -> OverheadCamera {
-    if camera.focal_px >= 0.0 {
-        return camera;
-    }
-    let t = camera.field_from_camera();
-    let half_turn = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI);
-    let turned: Transform<Field, Camera> =
-        Transform::new(t.origin().coords.coords, t.rotation() * half_turn);
-    OverheadCamera {
-        focal_px: -camera.focal_px,
-        pose: PoseRecord::from_transform(&turned),
-        ..camera
-    }
-}
-
-fn solve(
-    start: OverheadCamera,
-    targets: &[Target],
-    lines: &[LineObservation],
-    prior: Priors,
-) -> Result<OverheadCamera, CalibrationError> {
-    let problem = Problem {
-        base: start,
-        base_rotation: start.field_from_camera().rotation(),
-        targets,
-        lines,
-        prior,
-        params: params_of(&start),
-    };
-    let (problem, report) = LevenbergMarquardt::new()
-        .with_patience(200)
-        .minimize(problem);
-    let camera = with_positive_focal(problem.camera(&problem.params));
-    let finite = problem.params.iter().all(|v| v.is_finite());
-    if !finite || !report.objective_function.is_finite() || camera.focal_px <= 0.0 {
-        return Err(CalibrationError::NoFit {
-            reason: format!(
-                "{:?}, focal {:.1} px, objective {:.3e}",
-                report.termination, camera.focal_px, report.objective_function
-            ),
-        });
-    }
-    Ok(camera)
 }
 
 #[cfg(test)]

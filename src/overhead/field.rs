@@ -2,8 +2,11 @@
 //! painted lines the calibration is refined along, and the heights overhead recognition needs.
 //!
 //! A description is a small JSON file (`params/fields/*.json`): one for our 2005 Four-Legged
-//! League field (the simulator's, [`FieldDescription::four_legged_2005`]) and one for the Small
-//! Size League field of 2008 (the real overhead frame of `../shared/data/ssl2008/`). Field
+//! League field (the simulator's, [`FieldDescription::four_legged_2005`]), one for the Small
+//! Size League field of 2008 (the real overhead frame of `../shared/data/ssl2008/`), and today's
+//! fields: the Standard Platform League's of 2020 (`spl-2020`) and the Small Size League's
+//! divisions A and B (`ssl-div-a`, `ssl-div-b`). These are built in ([`SHIPPED_FIELDS`]):
+//! `--field` takes a shipped field's name or a file ([`FieldDescription::resolve`]). Field
 //! coordinates follow `FORMATS.md`: centimetres, origin at the centre spot, x towards the yellow
 //! goal, y left. Lines are given along their painted centres.
 //!
@@ -29,6 +32,37 @@ pub const MAX_FIELD_ITEMS: usize = 1000;
 pub const MAX_LINE_SAMPLES: usize = 20_000;
 /// Largest size (line width, ball radius) a description may give, centimetres.
 const MAX_SIZE_CM: f64 = 100.0;
+
+/// The field descriptions shipped with eotn (`params/fields/NAME.json`, built in), by the name
+/// `--field` takes.
+pub const SHIPPED_FIELDS: [(&str, &str); 5] = [
+    (
+        "four-legged-2005",
+        include_str!("../../params/fields/four-legged-2005.json"),
+    ),
+    (
+        "ssl-2008",
+        include_str!("../../params/fields/ssl-2008.json"),
+    ),
+    (
+        "spl-2020",
+        include_str!("../../params/fields/spl-2020.json"),
+    ),
+    (
+        "ssl-div-a",
+        include_str!("../../params/fields/ssl-div-a.json"),
+    ),
+    (
+        "ssl-div-b",
+        include_str!("../../params/fields/ssl-div-b.json"),
+    ),
+];
+
+/// The shipped fields' names, comma-separated (for messages and help).
+#[must_use]
+pub fn shipped_field_names() -> String {
+    SHIPPED_FIELDS.map(|(name, _)| name).join(", ")
+}
 
 /// A named point of the field that a user can click.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -110,6 +144,7 @@ impl FieldError {
             Self::Io { source, .. } => Self::Io { path, source },
             Self::Parse { source, .. } => Self::Parse { path, source },
             Self::Invalid { problem, .. } => Self::Invalid { path, problem },
+            unknown @ Self::Unknown { .. } => unknown,
         }
     }
 }
@@ -132,6 +167,15 @@ pub enum FieldError {
         path: String,
         /// The error.
         source: serde_json::Error,
+    },
+    /// Neither a shipped field's name nor a file.
+    #[error(
+        "no field {name:?}: give a field description file or one of the shipped fields ({})",
+        shipped_field_names()
+    )]
+    Unknown {
+        /// What was given.
+        name: String,
     },
     /// JSON of the right shape with a value out of range.
     #[error("{path}: {problem}")]
@@ -478,6 +522,28 @@ impl FieldDescription {
         }
     }
 
+    /// The field a `--field` argument names: a shipped field by its name ([`SHIPPED_FIELDS`]),
+    /// else a description file.
+    ///
+    /// # Errors
+    /// [`FieldError::Unknown`] for a name that is neither shipped nor a file path (the shipped
+    /// names listed), or the loader's error for a file.
+    pub fn resolve(arg: &str) -> Result<Self, FieldError> {
+        if let Some((_, text)) = SHIPPED_FIELDS.iter().find(|(name, _)| *name == arg) {
+            return Self::from_json(text).map_err(|e| e.at(&format!("shipped field {arg}")));
+        }
+        let path = Path::new(arg);
+        let looks_like_a_path = arg.contains(std::path::MAIN_SEPARATOR)
+            || arg.contains('/')
+            || path.extension().is_some();
+        if !looks_like_a_path && !path.exists() {
+            return Err(FieldError::Unknown {
+                name: arg.to_owned(),
+            });
+        }
+        Self::load(path)
+    }
+
     /// Our field: the 2005 Four-Legged League field the simulator renders.
     #[must_use]
     pub fn four_legged_2005() -> Self {
@@ -516,6 +582,63 @@ mod tests {
             Path::new(env!("CARGO_MANIFEST_DIR")).join("params/fields/four-legged-2005.json");
         let shipped = FieldDescription::load(&path).expect("shipped description loads");
         assert_eq!(shipped, FieldDescription::four_legged_2005());
+    }
+
+    #[test]
+    fn every_shipped_field_resolves_by_name_and_by_path_alike() {
+        for (name, _) in SHIPPED_FIELDS {
+            let by_name = FieldDescription::resolve(name).expect("shipped");
+            let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("params/fields")
+                .join(format!("{name}.json"));
+            let by_path = FieldDescription::resolve(&path.display().to_string()).expect("the file");
+            assert_eq!(by_name, by_path, "{name}");
+            assert!(by_name.landmark("centre").is_some(), "{name}");
+        }
+        let err = FieldDescription::resolve("spl-2021").expect_err("unknown");
+        let text = err.to_string();
+        assert!(
+            text.contains("\"spl-2021\"") && text.contains("spl-2020, ssl-div-a, ssl-div-b"),
+            "{text}"
+        );
+        // A path that does not exist is the loader's error, naming the file.
+        let err = FieldDescription::resolve("no/such/field.json").expect_err("missing");
+        assert!(err.to_string().contains("no/such/field.json"), "{err}");
+    }
+
+    #[test]
+    fn todays_fields_have_the_rule_books_dimensions() {
+        let spl = FieldDescription::resolve("spl-2020").expect("shipped");
+        let at = |f: &FieldDescription, n: &str| f.landmark(n).map(|l| l.field_cm);
+        // SPL 2020: 9 × 6 m, centre circle 1.5 m across, penalty mark 1.3 m from the goal
+        // line, penalty area 1.65 × 4 m, goal area 0.6 × 2.2 m, goal 1.5 m wide inside.
+        assert_eq!(at(&spl, "+x left corner"), Some([450.0, 300.0]));
+        assert_eq!(at(&spl, "centre circle left"), Some([0.0, 75.0]));
+        assert_eq!(at(&spl, "+x penalty mark"), Some([320.0, 0.0]));
+        assert_eq!(
+            at(&spl, "-x penalty area left front corner"),
+            Some([-285.0, -200.0])
+        );
+        assert_eq!(
+            at(&spl, "+x goal area right front corner"),
+            Some([390.0, -110.0])
+        );
+        let post = at(&spl, "+x goal left post foot").expect("post");
+        // Post centres 5 cm (half a 10 cm post) outside the 1.5 m inner width.
+        assert_eq!(post[1], 80.0);
+        for (name, length, width, defense) in [
+            ("ssl-div-a", 1200.0, 900.0, [480.0, 120.0]),
+            ("ssl-div-b", 900.0, 600.0, [350.0, 100.0]),
+        ] {
+            let f = FieldDescription::resolve(name).expect("shipped");
+            assert_eq!(
+                at(&f, "+x left corner"),
+                Some([length / 2.0, width / 2.0]),
+                "{name}"
+            );
+            assert_eq!(at(&f, "+x defense area left front corner"), Some(defense));
+            assert_eq!(at(&f, "centre circle left"), Some([0.0, 50.0]));
+        }
     }
 
     #[test]

@@ -18,6 +18,7 @@
 pub mod calibration;
 pub mod drawing;
 pub mod field;
+pub mod intrinsics;
 pub mod lines;
 pub mod merge;
 pub mod pipeline;

@@ -148,16 +148,7 @@ impl OverheadPipeline {
         match frame_fit(&self.camera, w, h) {
             FrameFit::Same => Some(self.camera),
             FrameFit::Mismatch { .. } => None,
-            FrameFit::Scaled { .. } => {
-                let s = w as f64 / self.camera.width_px.max(1) as f64;
-                let mut c = self.camera;
-                c.width_px = w;
-                c.height_px = h;
-                c.focal_px *= s;
-                c.centre.x_px *= s;
-                c.centre.y_px *= h as f64 / self.camera.height_px.max(1) as f64;
-                Some(c)
-            }
+            FrameFit::Scaled { .. } => Some(self.camera.scaled_to(w, h)),
         }
     }
 

@@ -9,12 +9,19 @@
 //! below the field, refuse ([`Severity::Refuse`]); a median residual over 2 px or any over 8 px,
 //! a focal length outside 0.3–3 image widths, a principal point outside the middle half of the
 //! image, |k1| over 1, or a camera not 0.5–15 m above the field are doubts
-//! ([`Severity::Doubt`]: the command line writes such a calibration only with `--accept`);
-//! points outside the field description (wrong units?) are noted ([`Severity::Note`]).
+//! ([`Severity::Doubt`]: the command line writes such a calibration only with `--accept`), and
+//! so are the points not determining the camera: without intrinsics, clicks spanning less than
+//! half the image's width or height ([`MIN_COVERAGE`]); any fit whose camera position has a
+//! standard deviation over 25 cm, focal length over 6 %, or principal point over 3 % of the
+//! image width (from the fit's covariance, [`Uncertainty`]); and points whose coordinates are
+//! not those of the field description's landmark of that name (points for another field).
+//! Fewer points than the fitted parameters need (five residuals to spare) refuse. Points more
+//! than half a metre outside the field description (another field, wrong units?) are noted
+//! ([`Severity::Note`]).
 
 use std::collections::HashSet;
 
-use super::calibration::Calibration;
+use super::calibration::{Calibration, Uncertainty};
 use super::field::FieldDescription;
 use super::points::PointsFile;
 use crate::geometry::OverheadCamera;
@@ -31,6 +38,28 @@ pub const FOCAL_WIDTHS: (f64, f64) = (0.3, 3.0);
 pub const MAX_K1: f64 = 1.0;
 /// Camera heights outside this range are doubtful, centimetres (0.5–15 m).
 pub const HEIGHT_RANGE_CM: (f64, f64) = (50.0, 1500.0);
+/// Without intrinsics, the clicks must span at least this fraction of the image's width and of
+/// its height (their bounding box): the lens (focal length, principal point, distortion) is
+/// seen only where points are.
+pub const MIN_COVERAGE: f64 = 0.5;
+/// A camera position whose standard deviation (the largest of x, y, z) exceeds this is not
+/// determined by the clicks, centimetres. About twice what every landmark of the 2005 field
+/// clicked with 1 px of noise gives the simulator's camera looking straight down (13 cm, its
+/// height, which ground points cannot tell from the focal length): the two click sets
+/// gave cameras 42 cm apart.
+pub const MAX_POSITION_SD_CM: f64 = 25.0;
+/// A focal length whose standard deviation exceeds this fraction of it is not determined
+/// (the same clicks: 3.6 %; the two fits: 492 and 408 px).
+pub const MAX_FOCAL_SD_FRACTION: f64 = 0.06;
+/// A principal point whose standard deviation (x or y) exceeds this fraction of the image
+/// width is not determined (the weak prior alone holds it: 5 % of the width).
+pub const MAX_CENTRE_SD_FRACTION: f64 = 0.03;
+/// A clicked point's field coordinates this far from the field description's landmark of the
+/// same name mean the points were made for another field, centimetres.
+pub const LANDMARK_MISMATCH_CM: f64 = 5.0;
+/// Clicked points farther than this beyond the field description's landmarks and lines are
+/// outside the field, centimetres.
+pub const OUTSIDE_FIELD_MARGIN_CM: f64 = 50.0;
 /// Ground points spread across their line by less than this fraction of their spread along it
 /// are on one line.
 const COLLINEAR_FRACTION: f64 = 0.02;
@@ -67,6 +96,73 @@ pub enum Finding {
         across_cm: f64,
         /// Spread along it, centimetres.
         along_cm: f64,
+    },
+    /// Fewer points than the fitted parameters need.
+    #[error(
+        "{count} calibration points, {needed} are needed to fit {parameters} parameters (two residuals per point, five to spare){hint}",
+        hint = if *parameters > 6 { "; with the lens's intrinsics (--intrinsics) only the pose is fitted, from fewer points" } else { "" }
+    )]
+    TooFewForParameters {
+        /// Points given.
+        count: usize,
+        /// Points needed.
+        needed: usize,
+        /// Parameters fitted.
+        parameters: usize,
+    },
+    /// Without intrinsics, clicks in one part of the image only.
+    #[error(
+        "the clicks cover {x_pct:.0}% of the image width and {y_pct:.0}% of its height (x {x0:.0}–{x1:.0}, y {y0:.0}–{y1:.0} px): fitting the lens needs clicks spread over at least {need:.0}% of each; click landmarks across the whole image, or give the lens's intrinsics (--intrinsics) so that only the pose is fitted",
+        need = MIN_COVERAGE * 100.0
+    )]
+    Clustered {
+        /// Width covered, percent.
+        x_pct: f64,
+        /// Height covered, percent.
+        y_pct: f64,
+        /// Leftmost click, pixels.
+        x0: f64,
+        /// Rightmost click, pixels.
+        x1: f64,
+        /// Topmost click, pixels.
+        y0: f64,
+        /// Bottommost click, pixels.
+        y1: f64,
+    },
+    /// A fitted parameter the clicks leave uncertain.
+    #[error(
+        "the clicks do not determine the {what}: standard deviation {sd:.2} {unit} (limit {limit:.2} {unit}); click more landmarks spread over the image{hint}",
+        hint = if *with_intrinsics { "" } else { ", or give the lens's intrinsics (--intrinsics)" }
+    )]
+    Uncertain {
+        /// Which parameter.
+        what: &'static str,
+        /// Its standard deviation.
+        sd: f64,
+        /// The limit.
+        limit: f64,
+        /// The unit of both.
+        unit: &'static str,
+        /// Whether the lens was given (then only the pose was fitted).
+        with_intrinsics: bool,
+    },
+    /// A clicked point at other coordinates than the field's landmark of the same name.
+    #[error(
+        "point {name:?} is at ({x:.0}, {y:.0}) cm in the points file, the field description {field:?} has it at ({fx:.0}, {fy:.0}) cm: points made for another field? (--field names the field)"
+    )]
+    LandmarkMismatch {
+        /// The point's name.
+        name: String,
+        /// The field description's name.
+        field: String,
+        /// Points file x, centimetres.
+        x: f64,
+        /// Points file y, centimetres.
+        y: f64,
+        /// The field's x, centimetres.
+        fx: f64,
+        /// The field's y, centimetres.
+        fy: f64,
     },
     /// The same landmark clicked twice.
     #[error("landmark {name:?} is clicked twice")]
@@ -164,11 +260,13 @@ pub enum Finding {
     },
     /// A clicked point outside the field description.
     #[error(
-        "point {name:?} at ({x:.0}, {y:.0}) cm lies outside the field description (other units?)"
+        "point {name:?} at ({x:.0}, {y:.0}) cm lies outside the field description {field:?} (another field, or other units? --field names the field)"
     )]
     OutsideField {
         /// The point's name.
         name: String,
+        /// The field description's name.
+        field: String,
         /// Field x, centimetres.
         x: f64,
         /// Field y, centimetres.
@@ -187,13 +285,17 @@ impl Finding {
             | Self::OutsideImage { .. }
             | Self::NotDetermined { .. }
             | Self::NotSeen { .. }
-            | Self::CameraBelowField { .. } => Severity::Refuse,
+            | Self::CameraBelowField { .. }
+            | Self::TooFewForParameters { .. } => Severity::Refuse,
             Self::MedianResidual { .. }
             | Self::LargeResidual { .. }
             | Self::Focal { .. }
             | Self::PrincipalPoint { .. }
             | Self::Distortion { .. }
-            | Self::Height { .. } => Severity::Doubt,
+            | Self::Height { .. }
+            | Self::Clustered { .. }
+            | Self::Uncertain { .. }
+            | Self::LandmarkMismatch { .. } => Severity::Doubt,
             Self::OutsideField { .. } => Severity::Note,
         }
     }
@@ -228,7 +330,8 @@ impl Review {
 }
 
 /// The checks of clicked points before anything is solved: too few, on one line, clicked twice
-/// or outside the image refuse; points outside the field description are notes (returned).
+/// or outside the image refuse; points outside the field description (notes) or at other
+/// coordinates than its landmark of the same name (doubts) are returned.
 ///
 /// # Errors
 /// The first refusal.
@@ -303,6 +406,12 @@ pub fn review(cal: &Calibration) -> Review {
             });
         }
     }
+    if cal.intrinsics.is_none() {
+        findings.extend(coverage(cal));
+    }
+    if let Some(u) = &cal.uncertainty {
+        findings.extend(uncertain(u, &cal.camera, cal.intrinsics.is_some()));
+    }
     let median = cal.median_point_error_px();
     if median > MAX_MEDIAN_RESIDUAL_PX {
         findings.push(Finding::MedianResidual { px: median });
@@ -321,6 +430,65 @@ pub fn review(cal: &Calibration) -> Review {
     }
     findings.sort_by_key(|f| std::cmp::Reverse(f.severity()));
     Review { findings }
+}
+
+/// The clicks' bounding box against [`MIN_COVERAGE`] of the image.
+fn coverage(cal: &Calibration) -> Option<Finding> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &cal.points {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p.image_px[k]);
+            hi[k] = hi[k].max(p.image_px[k]);
+        }
+    }
+    let (w, h) = (cal.camera.width_px as f64, cal.camera.height_px as f64);
+    let (fx, fy) = ((hi[0] - lo[0]) / w.max(1.0), (hi[1] - lo[1]) / h.max(1.0));
+    let covered = fx >= MIN_COVERAGE && fy >= MIN_COVERAGE;
+    (!covered && !cal.points.is_empty()).then_some(Finding::Clustered {
+        x_pct: 100.0 * fx,
+        y_pct: 100.0 * fy,
+        x0: lo[0],
+        x1: hi[0],
+        y0: lo[1],
+        y1: hi[1],
+    })
+}
+
+/// The fitted parameters whose standard deviations exceed their limits.
+fn uncertain(u: &Uncertainty, camera: &OverheadCamera, with_intrinsics: bool) -> Vec<Finding> {
+    let finding = |what, sd: f64, limit, unit| {
+        (sd.is_nan() || sd > limit).then_some(Finding::Uncertain {
+            what,
+            sd,
+            limit,
+            unit,
+            with_intrinsics,
+        })
+    };
+    let centre_sd = u.centre_px.map_or(0.0, |[x, y]| x.max(y));
+    [
+        finding(
+            "camera position",
+            u.position_sd_cm(),
+            MAX_POSITION_SD_CM,
+            "cm",
+        ),
+        finding(
+            "focal length",
+            u.focal_px.unwrap_or(0.0),
+            MAX_FOCAL_SD_FRACTION * camera.focal_px,
+            "px",
+        ),
+        finding(
+            "principal point",
+            centre_sd,
+            MAX_CENTRE_SD_FRACTION * camera.width_px as f64,
+            "px",
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// The checks of the camera alone: where it is and what its lens is like.
@@ -358,8 +526,9 @@ pub fn review_camera(c: &OverheadCamera) -> Vec<Finding> {
     findings
 }
 
-/// Clicked points beyond the field description's landmarks and lines (with a margin of a
-/// fifth of its size and half a metre): notes.
+/// Clicked points beyond the field description's landmarks and lines by more than
+/// [`OUTSIDE_FIELD_MARGIN_CM`] (notes), and points whose coordinates differ from the field's
+/// landmark of the same name (doubts).
 fn outside_field(points: &PointsFile, field: &FieldDescription) -> Vec<Finding> {
     let corners = field
         .landmarks
@@ -376,19 +545,34 @@ fn outside_field(points: &PointsFile, field: &FieldDescription) -> Vec<Finding> 
     if !(lo[0] <= hi[0] && lo[1] <= hi[1]) {
         return Vec::new();
     }
-    let margin = [0, 1].map(|k| 0.2 * (hi[k] - lo[k]) + 50.0);
+    let margin = OUTSIDE_FIELD_MARGIN_CM;
+    let mismatched = points.points.iter().filter_map(|p| {
+        let l = field.landmark(&p.name)?;
+        let d = (l.field_cm[0] - p.field_cm[0]).hypot(l.field_cm[1] - p.field_cm[1]);
+        (d > LANDMARK_MISMATCH_CM).then(|| Finding::LandmarkMismatch {
+            name: p.name.clone(),
+            field: field.name.clone(),
+            x: p.field_cm[0],
+            y: p.field_cm[1],
+            fx: l.field_cm[0],
+            fy: l.field_cm[1],
+        })
+    });
+    let mismatched: Vec<Finding> = mismatched.collect();
     points
         .points
         .iter()
         .filter(|p| {
             let f = p.field_cm;
-            (0..2).any(|k| f[k] < lo[k] - margin[k] || f[k] > hi[k] + margin[k])
+            (0..2).any(|k| f[k] < lo[k] - margin || f[k] > hi[k] + margin)
         })
         .map(|p| Finding::OutsideField {
             name: p.name.clone(),
+            field: field.name.clone(),
             x: p.field_cm[0],
             y: p.field_cm[1],
         })
+        .chain(mismatched)
         .collect()
 }
 
@@ -458,11 +642,20 @@ mod tests {
         for p in &mut mm.points {
             p.field_cm = p.field_cm.map(|v| v * 10.0);
         }
-        let notes = check_points(&mm, &field).expect("notes only");
-        assert!(!notes.is_empty());
+        let found = check_points(&mm, &field).expect("notes and doubts only");
+        assert!(!found.is_empty());
+        // Beyond the field: notes; a landmark at ten times its place: a doubt naming it.
+        assert!(found.iter().all(|n| match n {
+            Finding::OutsideField { .. } => n.severity() == Severity::Note,
+            Finding::LandmarkMismatch { .. } => n.severity() == Severity::Doubt,
+            _ => false,
+        }));
         assert!(
-            notes.iter().all(|n| n.severity() == Severity::Note),
-            "{notes:?}"
+            found
+                .iter()
+                .any(|f| f.to_string().contains("\"yellow left corner\"")
+                    && f.to_string().contains("another field")),
+            "{found:?}"
         );
     }
 
@@ -494,6 +687,58 @@ mod tests {
     }
 
     #[test]
+    fn parameters_the_clicks_leave_uncertain_are_doubted_each_by_name() {
+        let camera = OverheadCamera::above_field_2005();
+        let sure = Uncertainty {
+            residual_sd_px: 0.8,
+            position_cm: [2.0, 3.0, 13.0],
+            rotation_deg: [0.2, 0.2, 0.1],
+            focal_px: Some(0.035 * camera.focal_px),
+            centre_px: Some([10.0, 12.0]),
+            k1: Some(0.01),
+            k2: Some(0.01),
+        };
+        assert!(uncertain(&sure, &camera, false).is_empty());
+        // The fits: cameras 42 cm apart, focal 492 vs 408 px, principal points 100 px.
+        let unsure = Uncertainty {
+            position_cm: [30.0, 12.0, 20.0],
+            focal_px: Some(45.0),
+            centre_px: Some([60.0, 20.0]),
+            ..sure
+        };
+        let found = uncertain(&unsure, &camera, false);
+        assert_eq!(kinds(&found), ["Uncertain", "Uncertain", "Uncertain"]);
+        let text: Vec<String> = found.iter().map(ToString::to_string).collect();
+        assert!(
+            text[0].contains("camera position: standard deviation 30.00 cm (limit 25.00 cm)"),
+            "{text:?}"
+        );
+        assert!(
+            text[1].contains("focal length") && text[2].contains("principal point"),
+            "{text:?}"
+        );
+        assert!(text.iter().all(|t| t.contains("--intrinsics")), "{text:?}");
+        assert!(found.iter().all(|f| f.severity() == Severity::Doubt));
+        // With intrinsics there is only the pose; the hint is not repeated.
+        let pose_only = Uncertainty {
+            focal_px: None,
+            centre_px: None,
+            k1: None,
+            k2: None,
+            ..unsure
+        };
+        let found = uncertain(&pose_only, &camera, true);
+        assert_eq!(kinds(&found), ["Uncertain"]);
+        assert!(!found[0].to_string().contains("--intrinsics"), "{found:?}");
+        // A standard deviation that is not a number is not a determined parameter.
+        let nan = Uncertainty {
+            position_cm: [f64::NAN, 1.0, 1.0],
+            ..sure
+        };
+        assert_eq!(kinds(&uncertain(&nan, &camera, false)), ["Uncertain"]);
+    }
+
+    #[test]
     fn residuals_too_large_or_unseen_points_are_found() {
         let cal = |errors: &[f64]| Calibration {
             camera: OverheadCamera::above_field_2005(),
@@ -510,6 +755,9 @@ mod tests {
                 .collect(),
             line_samples: 0,
             line_rms_px: None,
+            uncertainty: None,
+            // With intrinsics: the clicks' coverage is not asked for (tested below).
+            intrinsics: Some("a checkerboard".into()),
         };
         assert!(review(&cal(&[0.5, 1.0, 1.5, 7.9])).findings.is_empty());
         let r = review(&cal(&[2.5, 2.6, 2.7]));
@@ -522,6 +770,13 @@ mod tests {
             "{}",
             r.findings[0]
         );
+        // Without intrinsics, clicks on one spot of the image are doubtful, the coverage named.
+        let mut clustered = cal(&[0.5, 0.5, 0.5]);
+        clustered.intrinsics = None;
+        clustered.points[1].image_px = [100.0, 90.0];
+        let r = review(&clustered);
+        assert_eq!(kinds(&r.findings), ["Clustered"]);
+        assert!(r.findings[0].to_string().contains("at least 50%"), "{r:?}");
         let r = review(&cal(&[0.5, f64::NAN, 0.5]));
         assert!(
             matches!(r.refusal(), Some(Finding::NotSeen { .. })),

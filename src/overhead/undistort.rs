@@ -64,11 +64,11 @@ pub fn source_pixel_map(camera: &OverheadCamera, width: usize, height: usize) ->
 pub fn distorted_point(p: ImagePoint, camera: &OverheadCamera, size: (usize, usize)) -> ImagePoint {
     let (sx, sy) = scale(camera, size);
     let u = (p.x_px / sx - camera.centre.x_px) / camera.focal_px;
-    let v = (p.y_px / sy - camera.centre.y_px) / camera.focal_px;
+    let v = (p.y_px / sy - camera.centre.y_px) / camera.focal_y();
     let (ud, vd) = camera.distort(u, v);
     ImagePoint::new(
         (camera.centre.x_px + camera.focal_px * ud) * sx,
-        (camera.centre.y_px + camera.focal_px * vd) * sy,
+        (camera.centre.y_px + camera.focal_y() * vd) * sy,
     )
 }
 
@@ -82,11 +82,11 @@ pub fn undistorted_point(
 ) -> Option<ImagePoint> {
     let (sx, sy) = scale(camera, size);
     let ud = (p.x_px / sx - camera.centre.x_px) / camera.focal_px;
-    let vd = (p.y_px / sy - camera.centre.y_px) / camera.focal_px;
+    let vd = (p.y_px / sy - camera.centre.y_px) / camera.focal_y();
     let (u, v) = camera.undistort(ud, vd)?;
     Some(ImagePoint::new(
         (camera.centre.x_px + camera.focal_px * u) * sx,
-        (camera.centre.y_px + camera.focal_px * v) * sy,
+        (camera.centre.y_px + camera.focal_y() * v) * sy,
     ))
 }
 

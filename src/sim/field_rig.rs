@@ -152,7 +152,7 @@ impl FieldRig {
             frame: out.frame,
             labels: out.labels,
             sensors: None,
-            ground_truth: GroundTruth::Overhead(truth),
+            ground_truth: GroundTruth::Overhead(Box::new(truth)),
             extra: Vec::new(),
         })
     }

@@ -169,7 +169,7 @@ impl Simulator {
             frame: out.frame,
             labels: out.labels,
             sensors: None,
-            ground_truth: GroundTruth::Overhead(truth),
+            ground_truth: GroundTruth::Overhead(Box::new(truth)),
             extra: self.scenario.world_models(scene, t, at.index),
         })
     }

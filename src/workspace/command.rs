@@ -311,8 +311,14 @@ pub enum OverheadCommand {
     SaveCalibration(PathBuf),
     /// Forget the opened or solved calibration: the stream's own camera, if any, is used.
     CloseCalibration,
-    /// Use this field description (landmarks, lines; `params/fields/`).
+    /// Use this field description: a file (`params/fields/`) or a shipped field's name
+    /// (`spl-2020`, …).
     OpenField(PathBuf),
+    /// Use the lens's checkerboard intrinsics (a ROS `camera_info` YAML file): Calibrate then
+    /// fits only the camera's pose.
+    OpenIntrinsics(PathBuf),
+    /// Forget the intrinsics: Calibrate fits the lens too.
+    CloseIntrinsics,
     /// Open a points file (`*.points.json`) to go on picking or to calibrate from.
     OpenPoints(PathBuf),
     /// Save the picked points as a points file.

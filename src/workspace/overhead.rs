@@ -17,7 +17,8 @@ use super::Workspace;
 use super::command::OverheadCommand;
 use super::field_model::FieldModel;
 use crate::geometry::{ImagePoint, MarkerIdentity, MarkerTeam, OverheadCamera};
-use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate};
+use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate_with};
+use crate::overhead::intrinsics::Intrinsics;
 use crate::overhead::{
     CalibrationPoint, FieldDescription, OverheadDetections, OverheadParams, OverheadPipeline,
     PointsFile,
@@ -95,6 +96,8 @@ pub struct Overhead {
     stream_camera: Option<OverheadCamera>,
     field: FieldDescription,
     field_path: Option<PathBuf>,
+    /// The lens's checkerboard intrinsics and their file: Calibrate then fits only the pose.
+    intrinsics: Option<(Intrinsics, PathBuf)>,
     points: PointsFile,
     points_path: Option<PathBuf>,
     picks: Vec<PickEdit>,
@@ -127,6 +130,7 @@ impl Default for Overhead {
             stream_camera: None,
             field,
             field_path: None,
+            intrinsics: None,
             points: PointsFile::new(0, 0),
             points_path: None,
             picks: Vec::new(),
@@ -187,6 +191,12 @@ impl Overhead {
     #[must_use]
     pub fn calibration_path(&self) -> Option<&Path> {
         self.calibration_path.as_deref()
+    }
+
+    /// The intrinsics Calibrate uses (then only the pose is fitted) and their file.
+    #[must_use]
+    pub fn intrinsics(&self) -> Option<(&Intrinsics, &Path)> {
+        self.intrinsics.as_ref().map(|(i, p)| (i, p.as_path()))
     }
 
     /// The field description (landmarks by name, lines).
@@ -403,8 +413,10 @@ impl Workspace {
                 self.reprocess();
                 self.status = self.overhead.calibration_status();
             }
+            OverheadCommand::OpenIntrinsics(p) => self.open_intrinsics(Some(p))?,
+            OverheadCommand::CloseIntrinsics => self.open_intrinsics(None)?,
             OverheadCommand::OpenField(p) => {
-                let field = FieldDescription::load(&p)?;
+                let field = FieldDescription::resolve(&p.to_string_lossy())?;
                 self.overhead.pipeline = OverheadPipeline::new(
                     self.pipeline.lut().clone(),
                     *self.overhead.pipeline.camera(),
@@ -461,6 +473,29 @@ impl Workspace {
                 self.frame_generation += 1;
             }
         }
+        Ok(())
+    }
+
+    /// Uses the intrinsics of `p` for Calibrate, or none.
+    fn open_intrinsics(&mut self, p: Option<PathBuf>) -> anyhow::Result<()> {
+        let Some(p) = p else {
+            self.overhead.intrinsics = None;
+            self.status = "no intrinsics: Calibrate fits the lens too".into();
+            return Ok(());
+        };
+        let mut i = Intrinsics::load(&p)?;
+        if i.camera_name.is_empty() {
+            i.camera_name = p.display().to_string();
+        }
+        self.status = format!(
+            "intrinsics {}: {}x{}, fx {:.1} px, {}; Calibrate fits only the pose",
+            p.display(),
+            i.width_px,
+            i.height_px,
+            i.fx,
+            i.lens.ros_name()
+        );
+        self.overhead.intrinsics = Some((i, p));
         Ok(())
     }
 
@@ -571,11 +606,12 @@ impl Workspace {
         });
         let notes =
             crate::overhead::review::check_points(&self.overhead.points, &self.overhead.field)?;
-        let cal = calibrate(
+        let cal = calibrate_with(
             &self.overhead.points,
             &self.overhead.field,
             frame.as_ref(),
             &CalibrationParams::default(),
+            self.overhead.intrinsics.as_ref().map(|(i, _)| i),
         )?;
         let review = crate::overhead::review::review(&cal);
         for f in notes.iter().chain(&review.findings) {
@@ -705,7 +741,7 @@ fn stream_camera(loaded: &SourceFrame) -> Option<OverheadCamera> {
 pub(super) fn truth_of(loaded: &SourceFrame) -> Option<crate::model::truth::OverheadTruth> {
     let value = loaded.channel(crate::streams::GROUND_TRUTH_TOPIC)?;
     match serde_json::from_value::<crate::model::truth::GroundTruth>(value.clone()) {
-        Ok(crate::model::truth::GroundTruth::Overhead(t)) => Some(t),
+        Ok(crate::model::truth::GroundTruth::Overhead(t)) => Some(*t),
         _ => None,
     }
 }

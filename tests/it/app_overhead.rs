@@ -54,7 +54,7 @@ fn fixture() -> (&'static PathBuf, &'static PathBuf) {
 fn truth(stream: &Path, index: usize) -> OverheadTruth {
     let record = StreamReader::open(stream).unwrap().read(index).unwrap();
     match serde_json::from_value(record.ground_truth.unwrap()).unwrap() {
-        GroundTruth::Overhead(t) => t,
+        GroundTruth::Overhead(t) => *t,
         GroundTruth::Robot(_) => panic!("an overhead stream"),
     }
 }
@@ -179,6 +179,8 @@ fn without_a_calibration_nothing_is_placed_and_the_status_says_so_until_one_is_o
         points: Vec::new(),
         line_samples: 0,
         line_rms_px: None,
+        uncertainty: None,
+        intrinsics: None,
     };
     let path = dir.path().join("true.calibration.json");
     cal.save(&path).unwrap();

@@ -36,6 +36,7 @@ mod motion;
 #[cfg(unix)]
 mod outputs;
 mod overhead;
+mod overhead_lens;
 mod patterns;
 mod peer;
 mod properties;

@@ -1,5 +1,6 @@
 //! Tests of the calibration solver, its file and its checks.
 
+use super::solver::with_positive_focal;
 use super::*;
 use crate::overhead::points::CalibrationPoint;
 use crate::sim::SimRng;
@@ -128,7 +129,7 @@ fn a_well_spread_fit_is_determined_and_points_on_one_spot_are_not() {
         centre_sd_px: 32.0,
         distortion_sd: 0.3,
     };
-    let good = conditioning(camera, &targets, &[], prior);
+    let good = conditioning(camera, &targets, &[], prior, Free::All);
     assert!(good > 1e3 * MIN_CONDITIONING, "{good:e}");
     // Every point on one spot: the turn and the focal length are free.
     let spot: Vec<Target> = targets
@@ -138,7 +139,7 @@ fn a_well_spread_fit_is_determined_and_points_on_one_spot_are_not() {
             image: targets[0].image,
         })
         .collect();
-    let bad = conditioning(camera, &spot, &[], prior);
+    let bad = conditioning(camera, &spot, &[], prior, Free::All);
     eprintln!("conditioning: spread {good:e}, one spot {bad:e}");
     assert!(bad < MIN_CONDITIONING, "{bad:e}");
 }
