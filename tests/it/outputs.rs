@@ -230,6 +230,20 @@ fn recipes() -> Vec<(&'static str, Recipe)> {
                 out.as_os_str(),
             ])
         }),
+        ("overhead sim-field --output", |_, out| {
+            args(&[
+                "overhead".as_ref(),
+                "sim-field".as_ref(),
+                "--cameras".as_ref(),
+                "1".as_ref(),
+                "--size".as_ref(),
+                "320x200".as_ref(),
+                "--frames".as_ref(),
+                "2".as_ref(),
+                "-o".as_ref(),
+                out.as_os_str(),
+            ])
+        }),
         ("overhead sim-points --output", |f, out| {
             args(&[
                 "overhead".as_ref(),
