@@ -21,7 +21,7 @@
 //! With a checkerboard's intrinsics ([`super::intrinsics`]: focal lengths, principal point and
 //! a plumb_bob, rational_polynomial or equidistant lens) only the six pose parameters are
 //! solved, from the pose of the homography between the field plane and the undistorted clicks
-//! ([`start`]). Either way the fit's covariance at the solution gives each parameter's standard
+//! (`start`). Either way the fit's covariance at the solution gives each parameter's standard
 //! deviation ([`Uncertainty`]), which [`super::review`] holds against its limits.
 
 use std::path::Path;

@@ -191,7 +191,7 @@ impl Intrinsics {
     /// message's once a recording's decoder gives them).
     ///
     /// # Errors
-    /// A size of 0 or beyond [`MAX_SIDE_PX`], a camera matrix that is not `fx 0 cx / 0 fy cy /
+    /// A size of 0 or beyond `MAX_SIDE_PX`, a camera matrix that is not `fx 0 cx / 0 fy cy /
     /// 0 0 1` with positive finite focal lengths, or a distortion model eotn does not know.
     pub fn from_camera_info(info: &CameraInfoFields<'_>) -> Result<Self, String> {
         let (w, h) = (info.width, info.height);
