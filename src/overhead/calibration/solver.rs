@@ -43,15 +43,7 @@ pub(super) fn conditioning(
     prior: Priors,
     free: Free,
 ) -> f64 {
-    let problem = Problem {
-        free,
-        base: camera,
-        base_rotation: camera.field_from_camera().rotation(),
-        targets,
-        lines,
-        prior,
-        params: params_of(&camera),
-    };
+    let problem = Problem::new(camera, targets, lines, prior, free);
     let Some(mut j) = problem.jacobian() else {
         return 0.0;
     };
@@ -85,7 +77,26 @@ struct Problem<'a> {
 /// finite, so it keeps going.
 const UNSEEN_PX: f64 = 1000.0;
 
-impl Problem<'_> {
+impl<'a> Problem<'a> {
+    /// The problem of fitting `free` parameters from `base`, the other parameters held.
+    fn new(
+        base: OverheadCamera,
+        targets: &'a [Target],
+        lines: &'a [LineObservation],
+        prior: Priors,
+        free: Free,
+    ) -> Self {
+        Self {
+            free,
+            base,
+            base_rotation: base.field_from_camera().rotation(),
+            targets,
+            lines,
+            prior,
+            params: params_of(&base),
+        }
+    }
+
     /// The camera of a parameter vector, and its `field_from_camera` built directly (the
     /// camera's pose record goes through Euler angles, which lose digits near straight down).
     fn model(&self, p: &[f64; PARAMS]) -> (OverheadCamera, Transform<Field, Camera>) {
@@ -228,15 +239,7 @@ pub(super) fn solve(
     prior: Priors,
     free: Free,
 ) -> Result<OverheadCamera, CalibrationError> {
-    let problem = Problem {
-        free,
-        base: start,
-        base_rotation: start.field_from_camera().rotation(),
-        targets,
-        lines,
-        prior,
-        params: params_of(&start),
-    };
+    let problem = Problem::new(start, targets, lines, prior, free);
     let (problem, report) = LevenbergMarquardt::new()
         .with_patience(200)
         .minimize(problem);
@@ -267,15 +270,7 @@ pub(super) fn covariance(
     free: Free,
     floor_px: f64,
 ) -> Option<(DMatrix<f64>, f64)> {
-    let problem = Problem {
-        free,
-        base: camera,
-        base_rotation: camera.field_from_camera().rotation(),
-        targets,
-        lines,
-        prior,
-        params: params_of(&camera),
-    };
+    let problem = Problem::new(camera, targets, lines, prior, free);
     let j = problem.jacobian()?;
     let r = problem.residuals_at(&problem.params);
     let pixel_rows = 2 * targets.len() + lines.len();
