@@ -97,6 +97,10 @@ pub struct RunOptions {
     pub quit_after: Option<Duration>,
     /// `--all-overlays`: every overlay on.
     pub all_overlays: bool,
+    /// `--camera`: the camera (image topic) of the recordings to show; `None`: the first.
+    pub camera: Option<String>,
+    /// `--labels`: a label set (YOLO or VOC folder, COCO JSON) opened over the frames.
+    pub labels: Option<PathBuf>,
 }
 
 #[cfg(test)]

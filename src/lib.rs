@@ -7,6 +7,7 @@
 //! |---|---|
 //! | [`atomic_file`] | how every output is written: temporary + fsync + rename, devices and FIFOs in place, links kept, inputs never replaced |
 //! | [`input_file`] | reading the files a user names: regular files only, bounded in size |
+//! | [`camera`] | which camera (a recording's topic, a live robot's channel, an overhead source) and the files it is recognised with: stream metadata, the `REC.cameras.json` sidecar |
 //! | [`stats`] | the median and the inverse-size least squares shared by recognition and evaluation |
 //! | [`kernels`] | which hot-loop kernels (portable, AVX2, AVX-512) this CPU runs: the choosing rule, `EOTN_KERNELS` |
 //! | [`frame`] | YUV frames (UYVY 4:2:2, YUV 4:4:4), RGB display conversion, frame files |
@@ -40,6 +41,7 @@ pub mod annotate;
 pub mod app_options;
 pub mod atomic_file;
 pub mod blobs;
+pub mod camera;
 pub mod classify;
 pub mod eval;
 pub mod formats;
@@ -61,6 +63,7 @@ pub mod sim;
 pub mod sources;
 pub mod stats;
 pub mod streams;
+pub mod wmd;
 pub mod workspace;
 
 pub mod cli;

@@ -1,13 +1,15 @@
 //! A hand classification written down as the clicks that made it: per class, the sensitivity
-//! (± table cells on Y, U, V) and the pixels clicked. Replayed through the app's own commands
-//! (`SetClass`, `SetSensitivity`, `Sample`, `Commit`), exactly as a user clicking those pixels in
-//! the window would make the table. Shared by `examples/replay_clicks` and the tests.
+//! (± table cells on Y, U, V), the frame (for a folder of frames) and the pixels clicked.
+//! Replayed through the app's own commands (`Seek`, `SetClass`, `SetSensitivity`, `Sample`,
+//! `Commit`), exactly as a user clicking those pixels in the window would make the table. Shared
+//! by `examples/replay_clicks` and the tests.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use eotn::eval::label_sets::is_held_out;
 use eotn::lut::{ColourClass, Sensitivity};
-use eotn::workspace::{TableCommand, Workspace};
+use eotn::workspace::{Command, PlaybackCommand, TableCommand, Workspace};
 use serde::Deserialize;
 
 /// A clicks file (`*.clicks.json`).
@@ -16,11 +18,11 @@ use serde::Deserialize;
 pub struct Clicks {
     /// Bits per channel of the new table (6, 7 or 8).
     pub bits: u8,
-    /// One entry per class and sensitivity, in the order they were clicked.
+    /// One entry per class, sensitivity and frame, in the order they were clicked.
     pub clicks: Vec<ClickGroup>,
 }
 
-/// Pixels clicked with one class and one sensitivity.
+/// Pixels clicked with one class and one sensitivity, on one frame.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClickGroup {
@@ -28,6 +30,13 @@ pub struct ClickGroup {
     pub class: String,
     /// ± table cells on Y, U, V.
     pub sensitivity: [u8; 3],
+    /// The frame clicked on, a file name in the folder of frames (`"00054.jpg"`); absent when
+    /// one frame or stream is open (its shown frame).
+    #[serde(default)]
+    pub frame: Option<String>,
+    /// Why these pixels: what they are in the frame (a note for the reader, not replayed).
+    #[serde(default)]
+    pub note: Option<String>,
     /// The clicked pixels `[x, y]`.
     pub pixels: Vec<[usize; 2]>,
 }
@@ -44,11 +53,51 @@ impl Clicks {
         self.clicks.iter().map(|g| g.pixels.len()).sum()
     }
 
-    /// Starts a new table in `ws` (whose frame must be open) and clicks every pixel: left
-    /// click (`Sample`) then right click (`Commit`), as in the window.
+    /// The frames the groups name, in order of first use, as files of `folder`. Held-out frames
+    /// (numbers ending in 7, 8 or 9) are refused: no table edit may look at them.
+    pub fn frames(&self, folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
+        let mut out: Vec<PathBuf> = Vec::new();
+        for name in self.clicks.iter().filter_map(|g| g.frame.as_deref()) {
+            let stem = Path::new(name)
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or(name);
+            anyhow::ensure!(
+                !is_held_out(stem),
+                "{name}: a held-out frame (number ends in 7, 8 or 9)"
+            );
+            let path = folder.join(name);
+            if !out.contains(&path) {
+                out.push(path);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Starts a new table in `ws` (whose frame must be open) and clicks every pixel.
     pub fn replay(&self, ws: &mut Workspace) -> anyhow::Result<()> {
         ws.apply(TableCommand::NewTable(self.bits).into())?;
+        self.click(ws, &[])
+    }
+
+    /// Clicks every pixel onto the table open in `ws`: for each group the frame is shown
+    /// (`frames` as opened, in order, see [`Self::frames`]), then per pixel a left click
+    /// (`Sample`) and a right click (`Commit`), as in the window.
+    pub fn click(&self, ws: &mut Workspace, frames: &[PathBuf]) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            ws.lut().bits() == self.bits,
+            "the clicks were made on a {}-bit table, the open table has {} bits",
+            self.bits,
+            ws.lut().bits()
+        );
         for g in &self.clicks {
+            if let Some(name) = &g.frame {
+                let index = frames
+                    .iter()
+                    .position(|p| p.file_name().is_some_and(|f| f == name.as_str()))
+                    .with_context(|| format!("frame {name} is not open"))?;
+                ws.apply(Command::Playback(PlaybackCommand::Seek(index)))?;
+            }
             let class = ColourClass::parse(&g.class)
                 .with_context(|| format!("unknown class {:?}", g.class))?;
             let [y, u, v] = g.sensitivity;
@@ -56,8 +105,13 @@ impl Clicks {
             ws.apply(TableCommand::SetSensitivity(Sensitivity { y, u, v }).into())?;
             for &[x, y] in &g.pixels {
                 ws.apply(TableCommand::Sample { x, y }.into())?;
-                ws.apply(TableCommand::Commit.into())
-                    .with_context(|| format!("{} at ({x}, {y})", g.class))?;
+                ws.apply(TableCommand::Commit.into()).with_context(|| {
+                    format!(
+                        "{} at ({x}, {y}) of {}",
+                        g.class,
+                        g.frame.as_deref().unwrap_or("the frame")
+                    )
+                })?;
             }
         }
         Ok(())

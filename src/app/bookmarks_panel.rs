@@ -49,7 +49,56 @@ pub fn bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
     ui.data_mut(|d| d.insert_temp(id, note));
     user_bookmarks_ui(ui, state, commands);
     ui.separator();
+    labels_ui(ui, state);
     events_ui(ui, state, commands);
+}
+
+/// The opened labels' report, as `eotn eval --labels` gives it, over the frames scored so far.
+fn labels_ui(ui: &mut Ui, state: &Workspace) {
+    let Some(labels) = state.labels() else {
+        return;
+    };
+    let r = labels.report();
+    let (done, total) = labels.progress();
+    ui.label(format!("Labels: {}", labels.path.display()));
+    if !labels.done() {
+        ui.add(
+            egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                .text(format!("scored {done} / {total} frames")),
+        );
+    }
+    let pct = |v: Option<f64>| v.map_or_else(|| "—".to_owned(), |v| format!("{:.1}%", v * 100.0));
+    egui::Grid::new("labels_report").show(ui, |ui| {
+        ui.label("frame recall");
+        ui.label(format!("{} / {} = {}", r.found, r.eligible, pct(r.recall)));
+        ui.end_row();
+        ui.label("precision");
+        ui.label(format!(
+            "{} / {} = {}",
+            r.correct,
+            r.reported,
+            pct(r.precision)
+        ));
+        ui.end_row();
+        ui.label("false balls");
+        ui.label(format!(
+            "{} in robot boxes, {} in goal boxes, {} in other boxes, {} elsewhere",
+            r.false_in_robot, r.false_in_goal, r.false_in_other, r.false_elsewhere
+        ));
+        ui.end_row();
+        if let Some(c) = &r.centre_error {
+            ui.label("centre error");
+            ui.label(format!("median {:.2}, p90 {:.2} of the box", c.p50, c.p90));
+            ui.end_row();
+        }
+        ui.label("labelled frames");
+        ui.label(format!(
+            "{} scored, {} with a ball",
+            r.frames, r.frames_with_ball
+        ));
+        ui.end_row();
+    });
+    ui.separator();
 }
 
 fn user_bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
@@ -125,6 +174,8 @@ fn event_colour(kind: EventKind) -> Color32 {
         EventKind::GoalAppears(c) => c.display_rgb(),
         EventKind::Warning => [230, 50, 50],
         EventKind::TryEditChange => [255, 0, 255],
+        EventKind::LabelMissed => [255, 200, 0],
+        EventKind::LabelFalse => [255, 60, 160],
     };
     Color32::from_rgb(rgb[0], rgb[1], rgb[2])
 }

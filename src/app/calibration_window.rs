@@ -107,7 +107,7 @@ fn files_ui(
     if path_row(
         ui,
         "intrinsics",
-        "camera_info.yaml",
+        "camera_info.yaml or a recording",
         &mut paths.intrinsics,
         &[("Open intrinsics", true)],
     ) == Some(0)

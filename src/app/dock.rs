@@ -230,6 +230,10 @@ pub struct DockBehavior<'a> {
     pub dialog: &'a mut Option<(super::file_dialog::FileAction, Option<String>)>,
     /// What the image view reported.
     pub view: MainViewOutput,
+    /// The textures of cameras shown beside the focused one.
+    pub beside: &'a super::side_by_side::BesideTextures,
+    /// Cameras side by side: where each camera's image was drawn.
+    pub panes: Vec<(String, super::overlays::ImageTransform)>,
 }
 
 impl DockBehavior<'_> {
@@ -261,6 +265,17 @@ impl DockBehavior<'_> {
 impl egui_tiles::Behavior<Pane> for DockBehavior<'_> {
     fn pane_ui(&mut self, ui: &mut Ui, _tile_id: TileId, pane: &mut Pane) -> UiResponse {
         match *pane {
+            Pane::Image if !self.state.camera_panes().is_empty() => {
+                let out = super::side_by_side::side_by_side_ui(
+                    ui,
+                    self.state,
+                    self.tex,
+                    self.beside,
+                    self.commands,
+                );
+                self.view = out.focused;
+                self.panes = out.panes;
+            }
             Pane::Image => {
                 self.view = views::main_view_ui(ui, self.state, self.tex, self.commands);
             }

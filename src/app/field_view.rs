@@ -217,8 +217,8 @@ fn paint_objects(
             painter.extend(egui::Shape::dashed_line(&[own, *c], stroke, 4.0, 3.0));
         }
         let text = format!(
-            "robot{}{}",
-            m.robot_id,
+            "{}{}",
+            m.robot,
             m.self_error_cm
                 .map(|e| format!(" {e:.0} cm"))
                 .unwrap_or_default()
@@ -259,11 +259,12 @@ fn errors_ui(ui: &mut Ui, state: &Workspace) {
             }
             ui.end_row();
             for m in model.world_models() {
-                ui.label(format!("robot{}", m.robot_id));
-                ui.label(
-                    m.key
-                        .map_or_else(|| "not seen".to_owned(), |k| format!("marker {k}")),
-                );
+                ui.label(format!("from {}", m.robot));
+                ui.label(match (m.matched, m.key) {
+                    (crate::wmd::Matched::Marker, Some(k)) => format!("marker {k}"),
+                    (crate::wmd::Matched::Position, Some(k)) => format!("by position: {k}"),
+                    _ => "not seen".to_owned(),
+                });
                 ui.monospace(cm(m.self_error_cm));
                 ui.monospace(cm(m.heading_error_deg));
                 ui.monospace(cm(m.ball_error_cm));
@@ -271,7 +272,8 @@ fn errors_ui(ui: &mut Ui, state: &Workspace) {
             }
         });
     let now_s = state.current().map_or(0.0, |c| c.time_ns as f64 / 1e9);
-    let ids: Vec<u32> = model.world_models().iter().map(|m| m.robot_id).collect();
+    let ids: Vec<crate::workspace::overhead::RobotKey> =
+        model.world_models().iter().map(|m| m.robot).collect();
     Plot::new("world-model-error-plot")
         .height(140.0)
         .legend(Legend::default())
@@ -287,7 +289,7 @@ fn errors_ui(ui: &mut Ui, state: &Workspace) {
                             e.map(|e| [s.time_s, e])
                         })
                         .collect();
-                    p.line(Line::new(format!("robot{id} {what}"), points));
+                    p.line(Line::new(format!("{id} {what}"), points));
                 }
             }
             p.vline(VLine::new("current frame", now_s).color(Color32::WHITE));

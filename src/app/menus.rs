@@ -581,6 +581,7 @@ fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         commands.push(PlaybackCommand::SetPlaying(!state.playing()).into());
         ui.close();
     }
+    cameras_menu_ui(ui, state, commands);
     ui.menu_button("Speed", |ui| {
         for s in SPEEDS {
             let name = speed_name(s);
@@ -591,6 +592,36 @@ fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 commands.push(PlaybackCommand::SetSpeed(s).into());
                 ui.close();
             }
+        }
+    });
+}
+
+/// The camera picker: every camera (image topic) of the open recording, the shown one ticked;
+/// picking one shows it at the same time with its own table (`Command::OpenCamera`).
+fn cameras_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    let (cameras, shown) = state.cameras();
+    ui.add_enabled_ui(cameras.len() > 1, |ui| {
+        ui.menu_button("Camera of the recording", |ui| {
+            for topic in cameras {
+                if ui
+                    .selectable_label(shown == Some(topic.as_str()), topic)
+                    .clicked()
+                {
+                    commands.push(Command::OpenCamera(Some(topic.clone())));
+                    ui.close();
+                }
+            }
+        });
+        // Every camera at once, stepped together by time, each with its own table.
+        let mut together = !state.camera_panes().is_empty();
+        if ui.checkbox(&mut together, "Cameras side by side").clicked() {
+            let topics = if together {
+                cameras.to_vec()
+            } else {
+                Vec::new()
+            };
+            commands.push(Command::ShowSideBySide(topics));
+            ui.close();
         }
     });
 }

@@ -12,6 +12,7 @@
 //! | `keyboard.rs` | the keyboard shortcuts |
 //! | `textures.rs` | the shown frame's images and highlight, uploaded when they change |
 //! | `views.rs` | the enlarged view (zoom, pan, hover, clicks) and the thumbnails |
+//! | `side_by_side.rs` | cameras side by side: one column each, its own table's classes and recognition; a click focuses a camera |
 //! | `overlays.rs` | drawing in image pixels through one transform: boxes, labels, markers |
 //! | `classify_panel.rs` | class picker, sensitivity, commit/undo/redo, try-on-stream |
 //! | `inspector.rs` | every recognition candidate with its confidence breakdown; selection |
@@ -52,6 +53,7 @@ pub mod params_panel;
 pub mod renderer;
 pub mod robots_panel;
 pub mod sensors_dialog;
+pub mod side_by_side;
 mod status_bar;
 mod textures;
 mod timeline;
@@ -154,8 +156,11 @@ fn start_window(
                 info.adapter,
                 info.reason
             );
-            let mut app = EotnApp::new(cc, opts.files.clone());
+            let mut app = EotnApp::new(cc, opts.files.clone(), opts.camera.clone());
             app.renderer = Some(info);
+            if let Some(labels) = &opts.labels {
+                app.state.run(Command::OpenLabels(labels.clone()));
+            }
             if opts.all_overlays {
                 app.state.settings.overlays = crate::workspace::Overlays::all_on();
             }
@@ -186,6 +191,9 @@ pub struct EotnApp {
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
     pub last_view: Option<ImageTransform>,
+    /// Cameras side by side: (image topic, where its image was last drawn), left to right.
+    pub last_panes: Vec<(String, ImageTransform)>,
+    beside_textures: side_by_side::BesideTextures,
     confirm_close: bool,
     allow_close: bool,
     show_warnings: bool,
@@ -211,7 +219,11 @@ impl EotnApp {
     /// The app with persisted settings from `cc`, opening `paths` (or the last session's files
     /// when there are none).
     #[must_use]
-    pub fn new(cc: &eframe::CreationContext<'_>, paths: Vec<PathBuf>) -> Self {
+    pub fn new(
+        cc: &eframe::CreationContext<'_>,
+        paths: Vec<PathBuf>,
+        camera: Option<String>,
+    ) -> Self {
         // Settings live in their own file (written through `atomic_file`); versions before
         // 2026-12-04 kept them in eframe's storage, read when there is no file yet.
         let settings_file = cc
@@ -232,6 +244,7 @@ impl EotnApp {
         let ctx = cc.egui_ctx.clone();
         app.state
             .set_wake(std::sync::Arc::new(move || ctx.request_repaint()));
+        app.state.set_camera_choice(camera);
         if paths.is_empty() {
             app.state.reopen_last();
         } else {
@@ -255,6 +268,8 @@ impl EotnApp {
             file_dialogs: file_dialog::FileDialogs::default(),
             hovered: None,
             last_view: None,
+            last_panes: Vec::new(),
+            beside_textures: side_by_side::BesideTextures::default(),
             confirm_close: false,
             allow_close: false,
             show_warnings: false,
@@ -296,7 +311,10 @@ impl EotnApp {
     }
 
     fn close_dialog(&mut self, ctx: &egui::Context, commands: &mut Vec<Command>) {
-        if ctx.input(|i| i.viewport().close_requested()) && self.state.dirty() && !self.allow_close
+        let unsaved_beside = self.state.unsaved_beside().join(", ");
+        if ctx.input(|i| i.viewport().close_requested())
+            && (self.state.dirty() || !unsaved_beside.is_empty())
+            && !self.allow_close
         {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.confirm_close = true;
@@ -311,8 +329,17 @@ impl EotnApp {
                 "{} has edits that are not saved.",
                 self.state.title()
             ));
+            if !unsaved_beside.is_empty() {
+                // Save and quit saves the focused camera's table only.
+                ui.label(format!(
+                    "The tables of {unsaved_beside} (side by side) have unsaved edits too: focus each and save it first."
+                ));
+            }
             ui.horizontal(|ui| {
-                if self.state.table_path().is_some() && ui.button("Save and quit").clicked() {
+                if self.state.table_path().is_some()
+                    && unsaved_beside.is_empty()
+                    && ui.button("Save and quit").clicked()
+                {
                     choice = Some(1);
                 }
                 if ui.button("Quit without saving").clicked() {
@@ -447,6 +474,8 @@ impl eframe::App for EotnApp {
         let mut commands = Vec::new();
         let mut quit = self.keyboard(&ctx, &mut commands);
         self.update_textures(&ctx);
+        self.beside_textures
+            .update(&ctx, &self.state, &self.palette);
         quit |= self.panels_ui(ui, &mut commands);
         self.windows_ui(&ctx, &mut commands);
         if let Some(at) = self.quit_at {

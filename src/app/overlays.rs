@@ -200,7 +200,49 @@ pub fn paint_view(
     {
         sample_marker(&painter, xf, x, y);
     }
+    if with_overlays && !state.undistorted_view() {
+        label_boxes(&painter, xf, state);
+    }
     super::overhead_overlays::paint_overhead(&painter, xf, kind, state, with_overlays);
+}
+
+/// The opened labels' boxes of the shown frame (`Command::OpenLabels`), dashed, by class: balls
+/// orange, robots blue, goals yellow, other classes grey; each with its class name above it.
+fn label_boxes(painter: &Painter, xf: &ImageTransform, state: &Workspace) {
+    use crate::eval::label_sets::LabelObject;
+    let Some(frame) = state.shown_label_boxes() else {
+        return;
+    };
+    for b in &frame.boxes {
+        let colour = match b.object {
+            LabelObject::Ball => Color32::from_rgb(255, 120, 0),
+            LabelObject::Robot => Color32::from_rgb(60, 140, 255),
+            LabelObject::Goal => Color32::from_rgb(255, 230, 0),
+            LabelObject::Other => Color32::from_gray(200),
+        };
+        let rect = Rect::from_min_max(
+            xf.to_screen(pos2(b.min_x as f32, b.min_y as f32)),
+            xf.to_screen(pos2(b.max_x as f32, b.max_y as f32)),
+        );
+        let stroke = Stroke::new(1.5, colour);
+        let corners = [
+            rect.left_top(),
+            rect.right_top(),
+            rect.right_bottom(),
+            rect.left_bottom(),
+            rect.left_top(),
+        ];
+        for side in corners.windows(2) {
+            painter.extend(egui::Shape::dashed_line(side, stroke, 4.0, 3.0));
+        }
+        painter.text(
+            rect.left_top() - vec2(0.0, 2.0),
+            egui::Align2::LEFT_BOTTOM,
+            &b.class,
+            FontId::proportional(10.0),
+            colour,
+        );
+    }
 }
 
 /// A blob's box on screen (pixel edges inclusive).

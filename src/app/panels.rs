@@ -49,8 +49,11 @@ impl EotnApp {
                     commands,
                     dialog: &mut self.menu_input.dialog,
                     view: views::MainViewOutput::default(),
+                    beside: &self.beside_textures,
+                    panes: Vec::new(),
                 };
                 let out = self.dock.ui(ui, &mut behavior);
+                self.last_panes = behavior.panes;
                 self.hovered = out.hovered;
                 self.last_view = out.transform;
             });

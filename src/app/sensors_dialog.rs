@@ -16,8 +16,13 @@ pub fn sensors_ui(ui: &mut egui::Ui, state: &Workspace) {
         ui.label("No frame open.");
         return;
     };
+    // With several cameras, the readings are those of the camera shown (focused).
+    let camera = match state.cameras() {
+        (all, Some(topic)) if all.len() > 1 => format!("camera {topic}, "),
+        _ => String::new(),
+    };
     ui.label(format!(
-        "frame {} at {:.3} s",
+        "{camera}frame {} at {:.3} s",
         state.index(),
         current.time_ns as f64 / 1e9
     ));

@@ -28,7 +28,7 @@ pub struct Args {
     /// 8: diagonal neighbours join a blob; 4: they do not.
     #[arg(long, default_value = "8", value_parser = parse_connectivity)]
     pub connectivity: Connectivity,
-    /// Recognition parameters as JSON (any subset of the fields; the rest keep their defaults).
+    /// Recognition parameters as JSON (any subset of the fields; the rest keep their defaults) (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// One JSON object per frame per line.
@@ -408,6 +408,62 @@ pub fn load_sensor_file(path: &std::path::Path) -> anyhow::Result<Vec<SensorRead
         .collect()
 }
 
+/// What the first recording among `paths` names for the camera read (`camera`; `None`: its
+/// first) — its sidecar's entry, else its `eotn.camera` metadata —, with that recording's path;
+/// `None` when no recording is among them.
+///
+/// # Errors
+/// An unreadable recording or sidecar, or a camera the recording does not have.
+pub fn named_camera_files(
+    paths: &[PathBuf],
+    camera: Option<&str>,
+) -> anyhow::Result<Option<(PathBuf, crate::camera::CameraFiles)>> {
+    let Some(rec) = paths.iter().find(|p| crate::streams::is_recording(p)) else {
+        return Ok(None);
+    };
+    let reader = crate::streams::StreamReader::open_camera(rec, camera)?;
+    Ok(Some((rec.clone(), reader.camera_files()?)))
+}
+
+/// The recognition parameters of a command: `--params` when given, else those the first
+/// recording among `paths` names for the camera read (a file, or a set's name found as the app
+/// finds it: `params/NAME.json` beside the recording or up to three folders above, or in the
+/// current folder), else the defaults.
+///
+/// # Errors
+/// As [`load_params`]; a named set found nowhere.
+pub fn params_or_camera_s(
+    explicit: Option<&std::path::Path>,
+    paths: &[PathBuf],
+    camera: Option<&str>,
+) -> anyhow::Result<crate::recognition::RecognitionParams> {
+    if explicit.is_some() {
+        return load_params(explicit);
+    }
+    let Some((rec, files)) = named_camera_files(paths, camera)? else {
+        return load_params(None);
+    };
+    let Some(name) = files.params else {
+        return load_params(None);
+    };
+    let path = if name.contains('/') || name.ends_with(".json") {
+        PathBuf::from(&name)
+    } else {
+        crate::workspace::params::find_param_set(&name, &rec).with_context(|| {
+            format!(
+                "{}: its camera's parameter set {name} is nowhere (params/{name}.json beside the recording or above it, or here): give --params",
+                rec.display()
+            )
+        })?
+    };
+    load_params(Some(&path)).with_context(|| {
+        format!(
+            "{}: the recognition parameters named for its camera",
+            rec.display()
+        )
+    })
+}
+
 /// Loads `--params`: recognition parameters as JSON over the defaults, every key and range
 /// checked ([`crate::recognition::params_file`]).
 ///
@@ -453,7 +509,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let params = PipelineParams {
         connectivity: args.connectivity,
         recognise: true,
-        recognition: load_params(args.params.as_deref())?,
+        recognition: params_or_camera_s(
+            args.params.as_deref(),
+            &args.input.frames,
+            args.input.camera.get(),
+        )?,
     };
     let mut pipeline = Pipeline::new(lut, params);
     if let Some(p) = &args.patterns {
@@ -467,11 +527,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "detect");
+    let mut last_size = None;
     for i in 0..inputs.len() {
         let Some(mut record) = inputs.load_record_or_skip(i, args.input.size)? else {
             bar.inc(1);
             continue;
         };
+        let size = (record.frame.width(), record.frame.height());
+        if let Some((w, h)) = last_size.replace(size)
+            && (w, h) != size
+        {
+            // Each frame is detected at its own size; the change is said where it happens.
+            log::warn!(
+                "{}: the frame size changes from {w}x{h} to {}x{}",
+                inputs.name(i),
+                size.0,
+                size.1
+            );
+        }
         let readings = readings_for(record.sensors.as_ref(), sensors.as_deref(), i);
         let result = pipeline.process(&record.frame, readings);
         let us = result.timings.recognition.as_secs_f64() * 1e6;

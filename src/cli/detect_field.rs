@@ -9,9 +9,9 @@ use std::path::Path;
 use anyhow::Context;
 use serde::Serialize;
 
-use super::field::open_cameras;
+use super::field::{field_views, frame_times, open_cameras};
 use super::overhead::{BallJson, RobotJson, SizeCheck};
-use crate::overhead::merge::{CameraId, FieldPicture, frame_near, merge_detections};
+use crate::overhead::merge::{CameraId, FieldPicture, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::session::Session;
 
@@ -59,44 +59,18 @@ struct FieldLineJson {
 pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
     let session = Session::load(path)?;
     let (_, mut cameras) = open_cameras(&session)?;
-    let times: Vec<Vec<u64>> = cameras
-        .iter()
-        .map(|c| {
-            (0..c.reader.len())
-                .filter_map(|i| c.reader.time_ns(i))
-                .collect()
-        })
-        .collect();
+    let times = frame_times(&cameras);
     let reference = times.first().cloned().unwrap_or_default();
     let period_ns = frame_period_ns(&reference);
     let mut sizes: Vec<SizeCheck> = cameras.iter().map(|_| SizeCheck::default()).collect();
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     for (i, &t_ref) in reference.iter().enumerate() {
-        let mut views: Vec<(CameraId, OverheadDetections)> = Vec::new();
-        let mut frames = Vec::new();
-        for (k, cam) in cameras.iter_mut().enumerate() {
-            let index = if k == 0 {
-                Some(i)
-            } else {
-                frame_near(&times[k], t_ref, period_ns)
-            };
-            let Some(index) = index else { continue };
-            let f = match cam.read(index) {
-                Ok(f) => f,
-                Err(e) => {
-                    log::warn!("camera {}: {e:#}; left out of this field frame", cam.id);
-                    continue;
-                }
-            };
-            let camera = *cam.pipeline.camera();
-            let name = format!("{} frame {index}", cam.name);
-            sizes[k].check(&camera, &name, f.frame.width(), f.frame.height())?;
-            views.push((cam.id, cam.pipeline.process(&f.frame).clone()));
-            frames.push(CameraFrameJson {
-                id: cam.id,
-                time_ns: f.time_ns,
-            });
-        }
+        let (views, frames) =
+            field_views(cameras.as_mut_slice(), &times, i, period_ns, &mut sizes)?;
+        let frames = frames
+            .into_iter()
+            .map(|(id, time_ns)| CameraFrameJson { id, time_ns })
+            .collect();
         let refs: Vec<(CameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let line = field_line(t_ref, &merge_detections(&refs), frames);
@@ -111,8 +85,22 @@ pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// One field frame as a line of `overhead detect --session --json` (`time_ns`, `ball`,
+/// `robots`, `cameras`), for `eotn wmd` to add its world models to.
+pub(super) fn field_line_value(
+    time_ns: u64,
+    p: &FieldPicture,
+    cameras: &[(CameraId, u64)],
+) -> serde_json::Result<serde_json::Value> {
+    let frames = cameras
+        .iter()
+        .map(|&(id, time_ns)| CameraFrameJson { id, time_ns })
+        .collect();
+    serde_json::to_value(field_line(time_ns, p, frames))
+}
+
 /// The reference camera's frame period: the median gap between its frames (1/75 s for one
-/// frame).
+/// frame, the SSL cameras' rate).
 fn frame_period_ns(times: &[u64]) -> u64 {
     let mut gaps: Vec<u64> = times
         .windows(2)

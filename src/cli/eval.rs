@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use serde::Serialize;
 
-use super::detect::load_params;
+use super::detect::{load_params, params_or_camera_s};
 use super::inputs::load_lut_arg;
 use super::pct;
 use crate::eval::skew::{self, SkewReport};
@@ -32,7 +32,7 @@ pub struct Args {
     /// Lookup table.
     #[arg(long)]
     pub lut: PathBuf,
-    /// Recognition parameters JSON.
+    /// Recognition parameters JSON (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// A second table to compare on the same frames.
@@ -57,11 +57,25 @@ pub struct Args {
     /// error histograms, found rates per distance band, post errors).
     #[arg(long, value_name = super::paths::OUT_DIR)]
     pub plots: Option<PathBuf>,
-    /// Score a real stream against hand labels instead of ground truth (a labels JSON file,
-    /// see the README's "Hand labels"): ball found/missed/false, centre and radius errors,
-    /// goals found and false, goal distances from size beside those of their foot. One stream.
+    /// Score real frames against hand labels instead of ground truth: eotn's labels JSON (see
+    /// the README's "Hand labels"; one stream: ball found/missed/false, centre and radius
+    /// errors, goals, goal distances), or boxes as teams keep them — a YOLO folder, a COCO
+    /// JSON file or a Pascal VOC folder, told apart by content — scored on the ball (frame
+    /// recall, precision, centre error, by ball size; docs/recognition.md).
     #[arg(long)]
     pub labels: Option<PathBuf>,
+    /// YOLO labels without `classes.txt`: the class names in order of their numbers
+    /// (`robot,ball,goal`).
+    #[arg(long, value_name = "NAMES")]
+    pub class_names: Option<String>,
+    /// Box labels: which eotn object each class name is, `name=object,…` (objects `ball`,
+    /// `robot`, `goal`, `other`; `ball`, `robot` and `goal` are themselves by default).
+    #[arg(long, value_name = "MAP")]
+    pub classes: Option<String>,
+    /// Labels: score every frame, the tuning frames, or the held-out frames (those whose
+    /// number ends in 7, 8 or 9: a file's number, or a stream frame's index).
+    #[arg(long, value_enum, default_value_t = crate::eval::label_sets::Split::All)]
+    pub split: crate::eval::label_sets::Split,
     /// A places file (`eotn patterns learn`): also score the pink markers' identification
     /// against the truth's markers (correct, wrong, missed; distance errors).
     #[arg(long)]
@@ -76,6 +90,9 @@ pub struct Args {
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
 }
 
 /// A frame whose results differ between the two configurations.
@@ -390,6 +407,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if overhead == args.streams.len() {
         return super::eval_overhead::run(
             &args.streams,
+            args.camera.get(),
             &args.lut,
             args.calibration.as_deref(),
             args.field.as_deref(),
@@ -403,12 +421,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .context("--calibration and --field are for overhead streams")?;
     }
     let lut = load_lut_arg(&args.lut)?;
-    let rp = load_params(args.params.as_deref())?;
+    let rp = params_or_camera_s(args.params.as_deref(), &args.streams, args.camera.get())?;
     if let Some(labels) = &args.labels {
-        let [stream] = args.streams.as_slice() else {
-            bail!("--labels scores one stream, {} given", args.streams.len());
-        };
-        return super::eval_labels::run(stream, labels, lut, rp, args.json);
+        return run_labels(args, labels, lut, rp);
     }
     let places = args
         .patterns
@@ -419,7 +434,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut c = Collected::default();
     let mut global = 0usize;
     for path in &args.streams {
-        let mut reader = StreamReader::open(path)?;
+        let mut reader = StreamReader::open_camera(path, args.camera.get())?;
         let name = crate::frame::display_name(path);
         let bar = super::inputs::progress(reader.len(), "eval");
         for i in 0..reader.len() {
@@ -478,6 +493,56 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         print_summary(&output);
     }
     Ok(())
+}
+
+/// `eotn eval --labels`: boxed labels as teams keep them (YOLO, COCO, VOC), or eotn's own
+/// labels JSON of one stream.
+fn run_labels(
+    args: &Args,
+    labels: &std::path::Path,
+    lut: crate::lut::LookupTable,
+    rp: RecognitionParams,
+) -> anyhow::Result<()> {
+    if !is_eotn_labels(labels) {
+        let boxes = super::eval_boxes::BoxEvalArgs {
+            images: &args.streams,
+            labels,
+            class_names: args.class_names.as_deref(),
+            classes: args.classes.as_deref(),
+            split: args.split,
+            plots: args.plots.as_deref(),
+            json: args.json,
+        };
+        return super::eval_boxes::run(&boxes, lut, rp);
+    }
+    let [stream] = args.streams.as_slice() else {
+        bail!("--labels scores one stream, {} given", args.streams.len());
+    };
+    super::eval_labels::run(
+        stream,
+        args.camera.get(),
+        labels,
+        lut,
+        rp,
+        args.split,
+        args.json,
+    )
+}
+
+/// Whether `path` is eotn's own labels JSON (`"format": "eotn.labels"`), told by content; any
+/// other file or folder is a YOLO, COCO or VOC set.
+fn is_eotn_labels(path: &std::path::Path) -> bool {
+    path.is_file()
+        && crate::input_file::read_text_bounded(
+            path,
+            crate::input_file::MAX_SIDE_FILE_BYTES,
+            "a labels file",
+        )
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .is_some_and(|v| {
+            v.get("format").and_then(|f| f.as_str()) == Some(crate::eval::labels::LABELS_FORMAT)
+        })
 }
 
 /// The human-readable summary: the ball, the skew study, goals, the frames that went wrong,

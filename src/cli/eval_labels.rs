@@ -10,6 +10,7 @@ use anyhow::{Context, bail};
 use serde::Serialize;
 
 use super::pct;
+use crate::eval::label_sets::Split;
 use crate::eval::labels::{LabelledFrameEval, Labels, LabelsReport, evaluate_labelled_frame};
 use crate::eval::{EvalParams, Percentiles, percentile_text, sample_size};
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -34,6 +35,8 @@ pub struct GoalDistances {
 /// Everything `eotn eval --labels` reports.
 #[derive(Debug, Clone, Serialize)]
 pub struct LabelsOutput {
+    /// Which frames were scored (`all`, `tuning`, `held-out`).
+    pub split: Split,
     /// The sums.
     pub report: LabelsReport,
     /// Found goals with both ends in the image: size-based / foot distance, percentiles.
@@ -54,13 +57,15 @@ pub struct LabelsOutput {
 /// Unreadable stream or labels, labels made on another frame size, or no labelled frame.
 pub fn run(
     stream: &Path,
+    camera: Option<&str>,
     labels_path: &Path,
     lut: crate::lut::LookupTable,
     params: RecognitionParams,
+    split: Split,
     json: bool,
 ) -> anyhow::Result<()> {
     let labels = Labels::load(labels_path)?;
-    let mut reader = StreamReader::open(stream)?;
+    let mut reader = StreamReader::open_camera(stream, camera)?;
     let mut pipeline = Pipeline::new(
         lut,
         PipelineParams {
@@ -75,6 +80,9 @@ pub fn run(
     let bar = super::inputs::progress(reader.len(), "eval");
     for i in 0..reader.len() {
         bar.inc(1);
+        if !split.takes(&i.to_string()) {
+            continue;
+        }
         let Some(label) = labels.frame(i) else {
             unlabelled.push(i);
             continue;
@@ -96,21 +104,7 @@ pub fn run(
         let ctx = params.context_for(w, h, sensors);
         let result = pipeline.process(&record.frame, sensors);
         let r = &result.recognition;
-        for g in r.goals.goals() {
-            let bottom = crate::geometry::ImagePoint::new(
-                (g.level_extent[0] + g.level_extent[2]) / 2.0,
-                g.level_extent[3],
-            );
-            let foot = bottom.rotated_about(ctx.camera.centre, -ctx.horizon_angle());
-            goal_distances.push(GoalDistances {
-                frame: i,
-                distance_cm: g.camera.distance_cm,
-                foot_distance_cm: (!g.cut_off.bottom)
-                    .then(|| ctx.distance_to_plane(foot, 0.0))
-                    .flatten(),
-                cut_top_or_bottom: g.cut_off.top || g.cut_off.bottom,
-            });
-        }
+        goal_distances.extend(goal_distances_of(i, r, &ctx));
         frames.push(evaluate_labelled_frame(r, label, w as f64, h as f64, &ep));
     }
     bar.finish_and_clear();
@@ -122,9 +116,10 @@ pub fn run(
         .collect();
     if frames.is_empty() {
         bail!(
-            "{}: no frame of {} is labelled",
+            "{}: no frame of {} in the {} split is labelled",
             labels_path.display(),
-            stream.display()
+            stream.display(),
+            super::eval_boxes::split_name(split)
         );
     }
     let ratios: Vec<f64> = goal_distances
@@ -133,6 +128,7 @@ pub fn run(
         .filter_map(|g| g.foot_distance_cm.map(|f| g.distance_cm / f))
         .collect();
     let output = LabelsOutput {
+        split,
         report: LabelsReport::from_frames(&frames),
         goal_size_over_foot: Percentiles::of(&ratios),
         goal_distances,
@@ -148,9 +144,39 @@ pub fn run(
     Ok(())
 }
 
+/// Each goal of a frame's recognition with its size-based distance and its foot's.
+fn goal_distances_of(
+    frame: usize,
+    r: &crate::recognition::Recognition,
+    ctx: &crate::recognition::ViewContext,
+) -> Vec<GoalDistances> {
+    r.goals
+        .goals()
+        .map(|g| {
+            let bottom = crate::geometry::ImagePoint::new(
+                (g.level_extent[0] + g.level_extent[2]) / 2.0,
+                g.level_extent[3],
+            );
+            let foot = bottom.rotated_about(ctx.camera.centre, -ctx.horizon_angle());
+            GoalDistances {
+                frame,
+                distance_cm: g.camera.distance_cm,
+                foot_distance_cm: (!g.cut_off.bottom)
+                    .then(|| ctx.distance_to_plane(foot, 0.0))
+                    .flatten(),
+                cut_top_or_bottom: g.cut_off.top || g.cut_off.bottom,
+            }
+        })
+        .collect()
+}
+
 fn print_summary(o: &LabelsOutput) {
     let r = &o.report;
-    outln!("labelled frames        {}", r.frames);
+    outln!(
+        "labelled frames        {} ({} split)",
+        r.frames,
+        super::eval_boxes::split_name(o.split)
+    );
     outln!(
         "ball found             {}/{} labelled visible = {}; cut by the image edge {}/{}; \
          ≥ 60% in view and ≥ 6 px {}/{}",

@@ -9,8 +9,7 @@ use anyhow::{Context, bail};
 use super::inputs::load_lut_arg;
 use super::overhead::{load_field, params_for};
 use crate::eval::overhead::{
-    OverheadEvalParams, OverheadEvalReport, WorldModel, evaluate_overhead_frame,
-    evaluate_world_model,
+    OverheadEvalParams, OverheadEvalReport, evaluate_overhead_frame, evaluate_world_model,
 };
 use crate::eval::{Percentiles, percentile_text};
 use crate::model::truth::GroundTruth;
@@ -36,6 +35,7 @@ pub fn is_overhead_stream(path: &Path) -> bool {
 /// Unreadable inputs, naming the file; no overhead frame at all.
 pub fn run(
     streams: &[PathBuf],
+    camera: Option<&str>,
     lut: &Path,
     calibration: Option<&Path>,
     field: Option<&Path>,
@@ -51,7 +51,7 @@ pub fn run(
     let (mut frames, mut models, mut skipped) = (Vec::new(), Vec::new(), Vec::<String>::new());
     let mut global = 0usize;
     for path in streams {
-        let mut reader = StreamReader::open(path)?;
+        let mut reader = StreamReader::open_camera(path, camera)?;
         let name = crate::frame::display_name(path);
         let mut pipeline: Option<OverheadPipeline> = None;
         let bar = super::inputs::progress(reader.len(), "eval overhead");
@@ -93,10 +93,10 @@ pub fn run(
             let detections = p.process(&record.frame).clone();
             frames.push(evaluate_overhead_frame(global, &detections, &truth, &ep));
             for (topic, value) in &record.extra {
-                if !topic.starts_with("/world_model/") {
+                if !crate::model::world_model::is_world_model_topic(topic) {
                     continue;
                 }
-                match serde_json::from_value::<WorldModel>(value.clone()) {
+                match crate::model::world_model::from_value(value) {
                     Ok(m) => models.extend(evaluate_world_model(&m, &truth, Some(&detections))),
                     Err(e) => skipped.push(format!("{name}#{i} {topic}: {e}")),
                 }

@@ -63,6 +63,9 @@ pub struct Args {
     /// Blobs view: leave out blobs with fewer pixels than this.
     #[arg(long, default_value_t = 4, value_parser = super::values::whole_in::<u32>(0, super::values::MAX_PIXELS))]
     pub min_pixels: u32,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
 }
 
 /// Runs `eotn export`.
@@ -76,7 +79,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (None, View::Raw) => None,
         (None, view) => bail!("--view {} needs --lut TABLE", view.suffix()),
     };
-    let mut inputs = FrameInputs::open(&args.inputs, args.frames.clone())?;
+    let mut inputs =
+        FrameInputs::open_camera(&args.inputs, args.frames.clone(), args.camera.get())?;
     crate::atomic_file::output_folder(&args.output)
         .with_context(|| format!("{}", args.output.display()))?;
     let mut classified = ClassifiedImage::default();

@@ -10,7 +10,8 @@ use super::inputs::load_lut_arg;
 use super::overhead::{load_usable_calibration, params_for};
 use crate::model::GroundTruth;
 use crate::model::truth::OverheadTruth;
-use crate::overhead::recognise::OverheadParams;
+use crate::overhead::merge::CameraId as MergeCameraId;
+use crate::overhead::recognise::{OverheadDetections, OverheadParams};
 use crate::overhead::{FieldDescription, OverheadPipeline};
 use crate::session::{CameraId, OverheadEntry, Session, SessionSource};
 use crate::streams::StreamReader;
@@ -67,19 +68,13 @@ fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<Fi
             e.source
         );
     };
-    if let Some(topic) = &e.camera {
-        log::warn!(
-            "camera {}: topic {topic:?} given; the recording's image channel is read",
-            e.id
-        );
-    }
     let lut = load_lut_arg(&e.lut)?;
     let cal = load_usable_calibration(&e.calibration)?;
     let params = match &e.params {
         Some(p) => load_params(p)?,
         None => params_for(field),
     };
-    let reader = StreamReader::open(path)?;
+    let reader = StreamReader::open_camera(path, e.camera.as_deref())?;
     Ok(FieldCamera {
         id: e.id,
         pipeline: OverheadPipeline::new(lut, cal.camera, params),
@@ -136,4 +131,68 @@ impl FieldCamera {
             truth,
         })
     }
+}
+
+/// One field frame's detections by camera, and each camera's frame time (nanoseconds).
+pub type FieldViews = (
+    Vec<(MergeCameraId, OverheadDetections)>,
+    Vec<(MergeCameraId, u64)>,
+);
+
+/// Each camera's frame times, nanoseconds on its recording's clock, in frame order.
+#[must_use]
+pub fn frame_times(cameras: &[FieldCamera]) -> Vec<Vec<u64>> {
+    cameras
+        .iter()
+        .map(|c| {
+            (0..c.reader.len())
+                .filter_map(|i| c.reader.time_ns(i))
+                .collect()
+        })
+        .collect()
+}
+
+/// One field frame's views: the reference camera's frame `i` and each other camera's frame
+/// within half a frame period of it (`times` from [`frame_times`]), each through its own
+/// pipeline; with the (camera, frame time) of each view.
+///
+/// # Errors
+/// A camera's frame of another shape than its calibration. An unreadable frame is warned about
+/// and left out.
+pub fn field_views(
+    cameras: &mut [FieldCamera],
+    times: &[Vec<u64>],
+    i: usize,
+    period_ns: u64,
+    sizes: &mut [super::overhead::SizeCheck],
+) -> anyhow::Result<FieldViews> {
+    let Some(&t_ref) = times.first().and_then(|t| t.get(i)) else {
+        return Ok((Vec::new(), Vec::new()));
+    };
+    let (mut views, mut frames) = (Vec::new(), Vec::new());
+    for (k, cam) in cameras.iter_mut().enumerate() {
+        let index = if k == 0 {
+            Some(i)
+        } else {
+            times
+                .get(k)
+                .and_then(|t| crate::overhead::merge::frame_near(t, t_ref, period_ns))
+        };
+        let Some(index) = index else { continue };
+        let f = match cam.read(index) {
+            Ok(f) => f,
+            Err(e) => {
+                log::warn!("camera {}: {e:#}; left out of this field frame", cam.id);
+                continue;
+            }
+        };
+        let camera = *cam.pipeline.camera();
+        let name = format!("{} frame {index}", cam.name);
+        if let Some(size) = sizes.get_mut(k) {
+            size.check(&camera, &name, f.frame.width(), f.frame.height())?;
+        }
+        views.push((cam.id, cam.pipeline.process(&f.frame).clone()));
+        frames.push((cam.id, f.time_ns));
+    }
+    Ok((views, frames))
 }

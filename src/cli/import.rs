@@ -65,6 +65,11 @@ pub struct Args {
     /// Foxglove; the cameras' own order). The same samples either way.
     #[arg(long, default_value = "yuyv")]
     pub image_encoding: ImageEncoding,
+    /// Import only this camera (image topic) of a recording; repeat for several. Default: every
+    /// camera. One camera is written as a one-camera stream (`/camera/image`), several each on
+    /// its own topic with its own channels (docs/formats.md, "Several cameras").
+    #[arg(long = "camera", value_name = "TOPIC")]
+    pub cameras: Vec<String>,
     /// The stream to write (`.mcap`); written as `OUT.partial` and renamed when complete.
     #[arg(short, long, value_name = super::paths::OUT)]
     pub output: PathBuf,
@@ -90,6 +95,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         && is_recording(stream)
     {
         return rewrite_stream(stream, args);
+    }
+    if !args.cameras.is_empty() {
+        bail!("--camera chooses cameras of a recording; frame files have none to choose");
     }
     let paths = expand_frame_paths(&args.frames)?;
     if let Some(stream) = paths.iter().find(|p| is_recording(p)) {
@@ -205,14 +213,50 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
     if args.sensors.is_some() || args.size.is_some() {
         bail!("--sensors and --size are for frame files; a stream keeps its own readings");
     }
-    let mut reader = StreamReader::open(input)?;
-    for w in reader.warnings() {
-        log::warn!("{}: {w}", input.display());
+    let first = StreamReader::open(input)?;
+    let topics: Vec<String> = if args.cameras.is_empty() {
+        first
+            .image_topics()
+            .iter()
+            .map(|t| t.topic.clone())
+            .collect()
+    } else {
+        args.cameras.clone()
+    };
+    if topics.len() <= 1 && args.cameras.is_empty() {
+        return rewrite_cameras(input, args, vec![first]);
     }
-    for n in reader.notes() {
-        log::warn!("{}: note: {n}", input.display());
+    if topics.len() == 1 {
+        let reader = StreamReader::open_camera(input, topics.first().map(String::as_str))?;
+        return rewrite_cameras(input, args, vec![reader]);
     }
-    if reader.is_empty() {
+    let readers = topics
+        .iter()
+        .map(|t| StreamReader::open_camera(input, Some(t)))
+        .collect::<Result<Vec<_>, _>>()?;
+    rewrite_cameras(input, args, readers)
+}
+
+/// The stream's cameras into one stream: one reader gives a one-camera stream as always;
+/// several are merged by time, each camera on its own topic (the first camera `/camera/image`
+/// stays so), a channel shared by the cameras written once, with the first camera's frames.
+fn rewrite_cameras(
+    input: &std::path::Path,
+    args: &Args,
+    mut readers: Vec<StreamReader>,
+) -> anyhow::Result<()> {
+    let several = readers.len() > 1;
+    if let Some(first) = readers.first() {
+        // One camera's reader says what every camera's would (the same file).
+        for w in first.warnings() {
+            log::warn!("{}: {w}", input.display());
+        }
+        for n in first.notes() {
+            log::warn!("{}: note: {n}", input.display());
+        }
+    }
+    let total: usize = readers.iter().map(StreamReader::len).sum();
+    if total == 0 {
         // The notes above say why (no image channel, one in an encoding eotn does not read).
         bail!(
             "{}: no camera frames to import; nothing written to {}",
@@ -220,33 +264,50 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
             args.output.display()
         );
     }
-    let mut info = reader.info().clone();
-    if info.source == "unknown" {
-        // Another tool's recording: the import's own source kind and a note of where from.
-        info.source.clone_from(&args.source);
-        info.description = if args.description.is_empty() {
-            format!("imported from {}", input.display())
-        } else {
-            args.description.clone()
-        };
-    }
+    let Some(head) = readers.first() else {
+        bail!("{}: no camera to import", input.display());
+    };
+    let info = imported_info(head.info(), input, args);
+    let topics: Vec<String> = readers
+        .iter()
+        .map(|r| r.camera().unwrap_or(crate::streams::IMAGE_TOPIC).to_owned())
+        .collect();
     let mut writer = StreamWriter::create_with(&args.output, &info, writer_options(args))?;
-    let bar = progress(reader.len(), "import");
+    if let Some(param_set) = head.param_set().filter(|_| several) {
+        writer.name_param_set(param_set)?;
+    }
+    let bar = progress(total, "import");
     let (mut written, mut skipped) = (0usize, Vec::new());
-    for index in 0..reader.len() {
+    let mut next = vec![0usize; readers.len()];
+    // The camera whose next frame is earliest, each camera in its own order.
+    while let Some(c) = (0..readers.len())
+        .filter(|&c| next[c] < readers[c].len())
+        .min_by_key(|&c| (readers[c].time_ns(next[c]).unwrap_or(u64::MAX), c))
+    {
+        let index = next[c];
+        next[c] += 1;
         bar.inc(1);
-        match reader.read_with_image(index) {
-            Ok((record, image)) => {
+        match readers[c].read_with_image(index) {
+            Ok((mut record, image)) => {
                 // eotn's own 4:2:2 frames take the chosen byte order; every other image is
                 // stored as the message it came in (converted only when read).
                 let keep = (!is_plain_422(&image)).then_some(&image);
-                writer
-                    .write_with_image(&record, keep)
-                    .with_context(|| format!("{}: frame {index}", args.output.display()))?;
+                if several {
+                    own_channels(&mut record, &topics[c], c == 0);
+                    writer.write_camera(&topics[c], &record, keep)
+                } else {
+                    writer.write_with_image(&record, keep)
+                }
+                .with_context(|| format!("{}: frame {index}", args.output.display()))?;
                 written += 1;
             }
             Err(e) => {
-                log::warn!("{}: frame {index} skipped: {e}", input.display());
+                let camera = if several {
+                    format!(" of {}", topics[c])
+                } else {
+                    String::new()
+                };
+                log::warn!("{}: frame {index}{camera} skipped: {e}", input.display());
                 skipped.push(index);
             }
         }
@@ -262,12 +323,51 @@ fn rewrite_stream(input: &std::path::Path, args: &Args) -> anyhow::Result<()> {
         );
     }
     writer.finish()?;
+    let cameras = if several {
+        format!(" of {} cameras", topics.len())
+    } else {
+        String::new()
+    };
     eprintln!(
-        "eotn: wrote {written} frames to {} ({} skipped)",
+        "eotn: wrote {written} frames{cameras} to {} ({} skipped)",
         args.output.display(),
         skipped.len()
     );
     Ok(())
+}
+
+/// The stream's description: the recording's own, or for another tool's recording the import's
+/// source kind and a note of where from.
+fn imported_info(
+    info: &crate::streams::StreamInfo,
+    input: &std::path::Path,
+    args: &Args,
+) -> crate::streams::StreamInfo {
+    let mut info = info.clone();
+    if info.source == "unknown" {
+        info.source.clone_from(&args.source);
+        info.description = if args.description.is_empty() {
+            format!("imported from {}", input.display())
+        } else {
+            args.description.clone()
+        };
+    }
+    info
+}
+
+/// A frame's extra channels as one camera of several writes them: its camera intrinsics
+/// under its own name (`CAMERA/camera_info`); the channels every camera reads (joints, world
+/// models) with the first camera only, so they are written once.
+fn own_channels(record: &mut crate::streams::FrameRecord, camera: &str, first: bool) {
+    let info_topic = crate::camera::CameraChannel::CameraInfo.topic(camera);
+    record.extra.retain_mut(|(topic, _)| {
+        if topic.ends_with("/camera_info") || topic.ends_with("/camera_calibration") {
+            topic.clone_from(&info_topic);
+            true
+        } else {
+            first
+        }
+    });
 }
 
 /// The writer options of the command line.

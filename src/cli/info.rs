@@ -19,6 +19,10 @@ pub struct Args {
     /// Print one JSON object per file per line.
     #[arg(long)]
     pub json: bool,
+    /// The camera (image topic) of recordings to describe (`frames`, `width`, …); default: the
+    /// first. Every camera is listed under `cameras` whichever is chosen.
+    #[arg(long, value_name = "TOPIC")]
+    pub camera: Option<String>,
 }
 
 /// Runs `eotn info`.
@@ -29,7 +33,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for path in &args.files {
         let value = if is_recording(path) || path.is_dir() {
             // A folder is a ROS 2 bag or nothing `info` describes: the reader says which.
-            stream_info(path)?
+            stream_info(path, args.camera.as_deref())?
         } else if is_frame_file(path) {
             let f = load_frame_arg(path, args.size)?;
             serde_json::json!({
@@ -59,11 +63,113 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Every camera of a recording: topic, frames, and the size and encoding of its first
+/// readable frame (`null` when none reads), its first and last times and frame rate; every size
+/// when it changes mid-recording. With several cameras, the lines worth a warning: a camera
+/// whose frame size changes, one that ends (or begins) well before (after) the others, and
+/// cameras at different frame rates — each shown as it is, never matched by frame number.
+fn cameras(reader: &StreamReader) -> anyhow::Result<(Vec<serde_json::Value>, Vec<String>)> {
+    let mut out = Vec::new();
+    let mut warnings = Vec::new();
+    // (topic, first ns, last ns, frames per second) of each camera with frames.
+    let mut spans: Vec<(String, u64, u64, Option<f64>)> = Vec::new();
+    for t in reader.image_topics() {
+        let mut one = StreamReader::open_camera(reader.path(), Some(&t.topic))?;
+        let n = one.len();
+        let first = (0..n).find_map(|i| one.read_with_image(i).ok().map(|r| (i, r)));
+        let (width, height, encoding) =
+            first
+                .as_ref()
+                .map_or((None, None, None), |(_, (r, image))| {
+                    (
+                        Some(r.frame.width()),
+                        Some(r.frame.height()),
+                        Some(image.encoding().to_owned()),
+                    )
+                });
+        let mut one_value = serde_json::json!({
+            "topic": t.topic, "frames": n,
+            "width": width, "height": height, "encoding": encoding,
+        });
+        if let (Some(a), Some(b)) = (
+            one.time_ns(0),
+            n.checked_sub(1).and_then(|i| one.time_ns(i)),
+        ) {
+            let fps = (n > 1 && b > a).then(|| duration_and_rate(b - a, n).1);
+            one_value["first_time_ns"] = a.into();
+            one_value["last_time_ns"] = b.into();
+            one_value["fps"] = fps.into();
+            spans.push((t.topic.clone(), a, b, fps));
+        }
+        if let Some((i, _)) = first {
+            let sizes = frame_sizes(&mut one, i);
+            if sizes.len() > 1 {
+                let list: Vec<String> = sizes
+                    .iter()
+                    .map(|((w, h), k)| format!("{w}x{h}: {k} frames"))
+                    .collect();
+                warnings.push(format!(
+                    "camera {}: the frame size changes mid-recording ({})",
+                    t.topic,
+                    list.join(", ")
+                ));
+                one_value["sizes"] = list.into();
+            }
+        }
+        out.push(one_value);
+    }
+    warnings.extend(span_warnings(&spans));
+    Ok((out, warnings))
+}
+
+/// With several cameras: one that ends (or begins) more than a second before (after) the
+/// others, and cameras at frame rates more than 5% apart.
+fn span_warnings(spans: &[(String, u64, u64, Option<f64>)]) -> Vec<String> {
+    let mut out = Vec::new();
+    if spans.len() < 2 {
+        return out;
+    }
+    let end = spans.iter().map(|s| s.2).max().unwrap_or(0);
+    let start = spans.iter().map(|s| s.1).min().unwrap_or(0);
+    for (topic, a, b, _) in spans {
+        if end - b > 1_000_000_000 {
+            out.push(format!(
+                "camera {topic} ends {:.2} s before the recording's last frame: side by side it shows its last frame, marked as ended",
+                (end - b) as f64 / 1e9
+            ));
+        }
+        if a - start > 1_000_000_000 {
+            out.push(format!(
+                "camera {topic} begins {:.2} s after the recording's first frame",
+                (a - start) as f64 / 1e9
+            ));
+        }
+    }
+    let rates: Vec<(&str, f64)> = spans
+        .iter()
+        .filter_map(|(t, _, _, f)| f.map(|f| (t.as_str(), f)))
+        .collect();
+    let (lo, hi) = rates.iter().fold((f64::MAX, 0.0_f64), |(lo, hi), (_, f)| {
+        (lo.min(*f), hi.max(*f))
+    });
+    if rates.len() > 1 && hi > lo * 1.05 {
+        let list: Vec<String> = rates
+            .iter()
+            .map(|(t, f)| format!("{t} {f:.1} fps"))
+            .collect();
+        out.push(format!(
+            "the cameras run at different frame rates ({}): frames are matched by time, never by number",
+            list.join(", ")
+        ));
+    }
+    out
+}
+
 /// A stream's description: source, frames, times, frame size, which channels the first readable
 /// frame has, every channel of the file with its message count, record counts, and the
 /// reader's notes and warnings.
-fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
-    let mut reader = StreamReader::open(path)?;
+fn stream_info(path: &std::path::Path, camera: Option<&str>) -> anyhow::Result<serde_json::Value> {
+    let mut reader = StreamReader::open_camera(path, camera)?;
     let n = reader.len();
     let (first, last) = (
         reader.time_ns(0),
@@ -107,6 +213,9 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
         .map(|t| serde_json::json!({"topic": t.topic, "type": t.kind.schema_name()}))
         .collect();
     value["image_topics"] = topics.into();
+    let (camera_values, camera_warnings) = cameras(&reader)?;
+    value["cameras"] = camera_values.into();
+    value["camera"] = reader.camera().into();
     let first_readable = (0..n).find_map(|i| match reader.read_with_image(i) {
         Ok((r, image)) => {
             value["image_encoding"] = image.encoding().into();
@@ -146,19 +255,24 @@ fn stream_info(path: &std::path::Path) -> anyhow::Result<serde_json::Value> {
         }
     }
     let mut warnings = reader.warnings().to_vec();
-    if let (Some(first), Some(last)) = (unreadable.first(), unreadable.last()) {
-        warnings.push(if unreadable.len() == 1 {
-            first.clone()
-        } else {
-            format!(
-                "{} frames unreadable before the first readable one ({first} … {last})",
-                unreadable.len()
-            )
-        });
-    }
+    warnings.extend(camera_warnings);
+    warnings.extend(unreadable_warning(&unreadable));
     value["notes"] = reader.notes().into();
     value["warnings"] = warnings.into();
     Ok(value)
+}
+
+/// The warning for the frames unreadable before the first readable one (`None`: none).
+fn unreadable_warning(unreadable: &[String]) -> Option<String> {
+    let (first, last) = (unreadable.first()?, unreadable.last()?);
+    Some(if unreadable.len() == 1 {
+        first.clone()
+    } else {
+        format!(
+            "{} frames unreadable before the first readable one ({first} … {last})",
+            unreadable.len()
+        )
+    })
 }
 
 /// How many readable frames from `first` on have each size (width, height).

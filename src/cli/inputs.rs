@@ -116,24 +116,72 @@ pub struct InputArgs {
     /// its `.db3`/`.mcap` file).
     #[arg(required = true)]
     pub frames: Vec<PathBuf>,
-    /// Lookup table (`.lut`, 6, 7 or 8 bits per channel).
+    /// Lookup table (`.lut`, 6, 7 or 8 bits per channel); default: the table the first
+    /// recording names for its camera (its `REC.cameras.json` sidecar, else its metadata).
     #[arg(long)]
-    pub lut: PathBuf,
+    pub lut: Option<PathBuf>,
     /// Frame size of raw files, WxH; 208x160 and 640x480 are inferred from the file length.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: CameraArg,
+}
+
+/// `--camera TOPIC`: which camera of a recording to read, for every command that reads frames.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct CameraArg {
+    /// The camera (image topic) of the recordings to read, e.g. `/camera/bottom`; default: the
+    /// first. An unknown topic is an error listing the cameras there are.
+    #[arg(long = "camera", value_name = "TOPIC")]
+    pub topic: Option<String>,
+}
+
+impl CameraArg {
+    /// The topic asked for.
+    #[must_use]
+    pub fn get(&self) -> Option<&str> {
+        self.topic.as_deref()
+    }
 }
 
 impl InputArgs {
     /// Loads the table and opens the frames, the first step of every frame command.
     ///
     /// # Errors
-    /// An unreadable table or frame file, naming it.
+    /// An unreadable table or frame file, naming it; no `--lut` and no table named for the
+    /// first recording's camera.
     pub fn open(&self) -> anyhow::Result<(LookupTable, FrameInputs)> {
-        let lut = load_lut_arg(&self.lut)?;
-        let inputs = FrameInputs::open(&self.frames, None)?;
+        let inputs = FrameInputs::open_camera(&self.frames, None, self.camera.get())?;
+        let lut = match &self.lut {
+            Some(path) => load_lut_arg(path)?,
+            None => load_lut_arg(&camera_table(&inputs)?)?,
+        };
         Ok((lut, inputs))
     }
+}
+
+/// The table the first recording among the inputs names for the camera read (sidecar, else
+/// metadata), for a command given no `--lut`.
+///
+/// # Errors
+/// No recording among the inputs, or its camera names no table.
+pub fn camera_table(inputs: &FrameInputs) -> anyhow::Result<PathBuf> {
+    let Some(path) = inputs.items.iter().find_map(|i| match i {
+        FrameInput::Stream { path, .. } => Some(path),
+        FrameInput::File(_) => None,
+    }) else {
+        bail!("--lut is needed: the inputs are frame files, which name no table");
+    };
+    let reader = crate::streams::StreamReader::open_camera(path, inputs.camera.as_deref())?;
+    let camera = reader.camera().unwrap_or("its camera").to_owned();
+    reader.camera_files()?.lut.ok_or_else(|| {
+        anyhow!(
+            "--lut is needed: {} names no table for {camera} (in {} or its metadata)",
+            path.display(),
+            crate::camera::sidecar_path(path).display()
+        )
+    })
 }
 
 /// The frames named on a command line, in order: frame files, folders of them, and MCAP streams
@@ -150,6 +198,8 @@ pub struct FrameInputs {
     overhead_streams: Vec<PathBuf>,
     /// The other streams: robot cameras' (the overhead recogniser means nothing on them).
     robot_streams: Vec<PathBuf>,
+    /// The camera (image topic) read from every recording; `None`: each one's first.
+    camera: Option<String>,
 }
 
 /// Runs of consecutive stream frames skipped as unreadable, warned about once per run (when the
@@ -197,11 +247,24 @@ impl FrameInputs {
     /// A path that does not exist, a folder without frames, an unreadable stream, or a stream
     /// without frames (each naming the file).
     pub fn open(paths: &[PathBuf], range: Option<Range<usize>>) -> anyhow::Result<Self> {
+        Self::open_camera(paths, range, None)
+    }
+
+    /// Like [`FrameInputs::open`], reading the camera `camera` (an image topic) of every
+    /// recording; `None` reads each one's first.
+    ///
+    /// # Errors
+    /// As [`FrameInputs::open`]; a recording without that camera (the error lists its cameras).
+    pub fn open_camera(
+        paths: &[PathBuf],
+        range: Option<Range<usize>>,
+        camera: Option<&str>,
+    ) -> anyhow::Result<Self> {
         let mut items = Vec::new();
         let (mut overhead_streams, mut robot_streams) = (Vec::new(), Vec::new());
         for p in expand_frame_paths(paths)? {
             if is_recording(&p) {
-                let stream = StreamSource::open(&p)?;
+                let stream = StreamSource::open_camera(&p, camera)?;
                 if crate::sources::FrameSource::info(&stream).camera
                     == crate::sources::CameraKind::Overhead
                 {
@@ -237,6 +300,7 @@ impl FrameInputs {
             skipped: SkippedFrames::default(),
             overhead_streams,
             robot_streams,
+            camera: camera.map(str::to_owned),
         })
     }
 
@@ -314,7 +378,7 @@ impl FrameInputs {
             return self.load_record(i, size).map(Some);
         };
         if self.stream.as_ref().is_none_or(|s| s.path() != path) {
-            self.stream = Some(StreamSource::open(&path)?);
+            self.stream = Some(StreamSource::open_camera(&path, self.camera.as_deref())?);
         }
         let Some(stream) = self.stream.as_mut() else {
             bail!("{}: stream not open", path.display());
@@ -365,7 +429,7 @@ impl FrameInputs {
             }
             Some(FrameInput::Stream { path, index }) => {
                 if self.stream.as_ref().is_none_or(|s| s.path() != path) {
-                    self.stream = Some(StreamSource::open(path)?);
+                    self.stream = Some(StreamSource::open_camera(path, self.camera.as_deref())?);
                 }
                 let Some(stream) = self.stream.as_mut() else {
                     bail!("{}: stream not open", path.display());
@@ -450,5 +514,37 @@ mod tests {
         assert_eq!(parse_frame_range("4").ok(), Some(4..5));
         assert!(parse_frame_range("5..2").is_err());
         assert!(parse_frame_range("a..b").is_err());
+    }
+
+    /// Every command that reads frames of recordings — an input argument named `frames`,
+    /// `files`, `inputs`, `streams` or `stream` — takes `--camera TOPIC`.
+    #[test]
+    fn every_command_reading_recordings_takes_camera() {
+        use clap::CommandFactory as _;
+        /// Commands whose inputs are never recordings: `lut-from-labels` reads labelled frame
+        /// files (a `.cls` mask beside each).
+        const NO_RECORDINGS: [&str; 1] = ["lut-from-labels"];
+        fn walk(cmd: &clap::Command, path: &str, missing: &mut Vec<String>, seen: &mut usize) {
+            let name = format!("{path} {}", cmd.get_name());
+            let reads = cmd.get_arguments().any(|a| {
+                ["frames", "files", "inputs", "streams", "stream"].contains(&a.get_id().as_str())
+                    && crate::cli::paths::path_role(a) == Some(crate::cli::paths::PathRole::Input)
+            });
+            if reads && !NO_RECORDINGS.contains(&cmd.get_name()) {
+                *seen += 1;
+                let camera = cmd.get_arguments().find(|a| a.get_long() == Some("camera"));
+                let named = camera.and_then(|a| a.get_value_names().map(<[_]>::to_vec));
+                if named.is_none_or(|n| n.iter().all(|v| v.as_str() != "TOPIC")) {
+                    missing.push(name.clone());
+                }
+            }
+            for sub in cmd.get_subcommands() {
+                walk(sub, &name, missing, seen);
+            }
+        }
+        let (mut missing, mut seen) = (Vec::new(), 0);
+        walk(&crate::cli::Cli::command(), "", &mut missing, &mut seen);
+        assert!(missing.is_empty(), "no --camera TOPIC: {missing:?}");
+        assert!(seen >= 14, "only {seen} commands read recordings");
     }
 }

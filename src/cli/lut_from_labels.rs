@@ -14,8 +14,26 @@ use crate::sim::{Scenario, ScenarioKind, Simulator};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Labelled frames: each `NAME.uyvy`/`.png` needs a mask `NAME.cls` beside it (one class
-    /// code per pixel, row-major, as `eotn classify --raw` writes). Folders are searched.
+    /// code per pixel, row-major, as `eotn classify --raw` writes), or `--boxes`. Folders are
+    /// searched.
     pub frames: Vec<PathBuf>,
+    /// Instead of masks: boxed labels (a YOLO folder, COCO JSON or Pascal VOC folder, as
+    /// `eotn eval --labels`). The pixels within the ellipse inscribed in each ball box, shrunk
+    /// to `--ball-core` of its size, vote orange; every other pixel votes "no colour", so a cell
+    /// becomes orange only where ball pixels outnumber the rest (`--min-purity`).
+    #[arg(long, value_name = "LABELS")]
+    pub boxes: Option<PathBuf>,
+    /// With `--boxes`: the share of a ball box's width and height whose inscribed ellipse votes
+    /// orange (the rim mixes ball and background).
+    #[arg(long, default_value_t = 0.7, value_parser = super::values::number_in(0.05, 1.0))]
+    pub ball_core: f64,
+    /// With `--boxes`: YOLO class names in order of their numbers.
+    #[arg(long, value_name = "NAMES")]
+    pub class_names: Option<String>,
+    /// With `--boxes`: which frames to learn from (`tuning`: frames whose number ends in 0–6;
+    /// the held-out ones, 7–9, are never looked at).
+    #[arg(long, value_enum, default_value_t = crate::eval::label_sets::Split::Tuning)]
+    pub split: crate::eval::label_sets::Split,
     /// Also (or instead) render labelled frames of these scenarios (repeatable).
     #[arg(long = "sim")]
     pub scenarios: Vec<String>,
@@ -151,10 +169,38 @@ fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Resul
     } else {
         expand_frame_paths(&args.frames)?
     };
+    let boxes = match &args.boxes {
+        Some(p) => Some(crate::eval::label_sets::LabelSet::load(
+            p,
+            &crate::eval::label_sets::ReadOptions {
+                class_names: args
+                    .class_names
+                    .as_ref()
+                    .map(|t| t.split(',').map(|n| n.trim().to_owned()).collect()),
+                ..Default::default()
+            },
+        )?),
+        None => None,
+    };
     for path in &paths {
-        let frame = load_frame_arg(path, args.size)?;
-        let labels = load_mask(path, &frame)?;
-        training.take(path.display().to_string(), frame, labels)?;
+        let labels = match &boxes {
+            Some(set) => {
+                let stem = crate::eval::label_sets::file_stem(path);
+                if !args.split.takes(&stem) || !set.frames.contains_key(&stem) {
+                    continue;
+                }
+                let frame = load_frame_arg(path, args.size)?;
+                let mask = box_mask(set, &stem, &frame, args.ball_core);
+                training.take(path.display().to_string(), frame, mask)?;
+                continue;
+            }
+            None => {
+                let frame = load_frame_arg(path, args.size)?;
+                let mask = load_mask(path, &frame)?;
+                (frame, mask)
+            }
+        };
+        training.take(path.display().to_string(), labels.0, labels.1)?;
     }
     for name in &args.scenarios {
         let kind =
@@ -172,6 +218,35 @@ fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Resul
         bar.finish_and_clear();
     }
     Ok(())
+}
+
+/// A label mask from boxes: orange within the ellipse inscribed in each ball box shrunk to
+/// `core` of its size (pixel centres at +0.5), no colour (code 0) everywhere else.
+fn box_mask(
+    set: &crate::eval::label_sets::LabelSet,
+    stem: &str,
+    frame: &Frame,
+    core: f64,
+) -> Vec<u8> {
+    let (w, h) = (frame.width(), frame.height());
+    let mut mask = vec![0u8; w * h];
+    let Some(labels) = set.frame_in_pixels(stem, w, h) else {
+        return mask;
+    };
+    for b in labels.balls() {
+        let [cx, cy] = b.centre();
+        let (rx, ry) = (core * b.width() / 2.0, core * b.height() / 2.0);
+        let clamp = |v: f64, n: usize| (v.max(0.0) as usize).min(n);
+        for y in clamp(cy - ry, h)..clamp(cy + ry + 1.0, h) {
+            for x in clamp(cx - rx, w)..clamp(cx + rx + 1.0, w) {
+                let (dx, dy) = ((x as f64 + 0.5 - cx) / rx, (y as f64 + 0.5 - cy) / ry);
+                if dx * dx + dy * dy <= 1.0 {
+                    mask[y * w + x] = ColourClass::Orange.code();
+                }
+            }
+        }
+    }
+    mask
 }
 
 /// The table written and its scores on the held-back frames, as text or `--json`.

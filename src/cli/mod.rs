@@ -20,6 +20,7 @@ mod classify;
 pub mod detect;
 mod detect_field;
 mod eval;
+mod eval_boxes;
 mod eval_labels;
 mod eval_overhead;
 mod export;
@@ -44,6 +45,8 @@ mod sim;
 mod sim_field;
 mod sources;
 pub mod values;
+mod wmd;
+mod wmd_inputs;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -107,6 +110,10 @@ pub enum Command {
     /// (`calibrate`), ball and robots in field coordinates (`detect`), points from a synthetic
     /// stream's truth (`sim-points`).
     Overhead(overhead::Args),
+    /// The World Model Debugger headless: the robots' recorded world models against an
+    /// overhead camera (or a session's): matched by marker, errors and the tape measure per
+    /// frame (`--json`) or per robot.
+    Wmd(wmd::Args),
     /// Latency and CPU of live robots on loopback: sender's write to the frame in the app state.
     BenchLive(bench_live::Args),
     /// A stand-in robot: play a stream at its recorded rate as a Foxglove WebSocket server.
@@ -148,6 +155,7 @@ pub fn run(command: Command, inputs: &[PathBuf], outputs: &[PathBuf]) -> anyhow:
         Command::BenchLive(a) => bench_live::run(&a),
         Command::Serve(a) => serve::run(&a),
         Command::Record(a) => record::run(&a),
+        Command::Wmd(a) => wmd::run(&a),
     }
 }
 

@@ -32,6 +32,14 @@ pub struct Args {
     /// Close the window after this many seconds (for demos, scripts and benchmarks).
     #[arg(long, value_name = "SECONDS", value_parser = super::values::number_in(0.0, super::values::MAX_SECONDS))]
     pub quit_after: Option<f64>,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
+    /// Boxed labels of the frames (a YOLO folder, a COCO JSON file or a Pascal VOC folder, as
+    /// `eotn eval --labels`): drawn over each frame by class, recognition scored against them,
+    /// the missed and false frames listed as events (Windows ▸ Events and bookmarks).
+    #[arg(long, value_name = "LABELS")]
+    pub labels: Option<PathBuf>,
 }
 
 impl Args {
@@ -41,6 +49,7 @@ impl Args {
     pub fn run_options(&self) -> RunOptions {
         RunOptions {
             files: self.files.clone(),
+            camera: self.camera.topic.clone(),
             renderer: self.renderer,
             play: self.play.then_some(self.speed),
             quit_after: self
@@ -48,6 +57,7 @@ impl Args {
                 .filter(|s| s.is_finite() && *s >= 0.0)
                 .map(|s| Duration::from_secs_f64(s.min(1e9))),
             all_overlays: self.all_overlays,
+            labels: self.labels.clone(),
         }
     }
 }

@@ -93,11 +93,20 @@ pub struct CalibrateArgs {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
     /// The lens's intrinsics from a checkerboard calibration: a ROS `camera_info` YAML file as
-    /// `camera_calibration` writes it (plumb_bob, rational_polynomial or equidistant); then only
-    /// the camera's pose is fitted. Intrinsics made at a whole multiple or fraction of the
-    /// points' frame size are scaled.
+    /// `camera_calibration` writes it (plumb_bob, rational_polynomial or equidistant), or a
+    /// recording holding a `sensor_msgs/CameraInfo` or `foxglove.CameraCalibration` channel
+    /// (its first message); then only the camera's pose is fitted. Intrinsics made at a whole
+    /// multiple or fraction of the points' frame size are scaled.
     #[arg(long)]
     pub intrinsics: Option<PathBuf>,
+    /// With a recording as `--intrinsics` holding several cameras: the image topic whose camera
+    /// info to take.
+    #[arg(
+        long = "intrinsics-camera",
+        value_name = "TOPIC",
+        requires = "intrinsics"
+    )]
+    pub intrinsics_camera: Option<String>,
     /// Do not refine along the lines even with `--image`.
     #[arg(long)]
     pub no_lines: bool,
@@ -119,11 +128,13 @@ pub struct DetectArgs {
     /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams.
     #[arg(required_unless_present = "session", conflicts_with = "session")]
     pub frames: Vec<PathBuf>,
-    /// Lookup table of the overhead camera.
-    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    /// Lookup table of the overhead camera (default: the one the recording names for the
+    /// camera read, docs/formats.md 'Several cameras').
+    #[arg(long, conflicts_with = "session")]
     pub lut: Option<PathBuf>,
-    /// Calibration (`eotn overhead calibrate`).
-    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    /// Calibration (`eotn overhead calibrate`; default: the one the recording names for the
+    /// camera read).
+    #[arg(long, conflicts_with = "session")]
     pub calibration: Option<PathBuf>,
     /// A session file (docs/formats.md): every overhead camera through its own table and
     /// calibration, merged into one field picture per frame of the first (reference) camera;
@@ -141,6 +152,9 @@ pub struct DetectArgs {
     /// One JSON object per frame per line.
     #[arg(long)]
     pub json: bool,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
 }
 
 /// Arguments of `eotn overhead sim-points`.
@@ -155,6 +169,9 @@ pub struct SimPointsArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 1, value_parser = super::values::seed())]
     pub seed: u64,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
     /// Field description: a file or a shipped field's name (as `overhead calibrate --field`);
     /// four-legged-2005 by default.
     #[arg(long, value_name = "FIELD")]
@@ -383,14 +400,23 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     if let Some(session) = &a.session {
         return super::detect_field::run(session, a.json);
     }
-    let (Some(lut), Some(cal)) = (&a.lut, &a.calibration) else {
-        bail!("--lut and --calibration are needed with frames (or give --session)");
+    // Not given: the table and calibration the recording names for the camera read.
+    let named = super::detect::named_camera_files(&a.frames, a.camera.get())?
+        .map(|(_, files)| files)
+        .unwrap_or_default();
+    let (Some(lut), Some(cal)) = (
+        a.lut.as_ref().or(named.lut.as_ref()),
+        a.calibration.as_ref().or(named.calibration.as_ref()),
+    ) else {
+        bail!(
+            "--lut and --calibration are needed with frames whose recording names none for the camera (or give --session)"
+        );
     };
     let lut = load_lut_arg(lut)?;
     let cal = load_usable_calibration(cal)?;
     let field = load_field(a.field.as_deref())?;
     let mut pipeline = OverheadPipeline::new(lut, cal.camera, params_for(&field));
-    let mut inputs = FrameInputs::open(&a.frames, None)?;
+    let mut inputs = FrameInputs::open_camera(&a.frames, None, a.camera.get())?;
     refuse_robot_streams(inputs.robot_streams())?;
     let mut sizes = SizeCheck::default();
     let stdout = std::io::stdout();
@@ -468,8 +494,8 @@ pub fn simulated_clicks(
 ///
 /// # Errors
 /// A stream without overhead truth.
-pub fn stream_truth_camera(path: &Path) -> anyhow::Result<OverheadCamera> {
-    let mut reader = StreamReader::open(path)?;
+pub fn stream_truth_camera(path: &Path, camera: Option<&str>) -> anyhow::Result<OverheadCamera> {
+    let mut reader = StreamReader::open_camera(path, camera)?;
     let record = reader.read(0)?;
     let truth = record
         .ground_truth
@@ -488,7 +514,7 @@ fn run_sim_points(a: &SimPointsArgs) -> anyhow::Result<()> {
         bail!("--noise-px must be a non-negative number");
     }
     let field = load_field(a.field.as_deref())?;
-    let camera = stream_truth_camera(&a.stream)?;
+    let camera = stream_truth_camera(&a.stream, a.camera.get())?;
     let file = simulated_clicks(&camera, &field, a.noise_px, a.seed);
     file.save(&a.output)?;
     eprintln!(

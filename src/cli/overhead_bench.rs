@@ -26,6 +26,9 @@ pub struct BenchArgs {
     /// Frames (`.uyvy`, `.png`, `.jpg`), folders of them, or MCAP streams of one camera.
     #[arg(required_unless_present = "session", conflicts_with = "session")]
     pub frames: Vec<PathBuf>,
+    /// Which camera of the recordings (with FRAME…).
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
     /// Lookup table of the camera (with FRAME…).
     #[arg(long, required_unless_present = "session", conflicts_with = "session")]
     pub lut: Option<PathBuf>,
@@ -209,7 +212,7 @@ fn frames_camera(a: &BenchArgs) -> anyhow::Result<BenchCamera> {
     let lut = load_lut_arg(lut)?;
     let cal = load_usable_calibration(cal)?;
     let field = load_field(None)?;
-    let mut inputs = FrameInputs::open(&a.frames, None)?;
+    let mut inputs = FrameInputs::open_camera(&a.frames, None, a.camera.get())?;
     refuse_robot_streams(inputs.robot_streams())?;
     let mut sizes = super::overhead::SizeCheck::default();
     let mut frames = Vec::new();

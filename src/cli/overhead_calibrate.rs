@@ -53,8 +53,9 @@ fn severity_name(f: &Finding) -> &'static str {
 }
 
 /// The intrinsics of `--intrinsics`, named by their file when the file gives no camera name.
-fn load_intrinsics(path: &Path) -> anyhow::Result<Intrinsics> {
-    let mut i = Intrinsics::load(path)?;
+fn load_intrinsics(path: &Path, camera: Option<&str>) -> anyhow::Result<Intrinsics> {
+    let mut i =
+        crate::streams::camera_info::load_intrinsics(path, camera).map_err(anyhow::Error::msg)?;
     if i.camera_name.is_empty() {
         i.camera_name = path.display().to_string();
     }
@@ -70,7 +71,11 @@ pub fn run(a: &CalibrateArgs) -> anyhow::Result<()> {
     let png = crate::atomic_file::beside_output(&a.output, "lines.png");
     let field = load_field(a.field.as_deref())?;
     let points = PointsFile::load(&a.points)?;
-    let intrinsics = a.intrinsics.as_deref().map(load_intrinsics).transpose()?;
+    let intrinsics = a
+        .intrinsics
+        .as_deref()
+        .map(|p| load_intrinsics(p, a.intrinsics_camera.as_deref()))
+        .transpose()?;
     let frame = a
         .image
         .as_deref()

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::{Deserialize, Serialize};
 
-use super::detect::{load_params, load_sensor_file, readings_for};
+use super::detect::{load_sensor_file, readings_for};
 use super::inputs::{FrameInput, InputArgs, load_frame_arg, progress};
 use crate::geometry::RobotPose;
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -57,7 +57,7 @@ pub struct LearnArgs {
     /// Sensor readings JSON for raw frames (as for `eotn detect`); streams carry their own.
     #[arg(long)]
     pub sensors: Option<PathBuf>,
-    /// Recognition parameters JSON (the `patterns` part sets min_pixels, min_agreement, …).
+    /// Recognition parameters JSON (the `patterns` part sets min_pixels, min_agreement, …) (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// Start from this places file and add to it (it may be the output).
@@ -252,7 +252,11 @@ pub fn learn(args: &LearnArgs) -> anyhow::Result<LearnOutput> {
     let (lut, inputs) = args.input.open()?;
     let table = args.poses.as_deref().map(load_pose_table).transpose()?;
     let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
-    let recognition = load_params(args.params.as_deref())?;
+    let recognition = super::detect::params_or_camera_s(
+        args.params.as_deref(),
+        &args.input.frames,
+        args.input.camera.get(),
+    )?;
     let mut memory = match &args.update {
         Some(p) if p.exists() || p != &args.output => PatternMemory::load(p)?,
         _ => PatternMemory::default(),
@@ -285,7 +289,8 @@ pub fn learn(args: &LearnArgs) -> anyhow::Result<LearnOutput> {
     let bar = progress(inputs.len(), "learn");
     for (i, item) in inputs.items().iter().enumerate() {
         bar.inc(1);
-        let (frame, recorded_sensors, recorded) = read_input(item, &mut reader, args.input.size)?;
+        let (frame, recorded_sensors, recorded) =
+            read_input(item, &mut reader, args.input.size, args.input.camera.get())?;
         let path = match item {
             FrameInput::File(p) | FrameInput::Stream { path: p, .. } => p,
         };
@@ -342,6 +347,7 @@ fn read_input(
     item: &FrameInput,
     reader: &mut Option<StreamReader>,
     size: Option<(usize, usize)>,
+    camera: Option<&str>,
 ) -> anyhow::Result<(
     crate::frame::Frame,
     Option<crate::sensors::SensorReadings>,
@@ -351,7 +357,7 @@ fn read_input(
         FrameInput::File(p) => (load_frame_arg(p, size)?, None, None),
         FrameInput::Stream { path, index } => {
             if reader.as_ref().is_none_or(|r| r.path() != path) {
-                *reader = Some(StreamReader::open(path)?);
+                *reader = Some(StreamReader::open_camera(path, camera)?);
             }
             let Some(r) = reader.as_mut() else {
                 bail!("{}: stream not open", path.display());

@@ -36,6 +36,10 @@ pub struct Args {
     /// `--seconds`, record until Ctrl+C or SIGTERM.
     #[arg(long, value_parser = seconds, allow_negative_numbers = true)]
     pub seconds: Option<f64>,
+    /// Keep only this camera (image topic, e.g. `/camera/top`) and its own channels; repeat
+    /// for several. Default: every camera the robot sends.
+    #[arg(long = "camera", value_name = "TOPIC")]
+    pub cameras: Vec<String>,
 }
 
 /// One robot's recording as the connection thread fills it.
@@ -51,6 +55,8 @@ struct Recording {
     error: Option<String>,
     /// The error was reported on stderr.
     reported: bool,
+    /// `--camera`: the cameras kept (empty: every one).
+    cameras: Vec<String>,
 }
 
 /// Where each robot's file goes; file names given out so far.
@@ -100,7 +106,7 @@ impl Recording {
                 description: format!("recorded live from {name} ({})", self.url),
             };
             match LiveRecorder::create(&path, &info) {
-                Ok(r) => self.recorder = Some(r),
+                Ok(r) => self.recorder = Some(r.only_cameras(self.cameras.clone())),
                 Err(e) => {
                     self.error = Some(e.to_string());
                     return;
@@ -111,7 +117,7 @@ impl Recording {
             return;
         };
         match r.message(channel, log_time_ns, payload) {
-            Ok(Recorded::Written) => {}
+            Ok(Recorded::Written | Recorded::OtherCamera) => {}
             Ok(Recorded::OverChannelLimit) => {
                 if r.over_limit() == 1 {
                     eprintln!(
@@ -202,6 +208,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             closed: false,
             error: None,
             reported: false,
+            cameras: args.cameras.clone(),
         }));
         let client = RobotClient::spawn(url, ClientOptions::default(), {
             let (rec, naming, limit) = (Arc::clone(&rec), Arc::clone(&naming), args.frames);

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::detect::{load_params, load_sensor_file, readings_for};
+use super::detect::{load_sensor_file, readings_for};
 use super::inputs::InputArgs;
 use crate::frame::save_rgb_png;
 use crate::overlay::Canvas;
@@ -62,7 +62,7 @@ pub struct Args {
     /// Sensor readings JSON (as for `eotn detect`).
     #[arg(long)]
     pub sensors: Option<PathBuf>,
-    /// Recognition parameters JSON.
+    /// Recognition parameters JSON (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
     /// The picture under the overlays.
@@ -109,7 +109,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     let sensors = args.sensors.as_deref().map(load_sensor_file).transpose()?;
     let params = PipelineParams {
-        recognition: load_params(args.params.as_deref())?,
+        recognition: super::detect::params_or_camera_s(
+            args.params.as_deref(),
+            &args.input.frames,
+            args.input.camera.get(),
+        )?,
         ..PipelineParams::default()
     };
     crate::atomic_file::output_folder(&args.output)

@@ -38,6 +38,9 @@ pub struct Args {
     /// Seconds a new connection has to finish its WebSocket handshake (above 0, at most 600).
     #[arg(long, default_value_t = 5.0, value_parser = deadline_seconds, allow_negative_numbers = true)]
     pub handshake_timeout: f64,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
 }
 
 /// Runs `eotn serve` until the stream ends (or forever with `--loop`).
@@ -45,7 +48,7 @@ pub struct Args {
 /// # Errors
 /// The stream cannot be read, or the address cannot be listened on.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let mut reader = StreamReader::open(&args.stream)?;
+    let mut reader = StreamReader::open_camera(&args.stream, args.camera.get())?;
     let (host, port) = args
         .listen
         .rsplit_once(':')

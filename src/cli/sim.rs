@@ -39,6 +39,66 @@ pub struct Args {
     /// List the scenarios and exit.
     #[arg(long)]
     pub list: bool,
+    /// overhead-game: give robot N's world model a known error, `N:DX_CM,DY_CM,DHEADING_DEG` or
+    /// `N:DX_CM,DY_CM,DHEADING_DEG,DISTANCE_PERCENT` (its `seen` distances that much too long),
+    /// N the truth's robot number; repeatable. The robots' `seen` measurements are made from
+    /// the truth with noise (the game renders no robot camera).
+    #[arg(long, value_name = "N:DX,DY,DHEADING[,PERCENT]", value_parser = known_error)]
+    pub world_model_error: Vec<crate::sim::KnownError>,
+    /// overhead-game: scale of the world models' noise and drifting bias (0: the truth plus the
+    /// known errors exactly).
+    #[arg(long, default_value_t = 1.0, value_parser = super::values::number_in(0.0, 10.0))]
+    pub world_model_noise: f64,
+}
+
+/// `N:DX,DY,DHEADING[,PERCENT]` of `--world-model-error`.
+fn known_error(text: &str) -> Result<crate::sim::KnownError, String> {
+    let usage = || format!("'{text}' is not N:DX_CM,DY_CM,DHEADING_DEG[,DISTANCE_PERCENT]");
+    let (robot, rest) = text.split_once(':').ok_or_else(usage)?;
+    let robot: u32 = robot.trim().parse().map_err(|_| usage())?;
+    let values: Vec<f64> = rest
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| usage())?;
+    let ([dx, dy, dh] | [dx, dy, dh, _]) = values[..] else {
+        return Err(usage());
+    };
+    let percent = values.get(3).copied().unwrap_or(0.0);
+    let ok = |v: f64, lo: f64, hi: f64| v.is_finite() && (lo..=hi).contains(&v);
+    if !(ok(dx, -1000.0, 1000.0) && ok(dy, -1000.0, 1000.0)) {
+        return Err(format!("{text}: offsets must be from -1000 to 1000 cm"));
+    }
+    if !ok(dh, -180.0, 180.0) || !ok(percent, -90.0, 900.0) {
+        return Err(format!(
+            "{text}: the heading error must be from -180 to 180 degrees, the distance error from -90 to 900 %"
+        ));
+    }
+    Ok(crate::sim::KnownError {
+        robot,
+        offset_cm: [dx, dy],
+        heading_rad: dh.to_radians(),
+        distance_scale: 1.0 + percent / 100.0,
+    })
+}
+
+/// The world-model options as given, for the stream's description.
+fn world_model_options(args: &Args) -> String {
+    let mut out = String::new();
+    for k in &args.world_model_error {
+        out += &format!(
+            " --world-model-error {}:{},{},{},{}",
+            k.robot,
+            k.offset_cm[0],
+            k.offset_cm[1],
+            k.heading_rad.to_degrees(),
+            (k.distance_scale - 1.0) * 100.0
+        );
+    }
+    if args.world_model_noise != 1.0 {
+        out += &format!(" --world-model-noise {}", args.world_model_noise);
+    }
+    out
 }
 
 /// Runs `eotn sim`.
@@ -68,10 +128,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.ideal {
         sim = sim.with_effects(crate::sim::CameraEffects::NONE);
     }
+    sim = sim.with_world_model_errors(crate::sim::WorldModelErrors {
+        known: args.world_model_error.clone(),
+        noise: args.world_model_noise,
+    });
     let info = StreamInfo {
         source: format!("sim:{}", kind.name()),
         description: format!(
-            "eotn sim --scenario {} --frames {} --seed {}{}{}: {}",
+            "eotn sim --scenario {} --frames {} --seed {}{}{}{}: {}",
             kind.name(),
             args.frames,
             args.seed,
@@ -81,6 +145,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 String::new()
             },
             if args.ideal { " --ideal" } else { "" },
+            world_model_options(args),
             kind.description()
         ),
     };

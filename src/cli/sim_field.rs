@@ -10,7 +10,8 @@ use anyhow::{Context, bail};
 use super::inputs::parse_size;
 use super::overhead::{load_field, simulated_clicks};
 use crate::lut::learn::{LearnParams, TableBuilder};
-use crate::overhead::calibration::{CalibrationParams, calibrate};
+use crate::overhead::calibration::{CalibrationParams, calibrate_with};
+use crate::overhead::intrinsics::Intrinsics;
 use crate::overhead::review::{Severity, review};
 use crate::sim::field_rig::{FieldRig, MAX_RIG_CAMERAS, MAX_RIG_SIZE, RIG_FPS};
 use crate::streams::{FrameRecord, StreamInfo, StreamWriter};
@@ -191,8 +192,17 @@ fn write_calibration(
 ) -> anyhow::Result<()> {
     let field = load_field(None)?;
     let points = simulated_clicks(camera, &field, a.noise_px, a.seed ^ (k as u64 + 1));
-    let cal = calibrate(&points, &field, frame, &CalibrationParams::default())
-        .with_context(|| format!("camera {k}: its simulated calibration failed"))?;
+    // As a team would: the lens known from a checkerboard, only the pose fitted from clicks (a
+    // camera seeing few landmarks cannot determine its lens from them).
+    let intrinsics = true_intrinsics(camera, k);
+    let cal = calibrate_with(
+        &points,
+        &field,
+        frame,
+        &CalibrationParams::default(),
+        Some(&intrinsics),
+    )
+    .with_context(|| format!("camera {k}: its simulated calibration failed"))?;
     let r = review(&cal);
     if let Some(refusal) = r.refusal() {
         bail!("camera {k}: its simulated calibration is refused: {refusal}");
@@ -205,4 +215,24 @@ fn write_calibration(
     }
     cal.save(path)?;
     Ok(())
+}
+
+/// The simulated camera's own intrinsics (its lens; a k1/k2 lens as `plumb_bob`, the same
+/// normalised-coordinate polynomial).
+fn true_intrinsics(camera: &crate::geometry::OverheadCamera, k: usize) -> Intrinsics {
+    Intrinsics {
+        camera_name: format!("simulated camera {k}"),
+        width_px: camera.width_px,
+        height_px: camera.height_px,
+        fx: camera.focal_px,
+        fy: camera.focal_y(),
+        centre: camera.centre,
+        lens: camera.lens.unwrap_or(crate::geometry::LensModel::PlumbBob {
+            k1: camera.k1,
+            k2: camera.k2,
+            p1: 0.0,
+            p2: 0.0,
+            k3: 0.0,
+        }),
+    }
 }

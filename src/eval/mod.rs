@@ -4,7 +4,9 @@
 //! Pure functions on [`Recognition`] and the renderer's [`RobotViewTruth`]; `eotn eval` reads
 //! streams and runs the pipeline, this module only compares.
 
+pub mod ball_boxes;
 pub mod beacons;
+pub mod label_sets;
 pub mod labels;
 pub mod overhead;
 pub mod patterns;

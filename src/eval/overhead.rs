@@ -1,6 +1,6 @@
 //! Overhead evaluation: the overhead recogniser against the truth of synthetic overhead frames
 //! (ball and robot position errors, identity and heading accuracy), and each robot's own world
-//! model (`/world_model/robotN`) against the overhead truth and against what the overhead
+//! model (docs/formats.md, "World models") against the overhead truth and against what the overhead
 //! camera found.
 //!
 //! A robot counts for identity when its marker is fully visible (`OverheadMarkerTruth::
@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use super::Percentiles;
 use crate::geometry::{MarkerIdentity, MarkerTeam};
 use crate::model::truth::OverheadTruth;
+use crate::model::world_model::WorldModelMessage;
 use crate::overhead::OverheadDetections;
 
 /// Matching rules.
@@ -153,47 +154,19 @@ pub struct WorldModelFrameEval {
     pub ball_error_vs_overhead_cm: Option<f64>,
 }
 
-/// A robot's world model as the simulator writes it on `/world_model/robotN`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct WorldModel {
-    /// Robot id.
-    pub robot_id: u32,
-    /// Its estimate of itself.
-    #[serde(rename = "self")]
-    pub own: WorldModelPose,
-    /// Its estimate of the ball, if any.
-    pub ball: Option<WorldModelBall>,
-}
-
-/// A world model's self estimate.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct WorldModelPose {
-    /// Field x, centimetres.
-    pub x_cm: f64,
-    /// Field y, centimetres.
-    pub y_cm: f64,
-    /// Heading, radians.
-    pub heading_rad: f64,
-}
-
-/// A world model's ball estimate.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct WorldModelBall {
-    /// Field x, centimetres.
-    pub x_cm: f64,
-    /// Field y, centimetres.
-    pub y_cm: f64,
-}
-
-/// Compares one world-model message with the frame's truth and detections; `None` when the
-/// robot is not in the truth.
+/// Compares one world-model message with the frame's truth and detections; `None` when no
+/// robot of the truth wears the marker it names. Its `robot_id` in the result is the truth's
+/// robot number.
 #[must_use]
 pub fn evaluate_world_model(
-    model: &WorldModel,
+    model: &WorldModelMessage,
     truth: &OverheadTruth,
     detections: Option<&OverheadDetections>,
 ) -> Option<WorldModelFrameEval> {
-    let t = truth.robots.iter().find(|r| r.id == model.robot_id)?;
+    let t = truth.robots.iter().find(|r| {
+        r.marker
+            .is_some_and(|m| m.team == model.robot.team && m.identity == model.robot.identity)
+    })?;
     let own = [model.own.x_cm, model.own.y_cm];
     let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     let overhead = t.marker.and_then(|m| {
@@ -203,7 +176,7 @@ pub fn evaluate_world_model(
             .find(|d| d.team == m.team && d.identity == m.identity)
     });
     Some(WorldModelFrameEval {
-        robot_id: model.robot_id,
+        robot_id: t.id,
         self_error_cm: Some(dist(own, t.field_cm)),
         heading_error_deg: Some(
             angle_diff(model.own.heading_rad, t.heading_rad)
@@ -211,7 +184,7 @@ pub fn evaluate_world_model(
                 .to_degrees(),
         ),
         ball_error_cm: match (&model.ball, &truth.ball) {
-            (Some(b), Some(tb)) => Some(dist([b.x_cm, b.y_cm], tb.field_cm)),
+            (Some(b), Some(tb)) => Some(dist(*b, tb.field_cm)),
             _ => None,
         },
         self_error_vs_overhead_cm: overhead.map(|d| dist(own, d.field_cm)),
@@ -221,7 +194,7 @@ pub fn evaluate_world_model(
                 .to_degrees()
         }),
         ball_error_vs_overhead_cm: match (&model.ball, detections.and_then(|d| d.ball.as_ref())) {
-            (Some(b), Some(seen)) => Some(dist([b.x_cm, b.y_cm], seen.field_cm)),
+            (Some(b), Some(seen)) => Some(dist(*b, seen.field_cm)),
             _ => None,
         },
     })
@@ -427,12 +400,12 @@ mod tests {
 
     #[test]
     fn a_world_model_is_scored_against_truth_and_overhead() {
-        let model: WorldModel = serde_json::from_value(serde_json::json!({
-            "robot_id": 2, "team": "blue", "time_s": 0.0,
+        let model = crate::model::world_model::from_value(&serde_json::json!({
+            "robot_id": 2, "team": "blue",
             "self": {"x_cm": 103.0, "y_cm": 4.0, "heading_rad": 0.4, "sd_cm": 17.0},
             "ball": {"x_cm": 10.0, "y_cm": 0.0, "sd_cm": 25.0}
         }))
-        .expect("the simulator's shape");
+        .expect("a world model");
         let mut d = OverheadDetections {
             robots: vec![detected(2, 100.0, 0.5)],
             ..OverheadDetections::default()
@@ -455,8 +428,11 @@ mod tests {
         assert!((e.ball_error_vs_overhead_cm.expect("error") - 10.0).abs() < 1e-9);
         assert!(
             evaluate_world_model(
-                &WorldModel {
-                    robot_id: 9,
+                &WorldModelMessage {
+                    robot: crate::model::world_model::RobotKey {
+                        team: MarkerTeam::Blue,
+                        identity: MarkerIdentity::new(9).expect("in range"),
+                    },
                     ..model
                 },
                 &truth(),

@@ -348,6 +348,18 @@ fn histogram_chart(title: &str, x_label: &str, values: &[f64], colour: [u8; 3]) 
 
 /// Found / eligible per distance band: bars of the rate, with each band's count above it.
 fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3]) -> Chart {
+    rate_chart_over(title, "true distance", "cm", samples, band_cm, colour)
+}
+
+/// Found / eligible per band of `quantity` (in `unit`), as [`rate_chart`].
+fn rate_chart_over(
+    title: &str,
+    quantity: &str,
+    unit: &str,
+    samples: &[(f64, bool)],
+    band_cm: f64,
+    colour: [u8; 3],
+) -> Chart {
     let max = samples.iter().map(|s| s.0).fold(0.0, f64::max);
     let bands = ((max / band_cm).floor() as usize + 1).clamp(1, 40);
     let mut n = vec![0usize; bands];
@@ -361,7 +373,10 @@ fn rate_chart(title: &str, samples: &[(f64, bool)], band_cm: f64, colour: [u8; 3
         found[i] += usize::from(*ok);
     }
     let x_hi = bands as f64 * band_cm;
-    let x_label = format!("true distance (cm), {} cm bands", tick_label(band_cm, 1.0));
+    let x_label = format!(
+        "{quantity} ({unit}), {} {unit} bands",
+        tick_label(band_cm, 1.0)
+    );
     let mut c = Chart::new(title, &x_label, "found (%)", (0.0, x_hi), (0.0, 115.0));
     for i in 0..bands {
         if n[i] == 0 {
@@ -532,6 +547,56 @@ impl EvalSeries {
             ),
         ]
     }
+}
+
+/// Writes the charts of a score against boxed labels (`eotn eval --labels` with a YOLO, COCO
+/// or VOC set) into `dir`: `ball_detection.png` (eligible frames found, per 2 px band of the
+/// largest ball box's larger side) and `ball_centre_error.png` (found balls' centre error over
+/// the box's larger side).
+///
+/// # Errors
+/// The folder or a file cannot be written (the message names it).
+pub fn write_box_plots(
+    dir: &Path,
+    frames: &[super::ball_boxes::BoxFrameEval],
+) -> io::Result<Vec<PathBuf>> {
+    crate::atomic_file::output_folder(dir)
+        .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
+    let rates: Vec<(f64, bool)> = frames
+        .iter()
+        .filter(|f| f.eligible)
+        .filter_map(|f| f.ball_size_px.map(|s| (s, f.correct)))
+        .collect();
+    let errors: Vec<f64> = frames.iter().filter_map(|f| f.centre_error).collect();
+    let charts = [
+        (
+            "ball_detection.png",
+            rate_chart_over(
+                "ball found, per ball size (eligible frames)",
+                "largest ball box side",
+                "px",
+                &rates,
+                2.0,
+                BALL,
+            ),
+        ),
+        (
+            "ball_centre_error.png",
+            histogram_chart(
+                "ball centre error (found balls)",
+                "distance from the box centre / box side",
+                &errors,
+                BALL,
+            ),
+        ),
+    ];
+    let mut written = Vec::new();
+    for (name, chart) in &charts {
+        let path = dir.join(name);
+        chart.save(&path)?;
+        written.push(path);
+    }
+    Ok(written)
 }
 
 /// Draws a size → distance calibration: the samples (height px, true distance cm), the fitted

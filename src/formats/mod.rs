@@ -355,6 +355,73 @@ impl ImageMessage {
     }
 }
 
+/// A camera-info message as it came — `sensor_msgs/msg/CameraInfo` or
+/// `foxglove.CameraCalibration` —, with its lens: what `eotn overhead calibrate --intrinsics`
+/// takes from a recording (the frames' [`CameraIntrinsics`] keep only the pinhole part).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraInfoMessage {
+    /// The image size it was calibrated at, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+    /// Its frame id (the camera's name where nothing else names it).
+    pub frame_id: String,
+    /// `fx 0 cx / 0 fy cy / 0 0 1`, row-major, pixels (pixel centres at whole numbers).
+    pub k: [f64; 9],
+    /// `plumb_bob`, `rational_polynomial`, `equidistant`, …
+    pub distortion_model: String,
+    /// The distortion coefficients in the model's order.
+    pub d: Vec<f64>,
+}
+
+impl CameraInfoMessage {
+    /// Decodes a camera-info message of `kind`.
+    ///
+    /// # Errors
+    /// [`MessageError`] when the bytes are not such a message, its matrix does not have 9
+    /// values, or `kind` is no camera info.
+    pub fn decode(kind: MessageKind, bytes: &[u8]) -> Result<Self, MessageError> {
+        match kind {
+            MessageKind::RosCameraInfo => {
+                let m: ros2::CameraInfo =
+                    ros2::decode(bytes).map_err(|source| MessageError::Cdr {
+                        schema: kind.schema_name(),
+                        source,
+                    })?;
+                Ok(Self {
+                    width: m.width,
+                    height: m.height,
+                    frame_id: m.header.frame_id.0,
+                    k: m.k,
+                    distortion_model: m.distortion_model.0,
+                    d: m.d,
+                })
+            }
+            MessageKind::FoxgloveCameraCalibration => {
+                let protobuf = |detail: String| MessageError::Protobuf {
+                    schema: kind.schema_name(),
+                    detail,
+                };
+                let m = foxglove::messages::CameraCalibration::decode(bytes)
+                    .map_err(|e| protobuf(e.to_string()))?;
+                let k: [f64; 9] = m
+                    .k
+                    .try_into()
+                    .map_err(|k: Vec<f64>| protobuf(format!("K has {} values, not 9", k.len())))?;
+                Ok(Self {
+                    width: m.width,
+                    height: m.height,
+                    frame_id: m.frame_id,
+                    k,
+                    distortion_model: m.distortion_model,
+                    d: m.d,
+                })
+            }
+            other => Err(MessageError::NotAnImage(other.schema_name())),
+        }
+    }
+}
+
 /// A camera's intrinsics from `CameraInfo` / `CameraCalibration`, pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraIntrinsics {

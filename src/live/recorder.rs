@@ -36,6 +36,9 @@ pub enum Recorded {
     Written,
     /// Not written: its channel would be one more than [`MAX_CHANNELS`].
     OverChannelLimit,
+    /// Not written: the image channel of a camera not chosen (`eotn record --camera`), or one
+    /// of that camera's own channels (`TOPIC/…`, a ROS `NS/camera_info` beside `NS/image_raw`).
+    OtherCamera,
 }
 
 /// An open recording of one robot.
@@ -55,6 +58,10 @@ pub struct LiveRecorder {
     messages: u64,
     unflushed: bool,
     last_write: Instant,
+    /// The cameras (image topics) kept; empty: every camera.
+    cameras: Vec<String>,
+    /// Image topics seen that are not kept: their own channels are not written either.
+    dropped_cameras: HashSet<String>,
 }
 
 impl LiveRecorder {
@@ -78,6 +85,41 @@ impl LiveRecorder {
             messages: 0,
             unflushed: false,
             last_write: Instant::now(),
+            cameras: Vec::new(),
+            dropped_cameras: HashSet::new(),
+        })
+    }
+
+    /// Keeps only these cameras (image topics; empty: every camera, as recorded by default).
+    #[must_use]
+    pub fn only_cameras(mut self, topics: Vec<String>) -> Self {
+        self.cameras = topics;
+        self
+    }
+
+    /// Whether a message on `channel` belongs to a camera not kept.
+    fn other_camera(&mut self, channel: &AdvertisedChannel) -> bool {
+        if self.cameras.is_empty() {
+            return false;
+        }
+        let topic = channel.topic.as_str();
+        let image = crate::formats::MessageKind::of(&channel.schema_name, &channel.encoding)
+            .is_some_and(crate::formats::MessageKind::is_image);
+        if image {
+            let kept = self.cameras.iter().any(|c| c == topic);
+            if !kept && self.dropped_cameras.len() < MAX_CHANNELS {
+                self.dropped_cameras.insert(topic.to_owned());
+            }
+            return !kept;
+        }
+        self.dropped_cameras.iter().any(|camera| {
+            let namespace = camera
+                .strip_suffix("/image_raw")
+                .or_else(|| camera.strip_suffix("/image"));
+            topic
+                .strip_prefix(camera.as_str())
+                .is_some_and(|rest| rest.starts_with('/'))
+                || namespace.is_some_and(|ns| topic == format!("{ns}/camera_info"))
         })
     }
 
@@ -115,6 +157,9 @@ impl LiveRecorder {
         log_time_ns: u64,
         payload: &[u8],
     ) -> Result<Recorded, StreamError> {
+        if self.other_camera(channel) {
+            return Ok(Recorded::OtherCamera);
+        }
         let spec = match self.specs.get(channel) {
             Some(spec) => Arc::clone(spec),
             None => {

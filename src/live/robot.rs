@@ -591,7 +591,7 @@ impl Inner {
             return;
         };
         match r.message(channel, log_time_ns, payload) {
-            Ok(Recorded::Written) => {}
+            Ok(Recorded::Written | Recorded::OtherCamera) => {}
             Ok(Recorded::OverChannelLimit) => {
                 if r.over_limit() == 1 {
                     let w = format!(

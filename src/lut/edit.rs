@@ -227,6 +227,20 @@ impl EditRecord {
     }
 }
 
+/// Number of `cells` whose code is not `code`. Counted in byte-wide lanes, 255 cells at a
+/// time (a byte counter cannot overflow), which the compiler turns into wide vector compares.
+fn count_other_codes(cells: &[u8], code: u8) -> usize {
+    cells
+        .chunks(255)
+        .map(|chunk| {
+            let same = chunk
+                .iter()
+                .fold(0u8, |n, &c| n.wrapping_add(u8::from(c == code)));
+            chunk.len() - usize::from(same)
+        })
+        .sum()
+}
+
 /// Milliseconds since the Unix epoch, 0 if the clock is before it: the time stamp of edits and
 /// journal entries.
 #[must_use]
@@ -289,6 +303,13 @@ impl AppliedEdit {
 impl LookupTable {
     /// Writes an edit into the table and returns what it changed (for undo).
     pub fn apply(&mut self, record: EditRecord) -> AppliedEdit {
+        self.apply_reusing(record, Vec::new())
+    }
+
+    /// [`LookupTable::apply`], keeping a box's old codes in `spare` (cleared first): the undo
+    /// history hands back the buffer of a step it dropped, so a journal of whole-table edits
+    /// does not fault in 16 MiB of fresh memory per edit.
+    pub fn apply_reusing(&mut self, record: EditRecord, spare: Vec<u8>) -> AppliedEdit {
         let code = record.class.code();
         let (previous, changed) = match record.region.select_cells(self) {
             // Picked cells directly (sorted, once each, inside the table): resolving them to a
@@ -296,7 +317,7 @@ impl LookupTable {
             // took 30 s to replay on a 7-bit table).
             None => self.apply_to_cells(&record.region, code),
             // A box, row by row (a row of V is contiguous), without listing its cells.
-            Some(b) => self.apply_to_box(b, code),
+            Some(b) => self.apply_to_box(b, code, spare),
         };
         AppliedEdit {
             record,
@@ -305,23 +326,46 @@ impl LookupTable {
         }
     }
 
-    /// The rows of V of a box: (first index, length) of each.
+    /// The runs of contiguous cells of a box, in index order: (first index, length) of each.
+    /// A row of V is contiguous; rows spanning every V run on into the next U, and planes
+    /// spanning every U and V into the next Y, so a whole table is one run.
     fn box_rows(&self, b: CellBox) -> impl Iterator<Item = (usize, usize)> + use<> {
         let side = self.side();
+        let full_v = b.min[2] == 0 && b.max[2] + 1 == side;
+        let full_uv = full_v && b.min[1] == 0 && b.max[1] + 1 == side;
         let row_len = b.max[2] + 1 - b.min[2];
-        (b.min[0]..=b.max[0]).flat_map(move |y| {
-            (b.min[1]..=b.max[1]).map(move |u| ((y * side + u) * side + b.min[2], row_len))
+        // Per Y plane: one run when the plane's rows join up, else one run per U row.
+        let (u_runs, run_len) = if full_v {
+            (b.min[1]..=b.min[1], row_len * (b.max[1] + 1 - b.min[1]))
+        } else {
+            (b.min[1]..=b.max[1], row_len)
+        };
+        let (y_runs, run_len) = if full_uv {
+            (b.min[0]..=b.min[0], run_len * (b.max[0] + 1 - b.min[0]))
+        } else {
+            (b.min[0]..=b.max[0], run_len)
+        };
+        y_runs.flat_map(move |y| {
+            u_runs
+                .clone()
+                .map(move |u| ((y * side + u) * side + b.min[2], run_len))
         })
     }
 
-    fn apply_to_box(&mut self, b: CellBox, code: u8) -> (PreviousCodes, usize) {
-        let mut codes = Vec::with_capacity(b.len());
+    fn apply_to_box(&mut self, b: CellBox, code: u8, spare: Vec<u8>) -> (PreviousCodes, usize) {
+        let mut codes = spare;
+        codes.clear();
+        codes.reserve(b.len());
         let mut changed = 0;
         for (start, len) in self.box_rows(b) {
-            if let Some(row) = self.cells.get_mut(start..start + len) {
-                codes.extend_from_slice(row);
-                changed += row.iter().filter(|&&c| c != code).count();
-                row.fill(code);
+            if let Some(run) = self.cells.get_mut(start..start + len) {
+                // In pieces that stay in the first-level cache: kept, counted and overwritten
+                // in one pass over memory rather than three.
+                for piece in run.chunks_mut(4096) {
+                    codes.extend_from_slice(piece);
+                    changed += count_other_codes(piece, code);
+                    piece.fill(code);
+                }
             }
         }
         (PreviousCodes::Box { cells: b, codes }, changed)
@@ -405,6 +449,9 @@ pub struct EditHistory {
     bytes: usize,
     /// Undo steps dropped so far to stay within `max_bytes`.
     dropped: usize,
+    /// The old-codes buffer of the latest box step dropped, handed to the next edit (not
+    /// counted in `bytes`: at most one buffer, emptied).
+    spare: Vec<u8>,
 }
 
 impl Default for EditHistory {
@@ -424,16 +471,18 @@ impl EditHistory {
             max_bytes,
             bytes: 0,
             dropped: 0,
+            spare: Vec::new(),
         }
     }
 
     /// Applies `record` to `lut` and remembers it; clears the redo stack. Returns the number
     /// of cells that changed.
     pub fn commit(&mut self, lut: &mut LookupTable, record: EditRecord) -> usize {
-        let applied = lut.apply(record);
+        let applied = lut.apply_reusing(record, std::mem::take(&mut self.spare));
         let changed = applied.changed_cells();
-        for e in self.redo.drain(..) {
+        for e in std::mem::take(&mut self.redo) {
             self.bytes -= e.held_bytes();
+            self.keep_spare(e);
         }
         self.push_undo(applied);
         changed
@@ -447,7 +496,17 @@ impl EditHistory {
             if let Some(old) = self.undo.pop_front() {
                 self.bytes -= old.held_bytes();
                 self.dropped += 1;
+                self.keep_spare(old);
             }
+        }
+    }
+
+    /// Keeps a forgotten step's box buffer for the next edit when it is the largest seen.
+    fn keep_spare(&mut self, old: AppliedEdit) {
+        if let PreviousCodes::Box { codes, .. } = old.previous
+            && codes.capacity() > self.spare.capacity()
+        {
+            self.spare = codes;
         }
     }
 
@@ -476,7 +535,11 @@ impl EditHistory {
     pub fn redo(&mut self, lut: &mut LookupTable) -> Option<&EditRecord> {
         let edit = self.redo.pop()?;
         self.bytes -= edit.held_bytes();
-        let applied = lut.apply(edit.record);
+        let spare = match edit.previous {
+            PreviousCodes::Box { codes, .. } => codes,
+            PreviousCodes::Cells { .. } => std::mem::take(&mut self.spare),
+        };
+        let applied = lut.apply_reusing(edit.record, spare);
         self.push_undo(applied);
         self.undo.back().map(|e| &e.record)
     }
@@ -502,175 +565,11 @@ impl EditHistory {
     pub fn clear(&mut self) {
         self.undo.clear();
         self.redo.clear();
+        self.spare = Vec::new();
         self.bytes = 0;
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn around(y: u8, u: u8, v: u8, s: u8) -> Region {
-        Region::AroundSample {
-            sample: Yuv::new(y, u, v),
-            sensitivity: Sensitivity::uniform(s),
-        }
-    }
-
-    #[test]
-    fn sensitivity_zero_selects_one_cell_and_one_widens_by_one() {
-        let lut = LookupTable::new(7).unwrap();
-        let Selection::Box(b) = around(100, 100, 100, 0).select(&lut) else {
-            panic!("box expected")
-        };
-        assert_eq!(b.len(), 1);
-        assert_eq!(b.min, [50, 50, 50]);
-        let Selection::Box(b) = around(100, 100, 100, 1).select(&lut) else {
-            panic!("box expected")
-        };
-        assert_eq!((b.min, b.max, b.len()), ([49; 3], [51; 3], 27));
-    }
-
-    #[test]
-    fn selection_is_clamped_at_the_table_edges() {
-        let lut = LookupTable::new(6).unwrap();
-        let Selection::Box(b) = around(0, 255, 3, 2).select(&lut) else {
-            panic!("box expected")
-        };
-        assert_eq!(b.min, [0, 61, 0]);
-        assert_eq!(b.max, [2, 63, 2]);
-        assert_eq!(b.len(), 3 * 3 * 3);
-    }
-
-    #[test]
-    fn preview_marks_matching_pixels_without_writing() {
-        let lut = LookupTable::new(7).unwrap();
-        let frame = Frame::uyvy_from_fn(4, 2, |x, _| {
-            if x < 2 {
-                Yuv::new(120, 80, 190)
-            } else {
-                Yuv::new(60, 128, 128)
-            }
-        })
-        .unwrap();
-        let sel = around(121, 81, 191, 0).select(&lut);
-        let mask = sel.preview_mask(&lut, &frame);
-        assert_eq!(mask, [true, true, false, false, true, true, false, false]);
-        assert_eq!(
-            lut.class_counts()[0],
-            lut.cells().len(),
-            "preview writes nothing"
-        );
-    }
-
-    #[test]
-    fn commit_undo_redo_restore_exact_tables() {
-        let mut lut = LookupTable::new(6).unwrap();
-        let mut history = EditHistory::default();
-        let empty = lut.clone();
-        let changed = history.commit(
-            &mut lut,
-            EditRecord::now(ColourClass::Orange, around(120, 80, 190, 1)),
-        );
-        assert_eq!(changed, 27);
-        let after_first = lut.clone();
-        // An overlapping edit changes only the cells that differ.
-        let changed = history.commit(
-            &mut lut,
-            EditRecord::now(ColourClass::Green, around(124, 80, 190, 1)),
-        );
-        assert_eq!(changed, 27);
-        // Y cells 29..=31 then 30..=32: two of the three orange layers were overwritten.
-        assert_eq!(lut.class_counts()[1], 9);
-        assert_eq!(lut.class_counts()[5], 27);
-        let after_second = lut.clone();
-
-        assert_eq!(
-            history.undo(&mut lut).map(|r| r.class),
-            Some(ColourClass::Green)
-        );
-        assert_eq!(lut, after_first);
-        assert_eq!(
-            history.undo(&mut lut).map(|r| r.class),
-            Some(ColourClass::Orange)
-        );
-        assert_eq!(lut, empty);
-        assert!(history.undo(&mut lut).is_none());
-        history.redo(&mut lut);
-        history.redo(&mut lut);
-        assert_eq!(lut, after_second);
-        assert!(history.redo(&mut lut).is_none());
-    }
-
-    #[test]
-    fn new_commit_clears_redo_and_history_is_bounded_by_bytes() {
-        let mut lut = LookupTable::new(6).unwrap();
-        let one = |i: u8| EditRecord::now(ColourClass::Pink, around(i * 40, 10, 10, 0));
-        // Room for three one-cell steps.
-        let step = lut.clone().apply(one(0)).held_bytes();
-        let mut history = EditHistory::new(3 * step);
-        for i in 0..5u8 {
-            history.commit(&mut lut, one(i));
-        }
-        assert_eq!((history.undo_len(), history.dropped()), (3, 2));
-        assert!(history.held_bytes() <= 3 * step);
-        history.undo(&mut lut);
-        assert_eq!(history.redo_len(), 1);
-        history.commit(
-            &mut lut,
-            EditRecord::now(ColourClass::White, around(250, 128, 128, 0)),
-        );
-        assert_eq!(history.redo_len(), 0);
-        assert_eq!(
-            history.held_bytes(),
-            3 * step,
-            "the redo step's bytes are freed"
-        );
-        // A step larger than the whole limit is still kept, alone: it can be undone.
-        let whole = EditRecord::now(ColourClass::Green, around(128, 128, 128, 63));
-        history.commit(&mut lut, whole);
-        assert_eq!((history.undo_len(), history.dropped()), (1, 5));
-        history.undo(&mut lut);
-        assert_eq!(lut.class_counts()[5], 0);
-    }
-
-    #[test]
-    fn picked_cells_apply_like_their_selection() {
-        let indices = vec![900, 5, 9, 5, 1 << 30];
-        let region = Region::Cells {
-            indices: indices.clone(),
-        };
-        let mut direct = LookupTable::new(6).unwrap();
-        let applied = direct.apply(EditRecord::now(ColourClass::Yellow, region.clone()));
-        let expected: Vec<usize> = region.select(&direct).indices(&direct).collect();
-        assert_eq!(expected, [5, 9, 900]);
-        let PreviousCodes::Cells { indices, .. } = &applied.previous else {
-            panic!("picked cells keep a list");
-        };
-        let changed: Vec<usize> = indices.iter().map(|&i| i as usize).collect();
-        assert_eq!(changed, expected, "sorted, once each, inside the table");
-    }
-
-    #[test]
-    fn explicit_cells_region_and_records_serialise() {
-        let mut lut = LookupTable::new(6).unwrap();
-        let record = EditRecord {
-            class: ColourClass::Yellow,
-            region: Region::Cells {
-                indices: vec![5, 9, usize::MAX],
-            },
-            time_unix_ms: 42,
-            sampled_at: Some(SampleAt {
-                frame: 3,
-                x: 10,
-                y: 20,
-            }),
-        };
-        let json = serde_json::to_string(&record).unwrap();
-        let back: EditRecord = serde_json::from_str(&json).unwrap();
-        assert_eq!(back, record);
-        let applied = lut.apply(back);
-        assert_eq!(applied.changed_cells(), 2, "out-of-range index ignored");
-        assert_eq!(lut.get(9), Some(3));
-    }
-}
+#[path = "edit_tests.rs"]
+mod tests;

@@ -187,8 +187,24 @@ impl Intrinsics {
         })
     }
 
-    /// The intrinsics of a camera info's fields (the YAML file's, or a `sensor_msgs/CameraInfo`
-    /// message's once a recording's decoder gives them).
+    /// The intrinsics of a recording's camera-info message (`sensor_msgs/CameraInfo` or
+    /// `foxglove.CameraCalibration`); the camera is named by the message's frame id.
+    ///
+    /// # Errors
+    /// As [`Intrinsics::from_camera_info`].
+    pub fn from_message(m: &crate::formats::CameraInfoMessage) -> Result<Self, String> {
+        let size = |v: u32| usize::try_from(v).unwrap_or(usize::MAX);
+        Self::from_camera_info(&CameraInfoFields {
+            width: size(m.width),
+            height: size(m.height),
+            camera_name: &m.frame_id,
+            k: m.k,
+            distortion_model: &m.distortion_model,
+            d: &m.d,
+        })
+    }
+
+    /// The intrinsics of a camera info's fields (a YAML file's or a recording message's).
     ///
     /// # Errors
     /// A size of 0 or beyond `MAX_SIDE_PX`, a camera matrix that is not `fx 0 cx / 0 fy cy /

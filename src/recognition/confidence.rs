@@ -46,6 +46,9 @@ pub enum TestName {
     GreenBelow,
     /// Ball without a camera pose: share of field colours (green, white) right at its foot.
     FieldBelow,
+    /// Ball without a camera pose: share of field colours (green, white) in the strip beneath it,
+    /// down several radii (applied only when its weight has a penalty).
+    FieldBeneath,
     /// Goal: pixels of the basic goal colour.
     Pixels,
     /// Goal: real width from the box width at its distance, centimetres.
@@ -103,6 +106,7 @@ impl TestName {
             Self::HeightCm => "height_cm",
             Self::GreenBelow => "green_below",
             Self::FieldBelow => "field_below",
+            Self::FieldBeneath => "field_beneath",
             Self::Pixels => "pixels",
             Self::ApparentWidthCm => "apparent_width_cm",
             Self::BottomHeightCm => "bottom_height_cm",

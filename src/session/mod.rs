@@ -35,6 +35,22 @@ pub enum SessionSource {
     Device(PathBuf),
 }
 
+impl SessionSource {
+    /// What a command-line SOURCE names: a `ws://`/`wss://` server, a `/dev/…` device, else a
+    /// recording.
+    #[must_use]
+    pub fn parse_arg(arg: &Path) -> Self {
+        let s = arg.to_string_lossy();
+        if s.starts_with("ws://") || s.starts_with("wss://") {
+            Self::Live(s.into_owned())
+        } else if s.starts_with("/dev/") {
+            Self::Device(arg.to_owned())
+        } else {
+            Self::Recording(arg.to_owned())
+        }
+    }
+}
+
 /// The field of a session.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum FieldRef {

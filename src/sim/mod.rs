@@ -14,6 +14,7 @@ pub mod render;
 pub mod rng;
 pub mod scenario;
 pub mod truth;
+pub mod world_models;
 
 use thiserror::Error;
 
@@ -22,6 +23,7 @@ pub use effects::CameraEffects;
 pub use render::{Rendered, Renderer, World};
 pub use rng::SimRng;
 pub use scenario::{Scenario, ScenarioKind, View};
+pub use world_models::{KnownError, WorldModelErrors};
 
 use crate::frame::{Frame, FrameError};
 use crate::geometry::{
@@ -82,6 +84,7 @@ pub struct Simulator {
     head_camera: PinholeCamera,
     overhead_camera: OverheadCamera,
     effects: CameraEffects,
+    world_model_errors: WorldModelErrors,
 }
 
 impl Simulator {
@@ -103,7 +106,15 @@ impl Simulator {
             head_camera,
             overhead_camera,
             effects,
+            world_model_errors: WorldModelErrors::default(),
         }
+    }
+
+    /// The same, with the robots' world models erring as `errors` says (the overhead game).
+    #[must_use]
+    pub fn with_world_model_errors(mut self, errors: WorldModelErrors) -> Self {
+        self.world_model_errors = errors;
+        self
     }
 
     /// The same, with other camera effects (e.g. [`CameraEffects::NONE`] for ideal frames).
@@ -170,7 +181,13 @@ impl Simulator {
             labels: out.labels,
             sensors: None,
             ground_truth: GroundTruth::Overhead(Box::new(truth)),
-            extra: self.scenario.world_models(scene, t, at.index),
+            extra: world_models::world_models(
+                scene,
+                t,
+                at.index,
+                self.scenario.seed,
+                &self.world_model_errors,
+            ),
         })
     }
 

@@ -386,6 +386,13 @@ pub trait RecordedSource: FrameSource {
     /// Time of frame `index`, nanoseconds since the first frame.
     fn time_ns(&self, index: usize) -> u64;
 
+    /// The first frame's own time, nanoseconds on the source's clock (a recording's log
+    /// time): the cameras of one recording share this clock, so cameras shown side by side
+    /// are matched by it. 0 for sources without one.
+    fn start_ns(&self) -> u64 {
+        0
+    }
+
     /// The last frame at or before `time_ns` (relative to the first frame).
     fn index_at_time(&self, time_ns: u64) -> usize;
 

@@ -32,7 +32,15 @@ impl StreamSource {
     /// # Errors
     /// The reader's error, naming the file; a stream without frames.
     pub fn open(path: &Path) -> Result<Self, SourceError> {
-        let reader = StreamReader::open(path)?;
+        Self::open_camera(path, None)
+    }
+
+    /// Opens the camera `camera` (an image topic) of a recording; `None`: its first.
+    ///
+    /// # Errors
+    /// As [`StreamSource::open`]; a camera the recording does not have (listing those it has).
+    pub fn open_camera(path: &Path, camera: Option<&str>) -> Result<Self, SourceError> {
+        let reader = StreamReader::open_camera(path, camera)?;
         if reader.is_empty() {
             return Err(SourceError::Empty(format!(
                 "{}: the stream holds no camera frames",
@@ -45,6 +53,31 @@ impl StreamSource {
             connected: true,
             next: 0,
         })
+    }
+
+    /// The camera read (its image topic).
+    #[must_use]
+    pub fn camera(&self) -> Option<&str> {
+        self.reader.camera()
+    }
+
+    /// Every camera of the recording, by image topic.
+    #[must_use]
+    pub fn cameras(&self) -> Vec<String> {
+        self.reader
+            .image_topics()
+            .iter()
+            .map(|t| t.topic.clone())
+            .collect()
+    }
+
+    /// The files the camera read is recognised with (the stream's defaults, the sidecar's in
+    /// their place).
+    ///
+    /// # Errors
+    /// A sidecar that is there but cannot be used.
+    pub fn camera_files(&self) -> Result<crate::camera::CameraFiles, crate::camera::SidecarError> {
+        self.reader.camera_files()
     }
 
     /// The stream file.
@@ -127,6 +160,10 @@ impl RecordedSource for StreamSource {
         self.reader
             .time_ns(index)
             .map_or(0, |t| t.saturating_sub(first))
+    }
+
+    fn start_ns(&self) -> u64 {
+        self.reader.time_ns(0).unwrap_or(0)
     }
 
     fn index_at_time(&self, time_ns: u64) -> usize {

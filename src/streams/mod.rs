@@ -25,6 +25,7 @@
 //! ([`rosbag2`]: folders with `metadata.yaml`, SQLite or MCAP storage), their images in any
 //! encoding through [`crate::formats`].
 
+pub mod camera_info;
 mod reader;
 pub mod rosbag2;
 pub mod schema;
@@ -42,11 +43,7 @@ pub use writer::{Compression, RawChannelSpec, StreamWriter, WriterOptions};
 use crate::frame::Frame;
 use crate::sensors::SensorReadings;
 
-/// Topic of the camera image channel (`foxglove.RawImage`, protobuf).
-pub const IMAGE_TOPIC: &str = "/camera/image";
-/// Topic of camera images stored compressed, as they came (`foxglove.CompressedImage`, JPEG or
-/// PNG, written by `eotn import` from recordings that hold them).
-pub const COMPRESSED_IMAGE_TOPIC: &str = "/camera/image/compressed";
+pub use crate::camera::{CAMERA_METADATA_NAME, COMPRESSED_IMAGE_TOPIC, IMAGE_TOPIC};
 /// Topic of the sensor readings channel (JSON, schema `eotn.SensorReadings`).
 pub const SENSORS_TOPIC: &str = "/sensors";
 /// Topic of the ground-truth channel (JSON object, free form; written by renderers/simulators).
@@ -163,6 +160,16 @@ pub enum StreamError {
         index: usize,
         /// Number of frames.
         len: usize,
+    },
+    /// The camera asked for (`--camera TOPIC`) is not among the recording's image topics.
+    #[error("{path}: no camera {topic}; its cameras: {}", if cameras.is_empty() { "none".to_owned() } else { cameras.join(", ") })]
+    NoSuchCamera {
+        /// The recording.
+        path: PathBuf,
+        /// The topic asked for.
+        topic: String,
+        /// The image topics there are.
+        cameras: Vec<String>,
     },
     /// A record the writer cannot store (odd width, unserialisable JSON, bad topic).
     #[error("{path}: cannot write frame at {time_ns} ns: {detail}")]

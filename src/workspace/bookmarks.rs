@@ -25,6 +25,10 @@ pub enum EventKind {
     Warning,
     /// The pending try-edit changes this frame's blobs.
     TryEditChange,
+    /// The opened labels have an eligible ball here that recognition did not find.
+    LabelMissed,
+    /// Recognition reports a ball here outside every labelled ball box.
+    LabelFalse,
 }
 
 impl EventKind {
@@ -37,6 +41,8 @@ impl EventKind {
             Self::GoalAppears(c) => format!("{} goal appears", c.name()),
             Self::Warning => "warning".to_owned(),
             Self::TryEditChange => "try-edit changes blobs".to_owned(),
+            Self::LabelMissed => "labelled ball missed".to_owned(),
+            Self::LabelFalse => "false ball".to_owned(),
         }
     }
 }

@@ -20,12 +20,30 @@ pub enum Command {
     /// parameters or places (told by content), anything else as a table. Each file opens or
     /// fails on its own.
     Open(Vec<PathBuf>),
+    /// Show another camera of the open recording (its image topic; `None`: the first): the
+    /// recording reopens on that camera at the frame nearest the time shown, with that camera's
+    /// table (remembered for it, else the one the recording names). Also the camera later
+    /// recordings open on, when they have it.
+    OpenCamera(Option<String>),
+    /// Show these cameras (image topics) of the open recording side by side, stepped together
+    /// by time: each shows its frame nearest the shared cursor (the focused camera's frame
+    /// time), classified with its own table, its own recognition drawn. The camera shown so
+    /// far stays focused when listed. Fewer than two: one camera again (refused while a camera
+    /// leaving the view has unsaved table edits). `workspace/side_by_side.rs`.
+    ShowSideBySide(Vec<String>),
+    /// Make this camera (shown side by side) the focused one: hand classification, commit,
+    /// undo, save, playback and the sensors window act on it and its own table.
+    FocusCamera(String),
     /// Open a lookup table.
     OpenTable(PathBuf),
     /// Open a places file (`eotn patterns learn`): pink markers are identified as its places.
     OpenPlaces(PathBuf),
     /// Forget the places file: pink markers keep their signatures, unidentified.
     ClosePlaces,
+    /// Open a label set (a YOLO or Pascal VOC folder, a COCO JSON file) over the open frames:
+    /// its boxes drawn by class, recognition scored against them, the missed and false frames
+    /// as events (`workspace/labels.rs`).
+    OpenLabels(PathBuf),
     /// Open or close a window.
     ShowWindow(Window, bool),
     /// Select a recognition candidate (the object its primitives belong to) to highlight its

@@ -3,30 +3,32 @@
 //! that overhead truth, the error of each, and the errors over the frames seen so far (for the
 //! plot). The app's field view (`app/field_view.rs`) only draws this.
 //!
-//! A world model (`/world_model/robotN`) names its robot by number; the overhead camera knows
-//! robots by team colour and marker identity. A synthetic frame's truth says which marker robot
-//! N wears; without truth a world model goes with the nearest detected robot within
-//! [`MATCH_RADIUS_CM`] of its own estimate.
+//! A world model (`/world_model`, `/world_model/<anything>`; docs/formats.md) names its robot by
+//! the marker it wears; it is compared with the overhead robot reading that marker, else by
+//! position (`crate::wmd::compare`). Messages that are not world models are warned about once
+//! and skipped.
 
 use std::collections::{BTreeMap, VecDeque};
 
 use super::overhead::RobotKey;
-use crate::eval::overhead::WorldModel;
-use crate::model::truth::OverheadTruth;
+use crate::model::world_model::{self, is_world_model_topic};
 use crate::overhead::OverheadDetections;
+use crate::wmd::{Matched, OverheadRobotPose, OverheadView, Targets};
 
 /// Positions a trail keeps (frames).
 pub const TRAIL_FRAMES: usize = 30;
 
 /// Farthest a world model's self estimate may be from a detected robot to be matched with it
-/// when the frame carries no truth, centimetres.
-pub const MATCH_RADIUS_CM: f64 = 100.0;
+/// by position, centimetres.
+pub const MATCH_RADIUS_CM: f64 = crate::wmd::MATCH_RADIUS_CM;
 
 /// One robot's world model on the shown frame, beside the overhead truth.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WorldModelView {
-    /// The robot's number (`/world_model/robotN`).
-    pub robot_id: u32,
+    /// The robot, by the marker the message names.
+    pub robot: RobotKey,
+    /// How it was matched with an overhead robot.
+    pub matched: Matched,
     /// The overhead robot it is compared with, if found.
     pub key: Option<RobotKey>,
     /// Its own estimate of itself: field x, y (cm) and heading (rad).
@@ -46,8 +48,8 @@ pub struct WorldModelView {
 pub struct ErrorSample {
     /// Frame time, seconds since the first frame.
     pub time_s: f64,
-    /// Per robot number: self error and ball error, cm.
-    pub errors: Vec<(u32, Option<f64>, Option<f64>)>,
+    /// Per robot: self error and ball error, cm.
+    pub errors: Vec<(RobotKey, Option<f64>, Option<f64>)>,
 }
 
 /// See the module documentation.
@@ -58,17 +60,17 @@ pub struct FieldModel {
     last_index: Option<usize>,
     world_models: Vec<WorldModelView>,
     errors: BTreeMap<usize, ErrorSample>,
+    warned: bool,
 }
 
 impl FieldModel {
     /// Takes in the shown frame: `index` in the source, its time, what the overhead camera
-    /// found, the frame's truth if any and its extra channels (the world models).
+    /// found and its extra channels (the world models).
     pub fn observe(
         &mut self,
         index: usize,
         time_ns: u64,
         detections: Option<&OverheadDetections>,
-        truth: Option<&OverheadTruth>,
         extra: &[(String, serde_json::Value)],
     ) {
         // Trails follow playback: a jump (seek, step back) starts them again; the same frame
@@ -91,13 +93,36 @@ impl FieldModel {
                 push_trail(&mut self.ball_trail, index, b.field_cm);
             }
         }
-        self.world_models = extra
+        let models: Vec<world_model::WorldModelMessage> = extra
             .iter()
-            .filter(|(topic, _)| topic.starts_with("/world_model/"))
-            .filter_map(|(_, v)| serde_json::from_value::<WorldModel>(v.clone()).ok())
-            .map(|m| compare(&m, detections, truth))
+            .filter(|(topic, _)| is_world_model_topic(topic))
+            .filter_map(|(topic, v)| match world_model::from_value(v) {
+                Ok(m) => Some(m),
+                Err(e) => {
+                    if !std::mem::replace(&mut self.warned, true) {
+                        log::warn!("{topic}: not a world model ({e}); skipped");
+                    }
+                    None
+                }
+            })
             .collect();
-        self.world_models.sort_by_key(|m| m.robot_id);
+        let refs: Vec<&world_model::WorldModelMessage> = models.iter().collect();
+        let view = overhead_view(detections);
+        self.world_models = crate::wmd::compare(&view, &refs, &Targets::default())
+            .into_iter()
+            .zip(&models)
+            .map(|(c, m)| WorldModelView {
+                robot: m.robot,
+                matched: c.matched,
+                key: c.overhead_robot,
+                own: [m.own.x_cm, m.own.y_cm, m.own.heading_rad],
+                ball: m.ball,
+                self_error_cm: c.position_error_cm,
+                heading_error_deg: c.heading_error_deg.map(f64::abs),
+                ball_error_cm: c.ball_error_cm,
+            })
+            .collect();
+        self.world_models.sort_by_key(|m| m.robot);
         if !self.world_models.is_empty() {
             self.errors.insert(
                 index,
@@ -106,7 +131,7 @@ impl FieldModel {
                     errors: self
                         .world_models
                         .iter()
-                        .map(|m| (m.robot_id, m.self_error_cm, m.ball_error_cm))
+                        .map(|m| (m.robot, m.self_error_cm, m.ball_error_cm))
                         .collect(),
                 },
             );
@@ -125,7 +150,7 @@ impl FieldModel {
         &self.ball_trail
     }
 
-    /// The shown frame's world models, by robot number.
+    /// The shown frame's world models, blue team first, then by identity.
     #[must_use]
     pub fn world_models(&self) -> &[WorldModelView] {
         &self.world_models
@@ -147,56 +172,23 @@ fn push_trail(trail: &mut VecDeque<(usize, [f64; 2])>, index: usize, p: [f64; 2]
     }
 }
 
-/// Which overhead robot a world model is about, and its errors against it.
-fn compare(
-    m: &WorldModel,
-    detections: Option<&OverheadDetections>,
-    truth: Option<&OverheadTruth>,
-) -> WorldModelView {
-    let own = [m.own.x_cm, m.own.y_cm];
-    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
-    let key = match truth {
-        Some(t) => t
+/// What the overhead camera saw, as the comparison takes it.
+fn overhead_view(detections: Option<&OverheadDetections>) -> OverheadView {
+    detections.map_or_else(OverheadView::default, |d| OverheadView {
+        ball: d.ball.as_ref().map(|b| b.field_cm),
+        robots: d
             .robots
             .iter()
-            .find(|r| r.id == m.robot_id)
-            .and_then(|r| r.marker)
-            .map(|k| RobotKey {
-                team: k.team,
-                identity: k.identity,
-            }),
-        None => detections.and_then(|d| {
-            d.robots
-                .iter()
-                .map(|r| (dist(r.field_cm, own), r))
-                .filter(|(e, _)| *e <= MATCH_RADIUS_CM)
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, r)| RobotKey {
+            .map(|r| OverheadRobotPose {
+                key: RobotKey {
                     team: r.team,
                     identity: r.identity,
-                })
-        }),
-    };
-    let seen = key.and_then(|k| {
-        detections?
-            .robots
-            .iter()
-            .find(|r| r.team == k.team && r.identity == k.identity)
-    });
-    let ball = m.ball.map(|b| [b.x_cm, b.y_cm]);
-    let overhead_ball = detections.and_then(|d| d.ball.as_ref()).map(|b| b.field_cm);
-    WorldModelView {
-        robot_id: m.robot_id,
-        key,
-        own: [m.own.x_cm, m.own.y_cm, m.own.heading_rad],
-        ball,
-        self_error_cm: seen.map(|r| dist(r.field_cm, own)),
-        heading_error_deg: seen.map(|r| {
-            let d = (m.own.heading_rad - r.heading_rad).rem_euclid(std::f64::consts::TAU);
-            d.min(std::f64::consts::TAU - d).to_degrees()
-        }),
-        ball_error_cm: ball.zip(overhead_ball).map(|(a, b)| dist(a, b)),
-    }
+                },
+                field_cm: r.field_cm,
+                heading_rad: r.heading_rad,
+            })
+            .collect(),
+    })
 }
 
 #[cfg(test)]
@@ -229,30 +221,31 @@ mod tests {
 
     fn world_model(id: u32, x: f64, heading: f64, ball_x: f64) -> (String, serde_json::Value) {
         (
-            format!("/world_model/robot{id}"),
-            serde_json::json!({"robot_id": id, "self": {"x_cm": x, "y_cm": 0.0,
+            "/world_model".to_owned(),
+            serde_json::json!({"team": "blue", "robot_id": id, "self": {"x_cm": x, "y_cm": 0.0,
                 "heading_rad": heading}, "ball": {"x_cm": ball_x, "y_cm": 0.0}}),
         )
     }
 
     #[test]
-    fn a_world_model_is_compared_with_the_nearest_robot_without_truth() {
+    fn a_world_model_is_compared_with_its_marker_else_the_nearest_robot() {
         let mut m = FieldModel::default();
         let d = detections([100.0, 0.0], [0.0, 0.0]);
-        m.observe(0, 0, Some(&d), None, &[world_model(3, 130.0, 0.5, 40.0)]);
+        m.observe(0, 0, Some(&d), &[world_model(5, 130.0, 0.5, 40.0)]);
         let w = &m.world_models()[0];
+        assert_eq!(w.matched, Matched::Marker);
+        assert_eq!(w.key.map(|k| k.identity.value()), Some(5));
+        assert!((w.self_error_cm.expect("matched") - 30.0).abs() < 1e-9);
+        // Blue 3's marker is not read: the nearest robot, said as such.
+        m.observe(0, 0, Some(&d), &[world_model(3, 130.0, 0.5, 40.0)]);
+        let w = &m.world_models()[0];
+        assert_eq!(w.matched, Matched::Position);
         assert_eq!(w.key.map(|k| k.identity.value()), Some(5));
         assert!((w.self_error_cm.expect("matched") - 30.0).abs() < 1e-9);
         assert!((w.heading_error_deg.expect("matched") - 0.5f64.to_degrees()).abs() < 1e-9);
         assert!((w.ball_error_cm.expect("ball") - 40.0).abs() < 1e-9);
         // Too far from every robot: no match, no self error; the ball error stays.
-        m.observe(
-            1,
-            40_000_000,
-            Some(&d),
-            None,
-            &[world_model(3, 400.0, 0.0, 10.0)],
-        );
+        m.observe(1, 40_000_000, Some(&d), &[world_model(3, 400.0, 0.0, 10.0)]);
         let w = &m.world_models()[0];
         assert_eq!((w.key, w.self_error_cm), (None, None));
         assert_eq!(m.error_samples().count(), 2);
@@ -263,7 +256,7 @@ mod tests {
         let mut m = FieldModel::default();
         for i in 0..TRAIL_FRAMES + 5 {
             let d = detections([i as f64, 0.0], [0.0, i as f64]);
-            m.observe(i, 0, Some(&d), None, &[]);
+            m.observe(i, 0, Some(&d), &[]);
         }
         let trail = m.trails().values().next().expect("one robot");
         assert_eq!(trail.len(), TRAIL_FRAMES);
@@ -276,14 +269,13 @@ mod tests {
             TRAIL_FRAMES + 4,
             0,
             Some(&detections([-1.0, 0.0], [0.0, 0.0])),
-            None,
             &[],
         );
         let trail = m.trails().values().next().expect("one robot");
         assert_eq!(trail.len(), TRAIL_FRAMES);
         assert_eq!(trail.back(), Some(&(TRAIL_FRAMES + 4, [-1.0, 0.0])));
         assert_eq!(m.ball_trail().len(), TRAIL_FRAMES);
-        m.observe(3, 0, Some(&detections([0.0, 0.0], [0.0, 0.0])), None, &[]);
+        m.observe(3, 0, Some(&detections([0.0, 0.0], [0.0, 0.0])), &[]);
         assert_eq!(m.trails().values().next().map(VecDeque::len), Some(1));
     }
 }

@@ -54,9 +54,14 @@ impl Workspace {
                     s.display()
                 ));
             }
-            match Source::stream(&s) {
+            match Source::stream_camera(&s, self.camera_for(&s).as_deref()) {
                 Ok(source) => {
                     self.remember_recent(&s);
+                    if tables.is_empty()
+                        && let Some(t) = self.camera_table(&s, source.camera())
+                    {
+                        tables.push(t);
+                    }
                     match self.set_source(source) {
                         Ok(()) => offer = Some(s),
                         Err(e) => failures.push(format!("{e:#}")),
@@ -114,6 +119,9 @@ impl Workspace {
     }
 
     pub(super) fn set_source(&mut self, source: Source) -> anyhow::Result<()> {
+        // Cameras shown side by side belong to the source replaced (refused when one of their
+        // tables has unsaved edits).
+        self.close_side_by_side()?;
         let kind = source.info().camera;
         let old_kind = self.table_kind;
         let old = self.source.replace(source);
@@ -130,6 +138,7 @@ impl Workspace {
         self.live = None;
         self.robots.unshow();
         self.load_bookmarks();
+        self.labels = None;
         if let Some(src) = &self.source {
             self.settings.last_source = src
                 .paths()
@@ -227,11 +236,15 @@ impl Workspace {
             .max(src.first_index());
         let t0 = Instant::now();
         let loaded = src.read(index)?;
+        let resized = self.current.as_ref().and_then(|old| {
+            let topic = src.camera().unwrap_or("the source");
+            super::side_by_side::size_change(topic, &old.frame, &loaded.frame, index)
+        });
         let t1 = Instant::now();
         let t = self.run_pipeline(&loaded);
         let t2 = Instant::now();
         loaded.frame.to_rgb_into(&mut self.rgb);
-        for w in &loaded.warnings {
+        for w in resized.iter().chain(&loaded.warnings) {
             if !self.warnings.contains(w) {
                 self.warn(w.clone());
             }
@@ -250,6 +263,7 @@ impl Workspace {
             upload: Duration::ZERO,
         };
         self.frame_generation += 1;
+        self.sync_beside();
         Ok(())
     }
 

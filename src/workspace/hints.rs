@@ -173,6 +173,9 @@ impl Workspace {
                     }),
             );
         }
+        if let Some(labels) = self.labels() {
+            out.extend(labels.events());
+        }
         out.sort_by_key(|e| e.frame);
         out
     }
@@ -197,5 +200,6 @@ impl Workspace {
     pub fn hints_busy(&self) -> bool {
         self.hints.coverage.as_ref().is_some_and(|c| !c.done())
             || self.hints.events.as_ref().is_some_and(|e| !e.done())
+            || self.labels().is_some_and(|l| !l.done())
     }
 }

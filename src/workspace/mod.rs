@@ -22,13 +22,17 @@
 //! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
 //! | `stream_scan.rs` | [`StreamScan`]: the whole-stream checks' one loop, a few frames per UI frame |
 //! | `coverage.rs`, `cell_origin.rs`, `bookmarks.rs`, `hints.rs` | what is unclassified, who set a cell, events and bookmarks |
+//! | `labels.rs` | [`OpenLabels`]: a boxed label set over the open frames, scored; its missed and false frames as events |
 //! | `params.rs` | recognition parameters: open, tune, reset, save, the set a stream names, [`params::TryParams`] |
 //! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
 //! | `timings.rs` | step and frame-time measurements |
 //! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
+//! | `cameras.rs` | the camera shown of a recording with several (`Command::OpenCamera`) and each camera's own table |
+//! | `side_by_side.rs` | several cameras side by side, stepped together by time, each with its own table, pipeline and results; the focused one gets the clicks |
 //! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time |
 
 pub mod bookmarks;
+mod cameras;
 pub mod cell_origin;
 mod command;
 mod compose;
@@ -37,6 +41,7 @@ pub mod field_model;
 mod frames;
 mod hints;
 pub mod journal;
+mod labels;
 mod live;
 pub mod overhead;
 pub mod params;
@@ -44,6 +49,7 @@ mod playback;
 pub mod player;
 mod robots;
 mod settings;
+mod side_by_side;
 pub mod source;
 mod stream_scan;
 mod table;
@@ -59,6 +65,7 @@ pub use command::{
     SourceCommand, TableCommand, ViewCommand, Window,
 };
 pub use compose::{PrimitiveFilter, box_colour};
+pub use labels::OpenLabels;
 pub use live::Live;
 pub use overhead::{CalibrationSource, Overhead, RobotKey};
 pub use params::{ParamsOffer, ParamsSlot, TryParams, TryParamsRow};
@@ -68,6 +75,7 @@ pub use settings::{
     MAX_RECENT, MAX_WARNINGS, OverheadView, Overlays, SETTINGS_FILE_NAME, SPEEDS, Settings,
     ViewKind, ViewTransform, ZOOM_PRESETS, ZOOM_RANGE,
 };
+pub use side_by_side::CameraPane;
 pub use source::Source;
 pub use stream_scan::StreamScan;
 pub use table::TableSlot;
@@ -136,6 +144,9 @@ pub struct Workspace {
     history: EditHistory,
     dirty: bool,
     source: Option<Source>,
+    /// The camera (image topic) recordings open on (`eotn open --camera`, the camera picker);
+    /// `None`: each recording's first.
+    camera: Option<String>,
     index: usize,
     current: Option<SourceFrame>,
     rgb: Vec<u8>,
@@ -172,11 +183,19 @@ pub struct Workspace {
     overhead: overhead::Overhead,
     /// Coverage hints, events and bookmarks.
     hints: hints::Hints,
+    /// A label set opened over the source (`eotn open FOLDER --labels LABELS`), its scoring.
+    labels: Option<labels::OpenLabels>,
     /// The recognition parameters' file, the loaded values, the stream's offer.
     params: ParamsSlot,
+    /// The other cameras shown side by side with the focused one (empty: one camera shown).
+    beside: side_by_side::SideBySide,
     /// Edits in the undo history when the table was last opened or saved (`None` when that
     /// state can no longer be reached by undoing).
     saved_undo_len: Option<usize>,
+    /// A table without a file yet (new, or made in this session): the table it started from and
+    /// the journal entries since, written as its journal when it is first saved, so the journal
+    /// records from the table's first commit (`None` once the table has a file).
+    unsaved_journal: Option<(LookupTable, Vec<journal::JournalEntry>)>,
 }
 
 impl Default for Workspace {
@@ -200,6 +219,7 @@ impl Workspace {
             ..PipelineParams::default()
         };
         let table_counts = lut.class_counts();
+        let unsaved_journal = Some((lut.clone(), Vec::new()));
         Self {
             settings,
             pipeline: Pipeline::new(lut, params),
@@ -207,6 +227,7 @@ impl Workspace {
             history: EditHistory::default(),
             dirty: false,
             source: None,
+            camera: None,
             index: 0,
             current: None,
             rgb: Vec::new(),
@@ -234,8 +255,11 @@ impl Workspace {
             other_table: TableSlot::empty(bits),
             overhead: overhead::Overhead::default(),
             hints: hints::Hints::default(),
+            labels: None,
             params: ParamsSlot::default(),
+            beside: side_by_side::SideBySide::default(),
             saved_undo_len: Some(0),
+            unsaved_journal,
         }
     }
 
@@ -306,9 +330,13 @@ impl Workspace {
         }
         match command {
             Command::Open(paths) => self.open(paths)?,
+            Command::OpenCamera(topic) => self.open_camera(topic)?,
+            Command::ShowSideBySide(topics) => self.show_side_by_side(&topics)?,
+            Command::FocusCamera(topic) => self.focus_camera(&topic)?,
             Command::OpenTable(p) => self.open_table(&p)?,
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),
+            Command::OpenLabels(p) => self.open_labels(&p)?,
             Command::ShowWindow(w, open) => {
                 *self.window_flag(w) = open;
                 if w == Window::Inspector && !open {
@@ -655,6 +683,39 @@ mod tests {
                 .into()
             )
             .is_err()
+        );
+    }
+
+    #[test]
+    fn a_new_table_journals_from_its_first_commit() {
+        let dir = tempfile::tempdir().expect("temp");
+        let path = dir.path().join("new.lut");
+        let mut s = Workspace::default();
+        s.apply(TableCommand::NewTable(6).into()).unwrap();
+        for (class, cell) in [
+            (ColourClass::Orange, [30, 20, 50]),
+            (ColourClass::Green, [20, 12, 12]),
+            (ColourClass::White, [60, 32, 32]),
+        ] {
+            s.apply(TableCommand::SetClass(class).into()).unwrap();
+            s.apply(TableCommand::SampleCell(cell).into()).unwrap();
+            s.apply(TableCommand::Commit.into()).unwrap();
+        }
+        s.apply(TableCommand::Undo.into()).unwrap();
+        s.apply(TableCommand::SaveTableAs(path.clone()).into())
+            .unwrap();
+        // Before the fix the journal began at the save, with the edits folded into a base copy.
+        assert!(!journal::base_path(&path).exists());
+        let replay = journal::replay(&path).unwrap();
+        assert_eq!(replay.commits, 3);
+        assert_eq!(&replay.table, s.pipeline.lut());
+        assert_eq!(replay.table, LookupTable::load(&path).unwrap());
+        // Edits after the save are appended as before.
+        s.apply(TableCommand::Redo.into()).unwrap();
+        s.apply(TableCommand::SaveTable.into()).unwrap();
+        assert_eq!(
+            journal::replay(&path).unwrap().table,
+            LookupTable::load(&path).unwrap()
         );
     }
 }

@@ -16,7 +16,7 @@ use anyhow::Context as _;
 use super::Workspace;
 use super::command::OverheadCommand;
 use super::field_model::FieldModel;
-use crate::geometry::{ImagePoint, MarkerIdentity, MarkerTeam, OverheadCamera};
+use crate::geometry::{ImagePoint, OverheadCamera};
 use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate_with};
 use crate::overhead::intrinsics::Intrinsics;
 use crate::overhead::{
@@ -31,33 +31,7 @@ pub const MIN_CALIBRATION_POINTS: usize = crate::overhead::review::MIN_POINTS;
 
 /// One robot as the overhead camera identifies it: team colour and marker identity. The one
 /// robot selection of the workspace (field view, image overlays) is one of these.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct RobotKey {
-    /// Team dot colour.
-    pub team: MarkerTeam,
-    /// Marker identity, 0–15.
-    pub identity: MarkerIdentity,
-}
-
-impl Ord for RobotKey {
-    /// Blue team first, then by identity (listings, trails).
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        let rank = |k: &Self| (k.team == MarkerTeam::Yellow, k.identity);
-        rank(self).cmp(&rank(other))
-    }
-}
-
-impl PartialOrd for RobotKey {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl std::fmt::Display for RobotKey {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{} {}", self.team.name(), self.identity.value())
-    }
-}
+pub use crate::model::world_model::RobotKey;
 
 /// The undistorted view's pixel map and the camera and frame size it was made for.
 #[derive(Debug, Clone)]
@@ -351,13 +325,11 @@ impl Workspace {
         self.accepted_owners.clear();
         self.selected_object = None;
         self.frame_counts = self.overhead.pipeline.classified().histogram();
-        let truth = truth_of(loaded);
         let index = self.index_of_frame(loaded);
         self.overhead.field_model.observe(
             index,
             loaded.time_ns,
             self.overhead.detections.as_ref(),
-            truth.as_ref(),
             &loaded.extra,
         );
         let t = self.overhead.pipeline.timings();
@@ -483,7 +455,8 @@ impl Workspace {
             self.status = "no intrinsics: Calibrate fits the lens too".into();
             return Ok(());
         };
-        let mut i = Intrinsics::load(&p)?;
+        let mut i =
+            crate::streams::camera_info::load_intrinsics(&p, None).map_err(anyhow::Error::msg)?;
         if i.camera_name.is_empty() {
             i.camera_name = p.display().to_string();
         }

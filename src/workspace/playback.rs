@@ -53,6 +53,7 @@ impl Workspace {
             t.scan(src, self.pipeline.lut(), conn, min, SCAN_BUDGET);
         }
         self.tick_hints();
+        self.tick_labels();
         self.scan_try_params(SCAN_BUDGET);
         let Some(src) = self.source.as_ref() else {
             self.player.stop();

@@ -190,6 +190,9 @@ pub struct Settings {
     pub last_table: Option<PathBuf>,
     /// The overhead camera's table to reopen at start.
     pub last_overhead_table: Option<PathBuf>,
+    /// Each camera's files (table, parameters, calibration) as last used with it, by camera:
+    /// a recording's `/camera/bottom` opens with the table last used on `/camera/bottom`.
+    pub cameras: std::collections::BTreeMap<crate::camera::CameraId, crate::camera::CameraFiles>,
     /// The places file (learnt coloured patterns) to reopen at start.
     pub last_places: Option<PathBuf>,
     /// The recognition parameters file to reopen at start (`None`: the defaults).
@@ -263,6 +266,7 @@ impl Default for Settings {
             recent: Vec::new(),
             last_table: None,
             last_overhead_table: None,
+            cameras: std::collections::BTreeMap::new(),
             last_places: None,
             last_params: None,
             last_source: Vec::new(),

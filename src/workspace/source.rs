@@ -16,6 +16,9 @@ pub const CACHE_FRAMES: usize = 8;
 pub struct Source {
     inner: Box<dyn RecordedSource>,
     info: SourceInfo,
+    /// A recording's camera shown (its image topic), and every camera it has.
+    camera: Option<String>,
+    cameras: Vec<String>,
     cache: VecDeque<(usize, SourceFrame)>,
 }
 
@@ -37,6 +40,8 @@ impl Source {
         Self {
             inner,
             info,
+            camera: None,
+            cameras: Vec::new(),
             cache: VecDeque::new(),
         }
     }
@@ -54,7 +59,33 @@ impl Source {
     /// # Errors
     /// The reader's error, naming the file; a stream without frames.
     pub fn stream(path: &Path) -> Result<Self, SourceError> {
-        Ok(Self::new(Box::new(StreamSource::open(path)?)))
+        Self::stream_camera(path, None)
+    }
+
+    /// The camera `camera` (an image topic; `None`: the first) of a recording.
+    ///
+    /// # Errors
+    /// As [`Source::stream`]; a camera the recording does not have (listing those it has).
+    pub fn stream_camera(path: &Path, camera: Option<&str>) -> Result<Self, SourceError> {
+        let stream = StreamSource::open_camera(path, camera)?;
+        let shown = stream.camera().map(str::to_owned);
+        let cameras = stream.cameras();
+        let mut source = Self::new(Box::new(stream));
+        source.camera = shown;
+        source.cameras = cameras;
+        Ok(source)
+    }
+
+    /// The recording's camera shown (its image topic); `None` for frame files and live sources.
+    #[must_use]
+    pub fn camera(&self) -> Option<&str> {
+        self.camera.as_deref()
+    }
+
+    /// Every camera of the recording, by image topic (the camera picker's list).
+    #[must_use]
+    pub fn cameras(&self) -> &[String] {
+        &self.cameras
     }
 
     /// What it is: kind, label, camera kind, files.
@@ -109,6 +140,13 @@ impl Source {
     #[must_use]
     pub fn time_ns(&self, index: usize) -> u64 {
         self.inner.time_ns(index)
+    }
+
+    /// The first frame's own time, nanoseconds on the recording's clock (see
+    /// [`RecordedSource::start_ns`]).
+    #[must_use]
+    pub fn start_ns(&self) -> u64 {
+        self.inner.start_ns()
     }
 
     /// The last frame at or before `time_ns` (relative to the first frame).

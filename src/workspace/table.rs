@@ -119,6 +119,7 @@ impl Workspace {
     }
 
     fn set_table(&mut self, lut: LookupTable, path: Option<PathBuf>) {
+        self.unsaved_journal = path.is_none().then(|| (lut.clone(), Vec::new()));
         self.pipeline.set_lut(lut);
         self.table_path = path;
         self.history.clear();
@@ -131,11 +132,18 @@ impl Workspace {
         let moved = self.table_path.as_deref() != Some(path);
         self.pipeline.lut().save(path)?;
         if moved && !journal::journal_path(path).exists() {
-            // The journal follows the table: a new file starts one from the table as saved.
-            if let Err(e) = journal::append(path, self.pipeline.lut(), &[]) {
+            // The journal follows the table. A table saved for the first time writes the edits
+            // made since it was new (the journal then replays from its first commit); a table
+            // saved under another name starts one from the table as saved.
+            let written = match self.unsaved_journal.take() {
+                Some((start, entries)) => journal::append(path, &start, &entries),
+                None => journal::append(path, self.pipeline.lut(), &[]),
+            };
+            if let Err(e) = written {
                 self.warn(format!("{e:#}"));
             }
         }
+        self.unsaved_journal = None;
         self.table_path = Some(path.to_owned());
         self.remember_table(path);
         self.remember_recent(path);
@@ -147,6 +155,9 @@ impl Workspace {
 
     fn journal(&mut self, entry: &JournalEntry) {
         let Some(path) = self.table_path.clone() else {
+            if let Some((_, entries)) = self.unsaved_journal.as_mut() {
+                entries.push(entry.clone());
+            }
             return;
         };
         if let Err(e) = journal::append(&path, self.pipeline.lut(), std::slice::from_ref(entry)) {
@@ -221,7 +232,7 @@ impl Workspace {
         }
     }
 
-    fn table_changed(&mut self) {
+    pub(super) fn table_changed(&mut self) {
         self.table_generation += 1;
         self.table_counts = self.pipeline.lut().class_counts();
         self.try_edit = None;
@@ -391,13 +402,17 @@ pub struct TableSlot {
     pub(super) history: crate::lut::EditHistory,
     pub(super) dirty: bool,
     pub(super) saved_undo_len: Option<usize>,
+    /// The journal of a table without a file (see `Workspace::unsaved_journal`).
+    pub(super) unsaved_journal: Option<(LookupTable, Vec<JournalEntry>)>,
 }
 
 impl TableSlot {
     /// An empty table of `bits` per channel, without a file.
     pub(super) fn empty(bits: u8) -> Self {
+        let lut = LookupTable::new(bits).unwrap_or_else(|_| super::seven_bit_table());
         Self {
-            lut: LookupTable::new(bits).unwrap_or_else(|_| super::seven_bit_table()),
+            unsaved_journal: Some((lut.clone(), Vec::new())),
+            lut,
             path: None,
             history: crate::lut::EditHistory::default(),
             dirty: false,
@@ -430,6 +445,7 @@ impl Workspace {
         std::mem::swap(&mut self.history, &mut o.history);
         std::mem::swap(&mut self.dirty, &mut o.dirty);
         std::mem::swap(&mut self.saved_undo_len, &mut o.saved_undo_len);
+        std::mem::swap(&mut self.unsaved_journal, &mut o.unsaved_journal);
         self.table_kind = kind;
         self.selection = None;
         self.table_changed();
@@ -450,6 +466,14 @@ impl Workspace {
     /// Remembers `path` as the table of the camera in use, to reopen at start.
     pub(super) fn remember_table(&mut self, path: &Path) {
         let p = Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        if let Some(id) = self.camera_id() {
+            self.settings
+                .cameras
+                .entry(id)
+                .or_default()
+                .lut
+                .clone_from(&p);
+        }
         match self.table_kind {
             CameraKind::Robot => self.settings.last_table = p,
             CameraKind::Overhead => self.settings.last_overhead_table = p,

@@ -658,7 +658,7 @@ fn file_open_table_shows_the_in_app_dialog() {
         .with_size(Vec2::new(1280.0, 800.0))
         .allow_missing_glyphs()
         .with_accessibility_check(false)
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()));
+        .build_eframe(move |cc| EotnApp::new(cc, paths.clone(), None));
     h.run();
     click_label(&mut h, "File");
     click_label(&mut h, "Open table…");

@@ -220,3 +220,71 @@ fn events_and_bookmarks_mark_the_timeline_and_bookmarks_stay_beside_the_stream()
         s.warnings()
     );
 }
+
+/// Boxed labels opened over the frames (`eotn open FOLDER --labels LABELS` sends the same
+/// command): the Events and bookmarks window shows the report's figures, the missed and false
+/// frames are marks to step between.
+#[test]
+fn labels_over_frames_show_the_report_and_step_between_missed_and_false_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut paths = fixture(dir.path());
+    // The fixture's table knows green only: orange too, so the balls of frames 1 and 2 are seen.
+    let table = paths.pop().unwrap();
+    let mut lut = LookupTable::load(&table).unwrap();
+    lut.apply(EditRecord::now(
+        ColourClass::Orange,
+        Region::AroundSample {
+            sample: ORANGE,
+            sensitivity: Sensitivity::uniform(2),
+        },
+    ));
+    lut.save(&table).unwrap();
+    paths.push(table);
+    // YOLO: frame 0 labelled with a ball it does not show (missed), frame 1's ball labelled
+    // (found), frame 2's ball not labelled (false).
+    let labels = dir.path().join("labels");
+    std::fs::create_dir_all(&labels).unwrap();
+    std::fs::write(labels.join("classes.txt"), "robot\nball\ngoal\n").unwrap();
+    let ball = |bx: f64| {
+        format!(
+            "1 {} {} {} {}\n",
+            (bx + 10.0) / 208.0,
+            50.0 / 160.0,
+            20.0 / 208.0,
+            20.0 / 160.0
+        )
+    };
+    std::fs::write(labels.join("f0.txt"), ball(60.0)).unwrap();
+    std::fs::write(labels.join("f1.txt"), ball(70.0)).unwrap();
+    std::fs::write(labels.join("f2.txt"), "0 0.9 0.9 0.1 0.1\n").unwrap();
+    let mut h = harness(paths);
+    h.state_mut().state.run(Command::OpenLabels(labels));
+    show_window(&mut h, Window::Bookmarks);
+    run_until(&mut h, WITHIN, |a| {
+        a.state
+            .labels()
+            .is_some_and(eotn::workspace::OpenLabels::done)
+    });
+    h.run();
+    // Recall (1 of 2 eligible frames) and precision (1 of 2 reported balls).
+    assert_eq!(h.query_all_by_label("1 / 2 = 50.0%").count(), 2);
+    let kinds: Vec<(usize, EventKind)> = workspace(&h)
+        .events()
+        .iter()
+        .filter(|e| matches!(e.kind, EventKind::LabelMissed | EventKind::LabelFalse))
+        .map(|e| (e.frame, e.kind))
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![(0, EventKind::LabelMissed), (2, EventKind::LabelFalse)]
+    );
+    assert_eq!(workspace(&h).index(), 0);
+    assert_eq!(
+        workspace(&h).shown_label_boxes().map(|b| b.boxes.len()),
+        Some(1)
+    );
+    click_label(&mut h, "Next mark");
+    assert_eq!(workspace(&h).index(), 2);
+    click_label(&mut h, "Previous mark");
+    assert_eq!(workspace(&h).index(), 0);
+}

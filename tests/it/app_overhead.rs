@@ -374,20 +374,27 @@ fn world_models_are_compared_with_the_overhead_robots() {
     assert!(models.len() >= 4, "{models:?}");
     let t = truth(stream, 2);
     for m in models {
-        let r = t.robots.iter().find(|r| r.id == m.robot_id).unwrap();
-        let marker = r.marker.unwrap();
-        assert_eq!(
-            m.key,
-            Some(RobotKey {
-                team: marker.team,
-                identity: marker.identity
+        // The world model names the marker its robot wears.
+        let r = t
+            .robots
+            .iter()
+            .find(|r| {
+                r.marker.is_some_and(|k| {
+                    RobotKey {
+                        team: k.team,
+                        identity: k.identity,
+                    } == m.robot
+                })
             })
-        );
+            .unwrap();
+        let marker = r.marker.unwrap();
         if marker.fully_visible() {
+            assert_eq!(m.key, Some(m.robot));
+            assert_eq!(m.matched, eotn::wmd::Matched::Marker);
             // The simulator's world models are the truth plus at most about 15 cm of bias and
             // 8 cm noise per axis.
             let e = m.self_error_cm.expect("the robot is seen");
-            assert!(e < 80.0, "robot{} {e} cm", m.robot_id);
+            assert!(e < 80.0, "{} {e} cm", m.robot);
         }
     }
     assert_eq!(model.error_samples().count(), 3);

@@ -402,7 +402,7 @@ fn double_click_fits_the_view_and_keeps_the_selection() {
     let mut h = Harness::builder()
         .with_size(Vec2::new(1280.0, 800.0))
         .with_step_dt(1.0 / 60.0)
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()));
+        .build_eframe(move |cc| EotnApp::new(cc, paths.clone(), None));
     h.run();
     // A selection made earlier (a field pixel), then zoomed in.
     h.state_mut()

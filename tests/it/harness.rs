@@ -87,7 +87,7 @@ pub fn harness(paths: Vec<PathBuf>) -> Harness<'static, EotnApp> {
 pub fn harness_sized(paths: Vec<PathBuf>, size: Vec2) -> Harness<'static, EotnApp> {
     Harness::builder()
         .with_size(size)
-        .build_eframe(move |cc| EotnApp::new(cc, paths.clone()))
+        .build_eframe(move |cc| EotnApp::new(cc, paths.clone(), None))
 }
 
 /// The app in a [`WINDOW`]-sized window around a workspace made beforehand.

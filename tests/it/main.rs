@@ -7,6 +7,8 @@ mod app;
 #[cfg(feature = "gui")]
 mod app_camera;
 #[cfg(feature = "gui")]
+mod app_cameras;
+#[cfg(feature = "gui")]
 mod app_daily;
 #[cfg(feature = "gui")]
 mod app_hints;
@@ -18,6 +20,8 @@ mod app_overhead;
 mod app_papercuts;
 mod beacons;
 mod camera;
+mod cameras;
+mod cameras_input;
 mod cli;
 mod common;
 mod crash_safety;
@@ -29,6 +33,7 @@ mod hardening_files;
 mod harness;
 mod jpeg_colour;
 mod kernels;
+mod label_sets;
 mod live;
 mod live_peers;
 mod mcap_conformance;
@@ -49,8 +54,10 @@ mod sim;
 mod sim_table;
 mod snapshots;
 mod ssl2008;
+mod ssl_onboard;
 mod streams;
 mod viewers;
 #[cfg(feature = "gui")]
 mod window;
 mod without_readings;
+mod wmd;

@@ -231,6 +231,34 @@ fn the_overhead_command_line_calibrates_detects_and_evaluates() {
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
     assert_eq!(lines.len(), 3);
+    // Without --lut and --calibration: the ones the recording's sidecar names for its camera
+    // (issue 28), the same detections.
+    let sidecar = eotn::camera::sidecar_path(&stream);
+    let named =
+        serde_json::json!({"cameras": {"/camera/image": {"lut": table, "calibration": cal}}});
+    std::fs::write(&sidecar, named.to_string()).unwrap();
+    let out = eotn_ok(&[
+        OsStr::new("overhead"),
+        OsStr::new("detect"),
+        stream.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    let without_times = |text: &[u8]| -> Vec<serde_json::Value> {
+        String::from_utf8_lossy(text)
+            .lines()
+            .map(|l| {
+                let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+                v.as_object_mut().unwrap().remove("overhead_us");
+                v
+            })
+            .collect()
+    };
+    let mut explicit = lines.clone();
+    for l in &mut explicit {
+        l.as_object_mut().unwrap().remove("overhead_us");
+    }
+    assert_eq!(without_times(&out.stdout), explicit);
+    std::fs::remove_file(&sidecar).unwrap();
     let line = &lines[0];
     let keys: Vec<&str> = line
         .as_object()

@@ -276,6 +276,72 @@ fn the_command_line_fits_the_pose_with_intrinsics_and_refuses_clustered_clicks()
         truth.image_from_field(&p).unwrap(),
     );
     assert!(a.distance_to(&b) < 3.0, "{a:?} {b:?}");
+    // The same intrinsics as a recording's `sensor_msgs/CameraInfo` (an MCAP written by the
+    // `mcap` crate): the same calibration, named by the message's frame id.
+    let from_yaml = json["calibration"]["camera"].clone();
+    let rec = camera_info_recording(dir.path(), &truth);
+    let out = base(&[
+        OsStr::new("--intrinsics"),
+        rec.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["calibration"]["camera"], from_yaml);
+    assert_eq!(json["calibration"]["intrinsics"], "overhead_optical_frame");
+    // A camera whose info the recording does not have: an error naming it.
+    let out = base(&[
+        OsStr::new("--intrinsics"),
+        rec.as_os_str(),
+        OsStr::new("--intrinsics-camera"),
+        OsStr::new("/camera/bottom/image_raw"),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("/camera/bottom/image_raw"), "{err}");
+}
+
+/// An MCAP holding one `sensor_msgs/msg/CameraInfo` message (CDR) of `camera`'s intrinsics on
+/// `/overhead/camera_info`, beside no image.
+fn camera_info_recording(dir: &Path, camera: &OverheadCamera) -> PathBuf {
+    use eotn::formats::ros2;
+    let (cx, cy) = (camera.centre.x_px - 0.5, camera.centre.y_px - 0.5);
+    let (fx, fy) = (camera.focal_px, camera.focal_y());
+    let info = ros2::CameraInfo {
+        header: ros2::Header {
+            frame_id: ros2::CdrString("overhead_optical_frame".to_owned()),
+            ..ros2::Header::default()
+        },
+        width: u32::try_from(camera.width_px).unwrap(),
+        height: u32::try_from(camera.height_px).unwrap(),
+        distortion_model: ros2::CdrString("equidistant".to_owned()),
+        d: camera.lens.expect("a lens").coefficients().to_vec(),
+        k: [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0],
+        ..ros2::CameraInfo::default()
+    };
+    let path = dir.join("overhead_info.mcap");
+    let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    let mut w = mcap::Writer::new(file).unwrap();
+    let schema = w
+        .add_schema("sensor_msgs/msg/CameraInfo", "ros2msg", b"")
+        .unwrap();
+    let channel = w
+        .add_channel(schema, "/overhead/camera_info", "cdr", &Default::default())
+        .unwrap();
+    let header = mcap::records::MessageHeader {
+        channel_id: channel,
+        sequence: 0,
+        log_time: 1,
+        publish_time: 1,
+    };
+    w.write_to_known_channel(&header, &ros2::encode(&info).unwrap())
+        .unwrap();
+    w.finish().unwrap();
+    path
 }
 
 #[test]

@@ -656,6 +656,32 @@ fn eval_labels_cli_reports_json_and_refuses_bad_input() {
     assert!(ratio["n"].as_u64().unwrap() >= 30, "{ratio}");
     let median = ratio["p50"].as_f64().unwrap();
     assert!((0.9..1.25).contains(&median), "{ratio}");
+    // `--split held-out`: the frames whose index ends in 7, 8 or 9, and only those.
+    let o = crate::common::eotn(&[
+        "eval".as_ref(),
+        stream.as_os_str(),
+        "--lut".as_ref(),
+        lut.as_os_str(),
+        "--labels".as_ref(),
+        labels.as_os_str(),
+        "--params".as_ref(),
+        params.as_os_str(),
+        "--split".as_ref(),
+        "held-out".as_ref(),
+        "--json".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["split"], "held-out");
+    assert_eq!(v["report"]["frames"], 48);
+    let scored: Vec<u64> = v["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f["frame"].as_u64())
+        .collect();
+    assert_eq!(scored.len(), 48);
+    assert!(scored.iter().all(|n| n % 10 >= 7), "{scored:?}");
     // Two streams, or a file that is not labels: a one-line error naming the problem.
     let o = crate::common::eotn(&[
         "eval".as_ref(),

@@ -20,7 +20,11 @@ use eotn::workspace::{Command, Workspace};
 use crate::common::{eotn_ok, shared_file};
 
 #[path = "../../examples/replay_clicks/clicks.rs"]
-mod clicks;
+#[allow(
+    dead_code,
+    reason = "shared by the example and the tests, each using a part of it"
+)]
+pub mod clicks;
 
 const FRAME: &str = "data/ssl2008/ssl-field-2008.jpg";
 

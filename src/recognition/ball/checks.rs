@@ -205,8 +205,43 @@ fn place_tests(
             ),
             None => confidence.skipped(TestName::FieldBelow, params.field_below_without_pose),
         }
+        if params.field_beneath_without_pose_weight.penalty > 0.0 {
+            match field_beneath(img, m.outline.bounds, params.field_beneath_radii) {
+                Some(field) => confidence.range_test(
+                    TestName::FieldBeneath,
+                    field,
+                    params.field_beneath_without_pose,
+                    params.field_beneath_without_pose_weight,
+                ),
+                None => {
+                    confidence.skipped(TestName::FieldBeneath, params.field_beneath_without_pose);
+                }
+            }
+        }
     }
     below_scan.area
+}
+
+/// Share of field colours (green or white) in the strip beneath the box: its columns, from two
+/// pixels below it down `radii` × half its larger side (pixels inside the image only); `None`
+/// when the strip lies wholly outside (a ball at the image's bottom edge).
+fn field_beneath(img: &ClassifiedImage, b: PixelBox, radii: f64) -> Option<f64> {
+    let (minx, maxx) = (i64::from(b.min_x), i64::from(b.max_x));
+    let (miny, maxy) = (i64::from(b.min_y), i64::from(b.max_y));
+    let radius = f64::from(u32::try_from((maxx - minx).max(maxy - miny) + 1).unwrap_or(0)) / 2.0;
+    // Whole pixels; a NaN or negative length gives an empty strip.
+    let length = (radius * radii).clamp(0.0, f64::from(u16::MAX)) as i64;
+    let (mut n, mut field) = (0u32, 0u32);
+    for y in maxy + 2..=maxy + 2 + length {
+        for x in minx..=maxx {
+            if let Some(c) = img.get_signed(x, y) {
+                n += 1;
+                field +=
+                    u32::from(c == ColourClass::Green.code() || c == ColourClass::White.code());
+            }
+        }
+    }
+    (n > 0).then(|| f64::from(field) / f64::from(n))
 }
 
 /// Share of field colours in a band three rows high just below the box, a few pixels down

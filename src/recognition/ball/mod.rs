@@ -74,6 +74,18 @@ pub struct BallParams {
     pub field_below_without_pose: [f64; 2],
     /// Weight of the field-below test (applied only without a pose).
     pub field_below_without_pose_weight: TestWeight,
+    /// Without a camera pose, the share of field colours (green or white) a ball needs in the
+    /// strip beneath it: as wide as its box, from two pixels below it down
+    /// [`Self::field_beneath_radii`] radii (inside the image). A ball on the field has field
+    /// down to the image's bottom but for robots and lines; an orange light or shirt in the
+    /// audience has people, banners and the field's border beneath it, even where a speck of
+    /// carpet-like grey passes `field_below` at its foot. Off unless its weight has a penalty
+    /// (`params/ssl-onboard.json` turns it on), so nothing else changes.
+    pub field_beneath_without_pose: [f64; 2],
+    /// Weight of the field-beneath test (applied only without a pose, and only with a penalty).
+    pub field_beneath_without_pose_weight: TestWeight,
+    /// Length of the field-beneath strip, in the candidate's radii (half its box's larger side).
+    pub field_beneath_radii: f64,
     /// Accepted box width / height for an uncut candidate.
     pub aspect: [f64; 2],
     /// Weight of the roundness test.
@@ -219,6 +231,9 @@ impl Default for BallParams {
             green_below_bonus: 1.0,
             field_below_without_pose: [0.5, 1.0],
             field_below_without_pose_weight: TestWeight::new(0.0, 2.5),
+            field_beneath_without_pose: [0.5, 1.0],
+            field_beneath_without_pose_weight: TestWeight::new(0.0, 0.0),
+            field_beneath_radii: 12.0,
             aspect: [0.6, 1.67],
             aspect_weight: TestWeight::new(0.5, 1.5),
             orange_fraction: [0.3, 1.0],

@@ -420,3 +420,57 @@ fn a_thin_orange_arc_does_not_fill_its_circle() {
         None
     );
 }
+
+#[test]
+fn without_a_pose_field_beneath_rejects_an_orange_light_above_the_field_when_asked() {
+    let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+        320,
+        240,
+        45.0_f64.to_radians(),
+    ));
+    // A 5-px orange light with a speck of carpet right at its foot, and 60 rows of dark
+    // audience (black) beneath it before the carpet starts.
+    let (cx, cy, r) = (160.0, 40.0, 5.0);
+    let img = big_scene(cx, cy, r, |_, _| false);
+    let mut codes = img.codes().to_vec();
+    for (i, c) in codes.iter_mut().enumerate() {
+        let (x, y) = ((i % 320) as f64 + 0.5, (i / 320) as f64 + 0.5);
+        let speck = y < cy + r + 5.0 && (x - cx).abs() < 8.0;
+        if *c == ColourClass::Green.code() && y < 110.0 && !speck {
+            *c = ColourClass::Black.code();
+        }
+    }
+    let light = ClassifiedImage::from_codes(320, 240, codes).expect("size");
+    let on = BallParams {
+        field_beneath_without_pose_weight: TestWeight::new(0.0, 2.5),
+        ..BallParams::default()
+    };
+    let blobs = BlobSet::from_image(&light, Connectivity::Eight);
+    // Off by default: the test is not even listed, and the light passes as a ball.
+    let res = recognise_ball(&light, &blobs, &ctx, &BallParams::default());
+    assert!(
+        res.candidates[0]
+            .confidence
+            .test(TestName::FieldBeneath)
+            .is_none()
+    );
+    assert!(res.ball.is_some(), "{:?}", res.candidates[0].confidence);
+    let off_total = res.candidates[0].confidence.total;
+    let res = recognise_ball(&light, &blobs, &ctx, &on);
+    let beneath = res.candidates[0]
+        .confidence
+        .test(TestName::FieldBeneath)
+        .expect("field beneath test");
+    assert!(beneath.value < 0.5 && beneath.effect < 0.0, "{beneath:?}");
+    assert!((res.candidates[0].confidence.total - (off_total - 2.5)).abs() < 1e-9);
+    // The same ball on the carpet passes it.
+    let ball = big_scene(cx, 150.0, r, |_, _| false);
+    let blobs = BlobSet::from_image(&ball, Connectivity::Eight);
+    let res = recognise_ball(&ball, &blobs, &ctx, &on);
+    let beneath = res.candidates[0]
+        .confidence
+        .test(TestName::FieldBeneath)
+        .expect("test");
+    assert!(beneath.value > 0.9 && beneath.effect == 0.0, "{beneath:?}");
+    assert!(res.ball.is_some());
+}

@@ -317,53 +317,6 @@ impl Scenario {
                 .map(|r| (r.pose, r.body, r.joints)),
         }
     }
-
-    /// Each robot's own estimate of where it and the ball are, as its world model would
-    /// report it: the truth plus a slowly drifting bias and per-frame noise (σ 8 cm, 0.05 rad;
-    /// ball σ 12 cm). One JSON value per robot, keyed by channel name `/world_model/robotN`.
-    #[must_use]
-    pub fn world_models(
-        &self,
-        scene: &Scene,
-        t_s: f64,
-        frame: u64,
-    ) -> Vec<(String, serde_json::Value)> {
-        let mut rng = SimRng::derived(self.seed ^ 0x3D_0D31, frame);
-        scene
-            .robots
-            .iter()
-            .map(|r| {
-                let id = f64::from(r.id);
-                let bias = |k: f64, amp: f64| amp * (0.3 * t_s + id * 1.7 + k).sin();
-                let x = r.pose.x_cm + bias(0.0, 15.0) + 8.0 * rng.normal();
-                let y = r.pose.y_cm + bias(1.0, 15.0) + 8.0 * rng.normal();
-                let heading = r.pose.heading_rad + bias(2.0, 0.1) + 0.05 * rng.normal();
-                let ball = scene.ball.map(|b| {
-                    serde_json::json!({
-                        "x_cm": b.x_cm + bias(3.0, 20.0) + 12.0 * rng.normal(),
-                        "y_cm": b.y_cm + bias(4.0, 20.0) + 12.0 * rng.normal(),
-                        "sd_cm": 25.0,
-                    })
-                });
-                (
-                    format!("/world_model/robot{}", r.id),
-                    serde_json::json!({
-                        "robot_id": r.id,
-                        "team": r.team,
-                        "time_s": t_s,
-                        "self": {
-                            "x_cm": x,
-                            "y_cm": y,
-                            "heading_rad": heading,
-                            "sd_cm": 17.0,
-                            "sd_heading_rad": 0.11,
-                        },
-                        "ball": ball,
-                    }),
-                )
-            })
-            .collect()
-    }
 }
 
 /// Head joints (lower tilt and pan; upper tilt 0) that put `target` at the image centre, within
@@ -512,16 +465,5 @@ mod tests {
         let s = Scenario::new(ScenarioKind::PatternTour, 1).scene_at(2.0);
         assert_eq!(s.markers.len(), 6);
         assert!(Scene::four_legged_2005().markers.is_empty());
-    }
-
-    #[test]
-    fn world_models_have_one_channel_per_robot() {
-        let s = Scenario::new(ScenarioKind::OverheadGame, 1);
-        let scene = s.scene_at(0.5);
-        let models = s.world_models(&scene, 0.5, 15);
-        assert_eq!(models.len(), scene.robots.len());
-        assert_eq!(models[0].0, "/world_model/robot1");
-        let x = models[0].1["self"]["x_cm"].as_f64().expect("x");
-        assert!((x - scene.robots[0].pose.x_cm).abs() < 80.0);
     }
 }

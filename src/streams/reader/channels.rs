@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use super::super::{
     ANNOTATIONS_TOPIC, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC,
 };
+use crate::camera::{CameraChannel, is_default_camera};
 use crate::formats::MessageKind;
 
 /// Name of the schema of image overlays (`eotn detect --annotate`, or other tools').
@@ -79,6 +80,9 @@ pub(crate) struct ChannelTable {
     pub(crate) notes: Vec<String>,
     /// Channels of types eotn does not read, named once in the notes.
     unread: Vec<String>,
+    /// The topic of every channel given a role other than an image, to tell which camera it
+    /// belongs to once every image topic is known.
+    topics: HashMap<u16, String>,
 }
 
 impl ChannelTable {
@@ -112,7 +116,9 @@ impl ChannelTable {
                 ));
                 Role::Ignored
             }
-            _ if topic == ANNOTATIONS_TOPIC
+            _ if (topic == ANNOTATIONS_TOPIC
+                || CameraChannel::of(topic)
+                    .is_some_and(|(_, c)| c == CameraChannel::Annotations))
                 && schema_name == Some(ANNOTATIONS_SCHEMA)
                 && encoding == "protobuf" =>
             {
@@ -132,6 +138,9 @@ impl ChannelTable {
                 Role::Ignored
             }
         };
+        if !matches!(role, Role::Image(_) | Role::Ignored) {
+            self.topics.insert(id, topic.to_owned());
+        }
         self.roles.insert(id, role);
     }
 
@@ -158,8 +167,66 @@ impl ChannelTable {
         }
     }
 
+    /// Gives each camera its own channels once every image topic is known (the layout of
+    /// docs/formats.md, "Several cameras"): `CAMERA/sensors`, `CAMERA/ground_truth`,
+    /// `CAMERA/recognition`, `CAMERA/annotations` and `CAMERA/camera_info` belong to the image
+    /// topic `CAMERA`; the unprefixed `/sensors`, `/ground_truth`, `/recognition` and
+    /// `/camera/annotations` to the stream's first camera (`/camera/image` or
+    /// `/camera/image/compressed` when there, else the first image topic); a ROS `camera_info`
+    /// beside an image topic (`NS/camera_info` for `NS/image_raw`) to that camera. Another
+    /// camera's channels are not read; every other channel goes with whichever camera is read.
+    fn assign_camera_channels(&mut self) {
+        let Some(chosen) = self.image_topic.clone() else {
+            return;
+        };
+        let cameras: Vec<String> = self.image_topics.iter().map(|t| t.topic.clone()).collect();
+        let first = cameras
+            .iter()
+            .find(|t| is_default_camera(t))
+            .or(cameras.first())
+            .cloned();
+        let reads_first = first.as_deref() == Some(chosen.as_str());
+        for (id, topic) in &self.topics {
+            let Some(role) = self.roles.get_mut(id) else {
+                continue;
+            };
+            let owned =
+                CameraChannel::of(topic).filter(|(camera, _)| cameras.iter().any(|c| c == camera));
+            let keep = if let Some((camera, channel)) = owned {
+                let mine = camera == chosen;
+                if mine {
+                    *role = match (channel, &*role) {
+                        (CameraChannel::Sensors, Role::Extra(_)) => Role::Sensors,
+                        (CameraChannel::GroundTruth, Role::Extra(_)) => Role::GroundTruth,
+                        (CameraChannel::Recognition, Role::Extra(_)) => Role::Recognition,
+                        _ => role.clone(),
+                    };
+                }
+                mine
+            } else {
+                match role {
+                    Role::Sensors | Role::GroundTruth | Role::Recognition | Role::Annotations => {
+                        reads_first && !(*topic != ANNOTATIONS_TOPIC && *role == Role::Annotations)
+                    }
+                    Role::CameraInfo(..) => {
+                        let ns = namespace(topic);
+                        let beside: Vec<&String> =
+                            cameras.iter().filter(|c| namespace(c) == ns).collect();
+                        beside.is_empty() || beside.iter().any(|c| **c == chosen)
+                    }
+                    _ => true,
+                }
+            };
+            if !keep {
+                *role = Role::Ignored;
+            }
+        }
+    }
+
     /// The notes of a finished table: the channels not read and the other cameras, by name.
+    /// Also gives each camera its own channels (`assign_camera_channels`).
     pub(crate) fn note_other_cameras(&mut self) {
+        self.assign_camera_channels();
         if !self.unread.is_empty() {
             self.notes.push(format!(
                 "{} channels are not read: {} (eotn reads {})",
@@ -188,6 +255,11 @@ impl ChannelTable {
             self.notes.push(format!("frames are read from {chosen}"));
         }
     }
+}
+
+/// A topic's folder: `/camera/top` of `/camera/top/camera_info`.
+fn namespace(topic: &str) -> &str {
+    topic.rsplit_once('/').map_or("", |(ns, _)| ns)
 }
 
 #[cfg(test)]
@@ -232,5 +304,89 @@ mod tests {
         t.add(1, "/cam/left", "cdr", Some("sensor_msgs/msg/Image"));
         t.add(2, "/cam/right", "cdr", Some("sensor_msgs/msg/Image"));
         assert_eq!(t.image, Some(2));
+    }
+
+    #[test]
+    fn each_camera_reads_its_own_channels() {
+        let json = |t: &mut ChannelTable, id, topic| t.add(id, topic, "json", Some("eotn.Json"));
+        for (wanted, sensors, recognition) in [
+            (None, 3, 5),
+            (Some("/camera/image"), 3, 5),
+            (Some("/camera/bottom"), 4, 6),
+        ] {
+            let mut t = ChannelTable::wanting(wanted.map(str::to_owned));
+            t.add(1, IMAGE_TOPIC, "protobuf", Some("foxglove.RawImage"));
+            t.add(2, "/camera/bottom", "protobuf", Some("foxglove.RawImage"));
+            json(&mut t, 3, SENSORS_TOPIC);
+            json(&mut t, 4, "/camera/bottom/sensors");
+            json(&mut t, 5, RECOGNITION_TOPIC);
+            json(&mut t, 6, "/camera/bottom/recognition");
+            json(&mut t, 7, "/world_model/robot3");
+            t.add(
+                8,
+                "/camera/bottom/annotations",
+                "protobuf",
+                Some(ANNOTATIONS_SCHEMA),
+            );
+            t.note_other_cameras();
+            let of = |role: &Role| -> Vec<u16> {
+                let mut ids: Vec<u16> = t
+                    .roles
+                    .iter()
+                    .filter(|(_, r)| *r == role)
+                    .map(|(id, _)| *id)
+                    .collect();
+                ids.sort_unstable();
+                ids
+            };
+            assert_eq!(of(&Role::Sensors), [sensors], "{wanted:?}");
+            assert_eq!(of(&Role::Recognition), [recognition], "{wanted:?}");
+            assert_eq!(
+                t.roles[&7],
+                Role::Extra("/world_model/robot3".into()),
+                "shared"
+            );
+            let bottom = wanted == Some("/camera/bottom");
+            assert_eq!(t.roles[&8] == Role::Annotations, bottom, "{wanted:?}");
+        }
+    }
+
+    #[test]
+    fn a_ros_camera_info_goes_with_the_image_beside_it() {
+        for (wanted, top_info, bottom_info) in [
+            ("/camera/top/image_raw", true, false),
+            ("/camera/bottom/image_raw", false, true),
+        ] {
+            let mut t = ChannelTable::wanting(Some(wanted.into()));
+            t.add(
+                1,
+                "/camera/top/image_raw",
+                "cdr",
+                Some("sensor_msgs/msg/Image"),
+            );
+            t.add(
+                2,
+                "/camera/bottom/image_raw",
+                "cdr",
+                Some("sensor_msgs/msg/Image"),
+            );
+            t.add(
+                3,
+                "/camera/top/camera_info",
+                "cdr",
+                Some("sensor_msgs/msg/CameraInfo"),
+            );
+            t.add(
+                4,
+                "/camera/bottom/camera_info",
+                "cdr",
+                Some("sensor_msgs/msg/CameraInfo"),
+            );
+            t.add(5, "/calibration", "cdr", Some("sensor_msgs/msg/CameraInfo"));
+            t.note_other_cameras();
+            assert_eq!(t.roles[&3] != Role::Ignored, top_info);
+            assert_eq!(t.roles[&4] != Role::Ignored, bottom_info);
+            assert_ne!(t.roles[&5], Role::Ignored, "beside no camera: shared");
+        }
     }
 }

@@ -78,6 +78,8 @@ pub(super) struct McapFile {
     pub(super) info: StreamInfo,
     /// The recognition parameter set the stream names (`eotn.recognition` metadata).
     pub(super) param_set: Option<String>,
+    /// Each camera's default files (`eotn.camera` metadata), by image topic.
+    pub(super) camera_files: Vec<(String, crate::camera::CameraFiles)>,
     /// Written by eotn (its `eotn.stream` metadata): a frame's messages follow its image.
     pub(super) written_by_eotn: bool,
     roles: HashMap<u16, Role>,
@@ -134,6 +136,7 @@ impl McapFile {
             file_len,
             info: StreamInfo::default(),
             param_set: None,
+            camera_files: Vec::new(),
             written_by_eotn: false,
             roles: HashMap::new(),
             image_channel: None,
@@ -173,6 +176,7 @@ impl McapFile {
             catalog = Catalog::default();
             reader.info = StreamInfo::default();
             reader.param_set = None;
+            reader.camera_files.clear();
             reader.written_by_eotn = false;
             reader.notes.clear();
             reader.blocks.clear();

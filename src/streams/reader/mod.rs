@@ -24,6 +24,8 @@ use mcap_file::McapFile;
 pub use messages::StreamMessage;
 
 mod assemble;
+#[cfg(test)]
+mod cameras_tests;
 mod catalog;
 pub(crate) mod channels;
 mod chunk;
@@ -130,6 +132,10 @@ pub struct StreamReader {
     times_sorted: bool,
     info: StreamInfo,
     param_set: Option<String>,
+    /// Each camera's default files (`eotn.camera` metadata of the first MCAP file).
+    camera_files: Vec<(String, crate::camera::CameraFiles)>,
+    /// The image topic frames are read from (`None` when there is none).
+    camera: Option<String>,
     chunk_count: usize,
     /// Every channel of the storage files: the first file's by id, then those of later files
     /// (a split bag) that it does not have.
@@ -170,7 +176,21 @@ impl StreamReader {
     /// [`StreamError`] naming the file when it cannot be read, is not MCAP or SQLite, or is a
     /// folder that is not a bag.
     pub fn open(path: &Path) -> Result<Self, StreamError> {
-        let layout = layout_of(path)?;
+        Self::open_camera(path, None)
+    }
+
+    /// Opens a recording reading the frames of the camera `camera` (an image topic; `None`: the
+    /// first camera, as [`StreamReader::open`]). A stream's channels that belong to another
+    /// camera (docs/formats.md, "Several cameras") are not read.
+    ///
+    /// # Errors
+    /// As [`StreamReader::open`]; [`StreamError::NoSuchCamera`] listing the cameras there are
+    /// when `camera` is not one of them.
+    pub fn open_camera(path: &Path, camera: Option<&str>) -> Result<Self, StreamError> {
+        let mut layout = layout_of(path)?;
+        if let Some(c) = camera {
+            layout.image_topic = Some(c.to_owned());
+        }
         let mut reader = Self {
             path: path.to_owned(),
             parts: Vec::new(),
@@ -179,6 +199,8 @@ impl StreamReader {
             times_sorted: true,
             info: StreamInfo::default(),
             param_set: None,
+            camera_files: Vec::new(),
+            camera: None,
             chunk_count: 0,
             channels: Vec::new(),
             channel_ids: Vec::new(),
@@ -193,6 +215,23 @@ impl StreamReader {
             _decompressed: Vec::new(),
         };
         reader.open_parts(&layout)?;
+        if let Some(c) = camera
+            && !reader.image_topics.iter().any(|t| t.topic == c)
+        {
+            return Err(StreamError::NoSuchCamera {
+                path: path.to_owned(),
+                topic: c.to_owned(),
+                cameras: reader
+                    .image_topics
+                    .iter()
+                    .map(|t| t.topic.clone())
+                    .collect(),
+            });
+        }
+        reader.camera = camera
+            .map(str::to_owned)
+            .or_else(|| layout.image_topic.clone())
+            .or_else(|| reader.image_topics.first().map(|t| t.topic.clone()));
         Ok(reader)
     }
 
@@ -252,6 +291,7 @@ impl StreamReader {
                 if i == 0 {
                     self.info = m.info.clone();
                     self.param_set = m.param_set.clone();
+                    self.camera_files = m.camera_files.clone();
                 }
                 self.chunk_count += m.chunk_count();
                 self.counts.add(m.counts);
@@ -392,6 +432,34 @@ impl StreamReader {
     #[must_use]
     pub fn image_topics(&self) -> &[ImageTopic] {
         &self.image_topics
+    }
+
+    /// The image topic frames are read from; `None` when the recording has no camera.
+    #[must_use]
+    pub fn camera(&self) -> Option<&str> {
+        self.camera.as_deref()
+    }
+
+    /// Each camera's default files as the stream's `eotn.camera` metadata names them, by image
+    /// topic (paths as written; [`crate::camera::files_for`] resolves them and applies the
+    /// sidecar).
+    #[must_use]
+    pub fn camera_metadata(&self) -> &[(String, crate::camera::CameraFiles)] {
+        &self.camera_files
+    }
+
+    /// The files of the camera read: the stream's defaults with the sidecar's in their place,
+    /// the stream's parameter set ([`StreamReader::param_set`]) when neither names one.
+    ///
+    /// # Errors
+    /// A sidecar that is there but cannot be used.
+    pub fn camera_files(&self) -> Result<crate::camera::CameraFiles, crate::camera::SidecarError> {
+        let topic = self.camera.as_deref().unwrap_or_default();
+        let mut files = crate::camera::files_for(&self.path, &self.camera_files, topic)?;
+        if files.params.is_none() {
+            files.params = self.param_set().map(str::to_owned);
+        }
+        Ok(files)
     }
 
     /// Capture time of frame `index`, nanoseconds, or `None` past the end.

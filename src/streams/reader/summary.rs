@@ -7,7 +7,9 @@
 
 use mcap::records::{Channel, ChunkIndex, MetadataIndex, Record, Statistics, op};
 
-use super::super::{IMAGE_TOPIC, METADATA_NAME, PARAMS_METADATA_NAME, StreamError, StreamInfo};
+use super::super::{
+    CAMERA_METADATA_NAME, IMAGE_TOPIC, METADATA_NAME, PARAMS_METADATA_NAME, StreamError, StreamInfo,
+};
 use super::catalog::Catalog;
 use super::channels::ChannelTable;
 use super::mcap_file::{
@@ -260,11 +262,14 @@ impl McapFile {
         }
     }
 
-    /// The stream's own metadata records (`eotn.stream`, `eotn.recognition`), found through
+    /// The stream's own metadata records (`eotn.stream`, `eotn.recognition`, `eotn.camera`),
+    /// found through
     /// the summary's metadata indexes.
     fn metadata_from_indexes(&mut self, indexes: &[MetadataIndex]) {
         for index in indexes {
-            if index.name != METADATA_NAME && index.name != PARAMS_METADATA_NAME {
+            if ![METADATA_NAME, PARAMS_METADATA_NAME, CAMERA_METADATA_NAME]
+                .contains(&index.name.as_str())
+            {
                 continue;
             }
             if index.length > MAX_INDEX_BYTES
@@ -305,6 +310,12 @@ impl McapFile {
             }
             Ok(Record::Metadata(m)) if m.name == PARAMS_METADATA_NAME => {
                 self.param_set = m.metadata.get("params").filter(|s| !s.is_empty()).cloned();
+            }
+            Ok(Record::Metadata(m)) if m.name == CAMERA_METADATA_NAME => {
+                match crate::camera::CameraFiles::from_metadata(&m.metadata) {
+                    Ok(camera) => self.camera_files.push(camera),
+                    Err(e) => self.warn(format!("{e}; ignored")),
+                }
             }
             Ok(Record::Metadata(_)) => {}
             _ => self.warn("a metadata record is malformed; ignored".to_owned()),

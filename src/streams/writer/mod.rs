@@ -8,6 +8,8 @@ use foxglove::Encode as _;
 use mcap::records::MessageHeader;
 
 use crate::atomic_file::{OutputTarget, PartialFile};
+
+mod cameras;
 use crate::formats::{ImageMessage, MessageKind};
 
 use super::schema::{
@@ -71,6 +73,8 @@ pub struct StreamWriter {
     lazy_channels: HashMap<String, u16>,
     annotations_channel: Option<u16>,
     compressed_channel: Option<u16>,
+    /// Image channels of cameras other than the first, by topic and compressed or not.
+    camera_images: HashMap<(String, bool), u16>,
     frames_per_chunk: Option<usize>,
     image_encoding: ImageEncoding,
     frames_in_chunk: usize,
@@ -224,6 +228,7 @@ impl StreamWriter {
             lazy_channels: HashMap::new(),
             annotations_channel: None,
             compressed_channel: None,
+            camera_images: HashMap::new(),
             frames_per_chunk: options.frames_per_chunk.map(|n| n.max(1)),
             image_encoding: options.image_encoding,
             frames_in_chunk: 0,
@@ -284,12 +289,18 @@ impl StreamWriter {
         Ok(id)
     }
 
-    /// The channel for a JSON topic other than the sensors, added on first use.
     /// The `foxglove.ImageAnnotations` channel, added with the first annotated frame.
     fn annotations_channel(&mut self) -> Result<u16, StreamError> {
         if let Some(id) = self.annotations_channel {
             return Ok(id);
         }
+        let id = self.add_annotations_channel(ANNOTATIONS_TOPIC)?;
+        self.annotations_channel = Some(id);
+        Ok(id)
+    }
+
+    /// Adds a `foxglove.ImageAnnotations` channel on `topic` (with its schema).
+    pub(super) fn add_annotations_channel(&mut self, topic: &str) -> Result<u16, StreamError> {
         let schema = foxglove::messages::ImageAnnotations::get_schema().ok_or_else(|| {
             StreamError::Corrupt {
                 path: self.partial.clone(),
@@ -300,12 +311,9 @@ impl StreamWriter {
             .mcap
             .add_schema(&schema.name, &schema.encoding, &schema.data)
             .map_err(self.mcap_err("cannot add the annotations schema"))?;
-        let id = self
-            .mcap
-            .add_channel(schema_id, ANNOTATIONS_TOPIC, "protobuf", &BTreeMap::new())
-            .map_err(self.mcap_err("cannot add the annotations channel"))?;
-        self.annotations_channel = Some(id);
-        Ok(id)
+        self.mcap
+            .add_channel(schema_id, topic, "protobuf", &BTreeMap::new())
+            .map_err(self.mcap_err("cannot add an annotations channel"))
     }
 
     fn json_channel(&mut self, topic: &str) -> Result<u16, StreamError> {
@@ -371,6 +379,26 @@ impl StreamWriter {
                 context: "cannot write the parameter set's metadata".to_owned(),
                 source,
             })
+    }
+
+    /// Names the default files of the camera `topic` (its table, parameters, calibration): an
+    /// `eotn.camera` metadata record, which a sidecar beside the stream overrides
+    /// ([`crate::camera::files_for`]).
+    ///
+    /// # Errors
+    /// I/O errors naming the file.
+    pub fn name_camera_files(
+        &mut self,
+        topic: &str,
+        files: &crate::camera::CameraFiles,
+    ) -> Result<(), StreamError> {
+        let metadata = mcap::records::Metadata {
+            name: crate::camera::CAMERA_METADATA_NAME.to_owned(),
+            metadata: files.to_metadata(topic),
+        };
+        self.mcap
+            .write_metadata(&metadata)
+            .map_err(self.mcap_err("cannot write a camera's metadata"))
     }
 
     /// Appends one frame with its data. Non-finite sensor values are written as `null`.
@@ -463,6 +491,11 @@ impl StreamWriter {
             a.encode(&mut bytes).map_err(|e| bad(e.to_string()))?;
             self.put(id, record.time_ns, &bytes)?;
         }
+        self.frame_written()
+    }
+
+    /// Counts a frame written and ends its chunk when the chunk is full.
+    fn frame_written(&mut self) -> Result<(), StreamError> {
         self.frames = self.frames.saturating_add(1);
         self.frames_in_chunk += 1;
         let per_chunk = self.frames_per_chunk.unwrap_or_else(|| {
