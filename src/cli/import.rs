@@ -252,6 +252,9 @@ fn rewrite_cameras(
             log::warn!("{}: {w}", input.display());
         }
         for n in first.notes() {
+            if several && n.contains(crate::streams::CAMERA_CHOICE_NOTE) {
+                continue;
+            }
             log::warn!("{}: note: {n}", input.display());
         }
     }

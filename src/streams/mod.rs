@@ -35,7 +35,8 @@ mod writer;
 use std::path::PathBuf;
 
 pub use reader::{
-    ChannelSummary, ImageTopic, RecordCounts, SchemaSummary, StreamMessage, StreamReader,
+    CAMERA_CHOICE_NOTE, ChannelSummary, ImageTopic, RecordCounts, SchemaSummary, StreamMessage,
+    StreamReader,
 };
 pub use rosbag2::{is_bag_folder, is_recording};
 pub use writer::{Compression, RawChannelSpec, StreamWriter, WriterOptions};

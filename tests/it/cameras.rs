@@ -184,12 +184,15 @@ fn import_keeps_both_cameras_and_they_reopen() {
     let Some(p) = path("bag_two") else { return };
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("two.mcap");
-    eotn_ok(&[
+    let run = eotn_ok(&[
         "import".as_ref(),
         p.as_os_str(),
         "-o".as_ref(),
         out.as_os_str(),
     ]);
+    // Import keeps every camera: no note that one of them is "not read".
+    let said = String::from_utf8_lossy(&run.stderr);
+    assert!(!said.contains("not read"), "{said}");
     let v = info(&out, None);
     let cams: Vec<(String, u64, u64)> = v["cameras"]
         .as_array()
@@ -214,6 +217,16 @@ fn import_keeps_both_cameras_and_they_reopen() {
             )
         ]
     );
+    // No channel of the imported stream is empty (once, an unused `/camera/image` and
+    // `/sensors` were written beside the two cameras' own).
+    let empty: Vec<&str> = v["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["messages"].as_u64() == Some(0))
+        .map(|c| c["topic"].as_str().unwrap())
+        .collect();
+    assert!(empty.is_empty(), "empty channels: {empty:?}");
     for camera in ["/camera/top/image_raw", "/camera/bottom/image_raw"] {
         assert_eq!(
             detections(&out, Some(camera), Some(&bhuman_lut())),

@@ -247,15 +247,19 @@ impl ChannelTable {
             .collect();
         if !others.is_empty() {
             self.notes.push(format!(
-                "{} image topics: frames are read from {chosen}; not read: {}",
+                "{} image topics: {CAMERA_CHOICE_NOTE} {chosen}; not read: {}",
                 others.len() + 1,
                 others.join(", ")
             ));
         } else if chosen != IMAGE_TOPIC {
-            self.notes.push(format!("frames are read from {chosen}"));
+            self.notes.push(format!("{CAMERA_CHOICE_NOTE} {chosen}"));
         }
     }
 }
+
+/// The words of the note that says which camera a reader reads: a command that reads every
+/// camera (`eotn import` of several) leaves that note out.
+pub const CAMERA_CHOICE_NOTE: &str = "frames are read from";
 
 /// A topic's folder: `/camera/top` of `/camera/top/camera_info`.
 fn namespace(topic: &str) -> &str {

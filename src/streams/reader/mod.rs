@@ -18,8 +18,8 @@ use super::{FrameRecord, StreamError, StreamInfo, param_set_of_source};
 use crate::formats::tf::TfTree;
 use crate::formats::{ImageMessage, MessageKind, ros2};
 pub use catalog::{ChannelSummary, RecordCounts, SchemaSummary};
-pub use channels::ImageTopic;
 use channels::Role;
+pub use channels::{CAMERA_CHOICE_NOTE, ImageTopic};
 use mcap_file::McapFile;
 pub use messages::StreamMessage;
 

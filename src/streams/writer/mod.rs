@@ -68,8 +68,11 @@ pub struct StreamWriter {
     /// Where an earlier unfinished `PATH.partial` was moved.
     moved_aside: Option<PathBuf>,
     mcap: mcap::Writer<BufWriter<PartialFile>>,
-    image_channel: u16,
-    sensors_channel: u16,
+    /// `/camera/image` and `/sensors`, added with the first message of either (`/sensors` with
+    /// the image, as one-camera streams always had it): a stream whose cameras all have topics of
+    /// their own has no empty first-camera channels.
+    image_channel: Option<u16>,
+    sensors_channel: Option<u16>,
     lazy_channels: HashMap<String, u16>,
     annotations_channel: Option<u16>,
     compressed_channel: Option<u16>,
@@ -194,37 +197,13 @@ impl StreamWriter {
         };
         mcap.write_metadata(&metadata)
             .map_err(mcap_err("cannot write the stream metadata"))?;
-        let image_schema = raw_image_schema().ok_or_else(|| StreamError::Corrupt {
-            path: partial.clone(),
-            detail: "the foxglove.RawImage schema is not available".to_owned(),
-        })?;
-        let image_schema = mcap
-            .add_schema(
-                &image_schema.name,
-                &image_schema.encoding,
-                &image_schema.data,
-            )
-            .map_err(mcap_err("cannot add the image schema"))?;
-        let image_channel = mcap
-            .add_channel(image_schema, IMAGE_TOPIC, "protobuf", &BTreeMap::new())
-            .map_err(mcap_err("cannot add the image channel"))?;
-        let sensors_schema = mcap
-            .add_schema(
-                SENSORS_SCHEMA_NAME,
-                "jsonschema",
-                sensors_json_schema().to_string().as_bytes(),
-            )
-            .map_err(mcap_err("cannot add the sensors schema"))?;
-        let sensors_channel = mcap
-            .add_channel(sensors_schema, SENSORS_TOPIC, "json", &BTreeMap::new())
-            .map_err(mcap_err("cannot add the sensors channel"))?;
         Ok(Self {
             path: path.to_owned(),
             partial,
             moved_aside,
             mcap,
-            image_channel,
-            sensors_channel,
+            image_channel: None,
+            sensors_channel: None,
             lazy_channels: HashMap::new(),
             annotations_channel: None,
             compressed_channel: None,
@@ -451,7 +430,7 @@ impl StreamWriter {
                 bytes.clear();
                 match message.encode_foxglove(&mut bytes).map_err(&bad)? {
                     MessageKind::FoxgloveCompressedImage => self.compressed_channel()?,
-                    _ => self.image_channel,
+                    _ => self.image_channel()?,
                 }
             }
             None => {
@@ -462,7 +441,7 @@ impl StreamWriter {
                     &mut bytes,
                 )
                 .map_err(|e| bad(e.to_string()))?;
-                self.image_channel
+                self.image_channel()?
             }
         };
         let written = self.put(channel, record.time_ns, &bytes);
@@ -471,7 +450,8 @@ impl StreamWriter {
         if let Some(s) = &record.sensors {
             let (clean, _) = s.sanitised();
             let json = serde_json::to_vec(&clean).map_err(|e| bad(e.to_string()))?;
-            self.put(self.sensors_channel, record.time_ns, &json)?;
+            let id = self.sensors_channel()?;
+            self.put(id, record.time_ns, &json)?;
         }
         let fixed = [
             (GROUND_TRUTH_TOPIC, record.ground_truth.as_ref()),
@@ -492,6 +472,50 @@ impl StreamWriter {
             self.put(id, record.time_ns, &bytes)?;
         }
         self.frame_written()
+    }
+
+    /// The first camera's `foxglove.RawImage` channel, `/camera/image`, added when first used.
+    fn image_channel(&mut self) -> Result<u16, StreamError> {
+        if let Some(id) = self.image_channel {
+            return Ok(id);
+        }
+        let schema = raw_image_schema().ok_or_else(|| StreamError::Corrupt {
+            path: self.partial.clone(),
+            detail: "the foxglove.RawImage schema is not available".to_owned(),
+        })?;
+        let schema_id = self
+            .mcap
+            .add_schema(&schema.name, &schema.encoding, &schema.data)
+            .map_err(self.mcap_err("cannot add the image schema"))?;
+        let id = self
+            .mcap
+            .add_channel(schema_id, IMAGE_TOPIC, "protobuf", &BTreeMap::new())
+            .map_err(self.mcap_err("cannot add the image channel"))?;
+        self.image_channel = Some(id);
+        // A one-camera stream keeps its layout: `/sensors` beside the image, even when empty.
+        self.sensors_channel()?;
+        Ok(id)
+    }
+
+    /// The first camera's sensor readings channel, `/sensors`, added when first used.
+    fn sensors_channel(&mut self) -> Result<u16, StreamError> {
+        if let Some(id) = self.sensors_channel {
+            return Ok(id);
+        }
+        let schema_id = self
+            .mcap
+            .add_schema(
+                SENSORS_SCHEMA_NAME,
+                "jsonschema",
+                sensors_json_schema().to_string().as_bytes(),
+            )
+            .map_err(self.mcap_err("cannot add the sensors schema"))?;
+        let id = self
+            .mcap
+            .add_channel(schema_id, SENSORS_TOPIC, "json", &BTreeMap::new())
+            .map_err(self.mcap_err("cannot add the sensors channel"))?;
+        self.sensors_channel = Some(id);
+        Ok(id)
     }
 
     /// Counts a frame written and ends its chunk when the chunk is full.
@@ -534,9 +558,9 @@ impl StreamWriter {
         }
         let channel = if spec.is_image() {
             self.close_chunk_if_full(data.len())?;
-            self.image_channel
+            self.image_channel()?
         } else if spec.topic == SENSORS_TOPIC && spec.message_encoding == "json" {
-            self.sensors_channel
+            self.sensors_channel()?
         } else if let Some(&id) = self.raw_channels.get(spec) {
             id
         } else {
