@@ -132,11 +132,16 @@ pub fn side_by_side_ui(
     out
 }
 
-/// A column's header: the camera, its table (`*` unsaved), and which one is focused.
+/// A column's header: the camera, its table (`*` unsaved), its parameters when they came from
+/// a file, and which one is focused.
 fn header_ui(ui: &Ui, rect: egui::Rect, pane: &CameraPane<'_>) {
     let table = pane
         .table_path
         .map_or_else(|| "untitled table".to_owned(), crate::frame::display_name);
+    let params = pane
+        .params_path
+        .map(|p| format!(" · {}", crate::frame::display_name(p)))
+        .unwrap_or_default();
     let mark = if pane.dirty { " *" } else { "" };
     let focus = if pane.focused {
         " — focused"
@@ -151,7 +156,7 @@ fn header_ui(ui: &Ui, rect: egui::Rect, pane: &CameraPane<'_>) {
     ui.painter().text(
         rect.left_center() + vec2(4.0, 0.0),
         Align2::LEFT_CENTER,
-        format!("{} · {table}{mark}{focus}", pane.topic),
+        format!("{} · {table}{mark}{params}{focus}", pane.topic),
         egui::FontId::proportional(12.0),
         colour,
     );

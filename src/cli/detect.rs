@@ -446,16 +446,12 @@ pub fn params_or_camera_s(
     let Some(name) = files.params else {
         return load_params(None);
     };
-    let path = if name.contains('/') || name.ends_with(".json") {
-        PathBuf::from(&name)
-    } else {
-        crate::workspace::params::find_param_set(&name, &rec).with_context(|| {
-            format!(
-                "{}: its camera's parameter set {name} is nowhere (params/{name}.json beside the recording or above it, or here): give --params",
-                rec.display()
-            )
-        })?
-    };
+    let path = crate::workspace::params::named_param_file(&name, &rec).with_context(|| {
+        format!(
+            "{}: its camera's parameter set {name} is nowhere (params/{name}.json beside the recording or above it, or here): give --params",
+            rec.display()
+        )
+    })?;
     load_params(Some(&path)).with_context(|| {
         format!(
             "{}: the recognition parameters named for its camera",

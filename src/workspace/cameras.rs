@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use super::Workspace;
 use super::source::Source;
-use crate::camera::CameraId;
+use crate::camera::{CameraFiles, CameraId};
 
 impl Workspace {
     /// The camera shown, as settings remember it: the recording's image topic.
@@ -23,33 +23,82 @@ impl Workspace {
         self.camera.clone()
     }
 
-    /// The table of the camera `topic` of `recording`: the one last used with this camera
-    /// (when it is still there), else the one the recording names for it.
+    /// The files of the camera `topic` of `recording`: each the one last used with this camera
+    /// (a table only while its file is still there), else the one the recording names for it
+    /// (its sidecar, its `eotn.camera` metadata, its parameter set).
+    pub(super) fn camera_files(&mut self, recording: &Path, topic: Option<&str>) -> CameraFiles {
+        let Some(topic) = topic else {
+            return CameraFiles::default();
+        };
+        let mut remembered = self
+            .settings
+            .cameras
+            .get(&CameraId::recording(topic))
+            .cloned()
+            .unwrap_or_default();
+        remembered.lut = remembered.lut.filter(|p| p.is_file());
+        let named = crate::streams::StreamReader::open_camera(recording, Some(topic))
+            .map_err(|e| e.to_string())
+            .and_then(|r| r.camera_files().map_err(|e| e.to_string()));
+        match named {
+            Ok(files) => files.overridden_by(&remembered),
+            Err(e) => {
+                self.warn(format!("{}: {e}", recording.display()));
+                remembered
+            }
+        }
+    }
+
+    /// Remembers a file for the camera shown (its table, parameters or calibration: `set`
+    /// writes it into the camera's entry of the settings), to reopen with that camera.
+    pub(super) fn remember_for_camera(&mut self, set: impl FnOnce(&mut CameraFiles)) {
+        if let Some(id) = self.camera_id() {
+            set(self.settings.cameras.entry(id).or_default());
+        }
+    }
+
+    /// The table of the camera `topic` of `recording` ([`Workspace::camera_files`]).
     pub(super) fn camera_table(
         &mut self,
         recording: &Path,
         topic: Option<&str>,
     ) -> Option<PathBuf> {
-        let topic = topic?;
-        let remembered = self
-            .settings
-            .cameras
-            .get(&CameraId::recording(topic))
-            .and_then(|f| f.lut.clone())
-            .filter(|p| p.is_file());
-        if remembered.is_some() {
-            return remembered;
+        self.camera_files(recording, topic).lut
+    }
+
+    /// The camera's own parameters file, when it names one that is there (a name not found is
+    /// said once, and the parameters in use stay).
+    pub(super) fn camera_params(
+        &mut self,
+        recording: &Path,
+        files: &CameraFiles,
+    ) -> Option<PathBuf> {
+        let name = files.params.as_deref()?;
+        let found = super::params::named_param_file(name, recording).filter(|p| p.is_file());
+        if found.is_none() {
+            self.warn(format!(
+                "{}: the camera's parameter set {name} is not found (params/{name}.json beside the recording or above it): the parameters in use stay",
+                recording.display()
+            ));
         }
-        let named = crate::streams::StreamReader::open_camera(recording, Some(topic))
-            .map_err(|e| e.to_string())
-            .and_then(|r| r.camera_files().map_err(|e| e.to_string()));
-        match named {
-            Ok(files) => files.lut,
-            Err(e) => {
-                self.warn(format!("{}: {e}", recording.display()));
-                None
-            }
+        found
+    }
+
+    /// After a camera was shown: its own parameters and, for an overhead camera, its
+    /// calibration, when it has them; said in the status line.
+    fn open_camera_files(&mut self, recording: &Path, files: &CameraFiles) -> anyhow::Result<()> {
+        if let Some(p) = self.camera_params(recording, files)
+            && self.params_slot().path.as_deref() != Some(p.as_path())
+        {
+            self.open_params(&p)?;
         }
+        if let Some(c) = &files.calibration
+            && self.overhead.calibration_path() != Some(c.as_path())
+            && self.camera_kind() == crate::sources::CameraKind::Overhead
+        {
+            self.apply(super::OverheadCommand::OpenCalibration(c.clone()).into())?;
+        }
+        Ok(())
     }
 
     /// Shows the camera `topic` of the open recording (`None`: its first), at the frame nearest
@@ -71,7 +120,8 @@ impl Workspace {
         let source = Source::stream_camera(&path, topic.as_deref())?;
         let shown = source.camera().map(str::to_owned);
         let index = source.index_at_time(time);
-        let own_table = self.camera_table(&path, shown.as_deref());
+        let files = self.camera_files(&path, shown.as_deref());
+        let own_table = files.lut.clone();
         if let Some(t) = &own_table
             && self.dirty
             && self.table_path() != Some(t.as_path())
@@ -83,11 +133,20 @@ impl Workspace {
                 crate::frame::display_name(t)
             );
         }
+        anyhow::ensure!(
+            !self.params_modified()
+                || self
+                    .camera_params(&path, &files)
+                    .is_none_or(|p| { self.params_slot().path.as_deref() == Some(p.as_path()) }),
+            "the recognition parameters were tuned and not saved: save them (or reset them) before showing camera {}, which has parameters of its own",
+            shown.as_deref().unwrap_or("?")
+        );
         self.set_source(source)?;
         self.camera = topic;
         if let Some(t) = &own_table {
             self.open_table(t)?;
         }
+        self.open_camera_files(&path, &files)?;
         self.seek(index)?;
         let camera = shown.as_deref().unwrap_or("?");
         self.status = format!(
@@ -137,6 +196,7 @@ mod tests {
             "/camera/bottom",
             &CameraFiles {
                 lut: Some("bottom.lut".into()),
+                params: Some("bottom.json".into()),
                 ..CameraFiles::default()
             },
         )
@@ -165,7 +225,70 @@ mod tests {
             }
             t.save(&dir.join(name)).unwrap();
         }
+        std::fs::write(dir.join("bottom.json"), BOTTOM_PARAMS).unwrap();
         p
+    }
+
+    /// The bottom camera's own recognition parameters (a ball of at least 77 pixels).
+    const BOTTOM_PARAMS: &str = r#"{"ball": {"min_pixels": 77}}"#;
+
+    #[test]
+    fn each_camera_opens_with_its_own_parameters_remembered_per_camera() {
+        let dir = tempfile::tempdir().unwrap();
+        let rec = recording(dir.path());
+        let mut ws = Workspace::new(Settings::default());
+        ws.run(Command::Open(vec![rec, dir.path().join("top.lut")]));
+        let top_min = ws.recognition_params().ball.min_pixels;
+        assert_ne!(top_min, 77, "the top camera keeps the defaults");
+        ws.apply(Command::OpenCamera(Some("/camera/bottom".into())))
+            .unwrap();
+        assert_eq!(ws.recognition_params().ball.min_pixels, 77, "its own set");
+        let slot = ws
+            .params_slot()
+            .path
+            .as_deref()
+            .map(crate::frame::display_name);
+        assert_eq!(slot.as_deref(), Some("bottom.json"));
+        // Parameters opened for a camera are remembered for it, and only for it.
+        let other = dir.path().join("other.json");
+        std::fs::write(&other, r#"{"ball": {"min_pixels": 55}}"#).unwrap();
+        ws.apply(crate::workspace::ParamsCommand::OpenParams(other).into())
+            .unwrap();
+        let bottom = &ws.settings.cameras[&CameraId::recording("/camera/bottom")];
+        assert!(
+            bottom
+                .params
+                .as_deref()
+                .is_some_and(|p| p.ends_with("other.json")),
+            "{bottom:?}"
+        );
+        ws.apply(Command::OpenCamera(Some("/camera/image".into())))
+            .unwrap();
+        ws.apply(Command::OpenCamera(Some("/camera/bottom".into())))
+            .unwrap();
+        assert_eq!(
+            ws.recognition_params().ball.min_pixels,
+            55,
+            "the remembered set overrides the recording's"
+        );
+    }
+
+    #[test]
+    fn tuned_unsaved_parameters_are_not_replaced_by_another_camera_s() {
+        let dir = tempfile::tempdir().unwrap();
+        let rec = recording(dir.path());
+        let mut ws = Workspace::new(Settings::default());
+        ws.run(Command::Open(vec![rec, dir.path().join("top.lut")]));
+        let tune = crate::workspace::ParamsCommand::SetParamValue {
+            pointer: "/ball/min_pixels".into(),
+            value: serde_json::json!(33),
+        };
+        ws.apply(tune.into()).unwrap();
+        let e = ws.apply(Command::OpenCamera(Some("/camera/bottom".into())));
+        let text = format!("{:#}", e.unwrap_err());
+        assert!(text.contains("not saved"), "{text}");
+        assert_eq!(ws.cameras().1, Some("/camera/image"), "still shown");
+        assert_eq!(ws.recognition_params().ball.min_pixels, 33, "kept");
     }
 
     #[test]

@@ -365,6 +365,8 @@ impl Workspace {
                     cal.points.len(),
                     cal.median_point_error_px()
                 );
+                let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+                self.remember_for_camera(|f| f.calibration = Some(canonical));
                 self.overhead.user_calibration = Some(cal);
                 self.overhead.calibration_path = Some(p);
                 self.reprocess();
@@ -376,6 +378,8 @@ impl Workspace {
                     .as_ref()
                     .context("no calibration to save: open one or Calibrate first")?;
                 cal.save(&p)?;
+                let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+                self.remember_for_camera(|f| f.calibration = Some(canonical));
                 self.overhead.calibration_path = Some(p.clone());
                 self.status = format!("saved calibration {}", p.display());
             }

@@ -96,6 +96,17 @@ pub fn find_param_set(name: &str, stream: &Path) -> Option<PathBuf> {
         .find(|p| p.is_file())
 }
 
+/// The file of a parameter set as a camera names it (`CameraFiles::params`): a path (with a `/`
+/// or ending in `.json`) as it is, a shipped set's name found by [`find_param_set`].
+#[must_use]
+pub fn named_param_file(name: &str, recording: &Path) -> Option<PathBuf> {
+    if name.contains('/') || name.ends_with(".json") {
+        Some(PathBuf::from(name))
+    } else {
+        find_param_set(name, recording)
+    }
+}
+
 /// The values of `params` that differ from the defaults, as a parameters file holds them.
 #[must_use]
 pub fn differences_from_defaults(params: &RecognitionParams) -> Value {
@@ -287,8 +298,9 @@ impl Workspace {
         self.params.loaded = p;
         self.params.path = Some(path.to_owned());
         self.params.try_run = None;
-        self.settings.last_params =
-            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        let canonical = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned());
+        self.remember_for_camera(|f| f.params = Some(canonical.to_string_lossy().into_owned()));
+        self.settings.last_params = Some(canonical);
         self.remember_recent(path);
         if self
             .params
@@ -360,8 +372,9 @@ impl Workspace {
             .with_context(|| format!("cannot save {}", path.display()))?;
         self.params.loaded = *self.recognition_params();
         self.params.path = Some(path.to_owned());
-        self.settings.last_params =
-            Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
+        let canonical = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned());
+        self.remember_for_camera(|f| f.params = Some(canonical.to_string_lossy().into_owned()));
+        self.settings.last_params = Some(canonical);
         self.remember_recent(path);
         self.status = format!("saved parameters {}", path.display());
         Ok(())

@@ -12,12 +12,14 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 
 use super::journal::JournalEntry;
+use super::params::ParamsSlot;
 use super::source::Source;
 use super::{SensorSeries, Workspace};
 use crate::frame::Frame;
 use crate::lut::{EditHistory, LookupTable};
 use crate::pipeline::Pipeline;
 use crate::recognition::Primitive;
+use crate::recognition::params_file;
 use crate::sources::{SourceError, SourceFrame};
 
 /// A table's state beside its cells: file, undo history, unsaved mark, the journal of a table
@@ -36,8 +38,10 @@ struct TableState {
 pub(super) struct BesideCamera {
     topic: String,
     source: Source,
-    /// Classifies and recognises this camera's frames; holds its table.
+    /// Classifies and recognises this camera's frames; holds its table and parameters.
     pipeline: Pipeline,
+    /// Where its recognition parameters came from (moves with them when the focus moves).
+    params: ParamsSlot,
     table: TableState,
     index: usize,
     current: Option<SourceFrame>,
@@ -78,6 +82,8 @@ pub struct CameraPane<'a> {
     pub table_path: Option<&'a Path>,
     /// Unsaved edits in its table.
     pub dirty: bool,
+    /// The file of its recognition parameters, if they came from one.
+    pub params_path: Option<&'a Path>,
     /// Index of the frame shown in this camera's own frames.
     pub index: usize,
     /// The camera has ended or not begun at the cursor (its nearest frame is shown).
@@ -107,6 +113,7 @@ impl Workspace {
                     lut: self.pipeline.lut(),
                     table_path: self.table_path.as_deref(),
                     dirty: self.dirty,
+                    params_path: self.params.path.as_deref(),
                     index: self.index,
                     note: None,
                     generation: self.frame_generation,
@@ -122,6 +129,7 @@ impl Workspace {
                     lut: b.pipeline.lut(),
                     table_path: b.table.path.as_deref(),
                     dirty: b.table.dirty,
+                    params_path: b.params.path.as_deref(),
                     index: b.index,
                     note: b.note.as_deref(),
                     generation: b.generation,
@@ -215,8 +223,10 @@ impl Workspace {
     fn open_beside(&mut self, recording: &Path, topic: &str) -> anyhow::Result<BesideCamera> {
         let source = Source::stream_camera(recording, Some(topic))?;
         let bits = self.pipeline.lut().bits();
-        let own = self
-            .camera_table(recording, Some(topic))
+        let files = self.camera_files(recording, Some(topic));
+        let own = files
+            .lut
+            .clone()
             .map(|p| LookupTable::load(&p).map(|t| (t, p)));
         let (lut, path) = if let Some(Ok((t, p))) = own {
             (t, Some(p))
@@ -238,10 +248,25 @@ impl Workspace {
             dirty: false,
             saved_undo_len: Some(0),
         };
+        // Its own parameters when it names them, else those in use (said on its pane).
+        let mut params = *self.pipeline.params();
+        let mut slot = ParamsSlot {
+            path: self.params_slot().path.clone(),
+            loaded: self.params_slot().loaded,
+            ..ParamsSlot::default()
+        };
+        if let Some(p) = self.camera_params(recording, &files) {
+            let own = params_file::load(&p)
+                .with_context(|| format!("camera {topic}: its parameters {}", p.display()))?;
+            params.recognition = own;
+            slot.loaded = own;
+            slot.path = Some(p);
+        }
         Ok(BesideCamera {
             topic: topic.to_owned(),
             source,
-            pipeline: Pipeline::new(lut, *self.pipeline.params()),
+            params: slot,
+            pipeline: Pipeline::new(lut, params),
             table,
             index: 0,
             current: None,
@@ -289,6 +314,12 @@ impl Workspace {
         let b = &mut self.beside.cameras[pos];
         std::mem::swap(src, &mut b.source);
         std::mem::swap(self.pipeline.lut_mut(), b.pipeline.lut_mut());
+        let (mine, theirs) = (*self.pipeline.params(), *b.pipeline.params());
+        self.pipeline.set_params(theirs);
+        b.pipeline.set_params(mine);
+        std::mem::swap(&mut self.params.path, &mut b.params.path);
+        std::mem::swap(&mut self.params.loaded, &mut b.params.loaded);
+        self.params.try_run = None;
         std::mem::swap(&mut self.table_path, &mut b.table.path);
         std::mem::swap(&mut self.history, &mut b.table.history);
         std::mem::swap(&mut self.dirty, &mut b.table.dirty);

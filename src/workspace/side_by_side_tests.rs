@@ -15,6 +15,7 @@ fn recording(dir: &std::path::Path) -> std::path::PathBuf {
     let mut w = StreamWriter::create(&p, &StreamInfo::default()).unwrap();
     let files = CameraFiles {
         lut: Some("bottom.lut".into()),
+        params: Some("bottom.json".into()),
         ..CameraFiles::default()
     };
     w.name_camera_files("/camera/bottom", &files).unwrap();
@@ -39,6 +40,7 @@ fn recording(dir: &std::path::Path) -> std::path::PathBuf {
         t.set(i, class);
         t.save(&dir.join(name)).unwrap();
     }
+    std::fs::write(dir.join("bottom.json"), r#"{"ball": {"min_pixels": 77}}"#).unwrap();
     p
 }
 
@@ -153,6 +155,28 @@ fn an_edit_goes_to_the_focused_camera_s_table_only() {
     assert_eq!(top, top_before);
     ws.apply(Command::ShowSideBySide(Vec::new())).unwrap();
     assert!(ws.camera_panes().is_empty());
+}
+
+#[test]
+fn each_camera_side_by_side_recognises_with_its_own_parameters() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut ws = side_by_side(dir.path());
+    let default_min = ws.recognition_params().ball.min_pixels;
+    assert_ne!(default_min, 77);
+    let named = |ws: &Workspace| -> Vec<Option<String>> {
+        ws.camera_panes()
+            .iter()
+            .map(|p| p.params_path.map(crate::frame::display_name))
+            .collect()
+    };
+    assert_eq!(named(&ws), [None, Some("bottom.json".to_owned())]);
+    ws.apply(Command::FocusCamera("/camera/bottom".into()))
+        .unwrap();
+    assert_eq!(ws.recognition_params().ball.min_pixels, 77, "its own set");
+    assert_eq!(named(&ws), [None, Some("bottom.json".to_owned())]);
+    ws.apply(Command::FocusCamera("/camera/image".into()))
+        .unwrap();
+    assert_eq!(ws.recognition_params().ball.min_pixels, default_min);
 }
 
 #[test]

@@ -466,14 +466,7 @@ impl Workspace {
     /// Remembers `path` as the table of the camera in use, to reopen at start.
     pub(super) fn remember_table(&mut self, path: &Path) {
         let p = Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
-        if let Some(id) = self.camera_id() {
-            self.settings
-                .cameras
-                .entry(id)
-                .or_default()
-                .lut
-                .clone_from(&p);
-        }
+        self.remember_for_camera(|f| f.lut.clone_from(&p));
         match self.table_kind {
             CameraKind::Robot => self.settings.last_table = p,
             CameraKind::Overhead => self.settings.last_overhead_table = p,
