@@ -373,12 +373,14 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     assert!(tick_until(&mut w, 5.0, |w| w.index() + 1 == frames));
     for (k, id) in ids.iter().enumerate() {
         let r = row(&w, *id);
+        eprintln!("robot {k}: latency p99 {:?} ms", r.stats.latency_p99_ms);
         assert_eq!((r.stats.frames, r.stats.drops), (frames, 0), "robot {k}");
-        // Keeping up: 99% of frames in before the next one is sent (one frame interval,
-        // 33 ms). Achieved 2026-12-04: p99 0.8–4.2 ms per robot; the limit leaves room for a
-        // machine busy with the other tests, which run beside this one.
+        // Keeping up: 99% of frames in well within a frame interval (33 ms). Achieved
+        // 2026-12-07 (13 runs at load 14 on 2 cores, other builds beside): p99 1.2–12.4 ms per
+        // robot, most 3–5 ms; the limit is 2× the worst of those runs, since this test runs
+        // beside the rest of the suite.
         assert!(
-            r.stats.latency_p99_ms.is_some_and(|ms| ms < 33.0),
+            r.stats.latency_p99_ms.is_some_and(|ms| ms < 25.0),
             "robot {k}: {:?}",
             r.stats
         );
@@ -394,13 +396,14 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     }
     shown_latency_ms.sort_by(f64::total_cmp);
     let pick = |p: f64| shown_latency_ms[((shown_latency_ms.len() - 1) as f64 * p) as usize];
-    // Shown within a frame interval and a UI poll (33 + 16 ms) at the median; achieved 10 ms.
+    // Shown within a frame interval at the median (it includes the UI's 16 ms poll): achieved
+    // 2026-12-07 at load 14 a median of 7.5–14.0 ms in three runs, the limit 2.4× the worst.
     assert!(
         shown_latency_ms.len() >= frames / 2,
         "{} shown",
         shown_latency_ms.len()
     );
-    assert!(pick(0.5) < 49.0, "median {} ms", pick(0.5));
+    assert!(pick(0.5) < 33.0, "median {} ms", pick(0.5));
     println!(
         "four robots, {frames} frames each: sender's write to the frame shown in the workspace (UI polling every 16 ms): median {:.1} ms, p99 {:.1} ms over {} shown frames",
         pick(0.5),
