@@ -145,11 +145,10 @@ pub(crate) fn make_fifo(path: &Path) -> bool {
         .status()
         .is_ok_and(|s| s.success());
     if !made {
-        assert!(
-            !std::env::var("CI").is_ok_and(|v| v == "true" || v == "1"),
-            "mkfifo failed, and CI=true requires the FIFO case"
+        crate::test_skip::skipped(
+            "mkfifo failed: the FIFO case is not tested",
+            "install coreutils' mkfifo, on a file system that allows FIFOs",
         );
-        eprintln!("SKIPPED: mkfifo failed: the FIFO case is not tested");
     }
     made
 }

@@ -68,6 +68,9 @@ pub mod workspace;
 
 pub mod cli;
 
+#[cfg(test)]
+mod test_skip;
+
 /// The desktop app (egui/eframe on wgpu); only this module names the UI crates.
 #[cfg(feature = "gui")]
 pub mod app;

@@ -22,7 +22,7 @@ fn root() -> &'static Path {
 /// The recordings by name (`bag_two`, `bag_top`, `bag_bottom`, `fox_two`, …), written once.
 fn recordings() -> Option<&'static (tempfile::TempDir, serde_json::Value)> {
     static MADE: OnceLock<Option<(tempfile::TempDir, serde_json::Value)>> = OnceLock::new();
-    MADE.get_or_init(|| {
+    crate::common::made_once(&MADE, "the two-camera recordings", || {
         let python = python_with(
             "import rosbags, foxglove, cv2, mcap_protobuf",
             "rosbags, foxglove-sdk, opencv-python-headless and mcap-protobuf-support",
@@ -44,7 +44,6 @@ fn recordings() -> Option<&'static (tempfile::TempDir, serde_json::Value)> {
         let made = serde_json::from_slice(&out.stdout).unwrap();
         Some((dir, made))
     })
-    .as_ref()
 }
 
 fn path(name: &str) -> Option<PathBuf> {

@@ -61,7 +61,7 @@ pub(crate) fn joint_state_bag() -> Option<PathBuf> {
 /// The recordings, written once for all tests of this file.
 fn recordings() -> Option<&'static (tempfile::TempDir, Vec<Recording>)> {
     static MADE: OnceLock<Option<(tempfile::TempDir, Vec<Recording>)>> = OnceLock::new();
-    MADE.get_or_init(|| {
+    crate::common::made_once(&MADE, "the third-party recordings", || {
         let python = writers_python()?;
         let dir = tempfile::tempdir().unwrap();
         let out = Command::new(python)
@@ -89,7 +89,6 @@ fn recordings() -> Option<&'static (tempfile::TempDir, Vec<Recording>)> {
             .collect();
         Some((dir, list))
     })
-    .as_ref()
 }
 
 /// Ball centres of `eotn detect --json` on `path`, one per frame (`None`: no ball).
