@@ -604,6 +604,50 @@ fn a_damaged_message_costs_its_frame_only() {
     assert_eq!(named, 1, "{err}");
 }
 
+/// A `mono8` recording shows and steps in the app's workspace as any other: every frame in turn,
+/// grey (U = V = 128) with its own luma, the note that a colour table cannot classify it shown.
+#[test]
+fn a_mono8_recording_steps_frame_by_frame_in_the_workspace() {
+    use eotn::workspace::{Command, PlaybackCommand, Workspace};
+    let Some((_, list)) = recordings() else {
+        return;
+    };
+    let mono = list.iter().find(|r| r.matches == "grey").unwrap();
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![
+        mono.path.clone(),
+        root().join("lookup_tables/bhuman2009.lut"),
+    ]))
+    .unwrap();
+    let said = format!("{} {:?}", w.status, w.warnings());
+    assert!(said.contains("cannot classify"), "{}: {said}", mono.name);
+    let mut reference = StreamReader::open(&list[0].path).unwrap();
+    let mut lumas = Vec::new();
+    for i in 0..FRAMES {
+        if i > 0 {
+            w.apply(PlaybackCommand::Step(1).into()).unwrap();
+        }
+        assert_eq!(w.index(), i, "{}", mono.name);
+        let frame = w.frame().expect("a frame shown");
+        let want = reference.read(i).unwrap().frame;
+        assert_eq!(
+            (frame.width(), frame.height()),
+            (want.width(), want.height())
+        );
+        let mut luma = 0u64;
+        frame.for_each_pixel(|_, _, p| {
+            assert_eq!((p.u, p.v), (128, 128), "frame {i}: grey");
+            luma += u64::from(p.y);
+        });
+        lumas.push(luma);
+    }
+    lumas.dedup();
+    assert!(lumas.len() > FRAMES / 2, "the frames differ: {lumas:?}");
+    // Stepping past the end stays on the last frame.
+    w.apply(PlaybackCommand::Step(1).into()).unwrap();
+    assert_eq!(w.index(), FRAMES - 1);
+}
+
 /// The storage file of the `rosbags` rgb8 bag copied message by message into `out` (an MCAP file
 /// with its `ros2msg` schemas and `cdr` channels), `edit` given the index and CDR bytes of each
 /// `/camera/image_raw` message on the way.
