@@ -20,8 +20,11 @@ impl Workspace {
         let mut frames = Vec::new();
         let mut streams = Vec::new();
         // Tables open after the source: each camera kind has its own table, so a table given
-        // beside an overhead stream belongs in the overhead slot, whatever the order.
+        // beside an overhead stream belongs in the overhead slot, whatever the order. So do
+        // parameter and places files: what is opened is remembered for the camera shown.
         let mut tables = Vec::new();
+        let mut jsons = Vec::new();
+        let mut shown_camera = None;
         let mut offer = None;
         let mut failures = Vec::new();
         for p in paths {
@@ -29,21 +32,16 @@ impl Workspace {
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default();
-            let opened = if crate::streams::is_recording(&p) {
-                streams.push(p);
-                Ok(())
+            let kind = if crate::streams::is_recording(&p) {
+                &mut streams
             } else if ext == "json" {
-                self.open_json(&p)
+                &mut jsons
             } else if crate::sources::is_frame_file(&p) || p.is_dir() {
-                frames.push(p);
-                Ok(())
+                &mut frames
             } else {
-                tables.push(p);
-                Ok(())
+                &mut tables
             };
-            if let Err(e) = opened {
-                failures.push(format!("{e:#}"));
-            }
+            kind.push(p);
         }
         // One source is shown: the last stream given, else the frames as one sequence.
         if let Some(s) = streams.pop() {
@@ -57,13 +55,22 @@ impl Workspace {
             match Source::stream_camera(&s, self.camera_for(&s).as_deref()) {
                 Ok(source) => {
                     self.remember_recent(&s);
+                    // The camera's own files (remembered for this recording's camera, else
+                    // those it names): its table unless one is given.
+                    let camera = source.camera_id().map(|id| {
+                        let files = self.camera_files(&id);
+                        (id, files)
+                    });
                     if tables.is_empty()
-                        && let Some(t) = self.camera_table(&s, source.camera())
+                        && let Some(t) = camera.as_ref().and_then(|(_, f)| f.lut.clone())
                     {
                         tables.push(t);
                     }
                     match self.set_source(source) {
-                        Ok(()) => offer = Some(s),
+                        Ok(()) => {
+                            offer = Some(s);
+                            shown_camera = camera;
+                        }
                         Err(e) => failures.push(format!("{e:#}")),
                     }
                 }
@@ -86,6 +93,26 @@ impl Workspace {
         let source_status = self.status.clone();
         for t in tables {
             if let Err(e) = self.open_table(&t) {
+                failures.push(format!("{e:#}"));
+            }
+        }
+        let params_given = jsons.iter().any(|j| {
+            matches!(
+                super::params::json_kind(j),
+                Ok(super::params::JsonKind::Params)
+            )
+        });
+        for j in jsons {
+            if let Err(e) = self.open_json(&j) {
+                failures.push(format!("{e:#}"));
+            }
+        }
+        if let Some((id, mut files)) = shown_camera {
+            if params_given {
+                // The parameters given win over the camera's own.
+                files.params = None;
+            }
+            if let Err(e) = self.open_camera_files(&id, &files) {
                 failures.push(format!("{e:#}"));
             }
         }
@@ -237,8 +264,8 @@ impl Workspace {
         let t0 = Instant::now();
         let loaded = src.read(index)?;
         let resized = self.current.as_ref().and_then(|old| {
-            let topic = src.camera().unwrap_or("the source");
-            super::side_by_side::size_change(topic, &old.frame, &loaded.frame, index)
+            let topic = src.camera().unwrap_or_else(|| "the source".to_owned());
+            super::side_by_side::size_change(&topic, &old.frame, &loaded.frame, index)
         });
         let t1 = Instant::now();
         let t = self.run_pipeline(&loaded);
