@@ -279,21 +279,7 @@ fn rewrite_cameras(
     if let Some(param_set) = head.param_set().filter(|_| several) {
         writer.name_param_set(param_set)?;
     }
-    // Each camera kept keeps the files its recording names for it (`eotn.camera`), under its
-    // topic in the new stream (one camera: the stream's first, `/camera/image`).
-    for topic in &topics {
-        let first = |t: &str| crate::camera::is_default_camera(t);
-        let named =
-            (head.camera_metadata().iter()).find(|(t, _)| t == topic || (first(t) && first(topic)));
-        if let Some((_, files)) = named {
-            let written = if several {
-                topic.as_str()
-            } else {
-                crate::streams::IMAGE_TOPIC
-            };
-            writer.name_camera_files(written, &carried_files(files, input, &args.output))?;
-        }
-    }
+    name_kept_cameras(&mut writer, head, &topics, input, &args.output)?;
     let bar = progress(total, "import");
     let (mut written, mut skipped) = (0usize, Vec::new());
     let mut next = vec![0usize; readers.len()];
@@ -351,6 +337,31 @@ fn rewrite_cameras(
         args.output.display(),
         skipped.len()
     );
+    Ok(())
+}
+
+/// Each camera kept keeps the files its recording names for it (`eotn.camera`), under its topic
+/// in the new stream (one camera: the stream's first, `/camera/image`).
+fn name_kept_cameras(
+    writer: &mut StreamWriter,
+    head: &StreamReader,
+    topics: &[String],
+    input: &std::path::Path,
+    output: &std::path::Path,
+) -> anyhow::Result<()> {
+    let first = |t: &str| crate::camera::is_default_camera(t);
+    for topic in topics {
+        let named =
+            (head.camera_metadata().iter()).find(|(t, _)| t == topic || (first(t) && first(topic)));
+        if let Some((_, files)) = named {
+            let written = if topics.len() > 1 {
+                topic.as_str()
+            } else {
+                crate::streams::IMAGE_TOPIC
+            };
+            writer.name_camera_files(written, &carried_files(files, input, output))?;
+        }
+    }
     Ok(())
 }
 
