@@ -596,18 +596,24 @@ fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     });
 }
 
-/// The camera picker: every camera (image topic) of the open recording, the shown one ticked;
-/// picking one shows it at the same time with its own table (`Command::OpenCamera`).
+/// The camera picker: every camera (image topic) of the open recording or shown robot, the
+/// shown one ticked; picking one shows it at the same time with its own table
+/// (`Command::OpenCamera`).
 fn cameras_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let (cameras, shown) = state.cameras();
+    let of = if state.shown_robot().is_some() {
+        "Camera of the robot"
+    } else {
+        "Camera of the recording"
+    };
     ui.add_enabled_ui(cameras.len() > 1, |ui| {
-        ui.menu_button("Camera of the recording", |ui| {
-            for topic in cameras {
+        ui.menu_button(of, |ui| {
+            for camera in &cameras {
                 if ui
-                    .selectable_label(shown == Some(topic.as_str()), topic)
+                    .selectable_label(shown.as_ref() == Some(camera), camera.topic())
                     .clicked()
                 {
-                    commands.push(Command::OpenCamera(Some(topic.clone())));
+                    commands.push(Command::OpenCamera(Some(camera.clone())));
                     ui.close();
                 }
             }
@@ -615,12 +621,8 @@ fn cameras_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) 
         // Every camera at once, stepped together by time, each with its own table.
         let mut together = !state.camera_panes().is_empty();
         if ui.checkbox(&mut together, "Cameras side by side").clicked() {
-            let topics = if together {
-                cameras.to_vec()
-            } else {
-                Vec::new()
-            };
-            commands.push(Command::ShowSideBySide(topics));
+            let shown = if together { cameras } else { Vec::new() };
+            commands.push(Command::ShowSideBySide(shown));
             ui.close();
         }
     });

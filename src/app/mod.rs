@@ -191,8 +191,9 @@ pub struct EotnApp {
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
     pub last_view: Option<ImageTransform>,
-    /// Cameras side by side: (image topic, where its image was last drawn), left to right.
-    pub last_panes: Vec<(String, ImageTransform)>,
+    /// Cameras side by side: each pane as last drawn (where, how many primitives), left to
+    /// right.
+    pub last_panes: Vec<side_by_side::DrawnPane>,
     beside_textures: side_by_side::BesideTextures,
     confirm_close: bool,
     allow_close: bool,

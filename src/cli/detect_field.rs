@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::field::{field_views, frame_times, open_cameras};
 use super::overhead::{BallJson, RobotJson, SizeCheck};
-use crate::overhead::merge::{CameraId, FieldPicture, merge_detections};
+use crate::overhead::merge::{FieldPicture, SslCameraId, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::session::Session;
 
@@ -22,8 +22,8 @@ struct FieldBallJson {
     #[serde(flatten)]
     ball: BallJson,
     /// The camera whose ball it is (its `image_px`, `radius_px`).
-    camera_id: CameraId,
-    camera_ids: Vec<CameraId>,
+    camera_id: SslCameraId,
+    camera_ids: Vec<SslCameraId>,
 }
 
 /// A merged robot in a field line.
@@ -31,13 +31,13 @@ struct FieldBallJson {
 struct FieldRobotJson {
     #[serde(flatten)]
     robot: RobotJson,
-    camera_ids: Vec<CameraId>,
+    camera_ids: Vec<SslCameraId>,
 }
 
 /// A camera frame merged into a field frame.
 #[derive(Debug, Serialize)]
 struct CameraFrameJson {
-    id: CameraId,
+    id: SslCameraId,
     time_ns: u64,
 }
 
@@ -71,7 +71,7 @@ pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
             .into_iter()
             .map(|(id, time_ns)| CameraFrameJson { id, time_ns })
             .collect();
-        let refs: Vec<(CameraId, &OverheadDetections)> =
+        let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let line = field_line(t_ref, &merge_detections(&refs), frames);
         if json {
@@ -90,7 +90,7 @@ pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
 pub(super) fn field_line_value(
     time_ns: u64,
     p: &FieldPicture,
-    cameras: &[(CameraId, u64)],
+    cameras: &[(SslCameraId, u64)],
 ) -> serde_json::Result<serde_json::Value> {
     let frames = cameras
         .iter()

@@ -29,9 +29,10 @@ pub struct Args {
     /// Streams with a `/ground_truth` channel (from `eotn sim`).
     #[arg(required = true)]
     pub streams: Vec<PathBuf>,
-    /// Lookup table.
+    /// Lookup table; default: the table the first recording names for the camera read (its
+    /// `REC.cameras.json` sidecar, else its metadata).
     #[arg(long)]
-    pub lut: PathBuf,
+    pub lut: Option<PathBuf>,
     /// Recognition parameters JSON (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
@@ -399,6 +400,8 @@ fn calibrate_goals(
 /// # Errors
 /// Unreadable inputs or streams without ground truth, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    let lut_path =
+        super::inputs::table_or_camera_s(args.lut.as_deref(), &args.streams, args.camera.get())?;
     let overhead = args
         .streams
         .iter()
@@ -408,7 +411,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         return super::eval_overhead::run(
             &args.streams,
             args.camera.get(),
-            &args.lut,
+            &lut_path,
             args.calibration.as_deref(),
             args.field.as_deref(),
             args.json,
@@ -420,7 +423,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         super::overhead::refuse_robot_streams(&args.streams)
             .context("--calibration and --field are for overhead streams")?;
     }
-    let lut = load_lut_arg(&args.lut)?;
+    let lut = load_lut_arg(&lut_path)?;
     let rp = params_or_camera_s(args.params.as_deref(), &args.streams, args.camera.get())?;
     if let Some(labels) = &args.labels {
         return run_labels(args, labels, lut, rp);

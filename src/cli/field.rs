@@ -10,17 +10,17 @@ use super::inputs::load_lut_arg;
 use super::overhead::{load_usable_calibration, params_for};
 use crate::model::GroundTruth;
 use crate::model::truth::OverheadTruth;
-use crate::overhead::merge::CameraId as MergeCameraId;
+use crate::overhead::merge::SslCameraId as MergeCameraId;
 use crate::overhead::recognise::{OverheadDetections, OverheadParams};
 use crate::overhead::{FieldDescription, OverheadPipeline};
-use crate::session::{CameraId, OverheadEntry, Session, SessionSource};
+use crate::session::{OverheadEntry, Session, SessionSource, SslCameraId};
 use crate::streams::StreamReader;
 
 /// One overhead camera of a session, ready to run.
 #[derive(Debug)]
 pub struct FieldCamera {
     /// Its session id.
-    pub id: CameraId,
+    pub id: SslCameraId,
     /// Its pipeline: its own table, calibration and settings.
     pub pipeline: OverheadPipeline,
     /// Its recording.

@@ -15,7 +15,7 @@ use super::overhead::{load_field, load_usable_calibration, overhead_json, params
 use super::wmd_inputs::{FieldFrame, RobotModels, field_frames, read_world_models, recorded};
 use crate::model::world_model::RobotKey;
 use crate::overhead::OverheadPipeline;
-use crate::overhead::merge::{CameraId, frame_near};
+use crate::overhead::merge::{SslCameraId, frame_near};
 use crate::session::{Session, SessionSource};
 use crate::wmd::clock::{ClockOffset, estimate_offset, frame_period_ns, shifted};
 use crate::wmd::summary::{RobotSummary, Spread, Summaries};
@@ -225,7 +225,7 @@ fn open(a: &Args) -> anyhow::Result<Opened> {
     let lut = super::inputs::load_lut_arg(lut)?;
     let reader = crate::streams::StreamReader::open_camera(&overhead, a.camera.get())?;
     let camera = FieldCamera {
-        id: CameraId(0),
+        id: SslCameraId(0),
         pipeline: OverheadPipeline::new(lut, cal.camera, params_for(&field)),
         reader,
         name: crate::frame::display_name(&overhead),

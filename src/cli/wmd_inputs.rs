@@ -9,7 +9,7 @@ use anyhow::{Context, bail};
 
 use super::field::FieldCamera;
 use crate::model::world_model::{self, RobotKey, WorldModelMessage};
-use crate::overhead::merge::{CameraId, FieldPicture, merge_detections};
+use crate::overhead::merge::{FieldPicture, SslCameraId, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::session::SessionSource;
 use crate::streams::StreamReader;
@@ -25,7 +25,7 @@ pub struct FieldFrame {
     /// The merged picture (a session), as `overhead detect --session` prints it.
     pub picture: FieldPicture,
     /// The merged cameras' frames: id and time.
-    pub cameras: Vec<(CameraId, u64)>,
+    pub cameras: Vec<(SslCameraId, u64)>,
 }
 
 impl FieldFrame {
@@ -69,7 +69,7 @@ pub fn field_frames(cameras: &mut [FieldCamera], single: bool) -> anyhow::Result
     let mut out = Vec::with_capacity(reference.len());
     for (i, &t_ref) in reference.iter().enumerate() {
         let (views, frames) = super::field::field_views(cameras, &times, i, period_ns, &mut sizes)?;
-        let refs: Vec<(CameraId, &OverheadDetections)> =
+        let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let picture = merge_detections(&refs);
         out.push(FieldFrame {

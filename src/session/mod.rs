@@ -21,7 +21,7 @@ use crate::geometry::{MarkerIdentity, MarkerTeam};
 use crate::input_file::{MAX_SMALL_FILE_BYTES, read_text_bounded};
 use crate::overhead::FieldDescription;
 
-pub use crate::overhead::merge::CameraId;
+pub use crate::overhead::merge::SslCameraId;
 
 /// Where a camera's or robot's frames come from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -97,7 +97,7 @@ impl FieldRef {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct OverheadEntry {
     /// Its SSL camera id.
-    pub id: CameraId,
+    pub id: SslCameraId,
     /// Its frames.
     pub source: SessionSource,
     /// The topic of its frames when the source has several.
@@ -110,6 +110,25 @@ pub struct OverheadEntry {
     pub intrinsics: Option<PathBuf>,
     /// Its overhead recogniser parameters.
     pub params: Option<PathBuf>,
+}
+
+impl OverheadEntry {
+    /// Which camera this is, as the app and the settings name it: the overhead camera of its
+    /// source (a recording's canonical path, a server, a device) and topic (`/camera/image`
+    /// when it names none).
+    #[must_use]
+    pub fn camera_id(&self) -> crate::camera::CameraId {
+        let source = match &self.source {
+            SessionSource::Recording(p) => std::fs::canonicalize(p)
+                .unwrap_or_else(|_| p.clone())
+                .to_string_lossy()
+                .into_owned(),
+            SessionSource::Live(url) => url.clone(),
+            SessionSource::Device(p) => p.to_string_lossy().into_owned(),
+        };
+        let topic = self.camera.as_deref().unwrap_or(crate::camera::IMAGE_TOPIC);
+        crate::camera::CameraId::overhead(&source, topic)
+    }
 }
 
 /// One robot of the session, named by the marker it wears.
@@ -281,7 +300,7 @@ impl Session {
 
     /// The camera with `id`.
     #[must_use]
-    pub fn camera(&self, id: CameraId) -> Option<&OverheadEntry> {
+    pub fn camera(&self, id: SslCameraId) -> Option<&OverheadEntry> {
         self.overhead.iter().find(|o| o.id == id)
     }
 }
@@ -319,7 +338,7 @@ impl Resolver<'_> {
     fn overhead(&self, value: &Value) -> Result<OverheadEntry, String> {
         let raw: RawOverhead = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
         Ok(OverheadEntry {
-            id: CameraId(raw.id),
+            id: SslCameraId(raw.id),
             source: self.source(&raw.source)?,
             camera: raw.camera,
             lut: self.file("lut", "lookup table", &raw.lut)?,

@@ -45,7 +45,7 @@ fn two_cameras_and_two_robots_load_with_paths_beside_the_file() {
     let s = load(dir.path(), TWO_CAMERAS).expect("loads");
     assert_eq!(s.field, FieldRef::Shipped("four-legged-2005"));
     assert_eq!(s.overhead.len(), 2);
-    assert_eq!(s.overhead[1].id, CameraId(7));
+    assert_eq!(s.overhead[1].id, SslCameraId(7));
     assert_eq!(s.overhead[1].lut, dir.path().join("b.lut"));
     assert_eq!(s.overhead[1].camera.as_deref(), Some("/cam7"));
     assert_eq!(
@@ -62,8 +62,13 @@ fn two_cameras_and_two_robots_load_with_paths_beside_the_file() {
         s.robots[1].source,
         SessionSource::Live("ws://127.0.0.1:8765".into())
     );
-    assert!(s.camera(CameraId(7)).is_some());
-    assert!(s.camera(CameraId(1)).is_none());
+    assert!(s.camera(SslCameraId(7)).is_some());
+    assert!(s.camera(SslCameraId(1)).is_none());
+    // Each numbered camera is a camera of its own: its source and topic.
+    let (a, b) = (s.overhead[0].camera_id(), s.overhead[1].camera_id());
+    assert!(a.same_source(&b) && a != b, "{a} {b}");
+    assert_eq!(b.topic(), "/cam7");
+    assert!(matches!(b, crate::camera::CameraId::Overhead { .. }), "{b}");
     assert!(s.field.load().is_ok());
 }
 

@@ -8,6 +8,7 @@ use super::overhead::RobotKey;
 use super::robots::RobotId;
 use super::settings::{OverheadView, Overlays, ViewKind};
 use crate::blobs::Connectivity;
+use crate::camera::CameraId;
 use crate::lut::{ColourClass, Sensitivity};
 use crate::recognition::ObjectId;
 
@@ -20,20 +21,20 @@ pub enum Command {
     /// parameters or places (told by content), anything else as a table. Each file opens or
     /// fails on its own.
     Open(Vec<PathBuf>),
-    /// Show another camera of the open recording (its image topic; `None`: the first): the
-    /// recording reopens on that camera at the frame nearest the time shown, with that camera's
-    /// table (remembered for it, else the one the recording names). Also the camera later
-    /// recordings open on, when they have it.
-    OpenCamera(Option<String>),
-    /// Show these cameras (image topics) of the open recording side by side, stepped together
+    /// Show another camera of the open recording or shown robot (one of
+    /// [`crate::workspace::Workspace::cameras`]; `None`: the first): it is shown at the frame
+    /// nearest the time shown, with that camera's table, parameters and calibration
+    /// (remembered for it, else those the recording names). Reopening the recording opens on it.
+    OpenCamera(Option<CameraId>),
+    /// Show these cameras of the open recording or shown robot side by side, stepped together
     /// by time: each shows its frame nearest the shared cursor (the focused camera's frame
     /// time), classified with its own table, its own recognition drawn. The camera shown so
     /// far stays focused when listed. Fewer than two: one camera again (refused while a camera
     /// leaving the view has unsaved table edits). `workspace/side_by_side.rs`.
-    ShowSideBySide(Vec<String>),
+    ShowSideBySide(Vec<CameraId>),
     /// Make this camera (shown side by side) the focused one: hand classification, commit,
     /// undo, save, playback and the sensors window act on it and its own table.
-    FocusCamera(String),
+    FocusCamera(CameraId),
     /// Open a lookup table.
     OpenTable(PathBuf),
     /// Open a places file (`eotn patterns learn`): pink markers are identified as its places.

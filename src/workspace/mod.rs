@@ -83,6 +83,7 @@ pub use timings::{StepTiming, Timings, median};
 pub use try_edit::{TryEdit, TryEditRow};
 
 use crate::blobs::{Blob, BlobSet};
+use crate::camera::CameraId;
 use crate::classify::ClassifiedImage;
 use crate::frame::{Frame, Yuv, yuv_to_rgb};
 use crate::lut::edit::Selection;
@@ -144,9 +145,11 @@ pub struct Workspace {
     history: EditHistory,
     dirty: bool,
     source: Option<Source>,
-    /// The camera (image topic) recordings open on (`eotn open --camera`, the camera picker);
-    /// `None`: each recording's first.
-    camera: Option<String>,
+    /// The camera last picked (the camera picker, a pane focused): its recording reopens on it.
+    camera: Option<CameraId>,
+    /// The camera (image topic) other recordings open on (`eotn open --camera`); `None`: each
+    /// recording's first.
+    open_topic: Option<String>,
     index: usize,
     current: Option<SourceFrame>,
     rgb: Vec<u8>,
@@ -228,6 +231,7 @@ impl Workspace {
             dirty: false,
             source: None,
             camera: None,
+            open_topic: None,
             index: 0,
             current: None,
             rgb: Vec::new(),
@@ -330,9 +334,9 @@ impl Workspace {
         }
         match command {
             Command::Open(paths) => self.open(paths)?,
-            Command::OpenCamera(topic) => self.open_camera(topic)?,
-            Command::ShowSideBySide(topics) => self.show_side_by_side(&topics)?,
-            Command::FocusCamera(topic) => self.focus_camera(&topic)?,
+            Command::OpenCamera(camera) => self.open_camera(camera)?,
+            Command::ShowSideBySide(cameras) => self.show_side_by_side(&cameras)?,
+            Command::FocusCamera(camera) => self.focus_camera(&camera)?,
             Command::OpenTable(p) => self.open_table(&p)?,
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),

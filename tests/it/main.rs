@@ -48,6 +48,7 @@ mod properties;
 mod real_data;
 mod recognition;
 mod recordings;
+mod robot_cameras;
 mod robots;
 mod serve_load;
 mod sim;

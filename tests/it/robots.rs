@@ -22,7 +22,7 @@ use crate::live::{fake_robot_session, frame, image_message, image_payloads, reco
 
 /// Ticks the workspace as the app's UI does (about 60 times a second) until `done` holds;
 /// false when `secs` passed first.
-fn tick_until(w: &mut Workspace, secs: f64, mut done: impl FnMut(&Workspace) -> bool) -> bool {
+pub fn tick_until(w: &mut Workspace, secs: f64, mut done: impl FnMut(&Workspace) -> bool) -> bool {
     let until = Instant::now() + Duration::from_secs_f64(secs);
     while Instant::now() < until {
         w.tick(Duration::from_millis(16));
