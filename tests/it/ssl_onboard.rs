@@ -39,6 +39,42 @@ fn the_committed_journal_replays_to_the_committed_ssl_onboard_table() {
     assert!(base.cells() != saved.cells());
 }
 
+/// How the journal's base (the seed) is made, exactly as docs/recognition.md gives it:
+/// `eotn lut-from-labels IMAGES --boxes LABELS-YOLO` with these options (the tuning frames
+/// only, its default split).
+pub const SEED_OPTIONS: [&str; 6] = [
+    "--bits",
+    "7",
+    "--ball-core",
+    "0.95",
+    "--holdout-every",
+    "1000",
+];
+
+/// The seed is the journal's first step, so it must be made again byte for byte from the
+/// tuning frames' labels by the documented command.
+#[test]
+fn the_ssl_onboard_seed_is_made_again_byte_for_byte_from_the_tuning_labels() {
+    let Some(root) = shared_file("data/ssl-onboard") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let seed = dir.path().join("seed.lut");
+    let (images, labels) = (root.join("images"), root.join("labels-yolo"));
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "lut-from-labels".as_ref(),
+        images.as_os_str(),
+        "--boxes".as_ref(),
+        labels.as_os_str(),
+    ];
+    args.extend(SEED_OPTIONS.iter().map(std::ffi::OsStr::new));
+    args.extend(["-o".as_ref(), seed.as_os_str()]);
+    eotn_ok(&args);
+    let made = std::fs::read(&seed).unwrap();
+    let base = std::fs::read(journal::base_path(&repo_file(TABLE))).unwrap();
+    assert!(made == base, "the seed differs from {TABLE}.journal-base");
+}
+
 /// The clicks name tuning frames only: a held-out frame is refused before anything opens.
 #[test]
 fn the_ssl_onboard_clicks_name_no_held_out_frame() {
