@@ -21,8 +21,13 @@ use eotn::workspace::{Command, HintsCommand, PlaybackCommand, TableCommand, Work
 pub struct Look {
     /// A label set to open over the frames (scored on the tuning split).
     pub labels: Option<PathBuf>,
+    /// Recognition parameters to open first (File ▸ Open parameters…).
+    pub params: Option<PathBuf>,
     /// How many coverage hints to list (0: none).
     pub hints: usize,
+    /// The frames the hints count, by name (first and last, inclusive): every frame when
+    /// not given (the window's "frames from … to …").
+    pub hint_range: Option<(String, String)>,
     /// Clicks to preview.
     pub tries: Vec<Try>,
     /// Where to draw each listed hint over the frame showing most of it (`hint-K.png`: the
@@ -49,7 +54,11 @@ impl Try {
         };
         let numbers = |s: &str| -> anyhow::Result<Vec<usize>> {
             s.split(',')
-                .map(|v| v.trim().parse::<usize>().with_context(|| format!("{v} in {text}")))
+                .map(|v| {
+                    v.trim()
+                        .parse::<usize>()
+                        .with_context(|| format!("{v} in {text}"))
+                })
                 .collect()
         };
         let s = numbers(sens)?;
@@ -107,6 +116,9 @@ fn print_report(title: &str, r: &BoxReport) {
 impl Look {
     /// Prints what the windows show for the table open in `ws` over `frames`.
     pub fn print(&self, ws: &mut Workspace, frames: &[PathBuf]) -> anyhow::Result<()> {
+        if let Some(params) = &self.params {
+            ws.apply(eotn::workspace::ParamsCommand::OpenParams(params.clone()).into())?;
+        }
         let before = if let Some(labels) = &self.labels {
             ws.apply(Command::OpenLabels(labels.clone()))?;
             ws.apply(Command::SetLabelsSplit(Split::Tuning))?;
@@ -118,7 +130,19 @@ impl Look {
             None
         };
         if self.hints > 0 {
-            print_hints(ws, frames, self.hints, self.hint_pngs.as_deref())?;
+            let range = match &self.hint_range {
+                Some((a, b)) => {
+                    let at = |n: &str| {
+                        frames
+                            .iter()
+                            .position(|p| name(p) == n)
+                            .with_context(|| format!("{n} is not a tuning frame here"))
+                    };
+                    at(a)?..=at(b)?
+                }
+                None => 0..=frames.len().saturating_sub(1),
+            };
+            print_hints(ws, frames, range, self.hints, self.hint_pngs.as_deref())?;
         }
         for t in &self.tries {
             try_click(ws, frames, t, before.as_ref())?;
@@ -131,11 +155,12 @@ impl Look {
 fn print_hints(
     ws: &mut Workspace,
     frames: &[PathBuf],
+    range: std::ops::RangeInclusive<usize>,
     n: usize,
     pngs: Option<&Path>,
 ) -> anyhow::Result<()> {
-    let last = frames.len().saturating_sub(1);
-    ws.apply(HintsCommand::FindUnclassified { first: 0, last }.into())?;
+    let (first, last) = (*range.start(), *range.end());
+    ws.apply(HintsCommand::FindUnclassified { first, last }.into())?;
     settle(ws, |w| w.coverage().is_some_and(|c| c.done()));
     // One more tick ranks the last frames counted.
     ws.tick(Duration::ZERO);
@@ -156,7 +181,7 @@ fn print_hints(
     // Per hint and frame: pixels, and their box.
     let mut seen: HashMap<(usize, usize), (usize, [usize; 4])> = HashMap::new();
     let lut = ws.lut().clone();
-    for (f, path) in frames.iter().enumerate() {
+    for (f, path) in frames.iter().enumerate().take(last + 1).skip(first) {
         let frame = load_frame(path, None).with_context(|| format!("{}", path.display()))?;
         frame.for_each_pixel(|x, y, p| {
             if let Some(&h) = hint_of.get(&lut.index(p)) {
@@ -170,7 +195,14 @@ fn print_hints(
         let rgb = yuv_to_rgb(h.mean);
         println!(
             "hint {i}: {} px, mean YUV ({}, {}, {}) RGB ({}, {}, {}), {} cells",
-            h.pixels, h.mean.y, h.mean.u, h.mean.v, rgb[0], rgb[1], rgb[2], h.cells.len()
+            h.pixels,
+            h.mean.y,
+            h.mean.u,
+            h.mean.v,
+            rgb[0],
+            rgb[1],
+            rgb[2],
+            h.cells.len()
         );
         let mut where_: Vec<(usize, usize, [usize; 4])> = seen
             .iter()
@@ -180,12 +212,24 @@ fn print_hints(
         where_.sort_by_key(|w| std::cmp::Reverse(w.1));
         println!("  in {} frames; most in:", where_.len());
         for (f, n, b) in where_.iter().take(4) {
-            println!("    {} {n} px in ({},{})-({},{})", name(&frames[*f]), b[0], b[1], b[2], b[3]);
+            println!(
+                "    {} {n} px in ({},{})-({},{})",
+                name(&frames[*f]),
+                b[0],
+                b[1],
+                b[2],
+                b[3]
+            );
         }
         println!("  cells: {:?}", h.cells);
         if let (Some(dir), Some((f, _, _))) = (pngs, where_.first()) {
             let cells: std::collections::HashSet<usize> = h.cells.iter().copied().collect();
-            draw_hint(&dir.join(format!("hint-{i}.png")), &frames[*f], &lut, &cells)?;
+            draw_hint(
+                &dir.join(format!("hint-{i}.png")),
+                &frames[*f],
+                &lut,
+                &cells,
+            )?;
         }
     }
     Ok(())
@@ -239,7 +283,10 @@ fn try_click(
     ws.apply(TableCommand::SetClass(t.class).into())?;
     ws.apply(TableCommand::SetSensitivity(t.sensitivity).into())?;
     ws.apply(TableCommand::Sample { x: t.x, y: t.y }.into())?;
-    let pixel = ws.frame().and_then(|f| f.pixel(t.x, t.y)).context("pixel")?;
+    let pixel = ws
+        .frame()
+        .and_then(|f| f.pixel(t.x, t.y))
+        .context("pixel")?;
     println!(
         "try {} ±{},{},{} at {} ({}, {}): YUV ({}, {}, {}), now {}",
         t.class.name(),
@@ -256,9 +303,16 @@ fn try_click(
     );
     ws.apply(TableCommand::TryEditOnStream.into())?;
     settle(ws, |w| w.try_edit().is_none_or(|e| e.done()));
-    let rows = ws.try_edit().map(|e| e.stream.rows.clone()).unwrap_or_default();
+    let rows = ws
+        .try_edit()
+        .map(|e| e.stream.rows.clone())
+        .unwrap_or_default();
     let total: usize = rows.iter().map(|r| r.changed_pixels).sum();
-    println!("  changes {total} px in {} of {} frames; most:", rows.len(), frames.len());
+    println!(
+        "  changes {total} px in {} of {} frames; most:",
+        rows.len(),
+        frames.len()
+    );
     let mut sorted = rows;
     sorted.sort_by_key(|r| std::cmp::Reverse(r.changed_pixels));
     let most: Vec<String> = sorted

@@ -4,7 +4,8 @@
 //!   cargo run --example replay_clicks -- FRAME|STREAM CLICKS.json OUT.lut
 //!   cargo run --example replay_clicks -- --onto FOLDER CLICKS.json SEED.lut [--save-as OUT.lut]
 //!   cargo run --example replay_clicks -- --onto FOLDER CLICKS.json SEED.lut --look [--labels L]
-//!       [--hints N [--hint-pngs DIR]] [--try CLASS:Y,U,V:FRAME:X,Y]...
+//!       [--params P]
+//!       [--hints N [--hint-range FIRST.jpg..LAST.jpg] [--hint-pngs DIR]] [--try CLASS:Y,U,V:FRAME:X,Y]...
 //!
 //! The first starts a new table. `--onto` opens every tuning frame of FOLDER (the held-out
 //! ones, numbers ending in 7, 8 or 9, are never opened) and SEED.lut as it is (a table seeded
@@ -64,8 +65,16 @@ fn parse_args() -> anyhow::Result<Args> {
                 let n = value("--hints")?;
                 look.hints = n.to_string_lossy().parse().context("--hints N")?;
             }
+            Some("--hint-range") => {
+                let r = value("--hint-range")?.to_string_lossy().into_owned();
+                let (a, b) = r.split_once("..").context("--hint-range FIRST..LAST")?;
+                look.hint_range = Some((a.to_owned(), b.to_owned()));
+            }
+            Some("--params") => look.params = Some(value("--params")?),
             Some("--hint-pngs") => look.hint_pngs = Some(value("--hint-pngs")?),
-            Some("--try") => look.tries.push(look::Try::parse(&value("--try")?.to_string_lossy())?),
+            Some("--try") => look
+                .tries
+                .push(look::Try::parse(&value("--try")?.to_string_lossy())?),
             _ => args.positional.push(PathBuf::from(a)),
         }
     }

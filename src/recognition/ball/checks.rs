@@ -68,7 +68,8 @@ fn colour_tests(
         ),
         None => confidence.skipped(TestName::CircleFill, params.circle_fill),
     }
-    if let Some(share) = unclassified_around(img, m.outline.bounds) {
+    if let Some(share) = unclassified_around(img, m.outline.bounds, params.unclassified_ring_gap_px)
+    {
         confidence.range_test(
             TestName::UnclassifiedAround,
             share,
@@ -287,11 +288,12 @@ fn field_at_foot(img: &ClassifiedImage, b: PixelBox, down: i64) -> Option<f64> {
     (n > 0).then(|| f64::from(field) / f64::from(n))
 }
 
-/// Share of unclassified pixels on the ring one pixel outside the box (pixels inside the image
-/// only); `None` when the ring lies wholly outside.
-fn unclassified_around(img: &ClassifiedImage, b: PixelBox) -> Option<f64> {
-    let (minx, miny) = (i64::from(b.min_x) - 1, i64::from(b.min_y) - 1);
-    let (maxx, maxy) = (i64::from(b.max_x) + 1, i64::from(b.max_y) + 1);
+/// Share of unclassified pixels on the ring one pixel outside the box, or `gap` pixels further
+/// out (pixels inside the image only); `None` when the ring lies wholly outside.
+fn unclassified_around(img: &ClassifiedImage, b: PixelBox, gap: u32) -> Option<f64> {
+    let d = 1 + i64::from(gap);
+    let (minx, miny) = (i64::from(b.min_x) - d, i64::from(b.min_y) - d);
+    let (maxx, maxy) = (i64::from(b.max_x) + d, i64::from(b.max_y) + d);
     let ring = (minx..=maxx)
         .flat_map(|x| [(x, miny), (x, maxy)])
         .chain((miny + 1..maxy).flat_map(|y| [(minx, y), (maxx, y)]));

@@ -112,6 +112,11 @@ pub struct BallParams {
     pub unclassified_around: [f64; 2],
     /// Weight of the unclassified-surroundings test.
     pub unclassified_around_weight: TestWeight,
+    /// The unclassified-surroundings ring lies this many pixels further out than right beside
+    /// the box: past a blurred ball's rim, whose pixels mix the ball's colour with the carpet's
+    /// and classify as neither (the SSL on-board frames' small balls, `params/ssl-onboard.json`).
+    /// 0 (the default) reads the ring right beside the box.
+    pub unclassified_ring_gap_px: u32,
     /// Accepted share of ball colours among the image pixels inside the circle (where the image
     /// shows it): a ball fills its outline, even with a side hidden (an eligible ball is at
     /// least 60% in view) or holes in its classification; a thin orange arc — the red rim of the
@@ -254,6 +259,7 @@ impl Default for BallParams {
             orange_fraction_weight: TestWeight::new(0.5, 2.0),
             unclassified_around: [0.0, 0.6],
             unclassified_around_weight: TestWeight::new(0.0, 2.0),
+            unclassified_ring_gap_px: 0,
             circle_fill: [0.2, 1.0],
             circle_fill_weight: TestWeight::new(0.0, 3.0),
             edge_margin_px: 3,

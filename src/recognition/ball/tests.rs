@@ -534,7 +534,12 @@ fn min_pixels_counts_the_orange_core_and_soft_groups_alone_are_candidates_only_w
     // Soft colours alone are still a candidate by default.
     let soft_only = shirt(false);
     let blobs = BlobSet::from_image(&soft_only, Connectivity::Eight);
-    assert_eq!(recognise_ball(&soft_only, &blobs, &ctx, &params).candidates.len(), 1);
+    assert_eq!(
+        recognise_ball(&soft_only, &blobs, &ctx, &params)
+            .candidates
+            .len(),
+        1
+    );
     assert!(
         recognise_ball(&soft_only, &blobs, &ctx, &no_soft)
             .candidates
