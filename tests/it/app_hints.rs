@@ -343,7 +343,11 @@ fn labels_opened_from_the_menu_are_painted_and_scored_with_the_table_in_use() {
     field.type_text(&labels.display().to_string());
     h.run();
     click_label(&mut h, "Open");
-    assert!(workspace(&h).labels().is_some(), "{:?}", workspace(&h).warnings());
+    assert!(
+        workspace(&h).labels().is_some(),
+        "{:?}",
+        workspace(&h).warnings()
+    );
     run_until(&mut h, WITHIN, |a| {
         a.state
             .labels()
@@ -378,9 +382,9 @@ fn labels_opened_from_the_menu_are_painted_and_scored_with_the_table_in_use() {
     // The split: held-out frames only (none here: f1, f2 end in 1 and 2).
     click_label(&mut h, "held out");
     run_until(&mut h, WITHIN, |a| {
-        a.state.labels().is_some_and(|l| {
-            l.split() == eotn::eval::label_sets::Split::HeldOut && l.done()
-        })
+        a.state
+            .labels()
+            .is_some_and(|l| l.split() == eotn::eval::label_sets::Split::HeldOut && l.done())
     });
     assert_eq!(workspace(&h).labels().unwrap().report().eligible, 0);
 }

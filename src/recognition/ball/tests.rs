@@ -596,3 +596,50 @@ fn field_below_looks_past_the_ball_s_shadow_when_asked_but_not_past_a_robot() {
     let (share, effect) = field_below(&robot, 1.5);
     assert!(share < 0.5 && effect < 0.0, "a robot below: {share}");
 }
+
+/// `unclassified_ring_gap_px` reads the unclassified-surroundings ring past a blurred ball's
+/// rim: a ball whose outermost pixel ring classifies as nothing (the mix of ball and carpet)
+/// fails the test right beside its box and passes one pixel further out.
+#[test]
+fn the_unclassified_ring_can_lie_past_a_blurred_rim() {
+    let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+        320,
+        240,
+        45.0_f64.to_radians(),
+    ));
+    let (cx, cy, r) = (160.0, 150.0, 5.0);
+    let codes = (0..320 * 240)
+        .map(|i| {
+            let (x, y) = ((i % 320) as f64 + 0.5, (i / 320) as f64 + 0.5);
+            let d = (x - cx).hypot(y - cy);
+            if d <= r {
+                ColourClass::Orange.code()
+            } else if d <= r + 1.8 {
+                ColourClass::Unclassified.code()
+            } else {
+                ColourClass::Green.code()
+            }
+        })
+        .collect();
+    let img = ClassifiedImage::from_codes(320, 240, codes).expect("size");
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let share = |gap: u32| {
+        let params = BallParams {
+            unclassified_ring_gap_px: gap,
+            ..BallParams::default()
+        };
+        let res = recognise_ball(&img, &blobs, &ctx, &params);
+        let t = res.candidates[0]
+            .confidence
+            .test(TestName::UnclassifiedAround)
+            .expect("unclassified around");
+        (t.value, t.effect)
+    };
+    let (beside, effect) = share(0);
+    assert!(
+        beside > 0.6 && effect < 0.0,
+        "right beside the box: {beside}"
+    );
+    let (past, effect) = share(1);
+    assert!(past < 0.4 && effect == 0.0, "past the rim: {past}");
+}
