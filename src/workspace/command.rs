@@ -45,6 +45,9 @@ pub enum Command {
     /// its boxes drawn by class, recognition scored against them, the missed and false frames
     /// as events (`workspace/labels.rs`).
     OpenLabels(PathBuf),
+    /// Score the opened labels on these frames only: all, the tuning frames (numbers ending in
+    /// 0–6) or the held-out ones (7–9), from the first frame again.
+    SetLabelsSplit(crate::eval::label_sets::Split),
     /// Open or close a window.
     ShowWindow(Window, bool),
     /// Select a recognition candidate (the object its primitives belong to) to highlight its

@@ -95,6 +95,28 @@ pub fn append(
         .with_context(|| format!("{}: cannot write the edit journal", path.display()))
 }
 
+/// Makes the journal of `from` (with its base copy, when it has one) the journal of `to`, so
+/// a table saved under another name keeps its whole record.
+///
+/// # Errors
+/// Reading the journal or its base, or writing the copies; the messages name the files.
+pub fn copy(from: &Path, to: &Path) -> anyhow::Result<()> {
+    let source = journal_path(from);
+    let text = crate::input_file::read_text_bounded(
+        &source,
+        crate::input_file::MAX_SIDE_FILE_BYTES,
+        "an edit journal",
+    )
+    .with_context(|| format!("{}: cannot read the edit journal", source.display()))?;
+    let base = base_path(from);
+    if base.exists() {
+        LookupTable::load(&base)?.save(&base_path(to))?;
+    }
+    let target = journal_path(to);
+    crate::atomic_file::write_atomic(&target, text.as_bytes())
+        .with_context(|| format!("{}: cannot write the edit journal", target.display()))
+}
+
 /// What replaying a journal gives.
 #[derive(Debug)]
 pub struct Replay {

@@ -341,6 +341,7 @@ impl Workspace {
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),
             Command::OpenLabels(p) => self.open_labels(&p)?,
+            Command::SetLabelsSplit(split) => self.set_labels_split(split)?,
             Command::ShowWindow(w, open) => {
                 *self.window_flag(w) = open;
                 if w == Window::Inspector && !open {
@@ -721,5 +722,48 @@ mod tests {
             journal::replay(&path).unwrap().table,
             LookupTable::load(&path).unwrap()
         );
+    }
+
+    /// A table opened from a file (a seeded one, no journal yet), clicked on, then saved under
+    /// another name keeps every click in the new name's journal, which starts from the seed
+    /// (before, Save As folded the clicks into a new base copy).
+    #[test]
+    fn save_as_of_an_opened_table_keeps_its_journal_from_the_seed() {
+        let dir = tempfile::tempdir().expect("temp");
+        let seed = dir.path().join("seed.lut");
+        let mut lut = LookupTable::new(6).unwrap();
+        lut.apply(crate::lut::EditRecord::now(
+            ColourClass::Orange,
+            crate::lut::Region::Cells { indices: vec![5] },
+        ));
+        lut.save(&seed).unwrap();
+        let mut s = Workspace::default();
+        s.apply(Command::OpenTable(seed.clone())).unwrap();
+        for (class, cell) in [
+            (ColourClass::Green, [20, 12, 12]),
+            (ColourClass::White, [60, 32, 32]),
+        ] {
+            s.apply(TableCommand::SetClass(class).into()).unwrap();
+            s.apply(TableCommand::SampleCell(cell).into()).unwrap();
+            s.apply(TableCommand::Commit.into()).unwrap();
+        }
+        let path = dir.path().join("final.lut");
+        s.apply(TableCommand::SaveTableAs(path.clone()).into())
+            .unwrap();
+        let replay = journal::replay(&path).unwrap();
+        assert_eq!(replay.commits, 2);
+        assert_eq!(replay.table, LookupTable::load(&path).unwrap());
+        assert_eq!(
+            LookupTable::load(&journal::base_path(&path)).unwrap(),
+            LookupTable::load(&seed).unwrap()
+        );
+        // Later edits go to the new name's journal only.
+        s.apply(TableCommand::Undo.into()).unwrap();
+        s.apply(TableCommand::SaveTable.into()).unwrap();
+        assert_eq!(
+            journal::replay(&path).unwrap().table,
+            LookupTable::load(&path).unwrap()
+        );
+        assert_eq!(journal::replay(&seed).unwrap().commits, 2);
     }
 }

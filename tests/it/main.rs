@@ -34,6 +34,7 @@ mod harness;
 mod jpeg_colour;
 mod kernels;
 mod label_sets;
+mod label_sets_cli;
 mod live;
 mod live_peers;
 mod mcap_conformance;
