@@ -84,7 +84,7 @@ fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<Fi
 }
 
 /// The overhead recogniser's settings from a JSON file; unknown keys refused.
-fn load_params(path: &Path) -> anyhow::Result<OverheadParams> {
+pub(super) fn load_params(path: &Path) -> anyhow::Result<OverheadParams> {
     let text = crate::input_file::read_text_bounded(
         path,
         crate::input_file::MAX_SMALL_FILE_BYTES,
