@@ -5,6 +5,12 @@
 //! model (the truth plus its error, stamped with its own clock). Robot 1 is 50 cm off, 10°
 //! turned, measures distances 10 % long and its clock runs 0.4 s ahead; robot 2 is −20° turned,
 //! stops sending after 45 world models and crashes half a second later.
+//!
+//! The served game stands still (its frame 20, four seconds of it): a live world model is paired
+//! by its arrival, and the relay through this test and Python can hold one up past half a frame
+//! on a loaded machine, pairing it with the next frame; with the robots standing still that
+//! costs nothing, so the errors found are the known ones exactly. Pairing in time is checked on
+//! recordings (tests/it/wmd.rs, src/wmd/clock.rs).
 
 use std::ffi::OsStr;
 use std::io::{BufRead, BufReader, Write};
@@ -71,6 +77,24 @@ fn marker_of(n: u32) -> (String, u64) {
     )
 }
 
+/// The game's frame 20 (its image and truth) for four seconds at 30 fps.
+fn still_game(path: &Path) -> std::path::PathBuf {
+    let mut r = eotn::streams::StreamReader::open(&fixture().stream).unwrap();
+    let mut frame = r.read(20).unwrap();
+    frame.extra.clear();
+    let info = eotn::streams::StreamInfo {
+        source: "overhead".to_owned(),
+        description: "the overhead game standing still".to_owned(),
+    };
+    let mut w = eotn::streams::StreamWriter::create(path, &info).unwrap();
+    for i in 0..120 {
+        frame.time_ns = i * 33_333_333;
+        w.write(&frame).unwrap();
+    }
+    w.finish().unwrap();
+    path.to_owned()
+}
+
 /// Runs `eotn wmd` to its end, failing the test if it is not over within `limit`.
 fn run_bounded(args: &[&OsStr], limit: Duration) -> std::process::Output {
     let child = Command::new(env!("CARGO_BIN_EXE_eotn"))
@@ -105,7 +129,8 @@ fn live_robots_are_matched_by_marker_with_their_known_errors_and_their_clocks_sh
         return;
     };
     let f = fixture();
-    let served = serve(&f.stream, "127.0.0.1:0", &["--loop"]);
+    let still = still_game(&f.dir.path().join("still.mcap"));
+    let served = serve(&still, "127.0.0.1:0", &["--loop"]);
     let (one_robot, one_in) = python_robot(
         &python,
         1,
@@ -225,13 +250,13 @@ fn check_robot_one(lines: &[Value], stderr: &str) {
             if let (Some(measured), Some(truth)) = (x["measured_cm"].as_f64(), x["true_cm"].as_f64())
                 && truth > 50.0
             {
-                assert!((measured / truth - 1.1).abs() < 0.08, "{x}");
+                assert!((measured / truth - 1.1).abs() < 0.05, "{x}");
             }
         }
     }
     // Live pairing by arrival: a world model held up past half a frame misses its frame.
     assert!(
-        compared * 10 >= seen * 7 && compared >= 30,
+        compared * 10 >= seen * 8 && compared >= 30,
         "robot 1 compared in {compared} of the {seen} frames reading its marker"
     );
     let prefix = format!("{} {}: clock offset ", one.0, one.1);
