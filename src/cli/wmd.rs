@@ -31,11 +31,21 @@ use crate::wmd::{Comparison, Targets, WorldModelMessage, compare};
 pub struct Args {
     /// The overhead camera: a recording, a `ws://HOST:PORT` server or a camera device
     /// (`/dev/videoN`, as `eotn sources` lists them).
-    #[arg(long, value_name = "SOURCE", required_unless_present = "session", conflicts_with = "session")]
+    #[arg(
+        long,
+        value_name = "SOURCE",
+        required_unless_present = "session",
+        conflicts_with = "session"
+    )]
     pub overhead: Option<PathBuf>,
     /// A robot's world models (`/world_model`, `/world_model/<name>`; docs/formats.md): a
     /// recording or a `ws://HOST:PORT` robot; repeatable; one source may carry several robots'.
-    #[arg(long, value_name = "SOURCE", required_unless_present = "session", conflicts_with = "session")]
+    #[arg(
+        long,
+        value_name = "SOURCE",
+        required_unless_present = "session",
+        conflicts_with = "session"
+    )]
     pub robot: Vec<PathBuf>,
     /// The overhead camera's lookup table.
     #[arg(long, required_unless_present = "session", conflicts_with = "session")]
@@ -118,7 +128,9 @@ fn is_live(a: &Args) -> anyhow::Result<bool> {
         return Ok(sources.chain(robots).any(is_live_source));
     }
     let args = a.overhead.iter().chain(&a.robot);
-    Ok(args.map(|p| SessionSource::parse_arg(p)).any(|s| is_live_source(&s)))
+    Ok(args
+        .map(|p| SessionSource::parse_arg(p))
+        .any(|s| is_live_source(&s)))
 }
 
 fn is_live_source(s: &SessionSource) -> bool {
@@ -396,7 +408,11 @@ fn open(a: &Args) -> anyhow::Result<Opened> {
 }
 
 /// One field frame's `--json` line.
-pub(super) fn line_json(frame: &FieldFrame, results: &[Comparison], jumps: &[bool]) -> anyhow::Result<Value> {
+pub(super) fn line_json(
+    frame: &FieldFrame,
+    results: &[Comparison],
+    jumps: &[bool],
+) -> anyhow::Result<Value> {
     let mut line = match &frame.single {
         Some(d) => {
             let mut v = serde_json::to_value(overhead_json(String::new(), d, 0.0))?;

@@ -49,7 +49,7 @@ pub enum OverheadFeed {
     /// A camera device, grabbed on its own thread.
     Device(Streamer),
     /// A recording, replayed on its own clock.
-    Replay(Replay),
+    Replay(Box<Replay>),
 }
 
 impl std::fmt::Debug for OverheadFeed {
@@ -92,11 +92,11 @@ impl OverheadFeed {
     pub fn replay(path: &Path, camera: Option<&str>) -> anyhow::Result<Self> {
         let reader = StreamReader::open_camera(path, camera)?;
         let first_ns = reader.time_ns(0).unwrap_or(0);
-        Ok(Self::Replay(Replay {
+        Ok(Self::Replay(Box::new(Replay {
             reader,
             next: 0,
             first_ns,
-        }))
+        })))
     }
 
     /// True for a recording played to its end (a live source never ends by itself).
@@ -306,12 +306,7 @@ impl RobotFeed {
 
 /// One event of a live robot's connection, on its thread: world models parsed (refusals said),
 /// wanted camera frames decoded into their messages, the connection's changes said.
-fn on_event(
-    inbox: &mut Inbox,
-    wants: &RobotWants,
-    camera: &mut Option<String>,
-    event: LiveEvent,
-) {
+fn on_event(inbox: &mut Inbox, wants: &RobotWants, camera: &mut Option<String>, event: LiveEvent) {
     match event {
         LiveEvent::Connected { server_name } => {
             inbox.lines.push(format!("connected to '{server_name}'"));
@@ -334,7 +329,14 @@ fn on_event(
             if world_model::is_world_model_topic(&channel.topic) && channel.encoding == "json" {
                 model(inbox, wants, log_time_ns, received_ns, &payload);
             } else if let Some(topic) = &wants.frames {
-                frame(inbox, topic.as_deref(), camera, &channel, received_ns, &payload);
+                frame(
+                    inbox,
+                    topic.as_deref(),
+                    camera,
+                    &channel,
+                    received_ns,
+                    &payload,
+                );
             }
         }
     }
@@ -372,8 +374,8 @@ fn frame(
     arrival_ns: u64,
     payload: &[u8],
 ) {
-    let Some(kind) = MessageKind::of(&channel.schema_name, &channel.encoding)
-        .filter(|k| k.is_image())
+    let Some(kind) =
+        MessageKind::of(&channel.schema_name, &channel.encoding).filter(|k| k.is_image())
     else {
         return;
     };

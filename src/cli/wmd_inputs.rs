@@ -103,26 +103,19 @@ pub fn recorded(source: &SessionSource, what: &str) -> anyhow::Result<std::path:
         SessionSource::Recording(p) => Ok(p.clone()),
         SessionSource::Live(url) => bail!("{what} {url}: a live source in a recorded session"),
         SessionSource::Device(p) => {
-            bail!("{what} {}: a camera device in a recorded session", p.display())
+            bail!(
+                "{what} {}: a camera device in a recorded session",
+                p.display()
+            )
         }
     }
 }
 
-/// Says which keys of a session `eotn wmd` does not use, so none is ignored silently: an
-/// overhead camera's `intrinsics` (the calibration holds the lens it uses), a robot's `camera`,
-/// `lut` and `params` when its camera frames are not recorded (no `-o`, or a recorded robot:
-/// only a live robot's frames are recorded and, with a table, recognised).
+/// Says which keys of a session `eotn wmd` does not use, so none is ignored silently: a robot's
+/// `camera`, `lut` and `params` when its camera frames are not recorded (no `-o`, or a recorded
+/// robot: only a live robot's frames are recorded and, with a table, recognised). (An overhead
+/// camera's `intrinsics`: [`super::field::say_unused_intrinsics`].)
 pub fn say_unused_session_keys(session: &crate::session::Session, output: bool, live: bool) {
-    for (i, e) in session.overhead.iter().enumerate() {
-        if let Some(p) = &e.intrinsics {
-            log::warn!(
-                "overhead[{i}] (id {}): intrinsics {}: not read here: the calibration holds the \
-                 lens used (intrinsics are for `eotn overhead calibrate --intrinsics`)",
-                e.id,
-                p.display()
-            );
-        }
-    }
     for (i, r) in session.robots.iter().enumerate() {
         let keys: Vec<&str> = [
             r.camera.as_ref().map(|_| "camera"),
@@ -235,6 +228,98 @@ pub fn read_world_models(
     })
 }
 
+/// A live session's sources opened: the field, the overhead cameras, each robot's feed with
+/// the topic of its camera frames, its session entry and its name, each camera's files.
+struct LiveOpened {
+    field: crate::overhead::FieldDescription,
+    cameras: Vec<super::wmd_live::LiveCamera>,
+    robots: Vec<OpenedRobot>,
+    files: Vec<crate::camera::CameraFiles>,
+}
+
+/// A robot's feed, the topic of its camera frames, its session entry, its name.
+type OpenedRobot = (
+    super::wmd_feeds::RobotFeed,
+    String,
+    Option<crate::session::RobotEntry>,
+    String,
+);
+
+fn open_live_session(path: &Path, record: bool) -> anyhow::Result<LiveOpened> {
+    let session = crate::session::Session::load(path)?;
+    super::field::say_unused_intrinsics(&session);
+    say_unused_session_keys(&session, record, true);
+    let field = session
+        .field
+        .load()
+        .with_context(|| format!("{}: field", path.display()))?;
+    let mut cameras = Vec::new();
+    let mut files = Vec::new();
+    for e in &session.overhead {
+        let lut = super::inputs::load_lut_arg(&e.lut)?;
+        let cal = super::overhead::load_usable_calibration(&e.calibration)?;
+        let params = match &e.params {
+            Some(p) => super::field::load_params(p)?,
+            None => super::overhead::params_for(&field),
+        };
+        let pipeline = crate::overhead::OverheadPipeline::new(lut, cal.camera, params);
+        cameras.push(live_camera(e.id, &e.source, e.camera.as_deref(), pipeline)?);
+        files.push(camera_files(&e.lut, &e.calibration));
+    }
+    let mut robots = Vec::new();
+    for r in &session.robots {
+        let key = RobotKey {
+            team: r.team,
+            identity: r.robot_id,
+        };
+        let wants = super::wmd_feeds::RobotWants {
+            only: Some(key),
+            frames: record.then(|| r.camera.clone()),
+        };
+        let topic = format!("/robot/{}-{}", key.team.name(), key.identity.value());
+        let name = format!("{key} ({})", source_name(&r.source));
+        let feed = robot_feed(&r.source, wants, &key.to_string())?;
+        robots.push((feed, topic, Some(r.clone()), name));
+    }
+    Ok(LiveOpened {
+        field,
+        cameras,
+        robots,
+        files,
+    })
+}
+
+fn open_live_args(a: &super::wmd::Args, record: bool) -> anyhow::Result<LiveOpened> {
+    let (Some(overhead), Some(lut), Some(cal)) = (&a.overhead, &a.lut, &a.calibration) else {
+        bail!("--overhead, --lut and --calibration name the overhead camera (or give --session)");
+    };
+    let field = super::overhead::load_field(a.field.as_deref())?;
+    let pipeline = crate::overhead::OverheadPipeline::new(
+        super::inputs::load_lut_arg(lut)?,
+        super::overhead::load_usable_calibration(cal)?.camera,
+        super::overhead::params_for(&field),
+    );
+    let source = SessionSource::parse_arg(overhead);
+    let cameras = vec![live_camera(CameraId(0), &source, a.camera.get(), pipeline)?];
+    let mut robots = Vec::new();
+    for (i, p) in a.robot.iter().enumerate() {
+        let wants = super::wmd_feeds::RobotWants {
+            only: None,
+            frames: record.then_some(None),
+        };
+        let source = SessionSource::parse_arg(p);
+        let feed = robot_feed(&source, wants, &p.display().to_string())?;
+        let topic = format!("/robot/{}", i + 1);
+        robots.push((feed, topic, None, source_name(&source)));
+    }
+    Ok(LiveOpened {
+        field,
+        cameras,
+        robots,
+        files: vec![camera_files(lut, cal)],
+    })
+}
+
 /// Every source of a live session opened as a feed, and the recording started with `-o`.
 ///
 /// # Errors
@@ -242,70 +327,19 @@ pub fn read_world_models(
 /// device given as a robot (it sends no world models), a recording without world models.
 pub fn open_live(
     a: &super::wmd::Args,
-) -> anyhow::Result<(super::wmd_live::LiveInputs, Option<super::wmd_record::SessionRecorder>)> {
-    use super::wmd_feeds::RobotWants;
+) -> anyhow::Result<(
+    super::wmd_live::LiveInputs,
+    Option<super::wmd_record::SessionRecorder>,
+)> {
     let record = a.output.is_some();
-    let (field, cameras, robots, files) = if let Some(path) = &a.session {
-        let session = crate::session::Session::load(path)?;
-        say_unused_session_keys(&session, record, true);
-        let field = session
-            .field
-            .load()
-            .with_context(|| format!("{}: field", path.display()))?;
-        let mut cameras = Vec::new();
-        let mut files = Vec::new();
-        for e in &session.overhead {
-            let lut = super::inputs::load_lut_arg(&e.lut)?;
-            let cal = super::overhead::load_usable_calibration(&e.calibration)?;
-            let params = match &e.params {
-                Some(p) => super::field::load_params(p)?,
-                None => super::overhead::params_for(&field),
-            };
-            let pipeline = crate::overhead::OverheadPipeline::new(lut, cal.camera, params);
-            cameras.push(live_camera(e.id, &e.source, e.camera.as_deref(), pipeline)?);
-            files.push(camera_files(&e.lut, &e.calibration));
-        }
-        let mut robots = Vec::new();
-        for r in &session.robots {
-            let key = RobotKey {
-                team: r.team,
-                identity: r.robot_id,
-            };
-            let wants = RobotWants {
-                only: Some(key),
-                frames: record.then(|| r.camera.clone()),
-            };
-            let topic = format!("/robot/{}-{}", key.team.name(), key.identity.value());
-            let name = format!("{key} ({})", source_name(&r.source));
-            let feed = robot_feed(&r.source, wants, &key.to_string())?;
-            robots.push((feed, topic, Some(r.clone()), name));
-        }
-        (field, cameras, robots, files)
-    } else {
-        let (Some(overhead), Some(lut), Some(cal)) = (&a.overhead, &a.lut, &a.calibration) else {
-            bail!(
-                "--overhead, --lut and --calibration name the overhead camera (or give --session)"
-            );
-        };
-        let field = super::overhead::load_field(a.field.as_deref())?;
-        let pipeline = crate::overhead::OverheadPipeline::new(
-            super::inputs::load_lut_arg(lut)?,
-            super::overhead::load_usable_calibration(cal)?.camera,
-            super::overhead::params_for(&field),
-        );
-        let source = SessionSource::parse_arg(overhead);
-        let cameras = vec![live_camera(CameraId(0), &source, a.camera.get(), pipeline)?];
-        let mut robots = Vec::new();
-        for (i, p) in a.robot.iter().enumerate() {
-            let wants = RobotWants {
-                only: None,
-                frames: record.then_some(None),
-            };
-            let source = SessionSource::parse_arg(p);
-            let feed = robot_feed(&source, wants, &p.display().to_string())?;
-            robots.push((feed, format!("/robot/{}", i + 1), None, source_name(&source)));
-        }
-        (field, cameras, robots, vec![camera_files(lut, cal)])
+    let LiveOpened {
+        field,
+        cameras,
+        robots,
+        files,
+    } = match &a.session {
+        Some(path) => open_live_session(path, record)?,
+        None => open_live_args(a, record)?,
     };
     let recorder = match &a.output {
         Some(p) => {
@@ -359,7 +393,10 @@ fn camera_files(lut: &Path, calibration: &Path) -> crate::camera::CameraFiles {
 
 /// A session robot's recogniser: its table and parameters.
 fn robot_pipeline(e: &crate::session::RobotEntry) -> anyhow::Result<crate::pipeline::Pipeline> {
-    let lut = e.lut.as_deref().context("a robot's recogniser needs its table")?;
+    let lut = e
+        .lut
+        .as_deref()
+        .context("a robot's recogniser needs its table")?;
     let params = crate::pipeline::PipelineParams {
         recognition: super::detect::load_params(e.params.as_deref())?,
         ..crate::pipeline::PipelineParams::default()
@@ -385,7 +422,9 @@ fn live_camera(
         SessionSource::Recording(p) => OverheadFeed::replay(p, topic)?,
     };
     if topic.is_some() && !matches!(source, SessionSource::Recording(_)) {
-        log::warn!("{name}: a camera topic is chosen only in recordings; the server's first camera is read");
+        log::warn!(
+            "{name}: a camera topic is chosen only in recordings; the server's first camera is read"
+        );
     }
     Ok(super::wmd_live::LiveCamera {
         id,

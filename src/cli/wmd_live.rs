@@ -166,7 +166,7 @@ impl Session<'_> {
     ) -> anyhow::Result<()> {
         loop {
             self.poll_cameras()?;
-            self.poll_robots()?;
+            self.poll_robots();
             self.make_field_frames(unix_time_ns())?;
             self.warn_quiet(unix_time_ns());
             let all_played = self.inputs.cameras.iter().all(|c| c.feed.ended());
@@ -231,7 +231,7 @@ impl Session<'_> {
     }
 
     /// Each robot's news: lines said, world models kept for pairing, camera frames recorded.
-    fn poll_robots(&mut self) -> anyhow::Result<()> {
+    fn poll_robots(&mut self) {
         for r in &mut self.inputs.robots {
             let inbox = r.feed.poll(self.start, self.start_unix_ns);
             for line in &inbox.lines {
@@ -268,7 +268,6 @@ impl Session<'_> {
                 }
             }
         }
-        Ok(())
     }
 
     /// Warns once about each robot that has sent nothing for a while.
@@ -306,7 +305,9 @@ impl Session<'_> {
     /// the middle between the previous field frame and this one); older ones are let go.
     fn paired(&mut self, t: u64, period: u64) -> Vec<ArrivedModel> {
         let half = period / 2;
-        let after = self.last_field_ns.map_or(0, |p| p + t.saturating_sub(p) / 2);
+        let after = self
+            .last_field_ns
+            .map_or(0, |p| p + t.saturating_sub(p) / 2);
         let mut paired = Vec::new();
         for (key, list) in &mut self.waiting {
             let mut best: Option<ArrivedModel> = None;
@@ -368,7 +369,9 @@ impl Session<'_> {
         let jumps: Vec<bool> = results.iter().map(|c| self.summaries.add(t, c)).collect();
         for (m, c) in arrived.iter().zip(&results) {
             let (offsets, errors) = self.clock.entry(m.message.robot).or_default();
-            offsets.push(i64::try_from(i128::from(m.arrival_ns) - i128::from(m.robot_ns)).unwrap_or(0));
+            offsets.push(
+                i64::try_from(i128::from(m.arrival_ns) - i128::from(m.robot_ns)).unwrap_or(0),
+            );
             errors.extend(c.position_error_cm);
         }
         let line = super::wmd::line_json(&frame, &results, &jumps)?;
@@ -410,7 +413,9 @@ impl Session<'_> {
         let made = self.make_field_frames(u64::MAX);
         for (key, n) in &self.unpaired {
             if *n > 0 {
-                log::info!("{key}: {n} world models arrived with no overhead frame within half a period");
+                log::info!(
+                    "{key}: {n} world models arrived with no overhead frame within half a period"
+                );
             }
         }
         for r in std::mem::take(&mut self.inputs.robots) {
@@ -419,14 +424,21 @@ impl Session<'_> {
             }
             r.feed.stop();
         }
-        let recorded = self.recorder.take().map(SessionRecorder::finish).transpose();
+        let recorded = self
+            .recorder
+            .take()
+            .map(SessionRecorder::finish)
+            .transpose();
         made?;
         recorded?;
         let offsets: Vec<(RobotKey, ClockOffset)> = self
             .clock
             .iter()
             .map(|(k, (offsets, errors))| {
-                (*k, arrival_offset(offsets, offsets.len(), crate::stats::median(errors)))
+                (
+                    *k,
+                    arrival_offset(offsets, offsets.len(), crate::stats::median(errors)),
+                )
             })
             .collect();
         let period_ns = self.period_ns();

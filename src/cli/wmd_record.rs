@@ -6,9 +6,9 @@
 //! `/camera/image` with each world model paired with it on `/world_model/TEAM-ID` (the message as
 //! the robot sent it) and the `--json` line on [`LINE_TOPIC`]; every other overhead camera's frame
 //! on `/overhead/camera<ID>` (its own time); the field as a `foxglove.SceneUpdate` on
-//! [`SCENE_TOPIC`]. Each robot's camera frames, when it sends them, on `/robot/TEAM-ID` (or
-//! `/robot/N` for the N-th `--robot` before its world models name it), their recognition beside
-//! them when the session gives the robot a table. The stream's source is
+//! [`SCENE_TOPIC`]. Each live robot's camera frames, when it sends them, on `/robot/TEAM-ID` (a
+//! session's robot) or `/robot/N` (the N-th `--robot`), their recognition beside them when the
+//! session gives the robot a table. The stream's source is
 //! [`SESSION_SOURCE`]: `eotn wmd` reading it back takes the world models at their log times (the
 //! frames they were paired with), so a replay prints the same lines.
 
@@ -37,11 +37,7 @@ pub const SCENE_TOPIC: &str = "/wmd/scene";
 /// The topic of a robot's world models in a session recording.
 #[must_use]
 pub fn world_model_topic(key: RobotKey) -> String {
-    format!(
-        "/world_model/{}-{}",
-        key.team.name(),
-        key.identity.value()
-    )
+    format!("/world_model/{}-{}", key.team.name(), key.identity.value())
 }
 
 /// The image topic of an overhead camera in a session recording: the reference camera is the

@@ -131,9 +131,7 @@ pub fn world_models(
                         Some(_) => LANDMARK_HALF_VIEW_RAD,
                         None => std::f64::consts::FRAC_PI_2,
                     };
-                    let near = range.is_none_or(|(near, far)| {
-                        (near..=far).contains(&dx.hypot(dy))
-                    });
+                    let near = range.is_none_or(|(near, far)| (near..=far).contains(&dx.hypot(dy)));
                     (bearing.abs() <= half_view && near).then(|| {
                         let d = dx.hypot(dy);
                         Seen {

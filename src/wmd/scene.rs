@@ -42,7 +42,6 @@ fn cm(v: f64) -> f64 {
 
 fn timestamp(time_ns: u64) -> Timestamp {
     let sec = u32::try_from(time_ns / 1_000_000_000).unwrap_or(u32::MAX);
-    #[expect(clippy::cast_possible_truncation, reason = "below 1e9")]
     let nsec = (time_ns % 1_000_000_000) as u32;
     Timestamp::new(sec, nsec)
 }
@@ -315,10 +314,7 @@ mod tests {
         let comparisons = compare(&view, &[&model], &Targets::from_field(&field));
         let s = scene_update(2_500_000_000, &field, &view, &[&model], &comparisons);
         let ids: Vec<&str> = s.entities.iter().map(|e| e.id.as_str()).collect();
-        assert_eq!(
-            ids,
-            ["field", "ball", "robot/blue/3", "world_model/blue/3"]
-        );
+        assert_eq!(ids, ["field", "ball", "robot/blue/3", "world_model/blue/3"]);
         assert!(s.entities.iter().all(|e| e.frame_id == SCENE_FRAME_ID));
         let stamp = s.entities[1].timestamp.expect("stamped");
         assert_eq!((stamp.sec(), stamp.nsec()), (2, 500_000_000));
@@ -329,7 +325,10 @@ mod tests {
         let ball = ball.expect("placed");
         assert!((ball.x - 1.0).abs() < 1e-12 && (ball.y + 0.5).abs() < 1e-12);
         let robot = &s.entities[2];
-        let q = robot.arrows[0].pose.and_then(|p| p.orientation).expect("turned");
+        let q = robot.arrows[0]
+            .pose
+            .and_then(|p| p.orientation)
+            .expect("turned");
         // A quarter turn about z.
         assert!((q.z - q.w).abs() < 1e-12 && q.z > 0.0);
         assert_eq!(robot.texts[0].text, "blue 3");

@@ -465,7 +465,11 @@ fn session_file(robot1: &Path, extra_camera_keys: &str, field: &str) -> PathBuf 
 fn a_session_file_merges_its_cameras_and_reads_each_robots_own_world_models() {
     let own = robot_recording("own1.mcap", 1, Some, |_, _| {});
     let cal = fixture().cal.display().to_string();
-    let session = session_file(&own, &format!(r#", "intrinsics": "{cal}""#), "four-legged-2005");
+    let session = session_file(
+        &own,
+        &format!(r#", "intrinsics": "{cal}""#),
+        "four-legged-2005",
+    );
     let out = eotn_ok(&[
         OsStr::new("wmd"),
         OsStr::new("--session"),
@@ -474,8 +478,14 @@ fn a_session_file_merges_its_cameras_and_reads_each_robots_own_world_models() {
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     // Keys the command does not use are said, never ignored silently.
-    assert!(stderr.contains("overhead[1] (id 3): intrinsics"), "{stderr}");
-    assert!(stderr.contains("robots[1]") && stderr.contains("lut not used"), "{stderr}");
+    assert!(
+        stderr.contains("overhead[1] (id 3): intrinsics"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("robots[1]") && stderr.contains("lut not used"),
+        "{stderr}"
+    );
     let lines: Vec<Value> = String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
@@ -579,7 +589,10 @@ fn a_recorded_session_replays_to_the_same_lines_and_shows_in_foxglove_and_the_ap
     // carries the world models the field model compares.
     let mut r = StreamReader::open(&out_path).unwrap();
     assert!(r.info().source.contains("overhead"), "{:?}", r.info());
-    assert_eq!(r.camera_files().unwrap().lut.as_deref(), Some(f.table.as_path()));
+    assert_eq!(
+        r.camera_files().unwrap().lut.as_deref(),
+        Some(f.table.as_path())
+    );
     let rec = r.read(20).unwrap();
     let lut = eotn::lut::LookupTable::load(&f.table).unwrap();
     let cal = eotn::overhead::calibration::Calibration::load(&f.cal).unwrap();
@@ -608,7 +621,11 @@ fn a_recorded_session_replays_to_the_same_lines_and_shows_in_foxglove_and_the_ap
         .arg(&out_path)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let seen: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(seen["scenes"], 45);
     assert_eq!(seen["topics"]["/camera/image"], 45);
@@ -632,5 +649,8 @@ fn a_recorded_session_replays_to_the_same_lines_and_shows_in_foxglove_and_the_ap
     let topic = format!("/world_model/{}-{}", one.0, one.1);
     assert!(seen["topics"][&topic].as_u64().unwrap() >= 42, "{seen}");
     // The ball's sphere sits on the ground, in metres.
-    assert!((seen["ball_z"].as_f64().unwrap() - 0.0425).abs() < 1e-9, "{seen}");
+    assert!(
+        (seen["ball_z"].as_f64().unwrap() - 0.0425).abs() < 1e-9,
+        "{seen}"
+    );
 }

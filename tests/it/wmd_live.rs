@@ -4,7 +4,9 @@
 //! served frame's ground truth to them as it is sent, and each answers at once with its world
 //! model (the truth plus its error, stamped with its own clock). Robot 1 is 50 cm off, 10°
 //! turned, measures distances 10 % long and its clock runs 0.4 s ahead; robot 2 is −20° turned,
-//! stops sending after 45 world models and crashes half a second later.
+//! stops sending after 45 world models and crashes half a second later. The session is a
+//! session file: robot 1 sends its camera frames too, recorded into `-o` and recognised there with
+//! the table the session gives it.
 //!
 //! The served game stands still (its frame 20, four seconds of it): a live world model is paired
 //! by its arrival, and the relay through this test and Python can hold one up past half a frame
@@ -140,12 +142,19 @@ fn live_robots_are_matched_by_marker_with_their_known_errors_and_their_clocks_sh
             "1.1",
             "--clock-offset",
             "0.4",
+            "--image",
         ],
     );
     let (two_robot, two_in) = python_robot(
         &python,
         2,
-        &["--error=0,0,-20", "--stop-after", "45", "--exit-after", "0.5"],
+        &[
+            "--error=0,0,-20",
+            "--stop-after",
+            "45",
+            "--exit-after",
+            "0.5",
+        ],
     );
     // The relay: each frame's truth to both robots as `eotn serve` sends it.
     let inputs = Arc::new(Mutex::new(vec![one_in, two_in]));
@@ -170,19 +179,23 @@ fn live_robots_are_matched_by_marker_with_their_known_errors_and_their_clocks_sh
     .unwrap();
     let session = f.dir.path().join("live-session.mcap");
     let ws = |port: u16| format!("ws://127.0.0.1:{port}");
-    let (overhead, r1, r2) = (ws(served.port), ws(one_robot.port), ws(two_robot.port));
+    let (one, two) = (marker_of(1), marker_of(2));
+    let robot_table = crate::common::repo_file("lookup_tables/sim.lut");
+    let session_file = f.dir.path().join("live-session.json");
+    let json = serde_json::json!({
+        "field": "four-legged-2005",
+        "overhead": [{"id": 0, "source": ws(served.port), "lut": f.table, "calibration": f.cal}],
+        "robots": [
+            {"team": one.0, "robot_id": one.1, "source": ws(one_robot.port),
+             "camera": "/camera/image", "lut": robot_table},
+            {"team": two.0, "robot_id": two.1, "source": ws(two_robot.port)},
+        ],
+    });
+    std::fs::write(&session_file, json.to_string()).unwrap();
     let args: Vec<&OsStr> = [
         "wmd",
-        "--overhead",
-        &overhead,
-        "--robot",
-        &r1,
-        "--robot",
-        &r2,
-        "--lut",
-        f.table.to_str().unwrap(),
-        "--calibration",
-        f.cal.to_str().unwrap(),
+        "--session",
+        session_file.to_str().unwrap(),
         "--json",
         "--seconds",
         "4",
@@ -205,6 +218,13 @@ fn live_robots_are_matched_by_marker_with_their_known_errors_and_their_clocks_sh
     assert!(lines.len() >= 40, "{} field frames; {stderr}", lines.len());
     check_robot_one(&lines, &stderr);
     check_robot_two(&lines, &stderr);
+    // Robot 1's camera frames are in the recording as they came, recognised beside them.
+    let topics = topic_counts(&session);
+    let camera = format!("/robot/{}-{}", one.0, one.1);
+    let frames = topics.get(&camera).copied().unwrap_or(0);
+    assert!(frames >= 20, "{camera}: {frames} frames; {topics:?}");
+    assert_eq!(topics.get(&format!("{camera}/recognition")), Some(&frames));
+    assert_eq!(topics.get(&format!("/robot/{}-{}", two.0, two.1)), None);
     // The recording replays to the same lines.
     let again = eotn_ok(&[
         OsStr::new("wmd"),
@@ -228,6 +248,16 @@ fn live_robots_are_matched_by_marker_with_their_known_errors_and_their_clocks_sh
     }
 }
 
+/// Messages per topic of a recording, read with the `mcap` crate alone.
+fn topic_counts(path: &Path) -> std::collections::BTreeMap<String, usize> {
+    let bytes = std::fs::read(path).unwrap();
+    let mut counts = std::collections::BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        *counts.entry(m.unwrap().channel.topic.clone()).or_default() += 1;
+    }
+    counts
+}
+
 /// Robot 1: matched by marker with its known errors wherever the overhead camera reads its
 /// marker and its world model came in time; its clock 0.4 s ahead, shown.
 fn check_robot_one(lines: &[Value], stderr: &str) {
@@ -247,7 +277,8 @@ fn check_robot_one(lines: &[Value], stderr: &str) {
         let h = m["heading_error_deg"].as_f64().unwrap();
         assert!((h - 10.0).abs() < 4.0, "{m}");
         for x in m["measurements"].as_array().unwrap() {
-            if let (Some(measured), Some(truth)) = (x["measured_cm"].as_f64(), x["true_cm"].as_f64())
+            if let (Some(measured), Some(truth)) =
+                (x["measured_cm"].as_f64(), x["true_cm"].as_f64())
                 && truth > 50.0
             {
                 assert!((measured / truth - 1.1).abs() < 0.05, "{x}");
@@ -304,5 +335,8 @@ fn check_robot_two(lines: &[Value], stderr: &str) {
         "{stderr}"
     );
     assert!(stderr.contains("disconnected"), "{stderr}");
-    assert!(stderr.contains(&format!("{key}: no world model after")), "{stderr}");
+    assert!(
+        stderr.contains(&format!("{key}: no world model after")),
+        "{stderr}"
+    );
 }

@@ -8,7 +8,9 @@ ball, its distance to the ball times `--distance-scale`, stamped with its own cl
 (`time_ns` = this machine's clock + `--clock-offset` seconds). After `--stop-after` world models it
 stays connected but sends nothing more; `--exit-after` seconds after that it ends abruptly (its
 connection drops without a close), as a robot that crashes would. It ends when its input does.
-Nothing is sent (or counted) before a viewer subscribes.
+Nothing is sent (or counted) before a viewer subscribes. With `--image` it also sends a 64x48
+UYVY camera frame (foxglove.RawImage on /camera/image) with each world model, byte k of the
+n-th (k + 3 n) mod 256.
 """
 
 import argparse
@@ -20,6 +22,8 @@ import threading
 import time
 
 import foxglove
+from foxglove.channels import RawImageChannel
+from foxglove.messages import RawImage, Timestamp
 
 
 class Viewer(foxglove.ServerListener):
@@ -43,12 +47,14 @@ def main():
     ap.add_argument("--clock-offset", type=float, default=0.0, help="seconds its clock is ahead")
     ap.add_argument("--stop-after", type=int, default=0, help="world models, then silence (0: never)")
     ap.add_argument("--exit-after", type=float, default=0.0, help="seconds of silence, then exit")
+    ap.add_argument("--image", action="store_true", help="a camera frame with each world model")
     args = ap.parse_args()
     dx, dy, dh = (float(v) for v in args.error.split(","))
     viewer = Viewer()
     server = foxglove.start_server(name=f"python-robot-{args.robot}", host="127.0.0.1",
                                    port=args.port, server_listener=viewer)
     channel = foxglove.Channel("/world_model", message_encoding="json")
+    images = RawImageChannel(topic="/camera/image") if args.image else None
     print("ready", flush=True)
     sent = 0
     for line in sys.stdin:
@@ -75,6 +81,12 @@ def main():
             model["seen"] = [{"object": "ball", "distance_cm": math.hypot(bx, by) * args.distance_scale,
                               "bearing_rad": bearing}]
         channel.log(json.dumps(model).encode())
+        if images is not None:
+            now = time.time_ns()
+            data = bytes((k + 3 * sent) % 256 for k in range(64 * 48 * 2))
+            images.log(RawImage(timestamp=Timestamp(sec=now // 10**9, nsec=now % 10**9),
+                                frame_id="camera", width=64, height=48, encoding="uyvy",
+                                step=128, data=data))
         sent += 1
         if args.stop_after and sent >= args.stop_after and args.exit_after:
             threading.Timer(args.exit_after, os._exit, args=(0,)).start()
