@@ -15,7 +15,7 @@ SECONDS_PER_TARGET=${1:-60}
 shift || true
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked --version 0.13.2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol serve_viewer_messages lookup_tables bhuman_log text_files mcap_stream frame_files field_files app_files ros2_messages image_encodings rosbag2 label_sets)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol serve_viewer_messages lookup_tables bhuman_log text_files mcap_stream frame_files field_files app_files ros2_messages image_encodings rosbag2 label_sets wmd_inputs)
 
 # Seeds: a real input or two of each kind, copied into a temporary corpus so fuzz/ stays clean
 # (inputs up to 1 MiB: -max_len below).
@@ -37,6 +37,7 @@ seed app_files tests/data/journal-seed.jsonl tests/data/settings-seed.json
 seed rosbag2 fuzz/seeds/rosbag2/*
 seed ros2_messages fuzz/seeds/ros2_messages/*
 seed image_encodings fuzz/seeds/image_encodings/*
+seed wmd_inputs fuzz/seeds/wmd_inputs/*
 seed label_sets fuzz/seeds/label_sets/*
 for t in "${TARGETS[@]}"; do
   mkdir -p "$WORK/$t"

@@ -46,7 +46,10 @@ mod sim_field;
 mod sources;
 pub mod values;
 mod wmd;
+mod wmd_feeds;
 mod wmd_inputs;
+mod wmd_live;
+mod wmd_record;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

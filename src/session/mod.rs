@@ -20,6 +20,7 @@ use thiserror::Error;
 use crate::geometry::{MarkerIdentity, MarkerTeam};
 use crate::input_file::{MAX_SMALL_FILE_BYTES, read_text_bounded};
 use crate::overhead::FieldDescription;
+use crate::overhead::field::{SHIPPED_FIELDS, shipped_field_names};
 
 pub use crate::overhead::merge::SslCameraId;
 
@@ -56,21 +57,10 @@ impl SessionSource {
 pub enum FieldRef {
     /// A field description file, resolved against the session file's folder.
     File(PathBuf),
-    /// A field description shipped with eotn, by name ([`SHIPPED_FIELDS`]).
-    Shipped(&'static str),
+    /// A field description shipped with eotn, by name (the names `--field` takes:
+    /// [`crate::overhead::field::SHIPPED_FIELDS`]).
+    Shipped(String),
 }
-
-/// The field descriptions shipped with eotn (`params/fields/NAME.json`), by name.
-pub const SHIPPED_FIELDS: [(&str, &str); 2] = [
-    (
-        "four-legged-2005",
-        include_str!("../../params/fields/four-legged-2005.json"),
-    ),
-    (
-        "ssl-2008",
-        include_str!("../../params/fields/ssl-2008.json"),
-    ),
-];
 
 impl FieldRef {
     /// The field description.
@@ -80,15 +70,7 @@ impl FieldRef {
     pub fn load(&self) -> anyhow::Result<FieldDescription> {
         match self {
             Self::File(p) => Ok(FieldDescription::load(p)?),
-            Self::Shipped(name) => {
-                let text = SHIPPED_FIELDS
-                    .iter()
-                    .find(|(n, _)| n == name)
-                    .map(|(_, t)| *t)
-                    .ok_or_else(|| anyhow::anyhow!("no shipped field {name:?}"))?;
-                Ok(FieldDescription::from_json(text)
-                    .map_err(|e| anyhow::anyhow!("shipped field {name}: {e}"))?)
-            }
+            Self::Shipped(name) => Ok(FieldDescription::resolve(name)?),
         }
     }
 }
@@ -321,17 +303,16 @@ struct Resolver<'a> {
 impl Resolver<'_> {
     fn field(&self, name: &str) -> Result<FieldRef, String> {
         if let Some((n, _)) = SHIPPED_FIELDS.iter().find(|(n, _)| *n == name) {
-            return Ok(FieldRef::Shipped(n));
+            return Ok(FieldRef::Shipped((*n).to_owned()));
         }
         let p = self.base.join(name);
         if p.is_file() {
             return Ok(FieldRef::File(p));
         }
-        let shipped: Vec<&str> = SHIPPED_FIELDS.iter().map(|(n, _)| *n).collect();
         Err(format!(
             "{}: no such field file, and {name:?} is not a shipped field ({})",
             p.display(),
-            shipped.join(", ")
+            shipped_field_names()
         ))
     }
 

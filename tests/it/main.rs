@@ -63,3 +63,4 @@ mod viewers;
 mod window;
 mod without_readings;
 mod wmd;
+mod wmd_live;
