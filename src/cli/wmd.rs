@@ -274,8 +274,8 @@ fn recorded_cameras(
 /// Each camera's frame of a field frame read again (for the recording), by its time.
 fn read_frames(
     cameras: &mut [FieldCamera],
-    wanted: &[(CameraId, u64)],
-) -> anyhow::Result<Vec<(CameraId, u64, crate::frame::Frame)>> {
+    wanted: &[(SslCameraId, u64)],
+) -> anyhow::Result<Vec<(SslCameraId, u64, crate::frame::Frame)>> {
     let mut out = Vec::new();
     for &(id, time_ns) in wanted {
         let Some(cam) = cameras.iter_mut().find(|c| c.id == id) else {

@@ -300,7 +300,12 @@ fn open_live_args(a: &super::wmd::Args, record: bool) -> anyhow::Result<LiveOpen
         super::overhead::params_for(&field),
     );
     let source = SessionSource::parse_arg(overhead);
-    let cameras = vec![live_camera(CameraId(0), &source, a.camera.get(), pipeline)?];
+    let cameras = vec![live_camera(
+        SslCameraId(0),
+        &source,
+        a.camera.get(),
+        pipeline,
+    )?];
     let mut robots = Vec::new();
     for (i, p) in a.robot.iter().enumerate() {
         let wants = super::wmd_feeds::RobotWants {
@@ -409,7 +414,7 @@ fn robot_pipeline(e: &crate::session::RobotEntry) -> anyhow::Result<crate::pipel
 
 /// An overhead camera's feed.
 fn live_camera(
-    id: CameraId,
+    id: SslCameraId,
     source: &SessionSource,
     topic: Option<&str>,
     pipeline: crate::overhead::OverheadPipeline,

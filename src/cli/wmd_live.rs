@@ -22,7 +22,7 @@ use super::wmd_record::{CameraFrame, SessionRecorder};
 use crate::frame::Frame;
 use crate::live::unix_time_ns;
 use crate::model::world_model::RobotKey;
-use crate::overhead::merge::{CameraId, frame_near, merge_detections};
+use crate::overhead::merge::{SslCameraId, frame_near, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::overhead::{FieldDescription, OverheadPipeline};
 use crate::wmd::clock::{ClockOffset, DEFAULT_PERIOD_NS, arrival_offset, frame_period_ns};
@@ -40,7 +40,7 @@ const PERIOD_WINDOW: usize = 31;
 #[derive(Debug)]
 pub struct LiveCamera {
     /// Its session id.
-    pub id: CameraId,
+    pub id: SslCameraId,
     /// Its name in messages (the source).
     pub name: String,
     /// Its pipeline.
@@ -343,19 +343,19 @@ impl Session<'_> {
         self.last_field_ns = Some(t);
         let mut views = vec![(self.camera_id(0), reference.detections.clone())];
         let mut frames = vec![(self.camera_id(0), t)];
-        let mut used: Vec<(CameraId, u64, Option<&Frame>)> = Vec::new();
+        let mut used: Vec<(SslCameraId, u64, Option<&Frame>)> = Vec::new();
         for (k, recent) in self.recent.iter().enumerate().skip(1) {
             let times: Vec<u64> = recent.iter().map(|s| s.time_ns).collect();
             if let Some(seen) = frame_near(&times, t, period).and_then(|i| recent.get(i))
                 && seen.time_ns.abs_diff(t) <= half
             {
-                let id = self.inputs.cameras.get(k).map_or(CameraId(0), |c| c.id);
+                let id = self.inputs.cameras.get(k).map_or(SslCameraId(0), |c| c.id);
                 views.push((id, seen.detections.clone()));
                 frames.push((id, seen.time_ns));
                 used.push((id, seen.time_ns, seen.frame.as_ref()));
             }
         }
-        let refs: Vec<(CameraId, &OverheadDetections)> =
+        let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let frame = FieldFrame {
             time_ns: t,
@@ -386,7 +386,7 @@ impl Session<'_> {
             let mut cameras = Vec::new();
             if let Some(f) = &reference.frame {
                 cameras.push(CameraFrame {
-                    id: self.inputs.cameras.first().map_or(CameraId(0), |c| c.id),
+                    id: self.inputs.cameras.first().map_or(SslCameraId(0), |c| c.id),
                     time_ns: t,
                     frame: f,
                 });
@@ -403,8 +403,8 @@ impl Session<'_> {
         Ok(())
     }
 
-    fn camera_id(&self, k: usize) -> CameraId {
-        self.inputs.cameras.get(k).map_or(CameraId(0), |c| c.id)
+    fn camera_id(&self, k: usize) -> SslCameraId {
+        self.inputs.cameras.get(k).map_or(SslCameraId(0), |c| c.id)
     }
 
     /// Makes the last field frames, stops the robots, finishes the recording; the session's

@@ -22,7 +22,7 @@ use crate::camera::CameraFiles;
 use crate::formats::ImageMessage;
 use crate::frame::Frame;
 use crate::model::world_model::{RobotKey, WorldModelMessage};
-use crate::overhead::merge::CameraId;
+use crate::overhead::merge::SslCameraId;
 use crate::pipeline::Pipeline;
 use crate::streams::{FrameRecord, IMAGE_TOPIC, RawChannelSpec, StreamInfo, StreamWriter};
 
@@ -43,7 +43,7 @@ pub fn world_model_topic(key: RobotKey) -> String {
 /// The image topic of an overhead camera in a session recording: the reference camera is the
 /// stream's first camera.
 #[must_use]
-pub fn overhead_topic(id: CameraId, reference: bool) -> String {
+pub fn overhead_topic(id: SslCameraId, reference: bool) -> String {
     if reference {
         IMAGE_TOPIC.to_owned()
     } else {
@@ -55,7 +55,7 @@ pub fn overhead_topic(id: CameraId, reference: bool) -> String {
 #[derive(Debug, Clone)]
 pub struct RecordedCamera {
     /// Its session id.
-    pub id: CameraId,
+    pub id: SslCameraId,
     /// Its table and calibration (named in the recording's `eotn.camera` metadata, so the app
     /// opens the stream with them).
     pub files: CameraFiles,
@@ -65,7 +65,7 @@ pub struct RecordedCamera {
 #[derive(Debug, Clone, Copy)]
 pub struct CameraFrame<'a> {
     /// Which camera.
-    pub id: CameraId,
+    pub id: SslCameraId,
     /// Its time, nanoseconds.
     pub time_ns: u64,
     /// The frame.
@@ -84,7 +84,7 @@ struct RobotFrame {
 pub struct SessionRecorder {
     writer: StreamWriter,
     path: PathBuf,
-    reference: CameraId,
+    reference: SslCameraId,
     scene: RawChannelSpec,
     /// Robot frames not yet written: each goes in before the first field frame after it.
     robot_frames: Vec<RobotFrame>,
@@ -116,7 +116,7 @@ impl SessionRecorder {
                 .to_owned(),
         };
         let mut writer = StreamWriter::create(path, &info)?;
-        let reference = cameras.first().map_or(CameraId(0), |c| c.id);
+        let reference = cameras.first().map_or(SslCameraId(0), |c| c.id);
         for (i, c) in cameras.iter().enumerate() {
             if !c.files.is_empty() {
                 writer.name_camera_files(&overhead_topic(c.id, i == 0), &c.files)?;
