@@ -87,6 +87,14 @@ pub struct Args {
     /// Overhead streams: the field description (ball radius, plate height).
     #[arg(long)]
     pub field: Option<PathBuf>,
+    /// Overhead streams: take ssl-vision's detections of the same field as the truth, from a
+    /// league log file (`SSL_LOG_FILE`, plain or `.gz`) or live from `udp://GROUP:PORT`
+    /// (listened to until the packets stop): each stream frame is paired with every camera's
+    /// frame of nearest capture time within half a frame period, and scored as against the
+    /// simulator's truth (ball and robot position and heading errors, identities, misses,
+    /// false robots).
+    #[arg(long, value_name = "LOG_OR_UDP")]
+    pub truth_ssl: Option<PathBuf>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -394,11 +402,31 @@ fn calibrate_goals(
     Ok((m, o))
 }
 
+/// The streams among `args.streams` whose source kind is not an overhead camera's.
+fn robot_camera_streams(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
+    let inputs = super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
+    Ok(inputs.robot_streams().to_vec())
+}
+
 /// Runs `eotn eval`.
 ///
 /// # Errors
 /// Unreadable inputs or streams without ground truth, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if let Some(source) = &args.truth_ssl {
+        super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
+            .context("--truth-ssl is the truth of overhead streams")?;
+        let truth = super::eval_overhead::load_ssl_truth(source)?;
+        return super::eval_overhead::run(
+            &args.streams,
+            args.camera.get(),
+            &args.lut,
+            args.calibration.as_deref(),
+            args.field.as_deref(),
+            &truth,
+            args.json,
+        );
+    }
     let overhead = args
         .streams
         .iter()
@@ -411,6 +439,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             &args.lut,
             args.calibration.as_deref(),
             args.field.as_deref(),
+            &super::eval_overhead::TruthSource::Stream,
             args.json,
         );
     } else if overhead > 0 {

@@ -29,7 +29,9 @@ impl Workspace {
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default();
-            let opened = if crate::streams::is_recording(&p) {
+            let opened = if is_ssl_source(&p, &ext) {
+                self.open_ssl(&p)
+            } else if crate::streams::is_recording(&p) {
                 streams.push(p);
                 Ok(())
             } else if ext == "json" {
@@ -264,6 +266,7 @@ impl Workspace {
         };
         self.frame_generation += 1;
         self.sync_beside();
+        self.sync_ssl();
         Ok(())
     }
 
@@ -296,6 +299,15 @@ impl Workspace {
             self.sensor_series.points.push((t, r));
         }
     }
+}
+
+/// An SSL-Vision source given to Open: `udp://…`, or a `.log` (`.log.gz`) file (a B-Human log
+/// of the same name is told apart when read, and pointed to its importer).
+fn is_ssl_source(p: &std::path::Path, ext: &str) -> bool {
+    let text = p.to_string_lossy();
+    crate::ssl_vision::listener::is_udp_url(&text)
+        || ext == "log"
+        || (ext == "gz" && text.to_ascii_lowercase().ends_with(".log.gz"))
 }
 
 #[cfg(test)]

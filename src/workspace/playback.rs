@@ -47,6 +47,7 @@ impl Workspace {
     pub fn tick(&mut self, dt: Duration) {
         self.poll_live();
         self.poll_robots();
+        self.poll_ssl();
         self.scan_sensor_series();
         if let (Some(t), Some(src)) = (self.try_edit.as_mut(), self.source.as_mut()) {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
