@@ -283,20 +283,30 @@ fn ssl_feed_ui(
     ui.horizontal_wrapped(|ui| {
         ui.label(line);
         for f in shown {
-            ui.colored_label(ssl_camera_colour(f.camera_id), format!("■ camera {}", f.camera_id));
+            ui.colored_label(
+                ssl_camera_colour(f.camera_id),
+                format!("■ camera {}", f.camera_id),
+            );
         }
         if shown.is_empty() {
             let span = feed.span_ns().map_or_else(String::new, |(a, b)| {
-                format!(" (its frames span {:.3}–{:.3} s)", a as f64 * 1e-9, b as f64 * 1e-9)
+                format!(
+                    " (its frames span {:.3}–{:.3} s)",
+                    a as f64 * 1e-9,
+                    b as f64 * 1e-9
+                )
             });
-            ui.label(format!("no ssl-vision frame within half a frame period of this time{span}"));
+            ui.label(format!(
+                "no ssl-vision frame within half a frame period of this time{span}"
+            ));
         }
     });
     let (steps, step) = feed.steps();
     if state.source().is_none() && !feed.is_live() && steps > 1 {
         let mut chosen = step;
         let t = shown.first().map_or(0.0, |f| f.t_capture_s);
-        let slider = egui::Slider::new(&mut chosen, 0..=steps - 1).text(format!("ssl-vision step ({t:.3} s)"));
+        let slider = egui::Slider::new(&mut chosen, 0..=steps - 1)
+            .text(format!("ssl-vision step ({t:.3} s)"));
         if ui.add(slider).changed() {
             commands.push(Command::ShowSslStep(chosen));
         }
@@ -305,7 +315,11 @@ fn ssl_feed_ui(
 
 /// SSL-Vision's detections, each camera's in its own colour: robots as squares filled with
 /// their team's colour, with a heading tick and the id; balls as diamonds.
-fn paint_ssl(painter: &egui::Painter, xf: &FieldTransform, frames: &[crate::ssl_vision::CameraFrame]) {
+fn paint_ssl(
+    painter: &egui::Painter,
+    xf: &FieldTransform,
+    frames: &[crate::ssl_vision::CameraFrame],
+) {
     let half = (ROBOT_RADIUS_CM * xf.scale()).max(4.0) * 0.8;
     for f in frames {
         let colour = ssl_camera_colour(f.camera_id);
@@ -332,7 +346,12 @@ fn paint_ssl(painter: &egui::Painter, xf: &FieldTransform, frames: &[crate::ssl_
         for b in &f.balls {
             let c = xf.to_screen(b.field_cm);
             let d = (4.25 * xf.scale()).max(3.0) * 1.6;
-            let diamond = vec![c + vec2(0.0, -d), c + vec2(d, 0.0), c + vec2(0.0, d), c + vec2(-d, 0.0)];
+            let diamond = vec![
+                c + vec2(0.0, -d),
+                c + vec2(d, 0.0),
+                c + vec2(0.0, d),
+                c + vec2(-d, 0.0),
+            ];
             painter.add(egui::Shape::closed_line(diamond, stroke));
         }
     }

@@ -4,7 +4,7 @@
 //! relation to the truth and writes it as recognition parameters. `--labels` scores a real
 //! stream against hand labels instead (`eval_labels.rs`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use serde::Serialize;
@@ -402,9 +402,27 @@ fn calibrate_goals(
     Ok((m, o))
 }
 
+/// `eotn eval OVERHEAD… --truth-ssl LOG|udp://…`: the overhead streams against ssl-vision's
+/// detections.
+fn run_truth_ssl(args: &Args, source: &Path) -> anyhow::Result<()> {
+    super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
+        .context("--truth-ssl is the truth of overhead streams")?;
+    let truth = super::eval_overhead::load_ssl_truth(source)?;
+    super::eval_overhead::run(
+        &args.streams,
+        args.camera.get(),
+        &args.lut,
+        args.calibration.as_deref(),
+        args.field.as_deref(),
+        &truth,
+        args.json,
+    )
+}
+
 /// The streams among `args.streams` whose source kind is not an overhead camera's.
 fn robot_camera_streams(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
-    let inputs = super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
+    let inputs =
+        super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
     Ok(inputs.robot_streams().to_vec())
 }
 
@@ -414,18 +432,7 @@ fn robot_camera_streams(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
 /// Unreadable inputs or streams without ground truth, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(source) = &args.truth_ssl {
-        super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
-            .context("--truth-ssl is the truth of overhead streams")?;
-        let truth = super::eval_overhead::load_ssl_truth(source)?;
-        return super::eval_overhead::run(
-            &args.streams,
-            args.camera.get(),
-            &args.lut,
-            args.calibration.as_deref(),
-            args.field.as_deref(),
-            &truth,
-            args.json,
-        );
+        return run_truth_ssl(args, source);
     }
     let overhead = args
         .streams

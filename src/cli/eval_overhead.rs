@@ -69,7 +69,9 @@ pub fn run(
     for path in streams {
         let mut reader = StreamReader::open_camera(path, camera)?;
         let name = crate::frame::display_name(path);
-        let times: Vec<u64> = (0..reader.len()).filter_map(|i| reader.time_ns(i)).collect();
+        let times: Vec<u64> = (0..reader.len())
+            .filter_map(|i| reader.time_ns(i))
+            .collect();
         let period_ns = crate::wmd::clock::frame_period_ns(&times);
         let mut pipeline: Option<OverheadPipeline> = None;
         let bar = super::inputs::progress(reader.len(), "eval overhead");
@@ -89,9 +91,7 @@ pub fn run(
                     .map(|p| *p.camera())
                     .or_else(|| own.as_ref().ok().map(|t| t.camera))
             }) else {
-                bail!(
-                    "{name}: no --calibration and no overhead truth to take the camera from"
-                );
+                bail!("{name}: no --calibration and no overhead truth to take the camera from");
             };
             let truth = match truth {
                 TruthSource::Stream => own,
@@ -253,7 +253,9 @@ fn listen_for_truth(url: &str) -> anyhow::Result<Vec<crate::ssl_vision::CameraFr
             }
             Some(Received::Bad { from, why }) => {
                 if bad == 0 {
-                    log::warn!("{url}: a packet from {from} is not SSL-Vision: {why} (skipped; said once)");
+                    log::warn!(
+                        "{url}: a packet from {from} is not SSL-Vision: {why} (skipped; said once)"
+                    );
                 }
                 bad += 1;
             }
@@ -269,7 +271,11 @@ fn listen_for_truth(url: &str) -> anyhow::Result<Vec<crate::ssl_vision::CameraFr
     eprintln!(
         "{url}: {} detection frames received{}{}",
         frames.len(),
-        if bad > 0 { format!(", {bad} packets not SSL-Vision") } else { String::new() },
+        if bad > 0 {
+            format!(", {bad} packets not SSL-Vision")
+        } else {
+            String::new()
+        },
         match listener.dropped() {
             0 => String::new(),
             n => format!(", {n} dropped (eotn fell behind)"),
@@ -286,7 +292,9 @@ fn report(
 ) -> anyhow::Result<()> {
     if c.frames.is_empty() {
         match truth {
-            TruthSource::Stream => bail!("no frame with overhead ground truth in the given streams"),
+            TruthSource::Stream => {
+                bail!("no frame with overhead ground truth in the given streams")
+            }
             TruthSource::Ssl { name, .. } => bail!(
                 "no frame of the streams has an SSL-Vision frame of {name} within half a frame period (first skipped: {})",
                 c.skipped.first().map_or("none", String::as_str)

@@ -45,7 +45,10 @@ impl SslOut {
                 c.fit.rms_px,
                 c.fit.max_px,
                 if c.fit.skipped > 0 {
-                    format!(" ({} grid pixels where the lens folds over left out)", c.fit.skipped)
+                    format!(
+                        " ({} grid pixels where the lens folds over left out)",
+                        c.fit.skipped
+                    )
                 } else {
                     String::new()
                 }

@@ -80,7 +80,9 @@ fn mm(cm: f64) -> f32 {
 }
 
 fn mm_i32(cm: f64) -> i32 {
-    (cm * 10.0).round().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32
+    (cm * 10.0)
+        .round()
+        .clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32
 }
 
 /// The field's size and markings (see the module documentation for what is derived).
@@ -205,11 +207,18 @@ pub fn field_description(f: &SslGeometryFieldSize) -> FieldDescription {
             }
         })
         .collect();
-    let (hl, hw) = (f64::from(f.field_length) / 20.0, f64::from(f.field_width) / 20.0);
+    let (hl, hw) = (
+        f64::from(f.field_length) / 20.0,
+        f64::from(f.field_width) / 20.0,
+    );
     let landmarks = [(1.0, 1.0), (1.0, -1.0), (-1.0, -1.0), (-1.0, 1.0)]
         .iter()
         .map(|&(sx, sy)| Landmark {
-            name: format!("{} {} corner", if sx > 0.0 { "+x" } else { "-x" }, if sy > 0.0 { "left" } else { "right" }),
+            name: format!(
+                "{} {} corner",
+                if sx > 0.0 { "+x" } else { "-x" },
+                if sy > 0.0 { "left" } else { "right" }
+            ),
             field_cm: [sx * hl, sy * hw],
             height_cm: 0.0,
         })
@@ -233,7 +242,12 @@ pub fn field_description(f: &SslGeometryFieldSize) -> FieldDescription {
 }
 
 /// What a line is, by where it lies: along a border, across the middle, along the x axis.
-fn line_shape(a: [f64; 2], b: [f64; 2], half_length: f64, half_width: f64) -> Option<FieldShapeType> {
+fn line_shape(
+    a: [f64; 2],
+    b: [f64; 2],
+    half_length: f64,
+    half_width: f64,
+) -> Option<FieldShapeType> {
     let near = |v: f64, w: f64| (v - w).abs() < 0.5;
     let spans = |u: f64, v: f64, half: f64| near(u.min(v), -half) && near(u.max(v), half);
     if near(a[1], b[1]) && spans(a[0], b[0], half_length) {
@@ -329,7 +343,10 @@ pub fn ssl_image_from_field(c: &SslGeometryCameraCalibration, p_mm: [f64; 3]) ->
             pc.x / pc.z,
             pc.y / pc.z,
             f64::from(c.focal_length),
-            [f64::from(c.principal_point_x), f64::from(c.principal_point_y)],
+            [
+                f64::from(c.principal_point_x),
+                f64::from(c.principal_point_y),
+            ],
             f64::from(c.distortion),
         )
     })
@@ -363,10 +380,9 @@ fn grid_rays(camera: &OverheadCamera) -> (Vec<GridRay>, usize) {
                 (pixel[1] - camera.centre.y_px) / camera.focal_y(),
             );
             match camera.undistort(d.0, d.1) {
-                Some((u, v)) if u.is_finite() && v.is_finite() => rays.push(GridRay {
-                    pixel,
-                    ray: [u, v],
-                }),
+                Some((u, v)) if u.is_finite() && v.is_finite() => {
+                    rays.push(GridRay { pixel, ray: [u, v] })
+                }
                 _ => skipped += 1,
             }
         }
@@ -490,10 +506,18 @@ mod tests {
     fn the_field_size_comes_from_the_lines_and_posts() {
         let field = FieldDescription::resolve("ssl-div-b").expect("shipped");
         let f = field_size(&field);
-        assert_eq!((f.field_length, f.field_width, f.goal_width), (9000, 6000, 1000));
+        assert_eq!(
+            (f.field_length, f.field_width, f.goal_width),
+            (9000, 6000, 1000)
+        );
         assert_eq!(f.center_circle_radius, Some(500));
         let names: Vec<&str> = f.field_lines.iter().map(|l| l.name.as_str()).collect();
-        for n in ["TopTouchLine", "BottomTouchLine", "LeftGoalLine", "RightGoalLine"] {
+        for n in [
+            "TopTouchLine",
+            "BottomTouchLine",
+            "LeftGoalLine",
+            "RightGoalLine",
+        ] {
             assert!(names.contains(&n), "{names:?}");
         }
         assert_eq!(distorted_radius(0.5, 0.0), 0.5);

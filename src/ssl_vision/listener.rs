@@ -48,7 +48,10 @@ pub enum Received {
 #[derive(Debug, thiserror::Error)]
 pub enum ListenError {
     /// Not `udp://HOST:PORT`.
-    #[error("{given}: not an SSL-Vision address (udp://GROUP:PORT, e.g. udp://{})", super::LEAGUE_ADDRESS)]
+    #[error(
+        "{given}: not an SSL-Vision address (udp://GROUP:PORT, e.g. udp://{})",
+        super::LEAGUE_ADDRESS
+    )]
     Address {
         /// What was given.
         given: String,
@@ -315,7 +318,9 @@ mod tests {
             geometry: None,
         }
         .encode_to_vec();
-        sender.send_to(&[0xff, 0xff], ("127.0.0.1", port)).expect("send");
+        sender
+            .send_to(&[0xff, 0xff], ("127.0.0.1", port))
+            .expect("send");
         sender.send_to(&good, ("127.0.0.1", port)).expect("send");
         let first = listener.next_timeout(Duration::from_secs(5)).expect("one");
         assert!(matches!(first, Received::Bad { .. }), "{first:?}");

@@ -194,9 +194,13 @@ impl<R: Read> LogReader<R> {
         let receiver_ns = i64::from_be_bytes([
             head[0], head[1], head[2], head[3], head[4], head[5], head[6], head[7],
         ]);
-        let kind = MessageType::from_code(i32::from_be_bytes([head[8], head[9], head[10], head[11]]));
+        let kind =
+            MessageType::from_code(i32::from_be_bytes([head[8], head[9], head[10], head[11]]));
         let size = i32::from_be_bytes([head[12], head[13], head[14], head[15]]);
-        let Some(size) = usize::try_from(size).ok().filter(|s| *s <= MAX_MESSAGE_BYTES) else {
+        let Some(size) = usize::try_from(size)
+            .ok()
+            .filter(|s| *s <= MAX_MESSAGE_BYTES)
+        else {
             self.cut_off = Some(format!(
                 "a message at byte {at} claims {size} bytes (at most {MAX_MESSAGE_BYTES}): the rest is not read"
             ));
@@ -476,8 +480,16 @@ mod tests {
         assert_eq!(read.skipped.get("referee"), Some(&1));
         assert_eq!(read.skipped.get("blank"), Some(&1));
         assert_eq!(read.undecodable.0, 1);
-        assert!(read.cut_off.as_deref().is_some_and(|c| c.contains("cut off")));
-        assert!(read.summary().contains("2 detection frames"), "{}", read.summary());
+        assert!(
+            read.cut_off
+                .as_deref()
+                .is_some_and(|c| c.contains("cut off"))
+        );
+        assert!(
+            read.summary().contains("2 detection frames"),
+            "{}",
+            read.summary()
+        );
     }
 
     #[test]
@@ -485,7 +497,10 @@ mod tests {
         assert!(matches!(parse_log(b"HELLO"), Err(LogError::NotSslLog)));
         let mut v2 = LOG_MAGIC.to_vec();
         v2.extend_from_slice(&2i32.to_be_bytes());
-        assert!(matches!(parse_log(&v2), Err(LogError::Version { version: 2 })));
+        assert!(matches!(
+            parse_log(&v2),
+            Err(LogError::Version { version: 2 })
+        ));
         // A huge size claim stops reading without allocating it.
         let mut log = Vec::new();
         write_header(&mut log);

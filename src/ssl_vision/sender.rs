@@ -21,7 +21,10 @@ pub const GEOMETRY_EVERY: Duration = Duration::from_secs(3);
 #[derive(Debug, thiserror::Error)]
 pub enum SendError {
     /// Not `HOST:PORT`, or a host that does not resolve.
-    #[error("--ssl-vision {given}: not HOST:PORT (e.g. {}): {why}", super::LEAGUE_ADDRESS)]
+    #[error(
+        "--ssl-vision {given}: not HOST:PORT (e.g. {}): {why}",
+        super::LEAGUE_ADDRESS
+    )]
     Address {
         /// What was given.
         given: String,

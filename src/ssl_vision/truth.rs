@@ -65,8 +65,18 @@ impl FrameIndex {
     /// The first and last capture time over all cameras, nanoseconds.
     #[must_use]
     pub fn span_ns(&self) -> Option<(u64, u64)> {
-        let first = self.cameras.values().filter_map(|l| l.first()).map(|f| f.0).min()?;
-        let last = self.cameras.values().filter_map(|l| l.last()).map(|f| f.0).max()?;
+        let first = self
+            .cameras
+            .values()
+            .filter_map(|l| l.first())
+            .map(|f| f.0)
+            .min()?;
+        let last = self
+            .cameras
+            .values()
+            .filter_map(|l| l.last())
+            .map(|f| f.0)
+            .max()?;
         Some((first, last))
     }
 
@@ -232,7 +242,11 @@ mod tests {
         let index = FrameIndex::new([
             frame(0, 1.000, vec![robot(Some(2), 10.0, 0.5)]),
             frame(0, 1.020, vec![robot(Some(2), 11.0, 0.5)]),
-            frame(1, 1.004, vec![robot(Some(2), 12.0, 0.9), robot(Some(40), 0.0, 1.0)]),
+            frame(
+                1,
+                1.004,
+                vec![robot(Some(2), 12.0, 0.9), robot(Some(40), 0.0, 1.0)],
+            ),
         ]);
         assert_eq!(index.len(), 3);
         let near = index.near(1_003_000_000, 20_000_000);
@@ -244,7 +258,11 @@ mod tests {
         assert!(index.near(1_060_000_000, 20_000_000).is_empty());
         let (truth, left_out) =
             overhead_truth(&near, OverheadCamera::above_field_2005(), 22.5, 1.0);
-        assert_eq!((truth.robots.len(), left_out), (1, 1), "id 40 has no marker");
+        assert_eq!(
+            (truth.robots.len(), left_out),
+            (1, 1),
+            "id 40 has no marker"
+        );
         assert!(truth.robots[0].marker.is_some_and(|m| m.fully_visible()));
     }
 }

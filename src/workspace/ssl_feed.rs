@@ -246,10 +246,7 @@ impl Workspace {
 
     /// Shows a step of a log opened alone.
     pub(super) fn show_ssl_step(&mut self, step: usize) -> anyhow::Result<()> {
-        let feed = self
-            .ssl_vision
-            .as_mut()
-            .context("no SSL-Vision log open")?;
+        let feed = self.ssl_vision.as_mut().context("no SSL-Vision log open")?;
         anyhow::ensure!(!feed.is_live(), "a live SSL-Vision feed has no steps");
         feed.show_step(step);
         self.overhead.field_model.set_ssl(feed.shown());
@@ -299,7 +296,12 @@ mod tests {
         for k in 0..5 {
             let t = 100.0 + f64::from(k) / 60.0;
             write_message(&mut log, 0, MessageType::Vision2014, &packet(0, t, 100.0));
-            write_message(&mut log, 0, MessageType::Vision2014, &packet(1, t + 0.002, 200.0));
+            write_message(
+                &mut log,
+                0,
+                MessageType::Vision2014,
+                &packet(1, t + 0.002, 200.0),
+            );
             write_message(&mut log, 0, MessageType::Refbox2013, b"");
         }
         std::fs::write(&path, &log).expect("write");
@@ -308,7 +310,10 @@ mod tests {
         let feed = w.ssl_vision().expect("a feed");
         assert_eq!(feed.frames(), 10);
         assert!(feed.summary.contains("5 referee"), "{}", feed.summary);
-        assert!(feed.field().is_some_and(|f| f.lines.len() == field.lines.len()));
+        assert!(
+            feed.field()
+                .is_some_and(|f| f.lines.len() == field.lines.len())
+        );
         let shown = w.overhead().field_model.ssl();
         assert_eq!(shown.len(), 2, "both cameras near the first step");
         assert_eq!(shown[1].balls[0].field_cm, [20.0, 0.0]);
@@ -334,7 +339,8 @@ mod tests {
             let _ = k;
         }
         let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
-        while w.ssl_vision().map_or(0, SslFeed::frames) < 2 && std::time::Instant::now() < deadline {
+        while w.ssl_vision().map_or(0, SslFeed::frames) < 2 && std::time::Instant::now() < deadline
+        {
             std::thread::sleep(std::time::Duration::from_millis(20));
             w.tick(std::time::Duration::from_millis(20));
         }
@@ -342,6 +348,9 @@ mod tests {
         assert_eq!(feed.frames(), 2);
         assert_eq!(feed.bad_packets(), 1);
         assert!(w.warnings().iter().any(|m| m.contains("not SSL-Vision")));
-        assert_eq!(w.overhead().field_model.ssl()[0].balls[0].field_cm, [3.0, 0.0]);
+        assert_eq!(
+            w.overhead().field_model.ssl()[0].balls[0].field_cm,
+            [3.0, 0.0]
+        );
     }
 }

@@ -72,7 +72,10 @@ fn packets_of_overhead_detect_carry_the_json_positions_and_their_log_opens_in_eo
     let dir = tempfile::tempdir().unwrap();
     let stream = sim_stream(dir.path(), "overhead-game", 5, Some(4));
     let (table, cal) = (overhead_table(dir.path()), calibration(dir.path(), &stream));
-    let (decoded, log) = (dir.path().join("decoded.json"), dir.path().join("received.log"));
+    let (decoded, log) = (
+        dir.path().join("decoded.json"),
+        dir.path().join("received.log"),
+    );
     let mut reader = Command::new(&python)
         .arg(repo_file("tests/it/ssl_vision.py"))
         .args(["receive".as_ref(), decoded.as_os_str(), log.as_os_str()])
@@ -105,7 +108,10 @@ fn packets_of_overhead_detect_carry_the_json_positions_and_their_log_opens_in_eo
         stderr.contains("camera 3: distortion κ =") && stderr.contains("residual RMS"),
         "{stderr}"
     );
-    assert!(stderr.contains("5 detection and 1 geometry packets"), "{stderr}");
+    assert!(
+        stderr.contains("5 detection and 1 geometry packets"),
+        "{stderr}"
+    );
     let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
@@ -122,8 +128,14 @@ fn packets_of_overhead_detect_carry_the_json_positions_and_their_log_opens_in_eo
             (serde_json::Value::Null, None) => {}
             (b, Some(balls)) => {
                 let sent = &balls[0];
-                assert!((sent["x"].as_f64().unwrap() - mm(b, "x_cm")).abs() <= 1.0, "{k}");
-                assert!((sent["y"].as_f64().unwrap() - mm(b, "y_cm")).abs() <= 1.0, "{k}");
+                assert!(
+                    (sent["x"].as_f64().unwrap() - mm(b, "x_cm")).abs() <= 1.0,
+                    "{k}"
+                );
+                assert!(
+                    (sent["y"].as_f64().unwrap() - mm(b, "y_cm")).abs() <= 1.0,
+                    "{k}"
+                );
             }
             (b, None) => panic!("frame {k}: ball {b} not sent"),
         }
@@ -136,7 +148,10 @@ fn packets_of_overhead_detect_carry_the_json_positions_and_their_log_opens_in_eo
         let printed = line["robots"].as_array().unwrap();
         assert_eq!(sent.len(), printed.len(), "frame {k}");
         for r in printed {
-            let key = (r["team"].as_str().unwrap().to_owned(), r["id"].as_u64().unwrap());
+            let key = (
+                r["team"].as_str().unwrap().to_owned(),
+                r["id"].as_u64().unwrap(),
+            );
             let s = sent[&key];
             assert!((s["x"].as_f64().unwrap() - mm(r, "x_cm")).abs() <= 1.0);
             assert!((s["y"].as_f64().unwrap() - mm(r, "y_cm")).abs() <= 1.0);
@@ -186,7 +201,12 @@ fn truth_packets(stream: &Path) -> Vec<(i64, Vec<u8>)> {
                     },
                 )
             };
-            let robots: Vec<_> = t.robots.iter().filter(|r| r.marker.is_some()).map(robot).collect();
+            let robots: Vec<_> = t
+                .robots
+                .iter()
+                .filter(|r| r.marker.is_some())
+                .map(robot)
+                .collect();
             let of = |team| {
                 robots
                     .iter()
@@ -216,7 +236,10 @@ fn truth_packets(stream: &Path) -> Vec<(i64, Vec<u8>)> {
                 detection: Some(frame),
                 geometry: None,
             };
-            (i64::try_from(record.time_ns).unwrap(), packet.encode_to_vec())
+            (
+                i64::try_from(record.time_ns).unwrap(),
+                packet.encode_to_vec(),
+            )
         })
         .collect()
 }
@@ -272,6 +295,20 @@ fn an_ssl_log_of_a_streams_truth_scores_it_as_the_truth_does_from_a_file_and_liv
             );
         }
     }
+    // Opened beside the stream, the log shows the frame of the shown frame's time; stepping the
+    // stream steps the log's frame with it.
+    let mut w = eotn::workspace::Workspace::default();
+    let open = eotn::workspace::Command::Open(vec![stream.clone(), log.clone()]);
+    w.apply(open).unwrap();
+    let shown = |w: &eotn::workspace::Workspace| {
+        let ssl = w.overhead().field_model.ssl();
+        assert_eq!(ssl.len(), 1, "one camera");
+        ssl[0].frame_number
+    };
+    assert_eq!(shown(&w), 0);
+    w.apply(eotn::workspace::PlaybackCommand::Seek(3).into())
+        .unwrap();
+    assert_eq!(shown(&w), 3);
     // The same packets live over loopback, with a packet that is not SSL-Vision among them.
     let probe = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     let port = probe.local_addr().unwrap().port();
@@ -279,7 +316,9 @@ fn an_ssl_log_of_a_streams_truth_scores_it_as_the_truth_does_from_a_file_and_liv
     let sender = std::thread::spawn(move || {
         let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
         std::thread::sleep(std::time::Duration::from_millis(1500));
-        socket.send_to(&[0xff, 0xff, 0x07], ("127.0.0.1", port)).unwrap();
+        socket
+            .send_to(&[0xff, 0xff, 0x07], ("127.0.0.1", port))
+            .unwrap();
         for (_, p) in &packets {
             socket.send_to(p, ("127.0.0.1", port)).unwrap();
             std::thread::sleep(std::time::Duration::from_millis(5));
@@ -322,7 +361,11 @@ fn bad_logs_and_a_port_in_use_are_said_clearly() {
     let said = eval(garbage.as_os_str());
     assert!(said.contains("not an SSL-Vision log"), "{said}");
     let v2 = dir.path().join("v2.log");
-    std::fs::write(&v2, [b"SSL_LOG_FILE".as_slice(), &2i32.to_be_bytes()].concat()).unwrap();
+    std::fs::write(
+        &v2,
+        [b"SSL_LOG_FILE".as_slice(), &2i32.to_be_bytes()].concat(),
+    )
+    .unwrap();
     let said = eval(v2.as_os_str());
     assert!(said.contains("version 2"), "{said}");
     let empty = dir.path().join("empty.log");
@@ -336,4 +379,54 @@ fn bad_logs_and_a_port_in_use_are_said_clearly() {
         let said = eval(bhuman.as_os_str());
         assert!(said.contains("eotn import --bhuman"), "{said}");
     }
+}
+
+/// A log of two cameras' frames at three instants, shown alone in the app's field view.
+#[cfg(feature = "gui")]
+#[test]
+fn the_field_view_marks_each_cameras_detections_of_a_log_opened_alone() {
+    use egui_kittest::kittest::Queryable as _;
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("game.log");
+    let mut bytes = Vec::new();
+    write_header(&mut bytes);
+    for k in 0..3u32 {
+        for camera_id in [0, 1] {
+            let frame = SslDetectionFrame {
+                frame_number: k,
+                t_capture: 50.0 + f64::from(k) / 60.0 + f64::from(camera_id) * 0.003,
+                camera_id,
+                robots_blue: vec![SslDetectionRobot {
+                    confidence: 0.9,
+                    robot_id: Some(camera_id + 2),
+                    x: 1000.0 * camera_id as f32,
+                    orientation: Some(0.5),
+                    ..SslDetectionRobot::default()
+                }],
+                ..SslDetectionFrame::default()
+            };
+            let packet = SslWrapperPacket {
+                detection: Some(frame),
+                geometry: None,
+            };
+            write_message(
+                &mut bytes,
+                0,
+                MessageType::Vision2014,
+                &packet.encode_to_vec(),
+            );
+        }
+    }
+    std::fs::write(&log, bytes).unwrap();
+    let mut w = eotn::workspace::Workspace::default();
+    w.apply(eotn::workspace::Command::Open(vec![log])).unwrap();
+    let mut h = crate::harness::harness_with(w);
+    h.run();
+    h.run();
+    assert!(h.query_by_label("field drawing").is_some());
+    for camera in ["■ camera 0", "■ camera 1"] {
+        assert!(h.query_by_label(camera).is_some(), "{camera}");
+    }
+    assert!(h.query_by_label_contains("ssl-vision step").is_some());
+    assert_eq!(h.state().state.ssl_vision().unwrap().steps(), (6, 0));
 }
