@@ -285,7 +285,7 @@ fn ssl_feed_ui(
         for f in shown {
             ui.colored_label(
                 ssl_camera_colour(f.camera_id),
-                format!("■ camera {}", f.camera_id),
+                format!("camera {}", f.camera_id),
             );
         }
         if shown.is_empty() {

@@ -424,9 +424,9 @@ fn the_field_view_marks_each_cameras_detections_of_a_log_opened_alone() {
     h.run();
     h.run();
     assert!(h.query_by_label("field drawing").is_some());
-    for camera in ["■ camera 0", "■ camera 1"] {
+    for camera in ["camera 0", "camera 1"] {
         assert!(h.query_by_label(camera).is_some(), "{camera}");
     }
-    assert!(h.query_by_label_contains("ssl-vision step").is_some());
+    assert!(h.query_all_by_label_contains("ssl-vision step").count() > 0);
     assert_eq!(h.state().state.ssl_vision().unwrap().steps(), (6, 0));
 }
