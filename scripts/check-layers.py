@@ -14,7 +14,7 @@ import sys
 ORDER = [
     "test_skip", "atomic_file", "input_file", "camera", "stats", "kernels", "frame", "lut", "classify", "blobs", "sensors", "geometry",
     "model", "sim", "import", "formats",
-    "recognition", "overhead", "session", "wmd", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
+    "recognition", "overhead", "ssl_vision", "session", "wmd", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
     "live", "workspace", "app_options", "cli", "app",
 ]
 

@@ -61,6 +61,7 @@ pub mod sensors;
 pub mod session;
 pub mod sim;
 pub mod sources;
+pub mod ssl_vision;
 pub mod stats;
 pub mod streams;
 pub mod wmd;

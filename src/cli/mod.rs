@@ -44,6 +44,7 @@ mod serve;
 mod sim;
 mod sim_field;
 mod sources;
+pub mod ssl_vision_out;
 pub mod values;
 mod wmd;
 mod wmd_feeds;

@@ -18,8 +18,9 @@ use crate::recognition::ObjectId;
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     /// Open files by kind: `.mcap` streams, frame files (as one sequence), `.json` recognition
-    /// parameters or places (told by content), anything else as a table. Each file opens or
-    /// fails on its own.
+    /// parameters or places (told by content), SSL-Vision sources (a league log `.log` or
+    /// `.log.gz`, or `udp://GROUP:PORT`; shown in the field view), anything else as a table.
+    /// Each file opens or fails on its own.
     Open(Vec<PathBuf>),
     /// Show another camera of the open recording or shown robot (one of
     /// [`crate::workspace::Workspace::cameras`]; `None`: the first): it is shown at the frame
@@ -73,6 +74,9 @@ pub enum Command {
     Hints(HintsCommand),
     /// The overhead camera: calibration, picked points, robot selection, view options.
     Overhead(OverheadCommand),
+    /// Show this step (capture time) of an SSL-Vision log opened without a stream
+    /// (`workspace/ssl_feed.rs`).
+    ShowSslStep(usize),
 }
 
 /// The recognition parameters (`workspace/params.rs`): open, use the stream's set, tune, reset,

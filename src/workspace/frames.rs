@@ -21,6 +21,8 @@ struct OpenPaths {
     tables: Vec<PathBuf>,
     /// Recognition parameters or places files (told by content when opened).
     jsons: Vec<PathBuf>,
+    /// SSL-Vision sources: a league log file or a `udp://` multicast group.
+    ssl: Vec<PathBuf>,
 }
 
 impl OpenPaths {
@@ -30,13 +32,16 @@ impl OpenPaths {
             frames: Vec::new(),
             tables: Vec::new(),
             jsons: Vec::new(),
+            ssl: Vec::new(),
         };
         for p in paths {
             let ext = p
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default();
-            let kind = if crate::streams::is_recording(&p) {
+            let kind = if is_ssl_source(&p, &ext) {
+                &mut sorted.ssl
+            } else if crate::streams::is_recording(&p) {
                 &mut sorted.streams
             } else if ext == "json" {
                 &mut sorted.jsons
@@ -62,10 +67,16 @@ impl Workspace {
             frames,
             mut tables,
             jsons,
+            ssl,
         } = OpenPaths::sort(paths);
         let mut shown_camera = None;
         let mut offer = None;
         let mut failures = Vec::new();
+        for p in ssl {
+            if let Err(e) = self.open_ssl(&p) {
+                failures.push(format!("{e:#}"));
+            }
+        }
         // One source is shown: the last stream given, else the frames as one sequence.
         if let Some(s) = streams.pop() {
             for skipped in &streams {
@@ -332,6 +343,7 @@ impl Workspace {
         };
         self.frame_generation += 1;
         self.sync_beside();
+        self.sync_ssl();
         Ok(())
     }
 
@@ -364,6 +376,15 @@ impl Workspace {
             self.sensor_series.points.push((t, r));
         }
     }
+}
+
+/// An SSL-Vision source given to Open: `udp://…`, or a `.log` (`.log.gz`) file (a B-Human log
+/// of the same name is told apart when read, and pointed to its importer).
+fn is_ssl_source(p: &std::path::Path, ext: &str) -> bool {
+    let text = p.to_string_lossy();
+    crate::ssl_vision::listener::is_udp_url(&text)
+        || ext == "log"
+        || (ext == "gz" && text.to_ascii_lowercase().ends_with(".log.gz"))
 }
 
 #[cfg(test)]

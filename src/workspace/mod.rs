@@ -29,7 +29,8 @@
 //! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
 //! | `cameras.rs` | the camera shown of a recording with several (`Command::OpenCamera`) and each camera's own table |
 //! | `side_by_side.rs` | several cameras side by side, stepped together by time, each with its own table, pipeline and results; the focused one gets the clicks |
-//! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time |
+//! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time, SSL-Vision's detections by camera |
+//! | `ssl_feed.rs` | [`SslFeed`]: SSL-Vision's detections opened beside the frames (a league log, paired by capture time, or a live address) |
 
 pub mod bookmarks;
 mod cameras;
@@ -51,6 +52,7 @@ mod robots;
 mod settings;
 mod side_by_side;
 pub mod source;
+mod ssl_feed;
 mod stream_scan;
 mod table;
 mod timings;
@@ -77,6 +79,7 @@ pub use settings::{
 };
 pub use side_by_side::CameraPane;
 pub use source::Source;
+pub use ssl_feed::SslFeed;
 pub use stream_scan::StreamScan;
 pub use table::TableSlot;
 pub use timings::{StepTiming, Timings, median};
@@ -199,6 +202,8 @@ pub struct Workspace {
     /// the journal entries since, written as its journal when it is first saved, so the journal
     /// records from the table's first commit (`None` once the table has a file).
     unsaved_journal: Option<(LookupTable, Vec<journal::JournalEntry>)>,
+    /// SSL-Vision's detections opened beside the frames (a league log or a live address).
+    ssl_vision: Option<ssl_feed::SslFeed>,
 }
 
 impl Default for Workspace {
@@ -264,6 +269,7 @@ impl Workspace {
             beside: side_by_side::SideBySide::default(),
             saved_undo_len: Some(0),
             unsaved_journal,
+            ssl_vision: None,
         }
     }
 
@@ -366,6 +372,7 @@ impl Workspace {
             Command::Robots(c) => self.apply_robot_command(c)?,
             Command::Hints(c) => self.apply_hints(c)?,
             Command::Overhead(c) => self.apply_overhead(c)?,
+            Command::ShowSslStep(step) => self.show_ssl_step(step)?,
         }
         Ok(())
     }

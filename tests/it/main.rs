@@ -57,6 +57,7 @@ mod sim_table;
 mod snapshots;
 mod ssl2008;
 mod ssl_onboard;
+mod ssl_vision;
 mod streams;
 mod viewers;
 #[cfg(feature = "gui")]
