@@ -98,7 +98,9 @@ pub fn run(path: &Path, json: bool, ssl_vision: Option<&str>) -> anyhow::Result<
 }
 
 /// Each camera's id and calibration, for the SSL-Vision geometry.
-fn ssl_cameras(cameras: &[super::field::FieldCamera]) -> Vec<crate::ssl_vision::CameraEntry> {
+pub(super) fn ssl_cameras(
+    cameras: &[super::field::FieldCamera],
+) -> Vec<crate::ssl_vision::CameraEntry> {
     cameras
         .iter()
         .map(|c| crate::ssl_vision::CameraEntry {

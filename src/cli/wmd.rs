@@ -16,6 +16,7 @@ use serde_json::{Value, json};
 
 use super::field::{FieldCamera, open_cameras};
 use super::overhead::{load_field, load_usable_calibration, overhead_json, params_for};
+use super::ssl_vision_out::SslOut;
 use super::wmd_inputs::{FieldFrame, RobotModels, field_frames, read_world_models, recorded};
 use super::wmd_record::{CameraFrame, SessionRecorder};
 use crate::model::world_model::RobotKey;
@@ -76,6 +77,12 @@ pub struct Args {
     /// only).
     #[arg(long, default_value_t = 2.0, value_parser = super::values::number_in(0.0, 3600.0))]
     pub max_clock_offset: f64,
+    /// Also send the overhead detections as SSL-Vision packets over UDP to HOST:PORT (a unicast
+    /// address, or the league's group 224.5.23.2:10006): an `SSL_WrapperPacket` per camera frame,
+    /// `camera_id` the session's id (0 with `--overhead`), and the geometry every few seconds, as
+    /// `eotn overhead detect --ssl-vision` sends them.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub ssl_vision: Option<String>,
     /// Which camera of the overhead recording.
     #[command(flatten)]
     pub camera: super::inputs::CameraArg,
@@ -104,7 +111,12 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let outcome = if is_live(a)? {
         let (inputs, recorder) = super::wmd_inputs::open_live(a)?;
-        super::wmd_live::run(inputs, a.json, a.seconds, recorder, &mut out)?
+        let ssl = a
+            .ssl_vision
+            .as_deref()
+            .map(|addr| SslOut::open(addr, &inputs.field, &live_ssl_cameras(&inputs)))
+            .transpose()?;
+        super::wmd_live::run(inputs, a.json, a.seconds, (recorder, ssl), &mut out)?
     } else {
         if a.seconds.is_some() {
             log::warn!("--seconds: every source is a recording, read to its end");
@@ -117,6 +129,18 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         bail!("no overhead frame arrived");
     }
     Ok(())
+}
+
+/// Each live overhead camera's id and calibration, for the SSL-Vision geometry.
+fn live_ssl_cameras(inputs: &super::wmd_live::LiveInputs) -> Vec<crate::ssl_vision::CameraEntry> {
+    inputs
+        .cameras
+        .iter()
+        .map(|c| crate::ssl_vision::CameraEntry {
+            camera_id: super::ssl_vision_out::session_camera_id(c.id),
+            camera: *c.pipeline.camera(),
+        })
+        .collect()
 }
 
 /// True when any source is live or a device.
@@ -179,7 +203,15 @@ fn recorded_session(a: &Args, out: &mut impl Write) -> anyhow::Result<Outcome> {
         .as_deref()
         .map(|p| SessionRecorder::create(p, &recorded_cameras(a, &cameras)?))
         .transpose()?;
-    let frames = field_frames(&mut cameras, single)?;
+    let mut ssl = a
+        .ssl_vision
+        .as_deref()
+        .map(|addr| SslOut::open(addr, &field, &super::detect_field::ssl_cameras(&cameras)))
+        .transpose()?;
+    let frames = field_frames(&mut cameras, single, ssl.as_mut())?;
+    if let Some(ssl) = &ssl {
+        ssl.finish();
+    }
     if frames.is_empty() {
         bail!("the overhead recording has no frames");
     }

@@ -53,12 +53,17 @@ impl FieldFrame {
 }
 
 /// Runs every camera over its recording: one field frame per frame of the first (reference)
-/// camera; another camera's frame within half a frame period joins it.
+/// camera; another camera's frame within half a frame period joins it. With `ssl`, each
+/// camera's detections are also sent as SSL-Vision packets.
 ///
 /// # Errors
 /// A camera's frame of another shape than its calibration. An unreadable frame is warned about
 /// and left out.
-pub fn field_frames(cameras: &mut [FieldCamera], single: bool) -> anyhow::Result<Vec<FieldFrame>> {
+pub fn field_frames(
+    cameras: &mut [FieldCamera],
+    single: bool,
+    mut ssl: Option<&mut super::ssl_vision_out::SslOut>,
+) -> anyhow::Result<Vec<FieldFrame>> {
     let times = super::field::frame_times(cameras);
     let reference = times.first().cloned().unwrap_or_default();
     let period_ns = crate::wmd::clock::frame_period_ns(&reference);
@@ -70,6 +75,11 @@ pub fn field_frames(cameras: &mut [FieldCamera], single: bool) -> anyhow::Result
     let mut out = Vec::with_capacity(reference.len());
     for (i, &t_ref) in reference.iter().enumerate() {
         let (views, frames) = super::field::field_views(cameras, &times, i, period_ns, &mut sizes)?;
+        if let Some(out) = ssl.as_deref_mut() {
+            for ((id, d), (_, time_ns)) in views.iter().zip(&frames) {
+                out.send(super::ssl_vision_out::session_camera_id(*id), *time_ns, d);
+            }
+        }
         let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let picture = merge_detections(&refs);

@@ -9,6 +9,7 @@
 //! is said as such, and nothing waits on a robot: the session ends at `--seconds`, on Ctrl+C or
 //! SIGTERM, or when every overhead source is a recording played to its end.
 
+use super::ssl_vision_out::SslOut;
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::io::Write;
 use std::time::{Duration, Instant};
@@ -90,6 +91,8 @@ struct Session<'a> {
     json: bool,
     out: &'a mut dyn Write,
     recorder: Option<SessionRecorder>,
+    /// `--ssl-vision`: each camera's detections sent as SSL-Vision packets.
+    ssl: Option<SslOut>,
     start: Instant,
     start_unix_ns: u64,
     sizes: Vec<SizeCheck>,
@@ -121,7 +124,7 @@ pub fn run(
     inputs: LiveInputs,
     json: bool,
     seconds: Option<f64>,
-    recorder: Option<SessionRecorder>,
+    (recorder, ssl): (Option<SessionRecorder>, Option<SslOut>),
     out: &mut dyn Write,
 ) -> anyhow::Result<super::wmd::Outcome> {
     let interrupted = super::interrupt::catch("ending the session")?;
@@ -132,6 +135,7 @@ pub fn run(
         json,
         out,
         recorder,
+        ssl,
         start: Instant::now(),
         start_unix_ns: unix_time_ns(),
         sizes: (0..cameras).map(|_| SizeCheck::default()).collect(),
@@ -355,6 +359,11 @@ impl Session<'_> {
                 used.push((id, seen.time_ns, seen.frame.as_ref()));
             }
         }
+        if let Some(out) = self.ssl.as_mut() {
+            for ((id, d), (_, time_ns)) in views.iter().zip(&frames) {
+                out.send(super::ssl_vision_out::session_camera_id(*id), *time_ns, d);
+            }
+        }
         let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let frame = FieldFrame {
@@ -429,6 +438,9 @@ impl Session<'_> {
             .take()
             .map(SessionRecorder::finish)
             .transpose();
+        if let Some(ssl) = &self.ssl {
+            ssl.finish();
+        }
         made?;
         recorded?;
         let offsets: Vec<(RobotKey, ClockOffset)> = self

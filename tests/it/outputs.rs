@@ -33,6 +33,8 @@ struct Fixture {
     overhead: PathBuf,
     overhead_frame: PathBuf,
     points: PathBuf,
+    /// The overhead stream's camera, calibrated from `points`.
+    calibration: PathBuf,
     field: PathBuf,
     pattern_tour: PathBuf,
     foreign_table: PathBuf,
@@ -75,6 +77,16 @@ impl Fixture {
             "-o".as_ref(),
             points.as_os_str(),
         ]);
+        let calibration = dir.path().join("overhead.cal.json");
+        eotn_ok(&[
+            "overhead".as_ref(),
+            "calibrate".as_ref(),
+            "--points".as_ref(),
+            points.as_os_str(),
+            "--accept".as_ref(),
+            "-o".as_ref(),
+            calibration.as_os_str(),
+        ]);
         let pattern_tour = sim_stream(dir.path(), "pattern-tour", 30, None);
         let served = crate::live::serve(&ball_edge, "127.0.0.1:0", &["--loop"]);
         Self {
@@ -86,6 +98,7 @@ impl Fixture {
             overhead,
             overhead_frame,
             points,
+            calibration,
             field,
             pattern_tour,
             foreign_table,
@@ -217,6 +230,21 @@ fn recipes() -> Vec<(&'static str, Recipe)> {
                 "blue".as_ref(),
                 "--id".as_ref(),
                 "3".as_ref(),
+                "-o".as_ref(),
+                out.as_os_str(),
+            ])
+        }),
+        ("wmd --output", |f, out| {
+            args(&[
+                "wmd".as_ref(),
+                "--overhead".as_ref(),
+                f.overhead.as_os_str(),
+                "--robot".as_ref(),
+                f.overhead.as_os_str(),
+                "--lut".as_ref(),
+                f.lut.as_os_str(),
+                "--calibration".as_ref(),
+                f.calibration.as_os_str(),
                 "-o".as_ref(),
                 out.as_os_str(),
             ])

@@ -654,3 +654,80 @@ fn a_recorded_session_replays_to_the_same_lines_and_shows_in_foxglove_and_the_ap
         "{seen}"
     );
 }
+
+/// `eotn wmd --ssl-vision` sends what it compares: each overhead frame's ball and robots as
+/// SSL-Vision packets (decoded by the independent reader of `ssl_vision.py`), at the positions
+/// its `--json` lines print (≤ 1 mm apart), camera 0, numbered in order.
+#[test]
+fn wmd_sends_its_overhead_detections_as_ssl_vision_packets() {
+    let Some(python) =
+        crate::common::python_with("import struct, socket, json", "python3", "the SSL reader")
+    else {
+        return;
+    };
+    let f = fixture();
+    let dir = tempfile::tempdir().unwrap();
+    let (decoded, log) = (
+        dir.path().join("decoded.json"),
+        dir.path().join("received.log"),
+    );
+    let mut reader = std::process::Command::new(&python)
+        .arg(crate::common::repo_file("tests/it/ssl_vision.py"))
+        .args(["receive".as_ref(), decoded.as_os_str(), log.as_os_str()])
+        .args(["45", "60"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut port = String::new();
+    std::io::BufRead::read_line(
+        &mut std::io::BufReader::new(reader.stdout.take().unwrap()),
+        &mut port,
+    )
+    .unwrap();
+    let target = format!("127.0.0.1:{}", port.trim());
+    let (lines, stderr) = wmd(&[&f.stream], &["--json", "--ssl-vision", target.as_str()]);
+    assert!(reader.wait().unwrap().success());
+    assert!(stderr.contains("camera 0: distortion κ ="), "{stderr}");
+    assert!(stderr.contains("45 detection and"), "{stderr}");
+    let got: Value = serde_json::from_str(&std::fs::read_to_string(&decoded).unwrap()).unwrap();
+    let sent = got["detections"].as_array().unwrap();
+    assert_eq!(sent.len(), lines.len());
+    let mm = |v: &Value, key: &str| v[key].as_f64().unwrap() * 10.0;
+    let mut robots_compared = 0;
+    for (k, (packet, line)) in sent.iter().zip(&lines).enumerate() {
+        assert_eq!(packet["camera_id"], 0);
+        assert_eq!(packet["frame_number"], k);
+        match (&line["ball"], packet.get("balls")) {
+            (Value::Null, None) => {}
+            (b, Some(balls)) => {
+                assert!((balls[0]["x"].as_f64().unwrap() - mm(b, "x_cm")).abs() <= 1.0);
+                assert!((balls[0]["y"].as_f64().unwrap() - mm(b, "y_cm")).abs() <= 1.0);
+            }
+            (b, None) => panic!("frame {k}: ball {b} not sent"),
+        }
+        let mut by_key: BTreeMap<(String, u64), &Value> = BTreeMap::new();
+        for (team, key) in [("blue", "robots_blue"), ("yellow", "robots_yellow")] {
+            for r in packet
+                .get(key)
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+            {
+                by_key.insert((team.to_owned(), r["robot_id"].as_u64().unwrap()), r);
+            }
+        }
+        let printed = line["robots"].as_array().unwrap();
+        assert_eq!(by_key.len(), printed.len(), "frame {k}");
+        for r in printed {
+            let key = (
+                r["team"].as_str().unwrap().to_owned(),
+                r["id"].as_u64().unwrap(),
+            );
+            let s = by_key[&key];
+            assert!((s["x"].as_f64().unwrap() - mm(r, "x_cm")).abs() <= 1.0);
+            assert!((s["y"].as_f64().unwrap() - mm(r, "y_cm")).abs() <= 1.0);
+            robots_compared += 1;
+        }
+    }
+    assert!(robots_compared >= 45, "{robots_compared} robots compared");
+}
