@@ -27,11 +27,19 @@ use crate::streams::StreamReader;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Streams with a `/ground_truth` channel (from `eotn sim`).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "session")]
     pub streams: Vec<PathBuf>,
     /// Lookup table.
-    #[arg(long)]
-    pub lut: PathBuf,
+    #[arg(long, required_unless_present = "session")]
+    pub lut: Option<PathBuf>,
+    /// A whole overhead field instead of streams: every camera of a session file (`eotn
+    /// overhead sim-field` writes one) through its own table and calibration, each field
+    /// frame's merged picture against the truth, and each camera's own detections beside it.
+    #[arg(long, conflicts_with_all = [
+        "streams", "lut", "params", "compare_lut", "compare_params", "calibrate_goals", "plots",
+        "labels", "patterns", "calibration", "field", "topic",
+    ])]
+    pub session: Option<PathBuf>,
     /// Recognition parameters JSON (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
@@ -399,28 +407,52 @@ fn calibrate_goals(
 /// # Errors
 /// Unreadable inputs or streams without ground truth, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if let Some(session) = &args.session {
+        return super::eval_field::run(session, args.json);
+    }
+    run_streams(args)
+}
+
+/// The overhead evaluation when every stream is an overhead one (`None`: none is), an error when
+/// some are.
+fn run_overhead(args: &Args, lut: &std::path::Path) -> Option<anyhow::Result<()>> {
     let overhead = args
         .streams
         .iter()
         .filter(|p| super::eval_overhead::is_overhead_stream(p))
         .count();
     if overhead == args.streams.len() {
-        return super::eval_overhead::run(
+        Some(super::eval_overhead::run(
             &args.streams,
             args.camera.get(),
-            &args.lut,
+            lut,
             args.calibration.as_deref(),
             args.field.as_deref(),
             args.json,
-        );
+        ))
     } else if overhead > 0 {
-        bail!("give overhead streams and robot-camera streams to separate `eotn eval` runs");
+        Some(Err(anyhow::anyhow!(
+            "give overhead streams and robot-camera streams to separate `eotn eval` runs"
+        )))
+    } else {
+        None
+    }
+}
+
+/// `eotn eval` on streams.
+fn run_streams(args: &Args) -> anyhow::Result<()> {
+    let lut_path = args
+        .lut
+        .as_deref()
+        .context("--lut is needed with streams")?;
+    if let Some(overhead) = run_overhead(args, lut_path) {
+        return overhead;
     }
     if args.calibration.is_some() || args.field.is_some() {
         super::overhead::refuse_robot_streams(&args.streams)
             .context("--calibration and --field are for overhead streams")?;
     }
-    let lut = load_lut_arg(&args.lut)?;
+    let lut = load_lut_arg(lut_path)?;
     let rp = params_or_camera_s(args.params.as_deref(), &args.streams, args.camera.get())?;
     if let Some(labels) = &args.labels {
         return run_labels(args, labels, lut, rp);
