@@ -191,8 +191,9 @@ pub struct EotnApp {
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
     pub last_view: Option<ImageTransform>,
-    /// Cameras side by side: (image topic, where its image was last drawn), left to right.
-    pub last_panes: Vec<(String, ImageTransform)>,
+    /// Cameras side by side: each pane as last drawn (where, how many primitives), left to
+    /// right.
+    pub last_panes: Vec<side_by_side::DrawnPane>,
     beside_textures: side_by_side::BesideTextures,
     confirm_close: bool,
     allow_close: bool,
@@ -293,6 +294,11 @@ impl EotnApp {
             A::OpenParams | A::SaveParams => self.state.params_slot().path.clone(),
             A::OpenPlaces => self.state.places_path().map(std::path::Path::to_owned),
             A::Open | A::ExportView | A::Record => self.state.settings.last_source.first().cloned(),
+            // Label sets lie beside their frames: the folder holding the opened frames' folder.
+            A::OpenLabelsFolder | A::OpenLabelsFile => self.state.labels().map_or_else(
+                || self.state.settings.last_source.first().cloned(),
+                |l| Some(l.path.clone()),
+            ),
         };
         file.and_then(|f| f.parent().map(std::path::Path::to_owned))
             .filter(|d| !d.as_os_str().is_empty())

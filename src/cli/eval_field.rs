@@ -14,7 +14,7 @@ use crate::eval::overhead::{OverheadEvalParams, evaluate_overhead_frame};
 use crate::eval::overhead_field::{
     CameraTruth, FieldEvalReport, FieldFrameEval, evaluate_field_frame,
 };
-use crate::overhead::merge::{CameraId, merge_detections};
+use crate::overhead::merge::{SslCameraId, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::session::Session;
 
@@ -57,7 +57,7 @@ pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
         if truths.is_empty() {
             continue;
         }
-        let refs: Vec<(CameraId, &OverheadDetections)> =
+        let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|v| (v.id, &v.detections)).collect();
         let picture = merge_detections(&refs);
         field_frames.push(evaluate_field_frame(

@@ -20,7 +20,7 @@ use crate::eval::overhead_field::{CameraTruth, FieldEvalReport, evaluate_field_f
 use crate::frame::Frame;
 use crate::geometry::{ImagePoint, OverheadCamera};
 use crate::model::truth::OverheadTruth;
-use crate::overhead::merge::{CameraId, merge_detections};
+use crate::overhead::merge::{SslCameraId, merge_detections};
 use crate::overhead::{OverheadDetections, OverheadParams, OverheadPipeline};
 use crate::session::Session;
 
@@ -69,7 +69,7 @@ pub struct BenchArgs {
 
 /// One camera's frames in memory with its pipeline.
 struct BenchCamera {
-    id: CameraId,
+    id: SslCameraId,
     pipeline: OverheadPipeline,
     frames: Vec<Frame>,
     truths: Vec<Option<OverheadTruth>>,
@@ -343,7 +343,7 @@ fn frames_camera(a: &BenchArgs) -> anyhow::Result<BenchCamera> {
         frames.push(f);
     }
     Ok(BenchCamera {
-        id: CameraId(0),
+        id: SslCameraId(0),
         pipeline: OverheadPipeline::new(lut, cal.camera, params_for(&field)),
         truths: vec![None; frames.len()],
         frames,
@@ -459,7 +459,7 @@ fn merge_field_frames(
     let longest = detections.iter().map(Vec::len).max().unwrap_or(0);
     let (mut times, mut field, mut own) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..longest {
-        let views: Vec<(CameraId, &OverheadDetections)> = cameras
+        let views: Vec<(SslCameraId, &OverheadDetections)> = cameras
             .iter()
             .zip(detections)
             .filter_map(|(c, d)| Some((c.id, d.get(i)?)))

@@ -16,7 +16,7 @@ use super::overhead::{
     OverheadEvalParams, OverheadEvalReport, OverheadFrameEval, angle_diff, label,
 };
 use crate::model::truth::{OverheadRobot as TruthRobot, OverheadTruth};
-use crate::overhead::merge::{CameraId, FieldPicture, FieldRobot};
+use crate::overhead::merge::{SslCameraId, FieldPicture, FieldRobot};
 
 /// One field frame's comparison.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -43,7 +43,7 @@ pub struct BallMiss {
     pub frame: usize,
     /// Per camera that showed any of it: `(camera, pixels showing it, share of its whole image
     /// disc)`.
-    pub shown: Vec<(CameraId, usize, f64)>,
+    pub shown: Vec<(SslCameraId, usize, f64)>,
     /// Some camera's own detections had a ball within the match distance.
     pub found_by_a_camera: bool,
 }
@@ -52,7 +52,7 @@ pub struct BallMiss {
 #[derive(Debug, Clone, Copy)]
 pub struct CameraTruth<'a> {
     /// The camera.
-    pub camera: CameraId,
+    pub camera: SslCameraId,
     /// Its frame's truth.
     pub truth: &'a OverheadTruth,
     /// Whether its own detections had a ball near the true one.
@@ -355,7 +355,7 @@ mod tests {
             field_cm: [x, 0.0],
             heading_rad: 0.5,
             confidence: 0.9,
-            camera_ids: cameras.iter().map(|&c| CameraId(c)).collect(),
+            camera_ids: cameras.iter().map(|&c| SslCameraId(c)).collect(),
         }
     }
 
@@ -366,12 +366,12 @@ mod tests {
         let (t0, t1) = (truth(-100.0, [0.5, 1.0], 0), truth(-98.0, [1.0, 0.0], 0));
         let cams = [
             CameraTruth {
-                camera: CameraId(0),
+                camera: SslCameraId(0),
                 truth: &t0,
                 found_ball: false,
             },
             CameraTruth {
-                camera: CameraId(1),
+                camera: SslCameraId(1),
                 truth: &t1,
                 found_ball: false,
             },
@@ -412,12 +412,12 @@ mod tests {
         let cams = |found: bool| {
             [
                 CameraTruth {
-                    camera: CameraId(0),
+                    camera: SslCameraId(0),
                     truth: &t0,
                     found_ball: false,
                 },
                 CameraTruth {
-                    camera: CameraId(1),
+                    camera: SslCameraId(1),
                     truth: &t1,
                     found_ball: found,
                 },
@@ -430,8 +430,8 @@ mod tests {
                 radius_px: 4.0,
                 confidence: 0.8,
             },
-            camera: CameraId(1),
-            camera_ids: vec![CameraId(1)],
+            camera: SslCameraId(1),
+            camera_ids: vec![SslCameraId(1)],
         };
         let p = OverheadEvalParams::default();
         let seen = FieldPicture {
@@ -445,7 +445,7 @@ mod tests {
         let miss = e.ball_miss.clone().expect("a miss");
         assert!(miss.found_by_a_camera);
         assert_eq!(miss.shown.len(), 2);
-        assert_eq!((miss.shown[1].0, miss.shown[1].1), (CameraId(1), 80));
+        assert_eq!((miss.shown[1].0, miss.shown[1].1), (SslCameraId(1), 80));
         // The 2005 camera shows a 4.25 cm ball near the centre as a disc of about 5 px radius
         // (80 px): 80 px is nearly all of it, 12 px under a sixth.
         assert!(miss.shown[1].2 > 0.8 && miss.shown[0].2 < 0.17, "{miss:?}");

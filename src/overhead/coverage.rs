@@ -8,7 +8,7 @@
 
 use serde::Serialize;
 
-use super::merge::CameraId;
+use super::merge::SslCameraId;
 use super::pipeline::{FrameFit, frame_fit};
 use crate::geometry::{ImagePoint, OverheadCamera};
 
@@ -20,7 +20,7 @@ pub const SAMPLES_PER_SIDE: usize = 16;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CameraCoverage {
     /// The camera's session id.
-    pub camera: CameraId,
+    pub camera: SslCameraId,
     /// The frame border on the plane, centimetres `[x, y]`, in order around the border (image
     /// top-left, along the top, down the right side, back along the bottom and up the left).
     /// Border points whose ray misses the plane (a lens folding over, a camera tilted to the
@@ -72,7 +72,7 @@ pub fn coverage_polygon(
 /// drawn (see [`coverage_polygon`]) is left out.
 #[must_use]
 pub fn field_coverage(
-    cameras: &[(CameraId, OverheadCamera, usize, usize)],
+    cameras: &[(SslCameraId, OverheadCamera, usize, usize)],
     height_cm: f64,
 ) -> Vec<CameraCoverage> {
     cameras
@@ -88,7 +88,7 @@ pub fn field_coverage(
 
 /// The cameras whose coverage holds field point `p` (centimetres), in the order given.
 #[must_use]
-pub fn cameras_seeing(coverage: &[CameraCoverage], p: [f64; 2]) -> Vec<CameraId> {
+pub fn cameras_seeing(coverage: &[CameraCoverage], p: [f64; 2]) -> Vec<SslCameraId> {
     coverage
         .iter()
         .filter(|c| c.contains(p))
@@ -172,20 +172,20 @@ mod tests {
         let mut right = pinhole();
         right.pose.position_cm[0] += 400.0;
         let cams = [
-            (CameraId(3), left, 640, 400),
-            (CameraId(7), right, 640, 400),
-            (CameraId(9), pinhole(), 640, 480),
+            (SslCameraId(3), left, 640, 400),
+            (SslCameraId(7), right, 640, 400),
+            (SslCameraId(9), pinhole(), 640, 480),
         ];
         let coverage = field_coverage(&cams, 0.0);
         assert_eq!(coverage.len(), 2, "the mismatched frame size is left out");
-        assert_eq!(cameras_seeing(&coverage, [0.0, 0.0]), vec![CameraId(3)]);
+        assert_eq!(cameras_seeing(&coverage, [0.0, 0.0]), vec![SslCameraId(3)]);
         assert_eq!(
             cameras_seeing(&coverage, [200.0, 100.0]),
-            vec![CameraId(3), CameraId(7)]
+            vec![SslCameraId(3), SslCameraId(7)]
         );
         assert_eq!(
             cameras_seeing(&coverage, [400.0, -140.0]),
-            vec![CameraId(7)]
+            vec![SslCameraId(7)]
         );
         assert!(cameras_seeing(&coverage, [200.0, 200.0]).is_empty());
     }
