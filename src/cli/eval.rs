@@ -4,7 +4,7 @@
 //! relation to the truth and writes it as recognition parameters. `--labels` scores a real
 //! stream against hand labels instead (`eval_labels.rs`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use serde::Serialize;
@@ -411,30 +411,6 @@ fn calibrate_goals(
     Ok((m, o))
 }
 
-/// `eotn eval OVERHEAD… --truth-ssl LOG|udp://…`: the overhead streams against ssl-vision's
-/// detections.
-fn run_truth_ssl(args: &Args, source: &Path, lut_path: &Path) -> anyhow::Result<()> {
-    super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
-        .context("--truth-ssl is the truth of overhead streams")?;
-    let truth = super::eval_overhead::load_ssl_truth(source)?;
-    super::eval_overhead::run(
-        &args.streams,
-        args.camera.get(),
-        lut_path,
-        args.calibration.as_deref(),
-        args.field.as_deref(),
-        &truth,
-        args.json,
-    )
-}
-
-/// The streams among `args.streams` whose source kind is not an overhead camera's.
-fn robot_camera_streams(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
-    let inputs =
-        super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
-    Ok(inputs.robot_streams().to_vec())
-}
-
 /// Runs `eotn eval`.
 ///
 /// # Errors
@@ -446,41 +422,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     run_streams(args)
 }
 
-/// The overhead evaluation when every stream is an overhead one (`None`: none is), an error when
-/// some are.
-fn run_overhead(args: &Args, lut: &std::path::Path) -> Option<anyhow::Result<()>> {
-    let overhead = args
-        .streams
-        .iter()
-        .filter(|p| super::eval_overhead::is_overhead_stream(p))
-        .count();
-    if overhead == args.streams.len() {
-        Some(super::eval_overhead::run(
-            &args.streams,
-            args.camera.get(),
-            lut,
-            args.calibration.as_deref(),
-            args.field.as_deref(),
-            &super::eval_overhead::TruthSource::Stream,
-            args.json,
-        ))
-    } else if overhead > 0 {
-        Some(Err(anyhow::anyhow!(
-            "give overhead streams and robot-camera streams to separate `eotn eval` runs"
-        )))
-    } else {
-        None
-    }
-}
-
 /// `eotn eval` on streams.
 fn run_streams(args: &Args) -> anyhow::Result<()> {
     let lut_path =
         super::inputs::table_or_camera_s(args.lut.as_deref(), &args.streams, args.camera.get())?;
     if let Some(source) = &args.truth_ssl {
-        return run_truth_ssl(args, source, &lut_path);
+        return super::eval_overhead::run_truth_ssl(args, source, &lut_path);
     }
-    if let Some(overhead) = run_overhead(args, &lut_path) {
+    if let Some(overhead) = super::eval_overhead::run_overhead(args, &lut_path) {
         return overhead;
     }
     if args.calibration.is_some() || args.field.is_some() {

@@ -428,3 +428,61 @@ pub(super) fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &
         );
     }
 }
+
+/// `eotn eval OVERHEAD… --truth-ssl LOG|udp://…`: the overhead streams against ssl-vision's
+/// detections.
+pub(super) fn run_truth_ssl(
+    args: &super::eval::Args,
+    source: &Path,
+    lut_path: &Path,
+) -> anyhow::Result<()> {
+    super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
+        .context("--truth-ssl is the truth of overhead streams")?;
+    let truth = load_ssl_truth(source)?;
+    run(
+        &args.streams,
+        args.camera.get(),
+        lut_path,
+        args.calibration.as_deref(),
+        args.field.as_deref(),
+        &truth,
+        args.json,
+    )
+}
+
+/// The streams among `args.streams` whose source kind is not an overhead camera's.
+fn robot_camera_streams(args: &super::eval::Args) -> anyhow::Result<Vec<PathBuf>> {
+    let inputs =
+        super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
+    Ok(inputs.robot_streams().to_vec())
+}
+
+/// The overhead evaluation when every stream is an overhead one (`None`: none is), an error when
+/// some are.
+pub(super) fn run_overhead(
+    args: &super::eval::Args,
+    lut: &std::path::Path,
+) -> Option<anyhow::Result<()>> {
+    let overhead = args
+        .streams
+        .iter()
+        .filter(|p| is_overhead_stream(p))
+        .count();
+    if overhead == args.streams.len() {
+        Some(run(
+            &args.streams,
+            args.camera.get(),
+            lut,
+            args.calibration.as_deref(),
+            args.field.as_deref(),
+            &TruthSource::Stream,
+            args.json,
+        ))
+    } else if overhead > 0 {
+        Some(Err(anyhow::anyhow!(
+            "give overhead streams and robot-camera streams to separate `eotn eval` runs"
+        )))
+    } else {
+        None
+    }
+}

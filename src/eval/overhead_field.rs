@@ -16,7 +16,7 @@ use super::overhead::{
     OverheadEvalParams, OverheadEvalReport, OverheadFrameEval, angle_diff, label,
 };
 use crate::model::truth::{OverheadRobot as TruthRobot, OverheadTruth};
-use crate::overhead::merge::{SslCameraId, FieldPicture, FieldRobot};
+use crate::overhead::merge::{FieldPicture, FieldRobot, SslCameraId};
 
 /// One field frame's comparison.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
