@@ -426,11 +426,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 fn run_streams(args: &Args) -> anyhow::Result<()> {
     let lut_path =
         super::inputs::table_or_camera_s(args.lut.as_deref(), &args.streams, args.camera.get())?;
-    if let Some(source) = &args.truth_ssl {
-        return super::eval_overhead::run_truth_ssl(args, source, &lut_path);
-    }
-    if let Some(overhead) = super::eval_overhead::run_overhead(args, &lut_path) {
-        return overhead;
+    if super::eval_overhead::run_from_eval(args, &lut_path)? {
+        return Ok(());
     }
     if args.calibration.is_some() || args.field.is_some() {
         super::overhead::refuse_robot_streams(&args.streams)

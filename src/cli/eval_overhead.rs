@@ -431,11 +431,7 @@ pub(super) fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &
 
 /// `eotn eval OVERHEAD… --truth-ssl LOG|udp://…`: the overhead streams against ssl-vision's
 /// detections.
-pub(super) fn run_truth_ssl(
-    args: &super::eval::Args,
-    source: &Path,
-    lut_path: &Path,
-) -> anyhow::Result<()> {
+fn run_truth_ssl(args: &super::eval::Args, source: &Path, lut_path: &Path) -> anyhow::Result<()> {
     super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
         .context("--truth-ssl is the truth of overhead streams")?;
     let truth = load_ssl_truth(source)?;
@@ -457,32 +453,31 @@ fn robot_camera_streams(args: &super::eval::Args) -> anyhow::Result<Vec<PathBuf>
     Ok(inputs.robot_streams().to_vec())
 }
 
-/// The overhead evaluation when every stream is an overhead one (`None`: none is), an error when
-/// some are.
-pub(super) fn run_overhead(
-    args: &super::eval::Args,
-    lut: &std::path::Path,
-) -> Option<anyhow::Result<()>> {
+/// Overhead streams, against their own truth or ssl-vision's (`--truth-ssl`), are evaluated by
+/// `eval_overhead`: `Ok(true)` when they were, `Ok(false)` when the streams are robot cameras'.
+pub(super) fn run_from_eval(args: &super::eval::Args, lut_path: &Path) -> anyhow::Result<bool> {
+    if let Some(source) = &args.truth_ssl {
+        run_truth_ssl(args, source, lut_path)?;
+        return Ok(true);
+    }
     let overhead = args
         .streams
         .iter()
         .filter(|p| is_overhead_stream(p))
         .count();
     if overhead == args.streams.len() {
-        Some(run(
+        run(
             &args.streams,
             args.camera.get(),
-            lut,
+            lut_path,
             args.calibration.as_deref(),
             args.field.as_deref(),
             &TruthSource::Stream,
             args.json,
-        ))
+        )?;
+        return Ok(true);
     } else if overhead > 0 {
-        Some(Err(anyhow::anyhow!(
-            "give overhead streams and robot-camera streams to separate `eotn eval` runs"
-        )))
-    } else {
-        None
+        bail!("give overhead streams and robot-camera streams to separate `eotn eval` runs");
     }
+    Ok(false)
 }

@@ -350,39 +350,8 @@ impl Workspace {
     /// Applies an overhead command.
     pub(super) fn apply_overhead(&mut self, command: OverheadCommand) -> anyhow::Result<()> {
         match command {
-            OverheadCommand::OpenCalibration(p) => {
-                let cal = Calibration::load(&p)?;
-                let review = crate::overhead::review::review(&cal);
-                if let Some(refusal) = review.refusal() {
-                    anyhow::bail!("{}: not usable: {refusal}", p.display());
-                }
-                for f in &review.findings {
-                    self.warn(format!("{}: {f}", p.display()));
-                }
-                self.status = format!(
-                    "opened calibration {}: {} points, median error {:.2} px",
-                    p.display(),
-                    cal.points.len(),
-                    cal.median_point_error_px()
-                );
-                let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
-                self.remember_for_camera(|f| f.calibration = Some(canonical));
-                self.overhead.user_calibration = Some(cal);
-                self.overhead.calibration_path = Some(p);
-                self.reprocess();
-            }
-            OverheadCommand::SaveCalibration(p) => {
-                let cal = self
-                    .overhead
-                    .user_calibration
-                    .as_ref()
-                    .context("no calibration to save: open one or Calibrate first")?;
-                cal.save(&p)?;
-                let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
-                self.remember_for_camera(|f| f.calibration = Some(canonical));
-                self.overhead.calibration_path = Some(p.clone());
-                self.status = format!("saved calibration {}", p.display());
-            }
+            OverheadCommand::OpenCalibration(p) => self.open_calibration(p)?,
+            OverheadCommand::SaveCalibration(p) => self.save_calibration(p)?,
             OverheadCommand::CloseCalibration => {
                 self.overhead.user_calibration = None;
                 self.overhead.calibration_path = None;
@@ -449,6 +418,46 @@ impl Workspace {
                 self.frame_generation += 1;
             }
         }
+        Ok(())
+    }
+
+    /// Uses the calibration file `p` (refused when its review finds it unusable; its doubts
+    /// are warnings).
+    fn open_calibration(&mut self, p: PathBuf) -> anyhow::Result<()> {
+        let cal = Calibration::load(&p)?;
+        let review = crate::overhead::review::review(&cal);
+        if let Some(refusal) = review.refusal() {
+            anyhow::bail!("{}: not usable: {refusal}", p.display());
+        }
+        for f in &review.findings {
+            self.warn(format!("{}: {f}", p.display()));
+        }
+        self.status = format!(
+            "opened calibration {}: {} points, median error {:.2} px",
+            p.display(),
+            cal.points.len(),
+            cal.median_point_error_px()
+        );
+        let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+        self.remember_for_camera(|f| f.calibration = Some(canonical));
+        self.overhead.user_calibration = Some(cal);
+        self.overhead.calibration_path = Some(p);
+        self.reprocess();
+        Ok(())
+    }
+
+    /// Saves the calibration opened or solved as `p`, and remembers it for the camera.
+    fn save_calibration(&mut self, p: PathBuf) -> anyhow::Result<()> {
+        let cal = self
+            .overhead
+            .user_calibration
+            .as_ref()
+            .context("no calibration to save: open one or Calibrate first")?;
+        cal.save(&p)?;
+        let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+        self.remember_for_camera(|f| f.calibration = Some(canonical));
+        self.overhead.calibration_path = Some(p.clone());
+        self.status = format!("saved calibration {}", p.display());
         Ok(())
     }
 
