@@ -54,7 +54,8 @@ EOTN_SERVE_LOAD_STALLED=40 EOTN_SERVE_LOAD_SECONDS=${SERVE_SECONDS:-20} cargo te
 # rule picks `portable` there). A type check of the library without the app, no linking; the C
 # parts of the dependencies (SQLite, zstd, lz4) need a cross C compiler (Debian:
 # gcc-aarch64-linux-gnu) and the target (`rustup target add aarch64-unknown-linux-gnu`). Skipped,
-# said so, when either is missing. About 9 minutes cold on 2 busy cores (2026-12-07).
+# said so, when either is missing. Cold: 9.5 CPU-minutes, 23 minutes on 2 busy cores (2026-12-07),
+# too long for .ci/run.
 if rustup target list --installed 2>/dev/null | grep -qx aarch64-unknown-linux-gnu &&
   command -v aarch64-linux-gnu-gcc >/dev/null; then
   CC_aarch64_unknown_linux_gnu=aarch64-linux-gnu-gcc cargo check --quiet --lib \
