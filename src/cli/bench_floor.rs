@@ -23,6 +23,8 @@ pub struct Floor {
     program: PathBuf,
     dir: PathBuf,
     lut: PathBuf,
+    /// The table's bits per channel (which fixed-depth classify line is its).
+    bits: u8,
     /// Where the program came from, for the report.
     pub source: PathBuf,
 }
@@ -53,6 +55,7 @@ impl Floor {
             program: source.to_path_buf(),
             lut: dir.join("table.lut"),
             dir,
+            bits: lut.bits(),
             source: source.to_path_buf(),
         };
         std::fs::write(&floor.lut, lut.cells())
@@ -82,6 +85,32 @@ impl Floor {
     /// # Errors
     /// A frame that is not UYVY, or a floor that fails or prints no figure.
     pub fn measure(&self, frame: &Frame) -> anyhow::Result<f64> {
+        let text = self.run(frame)?;
+        parse_floor(&text)
+            .with_context(|| format!("no `{FLOOR_LINE}` figure from {}", self.program.display()))
+    }
+
+    /// The floor's median of each stage it has on `frame` (UYVY only), milliseconds a frame.
+    ///
+    /// # Errors
+    /// A frame that is not UYVY, or a floor that fails or misses a figure.
+    pub fn measure_stages(&self, frame: &Frame) -> anyhow::Result<FloorStages> {
+        let text = self.run(frame)?;
+        let get = |label: &str| {
+            parse_ms(&text, label)
+                .with_context(|| format!("no `{label}` figure from {}", self.program.display()))
+        };
+        let classify = format!("classify const b={}", self.bits);
+        Ok(FloorStages {
+            frame_copy_ms: get("memcpy frame (UYVY bytes)")?,
+            classify_ms: get(&classify)?,
+            blobs_ms: get("rle(avx2)+uf cc conn=8")?,
+            pipeline_ms: get(FLOOR_LINE)?,
+        })
+    }
+
+    /// The floor's output on `frame`.
+    fn run(&self, frame: &Frame) -> anyhow::Result<String> {
         if frame.layout() != PixelLayout::Uyvy {
             bail!("the C floor reads UYVY frames only");
         }
@@ -95,7 +124,6 @@ impl Floor {
             .arg(&self.lut)
             .output()
             .with_context(|| format!("running {}", self.program.display()))?;
-        let text = String::from_utf8_lossy(&out.stdout);
         if !out.status.success() {
             bail!(
                 "{} failed: {}",
@@ -103,8 +131,7 @@ impl Floor {
                 String::from_utf8_lossy(&out.stderr).trim()
             );
         }
-        parse_floor(&text)
-            .with_context(|| format!("no `{FLOOR_LINE}` figure from {}", self.program.display()))
+        Ok(String::from_utf8_lossy(&out.stdout).into_owned())
     }
 }
 
@@ -113,6 +140,31 @@ impl Drop for Floor {
         // Best effort: a leftover scratch folder in the temporary directory harms nothing.
         let _ = std::fs::remove_dir_all(&self.dir);
     }
+}
+
+/// The C floor's median of each stage on one frame, milliseconds a frame.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FloorStages {
+    /// Copying the frame's bytes (`memcpy`): no stage can be faster than reading its input.
+    pub frame_copy_ms: f64,
+    /// The table lookup of every pixel, the table's bit depth fixed at compile time.
+    pub classify_ms: f64,
+    /// Run-length encoding (AVX2 run search) and union-find, 8-connected.
+    pub blobs_ms: f64,
+    /// Both in a row.
+    pub pipeline_ms: f64,
+}
+
+/// The ms/frame figure of the line starting with `label` (`LABEL X ms/frame Y ns/pixel`).
+fn parse_ms(text: &str, label: &str) -> Option<f64> {
+    let rest = text.lines().find_map(|l| l.strip_prefix(label))?;
+    let words: Vec<&str> = rest.split_whitespace().collect();
+    let at = words.iter().position(|&w| w == "ms/frame")?;
+    words
+        .get(at.checked_sub(1)?)?
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite())
 }
 
 /// The ns/pixel figure of the pipeline line (`… ms/frame X ns/pixel`).
@@ -129,7 +181,22 @@ fn parse_floor(text: &str) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
-    use super::parse_floor;
+    use super::{parse_floor, parse_ms};
+
+    #[test]
+    fn each_stage_figure_is_read_by_its_label() {
+        let out = "memcpy frame (UYVY bytes)      0.2100 ms/frame   0.091 ns/pixel\n\
+                   classify const b=7             1.0500 ms/frame   0.456 ns/pixel\n\
+                   rle(avx2)+uf cc conn=8         0.3000 ms/frame   0.130 ns/pixel\n";
+        assert_eq!(parse_ms(out, "classify const b=7"), Some(1.05));
+        assert_eq!(parse_ms(out, "rle(avx2)+uf cc conn=8"), Some(0.3));
+        assert_eq!(parse_ms(out, "memcpy frame (UYVY bytes)"), Some(0.21));
+        assert_eq!(parse_ms(out, "classify const b=6"), None);
+        assert_eq!(
+            parse_ms("classify const b=7 nan ms/frame", "classify const b=7"),
+            None
+        );
+    }
 
     #[test]
     fn the_pipeline_figure_is_read_and_garbage_is_not() {

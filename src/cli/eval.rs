@@ -27,12 +27,20 @@ use crate::streams::StreamReader;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Streams with a `/ground_truth` channel (from `eotn sim`).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "session")]
     pub streams: Vec<PathBuf>,
     /// Lookup table; default: the table the first recording names for the camera read (its
     /// `REC.cameras.json` sidecar, else its metadata).
     #[arg(long)]
     pub lut: Option<PathBuf>,
+    /// A whole overhead field instead of streams: every camera of a session file (`eotn
+    /// overhead sim-field` writes one) through its own table and calibration, each field
+    /// frame's merged picture against the truth, and each camera's own detections beside it.
+    #[arg(long, conflicts_with_all = [
+        "streams", "lut", "params", "compare_lut", "compare_params", "calibrate_goals", "plots",
+        "labels", "patterns", "calibration", "field", "topic", "truth_ssl",
+    ])]
+    pub session: Option<PathBuf>,
     /// Recognition parameters JSON (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
@@ -408,6 +416,14 @@ fn calibrate_goals(
 /// # Errors
 /// Unreadable inputs or streams without ground truth, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if let Some(session) = &args.session {
+        return super::eval_field::run(session, args.json);
+    }
+    run_streams(args)
+}
+
+/// `eotn eval` on streams.
+fn run_streams(args: &Args) -> anyhow::Result<()> {
     let lut_path =
         super::inputs::table_or_camera_s(args.lut.as_deref(), &args.streams, args.camera.get())?;
     if super::eval_overhead::run_from_eval(args, &lut_path)? {

@@ -345,7 +345,8 @@ fn three(p: Option<&Percentiles>, unit: &str) -> String {
     )
 }
 
-fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
+/// The overhead report as text (`calibration`: what the frames were read through).
+pub(super) fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
     let pct = |n: usize, d: usize| {
         if d == 0 {
             "—".to_owned()

@@ -155,6 +155,21 @@ pub type FieldViews = (
     Vec<(MergeCameraId, u64)>,
 );
 
+/// One camera's frame of a field frame, through its pipeline.
+#[derive(Debug, Clone)]
+pub struct CameraView {
+    /// The camera's session id.
+    pub id: MergeCameraId,
+    /// Its frame's index in its recording.
+    pub index: usize,
+    /// Its frame's time, nanoseconds on its recording's clock.
+    pub time_ns: u64,
+    /// What its pipeline found.
+    pub detections: OverheadDetections,
+    /// The frame's overhead truth (simulated recordings).
+    pub truth: Option<OverheadTruth>,
+}
+
 /// Each camera's frame times, nanoseconds on its recording's clock, in frame order.
 #[must_use]
 pub fn frame_times(cameras: &[FieldCamera]) -> Vec<Vec<u64>> {
@@ -170,11 +185,10 @@ pub fn frame_times(cameras: &[FieldCamera]) -> Vec<Vec<u64>> {
 
 /// One field frame's views: the reference camera's frame `i` and each other camera's frame
 /// within half a frame period of it (`times` from [`frame_times`]), each through its own
-/// pipeline; with the (camera, frame time) of each view.
+/// pipeline; with the (camera, frame time) of each view. See [`camera_views`].
 ///
 /// # Errors
-/// A camera's frame of another shape than its calibration. An unreadable frame is warned about
-/// and left out.
+/// As [`camera_views`].
 pub fn field_views(
     cameras: &mut [FieldCamera],
     times: &[Vec<u64>],
@@ -182,33 +196,122 @@ pub fn field_views(
     period_ns: u64,
     sizes: &mut [super::overhead::SizeCheck],
 ) -> anyhow::Result<FieldViews> {
+    Ok(camera_views(cameras, times, i, period_ns, sizes)?
+        .into_iter()
+        .map(|v| ((v.id, v.detections), (v.id, v.time_ns)))
+        .unzip())
+}
+
+/// One field frame's views, in camera order: the reference camera's frame `i` and each other
+/// camera's frame within half a frame period of it (`times` from [`frame_times`]), each read
+/// and run through its own pipeline. The cameras run in parallel, on up to every core
+/// ([`worker_threads`]): each camera's reading and pipeline are its own.
+///
+/// # Errors
+/// A camera's frame of another shape than its calibration (`sizes`: one check per camera). An
+/// unreadable frame is warned about and left out.
+pub fn camera_views(
+    cameras: &mut [FieldCamera],
+    times: &[Vec<u64>],
+    i: usize,
+    period_ns: u64,
+    sizes: &mut [super::overhead::SizeCheck],
+) -> anyhow::Result<Vec<CameraView>> {
     let Some(&t_ref) = times.first().and_then(|t| t.get(i)) else {
-        return Ok((Vec::new(), Vec::new()));
+        return Ok(Vec::new());
     };
-    let (mut views, mut frames) = (Vec::new(), Vec::new());
-    for (k, cam) in cameras.iter_mut().enumerate() {
-        let index = if k == 0 {
-            Some(i)
-        } else {
-            times
-                .get(k)
-                .and_then(|t| crate::overhead::merge::frame_near(t, t_ref, period_ns))
-        };
-        let Some(index) = index else { continue };
-        let f = match cam.read(index) {
+    let mut spare: Vec<super::overhead::SizeCheck> = Vec::new();
+    spare.resize_with(cameras.len().saturating_sub(sizes.len()), Default::default);
+    let jobs: Vec<CameraJob<'_>> = cameras
+        .iter_mut()
+        .zip(sizes.iter_mut().chain(spare.iter_mut()))
+        .enumerate()
+        .filter_map(|(k, (camera, size))| {
+            let index = if k == 0 {
+                Some(i)
+            } else {
+                times
+                    .get(k)
+                    .and_then(|t| crate::overhead::merge::frame_near(t, t_ref, period_ns))
+            }?;
+            Some(CameraJob {
+                camera,
+                size,
+                index,
+            })
+        })
+        .collect();
+    let workers = worker_threads().min(jobs.len()).max(1);
+    let mut groups: Vec<Vec<CameraJob<'_>>> = (0..workers).map(|_| Vec::new()).collect();
+    for (n, job) in jobs.into_iter().enumerate() {
+        groups[n % workers].push(job);
+    }
+    let run_group = |group: Vec<CameraJob<'_>>| -> Vec<anyhow::Result<Option<CameraView>>> {
+        group.into_iter().map(CameraJob::run).collect()
+    };
+    let mut first = groups.remove(0);
+    let results: Vec<Vec<anyhow::Result<Option<CameraView>>>> = std::thread::scope(|s| {
+        let handles: Vec<_> = groups
+            .into_iter()
+            .map(|g| s.spawn(move || run_group(g)))
+            .collect();
+        let mine = run_group(std::mem::take(&mut first));
+        std::iter::once(Ok(mine))
+            .chain(handles.into_iter().map(|h| h.join()))
+            .map(|r| r.unwrap_or_else(|_| vec![Err(anyhow::anyhow!("a camera's thread failed"))]))
+            .collect()
+    });
+    // Back into camera order (job n ran in group n % workers, at place n / workers).
+    let mut out = Vec::new();
+    let longest = results.iter().map(Vec::len).max().unwrap_or(0);
+    let mut results: Vec<std::vec::IntoIter<_>> = results.into_iter().map(Vec::into_iter).collect();
+    for _ in 0..longest {
+        for group in &mut results {
+            if let Some(r) = group.next() {
+                out.extend(r?);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// One camera's part of a field frame: which of its frames, and its size check.
+struct CameraJob<'a> {
+    camera: &'a mut FieldCamera,
+    size: &'a mut super::overhead::SizeCheck,
+    index: usize,
+}
+
+impl CameraJob<'_> {
+    /// Reads the frame and runs the camera's pipeline on it; `None` (warned) when the frame
+    /// cannot be read.
+    fn run(self) -> anyhow::Result<Option<CameraView>> {
+        let cam = self.camera;
+        let f = match cam.read(self.index) {
             Ok(f) => f,
             Err(e) => {
                 log::warn!("camera {}: {e:#}; left out of this field frame", cam.id);
-                continue;
+                return Ok(None);
             }
         };
         let camera = *cam.pipeline.camera();
-        let name = format!("{} frame {index}", cam.name);
-        if let Some(size) = sizes.get_mut(k) {
-            size.check(&camera, &name, f.frame.width(), f.frame.height())?;
-        }
-        views.push((cam.id, cam.pipeline.process(&f.frame).clone()));
-        frames.push((cam.id, f.time_ns));
+        let name = format!("{} frame {}", cam.name, self.index);
+        self.size
+            .check(&camera, &name, f.frame.width(), f.frame.height())?;
+        let detections = cam.pipeline.process(&f.frame).clone();
+        Ok(Some(CameraView {
+            id: cam.id,
+            index: self.index,
+            time_ns: f.time_ns,
+            detections,
+            truth: f.truth,
+        }))
     }
-    Ok((views, frames))
+}
+
+/// Threads a field frame's cameras run on: every core (`available_parallelism`), decided once.
+#[must_use]
+pub fn worker_threads() -> usize {
+    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *THREADS.get_or_init(|| std::thread::available_parallelism().map_or(1, std::num::NonZero::get))
 }

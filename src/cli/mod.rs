@@ -21,6 +21,7 @@ pub mod detect;
 mod detect_field;
 mod eval;
 mod eval_boxes;
+mod eval_field;
 mod eval_labels;
 mod eval_overhead;
 mod export;

@@ -9,6 +9,7 @@ pub mod beacons;
 pub mod label_sets;
 pub mod labels;
 pub mod overhead;
+pub mod overhead_field;
 pub mod patterns;
 pub mod plots;
 pub mod skew;

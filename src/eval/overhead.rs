@@ -61,11 +61,13 @@ pub struct OverheadFrameEval {
     pub wrong_identities: Vec<(String, String)>,
 }
 
-fn angle_diff(a: f64, b: f64) -> f64 {
+/// `a − b` wrapped into [−π, π), radians.
+pub(super) fn angle_diff(a: f64, b: f64) -> f64 {
     (a - b + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
 }
 
-fn label(team: MarkerTeam, id: MarkerIdentity) -> String {
+/// A marker as `eval` names it (`blue 3`).
+pub(super) fn label(team: MarkerTeam, id: MarkerIdentity) -> String {
     format!("{} {id}", team.name())
 }
 

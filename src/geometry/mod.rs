@@ -42,7 +42,7 @@ pub use kinematics::{
 };
 pub use lens::{LensError, LensModel};
 pub use marker::{MarkerIdentity, MarkerTeam, RobotMarker};
-pub use overhead::OverheadCamera;
+pub use overhead::{OverheadCamera, OverheadProjector};
 
 /// The field frame: origin at the centre spot, x towards the yellow goal, y left, z up (cm).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

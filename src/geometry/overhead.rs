@@ -162,11 +162,22 @@ impl OverheadCamera {
     }
 
     /// Where a field point appears in the image, or `None` behind the camera. The result may lie
-    /// outside the image.
+    /// outside the image. (Many points: [`OverheadProjector`], which builds the pose once.)
     #[must_use]
     pub fn image_from_field(&self, p: &Point<Field>) -> Option<ImagePoint> {
         let c = self.field_from_camera().inverse() * *p;
         self.image_from_camera(&c)
+    }
+
+    /// This camera ready to carry many points: its pose's transforms built once.
+    #[must_use]
+    pub fn projector(&self) -> OverheadProjector {
+        let field_from_camera = self.field_from_camera();
+        OverheadProjector {
+            camera: *self,
+            camera_from_field: field_from_camera.inverse(),
+            field_from_camera,
+        }
     }
 
     /// Where a camera-frame point appears in the image, or `None` behind the camera.
@@ -196,14 +207,54 @@ impl OverheadCamera {
     /// or `None` when it does not.
     #[must_use]
     pub fn field_from_image(&self, p: ImagePoint, z_cm: f64) -> Option<Point<Field>> {
-        let field_from_camera = self.field_from_camera();
-        let ray = (field_from_camera * self.camera_ray(p)?).coords;
+        self.field_from_image_through(&self.field_from_camera(), p, z_cm)
+    }
+
+    fn field_from_image_through(
+        &self,
+        field_from_camera: &Transform<Field, Camera>,
+        p: ImagePoint,
+        z_cm: f64,
+    ) -> Option<Point<Field>> {
+        let ray = (*field_from_camera * self.camera_ray(p)?).coords;
         let origin = field_from_camera.origin().coords;
         if ray.z.abs() < 1e-12 {
             return None;
         }
         let t = (z_cm - origin.z) / ray.z;
         (t > 0.0 && t.is_finite()).then(|| Point::from(Point3::from(origin.coords + ray * t)))
+    }
+}
+
+/// An [`OverheadCamera`] with its pose's transforms built once ([`OverheadCamera::projector`]):
+/// the same results bit for bit, without rebuilding the rotation from the pose's angles for
+/// every point — the overhead recogniser carries thousands of points through the lens a frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OverheadProjector {
+    camera: OverheadCamera,
+    field_from_camera: Transform<Field, Camera>,
+    camera_from_field: Transform<Camera, Field>,
+}
+
+impl OverheadProjector {
+    /// The camera.
+    #[must_use]
+    pub fn camera(&self) -> &OverheadCamera {
+        &self.camera
+    }
+
+    /// As [`OverheadCamera::image_from_field`].
+    #[must_use]
+    pub fn image_from_field(&self, p: &Point<Field>) -> Option<ImagePoint> {
+        self.camera
+            .image_from_camera(&(self.camera_from_field * *p))
+    }
+
+    /// As [`OverheadCamera::field_from_image`].
+    #[must_use]
+    pub fn field_from_image(&self, p: ImagePoint, z_cm: f64) -> Option<Point<Field>> {
+        self.camera
+            .field_from_image_through(&self.field_from_camera, p, z_cm)
     }
 }
 

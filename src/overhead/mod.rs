@@ -10,12 +10,15 @@
 //!   [`pipeline`] runs classification, blobs and it on a frame.
 //! - [`merge`]: several cameras' detections of one instant → one field picture (robots by
 //!   identity, the ball by confidence), and which frames form one field frame.
+//! - [`coverage`]: each camera's view of the field as a polygon (from its calibration and
+//!   frame size), and which cameras see a field point.
 //! - [`undistort`]: the undistorted view; [`drawing`]: the printable marker (SVG).
 //!
 //! The marker's layout itself is a geometry type (`geometry::marker`) because the simulator
 //! paints it too.
 
 pub mod calibration;
+pub mod coverage;
 pub mod drawing;
 pub mod field;
 pub mod intrinsics;

@@ -10,7 +10,9 @@ use crate::frame::Frame;
 use crate::geometry::OverheadCamera;
 use crate::lut::LookupTable;
 
-use super::recognise::{OverheadDetections, OverheadParams, recognise_overhead};
+use super::recognise::{
+    OverheadDetections, OverheadParams, RecognitionParts, recognise_overhead_timed,
+};
 
 /// How long each stage took on the last frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -21,6 +23,8 @@ pub struct OverheadTimings {
     pub blobs: Duration,
     /// Ball and markers.
     pub recognition: Duration,
+    /// Of recognition: the ball, the markers, and the points carried through the lens.
+    pub parts: RecognitionParts,
 }
 
 impl OverheadTimings {
@@ -126,16 +130,18 @@ impl OverheadPipeline {
         let t1 = Instant::now();
         self.blobs.find(&self.classified, Connectivity::Eight);
         let t2 = Instant::now();
-        self.detections = match self.camera_for(frame) {
+        let parts;
+        (self.detections, parts) = match self.camera_for(frame) {
             Some(camera) => {
-                recognise_overhead(&self.classified, &self.blobs, &camera, &self.params)
+                recognise_overhead_timed(&self.classified, &self.blobs, &camera, &self.params)
             }
-            None => OverheadDetections::default(),
+            None => Default::default(),
         };
         self.timings = OverheadTimings {
             classify: t1 - t0,
             blobs: t2 - t1,
             recognition: t2.elapsed(),
+            parts,
         };
         &self.detections
     }

@@ -155,3 +155,76 @@ fn every_kernel_set_equals_the_portable_one_on_real_frames() {
         check_stream("streams/bhuman2009.mcap", &converted.table, name);
     }
 }
+
+/// `eotn bench --chosen-only --json` on a small frame with `EOTN_KERNELS` set to `value`.
+fn bench_with_kernels(value: &str) -> std::process::Output {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = Frame::uyvy_from_fn(208, 160, |x, _| {
+        eotn::frame::Yuv::new(if x < 100 { 90 } else { 160 }, 110, 110)
+    })
+    .unwrap();
+    let path = dir.path().join("f.uyvy");
+    std::fs::write(&path, frame.data()).unwrap();
+    std::process::Command::new(env!("CARGO_BIN_EXE_eotn"))
+        .env(eotn::kernels::ENV_VAR, value)
+        .args(["bench", "--chosen-only", "--no-floor", "--json"])
+        .args(["--reps", "1", "--warmup", "0", "--size", "208x160", "--lut"])
+        .arg(repo_file("lookup_tables/sample.lut"))
+        .arg(&path)
+        .output()
+        .expect("the eotn binary runs")
+}
+
+/// The kernel set `eotn bench --json` says it ran.
+fn kernels_run(out: &std::process::Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let last: serde_json::Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
+    last["kernels"].as_str().unwrap_or_default().to_owned()
+}
+
+#[test]
+fn eotn_kernels_on_the_command_line_runs_a_runnable_set_and_stops_on_others() {
+    for set in runnable(cpu()) {
+        assert_eq!(kernels_run(&bench_with_kernels(set.name())), set.name());
+    }
+    let auto = eotn::kernels::choose(cpu()).name();
+    assert_eq!(kernels_run(&bench_with_kernels("auto")), auto);
+    // An unknown name: one clear line naming the variable and the sets, nothing run.
+    let out = bench_with_kernels("avx9");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("EOTN_KERNELS=\"avx9\" is not a kernel set") && err.contains("portable"),
+        "{err}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "nothing ran: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    // A set this CPU lacks the instructions for: refused, naming what it can run.
+    match KernelSet::ALL
+        .into_iter()
+        .find(|s| !runnable(cpu()).contains(s))
+    {
+        Some(missing) => {
+            let out = bench_with_kernels(missing.name());
+            assert!(!out.status.success());
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                err.contains(&format!("EOTN_KERNELS={missing}: this CPU cannot run it"))
+                    && err.contains("portable"),
+                "{err}"
+            );
+        }
+        None => crate::common::skip_noted(
+            "this CPU runs every kernel set, so refusing one it cannot run is not exercised",
+            "run on a CPU without AVX-512 (or without AVX2); the rule is unit-tested against a table of CPUs",
+        ),
+    }
+}
