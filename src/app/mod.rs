@@ -191,6 +191,9 @@ pub struct EotnApp {
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
     pub last_view: Option<ImageTransform>,
+    /// Where the timeline's marks were last spread: the slider's track (tests compare it
+    /// with the slider's own rectangle).
+    pub last_timeline_track: Option<egui::Rect>,
     /// Cameras side by side: (image topic, where its image was last drawn), left to right.
     pub last_panes: Vec<(String, ImageTransform)>,
     beside_textures: side_by_side::BesideTextures,
@@ -268,6 +271,7 @@ impl EotnApp {
             file_dialogs: file_dialog::FileDialogs::default(),
             hovered: None,
             last_view: None,
+            last_timeline_track: None,
             last_panes: Vec::new(),
             beside_textures: side_by_side::BesideTextures::default(),
             confirm_close: false,
@@ -292,6 +296,16 @@ impl EotnApp {
             A::OpenTable | A::SaveTableAs => self.state.table_path().map(std::path::Path::to_owned),
             A::OpenParams | A::SaveParams => self.state.params_slot().path.clone(),
             A::OpenPlaces => self.state.places_path().map(std::path::Path::to_owned),
+            A::OpenCalibration | A::SaveCalibration => self
+                .state
+                .overhead()
+                .calibration_path()
+                .map(std::path::Path::to_owned),
+            A::OpenPoints | A::SavePoints => self
+                .state
+                .overhead()
+                .points_path()
+                .map(std::path::Path::to_owned),
             A::Open | A::ExportView | A::Record => self.state.settings.last_source.first().cloned(),
         };
         file.and_then(|f| f.parent().map(std::path::Path::to_owned))

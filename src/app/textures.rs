@@ -7,7 +7,7 @@ use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
 use super::EotnApp;
 use super::overlays::FrameTextures;
-use crate::workspace::Workspace;
+use crate::workspace::{PreviewPixel, Workspace, hatch_rgb};
 
 /// How much the pixels outside a pending selection are darkened (alpha of black over them).
 const PREVIEW_DIM_ALPHA: u8 = 110;
@@ -72,27 +72,32 @@ pub fn view_images(state: &Workspace, palette: &[Color32; 256]) -> Option<ViewIm
     Some(ViewImages { raw, classified })
 }
 
-/// The preview highlight image of the pending selection (class colour on selected pixels,
-/// dimmed elsewhere; transparent with no selection).
+/// The preview highlight image of the pending selection: the pixels a commit would change
+/// hatched in the class colour (so they stand out from pixels already shown in that colour),
+/// selected pixels already of the class left as they are, the rest dimmed; transparent with
+/// no selection.
 #[must_use]
 pub fn preview_image(state: &Workspace, size: [usize; 2]) -> ColorImage {
-    let mask = state.preview_mask();
-    let colour = state
-        .preview_colour()
-        .map_or(Color32::TRANSPARENT, |[r, g, b]| Color32::from_rgb(r, g, b));
-    if mask.len() != size[0] * size[1] {
-        return ColorImage::new(size, vec![Color32::TRANSPARENT; size[0] * size[1]]);
-    }
-    // Unselected pixels are dimmed, so the highlight shows even where the class colour is
-    // the colour of the pixels themselves (orange on an orange ball).
+    let n = size[0] * size[1];
+    let Some(class_rgb) = state.preview_colour() else {
+        return ColorImage::new(size, vec![Color32::TRANSPARENT; n]);
+    };
+    let rgb = |[r, g, b]: [u8; 3]| Color32::from_rgb(r, g, b);
     let dim = Color32::from_black_alpha(PREVIEW_DIM_ALPHA);
-    // A dark class colour (black, dark blue) would vanish on the dimmed dark pixels: those
-    // classes are previewed in a light colour instead.
-    let colour = visible_preview_colour(colour);
-    ColorImage::new(
-        size,
-        mask.iter().map(|&m| if m { colour } else { dim }).collect(),
-    )
+    let w = size[0].max(1);
+    let mut pixels: Vec<Color32> = state
+        .preview_pixels()
+        .enumerate()
+        .map(|(i, p)| match p {
+            PreviewPixel::Outside => dim,
+            PreviewPixel::Unchanged => Color32::TRANSPARENT,
+            PreviewPixel::Changes => rgb(hatch_rgb(i % w, i / w, class_rgb)),
+        })
+        .collect();
+    if pixels.len() != n {
+        pixels = vec![Color32::TRANSPARENT; n];
+    }
+    ColorImage::new(size, pixels)
 }
 
 /// The highlight colour of a previewed class: its own colour, or a light magenta for classes
@@ -100,16 +105,12 @@ pub fn preview_image(state: &Workspace, size: [usize; 2]) -> ColorImage {
 #[must_use]
 pub fn visible_preview_colour(class_colour: Color32) -> Color32 {
     let [r, g, b, a] = class_colour.to_array();
-    let luma = 0.299 * f32::from(r) + 0.587 * f32::from(g) + 0.114 * f32::from(b);
-    if a > 0 && luma < PREVIEW_MIN_LUMA {
-        Color32::from_rgb(255, 96, 255)
-    } else {
-        class_colour
+    if a == 0 {
+        return class_colour;
     }
+    let [r, g, b] = crate::workspace::visible_preview_rgb([r, g, b]);
+    Color32::from_rgb(r, g, b)
 }
-
-/// Class colours darker than this (0..255 luma) get a light preview colour.
-const PREVIEW_MIN_LUMA: f32 = 100.0;
 
 impl EotnApp {
     pub(super) fn update_textures(&mut self, ctx: &egui::Context) {

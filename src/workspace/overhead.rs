@@ -68,6 +68,8 @@ pub struct Overhead {
     user_calibration: Option<Calibration>,
     calibration_path: Option<PathBuf>,
     stream_camera: Option<OverheadCamera>,
+    /// The shown frame's own ground truth (a synthetic stream's `/ground_truth`), if any.
+    truth: Option<crate::model::truth::OverheadTruth>,
     field: FieldDescription,
     field_path: Option<PathBuf>,
     /// The lens's checkerboard intrinsics and their file: Calibrate then fits only the pose.
@@ -95,13 +97,17 @@ impl Default for Overhead {
             pipeline: OverheadPipeline::new(
                 crate::lut::LookupTable::new(6).unwrap_or_else(|_| super::seven_bit_table()),
                 OverheadCamera::above_field_2005(),
-                params_for(&field),
+                params_for(
+                    &field,
+                    &crate::recognition::OverheadRecognitionParams::default(),
+                ),
             ),
             active: false,
             detections: None,
             user_calibration: None,
             calibration_path: None,
             stream_camera: None,
+            truth: None,
             field,
             field_path: None,
             intrinsics: None,
@@ -119,12 +125,16 @@ impl Default for Overhead {
     }
 }
 
-/// The recogniser's settings for a field (ball radius, plate height).
-fn params_for(field: &FieldDescription) -> OverheadParams {
+/// The recogniser's settings: the field's ball radius and plate height, the rest from the
+/// recognition parameters' `overhead` section.
+fn params_for(
+    field: &FieldDescription,
+    recogniser: &crate::recognition::OverheadRecognitionParams,
+) -> OverheadParams {
     OverheadParams {
         ball_radius_cm: field.ball_radius_cm,
         plate_height_cm: field.plate_height_cm,
-        ..OverheadParams::default()
+        recogniser: *recogniser,
     }
 }
 
@@ -165,6 +175,13 @@ impl Overhead {
     #[must_use]
     pub fn calibration_path(&self) -> Option<&Path> {
         self.calibration_path.as_deref()
+    }
+
+    /// The shown frame's ground truth, where the stream carries it (a synthetic stream):
+    /// the field view draws it beside what the camera found.
+    #[must_use]
+    pub const fn truth(&self) -> Option<&crate::model::truth::OverheadTruth> {
+        self.truth.as_ref()
     }
 
     /// The intrinsics Calibrate uses (then only the pose is fitted) and their file.
@@ -306,12 +323,18 @@ impl Workspace {
             self.overhead.pipeline.set_lut(self.pipeline.lut().clone());
             self.overhead.synced_table = Some(self.table_generation);
         }
-        self.overhead.stream_camera = stream_camera(loaded);
+        self.overhead.truth = truth_of(loaded);
+        self.overhead.stream_camera = self.overhead.truth.as_ref().map(|t| t.camera);
         let camera = self.overhead.camera().map(|(c, _)| *c);
         if let Some(c) = camera {
             self.overhead.pipeline.set_camera(c);
         }
         let fits = camera.is_none_or(|c| self.frame_fits(&c, &loaded.frame));
+        // The parameters in use (tuned in the Parameters window, or a file's `overhead`).
+        let params = params_for(&self.overhead.field, &self.recognition_params().overhead);
+        if *self.overhead.pipeline.params() != params {
+            self.overhead.pipeline.set_params(params);
+        }
         self.overhead.pipeline.process(&loaded.frame);
         self.overhead.active = true;
         if (self.overhead.points.width, self.overhead.points.height) == (0, 0) {
@@ -396,7 +419,7 @@ impl Workspace {
                 self.overhead.pipeline = OverheadPipeline::new(
                     self.pipeline.lut().clone(),
                     *self.overhead.pipeline.camera(),
-                    params_for(&field),
+                    params_for(&field, &self.recognition_params().overhead),
                 );
                 self.overhead.synced_table = Some(self.table_generation);
                 self.status = format!(
@@ -435,8 +458,10 @@ impl Workspace {
             }
             OverheadCommand::ChooseLandmark(name) => self.choose_landmark(name)?,
             OverheadCommand::PickPoint { x_px, y_px } => self.pick_point(x_px, y_px)?,
+            OverheadCommand::SkipLandmark => self.skip_landmark()?,
             OverheadCommand::UndoPick => self.undo_pick()?,
             OverheadCommand::Calibrate => self.calibrate_from_points()?,
+            OverheadCommand::SetOverheadCamera(overhead) => self.set_overhead_camera(overhead)?,
             OverheadCommand::SelectRobot(key) => {
                 self.overhead.selected = key;
                 if let Some(k) = key {
@@ -449,6 +474,37 @@ impl Workspace {
                 self.frame_generation += 1;
             }
         }
+        Ok(())
+    }
+
+    /// Tells whether the open frame files come from an overhead camera: the frames are then
+    /// recognised as overhead frames (with the overhead table) or as a robot's.
+    fn set_overhead_camera(&mut self, overhead: bool) -> anyhow::Result<()> {
+        use crate::sources::{CameraKind, SourceKind};
+        let src = self.source.as_mut().context("no frames open")?;
+        anyhow::ensure!(
+            self.live.is_none() && src.info().kind == SourceKind::Files,
+            "only frame files (JPEG, PNG, raw frames) can be told which camera made them; {} says it itself",
+            src.label()
+        );
+        let kind = if overhead {
+            CameraKind::Overhead
+        } else {
+            CameraKind::Robot
+        };
+        src.set_camera_kind(kind);
+        self.reset_overhead_for_source();
+        // The table of that kind of camera; it re-runs the shown frame.
+        self.use_table_of(kind);
+        self.reprocess();
+        self.status = if overhead {
+            format!(
+                "overhead camera: the overhead recogniser runs; {}",
+                self.overhead.calibration_status()
+            )
+        } else {
+            "robot camera: the robot's recognisers run".to_owned()
+        };
         Ok(())
     }
 
@@ -537,14 +593,7 @@ impl Workspace {
             replaced,
         });
         // The next landmark not yet picked, so clicking round the field needs no menu.
-        let picked = |n: &str| self.overhead.points.points.iter().any(|p| p.name == n);
-        let next = self
-            .overhead
-            .field
-            .landmarks
-            .iter()
-            .map(|l| l.name.clone())
-            .find(|n| !picked(n));
+        let next = self.next_unpicked_landmark(&name);
         self.status = format!(
             "{name} at ({x_px:.1}, {y_px:.1}) px; {} points{}",
             self.overhead.points.points.len(),
@@ -552,6 +601,36 @@ impl Workspace {
                 .map(|n| format!("; next: {n}"))
                 .unwrap_or_default()
         );
+        self.overhead.landmark = next;
+        Ok(())
+    }
+
+    /// The first landmark not yet picked after `after` in the field's order, going round to
+    /// the start; `None` when every landmark but `after` is picked.
+    fn next_unpicked_landmark(&self, after: &str) -> Option<String> {
+        let landmarks = &self.overhead.field.landmarks;
+        let picked = |n: &str| self.overhead.points.points.iter().any(|p| p.name == n);
+        let start = landmarks
+            .iter()
+            .position(|l| l.name == after)
+            .map_or(0, |i| i + 1);
+        (0..landmarks.len())
+            .map(|k| &landmarks[(start + k) % landmarks.len()].name)
+            .find(|n| n.as_str() != after && !picked(n))
+            .cloned()
+    }
+
+    fn skip_landmark(&mut self) -> anyhow::Result<()> {
+        let current = self
+            .overhead
+            .landmark
+            .clone()
+            .context("not picking: choose a landmark first")?;
+        let next = self.next_unpicked_landmark(&current);
+        self.status = match &next {
+            Some(n) => format!("skipped {current}; click {n} in the image"),
+            None => format!("skipped {current}; every other landmark is picked"),
+        };
         self.overhead.landmark = next;
         Ok(())
     }
@@ -609,8 +688,27 @@ impl Workspace {
         );
         self.overhead.user_calibration = Some(cal);
         self.overhead.calibration_path = None;
+        // Calibrated: picking is over, and the next left click samples for classification
+        // (a landmark left armed silently added points the next Calibrate would use).
+        self.disarm_landmark_picking();
         self.reprocess();
         Ok(())
+    }
+
+    /// Stops picking landmarks: the next left click in the image samples for classification.
+    /// Calibrate, choosing a class and closing the Calibration window do this.
+    pub(super) fn disarm_landmark_picking(&mut self) {
+        self.overhead.landmark = None;
+    }
+
+    /// What a left click in the image does now, for the view's corner: "pick ‹landmark›"
+    /// while picking calibration points on an overhead frame, else "sample".
+    #[must_use]
+    pub fn left_click_mode(&self) -> String {
+        match self.overhead.landmark() {
+            Some(l) if self.overhead.active => format!("left click: pick {l}"),
+            _ => format!("left click: sample {}", self.settings.class.name()),
+        }
     }
 
     /// Makes or drops the undistorted view's pixel map for the shown frame and camera.
@@ -635,6 +733,25 @@ impl Workspace {
             }
             _ => self.overhead.view_map = None,
         }
+    }
+
+    /// Where pixel (x, y)'s centre lies on the ground, centimetres: through the calibration in
+    /// use (scaled to a frame of another size with its shape), for an overhead frame only.
+    #[must_use]
+    pub fn field_point_of_pixel(&self, x: usize, y: usize) -> Option<[f64; 2]> {
+        use crate::overhead::pipeline::{FrameFit, frame_fit};
+        if !self.overhead.active {
+            return None;
+        }
+        let (camera, _) = self.overhead.camera()?;
+        let (w, h) = self.image_size();
+        let camera = match frame_fit(camera, w, h) {
+            FrameFit::Same => *camera,
+            FrameFit::Scaled { .. } => camera.scaled_to(w, h),
+            FrameFit::Mismatch { .. } => return None,
+        };
+        let p = camera.field_from_image(ImagePoint::new(x as f64 + 0.5, y as f64 + 0.5), 0.0)?;
+        Some([p.x(), p.y()])
     }
 
     /// True when the views show the undistorted image.
@@ -695,6 +812,7 @@ impl Workspace {
         self.overhead.active = false;
         self.overhead.detections = None;
         self.overhead.stream_camera = None;
+        self.overhead.truth = None;
         self.overhead.field_model = FieldModel::default();
     }
 
@@ -707,11 +825,6 @@ impl Workspace {
             None => Some(p),
         }
     }
-}
-
-/// The camera a frame's own truth names, if it is a synthetic overhead frame.
-fn stream_camera(loaded: &SourceFrame) -> Option<OverheadCamera> {
-    truth_of(loaded).map(|t| t.camera)
 }
 
 /// The overhead truth a synthetic frame carries, if any.

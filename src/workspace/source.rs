@@ -94,6 +94,12 @@ impl Source {
         &self.info
     }
 
+    /// Says which camera made the frames: frame files (JPEG, PNG, …) do not say it themselves,
+    /// so the user does (Overhead ▸ This is an overhead camera).
+    pub fn set_camera_kind(&mut self, kind: crate::sources::CameraKind) {
+        self.info.camera = kind;
+    }
+
     /// Asks the source again what it is (a robot names itself once connected).
     pub fn refresh_info(&mut self) {
         self.info = self.inner.info();
