@@ -158,6 +158,18 @@ fn files_ui(
     if has_intrinsics && ui.button("Close intrinsics").clicked() {
         commands.push(OverheadCommand::CloseIntrinsics.into());
     }
+    saved_files_ui(ui, state, paths, commands, dialog);
+}
+
+/// The calibration and the points files: open, save (a dialog when no name is typed), close.
+fn saved_files_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    paths: &mut OverheadPaths,
+    commands: &mut Vec<Command>,
+    dialog: &mut DialogRequest,
+) {
+    let overhead = state.overhead();
     let has_cal = overhead.calibration().is_some();
     let clicked = path_row(
         ui,

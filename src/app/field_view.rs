@@ -102,7 +102,7 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 2.0, Color32::from_rgb(20, 90, 40));
     let xf = FieldTransform::fit(rect, overhead.field());
-    paint_field(&painter, &xf, overhead.field());
+    paint_field(&painter, &xf, overhead.field(), overhead.landmark());
     let show_truth_id = egui::Id::unique("eotn-field-view-truth");
     let mut show_truth: bool = ui.data(|d| d.get_temp(show_truth_id)).unwrap_or(true);
     if show_truth && let Some(t) = overhead.truth() {
@@ -168,23 +168,35 @@ fn paint_truth(
     }
 }
 
-fn paint_field(painter: &egui::Painter, xf: &FieldTransform, field: &FieldDescription) {
+/// The field's lines and landmarks; each landmark's name where it does not cover another's,
+/// and the one being picked (`picking`) always, highlighted: where to click for it.
+fn paint_field(
+    painter: &egui::Painter,
+    xf: &FieldTransform,
+    field: &FieldDescription,
+    picking: Option<&str>,
+) {
     let stroke = Stroke::new(1.5, Color32::from_gray(235));
     for l in &field.lines {
         painter.line_segment([xf.to_screen(l.from_cm), xf.to_screen(l.to_cm)], stroke);
     }
-    // Each landmark by name, as the Calibration window lists them: where to click for it.
     let name_colour = Color32::from_rgb(255, 230, 120);
-    for l in &field.landmarks {
+    let chosen_colour = Color32::from_rgb(255, 80, 220);
+    let mut placed: Vec<Rect> = Vec::new();
+    // The landmark being picked first, so its name is never the one left out.
+    let mut order: Vec<&crate::overhead::field::Landmark> = field.landmarks.iter().collect();
+    order.sort_by_key(|l| Some(l.name.as_str()) != picking);
+    for l in order {
         let at = xf.to_screen(l.field_cm);
-        painter.circle_filled(at, 2.5, name_colour);
-        painter.text(
-            at + vec2(3.0, -3.0),
-            egui::Align2::LEFT_BOTTOM,
-            &l.name,
-            FontId::proportional(9.0),
-            name_colour,
-        );
+        let chosen = Some(l.name.as_str()) == picking;
+        let colour = if chosen { chosen_colour } else { name_colour };
+        painter.circle_filled(at, if chosen { 4.5 } else { 2.5 }, colour);
+        let galley = painter.layout_no_wrap(l.name.clone(), FontId::proportional(9.0), colour);
+        let text_rect = Rect::from_min_size(at + vec2(3.0, -3.0 - galley.size().y), galley.size());
+        if chosen || !placed.iter().any(|p| p.intersects(text_rect)) {
+            placed.push(text_rect);
+            painter.galley(text_rect.min, galley, colour);
+        }
     }
     for a in &field.arcs {
         let n = 48;

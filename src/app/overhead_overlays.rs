@@ -59,7 +59,7 @@ pub fn paint_overhead(
             w as f64 / camera.width_px.max(1) as f64,
             h as f64 / camera.height_px.max(1) as f64,
         ];
-        for curve in crate::overhead::lines::projected_field_lines(overhead.field(), camera) {
+        for curve in overhead.projected_field_lines() {
             let pts: Vec<Pos2> = curve
                 .iter()
                 .filter_map(|p| to_screen(ImagePoint::new(p.x_px * s[0], p.y_px * s[1])))

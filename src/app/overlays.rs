@@ -164,9 +164,11 @@ pub fn paint_view(
         .saturating_mul(LABEL_SIZE_FACTOR);
     if state.undistorted_view() {
         // Boxes are in the camera's pixels: in the undistorted view each outline goes through
-        // the lens model (a box becomes a curved quadrilateral); no labels there.
+        // the lens model (a box becomes a curved quadrilateral, clipped to the image); no
+        // labels there.
+        let inside = painter.with_clip_rect(painter.clip_rect().intersect(xf.image_rect()));
         for b in &boxes {
-            undistorted_blob_box(&painter, xf, state, b);
+            undistorted_blob_box(&inside, xf, state, b);
         }
     } else {
         for b in &boxes {

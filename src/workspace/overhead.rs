@@ -17,7 +17,7 @@ use super::Workspace;
 use super::command::OverheadCommand;
 use super::field_model::FieldModel;
 use crate::geometry::{ImagePoint, OverheadCamera};
-use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate_with};
+use crate::overhead::calibration::Calibration;
 use crate::overhead::intrinsics::Intrinsics;
 use crate::overhead::{
     CalibrationPoint, FieldDescription, OverheadDetections, OverheadParams, OverheadPipeline,
@@ -32,6 +32,8 @@ pub const MIN_CALIBRATION_POINTS: usize = crate::overhead::review::MIN_POINTS;
 /// One robot as the overhead camera identifies it: team colour and marker identity. The one
 /// robot selection of the workspace (field view, image overlays) is one of these.
 pub use crate::model::world_model::RobotKey;
+
+mod picking;
 
 /// The undistorted view's pixel map and the camera and frame size it was made for.
 #[derive(Debug, Clone)]
@@ -82,6 +84,12 @@ pub struct Overhead {
     synced_table: Option<u64>,
     /// The undistorted view's pixel map, when that view is shown.
     view_map: Option<ViewMap>,
+    /// The field's lines projected through the camera in use (image polylines), the camera
+    /// and the field generation they were made for: made once per calibration, not once per
+    /// UI frame (at 2 cm steps through the lens model they cost milliseconds).
+    projected_lines: Option<(OverheadCamera, u64, Vec<Vec<ImagePoint>>)>,
+    /// Counts field changes (the projected lines follow them).
+    field_generation: u64,
     empty_recognition: Recognition,
     /// The field view's model: trails, world models, errors over time.
     pub field_model: FieldModel,
@@ -118,6 +126,8 @@ impl Default for Overhead {
             selected: None,
             synced_table: None,
             view_map: None,
+            projected_lines: None,
+            field_generation: 0,
             empty_recognition: Recognition::default(),
             field_model: FieldModel::default(),
             size_warned: None,
@@ -194,6 +204,31 @@ impl Overhead {
     #[must_use]
     pub const fn field(&self) -> &FieldDescription {
         &self.field
+    }
+
+    /// The field's lines and arcs as image polylines through the camera in use (its own
+    /// pixels, at the calibration's size; `overhead::lines::projected_field_lines`); empty
+    /// with no camera.
+    #[must_use]
+    pub fn projected_field_lines(&self) -> &[Vec<ImagePoint>] {
+        self.projected_lines
+            .as_ref()
+            .map_or(&[], |(_, _, lines)| lines.as_slice())
+    }
+
+    /// Makes the projected field lines for `camera`, unless they were made for it already.
+    fn refresh_projected_lines(&mut self, camera: Option<OverheadCamera>) {
+        let fresh = match (&self.projected_lines, camera) {
+            (Some((c, g, _)), Some(cam)) => *c == cam && *g == self.field_generation,
+            (None, None) => true,
+            _ => false,
+        };
+        if !fresh {
+            self.projected_lines = camera.map(|c| {
+                let lines = crate::overhead::lines::projected_field_lines(&self.field, &c);
+                (c, self.field_generation, lines)
+            });
+        }
     }
 
     /// The picked points.
@@ -329,6 +364,7 @@ impl Workspace {
         if let Some(c) = camera {
             self.overhead.pipeline.set_camera(c);
         }
+        self.overhead.refresh_projected_lines(camera);
         let fits = camera.is_none_or(|c| self.frame_fits(&c, &loaded.frame));
         // The parameters in use (tuned in the Parameters window, or a file's `overhead`).
         let params = params_for(&self.overhead.field, &self.recognition_params().overhead);
@@ -373,39 +409,8 @@ impl Workspace {
     /// Applies an overhead command.
     pub(super) fn apply_overhead(&mut self, command: OverheadCommand) -> anyhow::Result<()> {
         match command {
-            OverheadCommand::OpenCalibration(p) => {
-                let cal = Calibration::load(&p)?;
-                let review = crate::overhead::review::review(&cal);
-                if let Some(refusal) = review.refusal() {
-                    anyhow::bail!("{}: not usable: {refusal}", p.display());
-                }
-                for f in &review.findings {
-                    self.warn(format!("{}: {f}", p.display()));
-                }
-                self.status = format!(
-                    "opened calibration {}: {} points, median error {:.2} px",
-                    p.display(),
-                    cal.points.len(),
-                    cal.median_point_error_px()
-                );
-                let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
-                self.remember_for_camera(|f| f.calibration = Some(canonical));
-                self.overhead.user_calibration = Some(cal);
-                self.overhead.calibration_path = Some(p);
-                self.reprocess();
-            }
-            OverheadCommand::SaveCalibration(p) => {
-                let cal = self
-                    .overhead
-                    .user_calibration
-                    .as_ref()
-                    .context("no calibration to save: open one or Calibrate first")?;
-                cal.save(&p)?;
-                let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
-                self.remember_for_camera(|f| f.calibration = Some(canonical));
-                self.overhead.calibration_path = Some(p.clone());
-                self.status = format!("saved calibration {}", p.display());
-            }
+            OverheadCommand::OpenCalibration(p) => self.open_calibration(p)?,
+            OverheadCommand::SaveCalibration(p) => self.save_calibration(p)?,
             OverheadCommand::CloseCalibration => {
                 self.overhead.user_calibration = None;
                 self.overhead.calibration_path = None;
@@ -429,6 +434,7 @@ impl Workspace {
                     field.lines.len()
                 );
                 self.overhead.field = field;
+                self.overhead.field_generation += 1;
                 self.overhead.field_path = Some(p);
                 self.overhead.landmark = None;
                 self.reprocess();
@@ -474,6 +480,46 @@ impl Workspace {
                 self.frame_generation += 1;
             }
         }
+        Ok(())
+    }
+
+    /// Uses the calibration file `p` (refused when its review finds it unusable; its doubts
+    /// are warnings).
+    fn open_calibration(&mut self, p: PathBuf) -> anyhow::Result<()> {
+        let cal = Calibration::load(&p)?;
+        let review = crate::overhead::review::review(&cal);
+        if let Some(refusal) = review.refusal() {
+            anyhow::bail!("{}: not usable: {refusal}", p.display());
+        }
+        for f in &review.findings {
+            self.warn(format!("{}: {f}", p.display()));
+        }
+        self.status = format!(
+            "opened calibration {}: {} points, median error {:.2} px",
+            p.display(),
+            cal.points.len(),
+            cal.median_point_error_px()
+        );
+        let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+        self.remember_for_camera(|f| f.calibration = Some(canonical));
+        self.overhead.user_calibration = Some(cal);
+        self.overhead.calibration_path = Some(p);
+        self.reprocess();
+        Ok(())
+    }
+
+    /// Saves the calibration opened or solved as `p`, and remembers it for the camera.
+    fn save_calibration(&mut self, p: PathBuf) -> anyhow::Result<()> {
+        let cal = self
+            .overhead
+            .user_calibration
+            .as_ref()
+            .context("no calibration to save: open one or Calibrate first")?;
+        cal.save(&p)?;
+        let canonical = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+        self.remember_for_camera(|f| f.calibration = Some(canonical));
+        self.overhead.calibration_path = Some(p.clone());
+        self.status = format!("saved calibration {}", p.display());
         Ok(())
     }
 
@@ -530,185 +576,6 @@ impl Workspace {
         );
         self.overhead.intrinsics = Some((i, p));
         Ok(())
-    }
-
-    fn choose_landmark(&mut self, name: Option<String>) -> anyhow::Result<()> {
-        if let Some(n) = &name {
-            anyhow::ensure!(
-                self.overhead.field.landmark(n).is_some(),
-                "no landmark {n:?} in the field {}",
-                self.overhead.field.name
-            );
-            self.status = format!("click {n} in the image");
-        }
-        self.overhead.landmark = name;
-        Ok(())
-    }
-
-    fn pick_point(&mut self, x_px: f64, y_px: f64) -> anyhow::Result<()> {
-        let name = self
-            .overhead
-            .landmark
-            .clone()
-            .context("choose a landmark first (Calibration window)")?;
-        let (w, h) = self.image_size();
-        anyhow::ensure!(w > 0, "no frame to pick on");
-        anyhow::ensure!(
-            x_px.is_finite()
-                && y_px.is_finite()
-                && (0.0..w as f64).contains(&x_px)
-                && (0.0..h as f64).contains(&y_px),
-            "({x_px:.1}, {y_px:.1}) is outside the {w}×{h} frame"
-        );
-        let l = self
-            .overhead
-            .field
-            .landmark(&name)
-            .with_context(|| format!("no landmark {name:?}"))?
-            .clone();
-        if (self.overhead.points.width, self.overhead.points.height) != (w, h) {
-            anyhow::ensure!(
-                self.overhead.points.points.is_empty(),
-                "the picked points are for a {}×{} frame, this one is {w}×{h}",
-                self.overhead.points.width,
-                self.overhead.points.height
-            );
-            self.overhead.points = PointsFile::new(w, h);
-        }
-        let replaced = self
-            .overhead
-            .points
-            .points
-            .iter()
-            .find(|p| p.name == name)
-            .cloned();
-        self.overhead.points.set(CalibrationPoint {
-            name: name.clone(),
-            field_cm: l.field_cm,
-            height_cm: l.height_cm,
-            image_px: [x_px, y_px],
-        });
-        self.overhead.picks.push(PickEdit {
-            name: name.clone(),
-            replaced,
-        });
-        // The next landmark not yet picked, so clicking round the field needs no menu.
-        let next = self.next_unpicked_landmark(&name);
-        self.status = format!(
-            "{name} at ({x_px:.1}, {y_px:.1}) px; {} points{}",
-            self.overhead.points.points.len(),
-            next.as_ref()
-                .map(|n| format!("; next: {n}"))
-                .unwrap_or_default()
-        );
-        self.overhead.landmark = next;
-        Ok(())
-    }
-
-    /// The first landmark not yet picked after `after` in the field's order, going round to
-    /// the start; `None` when every landmark but `after` is picked.
-    fn next_unpicked_landmark(&self, after: &str) -> Option<String> {
-        let landmarks = &self.overhead.field.landmarks;
-        let picked = |n: &str| self.overhead.points.points.iter().any(|p| p.name == n);
-        let start = landmarks
-            .iter()
-            .position(|l| l.name == after)
-            .map_or(0, |i| i + 1);
-        (0..landmarks.len())
-            .map(|k| &landmarks[(start + k) % landmarks.len()].name)
-            .find(|n| n.as_str() != after && !picked(n))
-            .cloned()
-    }
-
-    fn skip_landmark(&mut self) -> anyhow::Result<()> {
-        let current = self
-            .overhead
-            .landmark
-            .clone()
-            .context("not picking: choose a landmark first")?;
-        let next = self.next_unpicked_landmark(&current);
-        self.status = match &next {
-            Some(n) => format!("skipped {current}; click {n} in the image"),
-            None => format!("skipped {current}; every other landmark is picked"),
-        };
-        self.overhead.landmark = next;
-        Ok(())
-    }
-
-    fn undo_pick(&mut self) -> anyhow::Result<()> {
-        let edit = self
-            .overhead
-            .picks
-            .pop()
-            .context("no picked point to undo")?;
-        self.overhead.points.remove(&edit.name);
-        if let Some(old) = edit.replaced {
-            self.overhead.points.set(old);
-        }
-        self.overhead.landmark = Some(edit.name.clone());
-        self.status = format!("undid the pick of {}", edit.name);
-        Ok(())
-    }
-
-    fn calibrate_from_points(&mut self) -> anyhow::Result<()> {
-        let n = self.overhead.points.points.len();
-        anyhow::ensure!(
-            n >= MIN_CALIBRATION_POINTS,
-            "{n} points picked: calibration needs at least {MIN_CALIBRATION_POINTS}"
-        );
-        let frame = self.frame().cloned();
-        let frame = frame.filter(|f| {
-            (f.width(), f.height()) == (self.overhead.points.width, self.overhead.points.height)
-        });
-        let notes =
-            crate::overhead::review::check_points(&self.overhead.points, &self.overhead.field)?;
-        let cal = calibrate_with(
-            &self.overhead.points,
-            &self.overhead.field,
-            frame.as_ref(),
-            &CalibrationParams::default(),
-            self.overhead.intrinsics.as_ref().map(|(i, _)| i),
-        )?;
-        let review = crate::overhead::review::review(&cal);
-        for f in notes.iter().chain(&review.findings) {
-            self.warn(format!("calibration: {f}"));
-        }
-        if frame.is_some() && cal.line_samples == 0 {
-            self.warn(format!(
-                "calibration: line refinement skipped: fewer than {} samples of the field lines found in the frame",
-                crate::overhead::calibration::MIN_LINE_SAMPLES
-            ));
-        }
-        self.status = format!(
-            "calibrated from {n} points: median error {:.2} px{}",
-            cal.median_point_error_px(),
-            cal.line_rms_px
-                .map(|r| format!(", lines {r:.2} px rms over {} samples", cal.line_samples))
-                .unwrap_or_default()
-        );
-        self.overhead.user_calibration = Some(cal);
-        self.overhead.calibration_path = None;
-        // Calibrated: picking is over, and the next left click samples for classification
-        // (a landmark left armed silently added points the next Calibrate would use).
-        self.disarm_landmark_picking();
-        self.reprocess();
-        Ok(())
-    }
-
-    /// Stops picking landmarks: the next left click in the image samples for classification.
-    /// Calibrate, choosing a class and closing the Calibration window do this.
-    pub(super) fn disarm_landmark_picking(&mut self) {
-        self.overhead.landmark = None;
-    }
-
-    /// What a left click in the image does now, for the view's corner: "pick ‹landmark›"
-    /// while picking calibration points on an overhead frame, else "sample".
-    #[must_use]
-    pub fn left_click_mode(&self) -> String {
-        match self.overhead.landmark() {
-            Some(l) if self.overhead.active => format!("left click: pick {l}"),
-            _ => format!("left click: sample {}", self.settings.class.name()),
-        }
     }
 
     /// Makes or drops the undistorted view's pixel map for the shown frame and camera.
