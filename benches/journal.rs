@@ -86,17 +86,51 @@ fn benches(c: &mut Criterion) {
             r
         });
     });
+    // The same after a small edit and its undo: the replay cannot begin at a whole-table edit
+    // (an undo comes before them), so all 40 are applied, as every replay did before.
+    let undo_first = dir.path().join("undo-first.lut");
+    std::fs::write(
+        journal::journal_path(&undo_first),
+        whole_table_journal_after(&[
+            JournalEntry::Commit {
+                record: EditRecord {
+                    class: ColourClass::White,
+                    region: Region::Cells { indices: vec![7] },
+                    time_unix_ms: 0,
+                    sampled_at: None,
+                },
+            },
+            JournalEntry::Undo { time_unix_ms: 0 },
+        ]),
+    )
+    .expect("write");
+    group.bench_function("replay_40_whole_table_edits_8bit_from_the_start", |b| {
+        b.iter(|| {
+            let r = journal::replay(black_box(&undo_first)).expect("replays");
+            assert_eq!(r.commits, 41);
+            r
+        });
+    });
     group.finish();
 }
 
 /// A journal of 40 edits, each of the whole 8-bit table, alternating two classes.
 fn whole_table_journal() -> String {
+    whole_table_journal_after(&[])
+}
+
+/// [`whole_table_journal`] with `first` before the 40 edits.
+fn whole_table_journal_after(first: &[JournalEntry]) -> String {
     let start = JournalEntry::Start {
         bits: 8,
         base: false,
         time_unix_ms: 0,
     };
     let mut text = serde_json::to_string(&start).expect("json");
+    for e in first {
+        text.push('\n');
+        text.push_str(&serde_json::to_string(e).expect("json"));
+    }
     for i in 0..40 {
         let record = EditRecord {
             class: [ColourClass::Orange, ColourClass::Green][i % 2],

@@ -12,9 +12,9 @@ import sys
 
 # Data-flow order: frames in, results out, front ends last (STYLE.md, ARCHITECTURE.md).
 ORDER = [
-    "atomic_file", "input_file", "camera", "stats", "kernels", "frame", "lut", "classify", "blobs", "sensors", "geometry",
+    "test_skip", "atomic_file", "input_file", "camera", "stats", "kernels", "frame", "lut", "classify", "blobs", "sensors", "geometry",
     "model", "sim", "import", "formats",
-    "recognition", "overhead", "session", "wmd", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
+    "recognition", "overhead", "ssl_vision", "session", "wmd", "pipeline", "overlay", "annotate", "eval", "streams", "sources",
     "live", "workspace", "app_options", "cli", "app",
 ]
 

@@ -3,7 +3,8 @@
 # it, viewers' and the server's messages as `eotn serve`'s gate takes them, lookup tables in all
 # seven formats, B-Human logs, parameter/label/sensor text files, MCAP streams, frame files,
 # field/points/calibration files, the edit journal and the settings file, ROS 2 CDR messages,
-# image encodings, rosbag2 metadata.yaml and .db3 files, YOLO/COCO/VOC label sets)
+# image encodings, rosbag2 metadata.yaml and .db3 files, YOLO/COCO/VOC label sets, SSL-Vision
+# packets and the league's SSL game logs)
 # with libFuzzer through cargo-fuzz, each for SECONDS (default 60), starting from the bundled
 # files as seeds. Prints executions and coverage per target; a crash stops the run, leaving its
 # input in fuzz/artifacts/TARGET/ (add it to fuzz/regressions/TARGET/ once fixed: CI replays
@@ -15,7 +16,7 @@ SECONDS_PER_TARGET=${1:-60}
 shift || true
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked --version 0.13.2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol serve_viewer_messages lookup_tables bhuman_log text_files mcap_stream frame_files field_files app_files ros2_messages image_encodings rosbag2 label_sets)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(live_protocol serve_viewer_messages lookup_tables bhuman_log text_files mcap_stream frame_files field_files app_files ros2_messages image_encodings rosbag2 label_sets ssl_vision_packets ssl_vision_logs wmd_inputs)
 
 # Seeds: a real input or two of each kind, copied into a temporary corpus so fuzz/ stays clean
 # (inputs up to 1 MiB: -max_len below).
@@ -37,7 +38,10 @@ seed app_files tests/data/journal-seed.jsonl tests/data/settings-seed.json
 seed rosbag2 fuzz/seeds/rosbag2/*
 seed ros2_messages fuzz/seeds/ros2_messages/*
 seed image_encodings fuzz/seeds/image_encodings/*
+seed wmd_inputs fuzz/seeds/wmd_inputs/*
 seed label_sets fuzz/seeds/label_sets/*
+seed ssl_vision_packets fuzz/seeds/ssl_vision_packets/*
+seed ssl_vision_logs fuzz/seeds/ssl_vision_logs/*
 for t in "${TARGETS[@]}"; do
   mkdir -p "$WORK/$t"
   [ -d "fuzz/regressions/$t" ] && cp fuzz/regressions/"$t"/* "$WORK/$t/" 2>/dev/null || true

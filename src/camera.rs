@@ -109,16 +109,25 @@ impl CameraChannel {
     }
 }
 
-/// Which camera, as a type: what settings are remembered under and what the app and commands
-/// pass around (never a bare string).
+/// Which camera, as a type: what settings remember each camera's files under, and what the app's
+/// commands name a camera by (never a bare string).
 ///
-/// Written as text (settings keys, messages): `recording:TOPIC`, `live:URL TOPIC`,
-/// `overhead:SOURCE`.
+/// A camera is its source and its image topic together: every one-camera stream eotn writes has
+/// the topic `/camera/image`, so a topic alone names no camera (two unrelated recordings, a robot's
+/// and an overhead one, would share one table).
+///
+/// Written as text (settings keys, messages): `recording:PATH TOPIC`, `live:URL TOPIC`,
+/// `overhead:SOURCE TOPIC` (topics start with `/` and hold no space, so the last space splits).
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum CameraId {
-    /// An image topic of recordings (`/camera/top`, `/camera/bottom/image_raw`): the same topic
-    /// in two recordings is the same camera, with the same table.
-    Recording(String),
+    /// A robot camera of one recording: the recording (its canonical path) and its image topic
+    /// (`/camera/top`, `/camera/bottom/image_raw`).
+    Recording {
+        /// The recording's file or bag folder, canonical.
+        recording: PathBuf,
+        /// The image topic.
+        topic: String,
+    },
     /// A live robot's image channel.
     Live {
         /// The robot's server, `ws://HOST:PORT`.
@@ -126,40 +135,100 @@ pub enum CameraId {
         /// The image channel's topic.
         topic: String,
     },
-    /// An overhead camera: its source (a recording, a `ws://` server, a camera device).
-    Overhead(String),
+    /// An overhead camera: its source (a recording's canonical path, a camera device, a
+    /// scenario) and image topic.
+    Overhead {
+        /// The source.
+        source: String,
+        /// The image topic (`/camera/image` for a source with one camera).
+        topic: String,
+    },
 }
 
 impl CameraId {
-    /// A recording's camera by its image topic.
+    /// The robot camera `topic` of the recording `recording` (canonical, or as given).
     #[must_use]
-    pub fn recording(topic: &str) -> Self {
-        Self::Recording(topic.to_owned())
+    pub fn recording(recording: &Path, topic: &str) -> Self {
+        Self::Recording {
+            recording: recording.to_owned(),
+            topic: topic.to_owned(),
+        }
     }
 
-    /// The image topic of a recording's or live robot's camera; `None` for an overhead source.
+    /// The image channel `topic` of the live robot at `robot` (`ws://HOST:PORT`).
     #[must_use]
-    pub fn topic(&self) -> Option<&str> {
-        match self {
-            Self::Recording(t) | Self::Live { topic: t, .. } => Some(t),
-            Self::Overhead(_) => None,
+    pub fn live(robot: &str, topic: &str) -> Self {
+        Self::Live {
+            robot: robot.to_owned(),
+            topic: topic.to_owned(),
         }
+    }
+
+    /// The overhead camera `topic` of `source`.
+    #[must_use]
+    pub fn overhead(source: &str, topic: &str) -> Self {
+        Self::Overhead {
+            source: source.to_owned(),
+            topic: topic.to_owned(),
+        }
+    }
+
+    /// Its image topic.
+    #[must_use]
+    pub fn topic(&self) -> &str {
+        match self {
+            Self::Recording { topic, .. }
+            | Self::Live { topic, .. }
+            | Self::Overhead { topic, .. } => topic,
+        }
+    }
+
+    /// Its source as text: the recording's path, the robot's address, the overhead source.
+    #[must_use]
+    pub fn source(&self) -> String {
+        match self {
+            Self::Recording { recording, .. } => recording.to_string_lossy().into_owned(),
+            Self::Live { robot, .. } => robot.clone(),
+            Self::Overhead { source, .. } => source.clone(),
+        }
+    }
+
+    /// True when both are cameras of the same source (two topics of one recording or robot).
+    #[must_use]
+    pub fn same_source(&self, other: &Self) -> bool {
+        std::mem::discriminant(self) == std::mem::discriminant(other)
+            && self.source() == other.source()
+    }
+
+    /// The camera `topic` of the same source.
+    #[must_use]
+    pub fn with_topic(&self, topic: &str) -> Self {
+        let mut id = self.clone();
+        match &mut id {
+            Self::Recording { topic: t, .. }
+            | Self::Live { topic: t, .. }
+            | Self::Overhead { topic: t, .. } => topic.clone_into(t),
+        }
+        id
     }
 }
 
 impl std::fmt::Display for CameraId {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Self::Recording(t) => write!(f, "recording:{t}"),
-            Self::Live { robot, topic } => write!(f, "live:{robot} {topic}"),
-            Self::Overhead(s) => write!(f, "overhead:{s}"),
-        }
+        let kind = match self {
+            Self::Recording { .. } => "recording",
+            Self::Live { .. } => "live",
+            Self::Overhead { .. } => "overhead",
+        };
+        write!(f, "{kind}:{} {}", self.source(), self.topic())
     }
 }
 
 /// Why a camera's written name could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("'{0}' names no camera (recording:TOPIC, live:ws://HOST:PORT TOPIC or overhead:SOURCE)")]
+#[error(
+    "'{0}' names no camera (recording:PATH TOPIC, live:ws://HOST:PORT TOPIC or overhead:SOURCE TOPIC)"
+)]
 pub struct BadCameraId(String);
 
 impl std::str::FromStr for CameraId {
@@ -168,19 +237,14 @@ impl std::str::FromStr for CameraId {
     fn from_str(text: &str) -> Result<Self, Self::Err> {
         let bad = || BadCameraId(text.to_owned());
         let (kind, rest) = text.split_once(':').ok_or_else(bad)?;
+        let (source, topic) = rest.rsplit_once(' ').ok_or_else(bad)?;
+        if source.is_empty() || !topic.starts_with('/') {
+            return Err(bad());
+        }
         match kind {
-            "recording" if rest.starts_with('/') => Ok(Self::Recording(rest.to_owned())),
-            "live" => {
-                let (robot, topic) = rest.rsplit_once(' ').ok_or_else(bad)?;
-                if robot.is_empty() || !topic.starts_with('/') {
-                    return Err(bad());
-                }
-                Ok(Self::Live {
-                    robot: robot.to_owned(),
-                    topic: topic.to_owned(),
-                })
-            }
-            "overhead" if !rest.is_empty() => Ok(Self::Overhead(rest.to_owned())),
+            "recording" => Ok(Self::recording(Path::new(source), topic)),
+            "live" => Ok(Self::live(source, topic)),
+            "overhead" => Ok(Self::overhead(source, topic)),
             _ => Err(bad()),
         }
     }
@@ -197,6 +261,26 @@ impl<'de> Deserialize<'de> for CameraId {
         let text = String::deserialize(d)?;
         text.parse().map_err(serde::de::Error::custom)
     }
+}
+
+/// Each camera's files by camera, read leniently: an entry whose key names no camera (written by
+/// an older eotn, which keyed cameras by topic alone) is left out, so the rest of the settings
+/// still load.
+///
+/// # Errors
+/// The value is not a map of camera files.
+pub fn deserialize_camera_map<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<BTreeMap<CameraId, CameraFiles>, D::Error> {
+    let raw = BTreeMap::<String, serde_json::Value>::deserialize(d)?;
+    Ok(raw
+        .into_iter()
+        .filter_map(|(k, v)| {
+            let id = k.parse().ok()?;
+            let files = serde_json::from_value(v).ok()?;
+            Some((id, files))
+        })
+        .collect())
 }
 
 /// The files one camera is recognised with; each may be unset (the command line's, the app's
@@ -392,13 +476,18 @@ pub fn files_for(
     topic: &str,
 ) -> Result<CameraFiles, SidecarError> {
     let folder = recording.parent().unwrap_or(Path::new("")).to_owned();
+    // The first camera is one camera whether its frames are raw or compressed.
+    let same = |t: &str| t == topic || (is_default_camera(t) && is_default_camera(topic));
     let defaults = metadata
         .iter()
-        .find(|(t, _)| t == topic)
+        .find(|(t, _)| same(t))
         .map(|(_, f)| f.clone().relative_to(&folder))
         .unwrap_or_default();
     let sidecar = Sidecar::load(recording)?;
-    Ok(match sidecar.as_ref().and_then(|s| s.cameras.get(topic)) {
+    let over = sidecar
+        .as_ref()
+        .and_then(|s| s.cameras.iter().find(|(t, _)| same(t)).map(|(_, f)| f));
+    Ok(match over {
         Some(over) => defaults.overridden_by(over),
         None => defaults,
     })
@@ -411,12 +500,9 @@ mod tests {
     #[test]
     fn camera_ids_read_back_what_they_write() {
         let ids = [
-            CameraId::recording("/camera/top"),
-            CameraId::Live {
-                robot: "ws://10.0.0.5:8765".into(),
-                topic: "/camera/bottom/image_raw".into(),
-            },
-            CameraId::Overhead("/dev/video0".into()),
+            CameraId::recording(Path::new("/data/game one.mcap"), "/camera/top"),
+            CameraId::live("ws://10.0.0.5:8765", "/camera/bottom/image_raw"),
+            CameraId::overhead("/dev/video0", "/camera/image"),
         ];
         for id in ids {
             let text = id.to_string();
@@ -427,12 +513,34 @@ mod tests {
         for bad in [
             "",
             "/camera/top",
-            "recording:top",
+            "recording:/camera/top",
+            "recording:a.mcap top",
             "live:/camera",
-            "weird:x",
+            "weird:x /camera",
         ] {
             assert!(bad.parse::<CameraId>().is_err(), "{bad}");
         }
+        let a = CameraId::recording(Path::new("/a.mcap"), "/camera/image");
+        assert!(a.same_source(&a.with_topic("/camera/bottom")));
+        assert!(!a.same_source(&CameraId::recording(Path::new("/b.mcap"), "/camera/image")));
+        assert!(!a.same_source(&CameraId::overhead("/a.mcap", "/camera/image")));
+    }
+
+    #[test]
+    fn settings_written_by_an_older_eotn_drop_only_their_topic_keyed_cameras() {
+        #[derive(Deserialize)]
+        struct Holder {
+            #[serde(deserialize_with = "deserialize_camera_map")]
+            cameras: BTreeMap<CameraId, CameraFiles>,
+        }
+        let text = r#"{"cameras": {
+            "recording:/camera/image": {"lut": "old.lut"},
+            "recording:/data/a.mcap /camera/image": {"lut": "a.lut"}
+        }}"#;
+        let h: Holder = serde_json::from_str(text).unwrap();
+        assert_eq!(h.cameras.len(), 1);
+        let a = CameraId::recording(Path::new("/data/a.mcap"), "/camera/image");
+        assert_eq!(h.cameras[&a].lut.as_deref(), Some(Path::new("a.lut")));
     }
 
     #[test]

@@ -23,7 +23,8 @@ pub const MAX_SMALL_FILE_BYTES: u64 = 4 << 20;
 
 /// Opens `path` for reading when it is a regular file, with its length: looked at before it is
 /// opened (a FIFO would block the open, a device is not a file) and again after (the path may
-/// have changed in between).
+/// have changed in between). The file becomes an input of the running command's guard
+/// ([`crate::atomic_file::guard_read`]), so no output of the command replaces it.
 ///
 /// # Errors
 /// The OS error, or `InvalidInput` saying that the path is not a regular file, so it cannot be
@@ -43,6 +44,8 @@ pub fn open_regular(path: &Path, what: &str) -> io::Result<(File, u64)> {
     if !meta.is_file() {
         return Err(not_a_file());
     }
+    // Whatever the command, a file it reads is one its outputs must not replace.
+    crate::atomic_file::guard_read(&meta, path);
     Ok((file, meta.len()))
 }
 
@@ -145,11 +148,10 @@ pub(crate) fn make_fifo(path: &Path) -> bool {
         .status()
         .is_ok_and(|s| s.success());
     if !made {
-        assert!(
-            !std::env::var("CI").is_ok_and(|v| v == "true" || v == "1"),
-            "mkfifo failed, and CI=true requires the FIFO case"
+        crate::test_skip::skipped(
+            "mkfifo failed: the FIFO case is not tested",
+            "install coreutils' mkfifo, on a file system that allows FIFOs",
         );
-        eprintln!("SKIPPED: mkfifo failed: the FIFO case is not tested");
     }
     made
 }

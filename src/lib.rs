@@ -61,12 +61,16 @@ pub mod sensors;
 pub mod session;
 pub mod sim;
 pub mod sources;
+pub mod ssl_vision;
 pub mod stats;
 pub mod streams;
 pub mod wmd;
 pub mod workspace;
 
 pub mod cli;
+
+#[cfg(test)]
+mod test_skip;
 
 /// The desktop app (egui/eframe on wgpu); only this module names the UI crates.
 #[cfg(feature = "gui")]

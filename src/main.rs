@@ -11,6 +11,7 @@ fn main() -> ExitCode {
         cli,
         inputs,
         outputs,
+        updated,
     } = eotn::cli::parse();
     // A kernel set forced by name is checked before anything runs (unknown, or not on this CPU).
     if let Err(e) = eotn::kernels::from_env() {
@@ -19,7 +20,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         #[cfg(feature = "gui")]
         Some(eotn::cli::Command::Open(args)) => eotn::app::run(args.run_options()),
-        Some(command) => eotn::cli::run(command, &inputs, &outputs),
+        Some(command) => eotn::cli::run(command, &inputs, &outputs, &updated),
         #[cfg(feature = "gui")]
         None => eotn::app::run(eotn::app_options::RunOptions::default()),
         #[cfg(not(feature = "gui"))]

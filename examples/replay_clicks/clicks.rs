@@ -1,15 +1,16 @@
 //! A hand classification written down as the clicks that made it: per class, the sensitivity
-//! (± table cells on Y, U, V), the frame (for a folder of frames) and the pixels clicked.
-//! Replayed through the app's own commands (`Seek`, `SetClass`, `SetSensitivity`, `Sample`,
-//! `Commit`), exactly as a user clicking those pixels in the window would make the table. Shared
-//! by `examples/replay_clicks` and the tests.
+//! (± table cells on Y, U, V), the frame (for a folder of frames) and the pixels clicked — or
+//! the cells of a coverage hint clicked. Replayed through the app's own commands (`Seek`,
+//! `SetClass`, `SetSensitivity`, `Sample` or `SelectCells`, `Commit`), exactly as a user
+//! clicking those pixels (or that hint) in the window would make the table. Shared by
+//! `examples/replay_clicks` and the tests.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use eotn::eval::label_sets::is_held_out;
 use eotn::lut::{ColourClass, Sensitivity};
-use eotn::workspace::{Command, PlaybackCommand, TableCommand, Workspace};
+use eotn::workspace::{Command, HintsCommand, PlaybackCommand, TableCommand, Workspace};
 use serde::Deserialize;
 
 /// A clicks file (`*.clicks.json`).
@@ -28,7 +29,8 @@ pub struct Clicks {
 pub struct ClickGroup {
     /// Class name as the app shows it (`"sky blue"`).
     pub class: String,
-    /// ± table cells on Y, U, V.
+    /// ± table cells on Y, U, V (of a pixel click; a hint's cells are taken as they are).
+    #[serde(default)]
     pub sensitivity: [u8; 3],
     /// The frame clicked on, a file name in the folder of frames (`"00054.jpg"`); absent when
     /// one frame or stream is open (its shown frame).
@@ -38,7 +40,12 @@ pub struct ClickGroup {
     #[serde(default)]
     pub note: Option<String>,
     /// The clicked pixels `[x, y]`.
+    #[serde(default)]
     pub pixels: Vec<[usize; 2]>,
+    /// The table cells of a coverage hint clicked (Classify ▸ What is still unclassified?),
+    /// by index: one click, committed as one edit (`HintsCommand::SelectCells`).
+    #[serde(default)]
+    pub cells: Vec<usize>,
 }
 
 impl Clicks {
@@ -48,9 +55,32 @@ impl Clicks {
         serde_json::from_str(&text).with_context(|| format!("{}", path.display()))
     }
 
-    /// Number of clicks.
+    /// Number of clicks: every pixel, and every hint.
     pub fn len(&self) -> usize {
-        self.clicks.iter().map(|g| g.pixels.len()).sum()
+        self.clicks
+            .iter()
+            .map(|g| g.pixels.len() + usize::from(!g.cells.is_empty()))
+            .sum()
+    }
+
+    /// Every frame of `folder` that is not held out (numbers ending in 0–6), sorted by name:
+    /// what a table is made on. The held-out frames are never opened.
+    pub fn tuning_frames(folder: &Path) -> anyhow::Result<Vec<PathBuf>> {
+        let mut out = Vec::new();
+        for entry in std::fs::read_dir(folder).with_context(|| format!("{}", folder.display()))? {
+            let path = entry?.path();
+            let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+            let frame = path
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| ["jpg", "jpeg", "png"].contains(&e.to_ascii_lowercase().as_str()));
+            if frame && !is_held_out(stem) {
+                out.push(path);
+            }
+        }
+        out.sort();
+        anyhow::ensure!(!out.is_empty(), "{}: no tuning frames", folder.display());
+        Ok(out)
     }
 
     /// The frames the groups name, in order of first use, as files of `folder`. Held-out frames
@@ -103,6 +133,11 @@ impl Clicks {
             let [y, u, v] = g.sensitivity;
             ws.apply(TableCommand::SetClass(class).into())?;
             ws.apply(TableCommand::SetSensitivity(Sensitivity { y, u, v }).into())?;
+            if !g.cells.is_empty() {
+                ws.apply(HintsCommand::SelectCells(g.cells.clone()).into())?;
+                ws.apply(TableCommand::Commit.into())
+                    .with_context(|| format!("{} hint of {} cells", g.class, g.cells.len()))?;
+            }
             for &[x, y] in &g.pixels {
                 ws.apply(TableCommand::Sample { x, y }.into())?;
                 ws.apply(TableCommand::Commit.into()).with_context(|| {

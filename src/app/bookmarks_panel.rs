@@ -49,18 +49,45 @@ pub fn bookmarks_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>)
     ui.data_mut(|d| d.insert_temp(id, note));
     user_bookmarks_ui(ui, state, commands);
     ui.separator();
-    labels_ui(ui, state);
+    labels_ui(ui, state, commands);
     events_ui(ui, state, commands);
 }
 
-/// The opened labels' report, as `eotn eval --labels` gives it, over the frames scored so far.
-fn labels_ui(ui: &mut Ui, state: &Workspace) {
+/// The opened labels' report, as `eotn eval --labels` gives it, over the frames scored so far
+/// with the table and parameters in use (scored again when they change), and the split scored.
+fn labels_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    use crate::eval::label_sets::Split;
     let Some(labels) = state.labels() else {
         return;
     };
     let r = labels.report();
     let (done, total) = labels.progress();
     ui.label(format!("Labels: {}", labels.path.display()));
+    ui.horizontal(|ui| {
+        ui.label("Score");
+        for (split, name, hover) in [
+            (Split::All, "all frames", "every labelled frame"),
+            (
+                Split::Tuning,
+                "tuning",
+                "frames whose number ends in 0–6: the ones to make the table on",
+            ),
+            (
+                Split::HeldOut,
+                "held out",
+                "frames whose number ends in 7, 8 or 9: kept for reporting, never tuned on",
+            ),
+        ] {
+            if ui
+                .selectable_label(labels.split() == split, name)
+                .on_hover_text(hover)
+                .clicked()
+                && labels.split() != split
+            {
+                commands.push(Command::SetLabelsSplit(split));
+            }
+        }
+    });
     if !labels.done() {
         ui.add(
             egui::ProgressBar::new(done as f32 / total.max(1) as f32)

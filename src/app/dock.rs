@@ -306,7 +306,7 @@ pub struct DockBehavior<'a> {
     /// The textures of cameras shown beside the focused one.
     pub beside: &'a super::side_by_side::BesideTextures,
     /// Cameras side by side: where each camera's image was drawn.
-    pub panes: Vec<(String, super::overlays::ImageTransform)>,
+    pub panes: Vec<super::side_by_side::DrawnPane>,
 }
 
 impl DockBehavior<'_> {

@@ -2,7 +2,9 @@
 //! robot where the overhead camera puts them (position, heading, team colour, identity) and
 //! short trails; each robot's own world-model estimate of itself and of the ball drawn beside
 //! that overhead truth with the error of each, and a plot of the errors over the frames seen.
-//! Clicking a robot selects it in every view. It draws the workspace's field model only.
+//! Clicking a robot selects it in every view. SSL-Vision's detections (a league log or a live
+//! address opened beside, or alone) are drawn over it, each camera's in its own colour. It draws
+//! the workspace's field model only.
 
 use egui::{Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, vec2};
 use egui_plot::{Line, Plot, VLine};
@@ -82,15 +84,23 @@ impl FieldTransform {
 /// The window's contents: the drawing, then the table and the plot of world-model errors.
 pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let overhead = state.overhead();
-    if !overhead.active() {
+    let ssl = state.ssl_vision();
+    if !overhead.active() && ssl.is_none() {
         ui.label(
-            "Not an overhead frame: open an overhead stream (e.g. streams/sim-overhead-game.mcap).",
+            "Not an overhead frame: open an overhead stream (e.g. streams/sim-overhead-game.mcap) or SSL-Vision packets (a league log, udp://224.5.23.2:10006).",
         );
         return;
     }
-    if overhead.detections().is_none() {
+    if overhead.active() && overhead.detections().is_none() {
         ui.label(overhead.calibration_status());
     }
+    if let Some(feed) = ssl {
+        ssl_feed_ui(ui, state, feed, commands);
+    }
+    let field = match ssl.and_then(crate::workspace::SslFeed::field) {
+        Some(f) if !overhead.active() => f,
+        _ => overhead.field(),
+    };
     let models = overhead.field_model.world_models();
     let plot_height = if models.is_empty() { 0.0 } else { 200.0 };
     let size = vec2(
@@ -101,14 +111,15 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "field drawing"));
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 2.0, Color32::from_rgb(20, 90, 40));
-    let xf = FieldTransform::fit(rect, overhead.field());
-    paint_field(&painter, &xf, overhead.field(), overhead.landmark());
+    let xf = FieldTransform::fit(rect, field);
+    paint_field(&painter, &xf, field, overhead.landmark());
     let show_truth_id = egui::Id::unique("eotn-field-view-truth");
     let mut show_truth: bool = ui.data(|d| d.get_temp(show_truth_id)).unwrap_or(true);
     if show_truth && let Some(t) = overhead.truth() {
         paint_truth(&painter, &xf, t);
     }
     let robots = paint_objects(&painter, &xf, state);
+    paint_ssl(&painter, &xf, overhead.field_model.ssl());
     if response.clicked()
         && let Some(pos) = response.interact_pointer_pos()
     {
@@ -312,6 +323,111 @@ fn paint_objects(
         }
     }
     out
+}
+
+/// The colour of SSL-Vision camera `id`'s marks.
+#[must_use]
+pub fn ssl_camera_colour(id: u32) -> Color32 {
+    const PALETTE: [Color32; 8] = [
+        Color32::from_rgb(255, 80, 200),
+        Color32::from_rgb(80, 230, 255),
+        Color32::from_rgb(180, 255, 80),
+        Color32::from_rgb(255, 190, 60),
+        Color32::from_rgb(170, 120, 255),
+        Color32::from_rgb(255, 255, 255),
+        Color32::from_rgb(255, 110, 90),
+        Color32::from_rgb(90, 255, 170),
+    ];
+    PALETTE[id as usize % PALETTE.len()]
+}
+
+/// What the SSL-Vision source is and shows; a log opened alone gets its own slider.
+fn ssl_feed_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    feed: &crate::workspace::SslFeed,
+    commands: &mut Vec<Command>,
+) {
+    let shown = state.overhead().field_model.ssl();
+    let mut line = format!("ssl-vision {}: {} frames", feed.name(), feed.frames());
+    if feed.bad_packets() > 0 {
+        line.push_str(&format!(", {} packets not SSL-Vision", feed.bad_packets()));
+    }
+    ui.horizontal_wrapped(|ui| {
+        ui.label(line);
+        for f in shown {
+            ui.colored_label(
+                ssl_camera_colour(f.camera_id),
+                format!("camera {}", f.camera_id),
+            );
+        }
+        if shown.is_empty() {
+            let span = feed.span_ns().map_or_else(String::new, |(a, b)| {
+                format!(
+                    " (its frames span {:.3}–{:.3} s)",
+                    a as f64 * 1e-9,
+                    b as f64 * 1e-9
+                )
+            });
+            ui.label(format!(
+                "no ssl-vision frame within half a frame period of this time{span}"
+            ));
+        }
+    });
+    let (steps, step) = feed.steps();
+    if state.source().is_none() && !feed.is_live() && steps > 1 {
+        let mut chosen = step;
+        let t = shown.first().map_or(0.0, |f| f.t_capture_s);
+        let slider = egui::Slider::new(&mut chosen, 0..=steps - 1)
+            .text(format!("ssl-vision step ({t:.3} s)"));
+        if ui.add(slider).changed() {
+            commands.push(Command::ShowSslStep(chosen));
+        }
+    }
+}
+
+/// SSL-Vision's detections, each camera's in its own colour: robots as squares filled with
+/// their team's colour, with a heading tick and the id; balls as diamonds.
+fn paint_ssl(
+    painter: &egui::Painter,
+    xf: &FieldTransform,
+    frames: &[crate::ssl_vision::CameraFrame],
+) {
+    let half = (ROBOT_RADIUS_CM * xf.scale()).max(4.0) * 0.8;
+    for f in frames {
+        let colour = ssl_camera_colour(f.camera_id);
+        let stroke = Stroke::new(1.5, colour);
+        for r in &f.robots {
+            let c = xf.to_screen(r.field_cm);
+            let rect = Rect::from_center_size(c, vec2(2.0 * half, 2.0 * half));
+            painter.rect_filled(rect, 0.0, team_colour(r.team).gamma_multiply(0.35));
+            painter.rect_stroke(rect, 0.0, stroke, egui::StrokeKind::Middle);
+            if let Some(h) = r.heading_rad {
+                let dir = vec2(h.cos() as f32, -(h.sin() as f32));
+                painter.line_segment([c, c + dir * half * 1.8], stroke);
+            }
+            if let Some(id) = r.robot_id {
+                painter.text(
+                    c + vec2(half, -half),
+                    egui::Align2::LEFT_BOTTOM,
+                    id.to_string(),
+                    FontId::proportional(10.0),
+                    colour,
+                );
+            }
+        }
+        for b in &f.balls {
+            let c = xf.to_screen(b.field_cm);
+            let d = (4.25 * xf.scale()).max(3.0) * 1.6;
+            let diamond = vec![
+                c + vec2(0.0, -d),
+                c + vec2(d, 0.0),
+                c + vec2(0.0, d),
+                c + vec2(-d, 0.0),
+            ];
+            painter.add(egui::Shape::closed_line(diamond, stroke));
+        }
+    }
 }
 
 /// Each world model's errors on this frame, and over the frames seen so far.

@@ -21,6 +21,10 @@ pub enum FileAction {
     OpenParams,
     /// A places file.
     OpenPlaces,
+    /// A label set kept as a folder (YOLO, Pascal VOC) over the open frames.
+    OpenLabelsFolder,
+    /// A label set kept as one file (COCO JSON) over the open frames.
+    OpenLabelsFile,
     /// Save the table under a new name.
     SaveTableAs,
     /// Save the recognition parameters.
@@ -48,6 +52,8 @@ impl FileAction {
             Self::OpenTable => "Open a lookup table",
             Self::OpenParams => "Open recognition parameters",
             Self::OpenPlaces => "Open a places file",
+            Self::OpenLabelsFolder => "Open labels: a YOLO or Pascal VOC folder",
+            Self::OpenLabelsFile => "Open labels: a COCO JSON file",
             Self::SaveTableAs => "Save the lookup table as",
             Self::SaveParams => "Save the recognition parameters as",
             Self::ExportView => "Export the view as PNG",
@@ -63,11 +69,12 @@ impl FileAction {
     #[must_use]
     pub const fn extensions(self) -> &'static [&'static str] {
         match self {
-            Self::Open => &[],
+            Self::Open | Self::OpenLabelsFolder => &[],
             Self::OpenTable | Self::SaveTableAs => &["lut", "cal", "raw", "tm", "col"],
             Self::OpenParams
             | Self::OpenPlaces
             | Self::SaveParams
+            | Self::OpenLabelsFile
             | Self::OpenCalibration
             | Self::SaveCalibration
             | Self::OpenPoints
@@ -97,6 +104,7 @@ impl FileAction {
             Self::OpenTable => Command::OpenTable(path),
             Self::OpenParams => Command::Params(ParamsCommand::OpenParams(path)),
             Self::OpenPlaces => Command::OpenPlaces(path),
+            Self::OpenLabelsFolder | Self::OpenLabelsFile => Command::OpenLabels(path),
             Self::SaveTableAs => Command::Table(TableCommand::SaveTableAs(path)),
             Self::SaveParams => Command::Params(ParamsCommand::SaveParams(path)),
             Self::ExportView => Command::View(ViewCommand::ExportView(path)),
@@ -135,6 +143,8 @@ impl FileDialogs {
     pub fn open(&mut self, action: FileAction, folder: Option<&Path>, file_name: Option<String>) {
         let mut d = if action.saves() {
             FileDialog::save_file()
+        } else if action == FileAction::OpenLabelsFolder {
+            FileDialog::select_folder()
         } else {
             FileDialog::open_file()
         };

@@ -27,6 +27,9 @@ pub struct MenuOutput {
 pub struct MenuInput {
     /// The "Open path" window is shown.
     pub open: bool,
+    /// The "Open path" window opens a label set over the frames (`Command::OpenLabels`)
+    /// instead of a stream, frames or a table.
+    pub open_labels: bool,
     /// The text of the path field.
     pub path: String,
     /// A file dialog to open (what for, and the file name to suggest for a save).
@@ -40,22 +43,39 @@ pub fn open_path_window(ctx: &egui::Context, input: &mut MenuInput, commands: &m
     }
     let mut open = true;
     let mut done = false;
-    egui::Window::new("Open path")
+    let (title, hint) = if input.open_labels {
+        (
+            "Open labels path",
+            "/path/to/labels-yolo, labels-voc or coco.json (over the open frames)",
+        )
+    } else {
+        (
+            "Open path",
+            "/path/to/stream.mcap, table.lut, params.json, places.json or frames",
+        )
+    };
+    egui::Window::new(title)
         .open(&mut open)
         .collapsible(false)
         .default_pos([300.0, 120.0])
         .show(ctx, |ui| {
-            let edit = ui.add(
-                egui::TextEdit::singleline(&mut input.path)
-                    .hint_text(
-                        "/path/to/stream.mcap, table.lut, params.json, places.json or frames",
-                    )
-                    .desired_width(420.0),
-            );
+            let label = ui.label("path");
+            let edit = ui
+                .add(
+                    egui::TextEdit::singleline(&mut input.path)
+                        .hint_text(hint)
+                        .desired_width(420.0),
+                )
+                .labelled_by(label.id);
             edit.request_focus();
             let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
             if (ui.button("Open").clicked() || enter) && !input.path.trim().is_empty() {
-                commands.push(Command::Open(vec![PathBuf::from(input.path.trim())]));
+                let path = PathBuf::from(input.path.trim());
+                commands.push(if input.open_labels {
+                    Command::OpenLabels(path)
+                } else {
+                    Command::Open(vec![path])
+                });
                 done = true;
             }
         });
@@ -117,8 +137,10 @@ fn file_menu_ui(
         .clicked()
     {
         input.open = true;
+        input.open_labels = false;
         ui.close();
     }
+    labels_items_ui(ui, state, input);
     ui.menu_button("New table", |ui| {
         for bits in [6u8, 7, 8] {
             if ui
@@ -187,6 +209,41 @@ fn file_menu_ui(
         out.quit = true;
         ui.close();
     }
+}
+
+/// File ▸ Open labels: a label set over the open frames (a YOLO or Pascal VOC folder from the
+/// folder dialog, a COCO JSON file from the file dialog, or any of them as a typed path).
+fn labels_items_ui(ui: &mut Ui, state: &Workspace, input: &mut MenuInput) {
+    let frames = state.source().is_some();
+    let why = "open the frames first, then their labels";
+    ui.menu_button("Open labels", |ui| {
+        if ui
+            .add_enabled(frames, egui::Button::new("Labels folder (YOLO, VOC)…"))
+            .on_disabled_hover_text(why)
+            .clicked()
+        {
+            input.dialog = Some((FileAction::OpenLabelsFolder, None));
+            ui.close();
+        }
+        if ui
+            .add_enabled(frames, egui::Button::new("Labels file (COCO JSON)…"))
+            .on_disabled_hover_text(why)
+            .clicked()
+        {
+            input.dialog = Some((FileAction::OpenLabelsFile, None));
+            ui.close();
+        }
+        if ui
+            .add_enabled(frames, egui::Button::new("Labels path…"))
+            .on_hover_text("type the path of a label set")
+            .on_disabled_hover_text(why)
+            .clicked()
+        {
+            input.open = true;
+            input.open_labels = true;
+            ui.close();
+        }
+    });
 }
 
 /// File ▸ Open parameters…, the stream's set, the defaults, Save parameters as….
@@ -596,18 +653,24 @@ fn stream_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     });
 }
 
-/// The camera picker: every camera (image topic) of the open recording, the shown one ticked;
-/// picking one shows it at the same time with its own table (`Command::OpenCamera`).
+/// The camera picker: every camera (image topic) of the open recording or shown robot, the
+/// shown one ticked; picking one shows it at the same time with its own table
+/// (`Command::OpenCamera`).
 fn cameras_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let (cameras, shown) = state.cameras();
+    let of = if state.shown_robot().is_some() {
+        "Camera of the robot"
+    } else {
+        "Camera of the recording"
+    };
     ui.add_enabled_ui(cameras.len() > 1, |ui| {
-        ui.menu_button("Camera of the recording", |ui| {
-            for topic in cameras {
+        ui.menu_button(of, |ui| {
+            for camera in &cameras {
                 if ui
-                    .selectable_label(shown == Some(topic.as_str()), topic)
+                    .selectable_label(shown.as_ref() == Some(camera), camera.topic())
                     .clicked()
                 {
-                    commands.push(Command::OpenCamera(Some(topic.clone())));
+                    commands.push(Command::OpenCamera(Some(camera.clone())));
                     ui.close();
                 }
             }
@@ -615,12 +678,8 @@ fn cameras_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) 
         // Every camera at once, stepped together by time, each with its own table.
         let mut together = !state.camera_panes().is_empty();
         if ui.checkbox(&mut together, "Cameras side by side").clicked() {
-            let topics = if together {
-                cameras.to_vec()
-            } else {
-                Vec::new()
-            };
-            commands.push(Command::ShowSideBySide(topics));
+            let shown = if together { cameras } else { Vec::new() };
+            commands.push(Command::ShowSideBySide(shown));
             ui.close();
         }
     });

@@ -197,8 +197,9 @@ pub struct EotnApp {
     /// Where the timeline's marks were last spread: the slider's track (tests compare it
     /// with the slider's own rectangle).
     pub last_timeline_track: Option<egui::Rect>,
-    /// Cameras side by side: (image topic, where its image was last drawn), left to right.
-    pub last_panes: Vec<(String, ImageTransform)>,
+    /// Cameras side by side: each pane as last drawn (where, how many primitives), left to
+    /// right.
+    pub last_panes: Vec<side_by_side::DrawnPane>,
     beside_textures: side_by_side::BesideTextures,
     confirm_close: bool,
     allow_close: bool,
@@ -316,6 +317,11 @@ impl EotnApp {
                 .points_path()
                 .map(std::path::Path::to_owned),
             A::Open | A::ExportView | A::Record => self.state.settings.last_source.first().cloned(),
+            // Label sets lie beside their frames: the folder holding the opened frames' folder.
+            A::OpenLabelsFolder | A::OpenLabelsFile => self.state.labels().map_or_else(
+                || self.state.settings.last_source.first().cloned(),
+                |l| Some(l.path.clone()),
+            ),
         };
         file.and_then(|f| f.parent().map(std::path::Path::to_owned))
             .filter(|d| !d.as_os_str().is_empty())

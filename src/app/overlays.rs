@@ -117,7 +117,8 @@ pub struct FrameTextures {
     pub preview: TextureId,
 }
 
-/// Paints one view of the shown frame, clipped to the transform's view.
+/// Paints one view of the shown frame, clipped to the transform's view; returns how many of
+/// recognition's primitives it drew.
 pub fn paint_view(
     painter: &Painter,
     xf: &ImageTransform,
@@ -125,7 +126,7 @@ pub fn paint_view(
     state: &Workspace,
     tex: &FrameTextures,
     with_overlays: bool,
-) {
+) -> usize {
     let painter = painter.with_clip_rect(xf.view);
     let img = xf.image_rect();
     let uv = Rect::from_min_max(Pos2::ZERO, pos2(1.0, 1.0));
@@ -185,6 +186,7 @@ pub fn paint_view(
             blob_label(&painter, xf, b, &mut placed);
         }
     }
+    let mut drawn = 0;
     if kind == ViewKind::Objects || (with_overlays && kind != ViewKind::Blobs) {
         let filter = if kind == ViewKind::Objects {
             let mut f = PrimitiveFilter::objects(o, state.accepted_owners());
@@ -194,7 +196,7 @@ pub fn paint_view(
         } else {
             PrimitiveFilter::all(o)
         };
-        paint_primitives(
+        drawn = paint_primitives(
             &painter,
             xf,
             state.primitives(),
@@ -212,6 +214,7 @@ pub fn paint_view(
         label_boxes(&painter, xf, state);
     }
     super::overhead_overlays::paint_overhead(&painter, xf, kind, state, with_overlays);
+    drawn
 }
 
 /// The opened labels' boxes of the shown frame (`Command::OpenLabels`), dashed, by class: balls
@@ -326,20 +329,23 @@ fn primitive_colour(p: &Primitive) -> Color32 {
     Color32::from_rgb(r, g, b)
 }
 
-/// Draws recognition's primitives through the view's transform. With a `selected` owner, its
-/// primitives are drawn thicker and every other object's are dimmed (the horizon stays).
+/// Draws recognition's primitives through the view's transform; returns how many it drew (those
+/// the filter shows). With a `selected` owner, its primitives are drawn thicker and every other
+/// object's are dimmed (the horizon stays).
 pub fn paint_primitives(
     painter: &Painter,
     xf: &ImageTransform,
     primitives: &[Primitive],
     filter: &PrimitiveFilter<'_>,
     selected: Option<ObjectId>,
-) {
+) -> usize {
     let at = |p: ImagePoint| xf.to_screen(pos2(p.x_px as f32, p.y_px as f32));
     // Edge points: a dot about a pixel wide, never smaller than 1.5 points.
     let dot = (xf.zoom * 0.5).clamp(1.5, 4.0);
     let clip = painter.clip_rect().expand(8.0);
+    let mut drawn = 0;
     for p in primitives.iter().filter(|p| filter.shows(p)) {
+        drawn += 1;
         let mine = selected == Some(p.owner());
         let dim = selected.is_some() && !mine && p.owner() != ObjectId::Horizon;
         let mut colour = primitive_colour(p);
@@ -400,6 +406,7 @@ pub fn paint_primitives(
             }
         }
     }
+    drawn
 }
 
 /// The screen rectangle of an inclusive pixel box `[minx, miny, maxx, maxy]` (pixels; the

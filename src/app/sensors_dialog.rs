@@ -18,7 +18,7 @@ pub fn sensors_ui(ui: &mut egui::Ui, state: &Workspace) {
     };
     // With several cameras, the readings are those of the camera shown (focused).
     let camera = match state.cameras() {
-        (all, Some(topic)) if all.len() > 1 => format!("camera {topic}, "),
+        (all, Some(camera)) if all.len() > 1 => format!("camera {}, ", camera.topic()),
         _ => String::new(),
     };
     ui.label(format!(

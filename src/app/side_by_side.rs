@@ -85,14 +85,25 @@ fn pane_images(p: &CameraPane<'_>, palette: &[Color32; 256]) -> Option<(ColorIma
     Some((raw, classified))
 }
 
-/// What the side-by-side view reports: the focused view's output and where each camera's
-/// image was drawn (tests click pixels through it).
+/// One camera's pane as it was drawn.
+#[derive(Debug, Clone)]
+pub struct DrawnPane {
+    /// The camera's image topic.
+    pub topic: String,
+    /// Where its image was drawn (tests click pixels through it).
+    pub transform: ImageTransform,
+    /// How many of its recognition's primitives were drawn over it.
+    pub primitives: usize,
+}
+
+/// What the side-by-side view reports: the focused view's output and each camera's pane as
+/// drawn.
 #[derive(Debug, Default, Clone)]
 pub struct SideBySideOutput {
     /// The focused camera's enlarged view.
     pub focused: MainViewOutput,
-    /// (image topic, where its image was drawn), left to right.
-    pub panes: Vec<(String, ImageTransform)>,
+    /// The panes, left to right.
+    pub panes: Vec<DrawnPane>,
 }
 
 /// The cameras side by side, filling `ui`.
@@ -122,10 +133,20 @@ pub fn side_by_side_ui(
             });
             out.focused = view.inner;
             if let Some(xf) = out.focused.transform {
-                out.panes.push((pane.topic.to_owned(), xf));
+                out.panes.push(DrawnPane {
+                    topic: pane.topic.to_owned(),
+                    transform: xf,
+                    primitives: out.focused.primitives_drawn,
+                });
             }
-        } else if let Some(xf) = beside_pane_ui(ui, body, state, pane, beside, commands) {
-            out.panes.push((pane.topic.to_owned(), xf));
+        } else if let Some((xf, primitives)) =
+            beside_pane_ui(ui, body, state, pane, beside, commands)
+        {
+            out.panes.push(DrawnPane {
+                topic: pane.topic.to_owned(),
+                transform: xf,
+                primitives,
+            });
         }
     }
     ui.advance_cursor_after_rect(area);
@@ -163,7 +184,8 @@ fn header_ui(ui: &Ui, rect: egui::Rect, pane: &CameraPane<'_>) {
 }
 
 /// A camera not focused: its frame, its classes over it, its recognition, and what it says when
-/// it has ended; a click focuses it and samples the pixel.
+/// it has ended; a click focuses it and samples the pixel. Returns where its image was drawn
+/// and how many of its primitives.
 fn beside_pane_ui(
     ui: &mut Ui,
     rect: egui::Rect,
@@ -171,7 +193,7 @@ fn beside_pane_ui(
     pane: &CameraPane<'_>,
     beside: &BesideTextures,
     commands: &mut Vec<Command>,
-) -> Option<ImageTransform> {
+) -> Option<(ImageTransform, usize)> {
     let response = ui.interact(
         rect,
         egui::Id::unique(("camera pane", pane.topic)),
@@ -203,7 +225,7 @@ fn beside_pane_ui(
             painter.image(t.classified.id(), img, uv, Color32::from_white_alpha(a));
         }
     }
-    paint_primitives(
+    let drawn = paint_primitives(
         &painter,
         &xf,
         pane.primitives,
@@ -217,12 +239,12 @@ fn beside_pane_ui(
         && let Some(pos) = response.interact_pointer_pos()
         && let Some((x, y)) = xf.pixel_at(pos)
     {
-        commands.push(Command::FocusCamera(pane.topic.to_owned()));
+        commands.push(Command::FocusCamera(pane.camera.clone()));
         commands.push(TableCommand::Sample { x, y }.into());
     }
     response.on_hover_text(format!(
         "camera {}: click to focus it and classify with its table",
         pane.topic
     ));
-    Some(xf)
+    Some((xf, drawn))
 }

@@ -21,6 +21,8 @@ pub struct MainViewOutput {
     pub hovered: Option<PixelInfo>,
     /// Where the view was drawn and how (tests click pixels through it).
     pub transform: Option<ImageTransform>,
+    /// How many of recognition's primitives it drew.
+    pub primitives_drawn: usize,
 }
 
 /// The enlarged view, filling `ui`; pushes what the user did as commands.
@@ -47,11 +49,12 @@ pub fn main_view_ui(
         return MainViewOutput::default();
     };
     let xf = ImageTransform::for_state(rect, state);
-    paint_view(&painter, &xf, kind, state, tex, true);
+    let primitives_drawn = paint_view(&painter, &xf, kind, state, tex, true);
 
     let mut out = MainViewOutput {
         hovered: None,
         transform: Some(xf),
+        primitives_drawn,
     };
     if let Some(pos) = response.hover_pos() {
         out.hovered = xf

@@ -6,8 +6,15 @@
 //! (every path its arguments name as inputs, folders expanded), and from then until the returned
 //! [`CommandGuard`] is dropped every [`super::OutputTarget::open`] refuses an output that is one
 //! of them, and an output this command has already written (two inputs of the same name would
-//! otherwise overwrite each other's result). The app does not guard: saving a table over the
-//! table it opened is what Save does.
+//! otherwise overwrite each other's result). The inputs a command finds on its own are guarded
+//! the same way, whichever command reads them: every file read through
+//! [`crate::input_file::open_regular`] (a rosbag2 folder's `metadata.yaml` and `.mcap` files,
+//! the table, parameters and `REC.cameras.json` a recording names, the files a session names)
+//! and every SQLite storage file is declared to the guard ([`guard_read`]) when it is opened,
+//! and an output is checked again just before it is renamed into place. Files the command line
+//! names as replaced on purpose ([`guard_updated`]: `patterns learn --update`) are read without
+//! becoming inputs. The app does not guard: saving a table over the table it opened is what
+//! Save does.
 
 use std::fs::{self, Metadata};
 use std::io;
@@ -56,12 +63,15 @@ struct Guarded {
     inputs: Vec<(FileId, PathBuf)>,
     /// What it has written so far.
     written: Vec<(FileId, PathBuf)>,
+    /// What it reads and then replaces on purpose (never an input).
+    updated: Vec<FileId>,
 }
 
 static GUARDED: Mutex<Guarded> = Mutex::new(Guarded {
     active: false,
     inputs: Vec::new(),
     written: Vec::new(),
+    updated: Vec::new(),
 });
 
 fn guarded() -> MutexGuard<'static, Guarded> {
@@ -84,18 +94,38 @@ pub fn guard_command<P: AsRef<Path>>(inputs: impl IntoIterator<Item = P>) -> Com
 }
 
 /// Adds inputs found while the command runs (the frames of a folder, a label mask beside a
-/// frame) to the guard; nothing happens when no command is guarded.
+/// frame, a bag's storage file) to the guard; nothing happens when no command is guarded.
 pub fn guard_inputs<P: AsRef<Path>>(inputs: impl IntoIterator<Item = P>) {
+    let mut g = guarded();
+    for p in inputs {
+        let p = p.as_ref();
+        if let Some(id) = FileId::of_path(p) {
+            g.add_input(id, p);
+        }
+    }
+}
+
+/// Declares a file the running command has just opened for reading, by the metadata of the
+/// open file (so the file read is the one guarded, whatever happens to its path later); nothing
+/// happens when no command is guarded. [`crate::input_file::open_regular`] calls it for every
+/// file it opens.
+pub fn guard_read(meta: &Metadata, path: &Path) {
+    if let Some(id) = FileId::of(meta) {
+        guarded().add_input(id, path);
+    }
+}
+
+/// Declares the files the guarded command reads and then replaces on purpose (`--update`):
+/// reading them does not make them inputs.
+pub fn guard_updated<P: AsRef<Path>>(paths: impl IntoIterator<Item = P>) {
     let mut g = guarded();
     if !g.active {
         return;
     }
-    for p in inputs {
-        let p = p.as_ref();
-        if let Some(id) = FileId::of_path(p)
-            && !g.inputs.iter().any(|(i, _)| *i == id)
-        {
-            g.inputs.push((id, p.to_owned()));
+    for p in paths {
+        if let Some(id) = FileId::of_path(p.as_ref()) {
+            g.inputs.retain(|(i, _)| *i != id);
+            g.updated.push(id);
         }
     }
 }
@@ -113,6 +143,15 @@ impl Drop for CommandGuard {
 }
 
 impl Guarded {
+    /// Adds the input `id` (at `path`) while a command is guarded, unless it is known already or
+    /// replaced on purpose.
+    fn add_input(&mut self, id: FileId, path: &Path) {
+        if self.active && !self.updated.contains(&id) && !self.inputs.iter().any(|(i, _)| *i == id)
+        {
+            self.inputs.push((id, path.to_owned()));
+        }
+    }
+
     /// Why the existing file `id` must not be replaced by an output, if it must not.
     fn refusal(&self, id: FileId) -> Option<io::Error> {
         if !self.active {
@@ -139,6 +178,15 @@ pub(super) fn check_output(meta: &Metadata) -> io::Result<()> {
     match FileId::of(meta).and_then(|id| guarded().refusal(id)) {
         Some(e) => Err(e),
         None => Ok(()),
+    }
+}
+
+/// Refuses, just before an output is renamed onto `path`, a file there that the guarded command
+/// has read meanwhile (an input found while it ran, after the output was opened).
+pub(super) fn check_before_rename(path: &Path) -> io::Result<()> {
+    match fs::metadata(path) {
+        Ok(meta) if meta.is_file() => check_output(&meta),
+        _ => Ok(()),
     }
 }
 
@@ -238,12 +286,21 @@ mod tests {
             active: true,
             inputs: vec![(id(&input), input.clone())],
             written: vec![(id(&written), written.clone())],
+            updated: Vec::new(),
         };
         let e = g.refusal(id(&input)).expect("an input");
         assert!(e.to_string().contains("would replace the input"), "{e}");
         let e = g.refusal(id(&written)).expect("written before");
         assert!(e.to_string().contains("written already"), "{e}");
         assert!(g.refusal(id(&other)).is_none());
+        // A file read and replaced on purpose is never an input.
+        let updated = dir.path().join("places.json");
+        fs::write(&updated, b"x").expect("write");
+        g.updated.push(id(&updated));
+        g.add_input(id(&updated), &updated);
+        g.add_input(id(&other), &other);
+        assert!(g.refusal(id(&updated)).is_none(), "updated on purpose");
+        assert!(g.refusal(id(&other)).is_some(), "read while running");
         g.active = false;
         assert!(g.refusal(id(&input)).is_none(), "no command guarded");
     }

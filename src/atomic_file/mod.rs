@@ -27,7 +27,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use guard::{
-    CommandGuard, FileId, guard_command, guard_inputs, refuse_inputs, refuse_overwriting,
+    CommandGuard, FileId, guard_command, guard_inputs, guard_read, guard_updated, refuse_inputs,
+    refuse_overwriting,
 };
 pub use partial::{PartialFile, is_partial_name, partial_path};
 pub use target::{OutputFile, OutputTarget, TargetKind};

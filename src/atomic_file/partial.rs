@@ -221,6 +221,7 @@ impl PartialFile {
         };
         self.file.sync_all()?;
         keep_mode_and_owner(&self.file, &self.path)?;
+        guard::check_before_rename(&self.path)?;
         fs::rename(&partial, &self.path)?;
         sync_parent(&self.path);
         guard::note_written(&self.path);

@@ -188,6 +188,7 @@ impl OutputFile {
         };
         let result = file.sync_all().and_then(|()| {
             drop(file);
+            guard::check_before_rename(&path)?;
             fs::rename(&tmp, &path)
         });
         if let Err(e) = result {

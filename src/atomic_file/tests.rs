@@ -159,11 +159,10 @@ pub(crate) fn private_null(dir: &Path) -> Option<PathBuf> {
     if ok {
         return Some(p);
     }
-    assert!(
-        std::env::var("CI").as_deref() != Ok("true"),
-        "mknod refused: the device-node case cannot be tested"
+    crate::test_skip::skipped(
+        "mknod is refused here (not root?): the device-node case is not tested",
+        "run the tests as root, or in a container that allows mknod",
     );
-    eprintln!("SKIPPED: mknod is refused here (not root?): the device-node case is not tested");
     None
 }
 
@@ -206,10 +205,9 @@ pub(crate) fn fifo_with_reader(dir: &Path) -> Option<(PathBuf, std::thread::Join
         .status()
         .is_ok_and(|s| s.success());
     if !made {
-        eprintln!("SKIPPED: mkfifo failed: the FIFO case is not tested");
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "mkfifo failed"
+        crate::test_skip::skipped(
+            "mkfifo failed: the FIFO case is not tested",
+            "install coreutils' mkfifo, on a file system that allows FIFOs",
         );
         return None;
     }

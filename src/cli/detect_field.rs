@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::field::{field_views, frame_times, open_cameras};
 use super::overhead::{BallJson, RobotJson, SizeCheck};
-use crate::overhead::merge::{CameraId, FieldPicture, merge_detections};
+use crate::overhead::merge::{FieldPicture, SslCameraId, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::session::Session;
 
@@ -22,8 +22,8 @@ struct FieldBallJson {
     #[serde(flatten)]
     ball: BallJson,
     /// The camera whose ball it is (its `image_px`, `radius_px`).
-    camera_id: CameraId,
-    camera_ids: Vec<CameraId>,
+    camera_id: SslCameraId,
+    camera_ids: Vec<SslCameraId>,
 }
 
 /// A merged robot in a field line.
@@ -31,13 +31,13 @@ struct FieldBallJson {
 struct FieldRobotJson {
     #[serde(flatten)]
     robot: RobotJson,
-    camera_ids: Vec<CameraId>,
+    camera_ids: Vec<SslCameraId>,
 }
 
 /// A camera frame merged into a field frame.
 #[derive(Debug, Serialize)]
 struct CameraFrameJson {
-    id: CameraId,
+    id: SslCameraId,
     time_ns: u64,
 }
 
@@ -51,14 +51,18 @@ struct FieldLineJson {
     cameras: Vec<CameraFrameJson>,
 }
 
-/// Runs `eotn overhead detect --session`.
+/// Runs `eotn overhead detect --session`; with `ssl_vision` (`HOST:PORT`) each camera's frames
+/// are also sent as SSL-Vision packets, `camera_id` its session id.
 ///
 /// # Errors
 /// An unusable session (named entry), a camera's frame of another shape than its calibration.
 /// A camera whose frame cannot be read is warned about and left out of that field frame.
-pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
+pub fn run(path: &Path, json: bool, ssl_vision: Option<&str>) -> anyhow::Result<()> {
     let session = Session::load(path)?;
-    let (_, mut cameras) = open_cameras(&session)?;
+    let (field, mut cameras) = open_cameras(&session)?;
+    let mut ssl = ssl_vision
+        .map(|addr| super::ssl_vision_out::SslOut::open(addr, &field, &ssl_cameras(&cameras)))
+        .transpose()?;
     let times = frame_times(&cameras);
     let reference = times.first().cloned().unwrap_or_default();
     let period_ns = frame_period_ns(&reference);
@@ -67,11 +71,16 @@ pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
     for (i, &t_ref) in reference.iter().enumerate() {
         let (views, frames) =
             field_views(cameras.as_mut_slice(), &times, i, period_ns, &mut sizes)?;
+        if let Some(out) = ssl.as_mut() {
+            for ((id, d), (_, time_ns)) in views.iter().zip(&frames) {
+                out.send(super::ssl_vision_out::session_camera_id(*id), *time_ns, d);
+            }
+        }
         let frames = frames
             .into_iter()
             .map(|(id, time_ns)| CameraFrameJson { id, time_ns })
             .collect();
-        let refs: Vec<(CameraId, &OverheadDetections)> =
+        let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let line = field_line(t_ref, &merge_detections(&refs), frames);
         if json {
@@ -82,7 +91,21 @@ pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
         }
     }
     out.flush().context("writing output")?;
+    if let Some(ssl) = &ssl {
+        ssl.finish();
+    }
     Ok(())
+}
+
+/// Each camera's id and calibration, for the SSL-Vision geometry.
+fn ssl_cameras(cameras: &[super::field::FieldCamera]) -> Vec<crate::ssl_vision::CameraEntry> {
+    cameras
+        .iter()
+        .map(|c| crate::ssl_vision::CameraEntry {
+            camera_id: super::ssl_vision_out::session_camera_id(c.id),
+            camera: *c.pipeline.camera(),
+        })
+        .collect()
 }
 
 /// One field frame as a line of `overhead detect --session --json` (`time_ns`, `ball`,
@@ -90,7 +113,7 @@ pub fn run(path: &Path, json: bool) -> anyhow::Result<()> {
 pub(super) fn field_line_value(
     time_ns: u64,
     p: &FieldPicture,
-    cameras: &[(CameraId, u64)],
+    cameras: &[(SslCameraId, u64)],
 ) -> serde_json::Result<serde_json::Value> {
     let frames = cameras
         .iter()

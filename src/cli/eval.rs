@@ -4,7 +4,7 @@
 //! relation to the truth and writes it as recognition parameters. `--labels` scores a real
 //! stream against hand labels instead (`eval_labels.rs`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use serde::Serialize;
@@ -29,9 +29,10 @@ pub struct Args {
     /// Streams with a `/ground_truth` channel (from `eotn sim`).
     #[arg(required = true)]
     pub streams: Vec<PathBuf>,
-    /// Lookup table.
+    /// Lookup table; default: the table the first recording names for the camera read (its
+    /// `REC.cameras.json` sidecar, else its metadata).
     #[arg(long)]
-    pub lut: PathBuf,
+    pub lut: Option<PathBuf>,
     /// Recognition parameters JSON (default: the set the first recording names for the camera read, else the defaults).
     #[arg(long)]
     pub params: Option<PathBuf>,
@@ -87,6 +88,14 @@ pub struct Args {
     /// Overhead streams: the field description (ball radius, plate height).
     #[arg(long)]
     pub field: Option<PathBuf>,
+    /// Overhead streams: take ssl-vision's detections of the same field as the truth, from a
+    /// league log file (`SSL_LOG_FILE`, plain or `.gz`) or live from `udp://GROUP:PORT`
+    /// (listened to until the packets stop): each stream frame is paired with every camera's
+    /// frame of nearest capture time within half a frame period, and scored as against the
+    /// simulator's truth (ball and robot position and heading errors, identities, misses,
+    /// false robots).
+    #[arg(long, value_name = "LOG_OR_UDP")]
+    pub truth_ssl: Option<PathBuf>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -394,11 +403,40 @@ fn calibrate_goals(
     Ok((m, o))
 }
 
+/// `eotn eval OVERHEAD… --truth-ssl LOG|udp://…`: the overhead streams against ssl-vision's
+/// detections.
+fn run_truth_ssl(args: &Args, source: &Path, lut_path: &Path) -> anyhow::Result<()> {
+    super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
+        .context("--truth-ssl is the truth of overhead streams")?;
+    let truth = super::eval_overhead::load_ssl_truth(source)?;
+    super::eval_overhead::run(
+        &args.streams,
+        args.camera.get(),
+        lut_path,
+        args.calibration.as_deref(),
+        args.field.as_deref(),
+        &truth,
+        args.json,
+    )
+}
+
+/// The streams among `args.streams` whose source kind is not an overhead camera's.
+fn robot_camera_streams(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
+    let inputs =
+        super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
+    Ok(inputs.robot_streams().to_vec())
+}
+
 /// Runs `eotn eval`.
 ///
 /// # Errors
 /// Unreadable inputs or streams without ground truth, naming the file.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    let lut_path =
+        super::inputs::table_or_camera_s(args.lut.as_deref(), &args.streams, args.camera.get())?;
+    if let Some(source) = &args.truth_ssl {
+        return run_truth_ssl(args, source, &lut_path);
+    }
     let overhead = args
         .streams
         .iter()
@@ -408,9 +446,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         return super::eval_overhead::run(
             &args.streams,
             args.camera.get(),
-            &args.lut,
+            &lut_path,
             args.calibration.as_deref(),
             args.field.as_deref(),
+            &super::eval_overhead::TruthSource::Stream,
             args.json,
         );
     } else if overhead > 0 {
@@ -420,7 +459,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         super::overhead::refuse_robot_streams(&args.streams)
             .context("--calibration and --field are for overhead streams")?;
     }
-    let lut = load_lut_arg(&args.lut)?;
+    let lut = load_lut_arg(&lut_path)?;
     let rp = params_or_camera_s(args.params.as_deref(), &args.streams, args.camera.get())?;
     if let Some(labels) = &args.labels {
         return run_labels(args, labels, lut, rp);

@@ -59,7 +59,7 @@ pub struct BoxEvalOutput {
 }
 
 /// The name a frame is known by in a label set: a file's stem, or a stream frame's index.
-fn label_name(input: &FrameInput) -> String {
+pub(super) fn label_name(input: &FrameInput) -> String {
     match input {
         FrameInput::File(p) => file_stem(p),
         FrameInput::Stream { index, .. } => index.to_string(),
@@ -67,7 +67,7 @@ fn label_name(input: &FrameInput) -> String {
 }
 
 /// The labels of a stream frame: its index may be written with leading zeros (`00042`).
-fn stream_key(set: &LabelSet, name: &str) -> Option<String> {
+pub(super) fn stream_key(set: &LabelSet, name: &str) -> Option<String> {
     if set.frames.contains_key(name) {
         return Some(name.to_owned());
     }

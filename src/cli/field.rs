@@ -10,17 +10,17 @@ use super::inputs::load_lut_arg;
 use super::overhead::{load_usable_calibration, params_for};
 use crate::model::GroundTruth;
 use crate::model::truth::OverheadTruth;
-use crate::overhead::merge::CameraId as MergeCameraId;
+use crate::overhead::merge::SslCameraId as MergeCameraId;
 use crate::overhead::recognise::{OverheadDetections, OverheadParams};
 use crate::overhead::{FieldDescription, OverheadPipeline};
-use crate::session::{CameraId, OverheadEntry, Session, SessionSource};
+use crate::session::{OverheadEntry, Session, SessionSource, SslCameraId};
 use crate::streams::StreamReader;
 
 /// One overhead camera of a session, ready to run.
 #[derive(Debug)]
 pub struct FieldCamera {
     /// Its session id.
-    pub id: CameraId,
+    pub id: SslCameraId,
     /// Its pipeline: its own table, calibration and settings.
     pub pipeline: OverheadPipeline,
     /// Its recording.
@@ -46,6 +46,7 @@ pub struct FieldFrame {
 /// A camera whose source is not a recording (live and device sources are not read here), an
 /// unreadable table, calibration, parameter file or recording: each named with the camera.
 pub fn open_cameras(session: &Session) -> anyhow::Result<(FieldDescription, Vec<FieldCamera>)> {
+    say_unused_intrinsics(session);
     let field = session
         .field
         .load()
@@ -59,6 +60,21 @@ pub fn open_cameras(session: &Session) -> anyhow::Result<(FieldDescription, Vec<
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     Ok((field, cameras))
+}
+
+/// Warns about each camera's `intrinsics`, which no command reading a session uses (the
+/// calibration holds the lens; intrinsics are for `eotn overhead calibrate --intrinsics`).
+pub(super) fn say_unused_intrinsics(session: &Session) {
+    for (i, e) in session.overhead.iter().enumerate() {
+        if let Some(p) = &e.intrinsics {
+            log::warn!(
+                "overhead[{i}] (id {}): intrinsics {}: not read here: the calibration holds the \
+                 lens used (intrinsics are for `eotn overhead calibrate --intrinsics`)",
+                e.id,
+                p.display()
+            );
+        }
+    }
 }
 
 fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<FieldCamera> {
@@ -84,7 +100,7 @@ fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<Fi
 }
 
 /// The overhead recogniser's settings from a JSON file; unknown keys refused.
-fn load_params(path: &Path) -> anyhow::Result<OverheadParams> {
+pub(super) fn load_params(path: &Path) -> anyhow::Result<OverheadParams> {
     let text = crate::input_file::read_text_bounded(
         path,
         crate::input_file::MAX_SMALL_FILE_BYTES,

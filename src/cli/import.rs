@@ -279,6 +279,7 @@ fn rewrite_cameras(
     if let Some(param_set) = head.param_set().filter(|_| several) {
         writer.name_param_set(param_set)?;
     }
+    name_kept_cameras(&mut writer, head, &topics, input, &args.output)?;
     let bar = progress(total, "import");
     let (mut written, mut skipped) = (0usize, Vec::new());
     let mut next = vec![0usize; readers.len()];
@@ -337,6 +338,50 @@ fn rewrite_cameras(
         skipped.len()
     );
     Ok(())
+}
+
+/// Each camera kept keeps the files its recording names for it (`eotn.camera`), under its topic
+/// in the new stream (one camera: the stream's first, `/camera/image`).
+fn name_kept_cameras(
+    writer: &mut StreamWriter,
+    head: &StreamReader,
+    topics: &[String],
+    input: &std::path::Path,
+    output: &std::path::Path,
+) -> anyhow::Result<()> {
+    let first = |t: &str| crate::camera::is_default_camera(t);
+    for topic in topics {
+        let named =
+            (head.camera_metadata().iter()).find(|(t, _)| t == topic || (first(t) && first(topic)));
+        if let Some((_, files)) = named {
+            let written = if topics.len() > 1 {
+                topic.as_str()
+            } else {
+                crate::streams::IMAGE_TOPIC
+            };
+            writer.name_camera_files(written, &carried_files(files, input, output))?;
+        }
+    }
+    Ok(())
+}
+
+/// A camera's files as the new stream names them: as they are when it is written in the
+/// recording's folder, else relative paths made absolute (resolved against the recording's
+/// folder, as readers resolve them); a shipped parameter set's name stays a name.
+fn carried_files(
+    files: &crate::camera::CameraFiles,
+    input: &std::path::Path,
+    output: &std::path::Path,
+) -> crate::camera::CameraFiles {
+    let folder = |p: &std::path::Path| {
+        let parent = p.parent().filter(|f| !f.as_os_str().is_empty());
+        std::fs::canonicalize(parent.unwrap_or(std::path::Path::new(".")))
+    };
+    match (folder(input), folder(output)) {
+        (Ok(a), Ok(b)) if a == b => files.clone(),
+        (Ok(a), _) => files.clone().relative_to(&a),
+        (Err(_), _) => files.clone(),
+    }
 }
 
 /// The stream's description: the recording's own, or for another tool's recording the import's

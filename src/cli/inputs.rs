@@ -173,7 +173,31 @@ pub fn camera_table(inputs: &FrameInputs) -> anyhow::Result<PathBuf> {
     }) else {
         bail!("--lut is needed: the inputs are frame files, which name no table");
     };
-    let reader = crate::streams::StreamReader::open_camera(path, inputs.camera.as_deref())?;
+    camera_table_of(path, inputs.camera.as_deref())
+}
+
+/// `--lut` when given, else the table the first recording among `paths` names for the camera
+/// read (for commands that take paths rather than [`InputArgs`]: `eval`).
+///
+/// # Errors
+/// No `--lut` and no recording among `paths`, or its camera names no table.
+pub fn table_or_camera_s(
+    explicit: Option<&Path>,
+    paths: &[PathBuf],
+    camera: Option<&str>,
+) -> anyhow::Result<PathBuf> {
+    if let Some(p) = explicit {
+        return Ok(p.to_owned());
+    }
+    let Some(rec) = paths.iter().find(|p| is_recording(p)) else {
+        bail!("--lut is needed: the inputs are no recordings, which would name a table");
+    };
+    camera_table_of(rec, camera)
+}
+
+/// The table the recording `path` names for its camera `camera` (`None`: its first).
+fn camera_table_of(path: &Path, camera: Option<&str>) -> anyhow::Result<PathBuf> {
+    let reader = crate::streams::StreamReader::open_camera(path, camera)?;
     let camera = reader.camera().unwrap_or("its camera").to_owned();
     reader.camera_files()?.lut.ok_or_else(|| {
         anyhow!(
@@ -521,16 +545,13 @@ mod tests {
     #[test]
     fn every_command_reading_recordings_takes_camera() {
         use clap::CommandFactory as _;
-        /// Commands whose inputs are never recordings: `lut-from-labels` reads labelled frame
-        /// files (a `.cls` mask beside each).
-        const NO_RECORDINGS: [&str; 1] = ["lut-from-labels"];
         fn walk(cmd: &clap::Command, path: &str, missing: &mut Vec<String>, seen: &mut usize) {
             let name = format!("{path} {}", cmd.get_name());
             let reads = cmd.get_arguments().any(|a| {
                 ["frames", "files", "inputs", "streams", "stream"].contains(&a.get_id().as_str())
                     && crate::cli::paths::path_role(a) == Some(crate::cli::paths::PathRole::Input)
             });
-            if reads && !NO_RECORDINGS.contains(&cmd.get_name()) {
+            if reads {
                 *seen += 1;
                 let camera = cmd.get_arguments().find(|a| a.get_long() == Some("camera"));
                 let named = camera.and_then(|a| a.get_value_names().map(<[_]>::to_vec));
@@ -545,6 +566,6 @@ mod tests {
         let (mut missing, mut seen) = (Vec::new(), 0);
         walk(&crate::cli::Cli::command(), "", &mut missing, &mut seen);
         assert!(missing.is_empty(), "no --camera TOPIC: {missing:?}");
-        assert!(seen >= 14, "only {seen} commands read recordings");
+        assert!(seen >= 15, "only {seen} commands read recordings");
     }
 }

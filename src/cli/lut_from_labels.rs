@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::inputs::{expand_frame_paths, load_frame_arg, parse_size, progress};
+use super::inputs::{FrameInput, FrameInputs, parse_size, progress};
 use crate::frame::Frame;
 use crate::lut::ColourClass;
 use crate::lut::learn::{Accuracy, LearnParams, TableBuilder};
@@ -15,8 +15,13 @@ use crate::sim::{Scenario, ScenarioKind, Simulator};
 pub struct Args {
     /// Labelled frames: each `NAME.uyvy`/`.png` needs a mask `NAME.cls` beside it (one class
     /// code per pixel, row-major, as `eotn classify --raw` writes), or `--boxes`. Folders are
-    /// searched.
+    /// searched. Recordings too (MCAP streams, ROS 2 bags; the camera `--camera` names): frame
+    /// N of `REC` is labelled by its index in `--boxes`, or by the mask `STEM_NNNNNN.cls`
+    /// beside the recording (as `eotn classify --raw REC` names it).
     pub frames: Vec<PathBuf>,
+    /// Which camera of the recordings.
+    #[command(flatten)]
+    pub camera: super::inputs::CameraArg,
     /// Instead of masks: boxed labels (a YOLO folder, COCO JSON or Pascal VOC folder, as
     /// `eotn eval --labels`). The pixels within the ellipse inscribed in each ball box, shrunk
     /// to `--ball-core` of its size, vote orange; every other pixel votes "no colour", so a cell
@@ -161,13 +166,17 @@ impl Training {
     }
 }
 
-/// The frames with their `.cls` masks, then `--frames-per-scenario` frames of each scenario
-/// with the simulator's labels.
+/// The frames with their `.cls` masks (or `--boxes`), then `--frames-per-scenario` frames of
+/// each scenario with the simulator's labels.
 fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Result<()> {
-    let paths = if args.frames.is_empty() {
-        Vec::new()
+    let mut inputs = if args.frames.is_empty() {
+        None
     } else {
-        expand_frame_paths(&args.frames)?
+        Some(FrameInputs::open_camera(
+            &args.frames,
+            None,
+            args.camera.get(),
+        )?)
     };
     let boxes = match &args.boxes {
         Some(p) => Some(crate::eval::label_sets::LabelSet::load(
@@ -182,25 +191,38 @@ fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Resul
         )?),
         None => None,
     };
-    for path in &paths {
-        let labels = match &boxes {
+    for i in 0..inputs.as_ref().map_or(0, FrameInputs::len) {
+        let Some(inputs) = inputs.as_mut() else {
+            break;
+        };
+        let input = inputs.items()[i].clone();
+        let name = match &input {
+            FrameInput::File(p) => p.display().to_string(),
+            FrameInput::Stream { path, index } => format!("{} frame {index}", path.display()),
+        };
+        let (frame, mask) = match &boxes {
             Some(set) => {
-                let stem = crate::eval::label_sets::file_stem(path);
-                if !args.split.takes(&stem) || !set.frames.contains_key(&stem) {
+                let stem = super::eval_boxes::label_name(&input);
+                let key = match &input {
+                    FrameInput::File(_) => {
+                        Some(stem.clone()).filter(|k| set.frames.contains_key(k))
+                    }
+                    FrameInput::Stream { .. } => super::eval_boxes::stream_key(set, &stem),
+                };
+                let Some(key) = key.filter(|_| args.split.takes(&stem)) else {
                     continue;
-                }
-                let frame = load_frame_arg(path, args.size)?;
-                let mask = box_mask(set, &stem, &frame, args.ball_core);
-                training.take(path.display().to_string(), frame, mask)?;
-                continue;
+                };
+                let frame = inputs.load(i, args.size)?;
+                let mask = box_mask(set, &key, &frame, args.ball_core);
+                (frame, mask)
             }
             None => {
-                let frame = load_frame_arg(path, args.size)?;
-                let mask = load_mask(path, &frame)?;
+                let frame = inputs.load(i, args.size)?;
+                let mask = load_mask(&mask_path(&input), &frame)?;
                 (frame, mask)
             }
         };
-        training.take(path.display().to_string(), labels.0, labels.1)?;
+        training.take(name, frame, mask)?;
     }
     for name in &args.scenarios {
         let kind =
@@ -218,6 +240,18 @@ fn gather_labelled_frames(args: &Args, training: &mut Training) -> anyhow::Resul
         bar.finish_and_clear();
     }
     Ok(())
+}
+
+/// Where a frame's label mask is looked for: beside a frame file (see [`load_mask`]); for frame
+/// N of a recording, `STEM_NNNNNN.cls` beside the recording ([`FrameInput::name`]).
+fn mask_path(input: &FrameInput) -> PathBuf {
+    match input {
+        FrameInput::File(p) => p.clone(),
+        FrameInput::Stream { path, .. } => {
+            let folder = path.parent().unwrap_or(Path::new(""));
+            folder.join(input.name())
+        }
+    }
 }
 
 /// A label mask from boxes: orange within the ellipse inscribed in each ball box shrunk to

@@ -44,9 +44,13 @@ mod serve;
 mod sim;
 mod sim_field;
 mod sources;
+pub mod ssl_vision_out;
 pub mod values;
 mod wmd;
+mod wmd_feeds;
 mod wmd_inputs;
+mod wmd_live;
+mod wmd_record;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -125,13 +129,20 @@ pub enum Command {
 }
 
 /// Runs a headless subcommand; no output it writes may replace one of `inputs` (the files its
-/// arguments name, [`paths::Parsed::inputs`]) or an output it wrote before. The `outputs` its
-/// arguments name are checked before it starts.
+/// arguments name, [`paths::Parsed::inputs`]), a file it reads while it runs, or an output it
+/// wrote before; `updated` ([`paths::Parsed::updated`]) are read and replaced on purpose. The
+/// `outputs` its arguments name are checked before it starts.
 ///
 /// # Errors
 /// An output that is an input; whatever the subcommand reports, with context naming the file.
-pub fn run(command: Command, inputs: &[PathBuf], outputs: &[PathBuf]) -> anyhow::Result<()> {
+pub fn run(
+    command: Command,
+    inputs: &[PathBuf],
+    outputs: &[PathBuf],
+    updated: &[PathBuf],
+) -> anyhow::Result<()> {
     let _guard = crate::atomic_file::guard_command(inputs);
+    crate::atomic_file::guard_updated(updated);
     for out in outputs {
         crate::atomic_file::refuse_inputs(out).with_context(|| format!("{}", out.display()))?;
     }

@@ -11,7 +11,9 @@ use crate::app_options::{PlaySpeed, RendererSetting, RunOptions};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Streams (`.mcap`), lookup tables (`.lut`), frames (`.uyvy`, `.png`, `.jpg`) or folders of
-    /// frames; several frames open as one sequence to step through.
+    /// frames; several frames open as one sequence to step through. SSL-Vision's detections
+    /// show in the field view: a league log (`GAME.log`, `GAME.log.gz`) or packets received
+    /// live (`udp://224.5.23.2:10006`, the league's group; `udp://HOST:PORT` for a unicast port).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// The renderer: `auto` (wgpu on a GPU, OpenGL on a software rasteriser), `wgpu` or `gl`.

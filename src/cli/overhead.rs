@@ -152,6 +152,22 @@ pub struct DetectArgs {
     /// One JSON object per frame per line.
     #[arg(long)]
     pub json: bool,
+    /// Also send the detections as SSL-Vision packets over UDP to HOST:PORT (a unicast address,
+    /// or the league's multicast group 224.5.23.2:10006): an `SSL_WrapperPacket` per camera
+    /// frame (millimetres in the field frame) and the field and each camera's calibration every
+    /// few seconds (docs/formats.md, "SSL-Vision packets").
+    #[arg(long, value_name = "HOST:PORT")]
+    pub ssl_vision: Option<String>,
+    /// The `camera_id` of a single camera's packets (a session's cameras send their session
+    /// ids).
+    #[arg(
+        long,
+        value_name = "ID",
+        default_value_t = 0,
+        requires = "ssl_vision",
+        conflicts_with = "session"
+    )]
+    pub ssl_camera_id: u8,
     /// Which camera of the recordings.
     #[command(flatten)]
     pub camera: super::inputs::CameraArg,
@@ -398,7 +414,7 @@ pub fn refuse_robot_streams(streams: &[PathBuf]) -> anyhow::Result<()> {
 
 fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     if let Some(session) = &a.session {
-        return super::detect_field::run(session, a.json);
+        return super::detect_field::run(session, a.json, a.ssl_vision.as_deref());
     }
     // Not given: the table and calibration the recording names for the camera read.
     let named = super::detect::named_camera_files(&a.frames, a.camera.get())?
@@ -418,14 +434,30 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     let mut pipeline = OverheadPipeline::new(lut, cal.camera, params_for(&field));
     let mut inputs = FrameInputs::open_camera(&a.frames, None, a.camera.get())?;
     refuse_robot_streams(inputs.robot_streams())?;
+    let camera_id = u32::from(a.ssl_camera_id);
+    let mut ssl = a
+        .ssl_vision
+        .as_deref()
+        .map(|addr| {
+            let entry = crate::ssl_vision::CameraEntry {
+                camera_id,
+                camera: cal.camera,
+            };
+            super::ssl_vision_out::SslOut::open(addr, &field, &[entry])
+        })
+        .transpose()?;
     let mut sizes = SizeCheck::default();
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     let bar = progress(inputs.len(), "overhead detect");
     for i in 0..inputs.len() {
-        let frame = inputs.load(i, a.size)?;
+        let loaded = inputs.load_source_frame(i, a.size)?;
+        let frame = &loaded.frame;
         sizes.check(&cal.camera, &inputs.name(i), frame.width(), frame.height())?;
-        pipeline.process(&frame);
+        pipeline.process(frame);
+        if let Some(out) = ssl.as_mut() {
+            out.send(camera_id, loaded.time_ns, pipeline.detections());
+        }
         let us = pipeline.timings().total().as_secs_f64() * 1e6;
         let line = overhead_json(inputs.name(i), pipeline.detections(), us);
         if a.json {
@@ -454,6 +486,9 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
     out.flush().context("writing output")?;
+    if let Some(ssl) = &ssl {
+        ssl.finish();
+    }
     Ok(())
 }
 

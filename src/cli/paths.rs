@@ -68,6 +68,8 @@ pub struct Parsed {
     /// Every output path (files and folders), checked against the inputs before the command
     /// runs.
     pub outputs: Vec<PathBuf>,
+    /// The files read and replaced on purpose ([`UPDATED`]): never inputs.
+    pub updated: Vec<PathBuf>,
 }
 
 /// Parses the process's command line; exits with clap's message (and usage) when it is wrong,
@@ -100,9 +102,12 @@ pub fn parse_from(args: impl IntoIterator<Item = OsString>) -> Parsed {
         &[PathRole::Output, PathRole::OutputFolder],
         &mut outputs,
     );
+    let mut updated = Vec::new();
+    collect(&command, &matches, &[PathRole::Updated], &mut updated);
     Parsed {
         inputs: expand_inputs(inputs),
         outputs,
+        updated,
         cli,
     }
 }
@@ -198,6 +203,7 @@ mod tests {
         ]);
         let names: Vec<_> = p.inputs.iter().map(|p| p.display().to_string()).collect();
         assert_eq!(names, ["s.mcap", "t.lut"], "--update may be the output");
+        assert_eq!(p.updated, [PathBuf::from("pl.json")]);
     }
 
     #[test]

@@ -132,6 +132,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         known: args.world_model_error.clone(),
         noise: args.world_model_noise,
     });
+    let field = crate::overhead::FieldDescription::four_legged_2005();
+    sim = sim.with_world_model_landmarks(
+        field
+            .landmarks
+            .iter()
+            .filter(|l| l.height_cm == 0.0)
+            .map(|l| (l.name.clone(), l.field_cm))
+            .collect(),
+    );
     let info = StreamInfo {
         source: format!("sim:{}", kind.name()),
         description: format!(

@@ -155,6 +155,14 @@ fn write_camera(rig: &FieldRig, k: usize, a: &SimFieldArgs) -> anyhow::Result<()
     };
     let mcap = dir.join(format!("{stem}.mcap"));
     let mut writer = StreamWriter::create(&mcap, &info)?;
+    // The recording names its own table and calibration (beside it), so the app and every
+    // command open the camera with them.
+    let files = crate::camera::CameraFiles {
+        lut: Some(format!("{stem}.lut").into()),
+        calibration: Some(format!("{stem}.cal.json").into()),
+        params: None,
+    };
+    writer.name_camera_files(crate::streams::IMAGE_TOPIC, &files)?;
     let mut builder = TableBuilder::new(7)?;
     let every = (a.frames / TABLE_FRAMES).max(1);
     let mut first = None;

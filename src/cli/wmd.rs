@@ -1,8 +1,12 @@
 //! `eotn wmd`: the World Model Debugger headless. An overhead camera (or a session's cameras)
-//! and the robots' recorded world models: each world model is paired with the overhead frame
-//! nearest in time after its robot's clock offset (`crate::wmd::clock`), matched with its
-//! robot by marker (else by position), and its errors measured; `--json` prints one line per
-//! overhead frame, else a table per robot.
+//! and the robots' world models: each world model is paired with the overhead frame nearest in
+//! time, matched with its robot by marker (else by position), and its errors measured; `--json`
+//! prints one line per overhead frame, else a table per robot; `-o` records the whole session.
+//!
+//! With recordings only, the session is read through as fast as it goes, each robot's clock
+//! offset searched from the data (`crate::wmd::clock`). With a live source (a `ws://` server, a
+//! camera device) it runs on this machine's clock until `--seconds`, Ctrl+C or SIGTERM
+//! ([`super::wmd_live`]).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -13,9 +17,10 @@ use serde_json::{Value, json};
 use super::field::{FieldCamera, open_cameras};
 use super::overhead::{load_field, load_usable_calibration, overhead_json, params_for};
 use super::wmd_inputs::{FieldFrame, RobotModels, field_frames, read_world_models, recorded};
+use super::wmd_record::{CameraFrame, SessionRecorder};
 use crate::model::world_model::RobotKey;
 use crate::overhead::OverheadPipeline;
-use crate::overhead::merge::{CameraId, frame_near};
+use crate::overhead::merge::{SslCameraId, frame_near};
 use crate::session::{Session, SessionSource};
 use crate::wmd::clock::{ClockOffset, estimate_offset, frame_period_ns, shifted};
 use crate::wmd::summary::{RobotSummary, Spread, Summaries};
@@ -24,12 +29,23 @@ use crate::wmd::{Comparison, Targets, WorldModelMessage, compare};
 /// Arguments of `eotn wmd`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The overhead camera's recording.
-    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    /// The overhead camera: a recording, a `ws://HOST:PORT` server or a camera device
+    /// (`/dev/videoN`, as `eotn sources` lists them).
+    #[arg(
+        long,
+        value_name = "SOURCE",
+        required_unless_present = "session",
+        conflicts_with = "session"
+    )]
     pub overhead: Option<PathBuf>,
-    /// A robot's recording with its world models (`/world_model`, `/world_model/<name>`;
-    /// docs/formats.md); repeatable; one recording may hold several robots'.
-    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    /// A robot's world models (`/world_model`, `/world_model/<name>`; docs/formats.md): a
+    /// recording or a `ws://HOST:PORT` robot; repeatable; one source may carry several robots'.
+    #[arg(
+        long,
+        value_name = "SOURCE",
+        required_unless_present = "session",
+        conflicts_with = "session"
+    )]
     pub robot: Vec<PathBuf>,
     /// The overhead camera's lookup table.
     #[arg(long, required_unless_present = "session", conflicts_with = "session")]
@@ -48,7 +64,16 @@ pub struct Args {
     /// `eotn overhead detect --json` prints them), `world_models`.
     #[arg(long)]
     pub json: bool,
-    /// How far to search for each robot's clock offset, seconds (0: the start only).
+    /// Record the whole session: overhead frames, detections (also as a `foxglove.SceneUpdate`),
+    /// each robot's world models and camera frames, in one MCAP (docs/formats.md).
+    #[arg(short, long, value_name = super::paths::OUT)]
+    pub output: Option<PathBuf>,
+    /// With a live source: stop after this many seconds (above 0, at most 604800). Without it a
+    /// live session runs until Ctrl+C or SIGTERM.
+    #[arg(long, value_parser = super::bounds::seconds, allow_negative_numbers = true)]
+    pub seconds: Option<f64>,
+    /// Recordings only: how far to search for each robot's clock offset, seconds (0: the start
+    /// only).
     #[arg(long, default_value_t = 2.0, value_parser = super::values::number_in(0.0, 3600.0))]
     pub max_clock_offset: f64,
     /// Which camera of the overhead recording.
@@ -56,19 +81,104 @@ pub struct Args {
     pub camera: super::inputs::CameraArg,
 }
 
+/// What a session came to, for the table and the closing warnings.
+#[derive(Debug)]
+pub struct Outcome {
+    /// Each robot's summary.
+    pub summaries: Vec<RobotSummary>,
+    /// Each robot's clock offset.
+    pub offsets: Vec<(RobotKey, ClockOffset)>,
+    /// The last field frame's time, nanoseconds.
+    pub last_ns: u64,
+    /// The reference camera's frame period, nanoseconds.
+    pub period_ns: u64,
+    /// Field frames made.
+    pub field_frames: usize,
+}
+
 /// Runs `eotn wmd`.
 ///
 /// # Errors
-/// An unreadable input (named), a live or device source, no world models at all.
+/// An unreadable input (named), no world models at all (recordings), no overhead frame.
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let outcome = if is_live(a)? {
+        let (inputs, recorder) = super::wmd_inputs::open_live(a)?;
+        super::wmd_live::run(inputs, a.json, a.seconds, recorder, &mut out)?
+    } else {
+        if a.seconds.is_some() {
+            log::warn!("--seconds: every source is a recording, read to its end");
+        }
+        recorded_session(a, &mut out)?
+    };
+    report(a.json, &outcome, &mut out)?;
+    out.flush().context("writing output")?;
+    if outcome.field_frames == 0 {
+        bail!("no overhead frame arrived");
+    }
+    Ok(())
+}
+
+/// True when any source is live or a device.
+fn is_live(a: &Args) -> anyhow::Result<bool> {
+    if let Some(path) = &a.session {
+        let session = Session::load(path)?;
+        let sources = session.overhead.iter().map(|e| &e.source);
+        let robots = session.robots.iter().map(|r| &r.source);
+        return Ok(sources.chain(robots).any(is_live_source));
+    }
+    let args = a.overhead.iter().chain(&a.robot);
+    Ok(args
+        .map(|p| SessionSource::parse_arg(p))
+        .any(|s| is_live_source(&s)))
+}
+
+fn is_live_source(s: &SessionSource) -> bool {
+    !matches!(s, SessionSource::Recording(_))
+}
+
+/// The closing report: robots that stopped early warned about; the table (or, with `--json`,
+/// each robot's clock offset on stderr).
+fn report(json: bool, o: &Outcome, out: &mut impl Write) -> anyhow::Result<()> {
+    for s in &o.summaries {
+        if o.last_ns.saturating_sub(s.last_ns) > 10 * o.period_ns {
+            log::warn!(
+                "{}: no world model after {:.3} s (the overhead frames run to {:.3} s)",
+                s.robot,
+                s.last_ns as f64 * 1e-9,
+                o.last_ns as f64 * 1e-9
+            );
+        }
+    }
+    if json {
+        for (key, off) in &o.offsets {
+            eprintln!("{key}: clock offset {}", offset_text(off));
+        }
+    } else {
+        write_table(out, &o.summaries, &o.offsets)?;
+    }
+    Ok(())
+}
+
+/// A session of recordings, read through: world models first, then the field frames, each
+/// robot's clock offset searched, every frame compared (and recorded with `-o`).
+fn recorded_session(a: &Args, out: &mut impl Write) -> anyhow::Result<Outcome> {
     let (field, mut cameras, robots, single) = open(a)?;
     let mut models = RobotModels::new();
+    let mut paired_before = std::collections::BTreeSet::new();
     for (path, only) in &robots {
-        read_world_models(path, *only, &mut models)?;
+        let read = read_world_models(path, *only, &mut models)?;
+        log::info!("{}: {} world models", path.display(), read.read);
+        paired_before.extend(read.paired_when_recorded);
     }
     if models.is_empty() {
         bail!("no world model in the robots' recordings");
     }
+    let mut recorder = a
+        .output
+        .as_deref()
+        .map(|p| SessionRecorder::create(p, &recorded_cameras(a, &cameras)?))
+        .transpose()?;
     let frames = field_frames(&mut cameras, single)?;
     if frames.is_empty() {
         bail!("the overhead recording has no frames");
@@ -82,51 +192,109 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     )]
     let max_offset = (a.max_clock_offset * 1e9) as u64;
     let views: Vec<crate::wmd::OverheadView> = frames.iter().map(FieldFrame::view).collect();
-    let (offsets, paired) = pair(&models, &times, &views, period, max_offset);
-    for (key, o) in &offsets {
-        log::info!(
-            "{key}: clock offset {:+.3} s ({:?}, {} pairs)",
-            o.offset_ns as f64 * 1e-9,
-            o.start,
-            o.pairs
-        );
-    }
+    let search = Search {
+        period,
+        max_offset,
+        paired_before: &paired_before,
+    };
+    let (offsets, paired) = pair(&models, &times, &views, &search);
     let targets = Targets::from_field(&field);
     let mut summaries = Summaries::default();
-    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     for (i, frame) in frames.iter().enumerate() {
         let results = compare(&views[i], &paired[i], &targets);
         let jumps: Vec<bool> = results
             .iter()
             .map(|c| summaries.add(frame.time_ns, c))
             .collect();
+        let line = line_json(frame, &results, &jumps)?;
         if a.json {
-            let line = line_json(frame, &results, &jumps)?;
-            serde_json::to_writer(&mut out, &line)?;
+            serde_json::to_writer(&mut *out, &line)?;
             writeln!(out)?;
         }
-    }
-    let summaries = summaries.finish();
-    let last_ns = times.last().copied().unwrap_or(0);
-    for s in &summaries {
-        if last_ns.saturating_sub(s.last_ns) > 10 * period {
-            log::warn!(
-                "{}: no world model after {:.3} s (the overhead frames run to {:.3} s)",
-                s.robot,
-                s.last_ns as f64 * 1e-9,
-                last_ns as f64 * 1e-9
+        if let Some(rec) = recorder.as_mut() {
+            let scene = crate::wmd::scene::scene_update(
+                frame.time_ns,
+                &field,
+                &views[i],
+                &paired[i],
+                &results,
             );
+            let read = read_frames(&mut cameras, &frame.cameras)?;
+            let cameras: Vec<CameraFrame<'_>> = read
+                .iter()
+                .map(|(id, time_ns, f)| CameraFrame {
+                    id: *id,
+                    time_ns: *time_ns,
+                    frame: f,
+                })
+                .collect();
+            rec.field_frame(frame.time_ns, &cameras, &paired[i], &line, &scene)?;
         }
     }
-    if a.json {
-        for (key, o) in &offsets {
-            eprintln!("{key}: clock offset {}", offset_text(o));
-        }
-    } else {
-        write_table(&mut out, &summaries, &offsets)?;
+    if let Some(rec) = recorder {
+        rec.finish()?;
     }
-    out.flush().context("writing output")?;
-    Ok(())
+    Ok(Outcome {
+        summaries: summaries.finish(),
+        offsets,
+        last_ns: times.last().copied().unwrap_or(0),
+        period_ns: period,
+        field_frames: frames.len(),
+    })
+}
+
+/// The overhead cameras as the recording names them, with their files.
+fn recorded_cameras(
+    a: &Args,
+    cameras: &[FieldCamera],
+) -> anyhow::Result<Vec<super::wmd_record::RecordedCamera>> {
+    let files: Vec<crate::camera::CameraFiles> = match &a.session {
+        Some(path) => Session::load(path)?
+            .overhead
+            .iter()
+            .map(|e| crate::camera::CameraFiles {
+                lut: Some(e.lut.clone()),
+                params: None,
+                calibration: Some(e.calibration.clone()),
+            })
+            .collect(),
+        None => vec![crate::camera::CameraFiles {
+            lut: a.lut.clone(),
+            params: None,
+            calibration: a.calibration.clone(),
+        }],
+    };
+    Ok(cameras
+        .iter()
+        .zip(files)
+        .map(|(c, files)| super::wmd_record::RecordedCamera { id: c.id, files })
+        .collect())
+}
+
+/// Each camera's frame of a field frame read again (for the recording), by its time.
+fn read_frames(
+    cameras: &mut [FieldCamera],
+    wanted: &[(SslCameraId, u64)],
+) -> anyhow::Result<Vec<(SslCameraId, u64, crate::frame::Frame)>> {
+    let mut out = Vec::new();
+    for &(id, time_ns) in wanted {
+        let Some(cam) = cameras.iter_mut().find(|c| c.id == id) else {
+            continue;
+        };
+        let index = (0..cam.len()).find(|&i| cam.reader.time_ns(i) == Some(time_ns));
+        if let Some(i) = index {
+            out.push((id, time_ns, cam.read(i)?.frame));
+        }
+    }
+    Ok(out)
+}
+
+/// How each robot's clock offset is found: the frame period, how far to search, and the robots
+/// whose world models were paired when their session was recorded (offset 0, not searched).
+struct Search<'a> {
+    period: u64,
+    max_offset: u64,
+    paired_before: &'a std::collections::BTreeSet<RobotKey>,
 }
 
 /// Each robot's clock offset, and the world models paired with each frame (of each robot the
@@ -135,8 +303,7 @@ fn pair<'a>(
     models: &'a RobotModels,
     times: &[u64],
     views: &[crate::wmd::OverheadView],
-    period: u64,
-    max_offset: u64,
+    search: &Search<'_>,
 ) -> (
     Vec<(RobotKey, ClockOffset)>,
     Vec<Vec<&'a WorldModelMessage>>,
@@ -154,6 +321,12 @@ fn pair<'a>(
                 .iter()
                 .find(|r| r.key == *key)
                 .map(|r| r.field_cm)
+        };
+        let period = search.period;
+        let max_offset = if search.paired_before.contains(key) {
+            0
+        } else {
+            search.max_offset
         };
         let offset = estimate_offset(times, period, robot_at, &own, max_offset);
         // The message nearest in time to each frame.
@@ -196,6 +369,7 @@ fn open(a: &Args) -> anyhow::Result<Opened> {
         for e in &session.overhead {
             recorded(&e.source, &format!("overhead camera {}", e.id))?;
         }
+        super::wmd_inputs::say_unused_session_keys(&session, a.output.is_some(), false);
         let robots = session
             .robots
             .iter()
@@ -225,7 +399,7 @@ fn open(a: &Args) -> anyhow::Result<Opened> {
     let lut = super::inputs::load_lut_arg(lut)?;
     let reader = crate::streams::StreamReader::open_camera(&overhead, a.camera.get())?;
     let camera = FieldCamera {
-        id: CameraId(0),
+        id: SslCameraId(0),
         pipeline: OverheadPipeline::new(lut, cal.camera, params_for(&field)),
         reader,
         name: crate::frame::display_name(&overhead),
@@ -233,7 +407,12 @@ fn open(a: &Args) -> anyhow::Result<Opened> {
     Ok((field, vec![camera], robots, true))
 }
 
-fn line_json(frame: &FieldFrame, results: &[Comparison], jumps: &[bool]) -> anyhow::Result<Value> {
+/// One field frame's `--json` line.
+pub(super) fn line_json(
+    frame: &FieldFrame,
+    results: &[Comparison],
+    jumps: &[bool],
+) -> anyhow::Result<Value> {
     let mut line = match &frame.single {
         Some(d) => {
             let mut v = serde_json::to_value(overhead_json(String::new(), d, 0.0))?;
@@ -272,6 +451,10 @@ fn offset_text(o: &ClockOffset) -> String {
     let start = match o.start {
         crate::wmd::clock::OffsetStart::SameClock => "searched from 0",
         crate::wmd::clock::OffsetStart::FirstMessages => "searched from the first messages",
+        crate::wmd::clock::OffsetStart::Arrival => {
+            "measured on arrival: this machine's clock − the robot's, latency included; live \
+             world models are paired by arrival"
+        }
     };
     let err = o
         .median_error_cm

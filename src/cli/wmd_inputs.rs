@@ -1,6 +1,7 @@
 //! What `eotn wmd` reads: the overhead cameras' field frames (one camera from the command line,
 //! or a session's cameras merged as `eotn overhead detect --session` merges them) and the
-//! robots' world models from their recordings.
+//! robots' world models from their recordings; for a live session ([`open_live`]) every source
+//! opened as a feed ([`super::wmd_feeds`]).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -9,7 +10,7 @@ use anyhow::{Context, bail};
 
 use super::field::FieldCamera;
 use crate::model::world_model::{self, RobotKey, WorldModelMessage};
-use crate::overhead::merge::{CameraId, FieldPicture, merge_detections};
+use crate::overhead::merge::{FieldPicture, SslCameraId, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::session::SessionSource;
 use crate::streams::StreamReader;
@@ -25,7 +26,7 @@ pub struct FieldFrame {
     /// The merged picture (a session), as `overhead detect --session` prints it.
     pub picture: FieldPicture,
     /// The merged cameras' frames: id and time.
-    pub cameras: Vec<(CameraId, u64)>,
+    pub cameras: Vec<(SslCameraId, u64)>,
 }
 
 impl FieldFrame {
@@ -69,7 +70,7 @@ pub fn field_frames(cameras: &mut [FieldCamera], single: bool) -> anyhow::Result
     let mut out = Vec::with_capacity(reference.len());
     for (i, &t_ref) in reference.iter().enumerate() {
         let (views, frames) = super::field::field_views(cameras, &times, i, period_ns, &mut sizes)?;
-        let refs: Vec<(CameraId, &OverheadDetections)> =
+        let refs: Vec<(SslCameraId, &OverheadDetections)> =
             views.iter().map(|(id, d)| (*id, d)).collect();
         let picture = merge_detections(&refs);
         out.push(FieldFrame {
@@ -92,27 +93,74 @@ pub fn field_frames(cameras: &mut [FieldCamera], single: bool) -> anyhow::Result
 /// the message's `time_ns`, else the recording's log time —, message).
 pub type RobotModels = BTreeMap<RobotKey, Vec<(u64, WorldModelMessage)>>;
 
-/// Refuses sources `eotn wmd` cannot read yet, naming them.
+/// The recording a source names, for a session of recordings only (a live session reads every
+/// kind: [`open_live`]).
 ///
 /// # Errors
 /// A live (`ws://`) or device source.
 pub fn recorded(source: &SessionSource, what: &str) -> anyhow::Result<std::path::PathBuf> {
     match source {
         SessionSource::Recording(p) => Ok(p.clone()),
-        SessionSource::Live(url) => bail!(
-            "{what} {url}: `eotn wmd` reads recordings; a live source is not read here yet (record it with `eotn record` and give the recording)"
-        ),
-        SessionSource::Device(p) => bail!(
-            "{what} {}: `eotn wmd` reads recordings; a camera device is not read here yet (record it with `eotn record`)",
-            p.display()
-        ),
+        SessionSource::Live(url) => bail!("{what} {url}: a live source in a recorded session"),
+        SessionSource::Device(p) => {
+            bail!(
+                "{what} {}: a camera device in a recorded session",
+                p.display()
+            )
+        }
     }
+}
+
+/// Says which keys of a session `eotn wmd` does not use, so none is ignored silently: a robot's
+/// `camera`, `lut` and `params` when its camera frames are not recorded (no `-o`, or a recorded
+/// robot: only a live robot's frames are recorded and, with a table, recognised). (An overhead
+/// camera's `intrinsics`: [`super::field::say_unused_intrinsics`].)
+pub fn say_unused_session_keys(session: &crate::session::Session, output: bool, live: bool) {
+    for (i, r) in session.robots.iter().enumerate() {
+        let keys: Vec<&str> = [
+            r.camera.as_ref().map(|_| "camera"),
+            r.lut.as_ref().map(|_| "lut"),
+            r.params.as_ref().map(|_| "params"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let recorded = output && live && matches!(r.source, SessionSource::Live(_));
+        if !keys.is_empty() && !recorded {
+            log::warn!(
+                "robots[{i}] ({} {}): {} not used: a robot's camera frames are recorded (and with \
+                 a table recognised) only from a live robot into -o",
+                r.team.name(),
+                r.robot_id,
+                keys.join(", ")
+            );
+        }
+        if recorded && r.lut.is_none() && r.params.is_some() {
+            log::warn!(
+                "robots[{i}] ({} {}): params not used without a lut",
+                r.team.name(),
+                r.robot_id
+            );
+        }
+    }
+}
+
+/// What one robot recording gave.
+#[derive(Debug, Default)]
+pub struct ReadModels {
+    /// World models read.
+    pub read: usize,
+    /// The robots whose world models a session recording (`eotn wmd -o`) holds: logged at the
+    /// overhead frame each was paired with, so they are taken at their log times with no clock
+    /// offset (a replay pairs them as the session did).
+    pub paired_when_recorded: Vec<RobotKey>,
 }
 
 /// Reads the world models of one robot recording into `into`: every JSON message on
 /// `/world_model` or `/world_model/<anything>`; with `only`, the messages naming that robot
 /// (others counted and warned about). A message refused is warned about (the first few by
-/// reason) and skipped.
+/// reason) and skipped. A message's time is its `time_ns` (the robot's clock), else its log
+/// time; in a session recording always its log time ([`ReadModels`]).
 ///
 /// # Errors
 /// An unreadable recording, naming it; a recording with no world-model channel.
@@ -120,9 +168,11 @@ pub fn read_world_models(
     path: &Path,
     only: Option<RobotKey>,
     into: &mut RobotModels,
-) -> anyhow::Result<usize> {
+) -> anyhow::Result<ReadModels> {
     let name = crate::frame::display_name(path);
     let mut reader = StreamReader::open(path).with_context(|| name.clone())?;
+    let session = reader.info().source == super::wmd_record::SESSION_SOURCE;
+    let mut keys = std::collections::BTreeSet::new();
     let channels: Vec<u16> = reader
         .channels()
         .iter()
@@ -141,7 +191,12 @@ pub fn read_world_models(
             match world_model::parse(m.data) {
                 Ok(w) if only.is_some_and(|k| k != w.robot) => others += 1,
                 Ok(w) => {
-                    let t = w.time_ns.unwrap_or(m.log_time_ns);
+                    let t = if session {
+                        m.log_time_ns
+                    } else {
+                        w.time_ns.unwrap_or(m.log_time_ns)
+                    };
+                    keys.insert(w.robot);
                     into.entry(w.robot).or_default().push((t, w));
                     read += 1;
                 }
@@ -163,5 +218,252 @@ pub fn read_world_models(
     for models in into.values_mut() {
         models.sort_by_key(|m| m.0);
     }
-    Ok(read)
+    Ok(ReadModels {
+        read,
+        paired_when_recorded: if session {
+            keys.into_iter().collect()
+        } else {
+            Vec::new()
+        },
+    })
+}
+
+/// A live session's sources opened: the field, the overhead cameras, each robot's feed with
+/// the topic of its camera frames, its session entry and its name, each camera's files.
+struct LiveOpened {
+    field: crate::overhead::FieldDescription,
+    cameras: Vec<super::wmd_live::LiveCamera>,
+    robots: Vec<OpenedRobot>,
+    files: Vec<crate::camera::CameraFiles>,
+}
+
+/// A robot's feed, the topic of its camera frames, its session entry, its name.
+type OpenedRobot = (
+    super::wmd_feeds::RobotFeed,
+    String,
+    Option<crate::session::RobotEntry>,
+    String,
+);
+
+fn open_live_session(path: &Path, record: bool) -> anyhow::Result<LiveOpened> {
+    let session = crate::session::Session::load(path)?;
+    super::field::say_unused_intrinsics(&session);
+    say_unused_session_keys(&session, record, true);
+    let field = session
+        .field
+        .load()
+        .with_context(|| format!("{}: field", path.display()))?;
+    let mut cameras = Vec::new();
+    let mut files = Vec::new();
+    for e in &session.overhead {
+        let lut = super::inputs::load_lut_arg(&e.lut)?;
+        let cal = super::overhead::load_usable_calibration(&e.calibration)?;
+        let params = match &e.params {
+            Some(p) => super::field::load_params(p)?,
+            None => super::overhead::params_for(&field),
+        };
+        let pipeline = crate::overhead::OverheadPipeline::new(lut, cal.camera, params);
+        cameras.push(live_camera(e.id, &e.source, e.camera.as_deref(), pipeline)?);
+        files.push(camera_files(&e.lut, &e.calibration));
+    }
+    let mut robots = Vec::new();
+    for r in &session.robots {
+        let key = RobotKey {
+            team: r.team,
+            identity: r.robot_id,
+        };
+        let wants = super::wmd_feeds::RobotWants {
+            only: Some(key),
+            frames: record.then(|| r.camera.clone()),
+        };
+        let topic = format!("/robot/{}-{}", key.team.name(), key.identity.value());
+        let name = format!("{key} ({})", source_name(&r.source));
+        let feed = robot_feed(&r.source, wants, &key.to_string())?;
+        robots.push((feed, topic, Some(r.clone()), name));
+    }
+    Ok(LiveOpened {
+        field,
+        cameras,
+        robots,
+        files,
+    })
+}
+
+fn open_live_args(a: &super::wmd::Args, record: bool) -> anyhow::Result<LiveOpened> {
+    let (Some(overhead), Some(lut), Some(cal)) = (&a.overhead, &a.lut, &a.calibration) else {
+        bail!("--overhead, --lut and --calibration name the overhead camera (or give --session)");
+    };
+    let field = super::overhead::load_field(a.field.as_deref())?;
+    let pipeline = crate::overhead::OverheadPipeline::new(
+        super::inputs::load_lut_arg(lut)?,
+        super::overhead::load_usable_calibration(cal)?.camera,
+        super::overhead::params_for(&field),
+    );
+    let source = SessionSource::parse_arg(overhead);
+    let cameras = vec![live_camera(
+        SslCameraId(0),
+        &source,
+        a.camera.get(),
+        pipeline,
+    )?];
+    let mut robots = Vec::new();
+    for (i, p) in a.robot.iter().enumerate() {
+        let wants = super::wmd_feeds::RobotWants {
+            only: None,
+            frames: record.then_some(None),
+        };
+        let source = SessionSource::parse_arg(p);
+        let feed = robot_feed(&source, wants, &p.display().to_string())?;
+        let topic = format!("/robot/{}", i + 1);
+        robots.push((feed, topic, None, source_name(&source)));
+    }
+    Ok(LiveOpened {
+        field,
+        cameras,
+        robots,
+        files: vec![camera_files(lut, cal)],
+    })
+}
+
+/// Every source of a live session opened as a feed, and the recording started with `-o`.
+///
+/// # Errors
+/// A malformed address, an unreadable table, calibration, parameter file or recording, a camera
+/// device given as a robot (it sends no world models), a recording without world models.
+pub fn open_live(
+    a: &super::wmd::Args,
+) -> anyhow::Result<(
+    super::wmd_live::LiveInputs,
+    Option<super::wmd_record::SessionRecorder>,
+)> {
+    let record = a.output.is_some();
+    let LiveOpened {
+        field,
+        cameras,
+        robots,
+        files,
+    } = match &a.session {
+        Some(path) => open_live_session(path, record)?,
+        None => open_live_args(a, record)?,
+    };
+    let recorder = match &a.output {
+        Some(p) => {
+            let described: Vec<super::wmd_record::RecordedCamera> = cameras
+                .iter()
+                .zip(files)
+                .map(|(c, files)| super::wmd_record::RecordedCamera { id: c.id, files })
+                .collect();
+            let mut rec = super::wmd_record::SessionRecorder::create(p, &described)?;
+            for (_, topic, entry, _) in &robots {
+                if let Some(e) = entry.as_ref().filter(|e| e.lut.is_some()) {
+                    rec.recognise(topic, robot_pipeline(e)?);
+                }
+            }
+            Some(rec)
+        }
+        None => None,
+    };
+    let robots = robots
+        .into_iter()
+        .map(|(feed, topic, _, name)| super::wmd_live::LiveRobotSource {
+            name,
+            topic,
+            feed,
+            received: 0,
+        })
+        .collect();
+    let inputs = super::wmd_live::LiveInputs {
+        field,
+        cameras,
+        robots,
+    };
+    Ok((inputs, recorder))
+}
+
+fn source_name(source: &SessionSource) -> String {
+    match source {
+        SessionSource::Live(url) => url.clone(),
+        SessionSource::Device(p) => p.display().to_string(),
+        SessionSource::Recording(p) => crate::frame::display_name(p),
+    }
+}
+
+fn camera_files(lut: &Path, calibration: &Path) -> crate::camera::CameraFiles {
+    crate::camera::CameraFiles {
+        lut: Some(lut.to_owned()),
+        params: None,
+        calibration: Some(calibration.to_owned()),
+    }
+}
+
+/// A session robot's recogniser: its table and parameters.
+fn robot_pipeline(e: &crate::session::RobotEntry) -> anyhow::Result<crate::pipeline::Pipeline> {
+    let lut = e
+        .lut
+        .as_deref()
+        .context("a robot's recogniser needs its table")?;
+    let params = crate::pipeline::PipelineParams {
+        recognition: super::detect::load_params(e.params.as_deref())?,
+        ..crate::pipeline::PipelineParams::default()
+    };
+    Ok(crate::pipeline::Pipeline::new(
+        super::inputs::load_lut_arg(lut)?,
+        params,
+    ))
+}
+
+/// An overhead camera's feed.
+fn live_camera(
+    id: SslCameraId,
+    source: &SessionSource,
+    topic: Option<&str>,
+    pipeline: crate::overhead::OverheadPipeline,
+) -> anyhow::Result<super::wmd_live::LiveCamera> {
+    use super::wmd_feeds::OverheadFeed;
+    let name = source_name(source);
+    let feed = match source {
+        SessionSource::Live(url) => OverheadFeed::live(url)?,
+        SessionSource::Device(p) => OverheadFeed::device(p)?,
+        SessionSource::Recording(p) => OverheadFeed::replay(p, topic)?,
+    };
+    if topic.is_some() && !matches!(source, SessionSource::Recording(_)) {
+        log::warn!(
+            "{name}: a camera topic is chosen only in recordings; the server's first camera is read"
+        );
+    }
+    Ok(super::wmd_live::LiveCamera {
+        id,
+        name,
+        pipeline,
+        feed,
+        connection: None,
+    })
+}
+
+/// A robot's feed: a live robot's connection, or a recording's world models replayed.
+fn robot_feed(
+    source: &SessionSource,
+    wants: super::wmd_feeds::RobotWants,
+    what: &str,
+) -> anyhow::Result<super::wmd_feeds::RobotFeed> {
+    use super::wmd_feeds::RobotFeed;
+    match source {
+        SessionSource::Live(url) => RobotFeed::live(url, wants),
+        SessionSource::Device(p) => bail!(
+            "robot {what}: {} is a camera device; a robot's source sends its world models (a recording or a ws:// robot)",
+            p.display()
+        ),
+        SessionSource::Recording(p) => {
+            let mut models = RobotModels::new();
+            read_world_models(p, wants.only, &mut models)?;
+            let mut all: Vec<(u64, WorldModelMessage)> = models.into_values().flatten().collect();
+            all.sort_by_key(|m| m.0);
+            let first_ns = all.first().map_or(0, |m| m.0);
+            Ok(RobotFeed::Replay {
+                models: all,
+                next: 0,
+                first_ns,
+            })
+        }
+    }
 }

@@ -190,5 +190,33 @@ pub fn active() -> KernelSet {
     })
 }
 
+/// For the tests that hold every set against the portable one: the sets this CPU runs, the
+/// others said as skips (`what` names the loop compared). An x86-64 CPU without AVX2 compares
+/// nothing, a skip that fails under `CI=true`; sets a CPU lacks by design (AVX-512 on most
+/// machines, every x86 set elsewhere) are noted in the summary without failing CI.
+#[cfg(test)]
+pub(crate) fn runnable_saying_the_rest(what: &str) -> Vec<KernelSet> {
+    let sets = runnable(cpu());
+    let lacking: Vec<&str> = KernelSet::ALL
+        .into_iter()
+        .filter(|s| !sets.contains(s))
+        .map(KernelSet::name)
+        .collect();
+    if lacking.is_empty() {
+        return sets;
+    }
+    let reason = format!(
+        "this CPU cannot run the {} kernels, so their {what} was not compared with the portable one",
+        lacking.join(", ")
+    );
+    let remedy = "run the tests on a CPU with those instructions (AVX2; AVX-512 F and BW)";
+    if cfg!(target_arch = "x86_64") && !sets.contains(&KernelSet::Avx2) {
+        crate::test_skip::skipped(&reason, remedy);
+    } else {
+        crate::test_skip::skip_noted(&reason, remedy);
+    }
+    sets
+}
+
 #[cfg(test)]
 mod tests;

@@ -11,11 +11,13 @@ use crate::streams::{
     FrameRecord, GROUND_TRUTH_TOPIC, IMAGE_TOPIC, RECOGNITION_TOPIC, SENSORS_TOPIC,
 };
 
-/// Attaches one JSON or CDR message to its frame (transforms go into the robot's tree); a note
-/// when it had to be skipped.
+/// Attaches one JSON or CDR message to its frame as the channel `as_topic` (a camera's
+/// `CAMERA/sensors` is its frames' `/sensors`; transforms go into the robot's tree); a note when
+/// it had to be skipped.
 pub(super) fn attach(
     record: &mut FrameRecord,
     channel: &AdvertisedChannel,
+    as_topic: &str,
     bytes: &[u8],
     tf: &mut TfTree,
 ) -> Option<String> {
@@ -61,7 +63,7 @@ pub(super) fn attach(
         Ok((v, _)) => v,
         Err(e) => return Some(format!("{topic}: not JSON ({e}); skipped")),
     };
-    match topic {
+    match as_topic {
         SENSORS_TOPIC => match serde_json::from_value::<SensorReadings>(value) {
             Ok(s) => record.sensors = Some(s.sanitised().0),
             Err(e) => return Some(format!("{topic}: not sensor readings ({e}); skipped")),

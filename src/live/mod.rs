@@ -11,6 +11,7 @@
 //! [`source`] is a robot as a [`crate::sources::FrameSource`] for the workspace and the app.
 
 mod attach;
+mod camera_frames;
 pub mod channels;
 pub mod client;
 pub mod gaps;

@@ -5,6 +5,12 @@
 //! memory (up to a byte budget) so a viewer can step back through them while reception goes on;
 //! a recording keeps all of them. A frame's JSON messages (sensors, world model) attach to the
 //! frame with the same log time, whether they come just before or just after its image.
+//!
+//! A robot with several image channels (a NAO's top and bottom cameras) has a camera for each
+//! ([`CameraFrames`]): the first — the canonical `/camera/image`, else the first advertised —
+//! is the one shown and counted in the statistics; each other camera keeps its own frames and
+//! arrival times on the same clock ([`LiveRobot::camera_view`]), and a channel `CAMERA/sensors`
+//! (or `…/recognition`, `…/ground_truth`) goes with that camera's frames.
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -12,15 +18,20 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use super::attach::{attach, image_kind};
+use super::camera_frames::CameraFrames;
 use super::client::{ClientOptions, LiveEvent, RobotClient};
-use super::gaps::{FrameGaps, Gap};
+use super::gaps::Gap;
 use super::protocol::AdvertisedChannel;
 use super::recorder::{LiveRecorder, MAX_CHANNELS, Recorded};
 use super::{RobotUrl, unix_time_ns};
+use crate::camera::CameraChannel;
 use crate::formats::tf::TfTree;
 use crate::formats::{ImageMessage, MessageKind, ros2};
 use crate::sensors::SensorReadings;
 use crate::streams::{FrameRecord, IMAGE_TOPIC, StreamError, StreamInfo};
+
+mod frames;
+pub use frames::RobotFrames;
 
 /// Frame bytes kept in memory per robot unless told otherwise (about 2,000 ERS-7 frames).
 pub const DEFAULT_KEEP_BYTES: usize = 128 << 20;
@@ -107,29 +118,24 @@ struct Problem {
 struct Inner {
     name: Option<String>,
     connection: Option<Connection>,
-    frames: VecDeque<Arc<LiveFrame>>,
-    kept_bytes: usize,
-    received: usize,
+    /// The robot's cameras, the one shown first (see the module documentation); empty until
+    /// an image channel is advertised.
+    cameras: Vec<CameraFrames>,
     drops: usize,
     connections: usize,
     arrivals: VecDeque<Instant>,
     latencies: VecDeque<u64>,
-    gaps: FrameGaps,
-    /// JSON messages waiting for their frame's image, and their bytes (bounded by the client's
-    /// [`super::Limits`]: `queue`, messages and bytes).
-    pending: VecDeque<(Arc<AdvertisedChannel>, u64, Vec<u8>)>,
+    /// JSON messages waiting for their frame's image (the camera they go with, their channel,
+    /// log time and bytes), and their bytes (bounded by the client's [`super::Limits`]:
+    /// `queue`, messages and bytes).
+    pending: VecDeque<(usize, Arc<AdvertisedChannel>, u64, Vec<u8>)>,
     pending_bytes: usize,
     queue: (usize, usize),
     problem: Option<Problem>,
     recorder: Option<LiveRecorder>,
     log: VecDeque<String>,
-    /// When the first frame arrived (the origin of the arrival times).
+    /// When the first frame of any camera arrived (the origin of the arrival times).
     first_arrival: Option<Instant>,
-    /// Every frame's arrival, nanoseconds after the first frame's, by index (8 bytes a frame,
-    /// kept for frames no longer in memory too, so the timeline's times never change).
-    arrival_offsets_ns: Vec<u64>,
-    /// The image topic shown (the first camera advertised; the others are recorded only).
-    camera: Option<String>,
     /// The robot's transform tree (`/tf`, `/tf_static`), for the camera's pose.
     tf: TfTree,
     /// The "grey frames" note was given.
@@ -144,111 +150,6 @@ pub struct LiveRobot {
     url: RobotUrl,
     shared: Arc<Mutex<Inner>>,
     client: Option<RobotClient>,
-}
-
-/// A read-only handle on a robot's frames (cheap to clone): what a viewer steps through while
-/// the robot's thread goes on adding frames. It reads the same state as its [`LiveRobot`] and
-/// stays readable (frozen) after the robot is dropped.
-#[derive(Clone)]
-pub struct RobotFrames {
-    url: RobotUrl,
-    shared: Arc<Mutex<Inner>>,
-}
-
-impl std::fmt::Debug for RobotFrames {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RobotFrames")
-            .field("url", &self.url)
-            .finish_non_exhaustive()
-    }
-}
-
-impl RobotFrames {
-    /// The robot's address.
-    #[must_use]
-    pub const fn url(&self) -> &RobotUrl {
-        &self.url
-    }
-
-    /// The robot's server name once it said it, else its address.
-    #[must_use]
-    pub fn name(&self) -> String {
-        lock(&self.shared)
-            .name
-            .clone()
-            .unwrap_or_else(|| self.url.to_string())
-    }
-
-    /// The connection's state.
-    #[must_use]
-    pub fn connection(&self) -> Connection {
-        lock(&self.shared)
-            .connection
-            .clone()
-            .unwrap_or(Connection::Connecting)
-    }
-
-    /// Frames received so far (the next frame's index).
-    #[must_use]
-    pub fn len(&self) -> usize {
-        lock(&self.shared).received
-    }
-
-    /// True before the first frame.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Index of the oldest frame still in memory (`len()` when none is).
-    #[must_use]
-    pub fn first_kept(&self) -> usize {
-        let inner = lock(&self.shared);
-        inner.frames.front().map_or(inner.received, |f| f.index)
-    }
-
-    /// Frame `index` if it is still in memory.
-    #[must_use]
-    pub fn frame(&self, index: usize) -> Option<Arc<LiveFrame>> {
-        let inner = lock(&self.shared);
-        let first = inner.frames.front()?.index;
-        inner.frames.get(index.checked_sub(first)?).cloned()
-    }
-
-    /// The newest frame.
-    #[must_use]
-    pub fn latest(&self) -> Option<Arc<LiveFrame>> {
-        lock(&self.shared).frames.back().cloned()
-    }
-
-    /// The figures for the robot list.
-    #[must_use]
-    pub fn stats(&self) -> RobotStats {
-        lock(&self.shared).stats()
-    }
-
-    /// When frame `index` arrived, nanoseconds after the first frame (the last frame's time
-    /// past the end; 0 before any frame).
-    #[must_use]
-    pub fn arrival_ns(&self, index: usize) -> u64 {
-        let inner = lock(&self.shared);
-        let times = &inner.arrival_offsets_ns;
-        times
-            .get(index)
-            .or_else(|| times.last())
-            .copied()
-            .unwrap_or(0)
-    }
-
-    /// The last frame that arrived at or before `offset_ns` after the first one (0 when none).
-    #[must_use]
-    pub fn index_at_arrival(&self, offset_ns: u64) -> usize {
-        let inner = lock(&self.shared);
-        inner
-            .arrival_offsets_ns
-            .partition_point(|&t| t <= offset_ns)
-            .saturating_sub(1)
-    }
 }
 
 impl std::fmt::Debug for LiveRobot {
@@ -310,10 +211,10 @@ impl LiveRobot {
         self.frames_view().connection()
     }
 
-    /// Frames received so far (the next frame's index).
+    /// Frames of the shown camera received so far (the next frame's index).
     #[must_use]
     pub fn len(&self) -> usize {
-        lock(&self.shared).received
+        self.frames_view().len()
     }
 
     /// True before the first frame.
@@ -337,16 +238,24 @@ impl LiveRobot {
     /// The newest frame.
     #[must_use]
     pub fn latest(&self) -> Option<Arc<LiveFrame>> {
-        lock(&self.shared).frames.back().cloned()
+        self.frames_view().latest()
     }
 
-    /// A handle on the frames for a viewer to step through while reception goes on.
+    /// A handle on the shown camera's frames for a viewer to step through while reception
+    /// goes on.
     #[must_use]
     pub fn frames_view(&self) -> RobotFrames {
         RobotFrames {
             url: self.url.clone(),
             shared: Arc::clone(&self.shared),
+            camera: None,
         }
+    }
+
+    /// A handle on the frames of the robot's camera `topic` (see [`RobotFrames::camera_view`]).
+    #[must_use]
+    pub fn camera_view(&self, topic: &str) -> RobotFrames {
+        self.frames_view().camera_view(topic)
     }
 
     /// Where the running recording goes, if one runs.
@@ -452,7 +361,7 @@ impl Inner {
             .count();
         let fps = recent as f64;
         RobotStats {
-            frames: self.received,
+            frames: self.cameras.first().map_or(0, |c| c.received),
             drops: self.drops,
             fps,
             latency_median_ms: percentile(&sorted, 0.5),
@@ -501,16 +410,16 @@ impl Inner {
                 self.note(format!("{again}connected to {server_name}"));
                 self.name = Some(server_name.clone());
                 self.connection = Some(Connection::Connected(server_name));
-                self.gaps.forget_last();
+                for c in &mut self.cameras {
+                    c.gaps.forget_last();
+                }
                 false
             }
             LiveEvent::Advertised(channels) => {
                 self.choose_camera(&channels);
                 for c in channels {
                     let read = MessageKind::of(&c.schema_name, &c.encoding).is_some();
-                    let shown =
-                        image_kind(&c).is_some() && self.camera.as_deref() == Some(&c.topic);
-                    if (!read && c.encoding != "json") || (image_kind(&c).is_some() && !shown) {
+                    if !read && c.encoding != "json" && image_kind(&c).is_none() {
                         self.note(format!(
                             "channel {} ({} {}) is recorded, not shown",
                             c.topic, c.schema_name, c.encoding
@@ -558,10 +467,18 @@ impl Inner {
             } => {
                 self.record(&channel, log_time_ns, &payload);
                 match image_kind(&channel) {
-                    Some(kind) if self.camera.as_deref() == Some(&channel.topic) => {
-                        self.image(kind, log_time_ns, received_ns, &payload, keep_bytes)
-                    }
-                    Some(_) => false,
+                    Some(kind) => match self.camera_index(&channel.topic) {
+                        Some(camera) => {
+                            let message = ImageMessageIn {
+                                kind,
+                                log_time_ns,
+                                received_ns,
+                                payload: &payload,
+                            };
+                            self.image(camera, &message, keep_bytes)
+                        }
+                        None => false,
+                    },
                     None if MessageKind::of(&channel.schema_name, &channel.encoding)
                         == Some(MessageKind::RosTf) =>
                     {
@@ -605,22 +522,21 @@ impl Inner {
         }
     }
 
-    /// Chooses the camera shown among the advertised image channels (once: the canonical
-    /// topic, else the first); the others are recorded, not shown.
+    /// Adds a camera for each image channel advertised: on the first advertisement the
+    /// canonical topic, else the first, becomes the camera shown; the others (and any advertised
+    /// later) are cameras of their own, offered beside it.
     fn choose_camera(&mut self, channels: &[Arc<AdvertisedChannel>]) {
-        if self.camera.is_some() {
-            return;
-        }
         let images: Vec<&Arc<AdvertisedChannel>> = channels
             .iter()
             .filter(|c| image_kind(c).is_some())
             .collect();
-        let chosen = images
-            .iter()
-            .find(|c| c.topic == IMAGE_TOPIC)
-            .or_else(|| images.first());
-        if let Some(c) = chosen {
-            self.camera = Some(c.topic.clone());
+        if self.cameras.is_empty()
+            && let Some(c) = images
+                .iter()
+                .find(|c| c.topic == IMAGE_TOPIC)
+                .or_else(|| images.first())
+        {
+            self.cameras.push(CameraFrames::new(&c.topic));
             if c.topic != IMAGE_TOPIC {
                 self.note(format!(
                     "frames are shown from {} ({} {})",
@@ -628,17 +544,45 @@ impl Inner {
                 ));
             }
         }
+        for c in images {
+            if self.camera_index(&c.topic).is_none() {
+                self.cameras.push(CameraFrames::new(&c.topic));
+                self.note(format!(
+                    "channel {} ({} {}) is another camera: pick it in the camera picker or show the cameras side by side",
+                    c.topic, c.schema_name, c.encoding
+                ));
+            }
+        }
     }
 
-    fn image(
-        &mut self,
-        kind: MessageKind,
-        log_time_ns: u64,
-        received_ns: u64,
-        payload: &[u8],
-        keep: usize,
-    ) -> bool {
-        let decoded = ImageMessage::decode(kind, payload).and_then(|m| {
+    /// The camera whose image channel is `topic`.
+    fn camera_index(&self, topic: &str) -> Option<usize> {
+        self.cameras.iter().position(|c| c.topic == topic)
+    }
+
+    /// The camera a JSON or CDR channel goes with, and the topic it is attached as: a
+    /// channel `CAMERA/sensors` (`recognition`, `ground_truth`) of a camera of this robot is
+    /// that camera's `/sensors`; any other goes with the camera shown, as it is.
+    fn channel_camera(&self, topic: &str) -> (usize, String) {
+        if let Some((camera, channel)) = CameraChannel::of(topic)
+            && let Some(i) = self.camera_index(camera)
+        {
+            let as_topic = match channel {
+                CameraChannel::Sensors
+                | CameraChannel::GroundTruth
+                | CameraChannel::Recognition => channel.topic(IMAGE_TOPIC),
+                CameraChannel::Annotations | CameraChannel::CameraInfo => topic.to_owned(),
+            };
+            return (i, as_topic);
+        }
+        (0, topic.to_owned())
+    }
+
+    /// Decodes an image of camera `camera` into a frame with the messages that came for it;
+    /// true when it made a frame.
+    fn image(&mut self, camera: usize, message: &ImageMessageIn<'_>, keep: usize) -> bool {
+        let log_time_ns = message.log_time_ns;
+        let decoded = ImageMessage::decode(message.kind, message.payload).and_then(|m| {
             let (time, frame_id, grey) = (m.timestamp_ns, m.frame_id.clone(), m.is_grey());
             m.into_frame().map(|f| (f, time, frame_id, grey))
         });
@@ -660,19 +604,28 @@ impl Inner {
         // Gaps are judged on the camera's capture times (regular), not on when the sender got
         // round to writing (jittery); images without a timestamp use their log time.
         let capture_ns = capture_ns.filter(|&t| t > 0).unwrap_or(log_time_ns);
-        match self.gaps.observe(capture_ns) {
+        let Some(gaps) = self.cameras.get_mut(camera).map(|c| &mut c.gaps) else {
+            return false;
+        };
+        match gaps.observe(capture_ns) {
             Gap::Regular => {}
-            Gap::Missed(n) => self.drops += n,
+            // Drops are counted on the camera shown (the robots list's figures).
+            Gap::Missed(n) => self.drops += if camera == 0 { n } else { 0 },
             Gap::ClockJump { by_ns } => self.note(format!(
                 "the robot's frame times jumped by {:+.1} s (restarted or looped): not counted as drops",
                 by_ns as f64 / 1e9
             )),
         }
         let mut record = FrameRecord::new(log_time_ns, frame);
-        self.pending_bytes = 0;
-        for (channel, time, bytes) in std::mem::take(&mut self.pending) {
+        let (mine, others): (VecDeque<_>, VecDeque<_>) = std::mem::take(&mut self.pending)
+            .into_iter()
+            .partition(|(c, ..)| *c == camera);
+        self.pending = others;
+        self.pending_bytes = self.pending.iter().map(|(.., p)| p.len()).sum();
+        for (_, channel, time, bytes) in mine {
+            let (_, as_topic) = self.channel_camera(&channel.topic);
             if time == log_time_ns
-                && let Some(n) = attach(&mut record, &channel, &bytes, &mut self.tf)
+                && let Some(n) = attach(&mut record, &channel, &as_topic, &bytes, &mut self.tf)
             {
                 self.note(n);
             }
@@ -688,29 +641,35 @@ impl Inner {
                 s.camera_yaw_rad = pose.camera_yaw_rad;
             }
         }
-        let bytes = record.frame.data().len();
-        let latency_ns = unix_time_ns().saturating_sub(log_time_ns);
-        self.frames.push_back(Arc::new(LiveFrame {
-            index: self.received,
+        self.keep_frame(camera, record, message.received_ns, keep);
+        true
+    }
+
+    /// Keeps a new frame of camera `camera` (within its share of `keep` bytes) and counts it.
+    fn keep_frame(&mut self, camera: usize, record: FrameRecord, received_ns: u64, keep: usize) {
+        let latency_ns = unix_time_ns().saturating_sub(record.time_ns);
+        let now = Instant::now();
+        let first = *self.first_arrival.get_or_insert(now);
+        let offset = u64::try_from(now.duration_since(first).as_nanos()).unwrap_or(u64::MAX);
+        let share = keep / self.cameras.len().max(1);
+        let Some(c) = self.cameras.get_mut(camera) else {
+            return;
+        };
+        let frame = LiveFrame {
+            index: c.received,
             record,
             received_ns,
             latency_ns,
-        }));
-        self.received += 1;
-        self.kept_bytes += bytes;
-        while self.kept_bytes > keep && self.frames.len() > 1 {
-            if let Some(old) = self.frames.pop_front() {
-                self.kept_bytes -= old.record.frame.data().len();
-            }
+        };
+        c.push(frame, offset, share);
+        if camera != 0 {
+            // The figures are the camera shown's.
+            return;
         }
         if self.latencies.len() >= LATENCY_WINDOW {
             self.latencies.pop_front();
         }
         self.latencies.push_back(latency_ns);
-        let now = Instant::now();
-        let first = *self.first_arrival.get_or_insert(now);
-        let offset = u64::try_from(now.duration_since(first).as_nanos()).unwrap_or(u64::MAX);
-        self.arrival_offsets_ns.push(offset);
         self.arrivals.push_back(now);
         while self
             .arrivals
@@ -719,22 +678,24 @@ impl Inner {
         {
             self.arrivals.pop_front();
         }
-        true
     }
 
-    /// Attaches a JSON or CDR message to its frame: eotn's senders give a frame's messages the
-    /// image's log time; a ROS bridge stamps each message when it came, so its `cdr` messages go
-    /// with the latest frame.
+    /// Attaches a JSON or CDR message to its camera's frame: eotn's senders give a frame's
+    /// messages the image's log time; a ROS bridge stamps each message when it came, so its
+    /// `cdr` messages go with the latest frame.
     fn json(&mut self, channel: Arc<AdvertisedChannel>, log_time_ns: u64, payload: Vec<u8>) {
         let by_arrival = channel.encoding == "cdr";
+        let (camera, as_topic) = self.channel_camera(&channel.topic);
         let latest = self
-            .frames
-            .back_mut()
+            .cameras
+            .get_mut(camera)
+            .and_then(|c| c.frames.back_mut())
             .filter(|f| by_arrival || f.record.time_ns == log_time_ns);
         if let Some(latest) = latest {
             let note = attach(
                 &mut Arc::make_mut(latest).record,
                 &channel,
+                &as_topic,
                 &payload,
                 &mut self.tf,
             );
@@ -742,16 +703,26 @@ impl Inner {
                 self.note(n);
             }
         } else {
-            self.pending.retain(|(_, t, _)| *t == log_time_ns);
-            self.pending.push_back((channel, log_time_ns, payload));
-            self.pending_bytes = self.pending.iter().map(|(_, _, p)| p.len()).sum();
+            self.pending
+                .retain(|(c, _, t, _)| *t == log_time_ns || *c != camera);
+            self.pending
+                .push_back((camera, channel, log_time_ns, payload));
+            self.pending_bytes = self.pending.iter().map(|(.., p)| p.len()).sum();
             let (messages, bytes) = self.queue;
             while self.pending.len() > messages || self.pending_bytes > bytes {
-                let Some((_, _, old)) = self.pending.pop_front() else {
+                let Some((.., old)) = self.pending.pop_front() else {
                     break;
                 };
                 self.pending_bytes -= old.len();
             }
         }
     }
+}
+
+/// An image message as it came: what the camera's frame is made from.
+struct ImageMessageIn<'a> {
+    kind: MessageKind,
+    log_time_ns: u64,
+    received_ns: u64,
+    payload: &'a [u8],
 }

@@ -210,6 +210,12 @@ impl RecordedSource for RobotFrames {
         self.arrival_ns(index)
     }
 
+    /// The camera's first frame on the robot's arrival clock: a robot's cameras side by side
+    /// are matched on it.
+    fn start_ns(&self) -> u64 {
+        RobotFrames::start_ns(self)
+    }
+
     fn index_at_time(&self, time_ns: u64) -> usize {
         self.index_at_arrival(time_ns)
     }

@@ -225,6 +225,27 @@ impl EditRecord {
             sampled_at: None,
         }
     }
+
+    /// True when the edit writes every cell of `lut` (a box over the whole table): the table
+    /// after it is the same whatever it was before.
+    #[must_use]
+    pub fn covers_table(&self, lut: &LookupTable) -> bool {
+        self.region
+            .select_cells(lut)
+            .is_some_and(|b| b.len() == lut.cells().len())
+    }
+
+    /// The fewest bytes the undo step of this edit on `lut` holds ([`AppliedEdit::held_bytes`]),
+    /// known before it is applied: exact for a box (one old code a cell), without the old codes
+    /// of picked cells (those that change, which only applying tells).
+    #[must_use]
+    pub fn least_held_bytes(&self, lut: &LookupTable) -> usize {
+        size_of::<AppliedEdit>()
+            + match &self.region {
+                Region::Cells { indices } => indices.len() * size_of::<usize>(),
+                Region::AroundSample { .. } => self.region.select_cells(lut).map_or(0, |b| b.len()),
+            }
+    }
 }
 
 /// Number of `cells` whose code is not `code`. Counted in byte-wide lanes, 255 cells at a
@@ -521,6 +542,18 @@ impl EditHistory {
     #[must_use]
     pub const fn held_bytes(&self) -> usize {
         self.bytes
+    }
+
+    /// Most bytes the steps may hold ([`MAX_HISTORY_BYTES`] by default).
+    #[must_use]
+    pub const fn max_bytes(&self) -> usize {
+        self.max_bytes
+    }
+
+    /// Counts `steps` more as dropped: steps a replay knew would be dropped and never kept
+    /// (`workspace::journal`'s replay from the last whole-table edit the bound drops).
+    pub const fn note_dropped(&mut self, steps: usize) {
+        self.dropped += steps;
     }
 
     /// Undoes the latest edit; returns its record, or `None` when there is nothing to undo.

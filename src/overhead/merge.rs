@@ -9,15 +9,17 @@ use crate::geometry::{MarkerIdentity, MarkerTeam};
 
 use super::recognise::{OverheadBall, OverheadDetections};
 
-/// The SSL `camera_id` of an overhead camera, 0–255: how merged detections name the cameras
-/// that saw them.
+/// The SSL `camera_id` of an overhead camera, 0–255: its number within a session (SSL-Vision's
+/// `camera_id`), how merged detections name the cameras that saw them. Which camera it is —
+/// its source and image topic, what its table and calibration are remembered under — is a
+/// [`crate::camera::CameraId`] (`OverheadEntry::camera_id` of a session).
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
 )]
 #[serde(transparent)]
-pub struct CameraId(pub u8);
+pub struct SslCameraId(pub u8);
 
-impl std::fmt::Display for CameraId {
+impl std::fmt::Display for SslCameraId {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}", self.0)
     }
@@ -36,9 +38,9 @@ pub struct FieldBall {
     /// The most confident camera's ball.
     pub ball: OverheadBall,
     /// The camera it came from.
-    pub camera: CameraId,
+    pub camera: SslCameraId,
     /// Every camera whose ball agrees with it, ascending.
-    pub camera_ids: Vec<CameraId>,
+    pub camera_ids: Vec<SslCameraId>,
 }
 
 /// A merged robot.
@@ -55,7 +57,7 @@ pub struct FieldRobot {
     /// The highest confidence of the readings.
     pub confidence: f64,
     /// The cameras that saw it, ascending.
-    pub camera_ids: Vec<CameraId>,
+    pub camera_ids: Vec<SslCameraId>,
 }
 
 /// One field frame's merged detections.
@@ -69,7 +71,7 @@ pub struct FieldPicture {
 
 /// Merges the detections of several cameras taken at (nearly) one instant.
 #[must_use]
-pub fn merge_detections(views: &[(CameraId, &OverheadDetections)]) -> FieldPicture {
+pub fn merge_detections(views: &[(SslCameraId, &OverheadDetections)]) -> FieldPicture {
     FieldPicture {
         ball: merge_ball(views),
         robots: merge_robots(views),
@@ -80,15 +82,15 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
-fn merge_ball(views: &[(CameraId, &OverheadDetections)]) -> Option<FieldBall> {
-    let balls: Vec<(CameraId, OverheadBall)> = views
+fn merge_ball(views: &[(SslCameraId, &OverheadDetections)]) -> Option<FieldBall> {
+    let balls: Vec<(SslCameraId, OverheadBall)> = views
         .iter()
         .filter_map(|(id, d)| d.ball.map(|b| (*id, b)))
         .collect();
     let (camera, best) = *balls
         .iter()
         .max_by(|a, b| a.1.confidence.total_cmp(&b.1.confidence))?;
-    let mut camera_ids: Vec<CameraId> = balls
+    let mut camera_ids: Vec<SslCameraId> = balls
         .iter()
         .filter(|(_, b)| dist(b.field_cm, best.field_cm) <= SAME_BALL_CM)
         .map(|(id, _)| *id)
@@ -102,8 +104,8 @@ fn merge_ball(views: &[(CameraId, &OverheadDetections)]) -> Option<FieldBall> {
     })
 }
 
-fn merge_robots(views: &[(CameraId, &OverheadDetections)]) -> Vec<FieldRobot> {
-    let mut readings: Vec<(CameraId, &super::recognise::OverheadRobot)> = views
+fn merge_robots(views: &[(SslCameraId, &OverheadDetections)]) -> Vec<FieldRobot> {
+    let mut readings: Vec<(SslCameraId, &super::recognise::OverheadRobot)> = views
         .iter()
         .flat_map(|(id, d)| d.robots.iter().map(move |r| (*id, r)))
         .collect();
@@ -132,7 +134,7 @@ fn merge_robots(views: &[(CameraId, &OverheadDetections)]) -> Vec<FieldRobot> {
             mean(&|r| r.heading_rad.sin()),
             mean(&|r| r.heading_rad.cos()),
         );
-        let mut camera_ids: Vec<CameraId> = agree.iter().map(|(id, _)| *id).collect();
+        let mut camera_ids: Vec<SslCameraId> = agree.iter().map(|(id, _)| *id).collect();
         camera_ids.sort_unstable();
         camera_ids.dedup();
         out.push(FieldRobot {
@@ -226,15 +228,15 @@ mod tests {
             ],
             ..OverheadDetections::default()
         };
-        let p = merge_detections(&[(CameraId(0), &a), (CameraId(4), &b)]);
+        let p = merge_detections(&[(SslCameraId(0), &a), (SslCameraId(4), &b)]);
         assert_eq!(p.robots.len(), 2);
         let blue = &p.robots[0];
         assert_eq!((blue.team, blue.identity.value()), (MarkerTeam::Blue, 3));
         assert!((blue.field_cm[0] - 100.5).abs() < 1e-9);
         // Headings either side of ±π average to π, not 0.
         assert!(blue.heading_rad.abs() > 3.1, "{}", blue.heading_rad);
-        assert_eq!(blue.camera_ids, vec![CameraId(0), CameraId(4)]);
-        assert_eq!(p.robots[1].camera_ids, vec![CameraId(4)]);
+        assert_eq!(blue.camera_ids, vec![SslCameraId(0), SslCameraId(4)]);
+        assert_eq!(p.robots[1].camera_ids, vec![SslCameraId(4)]);
     }
 
     #[test]
@@ -247,10 +249,10 @@ mod tests {
             robots: vec![robot(MarkerTeam::Blue, 3, -200.0, 10.0, 0.0, 0.5)],
             ..OverheadDetections::default()
         };
-        let p = merge_detections(&[(CameraId(0), &a), (CameraId(1), &b)]);
+        let p = merge_detections(&[(SslCameraId(0), &a), (SslCameraId(1), &b)]);
         assert_eq!(p.robots.len(), 1);
         assert_eq!(p.robots[0].field_cm, [100.0, 10.0]);
-        assert_eq!(p.robots[0].camera_ids, vec![CameraId(0)]);
+        assert_eq!(p.robots[0].camera_ids, vec![SslCameraId(0)]);
     }
 
     #[test]
@@ -263,11 +265,15 @@ mod tests {
             robots: vec![robot(MarkerTeam::Yellow, 1, -10.8, -28.9, 2.3, 0.95)],
             ..OverheadDetections::default()
         };
-        let views = [(CameraId(0), &a), (CameraId(1), &a), (CameraId(2), &b)];
+        let views = [
+            (SslCameraId(0), &a),
+            (SslCameraId(1), &a),
+            (SslCameraId(2), &b),
+        ];
         let p = merge_detections(&views);
         assert_eq!(p.robots.len(), 1);
         assert_eq!(p.robots[0].identity.value(), 9);
-        assert_eq!(p.robots[0].camera_ids, vec![CameraId(0), CameraId(1)]);
+        assert_eq!(p.robots[0].camera_ids, vec![SslCameraId(0), SslCameraId(1)]);
     }
 
     #[test]
@@ -284,11 +290,15 @@ mod tests {
             ball: Some(ball(200.0, 0.3)),
             ..OverheadDetections::default()
         };
-        let p = merge_detections(&[(CameraId(2), &a), (CameraId(1), &b), (CameraId(3), &c)]);
+        let p = merge_detections(&[
+            (SslCameraId(2), &a),
+            (SslCameraId(1), &b),
+            (SslCameraId(3), &c),
+        ]);
         let f = p.ball.expect("ball");
-        assert_eq!(f.camera, CameraId(1));
+        assert_eq!(f.camera, SslCameraId(1));
         assert_eq!(f.ball.field_cm[0], 12.0);
-        assert_eq!(f.camera_ids, vec![CameraId(1), CameraId(2)]);
+        assert_eq!(f.camera_ids, vec![SslCameraId(1), SslCameraId(2)]);
         assert!(merge_detections(&[]).ball.is_none());
     }
 

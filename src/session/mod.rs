@@ -20,8 +20,9 @@ use thiserror::Error;
 use crate::geometry::{MarkerIdentity, MarkerTeam};
 use crate::input_file::{MAX_SMALL_FILE_BYTES, read_text_bounded};
 use crate::overhead::FieldDescription;
+use crate::overhead::field::{SHIPPED_FIELDS, shipped_field_names};
 
-pub use crate::overhead::merge::CameraId;
+pub use crate::overhead::merge::SslCameraId;
 
 /// Where a camera's or robot's frames come from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -56,21 +57,10 @@ impl SessionSource {
 pub enum FieldRef {
     /// A field description file, resolved against the session file's folder.
     File(PathBuf),
-    /// A field description shipped with eotn, by name ([`SHIPPED_FIELDS`]).
-    Shipped(&'static str),
+    /// A field description shipped with eotn, by name (the names `--field` takes:
+    /// [`crate::overhead::field::SHIPPED_FIELDS`]).
+    Shipped(String),
 }
-
-/// The field descriptions shipped with eotn (`params/fields/NAME.json`), by name.
-pub const SHIPPED_FIELDS: [(&str, &str); 2] = [
-    (
-        "four-legged-2005",
-        include_str!("../../params/fields/four-legged-2005.json"),
-    ),
-    (
-        "ssl-2008",
-        include_str!("../../params/fields/ssl-2008.json"),
-    ),
-];
 
 impl FieldRef {
     /// The field description.
@@ -80,15 +70,7 @@ impl FieldRef {
     pub fn load(&self) -> anyhow::Result<FieldDescription> {
         match self {
             Self::File(p) => Ok(FieldDescription::load(p)?),
-            Self::Shipped(name) => {
-                let text = SHIPPED_FIELDS
-                    .iter()
-                    .find(|(n, _)| n == name)
-                    .map(|(_, t)| *t)
-                    .ok_or_else(|| anyhow::anyhow!("no shipped field {name:?}"))?;
-                Ok(FieldDescription::from_json(text)
-                    .map_err(|e| anyhow::anyhow!("shipped field {name}: {e}"))?)
-            }
+            Self::Shipped(name) => Ok(FieldDescription::resolve(name)?),
         }
     }
 }
@@ -97,7 +79,7 @@ impl FieldRef {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct OverheadEntry {
     /// Its SSL camera id.
-    pub id: CameraId,
+    pub id: SslCameraId,
     /// Its frames.
     pub source: SessionSource,
     /// The topic of its frames when the source has several.
@@ -110,6 +92,25 @@ pub struct OverheadEntry {
     pub intrinsics: Option<PathBuf>,
     /// Its overhead recogniser parameters.
     pub params: Option<PathBuf>,
+}
+
+impl OverheadEntry {
+    /// Which camera this is, as the app and the settings name it: the overhead camera of its
+    /// source (a recording's canonical path, a server, a device) and topic (`/camera/image`
+    /// when it names none).
+    #[must_use]
+    pub fn camera_id(&self) -> crate::camera::CameraId {
+        let source = match &self.source {
+            SessionSource::Recording(p) => std::fs::canonicalize(p)
+                .unwrap_or_else(|_| p.clone())
+                .to_string_lossy()
+                .into_owned(),
+            SessionSource::Live(url) => url.clone(),
+            SessionSource::Device(p) => p.to_string_lossy().into_owned(),
+        };
+        let topic = self.camera.as_deref().unwrap_or(crate::camera::IMAGE_TOPIC);
+        crate::camera::CameraId::overhead(&source, topic)
+    }
 }
 
 /// One robot of the session, named by the marker it wears.
@@ -281,7 +282,7 @@ impl Session {
 
     /// The camera with `id`.
     #[must_use]
-    pub fn camera(&self, id: CameraId) -> Option<&OverheadEntry> {
+    pub fn camera(&self, id: SslCameraId) -> Option<&OverheadEntry> {
         self.overhead.iter().find(|o| o.id == id)
     }
 }
@@ -302,24 +303,23 @@ struct Resolver<'a> {
 impl Resolver<'_> {
     fn field(&self, name: &str) -> Result<FieldRef, String> {
         if let Some((n, _)) = SHIPPED_FIELDS.iter().find(|(n, _)| *n == name) {
-            return Ok(FieldRef::Shipped(n));
+            return Ok(FieldRef::Shipped((*n).to_owned()));
         }
         let p = self.base.join(name);
         if p.is_file() {
             return Ok(FieldRef::File(p));
         }
-        let shipped: Vec<&str> = SHIPPED_FIELDS.iter().map(|(n, _)| *n).collect();
         Err(format!(
             "{}: no such field file, and {name:?} is not a shipped field ({})",
             p.display(),
-            shipped.join(", ")
+            shipped_field_names()
         ))
     }
 
     fn overhead(&self, value: &Value) -> Result<OverheadEntry, String> {
         let raw: RawOverhead = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
         Ok(OverheadEntry {
-            id: CameraId(raw.id),
+            id: SslCameraId(raw.id),
             source: self.source(&raw.source)?,
             camera: raw.camera,
             lut: self.file("lut", "lookup table", &raw.lut)?,

@@ -43,9 +43,9 @@ const TWO_CAMERAS: &str = r#"{
 fn two_cameras_and_two_robots_load_with_paths_beside_the_file() {
     let dir = folder();
     let s = load(dir.path(), TWO_CAMERAS).expect("loads");
-    assert_eq!(s.field, FieldRef::Shipped("four-legged-2005"));
+    assert_eq!(s.field, FieldRef::Shipped("four-legged-2005".to_owned()));
     assert_eq!(s.overhead.len(), 2);
-    assert_eq!(s.overhead[1].id, CameraId(7));
+    assert_eq!(s.overhead[1].id, SslCameraId(7));
     assert_eq!(s.overhead[1].lut, dir.path().join("b.lut"));
     assert_eq!(s.overhead[1].camera.as_deref(), Some("/cam7"));
     assert_eq!(
@@ -62,8 +62,13 @@ fn two_cameras_and_two_robots_load_with_paths_beside_the_file() {
         s.robots[1].source,
         SessionSource::Live("ws://127.0.0.1:8765".into())
     );
-    assert!(s.camera(CameraId(7)).is_some());
-    assert!(s.camera(CameraId(1)).is_none());
+    assert!(s.camera(SslCameraId(7)).is_some());
+    assert!(s.camera(SslCameraId(1)).is_none());
+    // Each numbered camera is a camera of its own: its source and topic.
+    let (a, b) = (s.overhead[0].camera_id(), s.overhead[1].camera_id());
+    assert!(a.same_source(&b) && a != b, "{a} {b}");
+    assert_eq!(b.topic(), "/cam7");
+    assert!(matches!(b, crate::camera::CameraId::Overhead { .. }), "{b}");
     assert!(s.field.load().is_ok());
 }
 
@@ -160,4 +165,18 @@ fn a_session_file_is_read_from_disk_with_paths_beside_it() {
     assert_eq!(s.overhead[0].calibration, dir.path().join("a.cal.json"));
     let gone = Session::load(&dir.path().join("none.json")).expect_err("missing");
     assert!(gone.to_string().contains("none.json"));
+}
+
+#[test]
+fn every_shipped_field_is_a_session_field_as_it_is_a_field_argument() {
+    // Regression: the session once kept its own list of two shipped fields, so
+    // `"field": "ssl-div-a"` was refused though `--field ssl-div-a` worked.
+    let dir = folder();
+    for (name, _) in crate::overhead::field::SHIPPED_FIELDS {
+        let s = load(dir.path(), &TWO_CAMERAS.replace("four-legged-2005", name))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let loaded = s.field.load().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let by_argument = crate::overhead::FieldDescription::resolve(name).expect("shipped");
+        assert_eq!(loaded, by_argument, "{name}");
+    }
 }

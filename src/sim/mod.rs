@@ -85,6 +85,8 @@ pub struct Simulator {
     overhead_camera: OverheadCamera,
     effects: CameraEffects,
     world_model_errors: WorldModelErrors,
+    /// The named ground places the overhead game's robots measure (field cm).
+    world_model_landmarks: Vec<(String, [f64; 2])>,
 }
 
 impl Simulator {
@@ -107,7 +109,16 @@ impl Simulator {
             overhead_camera,
             effects,
             world_model_errors: WorldModelErrors::default(),
+            world_model_landmarks: Vec::new(),
         }
+    }
+
+    /// The same, with the overhead game's robots measuring these named ground places (the
+    /// field file's landmarks, field cm) where their cameras would see them.
+    #[must_use]
+    pub fn with_world_model_landmarks(mut self, landmarks: Vec<(String, [f64; 2])>) -> Self {
+        self.world_model_landmarks = landmarks;
+        self
     }
 
     /// The same, with the robots' world models erring as `errors` says (the overhead game).
@@ -183,10 +194,14 @@ impl Simulator {
             ground_truth: GroundTruth::Overhead(Box::new(truth)),
             extra: world_models::world_models(
                 scene,
-                t,
-                at.index,
+                world_models::WorldModelAt {
+                    t_s: t,
+                    time_ns: at.time_ns,
+                    frame: at.index,
+                },
                 self.scenario.seed,
                 &self.world_model_errors,
+                &self.world_model_landmarks,
             ),
         })
     }

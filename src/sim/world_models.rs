@@ -2,7 +2,10 @@
 //! robot named by the marker it wears (team blue/yellow, identity 0–15), its own estimate of
 //! itself and of the ball, and `seen`: what its vision measured, made here from the truth with
 //! noise (the game renders no robot camera): the ball and the two goals' mouth centres when in
-//! front of it (bearing within ±90°).
+//! front of it (bearing within ±90°), and the field's landmarks (given by name: the field file's
+//! ground landmarks, [`Simulator::with_world_model_landmarks`](super::Simulator)) where its
+//! camera would see them: within its field of view (±28.45°, the ERS-7's) and 1 to 6 m away.
+//! Each message carries `time_ns`, the frame's time (the robot's clock is the simulator's).
 //!
 //! Without known errors a robot's estimate is the truth plus a slowly drifting bias (up to
 //! 15 cm, 0.1 rad; ball 20 cm) and per-frame noise (σ 8 cm, 0.05 rad; ball σ 12 cm; distances
@@ -47,16 +50,35 @@ impl Default for WorldModelErrors {
     }
 }
 
-/// Each marked robot's world model at time `t_s` of frame `frame`, keyed by its topic
-/// `/world_model/robotN` (N the scene's robot number).
+/// Half the horizontal field of view in which a robot sees a landmark, radians (the ERS-7's
+/// 56.9°).
+const LANDMARK_HALF_VIEW_RAD: f64 = 0.4965;
+/// Nearest and farthest a landmark is seen, centimetres (nearer ones are under the camera's
+/// view; farther ones too small to measure).
+const LANDMARK_RANGE_CM: (f64, f64) = (100.0, 600.0);
+
+/// Which frame a world model is for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorldModelAt {
+    /// Its time, seconds since the scenario start.
+    pub t_s: f64,
+    /// Its time as the stream gives it (the message's `time_ns`), nanoseconds.
+    pub time_ns: u64,
+    /// Its number.
+    pub frame: u64,
+}
+
+/// Each marked robot's world model at frame `at`, keyed by its topic `/world_model/robotN` (N the
+/// scene's robot number); `landmarks` the named ground places it may measure (field cm).
 #[must_use]
 pub fn world_models(
     scene: &Scene,
-    t_s: f64,
-    frame: u64,
+    at: WorldModelAt,
     seed: u64,
     errors: &WorldModelErrors,
+    landmarks: &[(String, [f64; 2])],
 ) -> Vec<(String, Value)> {
+    let (t_s, frame) = (at.t_s, at.frame);
     let mut rng = SimRng::derived(seed ^ 0x3D_0D31, frame);
     let s = errors.noise;
     let half = scene.field.length_cm / 2.0;
@@ -94,14 +116,23 @@ pub fn world_models(
             });
             let objects = scene
                 .ball
-                .map(|b| (SeenObject::Ball, [b.x_cm, b.y_cm]))
+                .map(|b| (SeenObject::Ball, [b.x_cm, b.y_cm], None))
                 .into_iter()
-                .chain(goals.iter().cloned());
+                .chain(goals.iter().map(|(o, p)| (o.clone(), *p, None)))
+                .chain(landmarks.iter().map(|(name, p)| {
+                    let object = SeenObject::from_name(name);
+                    (object, *p, Some(LANDMARK_RANGE_CM))
+                }));
             let seen = objects
-                .filter_map(|(object, p)| {
+                .filter_map(|(object, p, range)| {
                     let (dx, dy) = (p[0] - pose.x_cm, p[1] - pose.y_cm);
                     let bearing = angle_diff(dy.atan2(dx), pose.heading_rad);
-                    (bearing.abs() <= std::f64::consts::FRAC_PI_2).then(|| {
+                    let half_view = match range {
+                        Some(_) => LANDMARK_HALF_VIEW_RAD,
+                        None => std::f64::consts::FRAC_PI_2,
+                    };
+                    let near = range.is_none_or(|(near, far)| (near..=far).contains(&dx.hypot(dy)));
+                    (bearing.abs() <= half_view && near).then(|| {
                         let d = dx.hypot(dy);
                         Seen {
                             object,
@@ -118,7 +149,7 @@ pub fn world_models(
                 },
                 own,
                 ball,
-                time_ns: None,
+                time_ns: Some(at.time_ns),
                 seen,
             };
             Some((format!("/world_model/robot{}", r.id), message.to_json()))
@@ -152,7 +183,12 @@ mod tests {
             }],
             noise: 0.0,
         };
-        let models = world_models(&scene, 0.5, 15, 1, &errors);
+        let at = WorldModelAt {
+            t_s: 0.5,
+            time_ns: 500_000_000,
+            frame: 15,
+        };
+        let models = world_models(&scene, at, 1, &errors, &[]);
         assert_eq!(models.len(), scene.robots.len());
         assert_eq!(models[0].0, "/world_model/robot1");
         let m = from_value(&models[0].1).expect("a valid message");
@@ -169,9 +205,46 @@ mod tests {
             assert!(seen.bearing_rad.abs() <= std::f64::consts::FRAC_PI_2);
         }
         // Noise 1: the other robots err, but not wildly.
-        let noisy = world_models(&scene, 0.5, 15, 1, &WorldModelErrors::default());
+        assert_eq!(m.time_ns, Some(500_000_000));
+        let noisy = world_models(&scene, at, 1, &WorldModelErrors::default(), &[]);
         let m = from_value(&noisy[1].1).expect("a valid message");
         let r = &scene.robots[1];
         assert!((m.own.x_cm - r.pose.x_cm).abs() < 80.0);
+    }
+
+    #[test]
+    fn a_landmark_is_seen_in_the_cameras_view_between_one_and_six_metres() {
+        let s = Scenario::new(ScenarioKind::OverheadGame, 1);
+        let scene = s.scene_at(0.5);
+        let r = &scene.robots[0];
+        let (x, y, h) = (r.pose.x_cm, r.pose.y_cm, r.pose.heading_rad);
+        let at = |d: f64, turn: f64| [x + d * (h + turn).cos(), y + d * (h + turn).sin()];
+        let landmarks = vec![
+            ("ahead".to_owned(), at(300.0, 0.1)),
+            ("behind".to_owned(), at(300.0, 3.0)),
+            ("aside".to_owned(), at(300.0, 0.8)),
+            ("underfoot".to_owned(), at(50.0, 0.0)),
+            ("far".to_owned(), at(900.0, 0.0)),
+        ];
+        let exact = WorldModelErrors {
+            known: Vec::new(),
+            noise: 0.0,
+        };
+        let at0 = WorldModelAt {
+            t_s: 0.5,
+            time_ns: 500_000_000,
+            frame: 15,
+        };
+        let models = world_models(&scene, at0, 1, &exact, &landmarks);
+        let m = from_value(&models[0].1).expect("a valid message");
+        let named: Vec<&Seen> = m
+            .seen
+            .iter()
+            .filter(|s| matches!(s.object, SeenObject::Landmark(_)))
+            .collect();
+        assert_eq!(named.len(), 1, "{:?}", m.seen);
+        assert_eq!(named[0].object.name(), "ahead");
+        assert!((named[0].distance_cm - 300.0).abs() < 1e-6);
+        assert!((named[0].bearing_rad - 0.1).abs() < 1e-9);
     }
 }

@@ -134,15 +134,17 @@ pub enum StreamError {
         /// What was found instead.
         detail: String,
     },
-    /// The MCAP library reported a malformed record, bad CRC or failed decompression.
-    #[error("{path}: {context}: {source}")]
+    /// The MCAP library reported a malformed record, bad CRC, failed decompression, or the
+    /// file could not be written (a full disk, a full device).
+    #[error("{path}: {context}: {}", mcap_error_text(cause))]
     Mcap {
         /// The file.
         path: PathBuf,
         /// What we were doing.
         context: String,
-        /// The MCAP library's error.
-        source: mcap::McapError,
+        /// The MCAP library's error; its text, with its cause, is part of this error's, so
+        /// every caller shows "No space left on device" however it prints the error.
+        cause: mcap::McapError,
     },
     /// The file is MCAP but its contents do not make sense (bad index, broken message).
     #[error("{path}: {detail}")]
@@ -182,6 +184,22 @@ pub enum StreamError {
         /// What is wrong.
         detail: String,
     },
+}
+
+/// The MCAP library's error said with its cause: its I/O errors by the system's own words (its
+/// own text, "I/O error from writing, or reading a compression stream", hides them).
+fn mcap_error_text(e: &mcap::McapError) -> String {
+    if let mcap::McapError::Io(io) = e {
+        return io.to_string();
+    }
+    let mut text = e.to_string();
+    let mut cause = std::error::Error::source(e);
+    while let Some(c) = cause {
+        text.push_str(": ");
+        text.push_str(&c.to_string());
+        cause = c.source();
+    }
+    text
 }
 
 /// True when the path looks like an MCAP stream (`.mcap`, or `.mcap.partial` as a killed writer

@@ -47,6 +47,8 @@ pub enum OffsetStart {
     SameClock,
     /// They do not: the first world model lined up with the first overhead frame.
     FirstMessages,
+    /// A live robot: not searched but measured on arrival ([`arrival_offset`]).
+    Arrival,
 }
 
 /// A robot's estimated clock offset.
@@ -60,6 +62,27 @@ pub struct ClockOffset {
     pub pairs: usize,
     /// Their median position error at the chosen offset, centimetres.
     pub median_error_cm: Option<f64>,
+}
+
+/// A live robot's clock offset, measured rather than searched: live world models and overhead
+/// frames are both timed by their arrival on this machine and paired by it, so the robot's
+/// clock does not move the pairing; what it is is still shown: the median of (arrival − the
+/// message's time on the robot's clock) over `arrival_minus_robot_ns`, which is the two clocks'
+/// difference plus the network's latency. `pairs` and `median_error_cm` as for a searched offset.
+#[must_use]
+pub fn arrival_offset(
+    arrival_minus_robot_ns: &[i64],
+    pairs: usize,
+    median_error_cm: Option<f64>,
+) -> ClockOffset {
+    let mut sorted = arrival_minus_robot_ns.to_vec();
+    sorted.sort_unstable();
+    ClockOffset {
+        offset_ns: sorted.get(sorted.len() / 2).copied().unwrap_or(0),
+        start: OffsetStart::Arrival,
+        pairs,
+        median_error_cm,
+    }
 }
 
 /// The overhead time a robot time `t_ns` maps to under `offset_ns`, if not before 0.
@@ -221,5 +244,17 @@ mod tests {
     fn the_period_is_the_median_gap() {
         assert_eq!(frame_period_ns(&[0, 10, 20, 35, 45]), 10);
         assert_eq!(frame_period_ns(&[7]), DEFAULT_PERIOD_NS);
+    }
+
+    #[test]
+    fn a_live_offset_is_the_median_of_arrival_minus_robot_time() {
+        // A robot 0.4 s ahead with 1-9 ms of latency, and one message held up for 300 ms.
+        let mut samples: Vec<i64> = (1..10).map(|ms| ms * 1_000_000 - 400_000_000).collect();
+        samples.push(-100_000_000);
+        let c = arrival_offset(&samples, 10, Some(3.0));
+        assert_eq!(c.start, OffsetStart::Arrival);
+        assert_eq!(c.offset_ns, -394_000_000);
+        assert_eq!((c.pairs, c.median_error_cm), (10, Some(3.0)));
+        assert_eq!(arrival_offset(&[], 0, None).offset_ns, 0);
     }
 }

@@ -8,6 +8,7 @@
 //! robot's medians, 95th percentiles and error jumps.
 
 pub mod clock;
+pub mod scene;
 pub mod summary;
 
 use std::collections::{BTreeMap, BTreeSet};

@@ -8,6 +8,7 @@ use super::overhead::RobotKey;
 use super::robots::RobotId;
 use super::settings::{OverheadView, Overlays, ViewKind};
 use crate::blobs::Connectivity;
+use crate::camera::CameraId;
 use crate::lut::{ColourClass, Sensitivity};
 use crate::recognition::ObjectId;
 
@@ -17,23 +18,24 @@ use crate::recognition::ObjectId;
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     /// Open files by kind: `.mcap` streams, frame files (as one sequence), `.json` recognition
-    /// parameters or places (told by content), anything else as a table. Each file opens or
-    /// fails on its own.
+    /// parameters or places (told by content), SSL-Vision sources (a league log `.log` or
+    /// `.log.gz`, or `udp://GROUP:PORT`; shown in the field view), anything else as a table.
+    /// Each file opens or fails on its own.
     Open(Vec<PathBuf>),
-    /// Show another camera of the open recording (its image topic; `None`: the first): the
-    /// recording reopens on that camera at the frame nearest the time shown, with that camera's
-    /// table (remembered for it, else the one the recording names). Also the camera later
-    /// recordings open on, when they have it.
-    OpenCamera(Option<String>),
-    /// Show these cameras (image topics) of the open recording side by side, stepped together
+    /// Show another camera of the open recording or shown robot (one of
+    /// [`crate::workspace::Workspace::cameras`]; `None`: the first): it is shown at the frame
+    /// nearest the time shown, with that camera's table, parameters and calibration
+    /// (remembered for it, else those the recording names). Reopening the recording opens on it.
+    OpenCamera(Option<CameraId>),
+    /// Show these cameras of the open recording or shown robot side by side, stepped together
     /// by time: each shows its frame nearest the shared cursor (the focused camera's frame
     /// time), classified with its own table, its own recognition drawn. The camera shown so
     /// far stays focused when listed. Fewer than two: one camera again (refused while a camera
     /// leaving the view has unsaved table edits). `workspace/side_by_side.rs`.
-    ShowSideBySide(Vec<String>),
+    ShowSideBySide(Vec<CameraId>),
     /// Make this camera (shown side by side) the focused one: hand classification, commit,
     /// undo, save, playback and the sensors window act on it and its own table.
-    FocusCamera(String),
+    FocusCamera(CameraId),
     /// Open a lookup table.
     OpenTable(PathBuf),
     /// Open a places file (`eotn patterns learn`): pink markers are identified as its places.
@@ -44,6 +46,9 @@ pub enum Command {
     /// its boxes drawn by class, recognition scored against them, the missed and false frames
     /// as events (`workspace/labels.rs`).
     OpenLabels(PathBuf),
+    /// Score the opened labels on these frames only: all, the tuning frames (numbers ending in
+    /// 0–6) or the held-out ones (7–9), from the first frame again.
+    SetLabelsSplit(crate::eval::label_sets::Split),
     /// Open or close a window.
     ShowWindow(Window, bool),
     /// Select a recognition candidate (the object its primitives belong to) to highlight its
@@ -69,6 +74,9 @@ pub enum Command {
     Hints(HintsCommand),
     /// The overhead camera: calibration, picked points, robot selection, view options.
     Overhead(OverheadCommand),
+    /// Show this step (capture time) of an SSL-Vision log opened without a stream
+    /// (`workspace/ssl_feed.rs`).
+    ShowSslStep(usize),
 }
 
 /// The recognition parameters (`workspace/params.rs`): open, use the stream's set, tune, reset,

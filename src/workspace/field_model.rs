@@ -61,6 +61,8 @@ pub struct FieldModel {
     world_models: Vec<WorldModelView>,
     errors: BTreeMap<usize, ErrorSample>,
     warned: bool,
+    /// SSL-Vision's detections shown beside eotn's: each camera's frame (`workspace/ssl_feed.rs`).
+    ssl: Vec<crate::ssl_vision::CameraFrame>,
 }
 
 impl FieldModel {
@@ -159,6 +161,18 @@ impl FieldModel {
     /// The world-model errors of every frame seen so far, in frame order.
     pub fn error_samples(&self) -> impl Iterator<Item = &ErrorSample> {
         self.errors.values()
+    }
+
+    /// Takes the SSL-Vision frames to show (one per camera, by camera id).
+    pub fn set_ssl(&mut self, frames: &[crate::ssl_vision::CameraFrame]) {
+        self.ssl = frames.to_vec();
+    }
+
+    /// The SSL-Vision frames shown beside eotn's detections, one per camera, by camera id:
+    /// each camera's balls and robots (field centimetres), for the field view to mark by camera.
+    #[must_use]
+    pub fn ssl(&self) -> &[crate::ssl_vision::CameraFrame] {
+        &self.ssl
     }
 }
 

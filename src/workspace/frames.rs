@@ -1,7 +1,7 @@
 //! The frame side of the workspace: opening sources, showing a frame (the pipeline on it), and
 //! the background scans of the whole recording.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
@@ -9,7 +9,52 @@ use anyhow::Context as _;
 use super::source::Source;
 use super::timings::StepTiming;
 use super::{SCAN_BUDGET, SensorSeries, Workspace};
+use crate::camera::{CameraFiles, CameraId};
 use crate::sources::SourceFrame;
+
+/// The files given to Open, by kind. Tables, parameters and places open after the source: each
+/// camera kind has its own table (a table given beside an overhead stream belongs in the
+/// overhead slot, whatever the order), and what is opened is remembered for the camera shown.
+struct OpenPaths {
+    streams: Vec<PathBuf>,
+    frames: Vec<PathBuf>,
+    tables: Vec<PathBuf>,
+    /// Recognition parameters or places files (told by content when opened).
+    jsons: Vec<PathBuf>,
+    /// SSL-Vision sources: a league log file or a `udp://` multicast group.
+    ssl: Vec<PathBuf>,
+}
+
+impl OpenPaths {
+    fn sort(paths: Vec<PathBuf>) -> Self {
+        let mut sorted = Self {
+            streams: Vec::new(),
+            frames: Vec::new(),
+            tables: Vec::new(),
+            jsons: Vec::new(),
+            ssl: Vec::new(),
+        };
+        for p in paths {
+            let ext = p
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                .unwrap_or_default();
+            let kind = if is_ssl_source(&p, &ext) {
+                &mut sorted.ssl
+            } else if crate::streams::is_recording(&p) {
+                &mut sorted.streams
+            } else if ext == "json" {
+                &mut sorted.jsons
+            } else if crate::sources::is_frame_file(&p) || p.is_dir() {
+                &mut sorted.frames
+            } else {
+                &mut sorted.tables
+            };
+            kind.push(p);
+        }
+        sorted
+    }
+}
 
 impl Workspace {
     /// Opens each file by its kind; each opens or fails on its own (a bad table does not stop
@@ -17,31 +62,18 @@ impl Workspace {
     /// lists them all.
     pub(super) fn open(&mut self, paths: Vec<PathBuf>) -> anyhow::Result<()> {
         anyhow::ensure!(!paths.is_empty(), "nothing to open");
-        let mut frames = Vec::new();
-        let mut streams = Vec::new();
-        // Tables open after the source: each camera kind has its own table, so a table given
-        // beside an overhead stream belongs in the overhead slot, whatever the order.
-        let mut tables = Vec::new();
+        let OpenPaths {
+            mut streams,
+            frames,
+            mut tables,
+            jsons,
+            ssl,
+        } = OpenPaths::sort(paths);
+        let mut shown_camera = None;
         let mut offer = None;
         let mut failures = Vec::new();
-        for p in paths {
-            let ext = p
-                .extension()
-                .map(|e| e.to_string_lossy().to_ascii_lowercase())
-                .unwrap_or_default();
-            let opened = if crate::streams::is_recording(&p) {
-                streams.push(p);
-                Ok(())
-            } else if ext == "json" {
-                self.open_json(&p)
-            } else if crate::sources::is_frame_file(&p) || p.is_dir() {
-                frames.push(p);
-                Ok(())
-            } else {
-                tables.push(p);
-                Ok(())
-            };
-            if let Err(e) = opened {
+        for p in ssl {
+            if let Err(e) = self.open_ssl(&p) {
                 failures.push(format!("{e:#}"));
             }
         }
@@ -54,18 +86,10 @@ impl Workspace {
                     s.display()
                 ));
             }
-            match Source::stream_camera(&s, self.camera_for(&s).as_deref()) {
-                Ok(source) => {
-                    self.remember_recent(&s);
-                    if tables.is_empty()
-                        && let Some(t) = self.camera_table(&s, source.camera())
-                    {
-                        tables.push(t);
-                    }
-                    match self.set_source(source) {
-                        Ok(()) => offer = Some(s),
-                        Err(e) => failures.push(format!("{e:#}")),
-                    }
+            match self.open_recording(&s, &mut tables) {
+                Ok(camera) => {
+                    offer = Some(s);
+                    shown_camera = camera;
                 }
                 Err(e) => failures.push(format!("{e:#}")),
             }
@@ -89,6 +113,7 @@ impl Workspace {
                 failures.push(format!("{e:#}"));
             }
         }
+        self.open_given_files(jsons, shown_camera, &mut failures);
         if opened_source {
             // What was opened is said by the source's line (frames, calibration in use).
             self.status = source_status;
@@ -106,6 +131,60 @@ impl Workspace {
                     self.warn(f);
                 }
                 Err(anyhow::anyhow!(last))
+            }
+        }
+    }
+
+    /// Shows the recording `s` on its camera; the camera's own table goes into `tables` unless
+    /// one is given. Returns the camera shown and its own files, applied once the files given
+    /// are open ([`Workspace::open_given_files`]).
+    fn open_recording(
+        &mut self,
+        s: &Path,
+        tables: &mut Vec<PathBuf>,
+    ) -> anyhow::Result<Option<(CameraId, CameraFiles)>> {
+        let source = Source::stream_camera(s, self.camera_for(s).as_deref())?;
+        self.remember_recent(s);
+        // The camera's own files: remembered for this recording's camera, else those it names.
+        let camera = source.camera_id().map(|id| {
+            let files = self.camera_files(&id);
+            (id, files)
+        });
+        if tables.is_empty()
+            && let Some(t) = camera.as_ref().and_then(|(_, f)| f.lut.clone())
+        {
+            tables.push(t);
+        }
+        self.set_source(source)?;
+        Ok(camera)
+    }
+
+    /// After the source and its tables: the parameter and places files given, then the shown
+    /// camera's own parameters (unless parameters were given) and calibration.
+    fn open_given_files(
+        &mut self,
+        jsons: Vec<PathBuf>,
+        shown_camera: Option<(CameraId, CameraFiles)>,
+        failures: &mut Vec<String>,
+    ) {
+        let params_given = jsons.iter().any(|j| {
+            matches!(
+                super::params::json_kind(j),
+                Ok(super::params::JsonKind::Params)
+            )
+        });
+        for j in jsons {
+            if let Err(e) = self.open_json(&j) {
+                failures.push(format!("{e:#}"));
+            }
+        }
+        if let Some((id, mut files)) = shown_camera {
+            if params_given {
+                // The parameters given win over the camera's own.
+                files.params = None;
+            }
+            if let Err(e) = self.open_camera_files(&id, &files) {
+                failures.push(format!("{e:#}"));
             }
         }
     }
@@ -237,8 +316,8 @@ impl Workspace {
         let t0 = Instant::now();
         let loaded = src.read(index)?;
         let resized = self.current.as_ref().and_then(|old| {
-            let topic = src.camera().unwrap_or("the source");
-            super::side_by_side::size_change(topic, &old.frame, &loaded.frame, index)
+            let topic = src.camera().unwrap_or_else(|| "the source".to_owned());
+            super::side_by_side::size_change(&topic, &old.frame, &loaded.frame, index)
         });
         let t1 = Instant::now();
         let t = self.run_pipeline(&loaded);
@@ -264,6 +343,7 @@ impl Workspace {
         };
         self.frame_generation += 1;
         self.sync_beside();
+        self.sync_ssl();
         Ok(())
     }
 
@@ -296,6 +376,15 @@ impl Workspace {
             self.sensor_series.points.push((t, r));
         }
     }
+}
+
+/// An SSL-Vision source given to Open: `udp://…`, or a `.log` (`.log.gz`) file (a B-Human log
+/// of the same name is told apart when read, and pointed to its importer).
+fn is_ssl_source(p: &std::path::Path, ext: &str) -> bool {
+    let text = p.to_string_lossy();
+    crate::ssl_vision::listener::is_udp_url(&text)
+        || ext == "log"
+        || (ext == "gz" && text.to_ascii_lowercase().ends_with(".log.gz"))
 }
 
 #[cfg(test)]

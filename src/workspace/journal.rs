@@ -95,6 +95,28 @@ pub fn append(
         .with_context(|| format!("{}: cannot write the edit journal", path.display()))
 }
 
+/// Makes the journal of `from` (with its base copy, when it has one) the journal of `to`, so
+/// a table saved under another name keeps its whole record.
+///
+/// # Errors
+/// Reading the journal or its base, or writing the copies; the messages name the files.
+pub fn copy(from: &Path, to: &Path) -> anyhow::Result<()> {
+    let source = journal_path(from);
+    let text = crate::input_file::read_text_bounded(
+        &source,
+        crate::input_file::MAX_SIDE_FILE_BYTES,
+        "an edit journal",
+    )
+    .with_context(|| format!("{}: cannot read the edit journal", source.display()))?;
+    let base = base_path(from);
+    if base.exists() {
+        LookupTable::load(&base)?.save(&base_path(to))?;
+    }
+    let target = journal_path(to);
+    crate::atomic_file::write_atomic(&target, text.as_bytes())
+        .with_context(|| format!("{}: cannot write the edit journal", target.display()))
+}
+
 /// What replaying a journal gives.
 #[derive(Debug)]
 pub struct Replay {
@@ -141,18 +163,64 @@ pub struct Replayed {
 }
 
 /// Replays journal entries (after the start line) onto `lut`, rebuilding the undo history.
+///
+/// A journal whose oldest edits the history's bound drops is replayed from its last whole-table
+/// edit that the bound surely drops ([`settled_start`]): the table after that edit is the same
+/// whatever came before it, and nothing before it can be undone, so the edits before it are
+/// counted as dropped without being applied (40 whole-table edits of an 8-bit table: 17 passes
+/// over the table instead of 40).
 #[must_use]
 pub fn replay_onto(
     lut: &mut LookupTable,
     entries: impl IntoIterator<Item = JournalEntry>,
     name: &str,
 ) -> Replayed {
-    let mut history = EditHistory::default();
-    let (mut commits, mut warnings) = (0, Vec::new());
-    for e in entries {
+    replay_bounded(
+        lut,
+        entries.into_iter().collect(),
+        name,
+        EditHistory::default(),
+    )
+}
+
+/// [`replay_onto`] into `history` (empty, with its bound).
+fn replay_bounded(
+    lut: &mut LookupTable,
+    entries: Vec<JournalEntry>,
+    name: &str,
+    history: EditHistory,
+) -> Replayed {
+    let start = settled_start(lut, &entries, history.max_bytes()).unwrap_or(0);
+    if start == 0 {
+        return replay_from(lut, &entries, 0, name, history);
+    }
+    let before = lut.clone();
+    let fresh = EditHistory::new(history.max_bytes());
+    let replayed = replay_from(lut, &entries, start, name, history);
+    // The edit replay began with was dropped, so nothing applied before it mattered. Were it
+    // kept (the bound's arithmetic and `settled_start` disagreeing), replay it all.
+    if replayed.history.dropped() > start {
+        return replayed;
+    }
+    *lut = before;
+    replay_from(lut, &entries, 0, name, fresh)
+}
+
+/// Replays `entries[start..]` into `history`; the `start` entries before, all commits, are
+/// counted as commits and as dropped steps.
+fn replay_from(
+    lut: &mut LookupTable,
+    entries: &[JournalEntry],
+    start: usize,
+    name: &str,
+    mut history: EditHistory,
+) -> Replayed {
+    history.note_dropped(start);
+    let (mut commits, mut warnings) = (start, Vec::new());
+    for e in entries.iter().skip(start) {
         match e {
             JournalEntry::Commit { record } => {
-                history.commit(lut, record);
+                history.commit(lut, record.clone());
                 commits += 1;
             }
             JournalEntry::Undo { .. } => {
@@ -178,6 +246,59 @@ pub fn replay_onto(
         commits,
         warnings,
     }
+}
+
+/// Where a replay may begin: the last commit that writes the whole table, when every entry
+/// before it is a commit (so all of them are dropped before it, none undone) and the undo
+/// history bounded by `max_bytes` surely drops it. `None` when there is none.
+fn settled_start(lut: &LookupTable, entries: &[JournalEntry], max_bytes: usize) -> Option<usize> {
+    let commits_first = entries
+        .iter()
+        .position(|e| !matches!(e, JournalEntry::Commit { .. }))
+        .unwrap_or(entries.len());
+    (1..commits_first).rev().find(|&j| {
+        matches!(&entries[j], JournalEntry::Commit { record } if record.covers_table(lut))
+            && surely_dropped(lut, entries, j, max_bytes)
+    })
+}
+
+/// Whether the step of the commit `entries[j]` is dropped by a history bounded by `max_bytes`
+/// before anything undoes it, whatever the steps before it held: the steps after it are
+/// followed with the fewest bytes each can hold ([`EditRecord::least_held_bytes`]); a history
+/// drops its oldest steps first, so once the steps from `j` on hold more than the bound with
+/// one above `j`'s, everything before it and then `j`'s step go. An undo that would reach
+/// `j`'s step first gives `false`.
+fn surely_dropped(lut: &LookupTable, entries: &[JournalEntry], j: usize, max_bytes: usize) -> bool {
+    let Some(JournalEntry::Commit { record }) = entries.get(j) else {
+        return false;
+    };
+    let mut bytes = record.least_held_bytes(lut);
+    // The fewest bytes of each undo step above `j`'s, and of each redo step.
+    let (mut above, mut redo) = (Vec::new(), Vec::<usize>::new());
+    for e in &entries[j + 1..] {
+        match e {
+            JournalEntry::Commit { record } => {
+                bytes -= redo.drain(..).sum::<usize>();
+                let b = record.least_held_bytes(lut);
+                above.push(b);
+                bytes += b;
+            }
+            JournalEntry::Undo { .. } => match above.pop() {
+                Some(b) => redo.push(b),
+                None => return false,
+            },
+            JournalEntry::Redo { .. } => {
+                if let Some(b) = redo.pop() {
+                    above.push(b);
+                }
+            }
+            JournalEntry::Start { .. } => {}
+        }
+        if bytes > max_bytes && !above.is_empty() {
+            return true;
+        }
+    }
+    false
 }
 
 /// Reads the journal of `table` and replays it onto its starting table.
@@ -274,6 +395,121 @@ mod tests {
             r.table.class_counts()[ColourClass::Green.code() as usize],
             r.table.cells().len()
         );
+    }
+
+    fn small_edit(class: ColourClass, i: u8) -> JournalEntry {
+        JournalEntry::Commit {
+            record: EditRecord {
+                class,
+                region: Region::AroundSample {
+                    sample: Yuv::new(i.wrapping_mul(37), i.wrapping_mul(11), 200),
+                    sensitivity: Sensitivity::uniform(2),
+                },
+                time_unix_ms: 0,
+                sampled_at: None,
+            },
+        }
+    }
+
+    fn picked(class: ColourClass, first: usize) -> JournalEntry {
+        JournalEntry::Commit {
+            record: EditRecord {
+                class,
+                region: Region::Cells {
+                    indices: vec![first, first + 1, first + 4096],
+                },
+                time_unix_ms: 0,
+                sampled_at: None,
+            },
+        }
+    }
+
+    /// Replays `entries` onto a fresh 6-bit table both ways (from the start, and from where
+    /// `settled_start` says) with a history of `max_bytes`, and holds the two to the same
+    /// table, steps, bytes and drops, and the same tables after every undo and redo that
+    /// follows. Returns where the fast replay began.
+    fn assert_replays_alike(entries: &[JournalEntry], max_bytes: usize) -> usize {
+        let base = LookupTable::new(6).expect("6 bits");
+        let (mut full_lut, mut fast_lut) = (base.clone(), base.clone());
+        let full = replay_from(&mut full_lut, entries, 0, "j", EditHistory::new(max_bytes));
+        let fast = replay_bounded(
+            &mut fast_lut,
+            entries.to_vec(),
+            "j",
+            EditHistory::new(max_bytes),
+        );
+        let start = settled_start(&base, entries, max_bytes).unwrap_or(0);
+        let (mut a, mut b) = (full.history, fast.history);
+        assert!(full_lut == fast_lut, "tables differ (start {start})");
+        assert_eq!(
+            (
+                a.undo_len(),
+                a.redo_len(),
+                a.dropped(),
+                a.held_bytes(),
+                full.commits
+            ),
+            (
+                b.undo_len(),
+                b.redo_len(),
+                b.dropped(),
+                b.held_bytes(),
+                fast.commits
+            ),
+            "start {start}"
+        );
+        assert_eq!(full.warnings, fast.warnings);
+        while a.undo(&mut full_lut).is_some() {
+            assert!(b.undo(&mut fast_lut).is_some());
+            assert!(full_lut == fast_lut, "after an undo (start {start})");
+        }
+        assert!(b.undo(&mut fast_lut).is_none());
+        while a.redo(&mut full_lut).is_some() {
+            assert!(b.redo(&mut fast_lut).is_some());
+            assert!(full_lut == fast_lut, "after a redo (start {start})");
+        }
+        start
+    }
+
+    #[test]
+    fn replaying_from_the_last_dropped_whole_table_edit_gives_what_replaying_all_gives() {
+        use ColourClass::{Green, Orange, White, Yellow};
+        // A 6-bit table's whole-table step holds 256 KiB: a 1 MiB history keeps three of them.
+        let bound = 1 << 20;
+        let wholes = |n: usize| -> Vec<JournalEntry> {
+            (0..n)
+                .map(|i| whole_table([Orange, Green, Yellow][i % 3]))
+                .collect()
+        };
+        // Only whole-table edits: begun at the eighth of twelve, the rest counted as dropped.
+        let start = assert_replays_alike(&wholes(12), bound);
+        assert!(start >= 7, "{start}");
+        // Small edits, picked cells, undos and redos after them, and more whole-table edits.
+        let mut mixed = wholes(8);
+        mixed.extend([small_edit(White, 1), picked(Yellow, 77)]);
+        mixed.extend([
+            JournalEntry::Undo { time_unix_ms: 0 },
+            small_edit(Orange, 2),
+        ]);
+        mixed.extend(wholes(2));
+        mixed.extend([
+            JournalEntry::Undo { time_unix_ms: 0 },
+            JournalEntry::Undo { time_unix_ms: 0 },
+            JournalEntry::Redo { time_unix_ms: 0 },
+            picked(Green, 9000),
+        ]);
+        assert!(assert_replays_alike(&mixed, bound) > 0);
+        // Undone far enough to reach every whole-table edit the bound keeps: the replay
+        // begins earlier (or at the start) and still gives the same.
+        let mut undone = wholes(9);
+        undone.extend((0..7).map(|_| JournalEntry::Undo { time_unix_ms: 0 }));
+        assert_replays_alike(&undone, bound);
+        // An undo line before the whole-table edits: replayed from the start.
+        let mut early_undo = vec![small_edit(White, 3), JournalEntry::Undo { time_unix_ms: 0 }];
+        early_undo.extend(wholes(10));
+        assert_eq!(assert_replays_alike(&early_undo, bound), 0);
+        // Nothing dropped: from the start.
+        assert_eq!(assert_replays_alike(&wholes(3), bound), 0);
     }
 
     #[test]

@@ -3,7 +3,10 @@
 //! frames or a stream. Its boxes are drawn over each frame by class, recognition is scored
 //! against them frame by frame as `eotn eval --labels` scores it (`crate::eval::ball_boxes`, a
 //! few frames per UI frame), the missed and false frames become events to step between, and the
-//! report's figures are shown by the Events and bookmarks window. No egui here.
+//! report's figures are shown by the Events and bookmarks window. The scoring follows the table
+//! and parameters in use: an edit, an undo or a changed parameter starts it again, so the
+//! figures answer "what did that click do?" while a table is made. A split
+//! ([`Split::Tuning`] or [`Split::HeldOut`]) scores only its frames. No egui here.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -14,7 +17,7 @@ use super::Workspace;
 use super::bookmarks::{Event, EventKind};
 use super::source::Source;
 use crate::eval::ball_boxes::{BoxFrameEval, BoxReport, BoxScoring, evaluate_box_frame};
-use crate::eval::label_sets::{FrameBoxes, LabelSet, ReadOptions, file_stem};
+use crate::eval::label_sets::{FrameBoxes, LabelSet, ReadOptions, Split, file_stem};
 use crate::lut::LookupTable;
 use crate::pipeline::{Pipeline, PipelineParams};
 
@@ -26,7 +29,12 @@ pub struct OpenLabels {
     set: LabelSet,
     /// The label set's name of each source frame (its file's stem, or its index).
     names: Vec<String>,
+    /// Which frames are scored.
+    split: Split,
+    /// The table and parameters scored with: a copy of the workspace's, renewed when they change.
     pipeline: Pipeline,
+    /// The workspace's table generation the copy was taken at.
+    table_generation: u64,
     /// Next frame to score.
     next: usize,
     /// Scored frames: source index and how it went, in frame order.
@@ -42,6 +50,7 @@ impl OpenLabels {
         src: &Source,
         lut: &LookupTable,
         params: PipelineParams,
+        table_generation: u64,
     ) -> Self {
         let files = src.paths();
         let names = (0..src.len())
@@ -54,14 +63,38 @@ impl OpenLabels {
             path: path.to_owned(),
             set,
             names,
+            split: Split::All,
             pipeline: Pipeline::new(lut.clone(), params),
+            table_generation,
             next: 0,
             scored: Vec::new(),
         }
     }
 
-    /// The set's key of source frame `index`, if that frame is labelled.
+    /// Which frames are scored.
+    #[must_use]
+    pub const fn split(&self) -> Split {
+        self.split
+    }
+
+    /// Scores again from the first frame, with `lut` and `params` when given.
+    fn restart(&mut self, with: Option<(&LookupTable, PipelineParams, u64)>) {
+        if let Some((lut, params, generation)) = with {
+            self.pipeline.set_lut(lut.clone());
+            self.pipeline.set_params(params);
+            self.table_generation = generation;
+        }
+        self.next = 0;
+        self.scored.clear();
+    }
+
+    /// The set's key of source frame `index`, if that frame is labelled and in the split.
     fn key(&self, index: usize) -> Option<String> {
+        self.labelled_key(index).filter(|k| self.split.takes(k))
+    }
+
+    /// The set's key of source frame `index`, if that frame is labelled (whatever the split).
+    fn labelled_key(&self, index: usize) -> Option<String> {
         let name = self.names.get(index)?;
         if self.set.frames.contains_key(name) {
             return Some(name.clone());
@@ -78,7 +111,8 @@ impl OpenLabels {
     /// frame is not labelled.
     #[must_use]
     pub fn boxes(&self, index: usize, width: usize, height: usize) -> Option<FrameBoxes> {
-        self.set.frame_in_pixels(&self.key(index)?, width, height)
+        self.set
+            .frame_in_pixels(&self.labelled_key(index)?, width, height)
     }
 
     /// True when every frame was scored.
@@ -179,7 +213,14 @@ impl Workspace {
             .context("open the frames first, then their labels")?;
         let set = LabelSet::load(path, &ReadOptions::default())?;
         let warnings = set.warnings.clone();
-        let labels = OpenLabels::new(path, set, src, self.pipeline.lut(), *self.pipeline.params());
+        let labels = OpenLabels::new(
+            path,
+            set,
+            src,
+            self.pipeline.lut(),
+            *self.pipeline.params(),
+            self.table_generation,
+        );
         let labelled = (0..src.len()).filter(|&i| labels.key(i).is_some()).count();
         anyhow::ensure!(
             labelled > 0,
@@ -200,11 +241,34 @@ impl Workspace {
         Ok(())
     }
 
-    /// Advances the label scoring (called from [`Workspace::tick`]).
+    /// Scores only the frames of `split` (the held-out frames, numbers ending in 7, 8 or 9, or
+    /// the others), from the first frame again.
+    pub(super) fn set_labels_split(&mut self, split: Split) -> anyhow::Result<()> {
+        let labels = self.labels.as_mut().context("no labels open")?;
+        labels.split = split;
+        labels.restart(None);
+        let n = (0..labels.names.len())
+            .filter(|&i| labels.key(i).is_some())
+            .count();
+        self.status = format!("labels: scoring {n} labelled frames ({split:?})");
+        Ok(())
+    }
+
+    /// Advances the label scoring (called from [`Workspace::tick`]), first starting it again
+    /// when the table or the parameters changed since it began.
     pub(super) fn tick_labels(&mut self) {
         let (Some(src), Some(labels)) = (self.source.as_mut(), self.labels.as_mut()) else {
             return;
         };
+        if labels.table_generation != self.table_generation
+            || labels.pipeline.params() != self.pipeline.params()
+        {
+            labels.restart(Some((
+                self.pipeline.lut(),
+                *self.pipeline.params(),
+                self.table_generation,
+            )));
+        }
         if labels.done() {
             return;
         }
@@ -229,19 +293,16 @@ impl Workspace {
 }
 
 #[cfg(test)]
-mod tests {
-    use std::time::Duration;
+mod tests_support {
+    use std::path::Path;
 
-    use super::*;
     use crate::frame::save_rgb_png;
-    use crate::lut::{ColourClass, Sensitivity};
-    use crate::workspace::{Command, HintsCommand, TableCommand};
 
-    const W: usize = 96;
-    const H: usize = 72;
+    pub const W: usize = 96;
+    pub const H: usize = 72;
 
     /// Green carpet, with an orange disc of radius 6 px at (cx, cy) when given.
-    fn frame(path: &Path, ball: Option<(f64, f64)>) {
+    pub fn frame(path: &Path, ball: Option<(f64, f64)>) {
         let mut rgb = Vec::with_capacity(W * H * 3);
         for i in 0..W * H {
             let (x, y) = ((i % W) as f64 + 0.5, (i / W) as f64 + 0.5);
@@ -253,6 +314,17 @@ mod tests {
         }
         save_rgb_png(path, W, H, &rgb).unwrap();
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::time::Duration;
+
+    use super::*;
+    use crate::lut::{ColourClass, Sensitivity};
+    use crate::workspace::{Command, HintsCommand, TableCommand};
+
+    use super::tests_support::{H, W, frame};
 
     #[test]
     fn labels_over_frames_draw_score_and_mark_missed_and_false_frames() {
@@ -336,5 +408,96 @@ mod tests {
             ws.apply(HintsCommand::JumpToMark { forward: true }.into())
                 .is_err()
         );
+    }
+}
+
+#[cfg(test)]
+mod follow_tests {
+    use std::time::Duration;
+
+    use super::tests_support::frame;
+    use super::*;
+    use crate::lut::{ColourClass, Sensitivity};
+    use crate::workspace::{Command, ParamsCommand, TableCommand};
+
+    fn score_all(ws: &mut Workspace) -> BoxReport {
+        for _ in 0..100 {
+            ws.tick(Duration::ZERO);
+            if ws.labels().is_some_and(OpenLabels::done) {
+                break;
+            }
+        }
+        let labels = ws.labels().expect("labels open");
+        assert!(labels.done());
+        labels.report()
+    }
+
+    /// The scoring follows the table and the parameters in use (not a copy taken at open),
+    /// and scores only the chosen split.
+    #[test]
+    fn labels_are_scored_again_after_an_edit_an_undo_or_a_parameter_and_by_split() {
+        let dir = tempfile::tempdir().unwrap();
+        let frames = dir.path().join("frames");
+        let labels = dir.path().join("labels");
+        std::fs::create_dir_all(&frames).unwrap();
+        std::fs::create_dir_all(&labels).unwrap();
+        std::fs::write(labels.join("classes.txt"), "robot\nball\ngoal\n").unwrap();
+        // A ball on every frame, labelled; 17 is a held-out frame (its number ends in 7).
+        for name in ["10", "11", "17"] {
+            frame(&frames.join(format!("{name}.png")), Some((48.0, 36.0)));
+            std::fs::write(
+                labels.join(format!("{name}.txt")),
+                "1 0.5 0.5 0.125 0.1666667\n",
+            )
+            .unwrap();
+        }
+        let mut ws = Workspace::default();
+        ws.apply(Command::Open(vec![frames])).unwrap();
+        ws.apply(TableCommand::NewTable(6).into()).unwrap();
+        ws.apply(TableCommand::SetSensitivity(Sensitivity::uniform(1)).into())
+            .unwrap();
+        ws.apply(TableCommand::SetClass(ColourClass::Green).into())
+            .unwrap();
+        ws.apply(TableCommand::Sample { x: 5, y: 5 }.into())
+            .unwrap();
+        ws.apply(TableCommand::Commit.into()).unwrap();
+        // Opened before the orange is classified: nothing is found.
+        ws.apply(Command::OpenLabels(labels)).unwrap();
+        let r = score_all(&mut ws);
+        assert_eq!((r.eligible, r.found), (3, 0));
+        // The orange click is scored at once.
+        ws.apply(TableCommand::SetClass(ColourClass::Orange).into())
+            .unwrap();
+        ws.apply(TableCommand::Sample { x: 48, y: 36 }.into())
+            .unwrap();
+        ws.apply(TableCommand::Commit.into()).unwrap();
+        let r = score_all(&mut ws);
+        assert_eq!((r.eligible, r.found, r.reported), (3, 3, 3));
+        // A parameter that drops every candidate (min_pixels above the ball's), then back.
+        ws.apply(
+            ParamsCommand::SetParamValue {
+                pointer: "/ball/min_pixels".to_owned(),
+                value: serde_json::json!(1000),
+            }
+            .into(),
+        )
+        .unwrap();
+        assert_eq!(score_all(&mut ws).found, 0);
+        ws.apply(ParamsCommand::ResetParams.into()).unwrap();
+        assert_eq!(score_all(&mut ws).found, 3);
+        // The split: held-out frames only, then the tuning frames.
+        ws.apply(Command::SetLabelsSplit(Split::HeldOut)).unwrap();
+        let r = score_all(&mut ws);
+        assert_eq!((r.frames, r.eligible, r.found), (1, 1, 1));
+        ws.apply(Command::SetLabelsSplit(Split::Tuning)).unwrap();
+        assert_eq!(score_all(&mut ws).eligible, 2);
+        // An undo is scored too.
+        ws.apply(TableCommand::Undo.into()).unwrap();
+        let r = score_all(&mut ws);
+        assert_eq!((r.eligible, r.found), (2, 0));
+        // Boxes are drawn on every labelled frame, whatever the split.
+        ws.apply(crate::workspace::PlaybackCommand::Seek(2).into())
+            .unwrap();
+        assert!(ws.shown_label_boxes().is_some());
     }
 }

@@ -29,7 +29,8 @@
 //! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
 //! | `cameras.rs` | the camera shown of a recording with several (`Command::OpenCamera`) and each camera's own table |
 //! | `side_by_side.rs` | several cameras side by side, stepped together by time, each with its own table, pipeline and results; the focused one gets the clicks |
-//! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time |
+//! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time, SSL-Vision's detections by camera |
+//! | `ssl_feed.rs` | [`SslFeed`]: SSL-Vision's detections opened beside the frames (a league log, paired by capture time, or a live address) |
 
 pub mod bookmarks;
 mod cameras;
@@ -51,6 +52,7 @@ mod robots;
 mod settings;
 mod side_by_side;
 pub mod source;
+mod ssl_feed;
 mod stream_scan;
 mod table;
 mod timings;
@@ -77,12 +79,14 @@ pub use settings::{
 };
 pub use side_by_side::CameraPane;
 pub use source::Source;
+pub use ssl_feed::SslFeed;
 pub use stream_scan::StreamScan;
 pub use table::TableSlot;
 pub use timings::{StepTiming, Timings, median};
 pub use try_edit::{TryEdit, TryEditRow};
 
 use crate::blobs::{Blob, BlobSet};
+use crate::camera::CameraId;
 use crate::classify::ClassifiedImage;
 use crate::frame::{Frame, Yuv, yuv_to_rgb};
 use crate::lut::edit::Selection;
@@ -162,9 +166,11 @@ pub struct Workspace {
     history: EditHistory,
     dirty: bool,
     source: Option<Source>,
-    /// The camera (image topic) recordings open on (`eotn open --camera`, the camera picker);
-    /// `None`: each recording's first.
-    camera: Option<String>,
+    /// The camera last picked (the camera picker, a pane focused): its recording reopens on it.
+    camera: Option<CameraId>,
+    /// The camera (image topic) other recordings open on (`eotn open --camera`); `None`: each
+    /// recording's first.
+    open_topic: Option<String>,
     index: usize,
     current: Option<SourceFrame>,
     rgb: Vec<u8>,
@@ -214,6 +220,8 @@ pub struct Workspace {
     /// the journal entries since, written as its journal when it is first saved, so the journal
     /// records from the table's first commit (`None` once the table has a file).
     unsaved_journal: Option<(LookupTable, Vec<journal::JournalEntry>)>,
+    /// SSL-Vision's detections opened beside the frames (a league log or a live address).
+    ssl_vision: Option<ssl_feed::SslFeed>,
 }
 
 impl Default for Workspace {
@@ -246,6 +254,7 @@ impl Workspace {
             dirty: false,
             source: None,
             camera: None,
+            open_topic: None,
             index: 0,
             current: None,
             rgb: Vec::new(),
@@ -278,6 +287,7 @@ impl Workspace {
             beside: side_by_side::SideBySide::default(),
             saved_undo_len: Some(0),
             unsaved_journal,
+            ssl_vision: None,
         }
     }
 
@@ -348,13 +358,14 @@ impl Workspace {
         }
         match command {
             Command::Open(paths) => self.open(paths)?,
-            Command::OpenCamera(topic) => self.open_camera(topic)?,
-            Command::ShowSideBySide(topics) => self.show_side_by_side(&topics)?,
-            Command::FocusCamera(topic) => self.focus_camera(&topic)?,
+            Command::OpenCamera(camera) => self.open_camera(camera)?,
+            Command::ShowSideBySide(cameras) => self.show_side_by_side(&cameras)?,
+            Command::FocusCamera(camera) => self.focus_camera(&camera)?,
             Command::OpenTable(p) => self.open_table(&p)?,
             Command::OpenPlaces(p) => self.open_places(&p)?,
             Command::ClosePlaces => self.close_places(),
             Command::OpenLabels(p) => self.open_labels(&p)?,
+            Command::SetLabelsSplit(split) => self.set_labels_split(split)?,
             Command::ShowWindow(w, open) => {
                 *self.window_flag(w) = open;
                 if w == Window::Inspector && !open {
@@ -383,6 +394,7 @@ impl Workspace {
             Command::Robots(c) => self.apply_robot_command(c)?,
             Command::Hints(c) => self.apply_hints(c)?,
             Command::Overhead(c) => self.apply_overhead(c)?,
+            Command::ShowSslStep(step) => self.show_ssl_step(step)?,
         }
         Ok(())
     }
@@ -740,5 +752,48 @@ mod tests {
             journal::replay(&path).unwrap().table,
             LookupTable::load(&path).unwrap()
         );
+    }
+
+    /// A table opened from a file (a seeded one, no journal yet), clicked on, then saved under
+    /// another name keeps every click in the new name's journal, which starts from the seed
+    /// (before, Save As folded the clicks into a new base copy).
+    #[test]
+    fn save_as_of_an_opened_table_keeps_its_journal_from_the_seed() {
+        let dir = tempfile::tempdir().expect("temp");
+        let seed = dir.path().join("seed.lut");
+        let mut lut = LookupTable::new(6).unwrap();
+        lut.apply(crate::lut::EditRecord::now(
+            ColourClass::Orange,
+            crate::lut::Region::Cells { indices: vec![5] },
+        ));
+        lut.save(&seed).unwrap();
+        let mut s = Workspace::default();
+        s.apply(Command::OpenTable(seed.clone())).unwrap();
+        for (class, cell) in [
+            (ColourClass::Green, [20, 12, 12]),
+            (ColourClass::White, [60, 32, 32]),
+        ] {
+            s.apply(TableCommand::SetClass(class).into()).unwrap();
+            s.apply(TableCommand::SampleCell(cell).into()).unwrap();
+            s.apply(TableCommand::Commit.into()).unwrap();
+        }
+        let path = dir.path().join("final.lut");
+        s.apply(TableCommand::SaveTableAs(path.clone()).into())
+            .unwrap();
+        let replay = journal::replay(&path).unwrap();
+        assert_eq!(replay.commits, 2);
+        assert_eq!(replay.table, LookupTable::load(&path).unwrap());
+        assert_eq!(
+            LookupTable::load(&journal::base_path(&path)).unwrap(),
+            LookupTable::load(&seed).unwrap()
+        );
+        // Later edits go to the new name's journal only.
+        s.apply(TableCommand::Undo.into()).unwrap();
+        s.apply(TableCommand::SaveTable.into()).unwrap();
+        assert_eq!(
+            journal::replay(&path).unwrap().table,
+            LookupTable::load(&path).unwrap()
+        );
+        assert_eq!(journal::replay(&seed).unwrap().commits, 2);
     }
 }

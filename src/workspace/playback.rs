@@ -47,6 +47,7 @@ impl Workspace {
     pub fn tick(&mut self, dt: Duration) {
         self.poll_live();
         self.poll_robots();
+        self.poll_ssl();
         self.scan_sensor_series();
         if let (Some(t), Some(src)) = (self.try_edit.as_mut(), self.source.as_mut()) {
             let (conn, min) = (self.settings.connectivity, self.settings.min_blob_pixels);
@@ -81,7 +82,12 @@ impl Workspace {
                 .unwrap_or(30.0);
             return Some(Duration::from_secs_f64(0.5 / rate.min(240.0)));
         }
-        let robots = self.robots_poll_due();
+        // A live SSL-Vision feed is looked at about 20 times a second.
+        let robots = self.robots_poll_due().or_else(|| {
+            self.ssl_vision()
+                .filter(|f| f.is_live())
+                .map(|_| Duration::from_millis(50))
+        });
         let player = self.source.as_ref().and_then(|src| {
             self.player
                 .next_frame_due(self.settings.speed, self.index, src)

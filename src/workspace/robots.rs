@@ -97,6 +97,9 @@ pub struct Robots {
     follow_live: bool,
     next_id: u32,
     wake: WakeSlot,
+    /// The shown robot's camera whose own files (table, parameters) were last applied: a
+    /// robot names its cameras only once connected, so they are applied when it does.
+    camera_applied: Option<crate::camera::CameraId>,
 }
 
 impl Robots {
@@ -108,6 +111,7 @@ impl Robots {
 
     fn set_shown(&mut self, id: Option<RobotId>) {
         self.shown = id;
+        self.camera_applied = None;
         for e in &self.entries {
             e.shown.store(Some(e.id) == id, Ordering::Relaxed);
         }
@@ -195,9 +199,10 @@ impl Workspace {
     /// Shows robot `id` in the views, following its newest frame; the others keep receiving.
     pub(super) fn show_robot(&mut self, id: RobotId) -> anyhow::Result<()> {
         let view = self.robots.entry(id)?.robot.frames_view();
+        self.close_side_by_side()?;
         self.disconnect_live();
         self.stop_recording_recorded();
-        self.source = Some(Source::new(Box::new(view)));
+        self.source = Some(Source::robot(view));
         self.robots.set_shown(Some(id));
         self.robots.chosen = false;
         self.robots.follow_live = true;
@@ -210,7 +215,72 @@ impl Workspace {
         self.frame_generation += 1;
         self.status = format!("showing {}", self.connected_label());
         self.follow_newest();
+        self.apply_robot_camera_files();
         Ok(())
+    }
+
+    /// Shows another camera of the shown robot (`source`: its frames), following its newest
+    /// frame when the robot was followed live.
+    pub(super) fn show_robot_camera(&mut self, source: Source) -> anyhow::Result<()> {
+        anyhow::ensure!(self.robots.shown.is_some(), "no robot shown");
+        self.close_side_by_side()?;
+        let total = source.len();
+        self.robots.camera_applied = source.camera_id();
+        self.source = Some(source);
+        self.try_edit = None;
+        self.current = None;
+        self.selection = None;
+        self.sensor_series = super::SensorSeries {
+            total,
+            ..super::SensorSeries::default()
+        };
+        self.frame_generation += 1;
+        if self.robots.follow_live {
+            self.follow_newest();
+        }
+        Ok(())
+    }
+
+    /// The camera now shown (focused side by side) came with its own table and parameters:
+    /// nothing is to be applied for it.
+    pub(super) fn robot_camera_shown(&mut self) {
+        if self.robots.shown.is_some() {
+            self.robots.camera_applied = self.source.as_ref().and_then(Source::camera_id);
+        }
+    }
+
+    /// Once the shown robot names its camera: that camera's own table and parameters, as
+    /// remembered for it (a table with unsaved edits is kept, said as a warning).
+    fn apply_robot_camera_files(&mut self) {
+        let Some(id) = self
+            .source
+            .as_ref()
+            .filter(|s| s.robot_frames().is_some())
+            .and_then(Source::camera_id)
+        else {
+            return;
+        };
+        if self.robots.camera_applied.as_ref() == Some(&id) {
+            return;
+        }
+        self.robots.camera_applied = Some(id.clone());
+        let files = self.camera_files(&id);
+        if let Some(t) = &files.lut
+            && self.table_path() != Some(t.as_path())
+        {
+            if self.dirty {
+                self.warn(format!(
+                    "camera {}: its table {} is not opened: the table shown has unsaved edits",
+                    id.topic(),
+                    crate::frame::display_name(t)
+                ));
+            } else if let Err(e) = self.open_table(t) {
+                self.warn(format!("{e:#}"));
+            }
+        }
+        if let Err(e) = self.open_camera_files(&id, &files) {
+            self.warn(format!("{e:#}"));
+        }
     }
 
     /// Disconnects robot `id`, finishing its recording; another robot is shown if it was.
@@ -394,8 +464,13 @@ impl Workspace {
             self.status = note;
         }
         self.show_a_robot_with_frames();
+        self.apply_robot_camera_files();
         if self.robots.follow_live {
             self.follow_newest();
+        }
+        if self.robots.shown.is_some() {
+            // Cameras beside the robot's shown one gain frames too.
+            self.sync_beside();
         }
         if self.robots.shown.is_some()
             && let Some(src) = &self.source
@@ -433,14 +508,15 @@ impl Workspace {
         }
     }
 
-    /// Shows the shown robot's newest frame if it is not shown yet (or has gained its sensor
-    /// readings since).
-    fn follow_newest(&mut self) {
+    /// Shows the shown robot's camera's newest frame if it is not shown yet (or has gained its
+    /// sensor readings since).
+    pub(super) fn follow_newest(&mut self) {
         let Some(latest) = self
             .robots
             .shown
-            .and_then(|id| self.robots.entry(id).ok())
-            .and_then(|e| e.robot.latest())
+            .and(self.source.as_ref())
+            .and_then(Source::robot_frames)
+            .and_then(crate::live::RobotFrames::latest)
         else {
             return;
         };

@@ -190,8 +190,10 @@ pub struct Settings {
     pub last_table: Option<PathBuf>,
     /// The overhead camera's table to reopen at start.
     pub last_overhead_table: Option<PathBuf>,
-    /// Each camera's files (table, parameters, calibration) as last used with it, by camera:
-    /// a recording's `/camera/bottom` opens with the table last used on `/camera/bottom`.
+    /// Each camera's files (table, parameters, calibration) as last used with it, by camera
+    /// (its source and image topic): a recording's `/camera/bottom` reopens with the table last
+    /// used on it. Entries an older eotn keyed by topic alone are dropped when read.
+    #[serde(deserialize_with = "crate::camera::deserialize_camera_map")]
     pub cameras: std::collections::BTreeMap<crate::camera::CameraId, crate::camera::CameraFiles>,
     /// The places file (learnt coloured patterns) to reopen at start.
     pub last_places: Option<PathBuf>,

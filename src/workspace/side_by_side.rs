@@ -1,9 +1,9 @@
-//! Several cameras of one recording side by side (issue 28): the focused camera is the
+//! Several cameras of one recording or live robot side by side (issue 28): the focused camera is the
 //! workspace's own source, table and results, so hand classification, commit, undo, save,
 //! playback and the sensors window act on it as on one camera; every other camera shown is a
 //! [`BesideCamera`] with its own source, table (file, undo history, unsaved mark) and pipeline,
 //! showing its frame nearest the shared cursor — the focused camera's frame time on the
-//! recording's clock. Focusing another camera ([`crate::workspace::Command::FocusCamera`], a
+//! recording's clock (a live robot's: the arrival clock of its frames). Focusing another camera ([`crate::workspace::Command::FocusCamera`], a
 //! click on its pane) hands the workspace that camera's source and table and keeps the one
 //! focused before as a beside camera: a table never moves from one camera to another.
 
@@ -15,6 +15,7 @@ use super::journal::JournalEntry;
 use super::params::ParamsSlot;
 use super::source::Source;
 use super::{SensorSeries, Workspace};
+use crate::camera::CameraId;
 use crate::frame::Frame;
 use crate::lut::{EditHistory, LookupTable};
 use crate::pipeline::Pipeline;
@@ -36,7 +37,7 @@ struct TableState {
 /// A camera shown beside the focused one.
 #[derive(Debug)]
 pub(super) struct BesideCamera {
-    topic: String,
+    camera: CameraId,
     source: Source,
     /// Classifies and recognises this camera's frames; holds its table and parameters.
     pipeline: Pipeline,
@@ -56,14 +57,16 @@ pub(super) struct BesideCamera {
 /// The cameras shown side by side: their order on screen and those not focused.
 #[derive(Debug, Default)]
 pub(super) struct SideBySide {
-    /// Image topics, left to right.
-    order: Vec<String>,
+    /// The cameras, left to right.
+    order: Vec<CameraId>,
     cameras: Vec<BesideCamera>,
 }
 
 /// One camera's pane, as the app draws it.
 #[derive(Debug, Clone, Copy)]
 pub struct CameraPane<'a> {
+    /// The camera.
+    pub camera: &'a CameraId,
     /// The camera's image topic.
     pub topic: &'a str,
     /// True for the focused camera (the workspace's own frame, table and selection).
@@ -101,9 +104,11 @@ impl Workspace {
         }
         let shown = self.cameras().1;
         let mut panes = Vec::new();
-        for topic in &self.beside.order {
-            if shown == Some(topic.as_str()) {
+        for camera in &self.beside.order {
+            let topic = camera.topic();
+            if shown.as_ref() == Some(camera) {
                 panes.push(CameraPane {
+                    camera,
                     topic,
                     focused: true,
                     frame: self.frame(),
@@ -118,8 +123,9 @@ impl Workspace {
                     note: None,
                     generation: self.frame_generation,
                 });
-            } else if let Some(b) = self.beside.cameras.iter().find(|c| &c.topic == topic) {
+            } else if let Some(b) = self.beside.cameras.iter().find(|c| &c.camera == camera) {
                 panes.push(CameraPane {
+                    camera,
                     topic,
                     focused: false,
                     frame: b.current.as_ref().map(|c| c.frame.as_ref()),
@@ -146,7 +152,7 @@ impl Workspace {
             .cameras
             .iter()
             .filter(|c| c.table.dirty)
-            .map(|c| c.topic.as_str())
+            .map(|c| c.camera.topic())
             .collect()
     }
 
@@ -156,12 +162,12 @@ impl Workspace {
         Some(src.start_ns().saturating_add(src.time_ns(self.index)))
     }
 
-    /// Shows `topics` side by side (fewer than two: one camera again).
-    pub(super) fn show_side_by_side(&mut self, topics: &[String]) -> anyhow::Result<()> {
-        let mut wanted: Vec<String> = Vec::new();
-        for t in topics {
-            if !wanted.contains(t) {
-                wanted.push(t.clone());
+    /// Shows `cameras` side by side (fewer than two: one camera again).
+    pub(super) fn show_side_by_side(&mut self, cameras: &[CameraId]) -> anyhow::Result<()> {
+        let mut wanted: Vec<CameraId> = Vec::new();
+        for c in cameras {
+            if !wanted.contains(c) {
+                wanted.push(c.clone());
             }
         }
         if wanted.len() < 2 {
@@ -170,60 +176,78 @@ impl Workspace {
             self.status = "one camera shown".to_owned();
             return Ok(());
         }
-        let src = self.source.as_ref().context("no recording is open")?;
-        let path = src
-            .paths()
-            .into_iter()
-            .next()
-            .filter(|_| src.is_stream())
-            .context("the source is not a recording: it has no cameras to show side by side")?;
-        let cameras = src.cameras().to_vec();
-        if let Some(t) = wanted.iter().find(|t| !cameras.contains(t)) {
+        let src = self
+            .source
+            .as_ref()
+            .context("no recording or robot is shown")?;
+        let all = src.camera_ids();
+        anyhow::ensure!(
+            !all.is_empty(),
+            "the source is not a recording or robot: it has no cameras to show side by side"
+        );
+        if let Some(c) = wanted.iter().find(|c| !all.contains(c)) {
             anyhow::bail!(
-                "camera {t} is not in {}: its cameras are {}",
-                crate::frame::display_name(&path),
-                cameras.join(", ")
+                "camera {} is not in {}: its cameras are {}",
+                c.topic(),
+                src.label(),
+                src.cameras().join(", ")
             );
         }
-        self.refuse_unsaved_beside(|c| !wanted.contains(&c.topic))?;
-        let shown = src.camera().map(str::to_owned);
+        self.refuse_unsaved_beside(|c| !wanted.contains(&c.camera))?;
+        let shown = src.camera_id();
         if shown.as_ref().is_none_or(|s| !wanted.contains(s)) {
             anyhow::ensure!(
                 !self.dirty,
                 "the table of camera {} has unsaved edits: save it before it leaves the view",
-                shown.as_deref().unwrap_or("?")
+                shown.as_ref().map_or("?", CameraId::topic)
             );
             self.beside = SideBySide::default();
             self.open_camera(wanted.first().cloned())?;
         }
-        let shown = self.cameras().1.map(str::to_owned);
+        let shown = self.cameras().1;
         let mut kept = std::mem::take(&mut self.beside.cameras);
-        kept.retain(|c| wanted.contains(&c.topic));
-        for topic in &wanted {
-            if shown.as_ref() != Some(topic) && !kept.iter().any(|c| &c.topic == topic) {
-                kept.push(self.open_beside(&path, topic)?);
+        kept.retain(|c| wanted.contains(&c.camera));
+        for camera in &wanted {
+            if shown.as_ref() != Some(camera) && !kept.iter().any(|c| &c.camera == camera) {
+                kept.push(self.open_beside(camera)?);
             }
         }
+        let names: Vec<&str> = wanted.iter().map(CameraId::topic).collect();
+        self.status = format!(
+            "cameras side by side: {}; {} focused (clicks and edits go to its table)",
+            names.join(", "),
+            shown.as_ref().map_or("?", CameraId::topic)
+        );
         self.beside = SideBySide {
             order: wanted,
             cameras: kept,
         };
         self.sync_beside();
-        self.status = format!(
-            "cameras side by side: {}; {} focused (clicks and edits go to its table)",
-            self.beside.order.join(", "),
-            shown.as_deref().unwrap_or("?")
-        );
         Ok(())
     }
 
-    /// Camera `topic` of `recording`, opened beside the focused one with its own table (the
-    /// one used with it before, else the one the recording names, else a new empty table —
-    /// never the table of another camera).
-    fn open_beside(&mut self, recording: &Path, topic: &str) -> anyhow::Result<BesideCamera> {
-        let source = Source::stream_camera(recording, Some(topic))?;
+    /// Camera `camera` of the source shown, opened beside the focused one with its own table
+    /// (the one used with it before, else the one the recording names, else a new empty table
+    /// — never the table of another camera).
+    fn open_beside(&mut self, camera: &CameraId) -> anyhow::Result<BesideCamera> {
+        let src = self
+            .source
+            .as_ref()
+            .context("no recording or robot is shown")?;
+        let topic = camera.topic();
+        let source = match src.robot_frames() {
+            Some(robot) => Source::robot(robot.camera_view(topic)),
+            None => {
+                let path = src
+                    .paths()
+                    .into_iter()
+                    .next()
+                    .context("no recording is open")?;
+                Source::stream_camera(&path, Some(topic))?
+            }
+        };
         let bits = self.pipeline.lut().bits();
-        let files = self.camera_files(recording, Some(topic));
+        let files = self.camera_files(camera);
         let own = files
             .lut
             .clone()
@@ -255,7 +279,7 @@ impl Workspace {
             loaded: self.params_slot().loaded,
             ..ParamsSlot::default()
         };
-        if let Some(p) = self.camera_params(recording, &files) {
+        if let Some(p) = self.camera_params(camera, &files) {
             let own = params_file::load(&p)
                 .with_context(|| format!("camera {topic}: its parameters {}", p.display()))?;
             params.recognition = own;
@@ -263,7 +287,7 @@ impl Workspace {
             slot.path = Some(p);
         }
         Ok(BesideCamera {
-            topic: topic.to_owned(),
+            camera: camera.clone(),
             source,
             params: slot,
             pipeline: Pipeline::new(lut, params),
@@ -287,7 +311,7 @@ impl Workspace {
         {
             anyhow::bail!(
                 "the table of camera {} has unsaved edits: focus it and save (or undo) before it leaves the view",
-                c.topic
+                c.camera.topic()
             );
         }
         Ok(())
@@ -300,13 +324,14 @@ impl Workspace {
         Ok(())
     }
 
-    /// Makes camera `topic` (shown side by side) the focused one: the workspace takes its
+    /// Makes camera `camera` (shown side by side) the focused one: the workspace takes its
     /// source and table, the camera focused so far keeps its own as a beside camera.
-    pub(super) fn focus_camera(&mut self, topic: &str) -> anyhow::Result<()> {
-        if self.cameras().1 == Some(topic) {
+    pub(super) fn focus_camera(&mut self, camera: &CameraId) -> anyhow::Result<()> {
+        if self.cameras().1.as_ref() == Some(camera) {
             return Ok(());
         }
-        let Some(pos) = self.beside.cameras.iter().position(|c| c.topic == topic) else {
+        let topic = camera.topic();
+        let Some(pos) = self.beside.cameras.iter().position(|c| &c.camera == camera) else {
             anyhow::bail!("camera {topic} is not shown side by side");
         };
         let cursor = self.cursor_ns().unwrap_or(0);
@@ -325,12 +350,14 @@ impl Workspace {
         std::mem::swap(&mut self.dirty, &mut b.table.dirty);
         std::mem::swap(&mut self.saved_undo_len, &mut b.table.saved_undo_len);
         std::mem::swap(&mut self.unsaved_journal, &mut b.table.unsaved_journal);
-        b.topic = b.source.camera().unwrap_or_default().to_owned();
+        if let Some(id) = b.source.camera_id() {
+            b.camera = id;
+        }
         // Its results are of the other camera's frame: shown again at the next sync.
         b.current = None;
         let index = nearest_index(src, cursor);
         let total = src.len();
-        self.camera = Some(topic.to_owned());
+        self.camera = Some(camera.clone());
         self.current = None;
         self.selection = None;
         self.try_edit = None;
@@ -340,6 +367,7 @@ impl Workspace {
             ..SensorSeries::default()
         };
         self.table_changed();
+        self.robot_camera_shown();
         self.seek(index)?;
         let table = self.table_path.as_deref().map_or_else(
             || "a table without a file".to_owned(),
@@ -360,7 +388,7 @@ impl Workspace {
         let mut warnings = Vec::new();
         for b in &mut self.beside.cameras {
             if let Err(e) = b.show_at(cursor, &mut warnings) {
-                warnings.push(format!("camera {}: {e}", b.topic));
+                warnings.push(format!("camera {}: {e}", b.camera.topic()));
             }
         }
         for w in warnings {
@@ -384,7 +412,7 @@ impl BesideCamera {
         if let Some(w) = self
             .current
             .as_ref()
-            .and_then(|old| size_change(&self.topic, &old.frame, &loaded.frame, index))
+            .and_then(|old| size_change(self.camera.topic(), &old.frame, &loaded.frame, index))
         {
             warnings.push(w);
         }
@@ -403,7 +431,7 @@ impl BesideCamera {
 }
 
 /// The frame of `source` nearest `cursor` (ns on the recording's clock).
-fn nearest_index(source: &Source, cursor: u64) -> usize {
+pub(super) fn nearest_index(source: &Source, cursor: u64) -> usize {
     let rel = cursor.saturating_sub(source.start_ns());
     let i = source.index_at_time(rel);
     let next = (i + 1).min(source.len().saturating_sub(1));

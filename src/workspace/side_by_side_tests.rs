@@ -2,6 +2,7 @@ use crate::camera::CameraFiles;
 use crate::frame::{Frame, Yuv};
 use crate::lut::{ColourClass, LookupTable};
 use crate::streams::{FrameRecord, StreamInfo, StreamWriter};
+use crate::workspace::cameras::tests::{cam, cams, shown};
 use crate::workspace::{Command, PlaybackCommand, Settings, TableCommand, Workspace};
 
 const MS: u64 = 1_000_000;
@@ -49,10 +50,10 @@ fn side_by_side(dir: &std::path::Path) -> Workspace {
     let mut ws = Workspace::new(Settings::default());
     ws.apply(Command::Open(vec![rec, dir.join("top.lut")]))
         .unwrap();
-    ws.apply(Command::ShowSideBySide(vec![
-        "/camera/image".into(),
-        "/camera/bottom".into(),
-    ]))
+    ws.apply(Command::ShowSideBySide(cams(
+        &ws,
+        &["/camera/image", "/camera/bottom"],
+    )))
     .unwrap();
     ws
 }
@@ -106,9 +107,9 @@ fn an_edit_goes_to_the_focused_camera_s_table_only() {
     let mut ws = side_by_side(dir.path());
     let top_before = ws.camera_panes()[0].lut.clone();
     // A click on the bottom camera's pane focuses it, then samples there.
-    ws.apply(Command::FocusCamera("/camera/bottom".into()))
+    ws.apply(Command::FocusCamera(cam(&ws, "/camera/bottom")))
         .unwrap();
-    assert_eq!(ws.cameras().1, Some("/camera/bottom"));
+    assert_eq!(shown(&ws), Some("/camera/bottom".to_owned()));
     assert_eq!(
         ws.table_path().map(crate::frame::display_name).as_deref(),
         Some("bottom.lut")
@@ -133,7 +134,7 @@ fn an_edit_goes_to_the_focused_camera_s_table_only() {
     );
     assert!(panes[1].dirty && !panes[0].dirty);
     // Focus moves back: the top camera's own table, the bottom's edit kept beside it.
-    ws.apply(Command::FocusCamera("/camera/image".into()))
+    ws.apply(Command::FocusCamera(cam(&ws, "/camera/image")))
         .unwrap();
     assert_eq!(ws.lut(), &top_before);
     assert_eq!(ws.unsaved_beside(), ["/camera/bottom"]);
@@ -146,7 +147,7 @@ fn an_edit_goes_to_the_focused_camera_s_table_only() {
     );
     assert_eq!(ws.camera_panes().len(), 2, "still side by side");
     // Saved through its own focus, the bottom table's file has the edit, top.lut not.
-    ws.apply(Command::OpenCamera(Some("/camera/bottom".into())))
+    ws.apply(Command::OpenCamera(Some(cam(&ws, "/camera/bottom"))))
         .unwrap();
     ws.apply(TableCommand::SaveTable.into()).unwrap();
     let saved = LookupTable::load(&dir.path().join("bottom.lut")).unwrap();
@@ -170,11 +171,11 @@ fn each_camera_side_by_side_recognises_with_its_own_parameters() {
             .collect()
     };
     assert_eq!(named(&ws), [None, Some("bottom.json".to_owned())]);
-    ws.apply(Command::FocusCamera("/camera/bottom".into()))
+    ws.apply(Command::FocusCamera(cam(&ws, "/camera/bottom")))
         .unwrap();
     assert_eq!(ws.recognition_params().ball.min_pixels, 77, "its own set");
     assert_eq!(named(&ws), [None, Some("bottom.json".to_owned())]);
-    ws.apply(Command::FocusCamera("/camera/image".into()))
+    ws.apply(Command::FocusCamera(cam(&ws, "/camera/image")))
         .unwrap();
     assert_eq!(ws.recognition_params().ball.min_pixels, default_min);
 }
@@ -187,10 +188,10 @@ fn a_camera_without_a_table_of_its_own_gets_an_empty_one_not_another_s() {
     let mut ws = Workspace::new(Settings::default());
     ws.apply(Command::Open(vec![rec, dir.path().join("top.lut")]))
         .unwrap();
-    ws.run(Command::ShowSideBySide(vec![
-        "/camera/image".into(),
-        "/camera/bottom".into(),
-    ]));
+    ws.run(Command::ShowSideBySide(cams(
+        &ws,
+        &["/camera/image", "/camera/bottom"],
+    )));
     let panes = ws.camera_panes();
     assert_eq!(panes.len(), 2, "{:?}", ws.warnings());
     assert_eq!(panes[1].codes[0], 0, "unclassified by an empty table");
@@ -209,20 +210,20 @@ fn unknown_cameras_and_sources_without_cameras_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let mut ws = side_by_side(dir.path());
     let e = ws
-        .apply(Command::ShowSideBySide(vec![
-            "/camera/image".into(),
-            "/camera/side".into(),
-        ]))
+        .apply(Command::ShowSideBySide(cams(
+            &ws,
+            &["/camera/image", "/camera/side"],
+        )))
         .unwrap_err();
     let text = format!("{e:#}");
     assert!(text.contains("/camera/image, /camera/bottom"), "{text}");
     assert_eq!(ws.camera_panes().len(), 2, "unchanged");
-    let e = ws.apply(Command::FocusCamera("/camera/side".into()));
+    let e = ws.apply(Command::FocusCamera(cam(&ws, "/camera/side")));
     assert!(e.is_err());
     let mut empty = Workspace::new(Settings::default());
     assert!(
         empty
-            .apply(Command::ShowSideBySide(vec!["/a".into(), "/b".into()]))
+            .apply(Command::ShowSideBySide(cams(&empty, &["/a", "/b"])))
             .is_err()
     );
 }
@@ -242,10 +243,10 @@ fn a_frame_size_change_is_a_warning_line_and_each_frame_is_shown_as_it_is() {
     w.finish().unwrap();
     let mut ws = Workspace::new(Settings::default());
     ws.apply(Command::Open(vec![p])).unwrap();
-    ws.run(Command::ShowSideBySide(vec![
-        "/camera/image".into(),
-        "/camera/bottom".into(),
-    ]));
+    ws.run(Command::ShowSideBySide(cams(
+        &ws,
+        &["/camera/image", "/camera/bottom"],
+    )));
     ws.apply(PlaybackCommand::Seek(3).into()).unwrap();
     for pane in ws.camera_panes() {
         let f = pane.frame.unwrap();

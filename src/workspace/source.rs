@@ -5,6 +5,8 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 use super::player::Timeline;
+use crate::camera::CameraId;
+use crate::live::RobotFrames;
 use crate::sources::{
     FileSource, RecordedSource, SourceError, SourceFrame, SourceInfo, SourceKind, StreamSource,
 };
@@ -19,6 +21,10 @@ pub struct Source {
     /// A recording's camera shown (its image topic), and every camera it has.
     camera: Option<String>,
     cameras: Vec<String>,
+    /// A recording's canonical path: with the topic, what names its cameras ([`CameraId`]).
+    canonical: Option<PathBuf>,
+    /// A live robot's camera shown: its cameras are asked for as the robot advertises them.
+    robot: Option<RobotFrames>,
     cache: VecDeque<(usize, SourceFrame)>,
     /// A recording's reader on a thread of its own, reading the frame after the one read last.
     prefetch: Option<Prefetch>,
@@ -86,9 +92,25 @@ impl Source {
             info,
             camera: None,
             cameras: Vec::new(),
+            canonical: None,
+            robot: None,
             cache: VecDeque::new(),
             prefetch: None,
         }
+    }
+
+    /// One camera of a live robot (its frames as they arrive).
+    #[must_use]
+    pub fn robot(frames: RobotFrames) -> Self {
+        let mut source = Self::new(Box::new(frames.clone()));
+        source.robot = Some(frames);
+        source
+    }
+
+    /// The live robot's camera shown, when the source is one.
+    #[must_use]
+    pub const fn robot_frames(&self) -> Option<&RobotFrames> {
+        self.robot.as_ref()
     }
 
     /// Frame files, in the given order.
@@ -119,19 +141,64 @@ impl Source {
         source.prefetch = Prefetch::start(path, shown.as_deref());
         source.camera = shown;
         source.cameras = cameras;
+        source.canonical = Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
         Ok(source)
     }
 
-    /// The recording's camera shown (its image topic); `None` for frame files and live sources.
+    /// The camera shown (its image topic): a recording's or a live robot's; `None` for frame
+    /// files and a robot that has not advertised a camera yet.
     #[must_use]
-    pub fn camera(&self) -> Option<&str> {
-        self.camera.as_deref()
+    pub fn camera(&self) -> Option<String> {
+        match &self.robot {
+            Some(r) => r.camera(),
+            None => self.camera.clone(),
+        }
     }
 
-    /// Every camera of the recording, by image topic (the camera picker's list).
+    /// Every camera of the recording or live robot, by image topic (the camera picker's list).
     #[must_use]
-    pub fn cameras(&self) -> &[String] {
-        &self.cameras
+    pub fn cameras(&self) -> Vec<String> {
+        match &self.robot {
+            Some(r) => r.cameras(),
+            None => self.cameras.clone(),
+        }
+    }
+
+    /// The camera `topic` of this source as a [`CameraId`]: a recording's robot camera, an
+    /// overhead recording's camera, a live robot's image channel; `None` for frame files.
+    #[must_use]
+    pub fn camera_id_of(&self, topic: &str) -> Option<CameraId> {
+        if let Some(r) = &self.robot {
+            return Some(CameraId::live(&r.url().to_string(), topic));
+        }
+        let path = self.canonical.as_deref()?;
+        Some(match self.info.camera {
+            crate::sources::CameraKind::Robot => CameraId::recording(path, topic),
+            crate::sources::CameraKind::Overhead => {
+                CameraId::overhead(&path.to_string_lossy(), topic)
+            }
+        })
+    }
+
+    /// The camera shown as a [`CameraId`].
+    #[must_use]
+    pub fn camera_id(&self) -> Option<CameraId> {
+        self.camera_id_of(&self.camera()?)
+    }
+
+    /// Every camera as a [`CameraId`], the picker's order.
+    #[must_use]
+    pub fn camera_ids(&self) -> Vec<CameraId> {
+        self.cameras()
+            .iter()
+            .filter_map(|t| self.camera_id_of(t))
+            .collect()
+    }
+
+    /// The recording this source was opened from (its canonical path), for a stream.
+    #[must_use]
+    pub fn recording(&self) -> Option<&Path> {
+        self.canonical.as_deref()
     }
 
     /// What it is: kind, label, camera kind, files.

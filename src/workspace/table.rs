@@ -145,10 +145,10 @@ impl Workspace {
         if moved && !journal::journal_path(path).exists() {
             // The journal follows the table. A table saved for the first time writes the edits
             // made since it was new (the journal then replays from its first commit); a table
-            // saved under another name starts one from the table as saved.
+            // saved under another name takes its journal along.
             let written = match self.unsaved_journal.take() {
                 Some((start, entries)) => journal::append(path, &start, &entries),
-                None => journal::append(path, self.pipeline.lut(), &[]),
+                None => self.carry_journal(path),
             };
             if let Err(e) = written {
                 self.warn(format!("{e:#}"));
@@ -162,6 +162,20 @@ impl Workspace {
         self.saved_undo_len = Some(self.history.undo_len());
         self.status = format!("saved {}", path.display());
         Ok(())
+    }
+
+    /// The journal of a table saved under another name (`to`): the journal it had (with the
+    /// base copy it starts from) when that replays to the table, so the new file still replays
+    /// from its first edit (a seeded table opened, clicked on, then saved as the final name);
+    /// otherwise a journal starting from the table as saved.
+    fn carry_journal(&self, to: &Path) -> anyhow::Result<()> {
+        if let Some(from) = self.table_path.as_deref()
+            && journal::journal_path(from).exists()
+            && journal::replay(from).is_ok_and(|r| &r.table == self.pipeline.lut())
+        {
+            return journal::copy(from, to);
+        }
+        journal::append(to, self.pipeline.lut(), &[])
     }
 
     fn journal(&mut self, entry: &JournalEntry) {

@@ -283,3 +283,103 @@ fn labels_over_frames_show_the_report_and_step_between_missed_and_false_frames()
     click_label(&mut h, "Previous mark");
     assert_eq!(workspace(&h).index(), 0);
 }
+
+/// Label boxes painted over the image: dashed segments in the class's colour (ball orange) and
+/// the class name above each box.
+fn painted_label_boxes(h: &egui_kittest::Harness<'_, eotn::app::EotnApp>) -> (usize, usize) {
+    fn walk(shape: &egui::Shape, out: &mut (usize, usize)) {
+        match shape {
+            egui::Shape::LineSegment { stroke, .. }
+                if stroke.color == egui::Color32::from_rgb(255, 120, 0) =>
+            {
+                out.0 += 1;
+            }
+            egui::Shape::Text(t) if t.galley.text() == "ball" => out.1 += 1,
+            egui::Shape::Vec(shapes) => shapes.iter().for_each(|s| walk(s, out)),
+            _ => {}
+        }
+    }
+    let mut out = (0, 0);
+    for c in &h.output().shapes {
+        walk(&c.shape, &mut out);
+    }
+    out
+}
+
+/// Labels opened from inside the app (File ▸ Open labels ▸ Labels path…): the shown frame's
+/// ball box is painted, dashed and named; the scoring follows a table edit made afterwards.
+#[test]
+fn labels_opened_from_the_menu_are_painted_and_scored_with_the_table_in_use() {
+    let dir = tempfile::tempdir().unwrap();
+    let paths = fixture(dir.path());
+    let labels = dir.path().join("labels");
+    std::fs::create_dir_all(&labels).unwrap();
+    std::fs::write(labels.join("classes.txt"), "robot\nball\ngoal\n").unwrap();
+    // Frames 1 and 2 show a 20 × 20 ball at x = 70 and 80, y = 40: labelled there.
+    for n in 1..3 {
+        let x = (70.0 + 10.0 * (n - 1) as f64 + 10.0) / 208.0;
+        std::fs::write(
+            labels.join(format!("f{n}.txt")),
+            format!("1 {x} {} {} {}\n", 50.0 / 160.0, 20.0 / 208.0, 20.0 / 160.0),
+        )
+        .unwrap();
+    }
+    let mut h = harness(paths);
+    h.run();
+    show_window(&mut h, Window::Bookmarks);
+    h.state_mut().state.run(PlaybackCommand::Seek(1).into());
+    h.run();
+    assert_eq!(painted_label_boxes(&h), (0, 0));
+    click_label(&mut h, "File");
+    click_label(&mut h, "Open labels");
+    click_label(&mut h, "Labels path…");
+    let field = h.get_by_label("path");
+    field.focus();
+    field.type_text(&labels.display().to_string());
+    h.run();
+    click_label(&mut h, "Open");
+    assert!(
+        workspace(&h).labels().is_some(),
+        "{:?}",
+        workspace(&h).warnings()
+    );
+    run_until(&mut h, WITHIN, |a| {
+        a.state
+            .labels()
+            .is_some_and(eotn::workspace::OpenLabels::done)
+    });
+    h.run();
+    let (dashes, names) = painted_label_boxes(&h);
+    assert!(dashes >= 8, "{dashes} dashes of the ball box");
+    assert_eq!(names, 1);
+    // The fixture's table has no orange: no ball is found.
+    assert_eq!(workspace(&h).labels().unwrap().report().found, 0);
+    assert_eq!(h.query_all_by_label("0 / 2 = 0.0%").count(), 1);
+    // Orange clicked on the ball: scored again with the table in use, both balls are found.
+    h.state_mut()
+        .state
+        .run(TableCommand::SetClass(ColourClass::Orange).into());
+    h.state_mut()
+        .state
+        .run(TableCommand::SetSensitivity(Sensitivity::uniform(1)).into());
+    h.state_mut()
+        .state
+        .run(TableCommand::Sample { x: 80, y: 50 }.into());
+    h.state_mut().state.run(TableCommand::Commit.into());
+    run_until(&mut h, WITHIN, |a| {
+        a.state
+            .labels()
+            .is_some_and(|l| l.done() && l.report().found == 2)
+    });
+    h.run();
+    // Recall and precision.
+    assert_eq!(h.query_all_by_label("2 / 2 = 100.0%").count(), 2);
+    // The split: held-out frames only (none here: f1, f2 end in 1 and 2).
+    click_label(&mut h, "held out");
+    run_until(&mut h, WITHIN, |a| {
+        a.state
+            .labels()
+            .is_some_and(|l| l.split() == eotn::eval::label_sets::Split::HeldOut && l.done())
+    });
+    assert_eq!(workspace(&h).labels().unwrap().report().eligible, 0);
+}

@@ -156,6 +156,61 @@ fn stream_without_truth(dir: &Path) -> PathBuf {
 }
 
 #[test]
+fn each_overhead_recording_reopens_with_its_own_calibration() {
+    // Two overhead recordings, both one-camera streams on /camera/image: each is a camera of
+    // its own, and each reopens with the calibration last used with it.
+    let dir = tempfile::tempdir().unwrap();
+    let (a_dir, b_dir) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir(&a_dir).unwrap();
+    std::fs::create_dir(&b_dir).unwrap();
+    let (a, b) = (stream_without_truth(&a_dir), stream_without_truth(&b_dir));
+    let (stream, table) = fixture();
+    let mut cal = Calibration {
+        camera: truth(stream, 0).camera,
+        field: "four-legged-2005".into(),
+        points: Vec::new(),
+        line_samples: 0,
+        line_rms_px: None,
+        uncertainty: None,
+        intrinsics: None,
+    };
+    let (cal_a, cal_b) = (dir.path().join("a.cal.json"), dir.path().join("b.cal.json"));
+    cal.save(&cal_a).unwrap();
+    cal.camera.focal_px *= 1.01;
+    cal.save(&cal_b).unwrap();
+    let in_use = |w: &Workspace| {
+        w.overhead()
+            .calibration_path()
+            .map(eotn::frame::display_name)
+    };
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![a.clone(), table.clone()]))
+        .unwrap();
+    w.apply(OverheadCommand::OpenCalibration(cal_a).into())
+        .unwrap();
+    w.apply(Command::Open(vec![b.clone()])).unwrap();
+    // The second camera has none of its own: the first's stays, and that is said.
+    assert_eq!(in_use(&w).as_deref(), Some("a.cal.json"));
+    assert!(
+        w.warnings()
+            .iter()
+            .any(|l| l.contains("has no calibration of its own") && l.contains("a.cal.json")),
+        "{:?}",
+        w.warnings()
+    );
+    w.apply(OverheadCommand::OpenCalibration(cal_b).into())
+        .unwrap();
+    w.apply(Command::Open(vec![a])).unwrap();
+    assert_eq!(in_use(&w).as_deref(), Some("a.cal.json"), "its own again");
+    assert_eq!(
+        w.overhead().camera().map(|(_, s)| s),
+        Some(CalibrationSource::User)
+    );
+    w.apply(Command::Open(vec![b])).unwrap();
+    assert_eq!(in_use(&w).as_deref(), Some("b.cal.json"));
+}
+
+#[test]
 fn without_a_calibration_nothing_is_placed_and_the_status_says_so_until_one_is_opened() {
     let dir = tempfile::tempdir().unwrap();
     let (stream, table) = fixture();

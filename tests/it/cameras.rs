@@ -22,7 +22,7 @@ fn root() -> &'static Path {
 /// The recordings by name (`bag_two`, `bag_top`, `bag_bottom`, `fox_two`, …), written once.
 fn recordings() -> Option<&'static (tempfile::TempDir, serde_json::Value)> {
     static MADE: OnceLock<Option<(tempfile::TempDir, serde_json::Value)>> = OnceLock::new();
-    MADE.get_or_init(|| {
+    crate::common::made_once(&MADE, "the two-camera recordings", || {
         let python = python_with(
             "import rosbags, foxglove, cv2, mcap_protobuf",
             "rosbags, foxglove-sdk, opencv-python-headless and mcap-protobuf-support",
@@ -44,7 +44,6 @@ fn recordings() -> Option<&'static (tempfile::TempDir, serde_json::Value)> {
         let made = serde_json::from_slice(&out.stdout).unwrap();
         Some((dir, made))
     })
-    .as_ref()
 }
 
 fn path(name: &str) -> Option<PathBuf> {
@@ -280,4 +279,86 @@ fn the_sidecar_names_each_camera_s_table() {
         !out.status.success() && err.contains("no table for /camera/top"),
         "{err}"
     );
+}
+
+/// (topic, frames, width) of every camera `info --json` lists.
+fn cameras_of(path: &Path) -> Vec<(String, u64, u64)> {
+    info(path, None)["cameras"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            (
+                c["topic"].as_str().unwrap().to_owned(),
+                c["frames"].as_u64().unwrap(),
+                c["width"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn import_with_two_cameras_named_keeps_those_two() {
+    let Some(p) = path("bag_two") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("both.mcap");
+    let import = |cameras: &[&str], out: &Path| {
+        let mut args: Vec<&std::ffi::OsStr> = vec!["import".as_ref(), p.as_os_str()];
+        for c in cameras {
+            args.extend([std::ffi::OsStr::new("--camera"), std::ffi::OsStr::new(c)]);
+        }
+        args.extend([std::ffi::OsStr::new("-o"), out.as_os_str()]);
+        eotn(&args)
+    };
+    let top = "/camera/top/image_raw";
+    let bottom = "/camera/bottom/image_raw";
+    assert!(import(&[bottom, top], &out).status.success());
+    let mut cams = cameras_of(&out);
+    cams.sort();
+    assert_eq!(
+        cams,
+        [
+            (bottom.to_owned(), FRAMES as u64 / 2, 160),
+            (top.to_owned(), FRAMES as u64, 320),
+        ]
+    );
+    for camera in [top, bottom] {
+        assert_eq!(
+            detections(&out, Some(camera), Some(&bhuman_lut())),
+            detections(&p, Some(camera), Some(&bhuman_lut())),
+            "{camera}"
+        );
+    }
+    // A camera the recording does not have, among two, is an error listing those it has.
+    let bad = import(&[top, "/camera/side"], &dir.path().join("bad.mcap"));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success() && err.contains(bottom), "{err}");
+    assert!(!dir.path().join("bad.mcap").exists());
+}
+
+#[test]
+fn the_foxglove_sdk_two_camera_file_is_imported_and_reopens() {
+    let Some(p) = path("fox_two") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("fox.mcap");
+    eotn_ok(&[
+        "import".as_ref(),
+        p.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(
+        cameras_of(&out),
+        [
+            ("/camera/top".to_owned(), FRAMES as u64, 320),
+            ("/camera/bottom".to_owned(), FRAMES as u64 / 2, 160),
+        ]
+    );
+    for camera in ["/camera/top", "/camera/bottom"] {
+        assert_eq!(
+            detections(&out, Some(camera), Some(&bhuman_lut())),
+            detections(&p, Some(camera), Some(&bhuman_lut())),
+            "{camera}"
+        );
+    }
 }

@@ -1,7 +1,9 @@
 //! Several cameras, what a recording names and what goes wrong (issue 28 items 3 and 5): a
 //! camera's recognition parameters named by the recording (its sidecar) are used when no
 //! `--params` is given; cameras at different frame rates, one ending early and one changing its
-//! frame size are each said in `info`'s warnings, and `detect` says where a size changes.
+//! frame size are each said in `info`'s warnings, and `detect` says where a size changes;
+//! `import` keeps each camera's named files, `eval` and `lut-from-labels` read the camera's
+//! table and frames.
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
@@ -252,4 +254,174 @@ fn record_keeps_every_camera_of_a_robot_unless_told_which() {
         .filter_map(|c| c["topic"].as_str())
         .collect();
     assert_eq!(topics, ["/camera/image", "/camera/bottom"]);
+}
+
+/// `two.mcap` in `dir`: `/camera/image` 8×4 (Y 50) and `/camera/bottom` 4×2 (Y 200), three
+/// frames each; each camera names its table (`top.lut`, `tables/bottom.lut`, relative to the
+/// recording's folder).
+fn named_two(dir: &Path) -> PathBuf {
+    let p = dir.join("two.mcap");
+    let mut w = StreamWriter::create(&p, &StreamInfo::default()).unwrap();
+    for (topic, lut) in [
+        ("/camera/image", "top.lut"),
+        ("/camera/bottom", "tables/bottom.lut"),
+    ] {
+        let files = eotn::camera::CameraFiles {
+            lut: Some(lut.into()),
+            ..Default::default()
+        };
+        w.name_camera_files(topic, &files).unwrap();
+    }
+    for i in 0..3u64 {
+        let top = FrameRecord::new(
+            i * 40,
+            Frame::filled_uyvy(8, 4, Yuv::new(50, 1, 2)).unwrap(),
+        );
+        w.write_camera("/camera/image", &top, None).unwrap();
+        let bottom = FrameRecord::new(
+            i * 40 + 5,
+            Frame::filled_uyvy(4, 2, Yuv::new(200, 1, 2)).unwrap(),
+        );
+        w.write_camera("/camera/bottom", &bottom, None).unwrap();
+    }
+    w.finish().unwrap();
+    p
+}
+
+#[test]
+fn import_keeps_each_camera_s_named_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = named_two(dir.path());
+    let elsewhere = tempfile::tempdir().unwrap();
+    let files = |path: &Path, camera: Option<&str>| {
+        eotn::streams::StreamReader::open_camera(path, camera)
+            .unwrap()
+            .camera_files()
+            .unwrap()
+            .lut
+    };
+    // Written beside the recording: the names as they were, resolved as before.
+    let beside = dir.path().join("copy.mcap");
+    eotn_ok(&[
+        OsStr::new("import"),
+        rec.as_os_str(),
+        OsStr::new("-o"),
+        beside.as_os_str(),
+    ]);
+    for camera in ["/camera/image", "/camera/bottom"] {
+        assert_eq!(
+            files(&beside, Some(camera)),
+            files(&rec, Some(camera)),
+            "{camera}"
+        );
+    }
+    // Written elsewhere: still the recording's tables (their paths made absolute).
+    let far = elsewhere.path().join("far.mcap");
+    eotn_ok(&[
+        OsStr::new("import"),
+        rec.as_os_str(),
+        OsStr::new("-o"),
+        far.as_os_str(),
+    ]);
+    let bottom = std::fs::canonicalize(dir.path())
+        .unwrap()
+        .join("tables/bottom.lut");
+    assert_eq!(files(&far, Some("/camera/bottom")), Some(bottom.clone()));
+    // One camera kept: the one-camera stream's camera names that camera's table.
+    let one = elsewhere.path().join("bottom.mcap");
+    eotn_ok(&[
+        OsStr::new("import"),
+        rec.as_os_str(),
+        OsStr::new("--camera"),
+        OsStr::new("/camera/bottom"),
+        OsStr::new("-o"),
+        one.as_os_str(),
+    ]);
+    assert_eq!(files(&one, None), Some(bottom));
+}
+
+#[test]
+fn eval_without_lut_takes_the_camera_s_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("goal.mcap");
+    std::fs::copy(root().join("streams/sim-goalkeeper.mcap"), &rec).unwrap();
+    let lut = root().join("lookup_tables/sim.lut");
+    let eval = |extra: &[&OsStr]| {
+        let mut args = vec![OsStr::new("eval"), rec.as_os_str(), OsStr::new("--json")];
+        args.extend_from_slice(extra);
+        eotn(&args)
+    };
+    let refused = eval(&[]);
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        !refused.status.success() && err.contains("--lut is needed"),
+        "{err}"
+    );
+    let v = serde_json::json!({"cameras": {"/camera/image": {"lut": lut}}});
+    std::fs::write(eotn::camera::sidecar_path(&rec), v.to_string()).unwrap();
+    let report = |out: std::process::Output| {
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    assert_eq!(
+        report(eval(&[])),
+        report(eval(&[OsStr::new("--lut"), lut.as_os_str()])),
+        "the camera's table"
+    );
+}
+
+#[test]
+fn lut_from_labels_reads_the_camera_given_of_a_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = named_two(dir.path());
+    // Masks named as `eotn classify --raw` names a stream's frames, sized for the bottom
+    // camera (4×2): every pixel orange.
+    for i in 0..3 {
+        let mask = dir.path().join(format!("two_{i:06}.cls"));
+        std::fs::write(mask, [eotn::lut::ColourClass::Orange.code(); 8]).unwrap();
+    }
+    let table = dir.path().join("learnt.lut");
+    let learn = |camera: Option<&str>| {
+        let mut args = vec![
+            OsStr::new("lut-from-labels"),
+            rec.as_os_str(),
+            OsStr::new("--holdout-every"),
+            OsStr::new("1000"),
+            OsStr::new("--margin"),
+            OsStr::new("0"),
+            OsStr::new("-o"),
+            table.as_os_str(),
+        ];
+        if let Some(c) = camera {
+            args.extend([OsStr::new("--camera"), OsStr::new(c)]);
+        }
+        eotn(&args)
+    };
+    let out = learn(Some("/camera/bottom"));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let t = LookupTable::load(&table).unwrap();
+    assert_eq!(
+        t.class_of(Yuv::new(200, 1, 2)),
+        eotn::lut::ColourClass::Orange,
+        "the bottom camera's colour"
+    );
+    assert_ne!(
+        t.class_of(Yuv::new(50, 1, 2)),
+        eotn::lut::ColourClass::Orange
+    );
+    // The first camera's frames (8×4) do not fit the bottom camera's masks: refused, named.
+    let out = learn(None);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("two_000000.cls"),
+        "{err}"
+    );
 }

@@ -53,6 +53,30 @@ pub fn skip_noted(reason: &str, remedy: &str) {
     }
 }
 
+/// What `make` builds once for every test of a file (recordings written by Python tools), or
+/// `None` when it cannot be made. `make` says its own skip to the first test that asks; every
+/// later test that finds it missing says one too, naming `what`, so none passes unlisted.
+pub fn made_once<T: Sync>(
+    cell: &'static std::sync::OnceLock<Option<T>>,
+    what: &str,
+    make: impl FnOnce() -> Option<T>,
+) -> Option<&'static T> {
+    let mut made_here = false;
+    let made = cell
+        .get_or_init(|| {
+            made_here = true;
+            make()
+        })
+        .as_ref();
+    if made.is_none() && !made_here {
+        skipped(
+            &format!("{what} could not be made (see that file's first skip)"),
+            "install what that skip names",
+        );
+    }
+    made
+}
+
 /// A file under `../shared/`, or `None` with a clear "skipped" line when it is absent outside CI.
 /// Under `CI=true` a missing file fails the test.
 pub fn shared_file(relative: &str) -> Option<PathBuf> {

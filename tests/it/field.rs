@@ -5,7 +5,7 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
 use eotn::model::GroundTruth;
-use eotn::session::{CameraId, Session, SessionSource};
+use eotn::session::{Session, SessionSource, SslCameraId};
 
 use crate::common::{eotn, eotn_ok};
 
@@ -37,7 +37,7 @@ fn the_simulated_field_is_a_session_of_cameras_with_their_own_tables_calibration
     assert_eq!(session.overhead.len(), 2);
     let mut cameras = Vec::new();
     for (k, cam) in session.overhead.iter().enumerate() {
-        assert_eq!(cam.id, CameraId(u8::try_from(k).unwrap()));
+        assert_eq!(cam.id, SslCameraId(u8::try_from(k).unwrap()));
         let SessionSource::Recording(p) = &cam.source else {
             panic!("a recording expected");
         };

@@ -135,6 +135,74 @@ fn two_inputs_of_the_same_name_do_not_overwrite_each_others_output() {
     assert_eq!(&png.as_raw()[..3], &first[..3]);
 }
 
+/// The inputs a command finds on its own are guarded as those it is given (one guard, which
+/// every file read declares itself to): a rosbag2 folder's storage file and `metadata.yaml`,
+/// the table and parameters a recording's `REC.cameras.json` names, and that sidecar itself.
+/// Each refusal leaves the input byte for byte as it was.
+#[test]
+fn outputs_never_replace_the_inputs_a_command_finds_on_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    // A rosbag2 folder with MCAP storage (eotn's own stream as its storage file).
+    let bag = dir.path().join("bag");
+    std::fs::create_dir(&bag).unwrap();
+    let storage = bag.join("bag_0.mcap");
+    std::fs::copy(repo_file("streams/sim-ball-edge.mcap"), &storage).unwrap();
+    let metadata = bag.join("metadata.yaml");
+    std::fs::write(
+        &metadata,
+        "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  \
+         relative_file_paths:\n    - bag_0.mcap\n  topics_with_message_count: []\n",
+    )
+    .unwrap();
+    let info = eotn_ok(&["info".as_ref(), "--json".as_ref(), bag.as_os_str()]);
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(info["frames"], 15, "the bag opens: {info}");
+    let refused = |args: &[&OsStr], input: &Path| {
+        let before = std::fs::read(input).unwrap();
+        let err = fails(args);
+        assert!(
+            err.contains("would replace the input") && err.contains(&*input.to_string_lossy()),
+            "{args:?}: {err}"
+        );
+        assert_eq!(std::fs::read(input).unwrap(), before, "{}", input.display());
+    };
+    for input in [&storage, &metadata] {
+        refused(
+            &[
+                "import".as_ref(),
+                bag.as_os_str(),
+                "-o".as_ref(),
+                input.as_os_str(),
+            ],
+            input,
+        );
+    }
+    // A recording whose sidecar names its table and parameters; no --lut, no --params.
+    let rec = dir.path().join("rec.mcap");
+    std::fs::copy(repo_file("streams/sim-ball-edge.mcap"), &rec).unwrap();
+    let (lut, params) = (dir.path().join("t.lut"), dir.path().join("p.json"));
+    std::fs::copy(repo_file("lookup_tables/sim.lut"), &lut).unwrap();
+    std::fs::write(&params, "{}\n").unwrap();
+    let sidecar = dir.path().join("rec.mcap.cameras.json");
+    std::fs::write(
+        &sidecar,
+        r#"{"cameras": {"/camera/image": {"lut": "t.lut", "params": "p.json"}}}"#,
+    )
+    .unwrap();
+    eotn_ok(&["detect".as_ref(), "--json".as_ref(), rec.as_os_str()]);
+    for input in [&lut, &params, &sidecar] {
+        refused(
+            &[
+                "detect".as_ref(),
+                rec.as_os_str(),
+                "--annotate".as_ref(),
+                input.as_os_str(),
+            ],
+            input,
+        );
+    }
+}
+
 /// A points file of the shipped overhead stream's landmarks, clicked with 1 px of noise.
 fn overhead_points(dir: &Path) -> (PathBuf, serde_json::Value) {
     let points = dir.join("points.json");

@@ -20,6 +20,9 @@ use eotn::cli::paths::{PathRole, path_role};
 
 use crate::common::{eotn, eotn_ok, repo_file, sim_stream};
 
+/// The user and group id given to an output file before it is replaced (no such user needed).
+const OTHER_ID: u32 = 4242;
+
 /// Inputs every recipe may use, made once in a temporary folder.
 struct Fixture {
     dir: tempfile::TempDir,
@@ -352,19 +355,40 @@ fn failure(key: &str, case: &str, o: &Output) -> String {
 
 /// A private `/dev/null` (character device 1, 3), or `None` with a visible skip.
 fn private_null(dir: &Path) -> Option<PathBuf> {
-    let p = dir.join("null");
+    private_device(dir, "null", 3)
+}
+
+/// A private copy of the memory device `1, minor` (3 `/dev/null`, 7 `/dev/full`) named `name`
+/// in `dir`, mode 0666, or `None` with a visible skip where `mknod` is refused.
+fn private_device(dir: &Path, name: &str, minor: u32) -> Option<PathBuf> {
+    let p = dir.join(name);
     let made = Command::new("mknod")
         .args(["-m", "666"])
         .arg(&p)
-        .args(["c", "1", "3"])
+        .args(["c", "1", &minor.to_string()])
         .status()
         .is_ok_and(|s| s.success());
     if made {
         return Some(p);
     }
-    assert!(!crate::common::in_ci(), "mknod refused under CI=true");
-    eprintln!("SKIPPED: mknod is refused here (not root?): outputs onto a device are not tested");
+    crate::common::skipped(
+        "mknod is refused here (not root?): outputs onto a device are not tested",
+        "run the tests as root, or in a container that allows mknod",
+    );
     None
+}
+
+/// True while `p` is still the private device `1, minor` made by [`private_device`].
+fn is_private_device(p: &Path, minor: u64) -> bool {
+    let m = fs::symlink_metadata(p).unwrap();
+    m.file_type().is_char_device()
+        && m.rdev() == libc_makedev(1, minor)
+        && m.mode() & 0o777 == 0o666
+}
+
+/// `makedev(major, minor)` as Linux encodes small numbers (the `rdev` of a memory device).
+const fn libc_makedev(major: u64, minor: u64) -> u64 {
+    ((major & 0xfff) << 8) | (minor & 0xff)
 }
 
 fn is_private_null(p: &Path) -> bool {
@@ -419,6 +443,21 @@ fn file_output_cases(f: &Fixture, key: &str, recipe: Recipe) {
     ok(key, "a 0600 file", &run(f, recipe, &plain));
     assert_ne!(fs::read(&plain).unwrap(), b"old", "{key}: not written");
     assert_eq!(fs::metadata(&plain).unwrap().mode() & 0o777, 0o600, "{key}");
+    // A file of another owner keeps its owner and group (root can give them back; a user
+    // cannot make such a file, which is a visible skip).
+    let owned = dir.join("owned.out");
+    fs::write(&owned, b"old").unwrap();
+    if std::os::unix::fs::chown(&owned, Some(OTHER_ID), Some(OTHER_ID)).is_ok() {
+        ok(key, "a file of another owner", &run(f, recipe, &owned));
+        let m = fs::metadata(&owned).unwrap();
+        assert_ne!(fs::read(&owned).unwrap(), b"old", "{key}: not written");
+        assert_eq!((m.uid(), m.gid()), (OTHER_ID, OTHER_ID), "{key}: owner");
+    } else {
+        crate::common::skipped(
+            "chown is refused (not root): the kept owner of an output is not tested",
+            "run the tests as root",
+        );
+    }
     // A symlink stays; its target is replaced and keeps its mode.
     fs::create_dir(dir.join("real")).unwrap();
     let target = dir.join("real/target.out");
@@ -454,6 +493,38 @@ fn file_output_cases(f: &Fixture, key: &str, recipe: Recipe) {
         let left: Vec<_> = fs::read_dir(&devices).unwrap().flatten().collect();
         assert_eq!(left.len(), 1, "{key}: files beside the device: {left:?}");
     }
+    // A full device (`/dev/full`'s numbers): a clear error, the device kept, nothing beside it.
+    let full_dir = dir.join("full");
+    fs::create_dir(&full_dir).unwrap();
+    if let Some(full) = private_device(&full_dir, "full", 7) {
+        let err = failure(key, "a full device", &run(f, recipe, &full));
+        assert!(
+            err.contains("full") && err.contains("No space left on device"),
+            "{key}: {err}"
+        );
+        assert!(
+            is_private_device(&full, 7),
+            "{key}: the device was replaced"
+        );
+        let left: Vec<_> = fs::read_dir(&full_dir).unwrap().flatten().collect();
+        assert_eq!(left.len(), 1, "{key}: files beside the device: {left:?}");
+    }
+    // `/dev/stdout` prints: the child's standard output (a pipe here) gets the bytes the
+    // regular file got, and nothing is made beside the command.
+    let o = run(f, recipe, Path::new("/dev/stdout"));
+    ok(key, "/dev/stdout", &o);
+    let written = fs::read(&plain).unwrap();
+    assert!(
+        !o.stdout.is_empty() && o.stdout.len() >= written.len() / 2,
+        "{key}: /dev/stdout got {} bytes, the file {}",
+        o.stdout.len(),
+        written.len()
+    );
+    let head = &written[..written.len().min(8)];
+    assert!(
+        o.stdout.windows(head.len()).any(|w| w == head),
+        "{key}: the output's first bytes are not on standard output"
+    );
     // A FIFO is written in place.
     let (fifo, mut reader, got) = fifo_with_reader(dir);
     let o = run(f, recipe, &fifo);

@@ -326,10 +326,10 @@ fn the_overhead_command_line_calibrates_detects_and_evaluates() {
         overhead["robot_error_cm"]["n"].as_u64().unwrap_or(0) >= 8,
         "{overhead}"
     );
-    assert!(
-        overhead["robot_error_cm"]["p50"].as_f64().unwrap() < 5.0,
-        "{overhead}"
-    );
+    let robot_p50 = overhead["robot_error_cm"]["p50"].as_f64().unwrap();
+    eprintln!("eval --json: robot error median {robot_p50:.2} cm");
+    // About 2.5× what is achieved (2026-12-07: median 0.56 cm on these 3 frames of seed 4).
+    assert!(robot_p50 < 1.4, "{overhead}");
     // The robot-camera table still reads the stream (the command is the same either way).
     eotn_ok(&[
         OsStr::new("eval"),

@@ -175,14 +175,20 @@ fn recognition_on_synthetic_scenarios() {
     );
     assert_eq!(sum(&|r| r.beacons_colours_right), found);
     assert_eq!(sum(&|r| r.beacons_false), 0);
-    // Limits at 2–3× what seed 7 gives with this coarse table (median, p90); the issue's
-    // targets (≤ 3%, ≤ 8%) are asserted on held-out seeds in `beacons.rs`. Orange-clutter's far
-    // beacon in the shaded corner keeps few classified pixels here, hence its wider limits.
+    // The targets (median ≤ 3%, p90 ≤ 8%) on every scenario where this coarse table
+    // classifies the beacons' bands, or 2–3× what seed 7 gives where that is tighter. Seed 7
+    // gave (2026-12-07, median/p90): walk-and-pan 2.9%/5.0%, fast-pans 1.4%/4.0%, beacon-tour
+    // 0.6%/1.6%, orange-clutter 4.1%/11.0%. Orange-clutter's far beacon in the shaded corner
+    // (2.6 m) keeps few classified pixels with this table (54 frames of seed 100), so its band
+    // edges fall where the classification ends, not at the paint: its limits are 2.5× what is
+    // achieved, and the targets are asserted on it, with a table that classifies it, in
+    // `beacons.rs` (held-out seeds 41 and 53).
+    const TARGET: [f64; 2] = [0.03, 0.08];
     for (k, [p50, p90]) in [
-        (ScenarioKind::WalkAndPan, [0.07, 0.12]),
-        (ScenarioKind::FastPans, [0.04, 0.10]),
-        (ScenarioKind::OrangeClutter, [0.10, 0.25]),
+        (ScenarioKind::WalkAndPan, TARGET),
+        (ScenarioKind::FastPans, TARGET),
         (ScenarioKind::BeaconTour, [0.015, 0.04]),
+        (ScenarioKind::OrangeClutter, [0.10, 0.25]),
     ] {
         let d = sampled(report(k).beacon_distance_error, 20, k.name());
         eprintln!(
@@ -574,7 +580,7 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
         "{report}"
     );
     // Beacons against the truth (walk-and-pan shows them; seed 7's 60 frames: every whole one
-    // found, none false, median error 2.9% with this table — the limit is about 2.5× that).
+    // found, none false), within the targets: median ≤ 3%, p90 ≤ 8%.
     let r = &report["report"];
     let (eligible, found) = (
         r["beacons_eligible"].as_u64().unwrap(),
@@ -584,7 +590,13 @@ fn detect_render_and_eval_commands_on_a_rendered_stream() {
     assert_eq!(r["beacons_colours_right"], found, "{r}");
     assert_eq!(r["beacons_false"], 0, "{r}");
     let beacon_median = r["beacon_distance_error"]["p50"].as_f64().unwrap();
-    assert!(beacon_median <= 0.07, "{r}");
+    let beacon_p90 = r["beacon_distance_error"]["p90"].as_f64().unwrap();
+    eprintln!(
+        "eval on walk-and-pan: beacon distance error median {:.1}% p90 {:.1}%",
+        100.0 * beacon_median,
+        100.0 * beacon_p90
+    );
+    assert!(beacon_median <= 0.03 && beacon_p90 <= 0.08, "{r}");
     assert!(
         r["beacon_distance_error"]["n"].as_u64().unwrap() >= 20,
         "{r}"

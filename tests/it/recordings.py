@@ -13,6 +13,7 @@ BT.601) and OpenCV (JPEG, PNG). The manifest names each recording and what its f
 match: "exact" (lossless RGB/BGR and the 4:2:2 orders), "jpeg", "nv12", "bayer", "grey".
 """
 import json
+import re
 import shutil
 import sys
 import time
@@ -193,6 +194,17 @@ def write_bag(path, messages, ts, storage, compression=None):
             writer.write(conns[topic], t, ts.serialize_cdr(msg, msgtype))
 
 
+def as_version_7(metadata):
+    """Rewrites a version-8 `metadata.yaml` as version 7 (drops `ros_distro`)."""
+    text = metadata.read_text()
+    v7, n = re.subn(r"(?m)^(\s+version:) 8$", r"\1 7", text)
+    assert n == 1, text
+    v7, n = re.subn(r"(?m)^\s+ros_distro:.*\n?", "", v7)
+    assert n == 1, text
+    assert "type_description_hash" in v7, text
+    metadata.write_text(v7)
+
+
 def split_bag(path, messages, ts, storage):
     """A split bag: two bags written by rosbags, their files in one folder, metadata listing
     both (as `ros2 bag record --max-bag-size` leaves it)."""
@@ -336,6 +348,13 @@ def write_all(source, count, out):
             path = out / f"zstd_{mode}_{storage}"
             write_bag(path, ros_messages(ts, frames, encoding="yuyv"), ts, storage, mode)
             add(f"rosbag2 {storage} zstd {mode}", path, "exact")
+    # Metadata version 7, as Iron's rosbag2 writes it: rosbags writes versions 8 and 9 only,
+    # and version 7 is version 8 without `ros_distro` (rosbag2's yaml.hpp reads `ros_distro`
+    # from version 8 on, `type_description_hash` from 7 on), so a version-8 bag is rewritten so.
+    path = out / "bag_mcap_v7"
+    write_bag(path, ros_messages(ts, frames, encoding="rgb8"), ts, "mcap")
+    as_version_7(path / "metadata.yaml")
+    add("rosbag2 mcap metadata v7", path, "exact")
     write_mcap_ros2(out / "mcap_ros2_yuv422.mcap", frames, "uyvy")
     add("mcap-ros2-support sensor_msgs/Image yuv422", out / "mcap_ros2_yuv422.mcap", "exact")
     for name, cams, match in [

@@ -61,7 +61,7 @@ pub(crate) fn joint_state_bag() -> Option<PathBuf> {
 /// The recordings, written once for all tests of this file.
 fn recordings() -> Option<&'static (tempfile::TempDir, Vec<Recording>)> {
     static MADE: OnceLock<Option<(tempfile::TempDir, Vec<Recording>)>> = OnceLock::new();
-    MADE.get_or_init(|| {
+    crate::common::made_once(&MADE, "the third-party recordings", || {
         let python = writers_python()?;
         let dir = tempfile::tempdir().unwrap();
         let out = Command::new(python)
@@ -89,7 +89,6 @@ fn recordings() -> Option<&'static (tempfile::TempDir, Vec<Recording>)> {
             .collect();
         Some((dir, list))
     })
-    .as_ref()
 }
 
 /// Ball centres of `eotn detect --json` on `path`, one per frame (`None`: no ball).
@@ -126,7 +125,7 @@ fn every_recording_opens_and_recognition_matches_the_original_frames() {
     let reference = ball_centres(&list[0].path);
     let found = reference.iter().filter(|b| b.is_some()).count();
     assert!(found >= FRAMES * 3 / 4, "the reference finds {found} balls");
-    let mut report = Vec::new();
+    let (mut report, mut lost_to_pose) = (Vec::new(), Vec::new());
     for r in list {
         let i = info(&r.path);
         assert_eq!(i["frames"], FRAMES, "{}: {i}", r.name);
@@ -151,8 +150,13 @@ fn every_recording_opens_and_recognition_matches_the_original_frames() {
         for (k, (a, b)) in reference.iter().zip(&balls).enumerate() {
             match (a, b) {
                 (Some(a), Some(b)) => worst = worst.max((a.0 - b.0).hypot(a.1 - b.1)),
-                // With a camera pose from /tf the recogniser may judge a ball differently.
-                (Some(_), None) if r.matches == "pose" => {}
+                // With a camera pose from /tf_static the ball's height above the ground is
+                // tested, and the pose recordings.py gives (25 cm up, level) is not the Nao's:
+                // a ball lost there must be lost to that test alone.
+                (Some(a), None) if r.matches == "pose" => {
+                    assert_lost_to_the_height_test_alone(&r.path, k, *a);
+                    lost_to_pose.push(format!("{} frame {k}", r.name));
+                }
                 (a, b) => panic!(
                     "{}: frame {k}: ball {a:?} in the original, {b:?} here",
                     r.name
@@ -167,8 +171,48 @@ fn every_recording_opens_and_recognition_matches_the_original_frames() {
         report.push(format!("{}: {worst:.2} px", r.name));
     }
     eprintln!(
-        "largest ball-centre difference per recording:\n{}",
+        "largest ball-centre difference per recording:\n{}\nballs lost to the /tf_static \
+         pose's height test: {lost_to_pose:?}",
         report.join("\n")
+    );
+    // 2026-12-07: frames 13, 14, 21 and 23 of each pose recording (balls low in the image,
+    // cut by its bottom edge, whose centre the level camera 25 cm up puts under the ground).
+    assert!(lost_to_pose.len() <= 8, "{lost_to_pose:?}");
+}
+
+/// Asserts that frame `k` of `path`, whose ball the original frames show at `original`, has a
+/// ball candidate there that fails the height-above-ground test (which only a camera pose
+/// enables) and would have been accepted without it.
+fn assert_lost_to_the_height_test_alone(path: &Path, k: usize, original: (f64, f64)) {
+    use eotn::recognition::confidence::{TestName, TestOutcome};
+    let lut = eotn::lut::LookupTable::load(&root().join("lookup_tables/bhuman2009.lut")).unwrap();
+    let params = eotn::pipeline::PipelineParams {
+        recognition: eotn::recognition::params_file::load(&root().join("params/spl2009.json"))
+            .unwrap(),
+        ..Default::default()
+    };
+    let record = StreamReader::open(path).unwrap().read(k).unwrap();
+    assert!(
+        record.sensors.is_some(),
+        "frame {k}: the pose reached the readings"
+    );
+    let mut pipeline = eotn::pipeline::Pipeline::new(lut, params);
+    let result = pipeline.process(&record.frame, record.sensors.as_ref());
+    let explained = result.recognition.ball.candidates.iter().any(|c| {
+        let at = (c.center.x_px - original.0).hypot(c.center.y_px - original.1) <= 2.0;
+        let height = c
+            .confidence
+            .tests
+            .iter()
+            .find(|t| t.test == TestName::HeightCm && t.outcome == TestOutcome::Failed);
+        at && height.is_some_and(|h| c.confidence.total - h.effect > 0.0)
+    });
+    assert!(
+        explained,
+        "{} frame {k}: the ball at {original:?} lost to something else than the pose's height \
+         test: {:#?}",
+        path.display(),
+        result.recognition.ball.candidates
     );
 }
 
@@ -241,6 +285,32 @@ fn import_keeps_each_image_message_unchanged_with_its_channels() {
 
 #[test]
 fn folders_that_are_not_bags_and_unknown_encodings_say_so() {
+    // An image encoding eotn does not know (`8UC3`, OpenCV's name for 3 bytes a pixel, written
+    // over `rgb8` in every image of a `rosbags` recording) is named with the known ones, by the
+    // command a user runs.
+    if let Some((dir, list)) = recordings() {
+        let unknown = dir.path().join("encoding_8uc3.mcap");
+        copy_mcap_editing_images(&rgb8_storage_file(list), &unknown, |_, data| {
+            let rgb8 = b"\x05\x00\x00\x00rgb8\x00";
+            let at = data
+                .windows(rgb8.len())
+                .position(|w| w == rgb8)
+                .expect("the encoding field");
+            data[at + 4..at + 8].copy_from_slice(b"8UC3");
+        });
+        let out = eotn(&[
+            "detect".as_ref(),
+            "--lut".as_ref(),
+            root().join("lookup_tables/bhuman2009.lut").as_os_str(),
+            unknown.as_os_str(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        eprintln!("detect on 8UC3 images: {:?}\n{err}", out.status);
+        assert!(
+            err.contains("8UC3") && err.contains("bayer_rggb8") && err.contains("rgb8"),
+            "{err}"
+        );
+    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("notes.txt"), "x").unwrap();
     let out = eotn(&["info".as_ref(), dir.path().as_os_str()]);
@@ -530,6 +600,123 @@ fn a_damaged_message_costs_its_frame_only() {
     let lines = String::from_utf8_lossy(&out.stdout).lines().count();
     assert_eq!(lines, FRAMES - 1);
     let err = String::from_utf8_lossy(&out.stderr);
+    let named = err.lines().filter(|l| l.contains("frame 5")).count();
+    assert_eq!(named, 1, "{err}");
+}
+
+/// A `mono8` recording shows and steps in the app's workspace as any other: every frame in turn,
+/// grey (U = V = 128) with its own luma, the note that a colour table cannot classify it shown.
+#[test]
+fn a_mono8_recording_steps_frame_by_frame_in_the_workspace() {
+    use eotn::workspace::{Command, PlaybackCommand, Workspace};
+    let Some((_, list)) = recordings() else {
+        return;
+    };
+    let mono = list.iter().find(|r| r.matches == "grey").unwrap();
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![
+        mono.path.clone(),
+        root().join("lookup_tables/bhuman2009.lut"),
+    ]))
+    .unwrap();
+    let said = format!("{} {:?}", w.status, w.warnings());
+    assert!(said.contains("cannot classify"), "{}: {said}", mono.name);
+    let mut reference = StreamReader::open(&list[0].path).unwrap();
+    let mut lumas = Vec::new();
+    for i in 0..FRAMES {
+        if i > 0 {
+            w.apply(PlaybackCommand::Step(1).into()).unwrap();
+        }
+        assert_eq!(w.index(), i, "{}", mono.name);
+        let frame = w.frame().expect("a frame shown");
+        let want = reference.read(i).unwrap().frame;
+        assert_eq!(
+            (frame.width(), frame.height()),
+            (want.width(), want.height())
+        );
+        let mut luma = 0u64;
+        frame.for_each_pixel(|_, _, p| {
+            assert_eq!((p.u, p.v), (128, 128), "frame {i}: grey");
+            luma += u64::from(p.y);
+        });
+        lumas.push(luma);
+    }
+    lumas.dedup();
+    assert!(lumas.len() > FRAMES / 2, "the frames differ: {lumas:?}");
+    // Stepping past the end stays on the last frame.
+    w.apply(PlaybackCommand::Step(1).into()).unwrap();
+    assert_eq!(w.index(), FRAMES - 1);
+}
+
+/// The storage file of the `rosbags` rgb8 bag copied message by message into `out` (an MCAP file
+/// with its `ros2msg` schemas and `cdr` channels), `edit` given the index and CDR bytes of each
+/// `/camera/image_raw` message on the way.
+fn copy_mcap_editing_images(src: &Path, out: &Path, mut edit: impl FnMut(usize, &mut Vec<u8>)) {
+    let bytes = std::fs::read(src).unwrap();
+    let mut writer =
+        mcap::Writer::new(std::io::BufWriter::new(std::fs::File::create(out).unwrap())).unwrap();
+    let mut images = 0;
+    for message in mcap::MessageStream::new(&bytes).unwrap() {
+        let mut message = message.unwrap();
+        if message.channel.topic == "/camera/image_raw" {
+            let mut data = message.data.into_owned();
+            edit(images, &mut data);
+            message.data = data.into();
+            images += 1;
+        }
+        writer.write(&message).unwrap();
+    }
+    writer.finish().unwrap();
+    assert_eq!(images, FRAMES, "{}", src.display());
+}
+
+fn rgb8_storage_file(list: &[Recording]) -> PathBuf {
+    list.iter()
+        .find(|r| r.name == "rosbag2 storage file (.mcap) alone")
+        .unwrap()
+        .path
+        .clone()
+}
+
+/// A truncated CDR image inside an MCAP file (not only in SQLite storage) costs its frame only:
+/// the other 23 read as in the original file, and `detect` names the lost frame once.
+#[test]
+fn a_truncated_cdr_message_in_an_mcap_file_costs_its_frame_only() {
+    let Some((dir, list)) = recordings() else {
+        return;
+    };
+    let original = rgb8_storage_file(list);
+    let cut = dir.path().join("cut_image_5.mcap");
+    copy_mcap_editing_images(&original, &cut, |i, data| {
+        if i == 5 {
+            data.truncate(60);
+        }
+    });
+    let mut good = StreamReader::open(&original).unwrap();
+    let mut bad = StreamReader::open(&cut).unwrap();
+    assert_eq!(bad.len(), FRAMES);
+    for i in 0..FRAMES {
+        match bad.read(i) {
+            Err(e) => assert_eq!(i, 5, "frame {i} lost: {e}"),
+            Ok(got) => {
+                assert_ne!(i, 5, "the cut image read");
+                assert_eq!(got.frame, good.read(i).unwrap().frame, "frame {i}");
+            }
+        }
+    }
+    let out = eotn(&[
+        "detect".as_ref(),
+        "--json".as_ref(),
+        "--lut".as_ref(),
+        root().join("lookup_tables/bhuman2009.lut").as_os_str(),
+        cut.as_os_str(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).lines().count(),
+        FRAMES - 1
+    );
     let named = err.lines().filter(|l| l.contains("frame 5")).count();
     assert_eq!(named, 1, "{err}");
 }

@@ -22,7 +22,7 @@ use crate::live::{fake_robot_session, frame, image_message, image_payloads, reco
 
 /// Ticks the workspace as the app's UI does (about 60 times a second) until `done` holds;
 /// false when `secs` passed first.
-fn tick_until(w: &mut Workspace, secs: f64, mut done: impl FnMut(&Workspace) -> bool) -> bool {
+pub fn tick_until(w: &mut Workspace, secs: f64, mut done: impl FnMut(&Workspace) -> bool) -> bool {
     let until = Instant::now() + Duration::from_secs_f64(secs);
     while Instant::now() < until {
         w.tick(Duration::from_millis(16));
@@ -373,10 +373,21 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     assert!(tick_until(&mut w, 5.0, |w| w.index() + 1 == frames));
     for (k, id) in ids.iter().enumerate() {
         let r = row(&w, *id);
+        eprintln!(
+            "robot {k}: latency median {:?} ms, p99 {:?} ms",
+            r.stats.latency_median_ms, r.stats.latency_p99_ms
+        );
         assert_eq!((r.stats.frames, r.stats.drops), (frames, 0), "robot {k}");
-        // Keeping up: 99% of frames in before the next one is sent (one frame interval,
-        // 33 ms). Achieved 2026-12-04: p99 0.8–4.2 ms per robot; the limit leaves room for a
-        // machine busy with the other tests, which run beside this one.
+        // Keeping up: 99% of frames in before the next one is sent (one frame interval, 33 ms),
+        // and the median within half of one. On this shared machine both move tenfold with the
+        // load (2026-12-07, 2 cores at load 13–17, runs of 2 s: median 0.7–0.9 ms in most runs,
+        // up to 8.7 ms in some; p99 1.2–12.4 ms; a run of 60 s: p99 28 ms), so these limits are
+        // what keeping up means, about 2× the worst seen, not 2–3× a quiet run.
+        assert!(
+            r.stats.latency_median_ms.is_some_and(|ms| ms < 16.7),
+            "robot {k}: {:?}",
+            r.stats
+        );
         assert!(
             r.stats.latency_p99_ms.is_some_and(|ms| ms < 33.0),
             "robot {k}: {:?}",
@@ -394,13 +405,14 @@ fn four_robots_at_30_fps_into_the_workspace_lose_no_frame_and_keep_up() {
     }
     shown_latency_ms.sort_by(f64::total_cmp);
     let pick = |p: f64| shown_latency_ms[((shown_latency_ms.len() - 1) as f64 * p) as usize];
-    // Shown within a frame interval and a UI poll (33 + 16 ms) at the median; achieved 10 ms.
+    // Shown within a frame interval at the median (it includes the UI's 16 ms poll): achieved
+    // 2026-12-07 at load 14 a median of 7.5–14.0 ms in three runs, the limit 2.4× the worst.
     assert!(
         shown_latency_ms.len() >= frames / 2,
         "{} shown",
         shown_latency_ms.len()
     );
-    assert!(pick(0.5) < 49.0, "median {} ms", pick(0.5));
+    assert!(pick(0.5) < 33.0, "median {} ms", pick(0.5));
     println!(
         "four robots, {frames} frames each: sender's write to the frame shown in the workspace (UI polling every 16 ms): median {:.1} ms, p99 {:.1} ms over {} shown frames",
         pick(0.5),

@@ -202,7 +202,10 @@ fn shipped_sim_streams_classify_with_the_shipped_table() {
             checked_balls += 1;
         }
     }
-    assert!(checked_balls >= 10, "{checked_balls}");
+    eprintln!("the shipped table finds {good_balls} of {checked_balls} balls orange");
+    // Restored from before c96e484 lowered it to 10: the re-made streams (05b7319) show the ball
+    // in most frames of the ball-named streams again.
+    assert!(checked_balls > 20, "{checked_balls}");
     // Balls in the dark, blue-shifted image corners are missed sometimes (as on the robot).
     assert!(
         good_balls * 10 >= checked_balls * 8,

@@ -18,14 +18,14 @@ use crate::common::{eotn, eotn_ok};
 /// Robot 1: 30 cm, −40 cm off (50 cm), 10° turned, distances 10 % long. Robot 2: −20° turned.
 const ERRORS: [&str; 2] = ["1:30,-40,10,10", "2:0,0,-20"];
 
-struct Fixture {
-    dir: tempfile::TempDir,
-    stream: PathBuf,
-    table: PathBuf,
-    cal: PathBuf,
+pub struct Fixture {
+    pub dir: tempfile::TempDir,
+    pub stream: PathBuf,
+    pub table: PathBuf,
+    pub cal: PathBuf,
 }
 
-fn fixture() -> &'static Fixture {
+pub fn fixture() -> &'static Fixture {
     static FIXTURE: OnceLock<Fixture> = OnceLock::new();
     FIXTURE.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
@@ -117,12 +117,13 @@ fn marker_of(n: u32) -> (String, u64) {
     (m.team.name().to_owned(), u64::from(m.identity.value()))
 }
 
-/// A robot's own recording: its world models on `/world_model`, each logged at `time(t)`.
+/// A robot's own recording: its world models on `/world_model`, each logged (and stamped,
+/// `time_ns`) at `keep(t)` on its clock; `edit(t, message)` changes a message.
 fn robot_recording(
     name: &str,
     robot: u32,
     keep: impl Fn(u64) -> Option<u64>,
-    edit: impl Fn(&mut Value),
+    edit: impl Fn(u64, &mut Value),
 ) -> PathBuf {
     let path = fixture().dir.path().join(name);
     let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
@@ -135,7 +136,9 @@ fn robot_recording(
         let Some(log_time) = keep(t) else { continue };
         let (_, v) = extra.iter().find(|(k, _)| *k == topic).unwrap();
         let mut v = v.clone();
-        edit(&mut v);
+        assert_eq!(v["time_ns"], t, "the simulator stamps its world models");
+        v["time_ns"] = log_time.into();
+        edit(t, &mut v);
         let header = mcap::records::MessageHeader {
             channel_id: channel,
             sequence: u32::try_from(sequence).unwrap(),
@@ -271,7 +274,9 @@ fn a_robot_whose_marker_is_not_read_is_matched_by_position_and_says_so() {
         .map(|m| u64::from(m.identity.value()))
         .collect();
     let free = (0..16).find(|i| !claimed.contains(i)).unwrap();
-    let hidden = robot_recording("hidden.mcap", 1, Some, |v| v["robot_id"] = free.into());
+    let hidden = robot_recording("hidden.mcap", 1, Some, |_, v| {
+        v["robot_id"] = free.into();
+    });
     let (lines, _) = wmd(&[&hidden], &["--json"]);
     let mut by_position = 0;
     for line in &lines {
@@ -293,7 +298,7 @@ fn a_robot_whose_marker_is_not_read_is_matched_by_position_and_says_so() {
 #[test]
 fn a_clock_offset_is_found_and_shown() {
     // Robot 2's clock runs 0.4 s ahead of the overhead camera's.
-    let ahead = robot_recording("ahead.mcap", 2, |t| Some(t + 400_000_000), |_| {});
+    let ahead = robot_recording("ahead.mcap", 2, |t| Some(t + 400_000_000), |_, _| {});
     let (lines, stderr) = wmd(&[&ahead], &["--json"]);
     let two = marker_of(2);
     let line = stderr
@@ -325,7 +330,7 @@ fn a_clock_offset_is_found_and_shown() {
 #[test]
 fn a_robot_that_stops_sending_is_listed_until_then_and_warned_about() {
     let stop = 700_000_000;
-    let quiet = robot_recording("quiet.mcap", 2, |t| (t < stop).then_some(t), |_| {});
+    let quiet = robot_recording("quiet.mcap", 2, |t| (t < stop).then_some(t), |_, _| {});
     let (lines, stderr) = wmd(&[&quiet, &fixture().stream], &["--json"]);
     let two = marker_of(2);
     for line in &lines {
@@ -355,8 +360,8 @@ fn a_robot_that_stops_sending_is_listed_until_then_and_warned_about() {
 }
 
 #[test]
-fn bad_world_models_are_skipped_with_a_reason_and_live_sources_refused() {
-    let bad = robot_recording("bad.mcap", 1, Some, |v| v["team"] = "green".into());
+fn bad_world_models_are_skipped_with_a_reason_and_a_camera_device_is_no_robot() {
+    let bad = robot_recording("bad.mcap", 1, Some, |_, v| v["team"] = "green".into());
     let f = fixture();
     let out = eotn(&[
         OsStr::new("wmd"),
@@ -378,7 +383,7 @@ fn bad_world_models_are_skipped_with_a_reason_and_live_sources_refused() {
         OsStr::new("--overhead"),
         f.stream.as_os_str(),
         OsStr::new("--robot"),
-        OsStr::new("ws://127.0.0.1:8765"),
+        OsStr::new("/dev/video99"),
         OsStr::new("--lut"),
         f.table.as_os_str(),
         OsStr::new("--calibration"),
@@ -386,5 +391,266 @@ fn bad_world_models_are_skipped_with_a_reason_and_live_sources_refused() {
     ]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("live source is not read here yet"), "{err}");
+    assert!(err.contains("is a camera device"), "{err}");
+}
+
+#[test]
+fn a_jump_in_a_robots_error_is_marked_once_where_it_happens() {
+    // Robot 1 (50 cm off all along) is a further 150 cm off from 1 s on: one jump, there.
+    let at = 1_000_000_000;
+    let jumpy = robot_recording("jumpy.mcap", 1, Some, |t, v| {
+        if t >= at {
+            let x = v["self"]["x_cm"].as_f64().unwrap();
+            v["self"]["x_cm"] = (x + 150.0).into();
+        }
+    });
+    let (lines, _) = wmd(&[&jumpy], &["--json"]);
+    let one = marker_of(1);
+    let jumps: Vec<u64> = lines
+        .iter()
+        .filter(|l| entry(l, &one).0.is_some_and(|m| m["jump"] == true))
+        .map(|l| l["time_ns"].as_u64().unwrap())
+        .collect();
+    assert!(!jumps.is_empty(), "no jump marked");
+    // Marked at the first frame after the jump that reads its marker, and not again at once
+    // (the 15-frame median catches up with the new error).
+    assert!(jumps[0] >= at && jumps[0] < at + 200_000_000, "{jumps:?}");
+    assert!(
+        jumps.iter().all(|&t| t < at + 600_000_000),
+        "jumps go on: {jumps:?}"
+    );
+    let before = lines
+        .iter()
+        .filter(|l| l["time_ns"].as_u64().unwrap() < at)
+        .filter_map(|l| entry(l, &one).0)
+        .all(|m| m["jump"] == false);
+    assert!(before, "a jump marked before it happened");
+}
+
+/// A session file in the fixture's folder: the fixture's camera twice (ids 0 and 3, so every
+/// robot is seen by both and merged into one), robot 1 from its own recording, robot 2 from the
+/// game's stream (its other robots' world models left out).
+fn session_file(robot1: &Path, extra_camera_keys: &str, field: &str) -> PathBuf {
+    let f = fixture();
+    let (one, two) = (marker_of(1), marker_of(2));
+    let camera = |id: u8, extra: &str| {
+        format!(
+            r#"{{"id": {id}, "source": "{}", "lut": "{}", "calibration": "{}"{extra}}}"#,
+            f.stream.display(),
+            f.table.display(),
+            f.cal.display()
+        )
+    };
+    let json = format!(
+        r#"{{"field": "{field}",
+  "overhead": [{}, {}],
+  "robots": [{{"team": "{}", "robot_id": {}, "source": "{}"}},
+             {{"team": "{}", "robot_id": {}, "source": "{}", "lut": "{}"}}]}}"#,
+        camera(0, ""),
+        camera(3, extra_camera_keys),
+        one.0,
+        one.1,
+        robot1.display(),
+        two.0,
+        two.1,
+        f.stream.display(),
+        f.table.display(),
+    );
+    let path = f.dir.path().join(format!("session-{field}.json"));
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+#[test]
+fn a_session_file_merges_its_cameras_and_reads_each_robots_own_world_models() {
+    let own = robot_recording("own1.mcap", 1, Some, |_, _| {});
+    let cal = fixture().cal.display().to_string();
+    let session = session_file(
+        &own,
+        &format!(r#", "intrinsics": "{cal}""#),
+        "four-legged-2005",
+    );
+    let out = eotn_ok(&[
+        OsStr::new("wmd"),
+        OsStr::new("--session"),
+        session.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // Keys the command does not use are said, never ignored silently.
+    assert!(
+        stderr.contains("overhead[1] (id 3): intrinsics"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("robots[1]") && stderr.contains("lut not used"),
+        "{stderr}"
+    );
+    let lines: Vec<Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 45);
+    let (one, two) = (marker_of(1), marker_of(2));
+    let mut both = 0;
+    for line in &lines {
+        let cameras: Vec<u64> = line["cameras"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["id"].as_u64().unwrap())
+            .collect();
+        assert_eq!(cameras, [0, 3], "{line}");
+        for r in line["robots"].as_array().unwrap() {
+            assert_eq!(r["camera_ids"], serde_json::json!([0, 3]), "one robot: {r}");
+        }
+        let models = line["world_models"].as_array().unwrap();
+        // Only the session's two robots, though the game's stream carries more.
+        assert!(models.len() <= 2, "{models:?}");
+        let (m1, seen1) = entry(line, &one);
+        let (m2, _) = entry(line, &two);
+        if let (Some(m1), true, Some(_)) = (m1, seen1, m2) {
+            assert_eq!(m1["matched"], "marker");
+            let p = m1["position_error_cm"].as_f64().unwrap();
+            assert!((p - 50.0).abs() < 8.0, "{p}");
+            both += 1;
+        }
+    }
+    assert!(both >= 40, "both robots compared in {both} of 45 frames");
+    // Every shipped field is a session's field (the session once knew only two).
+    let session = session_file(&own, "", "ssl-div-a");
+    let out = eotn(&[
+        OsStr::new("wmd"),
+        OsStr::new("--session"),
+        session.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("not a shipped field"), "{stderr}");
+}
+
+/// An independent reader's view of a session recording: messages per topic, the scene
+/// updates' entity ids and frame ids (the `mcap` and `mcap-protobuf-support` Python packages).
+const READ_SESSION_PY: &str = r#"
+import json, sys
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+topics, ids, frames, scenes, ball_z = {}, set(), set(), 0, None
+with open(sys.argv[1], "rb") as f:
+    reader = make_reader(f, decoder_factories=[DecoderFactory()])
+    for schema, channel, message in reader.iter_messages():
+        topics[channel.topic] = topics.get(channel.topic, 0) + 1
+    f.seek(0)
+    reader = make_reader(f, decoder_factories=[DecoderFactory()])
+    for schema, channel, message, scene in reader.iter_decoded_messages(topics=["/wmd/scene"]):
+        assert schema.name == "foxglove.SceneUpdate", schema.name
+        scenes += 1
+        for e in scene.entities:
+            ids.add(e.id)
+            frames.add(e.frame_id)
+            if e.id == "ball":
+                ball_z = e.spheres[0].pose.position.z
+print(json.dumps({"topics": topics, "ids": sorted(ids), "frames": sorted(frames),
+                  "scenes": scenes, "ball_z": ball_z}))
+"#;
+
+#[test]
+fn a_recorded_session_replays_to_the_same_lines_and_shows_in_foxglove_and_the_app() {
+    let f = fixture();
+    // Robot 2 (20° turned), its clock 0.3 s ahead: the offset found is baked into the recording.
+    let own = robot_recording("own2.mcap", 2, |t| Some(t + 300_000_000), |_, _| {});
+    let out_path = f.dir.path().join("recorded-session.mcap");
+    let (lines, stderr) = wmd(&[&own], &["--json", "-o", out_path.to_str().unwrap()]);
+    assert!(stderr.contains("45 field frames"), "{stderr}");
+    assert!(!out_path.with_extension("mcap.partial").exists());
+    // Replayed from the recording alone: the same lines (the world models were logged at the
+    // frames they were paired with; the clock offset found is already in them).
+    let again = eotn_ok(&[
+        OsStr::new("wmd"),
+        OsStr::new("--overhead"),
+        out_path.as_os_str(),
+        OsStr::new("--robot"),
+        out_path.as_os_str(),
+        OsStr::new("--lut"),
+        f.table.as_os_str(),
+        OsStr::new("--calibration"),
+        f.cal.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    let replayed: Vec<Value> = String::from_utf8_lossy(&again.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(replayed.len(), lines.len());
+    for (a, b) in lines.iter().zip(&replayed) {
+        assert_eq!(a, b);
+    }
+    // The app's field view: the stream is an overhead camera's, names its table, and each frame
+    // carries the world models the field model compares.
+    let mut r = StreamReader::open(&out_path).unwrap();
+    assert!(r.info().source.contains("overhead"), "{:?}", r.info());
+    assert_eq!(
+        r.camera_files().unwrap().lut.as_deref(),
+        Some(f.table.as_path())
+    );
+    let rec = r.read(20).unwrap();
+    let lut = eotn::lut::LookupTable::load(&f.table).unwrap();
+    let cal = eotn::overhead::calibration::Calibration::load(&f.cal).unwrap();
+    let mut pipeline = eotn::overhead::OverheadPipeline::new(
+        lut,
+        cal.camera,
+        eotn::overhead::recognise::OverheadParams::default(),
+    );
+    let detections = pipeline.process(&rec.frame).clone();
+    let mut model = eotn::workspace::field_model::FieldModel::default();
+    model.observe(20, rec.time_ns, Some(&detections), &rec.extra);
+    assert!(
+        model
+            .world_models()
+            .iter()
+            .any(|w| w.matched == eotn::wmd::Matched::Marker),
+        "{:?}",
+        model.world_models()
+    );
+    // Foxglove: an independent reader finds the scene updates and decodes them.
+    let Some(python) = crate::common::python_with_mcap() else {
+        return;
+    };
+    let out = std::process::Command::new(python)
+        .args(["-c", READ_SESSION_PY])
+        .arg(&out_path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let seen: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(seen["scenes"], 45);
+    assert_eq!(seen["topics"]["/camera/image"], 45);
+    assert_eq!(seen["topics"]["/wmd/frame"], 45);
+    assert_eq!(seen["frames"], serde_json::json!(["field"]));
+    let ids: Vec<&str> = seen["ids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    let one = marker_of(2);
+    for want in [
+        "field".to_owned(),
+        "ball".to_owned(),
+        format!("robot/{}/{}", one.0, one.1),
+        format!("world_model/{}/{}", one.0, one.1),
+    ] {
+        assert!(ids.contains(&want.as_str()), "{want}: {ids:?}");
+    }
+    let topic = format!("/world_model/{}-{}", one.0, one.1);
+    assert!(seen["topics"][&topic].as_u64().unwrap() >= 42, "{seen}");
+    // The ball's sphere sits on the ground, in metres.
+    assert!(
+        (seen["ball_z"].as_f64().unwrap() - 0.0425).abs() < 1e-9,
+        "{seen}"
+    );
 }

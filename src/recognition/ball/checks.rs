@@ -68,7 +68,8 @@ fn colour_tests(
         ),
         None => confidence.skipped(TestName::CircleFill, params.circle_fill),
     }
-    if let Some(share) = unclassified_around(img, m.outline.bounds) {
+    if let Some(share) = unclassified_around(img, m.outline.bounds, params.unclassified_ring_gap_px)
+    {
         confidence.range_test(
             TestName::UnclassifiedAround,
             share,
@@ -196,7 +197,7 @@ fn place_tests(
         // colour (carpet, its shadow on the carpet, or a line) lies right at its foot; at the
         // foot of an off-field thing lie furniture or the floor, even where the carpet shows a
         // little lower in the image.
-        match field_at_foot(img, m.outline.bounds) {
+        match field_below(img, m.outline.bounds, params.field_below_reach_radii) {
             Some(field) => confidence.range_test(
                 TestName::FieldBelow,
                 field,
@@ -244,17 +245,31 @@ fn field_beneath(img: &ClassifiedImage, b: PixelBox, radii: f64) -> Option<f64> 
     (n > 0).then(|| f64::from(field) / f64::from(n))
 }
 
+/// The field-below share: the band at the box's foot ([`field_at_foot`]) and, when
+/// `reach_radii` is positive, the same band moved down one pixel at a time up to that many
+/// radii (half the box's larger side) further; the best share counts (`None` when no band lies
+/// inside the image).
+fn field_below(img: &ClassifiedImage, b: PixelBox, reach_radii: f64) -> Option<f64> {
+    let side = (b.max_x - b.min_x).max(b.max_y - b.min_y) + 1;
+    // Whole pixels; a NaN or negative reach reads the foot only.
+    let reach = (f64::from(side) / 2.0 * reach_radii).clamp(0.0, 1024.0) as i64;
+    (0..=reach)
+        .filter_map(|down| field_at_foot(img, b, down))
+        .max_by(f64::total_cmp)
+}
+
 /// Share of field colours in a band three rows high just below the box, a few pixels down
-/// (past the rim pixels whose UYVY pair mixes the ball's chroma with the carpet's) and across
-/// the middle three fifths of its width (pixels inside the image only); `None` when the band
-/// lies wholly outside (a ball cut by the bottom edge). White counts only beside some green
-/// (at least a tenth of the band): a line crossing under a ball has carpet beside it, while
-/// the white base of a beacon or a robot's shell standing off the field has none.
-fn field_at_foot(img: &ClassifiedImage, b: PixelBox) -> Option<f64> {
+/// (past the rim pixels whose UYVY pair mixes the ball's chroma with the carpet's) and `down`
+/// rows further, across the middle three fifths of its width (pixels inside the image only);
+/// `None` when the band lies wholly outside (a ball cut by the bottom edge). White counts only
+/// beside some green (at least a tenth of the band): a line crossing under a ball has carpet
+/// beside it, while the white base of a beacon or a robot's shell standing off the field has
+/// none.
+fn field_at_foot(img: &ClassifiedImage, b: PixelBox, down: i64) -> Option<f64> {
     let (minx, maxx) = (i64::from(b.min_x), i64::from(b.max_x));
     let (miny, maxy) = (i64::from(b.min_y), i64::from(b.max_y));
     let inset = (maxx - minx + 1) / 5;
-    let gap = ((maxy - miny + 1) / 16).clamp(1, 3);
+    let gap = ((maxy - miny + 1) / 16).clamp(1, 3) + down;
     let (mut n, mut green, mut white) = (0u32, 0u32, 0u32);
     for y in maxy + 1 + gap..=maxy + 3 + gap {
         for x in minx + inset..=maxx - inset {
@@ -273,11 +288,12 @@ fn field_at_foot(img: &ClassifiedImage, b: PixelBox) -> Option<f64> {
     (n > 0).then(|| f64::from(field) / f64::from(n))
 }
 
-/// Share of unclassified pixels on the ring one pixel outside the box (pixels inside the image
-/// only); `None` when the ring lies wholly outside.
-fn unclassified_around(img: &ClassifiedImage, b: PixelBox) -> Option<f64> {
-    let (minx, miny) = (i64::from(b.min_x) - 1, i64::from(b.min_y) - 1);
-    let (maxx, maxy) = (i64::from(b.max_x) + 1, i64::from(b.max_y) + 1);
+/// Share of unclassified pixels on the ring one pixel outside the box, or `gap` pixels further
+/// out (pixels inside the image only); `None` when the ring lies wholly outside.
+fn unclassified_around(img: &ClassifiedImage, b: PixelBox, gap: u32) -> Option<f64> {
+    let d = 1 + i64::from(gap);
+    let (minx, miny) = (i64::from(b.min_x) - d, i64::from(b.min_y) - d);
+    let (maxx, maxy) = (i64::from(b.max_x) + d, i64::from(b.max_y) + d);
     let ring = (minx..=maxx)
         .flat_map(|x| [(x, miny), (x, maxy)])
         .chain((miny + 1..maxy).flat_map(|y| [(minx, y), (maxx, y)]));

@@ -40,12 +40,18 @@ pub use distance::distance_from_circle;
 pub struct BallParams {
     /// Ball diameter, centimetres (2005 Four-Legged League: 8.5).
     pub diameter_cm: f64,
-    /// Candidates with fewer pixels are ignored.
+    /// Candidates whose orange core (the basic-orange blob, before soft colours join it) has
+    /// fewer pixels are ignored; a group of soft colours alone needs this many of its own.
     pub min_pixels: u32,
     /// At most this many candidates are scored per frame.
     pub max_candidates: usize,
     /// Soft-colour blobs join an orange blob when their boxes come this close, pixels.
     pub soft_join_px: u32,
+    /// Soft-colour blobs that join no orange blob are candidates of their own (scored with the
+    /// orange-fraction test). Off for a camera whose dim ball colours are soft classes shared
+    /// with skin, wood and lights (`params/ssl-onboard.json`): there a soft colour only widens an
+    /// orange core to the ball's rim and shadow side, and is never a ball by itself.
+    pub soft_candidates: bool,
     /// Accepted pixels / box area (a full disc fills π/4 ≈ 0.785 of its box).
     pub pixel_ratio: [f64; 2],
     /// Weight of the pixel-ratio test.
@@ -74,6 +80,12 @@ pub struct BallParams {
     pub field_below_without_pose: [f64; 2],
     /// Weight of the field-below test (applied only without a pose).
     pub field_below_without_pose_weight: TestWeight,
+    /// How far below its foot the field-below test may look, in the candidate's radii (half its
+    /// box's larger side): the band is also taken one, two, … pixels lower down to this reach,
+    /// and the best share counts. The carpet right under a lit ball is its own shadow (dark
+    /// enough to classify as black or not at all), while the foot of a light on a robot is the
+    /// robot's body all the way down. 0 (the default) reads the band at the foot only.
+    pub field_below_reach_radii: f64,
     /// Without a camera pose, the share of field colours (green or white) a ball needs in the
     /// strip beneath it: as wide as its box, from two pixels below it down
     /// [`Self::field_beneath_radii`] radii (inside the image). A ball on the field has field
@@ -100,6 +112,11 @@ pub struct BallParams {
     pub unclassified_around: [f64; 2],
     /// Weight of the unclassified-surroundings test.
     pub unclassified_around_weight: TestWeight,
+    /// The unclassified-surroundings ring lies this many pixels further out than right beside
+    /// the box: past a blurred ball's rim, whose pixels mix the ball's colour with the carpet's
+    /// and classify as neither (the SSL on-board frames' small balls, `params/ssl-onboard.json`).
+    /// 0 (the default) reads the ring right beside the box.
+    pub unclassified_ring_gap_px: u32,
     /// Accepted share of ball colours among the image pixels inside the circle (where the image
     /// shows it): a ball fills its outline, even with a side hidden (an eligible ball is at
     /// least 60% in view) or holes in its classification; a thin orange arc — the red rim of the
@@ -222,6 +239,7 @@ impl Default for BallParams {
             min_pixels: 5,
             max_candidates: 6,
             soft_join_px: 2,
+            soft_candidates: true,
             pixel_ratio: [0.4, 1.0],
             pixel_ratio_weight: TestWeight::new(1.0, 2.0),
             height_cm: [-6.0, 16.0],
@@ -231,6 +249,7 @@ impl Default for BallParams {
             green_below_bonus: 1.0,
             field_below_without_pose: [0.5, 1.0],
             field_below_without_pose_weight: TestWeight::new(0.0, 2.5),
+            field_below_reach_radii: 0.0,
             field_beneath_without_pose: [0.5, 1.0],
             field_beneath_without_pose_weight: TestWeight::new(0.0, 0.0),
             field_beneath_radii: 12.0,
@@ -240,6 +259,7 @@ impl Default for BallParams {
             orange_fraction_weight: TestWeight::new(0.5, 2.0),
             unclassified_around: [0.0, 0.6],
             unclassified_around_weight: TestWeight::new(0.0, 2.0),
+            unclassified_ring_gap_px: 0,
             circle_fill: [0.2, 1.0],
             circle_fill_weight: TestWeight::new(0.0, 3.0),
             edge_margin_px: 3,

@@ -124,8 +124,10 @@ fn is_robot_colour(code: u8) -> bool {
     )
 }
 
-/// Candidate groups: each orange blob joined with the soft-orange blobs near it, then soft blobs
-/// left over on their own; largest first.
+/// Candidate groups: each orange blob of at least `min_pixels` joined with the soft-orange blobs
+/// near it, then (when [`BallParams::soft_candidates`]) soft blobs left over on their own;
+/// largest first. The orange core alone must reach `min_pixels`: a speck of orange on a red
+/// shirt is not made a candidate by the shirt's soft colours joining it.
 pub(super) fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blob, u32)> {
     let soft: Vec<&Blob> = blobs
         .active()
@@ -133,7 +135,10 @@ pub(super) fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blo
         .collect();
     let mut used = vec![false; soft.len()];
     let mut groups: Vec<(Blob, u32)> = Vec::new();
-    for orange in blobs.of_class(ColourClass::Orange) {
+    let cores = blobs
+        .of_class(ColourClass::Orange)
+        .filter(|o| o.pixels >= params.min_pixels);
+    for orange in cores {
         let mut joined = *orange;
         for (i, s) in soft.iter().enumerate() {
             if !used[i] && joined.bounds().is_near(&s.bounds(), params.soft_join_px) {
@@ -143,9 +148,11 @@ pub(super) fn candidate_groups(blobs: &BlobSet, params: &BallParams) -> Vec<(Blo
         }
         groups.push((joined, orange.pixels));
     }
-    for (i, s) in soft.iter().enumerate() {
-        if !used[i] {
-            groups.push((**s, 0));
+    if params.soft_candidates {
+        for (i, s) in soft.iter().enumerate() {
+            if !used[i] {
+                groups.push((**s, 0));
+            }
         }
     }
     groups.retain(|(b, _)| b.pixels >= params.min_pixels);

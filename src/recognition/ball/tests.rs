@@ -474,3 +474,172 @@ fn without_a_pose_field_beneath_rejects_an_orange_light_above_the_field_when_ask
     assert!(beneath.value > 0.9 && beneath.effect == 0.0, "{beneath:?}");
     assert!(res.ball.is_some());
 }
+
+/// `min_pixels` counts the orange core, not the soft colours joining it (issue 33 item 18: a
+/// 4-pixel orange blob on a red shirt was accepted with `min_pixels` 5, the shirt's red-orange
+/// around it making up the count). A soft group alone is a candidate only when asked.
+#[test]
+fn min_pixels_counts_the_orange_core_and_soft_groups_alone_are_candidates_only_when_asked() {
+    let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+        320,
+        240,
+        45.0_f64.to_radians(),
+    ));
+    // A red-orange shirt patch (soft) of 12 × 12 on the carpet, with 2 × 2 orange inside.
+    let shirt = |orange: bool| {
+        let codes = (0..320 * 240)
+            .map(|i| {
+                let (x, y) = (i % 320, i / 320);
+                if orange && (105..107).contains(&x) && (105..107).contains(&y) {
+                    ColourClass::Orange.code()
+                } else if (100..112).contains(&x) && (100..112).contains(&y) {
+                    ColourClass::RedOrange.code()
+                } else {
+                    ColourClass::Green.code()
+                }
+            })
+            .collect();
+        ClassifiedImage::from_codes(320, 240, codes).expect("size")
+    };
+    let img = shirt(true);
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let params = BallParams::default();
+    assert_eq!(params.min_pixels, 5);
+    let res = recognise_ball(&img, &blobs, &ctx, &params);
+    // The 4-pixel core makes no candidate; the shirt is scored as a soft group of its own
+    // (orange pixels 0), not as a ball with a 4-pixel core.
+    assert!(
+        res.candidates.iter().all(|c| c.orange_pixels == 0),
+        "{:?}",
+        res.candidates
+    );
+    // With soft groups alone off, nothing is a candidate at all.
+    let no_soft = BallParams {
+        soft_candidates: false,
+        ..params
+    };
+    let res = recognise_ball(&img, &blobs, &ctx, &no_soft);
+    assert!(res.candidates.is_empty(), "{:?}", res.candidates);
+    // A core of at least min_pixels still joins the soft colours around it.
+    let big_core = BallParams {
+        min_pixels: 4,
+        ..no_soft
+    };
+    let res = recognise_ball(&img, &blobs, &ctx, &big_core);
+    assert_eq!(res.candidates.len(), 1);
+    assert_eq!(
+        (res.candidates[0].pixels, res.candidates[0].orange_pixels),
+        (144, 4)
+    );
+    // Soft colours alone are still a candidate by default.
+    let soft_only = shirt(false);
+    let blobs = BlobSet::from_image(&soft_only, Connectivity::Eight);
+    assert_eq!(
+        recognise_ball(&soft_only, &blobs, &ctx, &params)
+            .candidates
+            .len(),
+        1
+    );
+    assert!(
+        recognise_ball(&soft_only, &blobs, &ctx, &no_soft)
+            .candidates
+            .is_empty()
+    );
+}
+
+/// Without a pose, `field_below` may look past the ball's own shadow when asked
+/// (`field_below_reach_radii`): the band under a lit ball is dark, the carpet goes on below it;
+/// an orange light on a robot has the robot's body all the way down and still fails.
+#[test]
+fn field_below_looks_past_the_ball_s_shadow_when_asked_but_not_past_a_robot() {
+    let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+        320,
+        240,
+        45.0_f64.to_radians(),
+    ));
+    let (cx, cy, r) = (160.0, 150.0, 5.0);
+    // `dark_rows` rows of black right under the ball (its shadow, or a robot's body).
+    let scene_with = |dark_rows: f64| {
+        let img = big_scene(cx, cy, r, |_, _| false);
+        let mut codes = img.codes().to_vec();
+        for (i, c) in codes.iter_mut().enumerate() {
+            let (x, y) = ((i % 320) as f64 + 0.5, (i / 320) as f64 + 0.5);
+            if *c == ColourClass::Green.code()
+                && (x - cx).abs() < r + 2.0
+                && y > cy + r
+                && y < cy + r + dark_rows
+            {
+                *c = ColourClass::Black.code();
+            }
+        }
+        ClassifiedImage::from_codes(320, 240, codes).expect("size")
+    };
+    let field_below = |img: &ClassifiedImage, reach: f64| {
+        let params = BallParams {
+            field_below_reach_radii: reach,
+            ..BallParams::default()
+        };
+        let blobs = BlobSet::from_image(img, Connectivity::Eight);
+        let res = recognise_ball(img, &blobs, &ctx, &params);
+        let t = res.candidates[0]
+            .confidence
+            .test(TestName::FieldBelow)
+            .expect("field below");
+        (t.value, t.effect)
+    };
+    let shadow = scene_with(4.0);
+    let (share, effect) = field_below(&shadow, 0.0);
+    assert!(share < 0.5 && effect < 0.0, "at the foot only: {share}");
+    let (share, effect) = field_below(&shadow, 1.5);
+    assert!(share > 0.9 && effect == 0.0, "past the shadow: {share}");
+    let robot = scene_with(60.0);
+    let (share, effect) = field_below(&robot, 1.5);
+    assert!(share < 0.5 && effect < 0.0, "a robot below: {share}");
+}
+
+/// `unclassified_ring_gap_px` reads the unclassified-surroundings ring past a blurred ball's
+/// rim: a ball whose outermost pixel ring classifies as nothing (the mix of ball and carpet)
+/// fails the test right beside its box and passes one pixel further out.
+#[test]
+fn the_unclassified_ring_can_lie_past_a_blurred_rim() {
+    let ctx = ViewContext::without_pose(PinholeCamera::from_horizontal_fov(
+        320,
+        240,
+        45.0_f64.to_radians(),
+    ));
+    let (cx, cy, r) = (160.0, 150.0, 5.0);
+    let codes = (0..320 * 240)
+        .map(|i| {
+            let (x, y) = ((i % 320) as f64 + 0.5, (i / 320) as f64 + 0.5);
+            let d = (x - cx).hypot(y - cy);
+            if d <= r {
+                ColourClass::Orange.code()
+            } else if d <= r + 1.8 {
+                ColourClass::Unclassified.code()
+            } else {
+                ColourClass::Green.code()
+            }
+        })
+        .collect();
+    let img = ClassifiedImage::from_codes(320, 240, codes).expect("size");
+    let blobs = BlobSet::from_image(&img, Connectivity::Eight);
+    let share = |gap: u32| {
+        let params = BallParams {
+            unclassified_ring_gap_px: gap,
+            ..BallParams::default()
+        };
+        let res = recognise_ball(&img, &blobs, &ctx, &params);
+        let t = res.candidates[0]
+            .confidence
+            .test(TestName::UnclassifiedAround)
+            .expect("unclassified around");
+        (t.value, t.effect)
+    };
+    let (beside, effect) = share(0);
+    assert!(
+        beside > 0.6 && effect < 0.0,
+        "right beside the box: {beside}"
+    );
+    let (past, effect) = share(1);
+    assert!(past < 0.4 && effect == 0.0, "past the rim: {past}");
+}

@@ -364,10 +364,10 @@ impl McapFile {
 
     fn mcap_err(&self, context: String) -> impl FnOnce(mcap::McapError) -> StreamError {
         let path = self.path.clone();
-        move |source| StreamError::Mcap {
+        move |cause| StreamError::Mcap {
             path,
             context,
-            source,
+            cause,
         }
     }
 

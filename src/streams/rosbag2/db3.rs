@@ -95,6 +95,8 @@ impl Db3File {
             detail: format!("not a rosbag2 SQLite database: {e}"),
         };
         let conn = Connection::open_with_flags(immutable_uri(path), flags).map_err(sql)?;
+        // Read as every input is: no output of the running command may replace it.
+        crate::atomic_file::guard_inputs([path]);
         let mut file = Self {
             path: path.to_owned(),
             conn,

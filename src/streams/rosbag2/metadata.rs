@@ -263,6 +263,59 @@ mod tests {
   ros_distro: jazzy
 ";
 
+    /// Version 7 (Iron): `files`, `custom_data` and type hashes, qos as a string, no
+    /// `ros_distro` (rosbag2's `yaml.hpp` reads that from version 8 on).
+    const V7: &str = "rosbag2_bagfile_information:
+  version: 7
+  storage_identifier: mcap
+  duration:
+    nanoseconds: 800000000
+  starting_time:
+    nanoseconds_since_epoch: 1700000000000000000
+  message_count: 48
+  topics_with_message_count:
+    - topic_metadata:
+        name: /camera/image_raw
+        type: sensor_msgs/msg/Image
+        serialization_format: cdr
+        offered_qos_profiles: \"- history: 3\\n  depth: 0\\n  reliability: 1\\n\"
+        type_description_hash: RIHS01_d31d9d8d0e1ea53a
+      message_count: 24
+    - topic_metadata:
+        name: /joint_states
+        type: sensor_msgs/msg/JointState
+        serialization_format: cdr
+        offered_qos_profiles: \"\"
+        type_description_hash: RIHS01_a5a5
+      message_count: 24
+  compression_format: \"\"
+  compression_mode: \"\"
+  relative_file_paths:
+    - iron_0.mcap
+  files:
+    - path: iron_0.mcap
+      starting_time:
+        nanoseconds_since_epoch: 1700000000000000000
+      duration:
+        nanoseconds: 800000000
+      message_count: 48
+  custom_data: ~
+";
+
+    #[test]
+    fn version_seven_parses_with_its_type_hashes_and_without_a_distro() {
+        let m = BagMetadata::parse(V7.as_bytes()).unwrap();
+        assert_eq!(m.version, 7);
+        assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        assert_eq!(m.storage_identifier, "mcap");
+        assert_eq!(m.files, [PathBuf::from("iron_0.mcap")]);
+        assert_eq!(m.compression, BagCompression::None);
+        let names: Vec<&str> = m.topics.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["/camera/image_raw", "/joint_states"]);
+        assert_eq!(m.topics[0].type_name, "sensor_msgs/msg/Image");
+        assert_eq!(m.topics[0].message_count, 24);
+    }
+
     #[test]
     fn versions_four_and_nine_parse() {
         let m = BagMetadata::parse(V4.as_bytes()).unwrap();

@@ -162,10 +162,10 @@ impl StreamWriter {
         let mcap_err = |context: &str| {
             let path = partial.clone();
             let context = context.to_owned();
-            move |source| StreamError::Mcap {
+            move |cause| StreamError::Mcap {
                 path,
                 context,
-                source,
+                cause,
             }
         };
         let compression = match options.compression {
@@ -233,10 +233,10 @@ impl StreamWriter {
     fn mcap_err(&self, context: &str) -> impl FnOnce(mcap::McapError) -> StreamError {
         let path = self.partial.clone();
         let context = context.to_owned();
-        move |source| StreamError::Mcap {
+        move |cause| StreamError::Mcap {
             path,
             context,
-            source,
+            cause,
         }
     }
 
@@ -353,10 +353,10 @@ impl StreamWriter {
         let path = self.partial.clone();
         self.mcap
             .write_metadata(&metadata)
-            .map_err(|source| StreamError::Mcap {
+            .map_err(|cause| StreamError::Mcap {
                 path,
                 context: "cannot write the parameter set's metadata".to_owned(),
-                source,
+                cause,
             })
     }
 
