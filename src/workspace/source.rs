@@ -434,7 +434,8 @@ mod tests {
         let mut w = StreamWriter::create(&path, &info).unwrap();
         for k in 0..12u8 {
             let f = Frame::filled_uyvy(16, 8, Yuv::new(20 + k, 128, 128)).unwrap();
-            w.write(&FrameRecord::new(u64::from(k) * 1_000_000, f)).unwrap();
+            w.write(&FrameRecord::new(u64::from(k) * 1_000_000, f))
+                .unwrap();
         }
         w.finish().unwrap();
         let mut s = Source::stream(&path).unwrap();

@@ -119,6 +119,61 @@ fn pixels_already_in_the_class_are_neither_counted_nor_hatched() {
     assert!(img.pixels[50 * 208 + 65].a() < 255);
 }
 
+/// A view smaller than the image keeps one pixel in `step` each way (what nearest filtering
+/// shows at that scale): each texel is the image's pixel at (x·step, y·step), raw, classified
+/// and preview alike (issue 33 item 9: a 1920×1200 frame fitted into the window was converted
+/// and uploaded whole on every step).
+#[test]
+fn a_view_smaller_than_the_image_keeps_every_steps_pixel() {
+    use eotn::app::{
+        palette, preview_image, preview_image_every, texture_step, view_images, view_images_every,
+    };
+    assert_eq!(texture_step(1.0), 1);
+    assert_eq!(texture_step(2.5), 1);
+    assert_eq!(texture_step(0.5), 2);
+    assert_eq!(texture_step(0.34), 2);
+    assert_eq!(texture_step(0.33), 3);
+    assert_eq!(texture_step(f32::NAN), 1);
+    assert_eq!(texture_step(0.0), 1);
+    let dir = tempfile::tempdir().unwrap();
+    let (frame, table) = one_frame(dir.path());
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![frame, table])).unwrap();
+    w.settings.overlays.classified = true;
+    w.apply(TableCommand::SetClass(ColourClass::Orange).into())
+        .unwrap();
+    w.apply(TableCommand::Sample { x: 150, y: 120 }.into())
+        .unwrap();
+    let p = palette();
+    let whole = view_images(&w, &p).unwrap();
+    let whole_preview = preview_image(&w, [208, 160]);
+    for step in [2, 3, 5] {
+        let part = view_images_every(&w, &p, step).unwrap();
+        let preview = preview_image_every(&w, [208, 160], step);
+        let size = [208_usize.div_ceil(step), 160_usize.div_ceil(step)];
+        assert_eq!(part.raw.size, size);
+        assert_eq!(part.classified.size, size);
+        assert_eq!(preview.size, size);
+        for ty in 0..size[1] {
+            for tx in 0..size[0] {
+                let (t, i) = (ty * size[0] + tx, ty * step * 208 + tx * step);
+                assert_eq!(
+                    part.raw.pixels[t], whole.raw.pixels[i],
+                    "step {step} ({tx}, {ty})"
+                );
+                assert_eq!(part.classified.pixels[t], whole.classified.pixels[i]);
+                // Hatched texels keep their stripes in texels: opaque where the whole
+                // preview is, dimmed or clear where it is.
+                let (a, b) = (preview.pixels[t], whole_preview.pixels[i]);
+                assert_eq!(a.a() == 255, b.a() == 255, "step {step} ({tx}, {ty})");
+                if b.a() < 255 {
+                    assert_eq!(a, b);
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn a_click_in_the_image_takes_the_keyboard_from_a_text_field() {
     let dir = tempfile::tempdir().unwrap();

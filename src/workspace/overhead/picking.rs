@@ -5,8 +5,8 @@
 use anyhow::Context as _;
 
 use super::{MIN_CALIBRATION_POINTS, PickEdit};
-use crate::overhead::{CalibrationPoint, PointsFile};
 use crate::overhead::calibration::{CalibrationParams, calibrate_with};
+use crate::overhead::{CalibrationPoint, PointsFile};
 use crate::workspace::Workspace;
 
 impl Workspace {
