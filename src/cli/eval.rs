@@ -4,7 +4,7 @@
 //! relation to the truth and writes it as recognition parameters. `--labels` scores a real
 //! stream against hand labels instead (`eval_labels.rs`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use serde::Serialize;
@@ -403,30 +403,6 @@ fn calibrate_goals(
     Ok((m, o))
 }
 
-/// `eotn eval OVERHEAD… --truth-ssl LOG|udp://…`: the overhead streams against ssl-vision's
-/// detections.
-fn run_truth_ssl(args: &Args, source: &Path, lut_path: &Path) -> anyhow::Result<()> {
-    super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
-        .context("--truth-ssl is the truth of overhead streams")?;
-    let truth = super::eval_overhead::load_ssl_truth(source)?;
-    super::eval_overhead::run(
-        &args.streams,
-        args.camera.get(),
-        lut_path,
-        args.calibration.as_deref(),
-        args.field.as_deref(),
-        &truth,
-        args.json,
-    )
-}
-
-/// The streams among `args.streams` whose source kind is not an overhead camera's.
-fn robot_camera_streams(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
-    let inputs =
-        super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
-    Ok(inputs.robot_streams().to_vec())
-}
-
 /// Runs `eotn eval`.
 ///
 /// # Errors
@@ -434,26 +410,8 @@ fn robot_camera_streams(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let lut_path =
         super::inputs::table_or_camera_s(args.lut.as_deref(), &args.streams, args.camera.get())?;
-    if let Some(source) = &args.truth_ssl {
-        return run_truth_ssl(args, source, &lut_path);
-    }
-    let overhead = args
-        .streams
-        .iter()
-        .filter(|p| super::eval_overhead::is_overhead_stream(p))
-        .count();
-    if overhead == args.streams.len() {
-        return super::eval_overhead::run(
-            &args.streams,
-            args.camera.get(),
-            &lut_path,
-            args.calibration.as_deref(),
-            args.field.as_deref(),
-            &super::eval_overhead::TruthSource::Stream,
-            args.json,
-        );
-    } else if overhead > 0 {
-        bail!("give overhead streams and robot-camera streams to separate `eotn eval` runs");
+    if super::eval_overhead::run_from_eval(args, &lut_path)? {
+        return Ok(());
     }
     if args.calibration.is_some() || args.field.is_some() {
         super::overhead::refuse_robot_streams(&args.streams)

@@ -427,3 +427,56 @@ fn print_report(r: &OverheadEvalReport, calibration: &str, skipped: &[String]) {
         );
     }
 }
+
+/// `eotn eval OVERHEAD… --truth-ssl LOG|udp://…`: the overhead streams against ssl-vision's
+/// detections.
+fn run_truth_ssl(args: &super::eval::Args, source: &Path, lut_path: &Path) -> anyhow::Result<()> {
+    super::overhead::refuse_robot_streams(&robot_camera_streams(args)?)
+        .context("--truth-ssl is the truth of overhead streams")?;
+    let truth = load_ssl_truth(source)?;
+    run(
+        &args.streams,
+        args.camera.get(),
+        lut_path,
+        args.calibration.as_deref(),
+        args.field.as_deref(),
+        &truth,
+        args.json,
+    )
+}
+
+/// The streams among `args.streams` whose source kind is not an overhead camera's.
+fn robot_camera_streams(args: &super::eval::Args) -> anyhow::Result<Vec<PathBuf>> {
+    let inputs =
+        super::inputs::FrameInputs::open_camera(&args.streams, Some(0..1), args.camera.get())?;
+    Ok(inputs.robot_streams().to_vec())
+}
+
+/// Overhead streams, against their own truth or ssl-vision's (`--truth-ssl`), are evaluated by
+/// `eval_overhead`: `Ok(true)` when they were, `Ok(false)` when the streams are robot cameras'.
+pub(super) fn run_from_eval(args: &super::eval::Args, lut_path: &Path) -> anyhow::Result<bool> {
+    if let Some(source) = &args.truth_ssl {
+        run_truth_ssl(args, source, lut_path)?;
+        return Ok(true);
+    }
+    let overhead = args
+        .streams
+        .iter()
+        .filter(|p| is_overhead_stream(p))
+        .count();
+    if overhead == args.streams.len() {
+        run(
+            &args.streams,
+            args.camera.get(),
+            lut_path,
+            args.calibration.as_deref(),
+            args.field.as_deref(),
+            &TruthSource::Stream,
+            args.json,
+        )?;
+        return Ok(true);
+    } else if overhead > 0 {
+        bail!("give overhead streams and robot-camera streams to separate `eotn eval` runs");
+    }
+    Ok(false)
+}

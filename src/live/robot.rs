@@ -7,7 +7,7 @@
 //! frame with the same log time, whether they come just before or just after its image.
 //!
 //! A robot with several image channels (a NAO's top and bottom cameras) has a camera for each
-//! ([`CameraFrames`]): the first — the canonical `/camera/image`, else the first advertised —
+//! (`CameraFrames`): the first — the canonical `/camera/image`, else the first advertised —
 //! is the one shown and counted in the statistics; each other camera keeps its own frames and
 //! arrival times on the same clock ([`LiveRobot::camera_view`]), and a channel `CAMERA/sensors`
 //! (or `…/recognition`, `…/ground_truth`) goes with that camera's frames.

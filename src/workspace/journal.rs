@@ -165,7 +165,7 @@ pub struct Replayed {
 /// Replays journal entries (after the start line) onto `lut`, rebuilding the undo history.
 ///
 /// A journal whose oldest edits the history's bound drops is replayed from its last whole-table
-/// edit that the bound surely drops ([`settled_start`]): the table after that edit is the same
+/// edit that the bound surely drops (`settled_start`): the table after that edit is the same
 /// whatever came before it, and nothing before it can be undone, so the edits before it are
 /// counted as dropped without being applied (40 whole-table edits of an 8-bit table: 17 passes
 /// over the table instead of 40).

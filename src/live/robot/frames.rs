@@ -6,7 +6,7 @@ use super::{CameraFrames, Connection, Inner, LiveFrame, RobotStats, lock};
 use crate::live::RobotUrl;
 
 /// A read-only handle on a robot's frames (cheap to clone): what a viewer steps through while
-/// the robot's thread goes on adding frames. It reads the same state as its [`LiveRobot`] and
+/// the robot's thread goes on adding frames. It reads the same state as its [`LiveRobot`](super::LiveRobot) and
 /// stays readable (frozen) after the robot is dropped.
 #[derive(Clone)]
 pub struct RobotFrames {
