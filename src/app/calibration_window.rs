@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use egui::Ui;
 
+use super::file_dialog::FileAction;
 use crate::workspace::{
     Command, OverheadCommand, OverheadView, Workspace, overhead::MIN_CALIBRATION_POINTS,
 };
@@ -24,16 +25,20 @@ pub struct OverheadPaths {
     pub intrinsics: String,
 }
 
+/// A file dialog a window asks for: what for, and the file name a save suggests.
+pub type DialogRequest = Option<(FileAction, Option<String>)>;
+
 /// The window's contents.
 pub fn calibration_ui(
     ui: &mut Ui,
     state: &Workspace,
     paths: &mut OverheadPaths,
     commands: &mut Vec<Command>,
+    dialog: &mut DialogRequest,
 ) {
     let overhead = state.overhead();
     ui.label(overhead.calibration_status());
-    files_ui(ui, state, paths, commands);
+    files_ui(ui, state, paths, commands, dialog);
     ui.separator();
     view_options_ui(ui, state, commands);
     ui.separator();
@@ -42,12 +47,18 @@ pub fn calibration_ui(
     points_table_ui(ui, state);
 }
 
+/// One button of a [`path_row`]: its text, whether it can be used, and the file dialog it
+/// opens when no path is typed (`None`: it needs a typed path).
+type PathButton<'a> = (&'a str, bool, Option<FileAction>);
+
+/// A typed path and its buttons; returns the button clicked. A button with a dialog stays
+/// usable with no path typed (the dialog asks for one); one without says what it needs.
 fn path_row(
     ui: &mut Ui,
     label: &str,
     hint: &str,
     text: &mut String,
-    buttons: &[(&str, bool)],
+    buttons: &[PathButton<'_>],
 ) -> Option<usize> {
     let mut clicked = None;
     // Wrapped: the docked window may be narrower than a row.
@@ -59,14 +70,20 @@ fn path_row(
                 .desired_width(220.0),
         )
         .labelled_by(name.id);
-        for (k, (name, enabled)) in buttons.iter().enumerate() {
-            if ui
-                .add_enabled(
-                    *enabled && !text.trim().is_empty(),
-                    egui::Button::new(*name),
-                )
-                .clicked()
-            {
+        let empty = text.trim().is_empty();
+        for (k, (name, enabled, dialog)) in buttons.iter().enumerate() {
+            let usable = *enabled && (!empty || dialog.is_some());
+            let button = ui.add_enabled(usable, egui::Button::new(*name));
+            let button = if empty && dialog.is_some() {
+                button.on_hover_text("no file typed: choose one in a dialog")
+            } else {
+                button.on_disabled_hover_text(if empty {
+                    format!("type the {label} first")
+                } else {
+                    "nothing to save yet".to_owned()
+                })
+            };
+            if button.clicked() {
                 clicked = Some(k);
             }
         }
@@ -74,11 +91,35 @@ fn path_row(
     clicked
 }
 
+/// What a [`path_row`] button does: its command with the typed path, or with none typed the
+/// dialog that asks for one.
+fn path_action(
+    text: &str,
+    dialog_action: FileAction,
+    suggested: &str,
+    command: impl FnOnce(PathBuf) -> Command,
+    commands: &mut Vec<Command>,
+    dialog: &mut DialogRequest,
+) {
+    let typed = text.trim();
+    if typed.is_empty() {
+        let name = dialog_action_saves(dialog_action).then(|| suggested.to_owned());
+        *dialog = Some((dialog_action, name));
+    } else {
+        commands.push(command(PathBuf::from(typed)));
+    }
+}
+
+const fn dialog_action_saves(a: FileAction) -> bool {
+    matches!(a, FileAction::SaveCalibration | FileAction::SavePoints)
+}
+
 fn files_ui(
     ui: &mut Ui,
     state: &Workspace,
     paths: &mut OverheadPaths,
     commands: &mut Vec<Command>,
+    dialog: &mut DialogRequest,
 ) {
     let overhead = state.overhead();
     let path = |s: &str| PathBuf::from(s.trim());
@@ -88,7 +129,7 @@ fn files_ui(
         "field file or name",
         "spl-2020",
         &mut paths.field,
-        &[("Open field", true)],
+        &[("Open field", true, None)],
     ) == Some(0)
     {
         commands.push(OverheadCommand::OpenField(path(&paths.field)).into());
@@ -109,7 +150,7 @@ fn files_ui(
         "intrinsics",
         "camera_info.yaml or a recording",
         &mut paths.intrinsics,
-        &[("Open intrinsics", true)],
+        &[("Open intrinsics", true, None)],
     ) == Some(0)
     {
         commands.push(OverheadCommand::OpenIntrinsics(path(&paths.intrinsics)).into());
@@ -117,35 +158,83 @@ fn files_ui(
     if has_intrinsics && ui.button("Close intrinsics").clicked() {
         commands.push(OverheadCommand::CloseIntrinsics.into());
     }
+    saved_files_ui(ui, state, paths, commands, dialog);
+}
+
+/// The calibration and the points files: open, save (a dialog when no name is typed), close.
+fn saved_files_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    paths: &mut OverheadPaths,
+    commands: &mut Vec<Command>,
+    dialog: &mut DialogRequest,
+) {
+    let overhead = state.overhead();
     let has_cal = overhead.calibration().is_some();
-    match path_row(
+    let clicked = path_row(
         ui,
         "calibration",
         "camera.calibration.json",
         &mut paths.calibration,
-        &[("Open calibration", true), ("Save calibration", has_cal)],
-    ) {
-        Some(0) => commands.push(OverheadCommand::OpenCalibration(path(&paths.calibration)).into()),
-        Some(_) => commands.push(OverheadCommand::SaveCalibration(path(&paths.calibration)).into()),
+        &[
+            ("Open calibration", true, Some(FileAction::OpenCalibration)),
+            (
+                "Save calibration",
+                has_cal,
+                Some(FileAction::SaveCalibration),
+            ),
+        ],
+    );
+    match clicked {
+        Some(0) => path_action(
+            &paths.calibration,
+            FileAction::OpenCalibration,
+            "",
+            |p| OverheadCommand::OpenCalibration(p).into(),
+            commands,
+            dialog,
+        ),
+        Some(_) => path_action(
+            &paths.calibration,
+            FileAction::SaveCalibration,
+            "camera.calibration.json",
+            |p| OverheadCommand::SaveCalibration(p).into(),
+            commands,
+            dialog,
+        ),
         None => {}
     }
     if has_cal && ui.button("Close calibration").clicked() {
         commands.push(OverheadCommand::CloseCalibration.into());
     }
     let has_points = !overhead.points().points.is_empty();
-    match path_row(
+    let clicked = path_row(
         ui,
         "points",
         "camera.points.json",
         &mut paths.points,
-        &[("Open points", true), ("Save points", has_points)],
-    ) {
-        Some(0) => {
-            commands.push(OverheadCommand::OpenPoints(path(&paths.points)).into());
-        }
-        Some(_) => {
-            commands.push(OverheadCommand::SavePoints(path(&paths.points)).into());
-        }
+        &[
+            ("Open points", true, Some(FileAction::OpenPoints)),
+            ("Save points", has_points, Some(FileAction::SavePoints)),
+        ],
+    );
+    match clicked {
+        Some(0) => path_action(
+            &paths.points,
+            FileAction::OpenPoints,
+            "",
+            |p| OverheadCommand::OpenPoints(p).into(),
+            commands,
+            dialog,
+        ),
+        Some(_) => path_action(
+            &paths.points,
+            FileAction::SavePoints,
+            "camera.points.json",
+            |p| OverheadCommand::SavePoints(p).into(),
+            commands,
+            dialog,
+        ),
         None => {}
     }
 }
@@ -192,6 +281,20 @@ fn picking_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
                 }
             });
         if ui
+            .add_enabled(chosen.is_some(), egui::Button::new("Skip"))
+            .on_hover_text("not visible in this frame: go on to the next landmark not picked")
+            .clicked()
+        {
+            commands.push(OverheadCommand::SkipLandmark.into());
+        }
+        if ui
+            .add_enabled(chosen.is_some(), egui::Button::new("Stop picking"))
+            .on_hover_text("a left click in the image samples colours again")
+            .clicked()
+        {
+            commands.push(OverheadCommand::ChooseLandmark(None).into());
+        }
+        if ui
             .add_enabled(overhead.picks_to_undo() > 0, egui::Button::new("Undo pick"))
             .clicked()
         {
@@ -208,9 +311,13 @@ fn picking_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
             commands.push(OverheadCommand::Calibrate.into());
         }
     });
-    if chosen.is_some() {
-        ui.weak("Click the landmark in the image (left button); the next one is chosen after.");
-    }
+    match &chosen {
+        Some(l) => ui.label(format!(
+            "Picking: a left click in the image places {l}; the next landmark not picked follows \
+             (Skip one that is not in view). Calibrate, Stop picking or choosing a class ends it."
+        )),
+        None => ui.weak("Not picking: a left click in the image samples colours."),
+    };
 }
 
 fn points_table_ui(ui: &mut Ui, state: &Workspace) {

@@ -13,22 +13,34 @@ pub fn swatch(ui: &mut Ui, rgb: [u8; 3]) {
         .rect_filled(rect, 2.0, Color32::from_rgb(rgb[0], rgb[1], rgb[2]));
 }
 
-/// The side panel's contents.
+/// The side panel's contents: the pending selection (Commit, Clear, Try) and Undo/Redo at its
+/// foot, always in view; the classes and sensitivity above them, scrolling when the window is
+/// short (at 800 px the buttons had fallen below the fold, and the scroll jumped back up
+/// whenever a selection changed the content's height).
 pub fn classify_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
-    ui.heading("Classify");
-    ui.label(
-        RichText::new("left-click: sample · right-click: commit")
-            .small()
-            .weak(),
-    );
-    ui.separator();
-    classes_ui(ui, state, commands);
-    ui.separator();
-    sensitivity_ui(ui, state, commands);
-    ui.separator();
-    pending_selection_ui(ui, state, commands);
-    ui.separator();
-    undo_redo_ui(ui, state, commands);
+    egui::Panel::bottom("classify-actions")
+        .resizable(false)
+        .show(ui, |ui| {
+            ui.add_space(4.0);
+            pending_selection_ui(ui, state, commands);
+            ui.separator();
+            undo_redo_ui(ui, state, commands);
+        });
+    egui::ScrollArea::vertical()
+        .id_salt("classify-scroll")
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            ui.heading("Classify");
+            ui.label(
+                RichText::new("left-click: sample · right-click: commit")
+                    .small()
+                    .weak(),
+            );
+            ui.separator();
+            classes_ui(ui, state, commands);
+            ui.separator();
+            sensitivity_ui(ui, state, commands);
+        });
 }
 
 /// Each class with its table cells and frame pixels; clicking one picks it.
@@ -99,14 +111,21 @@ fn pending_selection_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
             } else {
                 ui.label("sample from the U–V plane");
             }
-            ui.label(format!(
-                "{cells} cells; {changing} pixels of this frame change class"
-            ))
-            .on_hover_text(format!(
-                "{selected} pixels selected, {} of them already {} (Try edit counts the {changing})",
-                selected - changing,
-                state.settings.class.name()
-            ));
+            match state.selection_class().map(ColourClass::name) {
+                Some(class) => ui
+                    .label(format!(
+                        "{cells} cells; {changing} pixels of this frame change to {class} ({} already {class})",
+                        selected - changing,
+                    ))
+                    .on_hover_text(format!(
+                        "{selected} pixels selected; the {changing} a commit changes are hatched, \
+                         those already {class} are left as they are (Try edit counts the {changing})"
+                    )),
+                None => ui.label(format!(
+                    "{cells} cells; {selected} pixels of this frame, no class chosen yet: pick the \
+                     class these colours are (Commit as… in the Coverage window, or a class above)"
+                )),
+            };
             ui.horizontal(|ui| {
                 if ui
                     .button("Commit")
@@ -163,7 +182,32 @@ pub fn try_edit_panel_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comm
     let has_stream = state.source().is_some_and(|s| s.len() > 1);
     ui.strong("Table edit");
     match state.try_edit() {
-        Some(t) => try_edit_ui(ui, t, state.index(), commands),
+        Some(t) => {
+            let stale = state.try_edit_stale();
+            if stale {
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    "This result is for an earlier selection (the selection, its sensitivity \
+                     or the class changed since).",
+                );
+            }
+            let again = if stale {
+                "Try the current selection"
+            } else {
+                "Try again"
+            };
+            if ui
+                .add_enabled(
+                    state.selection().is_some() && has_stream,
+                    egui::Button::new(again),
+                )
+                .on_disabled_hover_text("left-click a pixel to select its colours first")
+                .clicked()
+            {
+                commands.push(TableCommand::TryEditOnStream.into());
+            }
+            try_edit_ui(ui, t, state.index(), commands);
+        }
         None => {
             ui.weak(try_edit_hint(state, has_stream));
             if ui
@@ -232,16 +276,43 @@ fn try_edit_ui(ui: &mut Ui, t: &TryEdit, current: usize, commands: &mut Vec<Comm
             String::new()
         }
     ));
+    // Most changed first by default: "where" is the question after "how much".
+    let by_frame_id = egui::Id::unique("eotn-try-rows-by-frame");
+    let mut by_frame: bool = ui.data(|d| d.get_temp(by_frame_id)).unwrap_or(false);
+    ui.horizontal(|ui| {
+        ui.label(RichText::new("order:").small().weak());
+        ui.selectable_value(&mut by_frame, false, "most changed first");
+        ui.selectable_value(&mut by_frame, true, "by frame");
+    });
+    ui.data_mut(|d| d.insert_temp(by_frame_id, by_frame));
+    if let Some(most) = t.stream.rows.iter().max_by_key(|r| r.changed_pixels)
+        && ui
+            .button(format!(
+                "Go to frame {} ({} px change)",
+                most.index, most.changed_pixels
+            ))
+            .clicked()
+    {
+        commands.push(PlaybackCommand::Seek(most.index).into());
+    }
     ui.label(
         RichText::new("frame · pixels changed · blobs before -> after")
             .small()
             .weak(),
     );
+    let mut rows: Vec<&crate::workspace::TryEditRow> = t.stream.rows.iter().collect();
+    if !by_frame {
+        rows.sort_by(|a, b| {
+            b.changed_pixels
+                .cmp(&a.changed_pixels)
+                .then(a.index.cmp(&b.index))
+        });
+    }
     egui::ScrollArea::vertical()
         .id_salt("try_rows")
         .max_height(300.0)
         .show(ui, |ui| {
-            for r in &t.stream.rows {
+            for r in rows {
                 let delta = r.blobs_after as i64 - r.blobs_before as i64;
                 let text = format!(
                     "frame {:>5}   {:>6} px   blobs {} -> {} ({delta:+})",

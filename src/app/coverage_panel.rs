@@ -1,13 +1,18 @@
 //! "What is still unclassified?": the coverage hints — the colours of the stream (or a range of
 //! it) that the table leaves unclassified, most pixels first, as a list and as numbered marks
-//! on the U–V plane. Clicking a hint selects its cells (the image previews its pixels; Commit
-//! classifies them) and shows its Y layer in the U–V plane.
+//! on the U–V plane. Clicking a hint selects its cells (the image previews its pixels) and
+//! shows its Y layer in the U–V plane; its class is chosen here before it is committed. Each
+//! hint names the frames with most of its pixels (one click goes there with them previewed)
+//! and splits into its cells; after a commit the rows keep their places.
 
 use egui::{Color32, Painter, Rect, Stroke, Ui, pos2, vec2};
 
 use crate::frame::yuv_to_rgb;
-use crate::lut::Region;
-use crate::workspace::{Command, HintsCommand, ViewCommand, Workspace};
+use crate::lut::{ColourClass, Region};
+use crate::workspace::coverage::CoverageHint;
+use crate::workspace::{
+    Command, HintsCommand, PlaybackCommand, TableCommand, ViewCommand, Workspace,
+};
 
 /// The range, the scan's progress and the hints.
 pub fn coverage_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
@@ -75,39 +80,224 @@ fn hints_list_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
         Some(Region::Cells { indices }) => Some(indices),
         _ => None,
     };
+    let split_id = egui::Id::unique("eotn-coverage-split");
+    let mut split: Option<usize> = ui.data(|d| d.get_temp(split_id)).flatten();
+    ui.horizontal_wrapped(|ui| {
+        ui.weak("Rows keep their place after a commit;");
+        if ui
+            .small_button("Re-rank")
+            .on_hover_text("order the hints afresh by their unclassified pixels")
+            .clicked()
+        {
+            commands.push(HintsCommand::RankHints.into());
+        }
+    });
     egui::Grid::new("coverage_hints")
         .striped(true)
         .show(ui, |ui| {
-            ui.strong("#");
-            ui.strong("colour");
-            ui.strong("pixels");
-            ui.strong("cells");
+            for h in ["#", "colour", "pixels", "here", "cells", "most in frame"] {
+                ui.strong(h);
+            }
             ui.end_row();
             for (i, h) in scan.hints().iter().enumerate() {
-                let is_selected = selected == Some(h.cells.as_slice());
-                let label = format!("hint {}", i + 1);
-                if ui
-                    .selectable_label(is_selected, &label)
-                    .on_hover_text(
-                        "select these cells: the image shows their pixels; Commit classifies them",
-                    )
-                    .clicked()
-                {
-                    commands.push(HintsCommand::SelectCells(h.cells.clone()).into());
-                    commands.push(ViewCommand::SetUvPlaneY(h.mean.y).into());
-                }
-                ui.horizontal(|ui| {
-                    super::classify_panel::swatch(ui, yuv_to_rgb(h.mean));
-                    ui.monospace(format!("{:>3} {:>3} {:>3}", h.mean.y, h.mean.u, h.mean.v));
-                });
-                ui.label(format!("{}", h.pixels));
-                ui.label(format!("{}", h.cells.len()));
+                hint_row_ui(ui, state, i, h, selected, &mut split, commands);
                 ui.end_row();
             }
         });
+    ui.data_mut(|d| d.insert_temp(split_id, split));
+    if let Some(h) = split.and_then(|i| scan.hints().get(i).map(|h| (i, h))) {
+        hint_cells_ui(ui, state, h.0, h.1, selected, commands);
+    }
     if scan.hints().is_empty() && scan.done() {
         ui.label("Every colour of these frames is classified.");
     }
+    if selected.is_some() && state.selection().is_some() {
+        commit_as_ui(ui, state, commands);
+    }
+}
+
+/// One hint's row: select it, its colour, pixels (all, shown frame), its cells (split into
+/// rows), and the frame with most of its pixels (go there, its pixels previewed).
+fn hint_row_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    i: usize,
+    h: &CoverageHint,
+    selected: Option<&[usize]>,
+    split: &mut Option<usize>,
+    commands: &mut Vec<Command>,
+) {
+    let label = format!("hint {}", i + 1);
+    if let Some(class) = h.done {
+        ui.add_enabled(false, egui::Button::selectable(false, &label));
+        ui.horizontal(|ui| {
+            super::classify_panel::swatch(ui, class.display_rgb());
+            ui.weak(format!("now {}", class.name()));
+        });
+        ui.weak("0");
+        ui.weak("–");
+        ui.weak(format!("{}", h.cells.len()));
+        ui.weak("–");
+        return;
+    }
+    let is_selected = selected == Some(h.cells.as_slice());
+    if ui
+        .selectable_label(is_selected, &label)
+        .on_hover_text(
+            "select these cells: the image previews their pixels; choose their class to commit",
+        )
+        .clicked()
+    {
+        commands.push(HintsCommand::SelectCells(h.cells.clone()).into());
+        commands.push(ViewCommand::SetUvPlaneY(h.mean.y).into());
+    }
+    ui.horizontal(|ui| {
+        super::classify_panel::swatch(ui, yuv_to_rgb(h.mean));
+        ui.monospace(format!("{:>3} {:>3} {:>3}", h.mean.y, h.mean.u, h.mean.v));
+    });
+    ui.label(format!("{}", h.pixels));
+    ui.label(format!("{}", state.pixels_here(&h.cells)))
+        .on_hover_text("pixels of the shown frame in this hint's cells");
+    let open = *split == Some(i);
+    if ui
+        .selectable_label(open, format!("{} cells", h.cells.len()))
+        .on_hover_text("split the hint into its cells, each with its own frames")
+        .clicked()
+    {
+        *split = if open { None } else { Some(i) };
+    }
+    frames_ui(
+        ui,
+        &h.frames,
+        &h.cells,
+        &format!("hint {}", i + 1),
+        commands,
+    );
+}
+
+/// The frame with most of `cells`' pixels as a button (go there and select them), the others
+/// in its hover menu.
+fn frames_ui(
+    ui: &mut Ui,
+    frames: &[(usize, u64)],
+    cells: &[usize],
+    what: &str,
+    commands: &mut Vec<Command>,
+) {
+    let Some(&(best, n)) = frames.first() else {
+        ui.weak("–");
+        return;
+    };
+    let go = |commands: &mut Vec<Command>, frame: usize| {
+        commands.push(PlaybackCommand::Seek(frame).into());
+        commands.push(HintsCommand::SelectCells(cells.to_vec()).into());
+    };
+    ui.horizontal(|ui| {
+        if ui
+            .button(format!("frame {best}"))
+            .on_hover_text(format!(
+                "{n} px of {what} there: show that frame with them previewed"
+            ))
+            .clicked()
+        {
+            go(commands, best);
+        }
+        if frames.len() > 1 {
+            ui.menu_button("more", |ui| {
+                for &(f, n) in frames {
+                    if ui.button(format!("frame {f}: {n} px")).clicked() {
+                        go(commands, f);
+                        ui.close();
+                    }
+                }
+            });
+        }
+    });
+}
+
+/// The cells of hint `i`, one row each: its colour, pixels, frames; clicking one selects that
+/// cell alone (a hint whose cells are wall in one camera and carpet in another is split here).
+fn hint_cells_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    i: usize,
+    h: &CoverageHint,
+    selected: Option<&[usize]>,
+    commands: &mut Vec<Command>,
+) {
+    let Some(scan) = state.coverage() else {
+        return;
+    };
+    let lut = state.lut();
+    ui.separator();
+    ui.strong(format!("Cells of hint {}", i + 1));
+    egui::ScrollArea::vertical()
+        .id_salt("coverage_cells")
+        .max_height(240.0)
+        .show(ui, |ui| {
+            egui::Grid::new("coverage_cells_grid")
+                .striped(true)
+                .show(ui, |ui| {
+                    for &cell in &h.cells {
+                        let [y, u, v] = lut.cell_of_index(cell).map(|c| cell_value(c, lut.shift()));
+                        let one = [cell];
+                        let label = format!("cell {y} {u} {v}");
+                        if ui
+                            .selectable_label(selected == Some(&one[..]), &label)
+                            .on_hover_text("select this cell alone")
+                            .clicked()
+                        {
+                            commands.push(HintsCommand::SelectCells(one.to_vec()).into());
+                            commands.push(ViewCommand::SetUvPlaneY(y).into());
+                        }
+                        super::classify_panel::swatch(
+                            ui,
+                            yuv_to_rgb(crate::frame::Yuv::new(y, u, v)),
+                        );
+                        ui.label(format!("{} px", scan.cell_pixels(cell)));
+                        frames_ui(ui, scan.cell_frames(cell), &one, &label, commands);
+                        ui.end_row();
+                    }
+                });
+        });
+}
+
+/// The 8-bit value at the centre of table cell `c` along one channel.
+fn cell_value(c: usize, shift: u8) -> u8 {
+    u8::try_from((c << shift) + ((1usize << shift) >> 1)).unwrap_or(u8::MAX)
+}
+
+/// The selected hint's class, chosen here (never the Classify panel's class by accident),
+/// and its commit.
+fn commit_as_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
+    let chosen = state.selection_class();
+    ui.separator();
+    ui.horizontal_wrapped(|ui| {
+        let text = chosen.map_or("(choose a class)", ColourClass::name);
+        egui::ComboBox::from_label("class of these colours")
+            .selected_text(text)
+            .show_ui(ui, |ui| {
+                for class in ColourClass::ALL {
+                    if ui
+                        .selectable_label(chosen == Some(class), class.name())
+                        .clicked()
+                    {
+                        commands.push(TableCommand::SetClass(class).into());
+                    }
+                }
+            });
+        let commit = match chosen {
+            Some(c) => format!("Commit as {}", c.name()),
+            None => "Commit".to_owned(),
+        };
+        if ui
+            .add_enabled(chosen.is_some(), egui::Button::new(commit))
+            .on_disabled_hover_text("choose the class these colours are first")
+            .clicked()
+        {
+            commands.push(TableCommand::Commit.into());
+        }
+    });
 }
 
 /// Numbered marks of the hints on the U–V plane (`rect`, `n` cells a side, U down, V across):

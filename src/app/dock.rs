@@ -208,7 +208,80 @@ impl Dock {
     /// Draws the dock into `ui` (the central panel); returns what the image view reported.
     pub fn ui(&mut self, ui: &mut Ui, behavior: &mut DockBehavior<'_>) -> MainViewOutput {
         self.tree.ui(behavior, ui);
+        self.give_every_window_a_tab();
         behavior.view
+    }
+
+    /// Puts every docked window that lost its tab back into a tab group of its own. Dropping a
+    /// tab on a group's side splits the group: `egui_tiles` then makes a row or column inside
+    /// the tab group, whose windows have no tab bar (no title, no close button). The image
+    /// keeps no tab: it is never closed.
+    pub fn give_every_window_a_tab(&mut self) {
+        let tiles = &self.tree.tiles;
+        let bare: Vec<TileId> = tiles
+            .tile_ids()
+            .filter(|id| matches!(tiles.get_pane(id), Some(Pane::Window(_))))
+            .filter(|id| {
+                tiles
+                    .parent_of(*id)
+                    .and_then(|p| tiles.get_container(p))
+                    .is_none_or(|c| c.kind() != egui_tiles::ContainerKind::Tabs)
+            })
+            .collect();
+        for pane in bare {
+            let parent = self.tree.tiles.parent_of(pane);
+            let tabs = self.tree.tiles.insert_tab_tile(vec![pane]);
+            match parent.and_then(|p| self.tree.tiles.get_mut(p)) {
+                Some(Tile::Container(c)) => {
+                    let _ = c.replace_child(pane, tabs);
+                }
+                _ => {
+                    if self.tree.root == Some(pane) {
+                        self.tree.root = Some(tabs);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Each docked window's tab group: the window and the kind of container holding it (`Tabs`
+    /// for every window, once [`Self::give_every_window_a_tab`] has run).
+    #[must_use]
+    pub fn window_parents(&self) -> Vec<(Window, Option<egui_tiles::ContainerKind>)> {
+        let tiles = &self.tree.tiles;
+        tiles
+            .tile_ids()
+            .filter_map(|id| match tiles.get_pane(&id) {
+                Some(Pane::Window(w)) => Some((
+                    *w,
+                    tiles
+                        .parent_of(id)
+                        .and_then(|p| tiles.get_container(p))
+                        .map(egui_tiles::Container::kind),
+                )),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// The tree, for tests that rearrange it as a drag would.
+    pub fn tree_mut(&mut self) -> &mut Tree<Pane> {
+        &mut self.tree
+    }
+
+    /// The title a tab shows for tile `id`: a window's name, or for a row or column of windows
+    /// inside a tab group, their names joined (`egui_tiles` says "Horizontal").
+    #[must_use]
+    pub fn tab_title(tiles: &Tiles<Pane>, id: TileId) -> String {
+        match tiles.get(id) {
+            Some(Tile::Pane(Pane::Image)) => "Image".to_owned(),
+            Some(Tile::Pane(Pane::Window(w))) => w.name().to_owned(),
+            Some(Tile::Container(c)) => {
+                let names: Vec<String> = c.children().map(|k| Self::tab_title(tiles, *k)).collect();
+                names.join(" + ")
+            }
+            None => String::new(),
+        }
     }
 }
 
@@ -250,7 +323,13 @@ impl DockBehavior<'_> {
             }
             Window::FieldView => super::field_view::field_view_ui(ui, state, commands),
             Window::Calibration => {
-                super::calibration_window::calibration_ui(ui, state, self.overhead_paths, commands);
+                super::calibration_window::calibration_ui(
+                    ui,
+                    state,
+                    self.overhead_paths,
+                    commands,
+                    self.dialog,
+                );
             }
             Window::Robots => super::robots_panel::robots_ui(ui, state, self.robots, commands),
             Window::Coverage => super::coverage_panel::coverage_ui(ui, state, commands),
@@ -296,6 +375,10 @@ impl egui_tiles::Behavior<Pane> for DockBehavior<'_> {
             Pane::Image => "Image".into(),
             Pane::Window(w) => w.name().into(),
         }
+    }
+
+    fn tab_title_for_tile(&mut self, tiles: &Tiles<Pane>, tile_id: TileId) -> egui::WidgetText {
+        Dock::tab_title(tiles, tile_id).into()
     }
 
     fn is_tab_closable(&self, tiles: &Tiles<Pane>, tile_id: TileId) -> bool {

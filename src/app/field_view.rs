@@ -7,7 +7,7 @@
 //! the workspace's field model only.
 
 use egui::{Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, vec2};
-use egui_plot::{Legend, Line, Plot, VLine};
+use egui_plot::{Line, Plot, VLine};
 
 use super::overhead_overlays::team_colour;
 use crate::overhead::FieldDescription;
@@ -112,7 +112,12 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 2.0, Color32::from_rgb(20, 90, 40));
     let xf = FieldTransform::fit(rect, field);
-    paint_field(&painter, &xf, field);
+    paint_field(&painter, &xf, field, overhead.landmark());
+    let show_truth_id = egui::Id::unique("eotn-field-view-truth");
+    let mut show_truth: bool = ui.data(|d| d.get_temp(show_truth_id)).unwrap_or(true);
+    if show_truth && let Some(t) = overhead.truth() {
+        paint_truth(&painter, &xf, t);
+    }
     let robots = paint_objects(&painter, &xf, state);
     paint_ssl(&painter, &xf, overhead.field_model.ssl());
     if response.clicked()
@@ -126,15 +131,83 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
             .map(|(_, k)| k);
         commands.push(OverheadCommand::SelectRobot(hit).into());
     }
+    if overhead.truth().is_some() {
+        ui.horizontal_wrapped(|ui| {
+            ui.checkbox(&mut show_truth, "Ground truth").on_hover_text(
+                "the stream's own truth: dashed white rings and a ring for the ball",
+            );
+            ui.weak("filled: what the camera found; dashed: where they really are");
+        });
+        ui.data_mut(|d| d.insert_temp(show_truth_id, show_truth));
+    }
     if !models.is_empty() {
         errors_ui(ui, state);
     }
 }
 
-fn paint_field(painter: &egui::Painter, xf: &FieldTransform, field: &FieldDescription) {
+/// Colour of the ground truth's marks.
+const TRUTH_COLOUR: Color32 = Color32::from_rgb(255, 255, 255);
+
+/// The stream's ground truth: each robot as a dashed ring with its heading, the ball as a
+/// ring, so that what the camera found (filled) is seen against where things are.
+fn paint_truth(
+    painter: &egui::Painter,
+    xf: &FieldTransform,
+    truth: &crate::model::truth::OverheadTruth,
+) {
+    let stroke = Stroke::new(1.2, TRUTH_COLOUR);
+    let radius = (ROBOT_RADIUS_CM * xf.scale()).max(4.0) + 2.0;
+    for r in &truth.robots {
+        let c = xf.to_screen(r.field_cm);
+        let n = 24;
+        let ring: Vec<Pos2> = (0..=n)
+            .map(|k| {
+                let t = k as f32 / n as f32 * std::f32::consts::TAU;
+                c + vec2(radius * t.cos(), radius * t.sin())
+            })
+            .collect();
+        painter.extend(egui::Shape::dashed_line(&ring, stroke, 3.0, 3.0));
+        let dir = vec2(r.heading_rad.cos() as f32, -(r.heading_rad.sin() as f32));
+        painter.line_segment([c + dir * radius, c + dir * radius * 1.6], stroke);
+    }
+    if let Some(b) = &truth.ball {
+        painter.circle_stroke(
+            xf.to_screen(b.field_cm),
+            (4.25 * xf.scale()).max(3.0) + 3.0,
+            stroke,
+        );
+    }
+}
+
+/// The field's lines and landmarks; each landmark's name where it does not cover another's,
+/// and the one being picked (`picking`) always, highlighted: where to click for it.
+fn paint_field(
+    painter: &egui::Painter,
+    xf: &FieldTransform,
+    field: &FieldDescription,
+    picking: Option<&str>,
+) {
     let stroke = Stroke::new(1.5, Color32::from_gray(235));
     for l in &field.lines {
         painter.line_segment([xf.to_screen(l.from_cm), xf.to_screen(l.to_cm)], stroke);
+    }
+    let name_colour = Color32::from_rgb(255, 230, 120);
+    let chosen_colour = Color32::from_rgb(255, 80, 220);
+    let mut placed: Vec<Rect> = Vec::new();
+    // The landmark being picked first, so its name is never the one left out.
+    let mut order: Vec<&crate::overhead::field::Landmark> = field.landmarks.iter().collect();
+    order.sort_by_key(|l| Some(l.name.as_str()) != picking);
+    for l in order {
+        let at = xf.to_screen(l.field_cm);
+        let chosen = Some(l.name.as_str()) == picking;
+        let colour = if chosen { chosen_colour } else { name_colour };
+        painter.circle_filled(at, if chosen { 4.5 } else { 2.5 }, colour);
+        let galley = painter.layout_no_wrap(l.name.clone(), FontId::proportional(9.0), colour);
+        let text_rect = Rect::from_min_size(at + vec2(3.0, -3.0 - galley.size().y), galley.size());
+        if chosen || !placed.iter().any(|p| p.intersects(text_rect)) {
+            placed.push(text_rect);
+            painter.galley(text_rect.min, galley, colour);
+        }
     }
     for a in &field.arcs {
         let n = 48;
@@ -390,26 +463,68 @@ fn errors_ui(ui: &mut Ui, state: &Workspace) {
     let now_s = state.current().map_or(0.0, |c| c.time_ns as f64 / 1e9);
     let ids: Vec<crate::workspace::overhead::RobotKey> =
         model.world_models().iter().map(|m| m.robot).collect();
+    // Each series' colour; the legend is a row above the plot (drawn over it, egui_plot's
+    // legend hid a third of the curves).
+    let series: Vec<(String, Color32, crate::workspace::overhead::RobotKey, usize)> = ids
+        .iter()
+        .flat_map(|id| [(*id, 0usize), (*id, 1)])
+        .enumerate()
+        .map(|(k, (id, pick))| {
+            let what = if pick == 0 { "self" } else { "ball" };
+            (format!("{id} {what}"), series_colour(k), id, pick)
+        })
+        .collect();
+    ui.horizontal_wrapped(|ui| {
+        for (name, colour, _, _) in &series {
+            let (r, _) = ui.allocate_exact_size(vec2(14.0, 3.0), Sense::hover());
+            ui.painter().rect_filled(r, 0.0, *colour);
+            ui.label(egui::RichText::new(name).small());
+        }
+    });
+    // The wheel scrolls the window, not the plot (zooming under the wheel trapped the scroll).
     Plot::new("world-model-error-plot")
+        .id(errors_plot_id())
         .height(140.0)
-        .legend(Legend::default())
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .allow_drag(false)
+        .allow_boxed_zoom(false)
         .y_axis_label("error (cm)")
         .show(ui, |p| {
-            for id in ids {
-                for (what, pick) in [("self", 0usize), ("ball", 1)] {
-                    let points: Vec<[f64; 2]> = model
-                        .error_samples()
-                        .filter_map(|s| {
-                            let (_, own, ball) = s.errors.iter().find(|e| e.0 == id)?;
-                            let e = if pick == 0 { *own } else { *ball };
-                            e.map(|e| [s.time_s, e])
-                        })
-                        .collect();
-                    p.line(Line::new(format!("{id} {what}"), points));
-                }
+            for (name, colour, id, pick) in &series {
+                let points: Vec<[f64; 2]> = model
+                    .error_samples()
+                    .filter_map(|s| {
+                        let (_, own, ball) = s.errors.iter().find(|e| e.0 == *id)?;
+                        let e = if *pick == 0 { *own } else { *ball };
+                        e.map(|e| [s.time_s, e])
+                    })
+                    .collect();
+                p.line(Line::new(name.clone(), points).color(*colour));
             }
             p.vline(VLine::new("current frame", now_s).color(Color32::WHITE));
         });
+}
+
+/// The error plot's id (tests read its memory: the wheel leaves its bounds alone).
+#[must_use]
+pub fn errors_plot_id() -> egui::Id {
+    egui::Id::unique("eotn-world-model-error-plot")
+}
+
+/// The `k`th plotted series' colour: distinct hues round the wheel.
+fn series_colour(k: usize) -> Color32 {
+    const PALETTE: [Color32; 8] = [
+        Color32::from_rgb(255, 99, 71),
+        Color32::from_rgb(60, 170, 255),
+        Color32::from_rgb(250, 220, 40),
+        Color32::from_rgb(120, 220, 120),
+        Color32::from_rgb(230, 120, 230),
+        Color32::from_rgb(255, 160, 60),
+        Color32::from_rgb(80, 220, 220),
+        Color32::from_rgb(200, 200, 200),
+    ];
+    PALETTE[k % PALETTE.len()]
 }
 
 #[cfg(test)]

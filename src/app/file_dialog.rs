@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 
 use egui_file::{FileDialog, State};
 
-use crate::workspace::{Command, ParamsCommand, SourceCommand, TableCommand, ViewCommand};
+use crate::workspace::{
+    Command, OverheadCommand, ParamsCommand, SourceCommand, TableCommand, ViewCommand,
+};
 
 /// What a dialog is for; it decides the title, the filter and the command sent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,6 +33,14 @@ pub enum FileAction {
     ExportView,
     /// Record the connected source into a new stream.
     Record,
+    /// An overhead calibration (`*.json`).
+    OpenCalibration,
+    /// Save the overhead calibration.
+    SaveCalibration,
+    /// Picked calibration points (`*.points.json`).
+    OpenPoints,
+    /// Save the picked calibration points.
+    SavePoints,
 }
 
 impl FileAction {
@@ -48,6 +58,10 @@ impl FileAction {
             Self::SaveParams => "Save the recognition parameters as",
             Self::ExportView => "Export the view as PNG",
             Self::Record => "Record into",
+            Self::OpenCalibration => "Open an overhead calibration",
+            Self::SaveCalibration => "Save the overhead calibration as",
+            Self::OpenPoints => "Open picked calibration points",
+            Self::SavePoints => "Save the picked calibration points as",
         }
     }
 
@@ -57,9 +71,14 @@ impl FileAction {
         match self {
             Self::Open | Self::OpenLabelsFolder => &[],
             Self::OpenTable | Self::SaveTableAs => &["lut", "cal", "raw", "tm", "col"],
-            Self::OpenParams | Self::OpenPlaces | Self::SaveParams | Self::OpenLabelsFile => {
-                &["json"]
-            }
+            Self::OpenParams
+            | Self::OpenPlaces
+            | Self::SaveParams
+            | Self::OpenLabelsFile
+            | Self::OpenCalibration
+            | Self::SaveCalibration
+            | Self::OpenPoints
+            | Self::SavePoints => &["json"],
             Self::ExportView => &["png"],
             Self::Record => &["mcap"],
         }
@@ -68,7 +87,12 @@ impl FileAction {
     const fn saves(self) -> bool {
         matches!(
             self,
-            Self::SaveTableAs | Self::SaveParams | Self::ExportView | Self::Record
+            Self::SaveTableAs
+                | Self::SaveParams
+                | Self::ExportView
+                | Self::Record
+                | Self::SaveCalibration
+                | Self::SavePoints
         )
     }
 
@@ -85,6 +109,10 @@ impl FileAction {
             Self::SaveParams => Command::Params(ParamsCommand::SaveParams(path)),
             Self::ExportView => Command::View(ViewCommand::ExportView(path)),
             Self::Record => Command::Source(SourceCommand::StartRecording(path)),
+            Self::OpenCalibration => Command::Overhead(OverheadCommand::OpenCalibration(path)),
+            Self::SaveCalibration => Command::Overhead(OverheadCommand::SaveCalibration(path)),
+            Self::OpenPoints => Command::Overhead(OverheadCommand::OpenPoints(path)),
+            Self::SavePoints => Command::Overhead(OverheadCommand::SavePoints(path)),
         }
     }
 }

@@ -602,12 +602,16 @@ fn overhead_results_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comman
     if !d.rejected.is_empty() {
         ui.collapsing(format!("{} rejected candidates", d.rejected.len()), |ui| {
             for c in &d.rejected {
-                ui.label(format!(
-                    "{:?} at {:?}: {:?}",
-                    c.colour,
-                    c.bounds.to_array(),
-                    c.reason
-                ));
+                let [x0, y0, x1, y1] = c.bounds.to_array();
+                ui.add(
+                    egui::Label::new(format!(
+                        "{} blob at ({x0}, {y0})–({x1}, {y1}) px: {}",
+                        crate::lut::ColourClass::from_code(c.colour)
+                            .map_or_else(|| format!("class {}", c.colour), |k| k.name().to_owned()),
+                        c.reason
+                    ))
+                    .wrap(),
+                );
             }
         });
     }

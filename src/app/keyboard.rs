@@ -8,12 +8,15 @@ use crate::workspace::{HintsCommand, PlaybackCommand, TableCommand};
 
 impl EotnApp {
     /// Turns this frame's key presses into commands; true when the window should close.
-    pub(super) fn keyboard(&self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
+    /// Ctrl+S on a table without a file opens Save table as (saving needs a name).
+    pub(super) fn keyboard(&mut self, ctx: &egui::Context, commands: &mut Vec<Command>) -> bool {
         let mut quit = false;
         if ctx.egui_wants_keyboard_input() {
             return quit;
         }
         let menu_open = egui::Popup::is_any_open(ctx);
+        let untitled = self.state.table_path().is_none();
+        let mut save_as = false;
         ctx.input_mut(|i| {
             let cmd = |k| KeyboardShortcut::new(Modifiers::COMMAND, k);
             if i.consume_shortcut(&KeyboardShortcut::new(
@@ -27,7 +30,11 @@ impl EotnApp {
                 commands.push(TableCommand::Undo.into());
             }
             if i.consume_shortcut(&cmd(Key::S)) {
-                commands.push(TableCommand::SaveTable.into());
+                if untitled {
+                    save_as = true;
+                } else {
+                    commands.push(TableCommand::SaveTable.into());
+                }
             }
             if i.consume_shortcut(&cmd(Key::Q)) {
                 quit = true;
@@ -85,6 +92,12 @@ impl EotnApp {
                 commands.push(TableCommand::ClearSelection.into());
             }
         });
+        if save_as {
+            self.menu_input.dialog = Some((
+                super::file_dialog::FileAction::SaveTableAs,
+                Some("table.lut".to_owned()),
+            ));
+        }
         quit
     }
 }

@@ -68,7 +68,10 @@ use egui::Color32;
 pub use crate::workspace::{Command, PlaybackCommand, Settings, TableCommand, ViewKind, Workspace};
 
 use crate::app_options::{RendererSetting, RunOptions};
-pub use textures::{ViewImages, palette, preview_image, view_images, visible_preview_colour};
+pub use textures::{
+    ViewImages, palette, preview_image, preview_image_every, texture_step, view_images,
+    view_images_every, visible_preview_colour,
+};
 
 use crate::workspace::{PixelInfo, median};
 use overlays::ImageTransform;
@@ -96,6 +99,7 @@ pub struct RendererInfo {
 /// # Errors
 /// Neither renderer could create the window (no display, no Vulkan or GL driver).
 pub fn run(opts: RunOptions) -> anyhow::Result<()> {
+    let launched = Instant::now();
     let setting = match opts.renderer {
         Some(s) => {
             if let Err(e) = renderer::save_setting(s) {
@@ -106,7 +110,7 @@ pub fn run(opts: RunOptions) -> anyhow::Result<()> {
         None => renderer::saved_setting(),
     };
     let choice = renderer::choose(setting);
-    let first = start_window(choice.kind, &choice.reason, setting, &opts);
+    let first = start_window(choice.kind, &choice.reason, setting, &opts, launched);
     let Err(e) = first else { return Ok(()) };
     let other = choice.kind.other();
     eprintln!(
@@ -115,7 +119,7 @@ pub fn run(opts: RunOptions) -> anyhow::Result<()> {
         other.name()
     );
     let reason = format!("{} could not start", choice.kind.name());
-    start_window(other, &reason, setting, &opts)
+    start_window(other, &reason, setting, &opts, launched)
         .map_err(|e| anyhow::anyhow!("cannot open the app window: {e}"))
 }
 
@@ -125,6 +129,7 @@ fn start_window(
     reason: &str,
     setting: RendererSetting,
     opts: &RunOptions,
+    launched: Instant,
 ) -> Result<(), eframe::Error> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
@@ -165,6 +170,7 @@ fn start_window(
                 app.state.settings.overlays = crate::workspace::Overlays::all_on();
             }
             app.play_when_shown = opts.play.map(|speed| speed.as_factor());
+            app.launched = Some(launched);
             app.quit_at = opts.quit_after.map(|d| Instant::now() + d);
             Ok(Box::new(app))
         }),
@@ -191,6 +197,9 @@ pub struct EotnApp {
     hovered: Option<PixelInfo>,
     /// Where the enlarged view was last drawn (tests click pixels through it).
     pub last_view: Option<ImageTransform>,
+    /// Where the timeline's marks were last spread: the slider's track (tests compare it
+    /// with the slider's own rectangle).
+    pub last_timeline_track: Option<egui::Rect>,
     /// Cameras side by side: each pane as last drawn (where, how many primitives), left to
     /// right.
     pub last_panes: Vec<side_by_side::DrawnPane>,
@@ -214,6 +223,10 @@ pub struct EotnApp {
     /// The settings file (`settings.json` in eframe's storage folder); `None` when the app
     /// runs without storage (tests).
     settings_file: Option<PathBuf>,
+    /// When `app::run` started (the first frame's time after launch is measured from it).
+    launched: Option<Instant>,
+    /// The last UI frame had input (its successor's interval is a response time).
+    had_input: bool,
 }
 
 impl EotnApp {
@@ -269,6 +282,7 @@ impl EotnApp {
             file_dialogs: file_dialog::FileDialogs::default(),
             hovered: None,
             last_view: None,
+            last_timeline_track: None,
             last_panes: Vec::new(),
             beside_textures: side_by_side::BesideTextures::default(),
             confirm_close: false,
@@ -283,6 +297,8 @@ impl EotnApp {
             quit_at: None,
             play_when_shown: None,
             settings_file: None,
+            launched: None,
+            had_input: false,
         }
     }
 
@@ -293,6 +309,16 @@ impl EotnApp {
             A::OpenTable | A::SaveTableAs => self.state.table_path().map(std::path::Path::to_owned),
             A::OpenParams | A::SaveParams => self.state.params_slot().path.clone(),
             A::OpenPlaces => self.state.places_path().map(std::path::Path::to_owned),
+            A::OpenCalibration | A::SaveCalibration => self
+                .state
+                .overhead()
+                .calibration_path()
+                .map(std::path::Path::to_owned),
+            A::OpenPoints | A::SavePoints => self
+                .state
+                .overhead()
+                .points_path()
+                .map(std::path::Path::to_owned),
             A::Open | A::ExportView | A::Record => self.state.settings.last_source.first().cloned(),
             // Label sets lie beside their frames: the folder holding the opened frames' folder.
             A::OpenLabelsFolder | A::OpenLabelsFile => self.state.labels().map_or_else(
@@ -382,6 +408,25 @@ impl EotnApp {
         self.last_frame = Some(now);
         if dt > Duration::ZERO {
             self.state.record_frame_time(dt);
+            if self.had_input {
+                self.state.record_input_frame_time(dt);
+            }
+        }
+        self.had_input = ctx.input(|i| !i.events.is_empty());
+        if self.had_input && self.launched.is_some() && std::env::var_os("EOTN_STATS").is_some() {
+            // Measuring: the frame after one with input starts as soon as that one is on
+            // screen, so its interval is how long the window took to answer, not the pause
+            // until the next key.
+            ctx.request_repaint();
+        }
+        // The first frame is on screen when the second starts: it is asked for at once, so
+        // the time from launch to the first frame is measured (`EOTN_STATS`).
+        match self.launched {
+            Some(t) if dt > Duration::ZERO && self.state.timings.first_frame_ms.is_none() => {
+                self.state.timings.first_frame_ms = Some((now - t).as_secs_f64() * 1e3);
+            }
+            Some(_) if self.state.timings.first_frame_ms.is_none() => ctx.request_repaint(),
+            _ => {}
         }
         // Playback and scans use wall time, capped so a stall does not skip half the stream.
         self.state.tick(dt.min(Duration::from_millis(250)));
@@ -451,6 +496,14 @@ impl EotnApp {
     fn report_stats(&self) {
         if std::env::var_os("EOTN_STATS").is_some() {
             let t = &self.state.timings;
+            let input_max = t.input_frames_ms.iter().copied().fold(0.0, f64::max);
+            eprintln!(
+                "eotn stats: first frame {:.0} ms after launch; input frames {} median {:.2} ms max {:.1} ms",
+                t.first_frame_ms.unwrap_or(f64::NAN),
+                t.input_frames_ms.len(),
+                median(&t.input_frames_ms),
+                input_max,
+            );
             eprintln!(
                 "eotn stats: steps {} median {:.2} ms; frames {} median {:.2} ms; playing frames {} median {:.2} ms max {:.1} ms (our UI code {:.2} ms, eframe CPU {:.2} ms); played {} dropped {} late {}; renderer {}",
                 t.steps_ms.len(),

@@ -1,5 +1,6 @@
-//! The Overhead menu: the calibration window and the field view, the overhead view options
-//! (field lines, undistorted, picked points), closing the calibration.
+//! The Overhead menu: whether open frame files are an overhead camera's, the calibration
+//! window and the field view, the overhead view options (field lines, undistorted, picked
+//! points), closing the calibration.
 
 use egui::Ui;
 
@@ -8,6 +9,23 @@ use crate::workspace::{Command, OverheadCommand, Window, Workspace};
 /// The menu's items.
 pub fn overhead_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>) {
     let overhead = state.overhead();
+    // Frame files do not say which camera made them: the user does.
+    let files = state
+        .source()
+        .is_some_and(|s| s.info().kind == crate::sources::SourceKind::Files)
+        && state.live().is_none();
+    let mut is_overhead = state.camera_kind() == crate::sources::CameraKind::Overhead;
+    if ui
+        .add_enabled(
+            files,
+            egui::Checkbox::new(&mut is_overhead, "This is an overhead camera"),
+        )
+        .on_hover_text("the open JPEG or PNG frames are an overhead camera's: find robot markers and the ball on the field")
+        .on_disabled_hover_text("for frame files (JPEG, PNG); a stream says which camera made it")
+        .changed()
+    {
+        commands.push(OverheadCommand::SetOverheadCamera(is_overhead).into());
+    }
     if !overhead.active() {
         ui.weak("The shown frame is not from an overhead camera.");
     }

@@ -50,13 +50,16 @@ pub fn paint_overhead(
         && let Some((camera, _)) = overhead.camera()
     {
         let stroke = Stroke::new(1.0, FIELD_LINE_COLOUR.gamma_multiply(0.8));
+        // Projected lines run a little past the frame (points up to 20 px outside are kept so
+        // that lines reach its edges): clipped to the image, not drawn over the background.
+        let painter = painter.with_clip_rect(painter.clip_rect().intersect(xf.image_rect()));
         // The lines are computed for the calibration's size; scaled to the frame's.
         let (w, h) = state.image_size();
         let s = [
             w as f64 / camera.width_px.max(1) as f64,
             h as f64 / camera.height_px.max(1) as f64,
         ];
-        for curve in crate::overhead::lines::projected_field_lines(overhead.field(), camera) {
+        for curve in overhead.projected_field_lines() {
             let pts: Vec<Pos2> = curve
                 .iter()
                 .filter_map(|p| to_screen(ImagePoint::new(p.x_px * s[0], p.y_px * s[1])))

@@ -152,8 +152,6 @@ pub fn paint_view(
         painter.image(tex.preview, img, uv, Color32::WHITE);
     }
     let boxes = match kind {
-        // Boxes are in the camera's pixels: the undistorted view does not show them.
-        _ if state.undistorted_view() => Vec::new(),
         ViewKind::Objects => Vec::new(),
         ViewKind::Blobs => state.drawn_blobs(),
         _ if with_overlays && o.blob_boxes => state.drawn_blobs(),
@@ -165,10 +163,20 @@ pub fn paint_view(
         .settings
         .min_blob_pixels
         .saturating_mul(LABEL_SIZE_FACTOR);
-    for b in &boxes {
-        blob_box(&painter, xf, b);
+    if state.undistorted_view() {
+        // Boxes are in the camera's pixels: in the undistorted view each outline goes through
+        // the lens model (a box becomes a curved quadrilateral, clipped to the image); no
+        // labels there.
+        let inside = painter.with_clip_rect(painter.clip_rect().intersect(xf.image_rect()));
+        for b in &boxes {
+            undistorted_blob_box(&inside, xf, state, b);
+        }
+    } else {
+        for b in &boxes {
+            blob_box(&painter, xf, b);
+        }
     }
-    if labels {
+    if labels && !state.undistorted_view() {
         // Largest first, and none over another: a crowded frame shows its main blobs' labels
         // instead of a heap of text.
         let mut labelled: Vec<&Blob> = boxes.iter().filter(|b| b.pixels >= label_min).collect();
@@ -263,6 +271,31 @@ pub fn blob_box(painter: &Painter, xf: &ImageTransform, b: &Blob) {
         Stroke::new(1.5, colour),
         StrokeKind::Outside,
     );
+}
+
+/// One blob's box in the undistorted view: its outline, a few points a side, each placed
+/// through the lens model.
+fn undistorted_blob_box(painter: &Painter, xf: &ImageTransform, state: &Workspace, b: &Blob) {
+    const STEPS: usize = 4;
+    let [x0, y0, x1, y1] = b.bounds().to_array().map(|v| v as f64);
+    let (x1, y1) = (x1 + 1.0, y1 + 1.0);
+    let corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)];
+    let mut points = Vec::with_capacity(4 * STEPS + 1);
+    for side in corners.windows(2) {
+        let ((ax, ay), (bx, by)) = (side[0], side[1]);
+        for k in 0..STEPS {
+            let t = k as f64 / STEPS as f64;
+            let p = ImagePoint::new(ax + (bx - ax) * t, ay + (by - ay) * t);
+            if let Some(v) = state.overhead_view_point(p) {
+                points.push(xf.to_screen(pos2(v.x_px as f32, v.y_px as f32)));
+            }
+        }
+    }
+    let [r, g, bl] = box_colour(b.colour);
+    painter.add(egui::Shape::closed_line(
+        points,
+        Stroke::new(1.5, Color32::from_rgb(r, g, bl)),
+    ));
 }
 
 /// A blob's class and size below its box, unless it would cover a label in `placed`; the
@@ -446,7 +479,8 @@ pub fn sample_marker(painter: &Painter, xf: &ImageTransform, x: usize, y: usize)
     }
 }
 
-/// A short text with a dark background at a corner of the view (zoom level, frame time).
+/// A short text with a dark background at a corner of the view (zoom level, frame time, what
+/// a left click does).
 pub fn corner_text(painter: &Painter, view: Rect, align: Align2, text: String) {
     let galley = painter.layout_no_wrap(text, FontId::monospace(11.0), Color32::WHITE);
     let size = galley.size() + vec2(6.0, 4.0);

@@ -32,9 +32,7 @@ impl EotnApp {
             .resizable(true)
             .default_size(230.0)
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    classify_panel::classify_panel_ui(ui, &self.state, commands);
-                });
+                classify_panel::classify_panel_ui(ui, &self.state, commands);
             });
         self.dock.sync(&self.state);
         egui::CentralPanel::default()

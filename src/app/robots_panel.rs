@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use egui::{RichText, Ui};
 
 use crate::live::Connection;
-use crate::workspace::{Command, RobotRow, RobotsCommand, Workspace};
+use crate::workspace::{Command, RobotId, RobotRow, RobotsCommand, Workspace};
 
 /// What the robots window is editing.
 #[derive(Debug)]
@@ -18,6 +18,8 @@ pub struct RobotsPanel {
     pub address: String,
     /// The folder recordings go into, one file per robot named after it.
     pub folder: String,
+    /// The robot whose Disconnect was clicked once: it asks for a second click.
+    pub confirm_disconnect: Option<RobotId>,
 }
 
 impl Default for RobotsPanel {
@@ -25,9 +27,18 @@ impl Default for RobotsPanel {
         Self {
             address: "127.0.0.1:8765".to_owned(),
             folder: "recordings".to_owned(),
+            confirm_disconnect: None,
         }
     }
 }
+
+/// Widths of the robot rows' cells, points: fixed, so that no button moves when a figure, the
+/// recording or the connection changes (after Record all, the next click hit Disconnect).
+const FPS_WIDTH: f32 = 56.0;
+const DROPS_WIDTH: f32 = 76.0;
+const LATENCY_WIDTH: f32 = 120.0;
+const RECORDED_WIDTH: f32 = 110.0;
+const BUTTON_WIDTH: f32 = 120.0;
 
 /// The window's contents: the address field, recording into a folder, the robots list. Every
 /// line wraps, so in a narrow dock tab all buttons stay in view without scrolling sideways.
@@ -85,12 +96,13 @@ pub fn robots_ui(
     live_controls_ui(ui, state, commands);
 }
 
-/// One robot: its name (click to show it) and connection state, then its figures, recording
-/// and buttons.
+/// One robot: its name (click to show it) and connection state; its figures in cells of fixed
+/// width; Record/Stop as one button of constant width; Disconnect on its own line at the right,
+/// asking for a second click.
 fn robot_row_ui(
     ui: &mut Ui,
     state: &Workspace,
-    panel: &RobotsPanel,
+    panel: &mut RobotsPanel,
     row: &RobotRow,
     commands: &mut Vec<Command>,
 ) {
@@ -114,44 +126,90 @@ fn robot_row_ui(
     });
     ui.horizontal_wrapped(|ui| {
         let s = &row.stats;
-        ui.monospace(format!("{:.0} fps", s.fps));
-        ui.monospace(format!("{} drops", s.drops));
-        ui.monospace(match (s.latency_median_ms, s.latency_p99_ms) {
-            (Some(m), Some(p)) => format!("{m:.1} / {p:.1} ms"),
-            _ => "- ms".to_owned(),
-        })
+        let cell = |ui: &mut Ui, width: f32, text: String| {
+            ui.add_sized(
+                [width, ui.spacing().interact_size.y],
+                egui::Label::new(RichText::new(text).monospace()).truncate(),
+            )
+        };
+        cell(ui, FPS_WIDTH, format!("{:.0} fps", s.fps));
+        cell(ui, DROPS_WIDTH, format!("{} drops", s.drops));
+        cell(
+            ui,
+            LATENCY_WIDTH,
+            match (s.latency_median_ms, s.latency_p99_ms) {
+                (Some(m), Some(p)) => format!("{m:.1} / {p:.1} ms"),
+                _ => "- ms".to_owned(),
+            },
+        )
         .on_hover_text("latency, median / 99th percentile: the sender's write to the frame here");
-        match &row.recording {
-            Some(path) => {
-                ui.label(RichText::new(format!("rec {}", s.recorded.unwrap_or(0))).strong())
-                    .on_hover_text(path.display().to_string());
-                if ui.small_button("Stop").clicked() {
-                    commands.push(RobotsCommand::StopRecordingRobot(id).into());
-                }
-            }
-            None => {
-                let folder = PathBuf::from(panel.folder.trim());
-                if ui
-                    .small_button("Record")
-                    .on_hover_text("into the folder above, named after the robot")
-                    .clicked()
-                {
-                    commands.push(
-                        RobotsCommand::RecordRobot(id, state.robot_recording_path(id, &folder))
-                            .into(),
-                    );
-                }
-            }
+        let recorded = match &row.recording {
+            Some(_) => format!("rec {}", s.recorded.unwrap_or(0)),
+            None => "not recording".to_owned(),
+        };
+        let r = cell(ui, RECORDED_WIDTH, recorded);
+        if let Some(path) = &row.recording {
+            r.on_hover_text(path.display().to_string());
         }
-        if ui.small_button("Disconnect").clicked() {
-            commands.push(RobotsCommand::DisconnectRobot(id).into());
+    });
+    ui.horizontal(|ui| {
+        let (text, hover) = match &row.recording {
+            Some(_) => ("Stop recording", "close its recording"),
+            None => ("Record", "into the folder above, named after the robot"),
+        };
+        if ui
+            .add_sized([BUTTON_WIDTH, 0.0], egui::Button::new(text).small())
+            .on_hover_text(hover)
+            .clicked()
+        {
+            let command = match &row.recording {
+                Some(_) => RobotsCommand::StopRecordingRobot(id),
+                None => RobotsCommand::RecordRobot(
+                    id,
+                    state.robot_recording_path(id, &PathBuf::from(panel.folder.trim())),
+                ),
+            };
+            commands.push(command.into());
         }
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+            disconnect_ui(ui, panel, id, &row.name, commands);
+        });
     });
     if let Some(problem) = &row.stats.problem {
         // One line per misbehaviour (garbage, a message too large, a limit reached), kept
         // after the robot reconnects.
         ui.colored_label(ui.visuals().warn_fg_color, problem)
             .on_hover_text("what this robot last did wrong; hover its state for its log");
+    }
+}
+
+/// Disconnect, then (in its place) "Confirm disconnect" and Cancel: a robot is never dropped
+/// by one stray click.
+fn disconnect_ui(
+    ui: &mut Ui,
+    panel: &mut RobotsPanel,
+    id: RobotId,
+    name: &str,
+    commands: &mut Vec<Command>,
+) {
+    if panel.confirm_disconnect == Some(id) {
+        if ui.small_button("Cancel").clicked() {
+            panel.confirm_disconnect = None;
+        }
+        if ui
+            .small_button("Confirm disconnect")
+            .on_hover_text(format!("drop the connection to {name}"))
+            .clicked()
+        {
+            panel.confirm_disconnect = None;
+            commands.push(RobotsCommand::DisconnectRobot(id).into());
+        }
+    } else if ui
+        .small_button("Disconnect")
+        .on_hover_text("asks again before dropping the connection")
+        .clicked()
+    {
+        panel.confirm_disconnect = Some(id);
     }
 }
 

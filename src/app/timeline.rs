@@ -6,7 +6,7 @@ use crate::workspace::{PlaybackCommand, SPEEDS};
 
 impl EotnApp {
     /// The timeline bar's contents (nothing without an open source).
-    pub(super) fn timeline_ui(&self, ui: &mut egui::Ui, commands: &mut Vec<Command>) {
+    pub(super) fn timeline_ui(&mut self, ui: &mut egui::Ui, commands: &mut Vec<Command>) {
         let Some(src) = self.state.source() else {
             return;
         };
@@ -65,7 +65,14 @@ impl EotnApp {
             if slider.changed() {
                 commands.push(PlaybackCommand::Seek(j).into());
             }
-            bookmarks_panel::timeline_marks(ui.painter(), slider.rect, &self.state, len);
+            // The marks go along the slider's track: its response also covers the text after
+            // it, and marks spread over that ended a label's width past the last frame.
+            let track = egui::Rect::from_min_size(
+                slider.rect.min,
+                egui::vec2(ui.spacing().slider_width, slider.rect.height()),
+            );
+            bookmarks_panel::timeline_marks(ui.painter(), track, &self.state, len);
+            self.last_timeline_track = Some(track);
         });
     }
 }

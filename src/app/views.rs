@@ -87,6 +87,12 @@ pub fn main_view_ui(
     }
     // A click samples at once; when it turns out to be the first of a double-click (fit), the
     // selection from before it is put back, so fitting never changes the selection.
+    if response.clicked_by(PointerButton::Primary)
+        || response.clicked_by(PointerButton::Secondary)
+        || response.drag_started()
+    {
+        take_keyboard_focus(ui);
+    }
     let before_click = egui::Id::unique("eotn-selection-before-click");
     if response.double_clicked_by(PointerButton::Primary) {
         commands.push(ViewCommand::ResetView.into());
@@ -111,7 +117,19 @@ pub fn main_view_ui(
         Some(z) => format!("{:.0}%", z * 100.0),
     };
     corner_text(&painter, rect, Align2::RIGHT_TOP, zoom_text);
+    // What a left click does now: picking a calibration landmark or sampling a colour.
+    corner_text(&painter, rect, Align2::LEFT_TOP, state.left_click_mode());
     out
+}
+
+/// A click in the image takes the keyboard: a text field loses its focus (so Y/U/V and the
+/// arrows reach the shortcuts instead of the field), and the window asks the window manager
+/// for focus (under some window managers keys went nowhere until the title bar was clicked).
+fn take_keyboard_focus(ui: &Ui) {
+    ui.ctx().memory_mut(egui::Memory::stop_text_input);
+    if !ui.ctx().input(|i| i.focused) {
+        ui.ctx().send_viewport_cmd(egui::ViewportCommand::Focus);
+    }
 }
 
 /// The camera's pixel a view point (image pixels of the view) shows: the same, or through the
@@ -211,8 +229,12 @@ pub fn pixel_readout_ui(ui: &mut Ui, info: Option<&PixelInfo>) {
             )
         },
     );
+    let field = p
+        .field_cm
+        .map(|[x, y]| format!("  field ({x:.1}, {y:.1}) cm"))
+        .unwrap_or_default();
     ui.monospace(format!(
-        "({:>3},{:>3})  YUV {:>3} {:>3} {:>3}  RGB {:>3} {:>3} {:>3}  {}  {}",
+        "({:>3},{:>3})  YUV {:>3} {:>3} {:>3}  RGB {:>3} {:>3} {:>3}  {}  {}{field}",
         p.x,
         p.y,
         p.yuv.y,

@@ -336,8 +336,31 @@ impl Frame {
     /// written into `out` (resized), so a viewer can reuse one buffer.
     pub fn to_rgb_into(&self, out: &mut Vec<u8>) {
         out.clear();
-        out.reserve(self.pixel_count() * 3);
-        self.for_each_pixel(|_, _, p| out.extend_from_slice(&yuv_to_rgb(p)));
+        out.resize(self.pixel_count() * 3, 0);
+        match self.layout {
+            // A pixel pair at a time, written in place: the app converts every frame it shows
+            // (2.3 million pixels at 1920×1200), and a call per pixel with its position worked
+            // out by division, appending to the buffer, cost several times this.
+            PixelLayout::Uyvy => {
+                for (q, rgb) in self.data.chunks_exact(4).zip(out.chunks_exact_mut(6)) {
+                    let (u, v) = (q[0], q[2]);
+                    rgb[..3].copy_from_slice(&yuv_to_rgb(Yuv::new(q[1], u, v)));
+                    rgb[3..].copy_from_slice(&yuv_to_rgb(Yuv::new(q[3], u, v)));
+                }
+            }
+            PixelLayout::Yuv444Packed => {
+                for (p, rgb) in self.data.chunks_exact(3).zip(out.chunks_exact_mut(3)) {
+                    rgb.copy_from_slice(&yuv_to_rgb(Yuv::new(p[0], p[1], p[2])));
+                }
+            }
+            PixelLayout::Yuv444Planar => {
+                let w = self.width;
+                self.for_each_pixel(|x, y, p| {
+                    let i = (y * w + x) * 3;
+                    out[i..i + 3].copy_from_slice(&yuv_to_rgb(p));
+                });
+            }
+        }
     }
 
     /// The frame as packed 8-bit RGB; see [`Frame::to_rgb_into`].
@@ -416,6 +439,36 @@ pub fn round_u8(v: f64) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rgb_of_a_frame_is_each_pixels_rgb_in_every_layout() {
+        let yuv = |x: usize, y: usize| {
+            Yuv::new(
+                u8::try_from(16 + (x * 13 + y * 7) % 220).unwrap_or(0),
+                u8::try_from((x * 31 + y * 3) % 256).unwrap_or(0),
+                u8::try_from((x * 5 + y * 29) % 256).unwrap_or(0),
+            )
+        };
+        let frames = [
+            Frame::uyvy_from_fn(10, 4, yuv).unwrap(),
+            Frame::yuv444_from_fn(10, 4, yuv).unwrap(),
+        ];
+        for f in frames {
+            let rgb = f.to_rgb();
+            assert_eq!(rgb.len(), 10 * 4 * 3);
+            for y in 0..4 {
+                for x in 0..10 {
+                    let i = (y * 10 + x) * 3;
+                    assert_eq!(
+                        rgb[i..i + 3],
+                        yuv_to_rgb(f.pixel(x, y).unwrap()),
+                        "{:?} ({x}, {y})",
+                        f.layout()
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn yuv_to_rgb_matches_hand_computed_values() {

@@ -193,6 +193,17 @@ impl OverheadPipeline {
         self.camera = camera;
     }
 
+    /// The recogniser's settings in use.
+    #[must_use]
+    pub const fn params(&self) -> &OverheadParams {
+        &self.params
+    }
+
+    /// Replaces the recogniser's settings (the parameters were tuned or another field chosen).
+    pub fn set_params(&mut self, params: OverheadParams) {
+        self.params = params;
+    }
+
     /// The table in use.
     #[must_use]
     pub fn lut(&self) -> &LookupTable {

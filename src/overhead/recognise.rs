@@ -21,16 +21,17 @@ use serde::{Deserialize, Serialize};
 use crate::blobs::{Blob, BlobSet};
 use crate::classify::ClassifiedImage;
 use crate::frame::PixelBox;
-use crate::geometry::marker::{
-    ID_DOT_ANGLES_DEG, ID_DOT_DIAMETER_CM, ID_DOT_RADIUS_CM, TEAM_DOT_DIAMETER_CM,
-};
+use crate::geometry::marker::ID_DOT_ANGLES_DEG;
 use crate::geometry::{
     Field, ImagePoint, MarkerIdentity, MarkerTeam, OverheadCamera, OverheadProjector, Point,
 };
 use crate::lut::ColourClass;
+use crate::recognition::OverheadRecognitionParams;
 use crate::recognition::fit::fit_circle;
 
-/// Settings of the overhead recogniser.
+/// Settings of the overhead recogniser: the field's ball radius and plate height, and the
+/// tunable rest (the `overhead` section of the recognition parameters, its keys at the top
+/// level here as in a session's overhead parameters file).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct OverheadParams {
@@ -38,11 +39,9 @@ pub struct OverheadParams {
     pub ball_radius_cm: f64,
     /// Height of the marker plates, centimetres.
     pub plate_height_cm: f64,
-    /// Smallest and largest blob area as a share of the expected image area (ball, team dot).
-    pub area_ratio: [f64; 2],
-    /// Smallest share of the ring samples that must agree with the marker layout at the best
-    /// heading for a robot to be reported.
-    pub min_layout_agreement: f64,
+    /// Marker and ball sizes, fills, layout agreement.
+    #[serde(flatten)]
+    pub recogniser: OverheadRecognitionParams,
 }
 
 impl Default for OverheadParams {
@@ -50,8 +49,7 @@ impl Default for OverheadParams {
         Self {
             ball_radius_cm: 4.25,
             plate_height_cm: crate::geometry::marker::DEFAULT_PLATE_HEIGHT_CM,
-            area_ratio: [0.35, 1.8],
-            min_layout_agreement: 0.75,
+            recogniser: OverheadRecognitionParams::default(),
         }
     }
 }
@@ -98,11 +96,21 @@ pub enum OverheadRejection {
         pixels: u32,
         /// Expected pixels.
         expected: f64,
+        /// The accepted range of pixels / expected (`OverheadParams::area_ratio`).
+        #[serde(default)]
+        accepted_ratio: [f64; 2],
     },
-    /// It is not round enough (box aspect or fill).
+    /// Its box is too long for a disc: width / height outside 1:2 to 2:1.
     Shape {
         /// Box width / height.
         aspect: f64,
+    },
+    /// It fills too little of its box for a disc (a ring, a speckled or ragged blob).
+    Fill {
+        /// Blob pixels / box area.
+        fill: f64,
+        /// The least fill accepted (a disc fills π/4 of its box).
+        min: f64,
     },
     /// The camera does not see its place on the field.
     OffField,
@@ -110,9 +118,46 @@ pub enum OverheadRejection {
     NoMarker {
         /// Share of the ring samples that agreed at the best heading.
         agreement: f64,
+        /// The least share accepted (`OverheadParams::min_layout_agreement`).
+        #[serde(default)]
+        needed: f64,
     },
     /// Another candidate was better.
     Duplicate,
+}
+
+impl std::fmt::Display for OverheadRejection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Size {
+                pixels,
+                expected,
+                accepted_ratio: [lo, hi],
+            } => write!(
+                f,
+                "size: {pixels} px where {expected:.0} px are expected ({:.2}×; {lo:.2}× to {hi:.2}× accepted)",
+                f64::from(*pixels) / expected.max(1e-9)
+            ),
+            Self::Shape { aspect } => write!(
+                f,
+                "shape: its box is {aspect:.2} wide per unit of height (0.5 to 2 accepted)"
+            ),
+            Self::Fill { fill, min } => write!(
+                f,
+                "fill: it covers {:.0} % of its box, at least {:.0} % needed",
+                fill * 100.0,
+                min * 100.0
+            ),
+            Self::OffField => f.write_str("off the field: the calibration places it nowhere"),
+            Self::NoMarker { agreement, needed } => write!(
+                f,
+                "no marker: {:.0} % of the ring samples around it agree with the marker layout, {:.0} % needed",
+                agreement * 100.0,
+                needed * 100.0
+            ),
+            Self::Duplicate => f.write_str("duplicate: another candidate was better"),
+        }
+    }
 }
 
 /// A rejected candidate, for overlays.
@@ -302,25 +347,27 @@ fn sized_like(
         image_radius_px(camera, &ground, radius_cm).ok_or(OverheadRejection::OffField)?;
     let expected = std::f64::consts::PI * expected_r * expected_r;
     let ratio = f64::from(blob.pixels) / expected.max(1e-9);
-    if !(params.area_ratio[0]..=params.area_ratio[1]).contains(&ratio) {
+    let area_ratio = params.recogniser.area_ratio;
+    if !(area_ratio[0]..=area_ratio[1]).contains(&ratio) {
         return Err(OverheadRejection::Size {
             pixels: blob.pixels,
             expected,
+            accepted_ratio: area_ratio,
         });
     }
     let aspect = f64::from(blob.width()) / f64::from(blob.height());
-    let fill = f64::from(blob.pixels) / blob.area() as f64;
-    if !(0.5..=2.0).contains(&aspect) || fill < min_fill {
+    if !(0.5..=2.0).contains(&aspect) {
         return Err(OverheadRejection::Shape { aspect });
+    }
+    let fill = f64::from(blob.pixels) / blob.area() as f64;
+    if fill < min_fill {
+        return Err(OverheadRejection::Fill {
+            fill,
+            min: min_fill,
+        });
     }
     Ok((ground, expected_r, ratio))
 }
-
-/// Smallest share of its box a ball blob fills: a ball's shaded side often classifies in
-/// speckles (noise moves its pixels between table cells), leaving holes.
-const BALL_MIN_FILL: f64 = 0.3;
-/// Smallest share of its box a team dot fills (a disc fills π/4).
-const DOT_MIN_FILL: f64 = 0.5;
 
 /// Outline points of a blob: the outermost run ends of each row (holes inside a speckled blob
 /// are no outline).
@@ -355,16 +402,22 @@ fn find_ball(
     let r_cm = params.ball_radius_cm;
     let mut best: Option<OverheadBall> = None;
     for blob in blobs.of_class(ColourClass::Orange) {
-        let (_, expected_r, ratio) =
-            match sized_like(blob, camera, r_cm, r_cm, BALL_MIN_FILL, params) {
-                Ok(v) => v,
-                Err(reason) => {
-                    if blob.pixels >= 3 {
-                        rejected_out.push(rejected(blob, reason));
-                    }
-                    continue;
+        let (_, expected_r, ratio) = match sized_like(
+            blob,
+            camera,
+            r_cm,
+            r_cm,
+            params.recogniser.ball_min_fill,
+            params,
+        ) {
+            Ok(v) => v,
+            Err(reason) => {
+                if blob.pixels >= 3 {
+                    rejected_out.push(rejected(blob, reason));
                 }
-            };
+                continue;
+            }
+        };
         let outline = outline_points(blobs, blob);
         let (cx, cy) = blob.centroid();
         let (centre, radius) = match fit_circle(&outline) {
@@ -420,12 +473,14 @@ fn read_marker(
     params: &OverheadParams,
 ) -> Result<OverheadRobot, OverheadRejection> {
     let z = params.plate_height_cm;
+    let marker = &params.recogniser;
+    let ring_r = marker.id_dot_ring_radius_cm;
     let (centre, _, ratio) = sized_like(
         blob,
         camera,
         z,
-        TEAM_DOT_DIAMETER_CM / 2.0,
-        DOT_MIN_FILL,
+        marker.team_dot_diameter_cm / 2.0,
+        marker.team_dot_min_fill,
         params,
     )?;
     // Ring of samples through the dots' centres: which angles show a dot.
@@ -433,8 +488,8 @@ fn read_marker(
         .map(|k| {
             let a = k as f64 * std::f64::consts::TAU / RING_SAMPLES as f64;
             let p = Point::new(
-                centre.x() + ID_DOT_RADIUS_CM * a.cos(),
-                centre.y() + ID_DOT_RADIUS_CM * a.sin(),
+                centre.x() + ring_r * a.cos(),
+                centre.y() + ring_r * a.sin(),
                 z,
             );
             camera
@@ -443,20 +498,23 @@ fn read_marker(
                 .is_some_and(is_dot)
         })
         .collect();
-    let (heading, agreement) = best_layout_heading(&ring);
-    if agreement < params.min_layout_agreement {
-        return Err(OverheadRejection::NoMarker { agreement });
+    let (heading, agreement) = best_layout_heading(&ring, marker.id_dot_diameter_cm / 2.0 / ring_r);
+    if agreement < marker.min_layout_agreement {
+        return Err(OverheadRejection::NoMarker {
+            agreement,
+            needed: marker.min_layout_agreement,
+        });
     }
     // Each dot's own pixels: colour (majority) and centroid.
-    let dot_r = ID_DOT_DIAMETER_CM / 2.0;
+    let dot_r = marker.id_dot_diameter_cm / 2.0;
     let mut bits = [false; 4];
     let mut dots = [ImagePoint::default(); 4];
     let mut heading_sum = (0.0, 0.0);
     for (k, angle_deg) in ID_DOT_ANGLES_DEG.iter().enumerate() {
         let a = heading + angle_deg.to_radians();
         let expected = Point::new(
-            centre.x() + ID_DOT_RADIUS_CM * a.cos(),
-            centre.y() + ID_DOT_RADIUS_CM * a.sin(),
+            centre.x() + ring_r * a.cos(),
+            centre.y() + ring_r * a.sin(),
             z,
         );
         let Some(q) = camera.image_from_field(&expected) else {
@@ -496,21 +554,18 @@ fn read_marker(
 
 /// The heading (radians) whose four dot arcs best match the ring, and the share of ring
 /// samples that agree with the layout there (dot inside an arc, none outside). The first best
-/// turn wins a tie.
+/// turn wins a tie. `dot_over_ring` is an identity dot's radius over the ring's radius (their
+/// sine gives each dot's half-width as an angle).
 ///
 /// Every turn of the layout is tried against the ring as bits, a word at a time: at 180 samples
 /// that is 180 × 3 word compares where sample by sample it was 180 × 180 (the slowest part of
 /// reading a marker at 1920×1200, docs/speed.md).
-fn best_layout_heading(ring: &[bool]) -> (f64, f64) {
+fn best_layout_heading(ring: &[bool], dot_over_ring: f64) -> (f64, f64) {
     let n = ring.len();
     if n == 0 || n > RING_BITS {
         return (0.0, 0.0);
     }
-    let template = if n == RING_SAMPLES {
-        *layout_template()
-    } else {
-        layout_bits(n)
-    };
+    let template = layout_template(n, dot_over_ring);
     // The ring twice over, so a turn by `shift` is the n bits from bit `shift`.
     let mut doubled = [0u64; 2 * RING_WORDS + 1];
     for (k, &dot) in ring.iter().chain(ring).enumerate() {
@@ -552,16 +607,29 @@ fn word_mask(n: usize, w: usize) -> u64 {
     }
 }
 
-/// [`layout_bits`] of the ring recognition samples, built once.
-fn layout_template() -> &'static [u64; RING_WORDS] {
-    static TEMPLATE: std::sync::OnceLock<[u64; RING_WORDS]> = std::sync::OnceLock::new();
-    TEMPLATE.get_or_init(|| layout_bits(RING_SAMPLES))
+/// [`layout_bits`] of a ring, kept per thread for the last ring size and dot ratio asked (the
+/// same for every marker of a camera's parameters).
+fn layout_template(n: usize, dot_over_ring: f64) -> [u64; RING_WORDS] {
+    type Kept = Option<(usize, u64, [u64; RING_WORDS])>;
+    thread_local! {
+        static LAST: std::cell::Cell<Kept> = const { std::cell::Cell::new(None) };
+    }
+    let key = (n, dot_over_ring.to_bits());
+    LAST.with(|last| match last.get() {
+        Some((kn, kb, t)) if (kn, kb) == key => t,
+        _ => {
+            let t = layout_bits(n, dot_over_ring);
+            last.set(Some((key.0, key.1, t)));
+            t
+        }
+    })
 }
 
 /// The marker layout at heading 0 on a ring of `n` (at most [`RING_BITS`]) samples: sample k
-/// (at angle k·2π/n) is set when it falls on an identity dot.
-fn layout_bits(n: usize) -> [u64; RING_WORDS] {
-    let half_width = (ID_DOT_DIAMETER_CM / 2.0 / ID_DOT_RADIUS_CM).asin();
+/// (at angle k·2π/n) is set when it falls on an identity dot of radius `dot_over_ring` (of the
+/// ring's radius).
+fn layout_bits(n: usize, dot_over_ring: f64) -> [u64; RING_WORDS] {
+    let half_width = dot_over_ring.clamp(0.0, 1.0).asin();
     let step = std::f64::consts::TAU / n as f64;
     let mut bits = [0u64; RING_WORDS];
     for k in 0..n.min(RING_BITS) {
@@ -633,7 +701,7 @@ mod tests {
                     })
                 })
                 .collect();
-            let (found, agreement) = best_layout_heading(&ring);
+            let (found, agreement) = best_layout_heading(&ring, 0.3);
             let err = (found - h + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
                 - std::f64::consts::PI;
             assert!(err.abs() < 0.04, "{heading_deg}: {found}");
@@ -642,9 +710,9 @@ mod tests {
     }
 
     /// The sample-by-sample search the bit form replaced, as the reference it must equal.
-    fn best_layout_heading_by_sample(ring: &[bool]) -> (f64, f64) {
+    fn best_layout_heading_by_sample(ring: &[bool], dot_over_ring: f64) -> (f64, f64) {
         let n = ring.len();
-        let half_width = (ID_DOT_DIAMETER_CM / 2.0 / ID_DOT_RADIUS_CM).asin();
+        let half_width = dot_over_ring.asin();
         let step = std::f64::consts::TAU / n as f64;
         let template: Vec<bool> = (0..n)
             .map(|k| {
@@ -684,21 +752,23 @@ mod tests {
         for n in [RING_SAMPLES, 64, 65, 128, 130, 191, 192, 7] {
             for density in [2, 4, 8, 64] {
                 let ring: Vec<bool> = (0..n).map(|_| next() % density == 0).collect();
-                assert_eq!(
-                    best_layout_heading(&ring),
-                    best_layout_heading_by_sample(&ring),
-                    "{n} samples, 1 in {density} set"
-                );
+                for ratio in [0.3, 0.25] {
+                    assert_eq!(
+                        best_layout_heading(&ring, ratio),
+                        best_layout_heading_by_sample(&ring, ratio),
+                        "{n} samples, 1 in {density} set, dot/ring {ratio}"
+                    );
+                }
             }
         }
-        assert_eq!(best_layout_heading(&[]), (0.0, 0.0));
+        assert_eq!(best_layout_heading(&[], 0.3), (0.0, 0.0));
     }
 
     #[test]
     fn an_all_black_ring_is_no_marker() {
-        let (_, agreement) = best_layout_heading(&[false; RING_SAMPLES]);
+        let (_, agreement) = best_layout_heading(&[false; RING_SAMPLES], 0.3);
         assert!(
-            agreement < OverheadParams::default().min_layout_agreement,
+            agreement < OverheadParams::default().recogniser.min_layout_agreement,
             "{agreement}"
         );
     }

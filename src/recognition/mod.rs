@@ -11,6 +11,7 @@
 //! | [`scan`] | horizon-parallel scan areas, the six edge-scan patterns, skew removal |
 //! | [`ball`], [`goals`], [`beacons`] | the recognisers |
 //! | [`patterns`] | the "almost SLAM" coloured-pattern recogniser (learn, then identify) |
+//! | [`overhead_params`] | the overhead recogniser's settings (marker sizes, fills), a section of the parameters file |
 //! | [`draw`] | drawing primitives as data |
 
 pub mod ball;
@@ -20,6 +21,7 @@ pub mod context;
 pub mod draw;
 pub mod fit;
 pub mod goals;
+pub mod overhead_params;
 pub mod params_file;
 pub mod patterns;
 pub mod scan;
@@ -35,6 +37,7 @@ pub use beacons::{Beacon, BeaconParams};
 pub use context::{Relative, ViewContext};
 pub use draw::{CircleRole, LineRole, ObjectId, Primitive};
 pub use goals::{GoalCandidate, GoalParams, GoalResult};
+pub use overhead_params::OverheadRecognitionParams;
 
 /// Settings of every recogniser, and the camera to assume for frames that are not the ERS-7's.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -56,6 +59,8 @@ pub struct RecognitionParams {
     pub camera_readout_s: f64,
     /// Lengths of the head chain used to place the camera from the joints.
     pub body: Ers7Dimensions,
+    /// The overhead camera's recogniser: marker and ball sizes, fills, layout agreement.
+    pub overhead: OverheadRecognitionParams,
 }
 
 impl Default for RecognitionParams {
@@ -68,6 +73,7 @@ impl Default for RecognitionParams {
             other_camera_fov_deg: 46.4,
             camera_readout_s: context::DEFAULT_READOUT_S,
             body: Ers7Dimensions::ERS7,
+            overhead: OverheadRecognitionParams::default(),
         }
     }
 }

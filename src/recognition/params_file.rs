@@ -4,7 +4,9 @@
 //!
 //! Checked: every key exists (a misspelt `"bal"` would otherwise change nothing), every number
 //! is finite, every `[low, high]` range is ordered, sizes are positive, the field of view lies
-//! strictly between 0° and 180°, the shutter's read-out time between 0 and 1 s.
+//! strictly between 0° and 180°, the shutter's read-out time between 0 and 1 s, the overhead
+//! recogniser's fills and layout agreement (shares) above 0 and at most 1, its area ratios
+//! positive.
 
 use std::path::{Path, PathBuf};
 
@@ -191,6 +193,12 @@ fn check_values(v: &Value, key: &str) -> Result<(), ParamsError> {
             {
                 return Err(bad("a range must be [low, high], low ≤ high"));
             }
+            if key.ends_with("area_ratio")
+                && let Some(Value::Number(a)) = items.first()
+                && a.as_f64().is_none_or(|a| a <= 0.0)
+            {
+                return Err(bad("an area ratio must be positive"));
+            }
         }
         Value::Number(n) => {
             let x = n.as_f64().unwrap_or(f64::NAN);
@@ -199,6 +207,7 @@ fn check_values(v: &Value, key: &str) -> Result<(), ParamsError> {
                 return Err(bad("must be a finite number"));
             }
             let size = name.ends_with("diameter_cm")
+                || name.ends_with("radius_cm")
                 || name == "height_cm"
                 || name == "width_cm"
                 || name == "min_height_cm";
@@ -212,6 +221,12 @@ fn check_values(v: &Value, key: &str) -> Result<(), ParamsError> {
             }
             if name.ends_with("readout_s") && !(0.0..1.0).contains(&x) {
                 return Err(bad("a read-out time lies between 0 and 1 second"));
+            }
+            if key.starts_with("overhead.")
+                && (name.ends_with("_fill") || name.ends_with("_agreement"))
+                && !(x > 0.0 && x <= 1.0)
+            {
+                return Err(bad("a share lies between 0 (excluded) and 1"));
             }
         }
         _ => {}
@@ -265,6 +280,31 @@ mod tests {
             let e = err(&format!(r#"{{"other_camera_fov_deg": {fov}}}"#));
             assert!(e.contains("other_camera_fov_deg"), "{e}");
         }
+    }
+
+    #[test]
+    fn the_overhead_section_is_read_and_checked() {
+        let p = from_json(
+            r#"{"overhead": {"team_dot_diameter_cm": 5.0, "id_dot_ring_radius_cm": 6.5}}"#,
+        )
+        .unwrap();
+        assert_eq!(p.overhead.team_dot_diameter_cm, 5.0);
+        assert_eq!(p.overhead.id_dot_ring_radius_cm, 6.5);
+        assert_eq!(
+            p.overhead.min_layout_agreement,
+            RecognitionParams::default().overhead.min_layout_agreement
+        );
+        let e = err(r#"{"overhead": {"team_dot_diamter_cm": 5.0}}"#);
+        assert!(e.contains("'overhead.team_dot_diamter_cm'"), "{e}");
+        let e = err(r#"{"overhead": {"ball_min_fill": 1.5}}"#);
+        assert!(
+            e.contains("overhead.ball_min_fill") && e.contains("share"),
+            "{e}"
+        );
+        let e = err(r#"{"overhead": {"team_dot_diameter_cm": 0}}"#);
+        assert!(e.contains("positive"), "{e}");
+        let e = err(r#"{"overhead": {"area_ratio": [0, 2]}}"#);
+        assert!(e.contains("area ratio"), "{e}");
     }
 
     #[test]

@@ -302,6 +302,9 @@ pub enum HintsCommand {
     /// Select these table cells (by index), as clicking a coverage hint: the preview, nothing
     /// written until a Commit.
     SelectCells(Vec<usize>),
+    /// Order the coverage hints afresh by their unclassified pixels (after commits a hint
+    /// keeps its row until this).
+    RankHints,
     /// Run the pipeline over the whole source for its events (ball found or lost, goal
     /// appears, warnings), a few frames per UI frame.
     FindEvents,
@@ -358,10 +361,15 @@ pub enum OverheadCommand {
         /// Row, pixels.
         y_px: f64,
     },
+    /// Leave the chosen landmark unpicked (not in view) and choose the next one not picked.
+    SkipLandmark,
     /// Undo the latest pick.
     UndoPick,
     /// Solve the camera from the picked points, refined along the frame's field lines.
     Calibrate,
+    /// Frame files (JPEG, PNG, …) come from an overhead camera (`true`) or a robot's: the
+    /// overhead recogniser and the overhead table are used for them. Streams say it themselves.
+    SetOverheadCamera(bool),
     /// Select a robot in every view (`None` clears).
     SelectRobot(Option<RobotKey>),
     /// Overhead view options.

@@ -118,12 +118,18 @@ impl Workspace {
         if o.preview
             && let Some(k) = self.preview_colour()
         {
-            for (px, &m) in out.chunks_exact_mut(3).zip(&self.preview_mask) {
-                if m {
-                    px.copy_from_slice(&k);
-                } else {
+            for (i, (px, p)) in out
+                .chunks_exact_mut(3)
+                .zip(self.preview_pixels())
+                .enumerate()
+            {
+                match p {
+                    PreviewPixel::Changes => px.copy_from_slice(&hatch_rgb(i % w, i / w, k)),
+                    PreviewPixel::Unchanged => {}
                     // As on screen: the rest is dimmed so the highlight always shows.
-                    px.iter_mut().for_each(|v| *v = mix(*v, 0, 110.0 / 255.0));
+                    PreviewPixel::Outside => {
+                        px.iter_mut().for_each(|v| *v = mix(*v, 0, 110.0 / 255.0));
+                    }
                 }
             }
         }
@@ -157,14 +163,88 @@ impl Workspace {
     }
 
     /// The colour of the preview highlight: the class being defined (magenta for
-    /// unclassified, which erases).
+    /// unclassified, which erases), made light when the class colour is too dark to show
+    /// ([`visible_preview_rgb`]).
     #[must_use]
     pub fn preview_colour(&self) -> Option<[u8; 3]> {
         self.selection.as_ref()?;
-        Some(match self.settings.class {
-            ColourClass::Unclassified => [255, 0, 255],
-            c => c.display_rgb(),
+        Some(match self.selection_class() {
+            // A coverage hint's colours before a class is chosen for them: neutral white.
+            None => [235, 235, 235],
+            Some(ColourClass::Unclassified) => [255, 0, 255],
+            Some(c) => visible_preview_rgb(c.display_rgb()),
         })
+    }
+
+    /// How the selection preview shows each pixel of the shown frame, row by row: outside the
+    /// selection, selected but already of the class (a commit leaves it), or selected and
+    /// changed by a commit. Empty with no selection. The classification compared is the shown
+    /// frame's, from whichever pipeline ran (robot or overhead).
+    pub fn preview_pixels(&self) -> impl Iterator<Item = PreviewPixel> + '_ {
+        // With no class chosen (a coverage hint) every selected pixel is previewed.
+        let code = self.selection_class().map(ColourClass::code);
+        let codes = self.shown_classified().codes();
+        // A mask of another frame's size (none pending) previews nothing.
+        let n = if codes.len() == self.preview_mask.len() {
+            codes.len()
+        } else {
+            0
+        };
+        self.preview_mask
+            .iter()
+            .zip(codes)
+            .take(n)
+            .map(move |(&m, &c)| match (m, Some(c) == code) {
+                (false, _) => PreviewPixel::Outside,
+                (true, true) => PreviewPixel::Unchanged,
+                (true, false) => PreviewPixel::Changes,
+            })
+    }
+}
+
+/// How the selection preview shows one pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PreviewPixel {
+    /// Not selected: dimmed, so that the selection stands out.
+    Outside,
+    /// Selected, but already of the class: a commit does not change it, so it is left as it
+    /// is (neither dimmed nor hatched).
+    Unchanged,
+    /// Selected, and a commit changes its class: hatched.
+    Changes,
+}
+
+/// The colour of a hatched preview pixel at (`x`, `y`): diagonal stripes two pixels wide of
+/// the class colour `class_rgb` and of black or white, whichever contrasts with it. Hatched,
+/// the pixels a commit would change can be told from pixels already shown in the class's
+/// colour (a solid fill in the class colour cannot).
+#[must_use]
+pub fn hatch_rgb(x: usize, y: usize, class_rgb: [u8; 3]) -> [u8; 3] {
+    if (x + y) % 4 < 2 {
+        class_rgb
+    } else if luma(class_rgb) > 128.0 {
+        [0, 0, 0]
+    } else {
+        [255, 255, 255]
+    }
+}
+
+/// Rec. 601 luma of an RGB colour, 0..255.
+fn luma([r, g, b]: [u8; 3]) -> f32 {
+    0.299 * f32::from(r) + 0.587 * f32::from(g) + 0.114 * f32::from(b)
+}
+
+/// Class colours darker than this (0..255 luma) are previewed in a light colour.
+const PREVIEW_MIN_LUMA: f32 = 100.0;
+
+/// The highlight colour of a previewed class: its own colour, or a light magenta for classes
+/// too dark to show over dimmed pixels (black's near-black, dark blue).
+#[must_use]
+pub fn visible_preview_rgb(class_rgb: [u8; 3]) -> [u8; 3] {
+    if luma(class_rgb) < PREVIEW_MIN_LUMA {
+        [255, 96, 255]
+    } else {
+        class_rgb
     }
 }
 

@@ -10,7 +10,7 @@ use anyhow::Context as _;
 use super::bookmarks::{self, Event, EventKind, EventScan, UserBookmark};
 use super::cell_origin::{CellOrigin, cell_origin};
 use super::coverage::CoverageScan;
-use super::{HintsCommand, PendingSelection, SCAN_BUDGET, Workspace};
+use super::{HintsCommand, PendingSelection, SCAN_BUDGET, SelectionClass, Workspace};
 use crate::lut::Region;
 
 /// Coverage, events and bookmarks of the open source.
@@ -23,6 +23,9 @@ pub struct Hints {
     /// The bookmarks file of the open source, if it has a file.
     bookmarks_file: Option<PathBuf>,
     user: Vec<UserBookmark>,
+    /// The shown frame's pixels per table cell and the frame generation they were counted at
+    /// (each hint's pixels in the shown frame are summed from them).
+    shown: Option<(u64, std::collections::HashMap<usize, u64>)>,
 }
 
 impl Workspace {
@@ -43,11 +46,21 @@ impl Workspace {
                     "a cell lies outside the {}-bit table",
                     self.pipeline.lut().bits()
                 );
+                // A hint's colours are nobody's class yet: the class is chosen for them.
                 self.selection = Some(PendingSelection {
                     region: Region::Cells { indices },
                     pixel: None,
+                    class: SelectionClass::Unchosen,
                 });
                 self.refresh_preview();
+            }
+            HintsCommand::RankHints => {
+                let c = self
+                    .hints
+                    .coverage
+                    .as_mut()
+                    .context("no coverage count yet")?;
+                c.rank(self.pipeline.lut());
             }
             HintsCommand::FindEvents => {
                 let total = self.source.as_ref().context("no stream open")?.len();
@@ -101,6 +114,7 @@ impl Workspace {
     /// Loads the bookmarks kept beside the newly opened source (a bad file is a warning).
     pub(super) fn load_bookmarks(&mut self) {
         self.hints.coverage = None;
+        self.hints.shown = None;
         self.hints.events = None;
         self.hints.user.clear();
         self.hints.bookmarks_file = self
@@ -123,14 +137,46 @@ impl Workspace {
         };
         if let Some(c) = self.hints.coverage.as_mut() {
             let counted = c.scan(src, self.pipeline.lut(), SCAN_BUDGET);
-            if counted || self.hints.ranked_generation != self.table_generation {
+            if counted {
                 c.rank(self.pipeline.lut());
+                self.hints.ranked_generation = self.table_generation;
+            } else if self.hints.ranked_generation != self.table_generation {
+                // A commit or an undo: each row keeps its place (Re-rank orders afresh).
+                c.refresh(self.pipeline.lut());
                 self.hints.ranked_generation = self.table_generation;
             }
         }
         if let Some(e) = self.hints.events.as_mut() {
             e.scan(src, SCAN_BUDGET);
         }
+        let stale = self
+            .hints
+            .shown
+            .as_ref()
+            .is_none_or(|(g, _)| *g != self.frame_generation);
+        // One pass over the frame (a hash per pixel): not while playing, nor with the
+        // Coverage window closed.
+        if self.hints.coverage.is_some()
+            && stale
+            && self.settings.show_coverage
+            && !self.player.playing()
+        {
+            self.hints.shown = self.frame().map(|f| {
+                (
+                    self.frame_generation,
+                    super::coverage::cell_counts(f, self.pipeline.lut()),
+                )
+            });
+        }
+    }
+
+    /// Pixels of the shown frame in any of `cells` (a coverage hint's): 0 before the first
+    /// count of the shown frame.
+    #[must_use]
+    pub fn pixels_here(&self, cells: &[usize]) -> u64 {
+        self.hints.shown.as_ref().map_or(0, |(_, counts)| {
+            cells.iter().filter_map(|c| counts.get(c)).sum()
+        })
     }
 
     /// The unclassified-colours count, if one was started.

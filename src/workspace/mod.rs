@@ -66,7 +66,7 @@ pub use command::{
     Command, HintsCommand, OverheadCommand, ParamsCommand, PlaybackCommand, RobotsCommand,
     SourceCommand, TableCommand, ViewCommand, Window,
 };
-pub use compose::{PrimitiveFilter, box_colour};
+pub use compose::{PreviewPixel, PrimitiveFilter, box_colour, hatch_rgb, visible_preview_rgb};
 pub use labels::OpenLabels;
 pub use live::Live;
 pub use overhead::{CalibrationSource, Overhead, RobotKey};
@@ -114,6 +114,9 @@ pub struct PixelInfo {
     pub class: ColourClass,
     /// The blob it belongs to.
     pub blob: Option<Blob>,
+    /// Where the pixel's centre lies on the field (on the ground), centimetres `[x, y]`:
+    /// for an overhead frame with a calibration in use.
+    pub field_cm: Option<[f64; 2]>,
 }
 
 /// A pending (previewed, unwritten) selection.
@@ -123,6 +126,21 @@ pub struct PendingSelection {
     pub region: Region,
     /// The pixel it was made from, if any.
     pub pixel: Option<(usize, usize)>,
+    /// Which class a commit writes.
+    pub class: SelectionClass,
+}
+
+/// Which class a pending selection commits as.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SelectionClass {
+    /// The class chosen in the Classify panel (a sampled pixel, a U–V plane cell).
+    Current,
+    /// A class chosen for this selection (a coverage hint's colours, after Commit as…).
+    Chosen(ColourClass),
+    /// None yet: a coverage hint's colours are nobody's class until one is chosen for them
+    /// (committing them in whatever class happened to be selected turned a wall orange), so
+    /// a commit is refused and the preview is neutral.
+    Unchosen,
 }
 
 /// Sensor readings of every frame of the stream, filled a few frames per UI frame.
@@ -353,6 +371,10 @@ impl Workspace {
                 if w == Window::Inspector && !open {
                     // Its highlight belongs to it: closed, every object is drawn alike again.
                     self.selected_object = None;
+                }
+                if w == Window::Calibration && !open {
+                    // Picking belongs to the calibration window: closed, a click samples.
+                    self.disarm_landmark_picking();
                 }
             }
             Command::SelectObject(owner) => {
@@ -617,6 +639,7 @@ impl Workspace {
             rgb: yuv_to_rgb(yuv),
             class: self.pipeline.lut().class_of(yuv),
             blob: self.blobs().blob_at(x, y).copied(),
+            field_cm: self.field_point_of_pixel(x, y),
         })
     }
 

@@ -17,7 +17,7 @@ use super::Workspace;
 use super::command::OverheadCommand;
 use super::field_model::FieldModel;
 use crate::geometry::{ImagePoint, OverheadCamera};
-use crate::overhead::calibration::{Calibration, CalibrationParams, calibrate_with};
+use crate::overhead::calibration::Calibration;
 use crate::overhead::intrinsics::Intrinsics;
 use crate::overhead::{
     CalibrationPoint, FieldDescription, OverheadDetections, OverheadParams, OverheadPipeline,
@@ -32,6 +32,8 @@ pub const MIN_CALIBRATION_POINTS: usize = crate::overhead::review::MIN_POINTS;
 /// One robot as the overhead camera identifies it: team colour and marker identity. The one
 /// robot selection of the workspace (field view, image overlays) is one of these.
 pub use crate::model::world_model::RobotKey;
+
+mod picking;
 
 /// The undistorted view's pixel map and the camera and frame size it was made for.
 #[derive(Debug, Clone)]
@@ -68,6 +70,8 @@ pub struct Overhead {
     user_calibration: Option<Calibration>,
     calibration_path: Option<PathBuf>,
     stream_camera: Option<OverheadCamera>,
+    /// The shown frame's own ground truth (a synthetic stream's `/ground_truth`), if any.
+    truth: Option<crate::model::truth::OverheadTruth>,
     field: FieldDescription,
     field_path: Option<PathBuf>,
     /// The lens's checkerboard intrinsics and their file: Calibrate then fits only the pose.
@@ -80,6 +84,12 @@ pub struct Overhead {
     synced_table: Option<u64>,
     /// The undistorted view's pixel map, when that view is shown.
     view_map: Option<ViewMap>,
+    /// The field's lines projected through the camera in use (image polylines), the camera
+    /// and the field generation they were made for: made once per calibration, not once per
+    /// UI frame (at 2 cm steps through the lens model they cost milliseconds).
+    projected_lines: Option<(OverheadCamera, u64, Vec<Vec<ImagePoint>>)>,
+    /// Counts field changes (the projected lines follow them).
+    field_generation: u64,
     empty_recognition: Recognition,
     /// The field view's model: trails, world models, errors over time.
     pub field_model: FieldModel,
@@ -95,13 +105,17 @@ impl Default for Overhead {
             pipeline: OverheadPipeline::new(
                 crate::lut::LookupTable::new(6).unwrap_or_else(|_| super::seven_bit_table()),
                 OverheadCamera::above_field_2005(),
-                params_for(&field),
+                params_for(
+                    &field,
+                    &crate::recognition::OverheadRecognitionParams::default(),
+                ),
             ),
             active: false,
             detections: None,
             user_calibration: None,
             calibration_path: None,
             stream_camera: None,
+            truth: None,
             field,
             field_path: None,
             intrinsics: None,
@@ -112,6 +126,8 @@ impl Default for Overhead {
             selected: None,
             synced_table: None,
             view_map: None,
+            projected_lines: None,
+            field_generation: 0,
             empty_recognition: Recognition::default(),
             field_model: FieldModel::default(),
             size_warned: None,
@@ -119,12 +135,16 @@ impl Default for Overhead {
     }
 }
 
-/// The recogniser's settings for a field (ball radius, plate height).
-fn params_for(field: &FieldDescription) -> OverheadParams {
+/// The recogniser's settings: the field's ball radius and plate height, the rest from the
+/// recognition parameters' `overhead` section.
+fn params_for(
+    field: &FieldDescription,
+    recogniser: &crate::recognition::OverheadRecognitionParams,
+) -> OverheadParams {
     OverheadParams {
         ball_radius_cm: field.ball_radius_cm,
         plate_height_cm: field.plate_height_cm,
-        ..OverheadParams::default()
+        recogniser: *recogniser,
     }
 }
 
@@ -167,6 +187,13 @@ impl Overhead {
         self.calibration_path.as_deref()
     }
 
+    /// The shown frame's ground truth, where the stream carries it (a synthetic stream):
+    /// the field view draws it beside what the camera found.
+    #[must_use]
+    pub const fn truth(&self) -> Option<&crate::model::truth::OverheadTruth> {
+        self.truth.as_ref()
+    }
+
     /// The intrinsics Calibrate uses (then only the pose is fitted) and their file.
     #[must_use]
     pub fn intrinsics(&self) -> Option<(&Intrinsics, &Path)> {
@@ -177,6 +204,31 @@ impl Overhead {
     #[must_use]
     pub const fn field(&self) -> &FieldDescription {
         &self.field
+    }
+
+    /// The field's lines and arcs as image polylines through the camera in use (its own
+    /// pixels, at the calibration's size; `overhead::lines::projected_field_lines`); empty
+    /// with no camera.
+    #[must_use]
+    pub fn projected_field_lines(&self) -> &[Vec<ImagePoint>] {
+        self.projected_lines
+            .as_ref()
+            .map_or(&[], |(_, _, lines)| lines.as_slice())
+    }
+
+    /// Makes the projected field lines for `camera`, unless they were made for it already.
+    fn refresh_projected_lines(&mut self, camera: Option<OverheadCamera>) {
+        let fresh = match (&self.projected_lines, camera) {
+            (Some((c, g, _)), Some(cam)) => *c == cam && *g == self.field_generation,
+            (None, None) => true,
+            _ => false,
+        };
+        if !fresh {
+            self.projected_lines = camera.map(|c| {
+                let lines = crate::overhead::lines::projected_field_lines(&self.field, &c);
+                (c, self.field_generation, lines)
+            });
+        }
     }
 
     /// The picked points.
@@ -306,12 +358,19 @@ impl Workspace {
             self.overhead.pipeline.set_lut(self.pipeline.lut().clone());
             self.overhead.synced_table = Some(self.table_generation);
         }
-        self.overhead.stream_camera = stream_camera(loaded);
+        self.overhead.truth = truth_of(loaded);
+        self.overhead.stream_camera = self.overhead.truth.as_ref().map(|t| t.camera);
         let camera = self.overhead.camera().map(|(c, _)| *c);
         if let Some(c) = camera {
             self.overhead.pipeline.set_camera(c);
         }
+        self.overhead.refresh_projected_lines(camera);
         let fits = camera.is_none_or(|c| self.frame_fits(&c, &loaded.frame));
+        // The parameters in use (tuned in the Parameters window, or a file's `overhead`).
+        let params = params_for(&self.overhead.field, &self.recognition_params().overhead);
+        if *self.overhead.pipeline.params() != params {
+            self.overhead.pipeline.set_params(params);
+        }
         self.overhead.pipeline.process(&loaded.frame);
         self.overhead.active = true;
         if (self.overhead.points.width, self.overhead.points.height) == (0, 0) {
@@ -365,7 +424,7 @@ impl Workspace {
                 self.overhead.pipeline = OverheadPipeline::new(
                     self.pipeline.lut().clone(),
                     *self.overhead.pipeline.camera(),
-                    params_for(&field),
+                    params_for(&field, &self.recognition_params().overhead),
                 );
                 self.overhead.synced_table = Some(self.table_generation);
                 self.status = format!(
@@ -375,6 +434,7 @@ impl Workspace {
                     field.lines.len()
                 );
                 self.overhead.field = field;
+                self.overhead.field_generation += 1;
                 self.overhead.field_path = Some(p);
                 self.overhead.landmark = None;
                 self.reprocess();
@@ -404,8 +464,10 @@ impl Workspace {
             }
             OverheadCommand::ChooseLandmark(name) => self.choose_landmark(name)?,
             OverheadCommand::PickPoint { x_px, y_px } => self.pick_point(x_px, y_px)?,
+            OverheadCommand::SkipLandmark => self.skip_landmark()?,
             OverheadCommand::UndoPick => self.undo_pick()?,
             OverheadCommand::Calibrate => self.calibrate_from_points()?,
+            OverheadCommand::SetOverheadCamera(overhead) => self.set_overhead_camera(overhead)?,
             OverheadCommand::SelectRobot(key) => {
                 self.overhead.selected = key;
                 if let Some(k) = key {
@@ -461,6 +523,37 @@ impl Workspace {
         Ok(())
     }
 
+    /// Tells whether the open frame files come from an overhead camera: the frames are then
+    /// recognised as overhead frames (with the overhead table) or as a robot's.
+    fn set_overhead_camera(&mut self, overhead: bool) -> anyhow::Result<()> {
+        use crate::sources::{CameraKind, SourceKind};
+        let src = self.source.as_mut().context("no frames open")?;
+        anyhow::ensure!(
+            self.live.is_none() && src.info().kind == SourceKind::Files,
+            "only frame files (JPEG, PNG, raw frames) can be told which camera made them; {} says it itself",
+            src.label()
+        );
+        let kind = if overhead {
+            CameraKind::Overhead
+        } else {
+            CameraKind::Robot
+        };
+        src.set_camera_kind(kind);
+        self.reset_overhead_for_source();
+        // The table of that kind of camera; it re-runs the shown frame.
+        self.use_table_of(kind);
+        self.reprocess();
+        self.status = if overhead {
+            format!(
+                "overhead camera: the overhead recogniser runs; {}",
+                self.overhead.calibration_status()
+            )
+        } else {
+            "robot camera: the robot's recognisers run".to_owned()
+        };
+        Ok(())
+    }
+
     /// Uses the intrinsics of `p` for Calibrate, or none.
     fn open_intrinsics(&mut self, p: Option<PathBuf>) -> anyhow::Result<()> {
         let Some(p) = p else {
@@ -482,143 +575,6 @@ impl Workspace {
             i.lens.ros_name()
         );
         self.overhead.intrinsics = Some((i, p));
-        Ok(())
-    }
-
-    fn choose_landmark(&mut self, name: Option<String>) -> anyhow::Result<()> {
-        if let Some(n) = &name {
-            anyhow::ensure!(
-                self.overhead.field.landmark(n).is_some(),
-                "no landmark {n:?} in the field {}",
-                self.overhead.field.name
-            );
-            self.status = format!("click {n} in the image");
-        }
-        self.overhead.landmark = name;
-        Ok(())
-    }
-
-    fn pick_point(&mut self, x_px: f64, y_px: f64) -> anyhow::Result<()> {
-        let name = self
-            .overhead
-            .landmark
-            .clone()
-            .context("choose a landmark first (Calibration window)")?;
-        let (w, h) = self.image_size();
-        anyhow::ensure!(w > 0, "no frame to pick on");
-        anyhow::ensure!(
-            x_px.is_finite()
-                && y_px.is_finite()
-                && (0.0..w as f64).contains(&x_px)
-                && (0.0..h as f64).contains(&y_px),
-            "({x_px:.1}, {y_px:.1}) is outside the {w}×{h} frame"
-        );
-        let l = self
-            .overhead
-            .field
-            .landmark(&name)
-            .with_context(|| format!("no landmark {name:?}"))?
-            .clone();
-        if (self.overhead.points.width, self.overhead.points.height) != (w, h) {
-            anyhow::ensure!(
-                self.overhead.points.points.is_empty(),
-                "the picked points are for a {}×{} frame, this one is {w}×{h}",
-                self.overhead.points.width,
-                self.overhead.points.height
-            );
-            self.overhead.points = PointsFile::new(w, h);
-        }
-        let replaced = self
-            .overhead
-            .points
-            .points
-            .iter()
-            .find(|p| p.name == name)
-            .cloned();
-        self.overhead.points.set(CalibrationPoint {
-            name: name.clone(),
-            field_cm: l.field_cm,
-            height_cm: l.height_cm,
-            image_px: [x_px, y_px],
-        });
-        self.overhead.picks.push(PickEdit {
-            name: name.clone(),
-            replaced,
-        });
-        // The next landmark not yet picked, so clicking round the field needs no menu.
-        let picked = |n: &str| self.overhead.points.points.iter().any(|p| p.name == n);
-        let next = self
-            .overhead
-            .field
-            .landmarks
-            .iter()
-            .map(|l| l.name.clone())
-            .find(|n| !picked(n));
-        self.status = format!(
-            "{name} at ({x_px:.1}, {y_px:.1}) px; {} points{}",
-            self.overhead.points.points.len(),
-            next.as_ref()
-                .map(|n| format!("; next: {n}"))
-                .unwrap_or_default()
-        );
-        self.overhead.landmark = next;
-        Ok(())
-    }
-
-    fn undo_pick(&mut self) -> anyhow::Result<()> {
-        let edit = self
-            .overhead
-            .picks
-            .pop()
-            .context("no picked point to undo")?;
-        self.overhead.points.remove(&edit.name);
-        if let Some(old) = edit.replaced {
-            self.overhead.points.set(old);
-        }
-        self.overhead.landmark = Some(edit.name.clone());
-        self.status = format!("undid the pick of {}", edit.name);
-        Ok(())
-    }
-
-    fn calibrate_from_points(&mut self) -> anyhow::Result<()> {
-        let n = self.overhead.points.points.len();
-        anyhow::ensure!(
-            n >= MIN_CALIBRATION_POINTS,
-            "{n} points picked: calibration needs at least {MIN_CALIBRATION_POINTS}"
-        );
-        let frame = self.frame().cloned();
-        let frame = frame.filter(|f| {
-            (f.width(), f.height()) == (self.overhead.points.width, self.overhead.points.height)
-        });
-        let notes =
-            crate::overhead::review::check_points(&self.overhead.points, &self.overhead.field)?;
-        let cal = calibrate_with(
-            &self.overhead.points,
-            &self.overhead.field,
-            frame.as_ref(),
-            &CalibrationParams::default(),
-            self.overhead.intrinsics.as_ref().map(|(i, _)| i),
-        )?;
-        let review = crate::overhead::review::review(&cal);
-        for f in notes.iter().chain(&review.findings) {
-            self.warn(format!("calibration: {f}"));
-        }
-        if frame.is_some() && cal.line_samples == 0 {
-            self.warn(format!(
-                "calibration: line refinement skipped: fewer than {} samples of the field lines found in the frame",
-                crate::overhead::calibration::MIN_LINE_SAMPLES
-            ));
-        }
-        self.status = format!(
-            "calibrated from {n} points: median error {:.2} px{}",
-            cal.median_point_error_px(),
-            cal.line_rms_px
-                .map(|r| format!(", lines {r:.2} px rms over {} samples", cal.line_samples))
-                .unwrap_or_default()
-        );
-        self.overhead.user_calibration = Some(cal);
-        self.overhead.calibration_path = None;
-        self.reprocess();
         Ok(())
     }
 
@@ -644,6 +600,25 @@ impl Workspace {
             }
             _ => self.overhead.view_map = None,
         }
+    }
+
+    /// Where pixel (x, y)'s centre lies on the ground, centimetres: through the calibration in
+    /// use (scaled to a frame of another size with its shape), for an overhead frame only.
+    #[must_use]
+    pub fn field_point_of_pixel(&self, x: usize, y: usize) -> Option<[f64; 2]> {
+        use crate::overhead::pipeline::{FrameFit, frame_fit};
+        if !self.overhead.active {
+            return None;
+        }
+        let (camera, _) = self.overhead.camera()?;
+        let (w, h) = self.image_size();
+        let camera = match frame_fit(camera, w, h) {
+            FrameFit::Same => *camera,
+            FrameFit::Scaled { .. } => camera.scaled_to(w, h),
+            FrameFit::Mismatch { .. } => return None,
+        };
+        let p = camera.field_from_image(ImagePoint::new(x as f64 + 0.5, y as f64 + 0.5), 0.0)?;
+        Some([p.x(), p.y()])
     }
 
     /// True when the views show the undistorted image.
@@ -704,6 +679,7 @@ impl Workspace {
         self.overhead.active = false;
         self.overhead.detections = None;
         self.overhead.stream_camera = None;
+        self.overhead.truth = None;
         self.overhead.field_model = FieldModel::default();
     }
 
@@ -716,11 +692,6 @@ impl Workspace {
             None => Some(p),
         }
     }
-}
-
-/// The camera a frame's own truth names, if it is a synthetic overhead frame.
-fn stream_camera(loaded: &SourceFrame) -> Option<OverheadCamera> {
-    truth_of(loaded).map(|t| t.camera)
 }
 
 /// The overhead truth a synthetic frame carries, if any.

@@ -107,6 +107,11 @@ impl Workspace {
         }
     }
 
+    /// Records a UI frame interval that followed a frame with input.
+    pub fn record_input_frame_time(&mut self, dt: Duration) {
+        push_capped(&mut self.timings.input_frames_ms, dt.as_secs_f64() * 1e3);
+    }
+
     /// Records, while playing, how long our UI code and eframe's whole frame took (CPU time).
     pub fn record_ui_time(&mut self, ui: Duration, cpu_s: Option<f32>) {
         if self.player.playing() {

@@ -26,6 +26,50 @@ pub struct Source {
     /// A live robot's camera shown: its cameras are asked for as the robot advertises them.
     robot: Option<RobotFrames>,
     cache: VecDeque<(usize, SourceFrame)>,
+    /// A recording's reader on a thread of its own, reading the frame after the one read last.
+    prefetch: Option<Prefetch>,
+}
+
+/// Reads the frame after the one shown on a thread of its own, with its own reader of the
+/// recording, while the shown frame is worked on: playing a 1920×1200 stream, reading and
+/// decompressing a frame took as long as classifying it, and the second core was idle.
+struct Prefetch {
+    wanted: std::sync::mpsc::Sender<usize>,
+    ready: std::sync::mpsc::Receiver<(usize, SourceFrame)>,
+    /// The frame asked for and not yet taken.
+    pending: Option<usize>,
+}
+
+impl Prefetch {
+    /// A reader of camera `camera` of the recording at `path` on its own thread; `None` when
+    /// the thread cannot start (reading goes on without it).
+    fn start(path: &Path, camera: Option<&str>) -> Option<Self> {
+        let (wanted, requests) = std::sync::mpsc::channel::<usize>();
+        let (done, ready) = std::sync::mpsc::channel();
+        let (path, camera) = (path.to_owned(), camera.map(str::to_owned));
+        std::thread::Builder::new()
+            .name("eotn-prefetch".to_owned())
+            .spawn(move || {
+                let Ok(mut reader) = StreamSource::open_camera(&path, camera.as_deref()) else {
+                    return;
+                };
+                // Ends when the source is dropped (its sender with it).
+                while let Ok(index) = requests.recv() {
+                    // A failed read is left to the reader of the shown frame to report.
+                    if let Ok(frame) = reader.read(index)
+                        && done.send((index, frame)).is_err()
+                    {
+                        return;
+                    }
+                }
+            })
+            .ok()?;
+        Some(Self {
+            wanted,
+            ready,
+            pending: None,
+        })
+    }
 }
 
 impl std::fmt::Debug for Source {
@@ -51,6 +95,7 @@ impl Source {
             canonical: None,
             robot: None,
             cache: VecDeque::new(),
+            prefetch: None,
         }
     }
 
@@ -93,6 +138,7 @@ impl Source {
         let shown = stream.camera().map(str::to_owned);
         let cameras = stream.cameras();
         let mut source = Self::new(Box::new(stream));
+        source.prefetch = Prefetch::start(path, shown.as_deref());
         source.camera = shown;
         source.cameras = cameras;
         source.canonical = Some(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()));
@@ -159,6 +205,12 @@ impl Source {
     #[must_use]
     pub const fn info(&self) -> &SourceInfo {
         &self.info
+    }
+
+    /// Says which camera made the frames: frame files (JPEG, PNG, …) do not say it themselves,
+    /// so the user does (Overhead ▸ This is an overhead camera).
+    pub fn set_camera_kind(&mut self, kind: crate::sources::CameraKind) {
+        self.info.camera = kind;
     }
 
     /// Asks the source again what it is (a robot names itself once connected).
@@ -238,20 +290,70 @@ impl Source {
             // sensor readings that follow its image: never serve it from a stale copy.
             return self.inner.read(index);
         }
-        if let Some(pos) = self.cache.iter().position(|(i, _)| *i == index)
+        self.take_prefetched(index);
+        let frame = if let Some(pos) = self.cache.iter().position(|(i, _)| *i == index)
             && let Some(entry) = self.cache.remove(pos)
         {
             // Most recently used at the back.
             let frame = entry.1.clone();
             self.cache.push_back(entry);
-            return Ok(frame);
+            frame
+        } else {
+            let frame = self.read_uncached(index)?;
+            self.cache_frame(index, frame.clone());
+            frame
+        };
+        self.prefetch_after(index);
+        Ok(frame)
+    }
+
+    fn cache_frame(&mut self, index: usize, frame: SourceFrame) {
+        if self.cache.iter().any(|(i, _)| *i == index) {
+            return;
         }
-        let frame = self.read_uncached(index)?;
-        self.cache.push_back((index, frame.clone()));
+        self.cache.push_back((index, frame));
         while self.cache.len() > CACHE_FRAMES {
             self.cache.pop_front();
         }
-        Ok(frame)
+    }
+
+    /// Puts what the prefetch thread has read into the cache; when it is reading `index`
+    /// right now, waits for it rather than reading it twice.
+    fn take_prefetched(&mut self, index: usize) {
+        let Some(p) = self.prefetch.as_mut() else {
+            return;
+        };
+        let mut got = Vec::new();
+        if p.pending == Some(index) {
+            if let Ok(r) = p.ready.recv_timeout(std::time::Duration::from_secs(5)) {
+                got.push(r);
+            }
+            p.pending = None;
+        }
+        got.extend(p.ready.try_iter());
+        if got.iter().any(|(i, _)| Some(*i) == p.pending) {
+            p.pending = None;
+        }
+        for (i, frame) in got {
+            self.cache_frame(i, frame);
+        }
+    }
+
+    /// Asks the prefetch thread for the frame after `index`, unless it is cached or asked for.
+    fn prefetch_after(&mut self, index: usize) {
+        let next = index + 1;
+        if next >= self.len() || self.cache.iter().any(|(i, _)| *i == next) {
+            return;
+        }
+        if let Some(p) = self.prefetch.as_mut()
+            && p.pending.is_none()
+        {
+            if p.wanted.send(next).is_ok() {
+                p.pending = Some(next);
+            } else {
+                self.prefetch = None;
+            }
+        }
     }
 
     /// Number of frames in the cache (for tests and the status line).
@@ -317,6 +419,35 @@ mod tests {
         }
         assert!(s.read(10).is_ok(), "a cached frame is not read again");
         assert!(s.read(0).is_err(), "an evicted frame is read again");
+    }
+
+    #[test]
+    fn a_stream_read_in_order_gives_the_frames_the_recording_holds() {
+        use crate::frame::{Frame, Yuv};
+        use crate::streams::{FrameRecord, StreamInfo, StreamWriter};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.mcap");
+        let info = StreamInfo {
+            source: "robot".to_owned(),
+            description: "prefetch".to_owned(),
+        };
+        let mut w = StreamWriter::create(&path, &info).unwrap();
+        for k in 0..12u8 {
+            let f = Frame::filled_uyvy(16, 8, Yuv::new(20 + k, 128, 128)).unwrap();
+            w.write(&FrameRecord::new(u64::from(k) * 1_000_000, f))
+                .unwrap();
+        }
+        w.finish().unwrap();
+        let mut s = Source::stream(&path).unwrap();
+        // In order (the next frame read ahead on the prefetch thread), then back and forth.
+        let order: Vec<usize> = (0..12).chain([3, 4, 11, 0, 1]).collect();
+        for i in order {
+            let got = s.read(i).unwrap();
+            let want = s.read_uncached(i).unwrap();
+            assert_eq!(got.frame, want.frame, "frame {i}");
+            assert_eq!(got.time_ns, want.time_ns, "frame {i}");
+        }
+        assert!(s.cached() <= CACHE_FRAMES);
     }
 
     #[test]

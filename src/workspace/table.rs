@@ -6,10 +6,13 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 
 use super::journal::{self, JournalEntry, now_unix_ms};
-use super::{PendingSelection, TableCommand, TryEdit, Workspace};
+use super::{PendingSelection, SelectionClass, TableCommand, TryEdit, Workspace};
 use crate::frame::Yuv;
-use crate::lut::{EditRecord, LookupTable, Region, Sensitivity};
+use crate::lut::{ColourClass, EditRecord, LookupTable, Region, Sensitivity};
 use crate::sources::CameraKind;
+
+/// Why a commit or try of a coverage hint's colours is refused before a class is chosen.
+const UNCHOSEN_CLASS: &str = "choose the class of these colours first: Commit as… in the Coverage window, or a class in the Classify panel";
 
 impl Workspace {
     /// Applies the table's commands: new, save, the journal, the class and sensitivity, the
@@ -28,7 +31,19 @@ impl Workspace {
             TableCommand::SaveTableAs(p) => self.save_table(&p)?,
             TableCommand::RebuildFromJournal => self.rebuild_from_journal()?,
             TableCommand::DiscardUnsaved => self.discard_unsaved()?,
-            TableCommand::SetClass(c) => self.settings.class = c,
+            TableCommand::SetClass(c) => {
+                self.settings.class = c;
+                // A class picked while a coverage hint's colours are pending is their class.
+                if let Some(sel) = self.selection.as_mut()
+                    && sel.class != SelectionClass::Current
+                {
+                    sel.class = SelectionClass::Chosen(c);
+                }
+                // A class chosen means classifying: a left click samples again.
+                self.disarm_landmark_picking();
+                // The preview tells pixels already of the class from those a commit changes.
+                self.preview_generation += 1;
+            }
             TableCommand::SetSensitivity(s) => self.set_sensitivity(s),
             TableCommand::AdjustSensitivity { channel, delta } => {
                 self.adjust_sensitivity(channel, delta)?;
@@ -57,12 +72,8 @@ impl Workspace {
             .clone()
             .context("no pending selection to try")?;
         let total = self.source.as_ref().context("no stream open")?.len();
-        self.try_edit = Some(TryEdit::new(
-            self.settings.class,
-            sel.region,
-            self.pipeline.lut(),
-            total,
-        ));
+        let class = self.selection_class().context(UNCHOSEN_CLASS)?;
+        self.try_edit = Some(TryEdit::new(class, sel.region, self.pipeline.lut(), total));
         self.settings.show_try_edit = true;
         Ok(())
     }
@@ -184,7 +195,8 @@ impl Workspace {
             .selection
             .clone()
             .context("nothing selected: left-click a pixel first")?;
-        let mut record = EditRecord::now(self.settings.class, sel.region);
+        let class = self.selection_class().context(UNCHOSEN_CLASS)?;
+        let mut record = EditRecord::now(class, sel.region);
         record.sampled_at = sel.pixel.map(|(x, y)| crate::lut::SampleAt {
             frame: self.index,
             x,
@@ -211,8 +223,33 @@ impl Workspace {
         self.dirty = true;
         self.selection = None;
         self.table_changed();
-        self.status = format!("{changed} cells set to {}", self.settings.class.name());
+        self.status = format!("{changed} cells set to {}", class.name());
         Ok(())
+    }
+
+    /// True when the whole-stream try shown is not for the pending selection (another
+    /// region, sensitivity or class, or nothing pending): its rows are an earlier edit's.
+    #[must_use]
+    pub fn try_edit_stale(&self) -> bool {
+        let Some(t) = &self.try_edit else {
+            return false;
+        };
+        match &self.selection {
+            Some(sel) => sel.region != t.region || self.selection_class() != Some(t.class),
+            None => true,
+        }
+    }
+
+    /// The class a commit of the pending selection writes: the selection's own (a coverage
+    /// hint's, once chosen) or the Classify panel's; `None` with nothing pending or while a
+    /// hint's class is not chosen.
+    #[must_use]
+    pub fn selection_class(&self) -> Option<ColourClass> {
+        match self.selection.as_ref()?.class {
+            SelectionClass::Current => Some(self.settings.class),
+            SelectionClass::Chosen(c) => Some(c),
+            SelectionClass::Unchosen => None,
+        }
     }
 
     /// After `n` old undo steps were dropped to keep the history within its memory bound: the
@@ -360,6 +397,7 @@ impl Workspace {
                 sensitivity: self.settings.sensitivity,
             },
             pixel: Some((x, y)),
+            class: SelectionClass::Current,
         });
         self.refresh_preview();
         Ok(())
@@ -367,21 +405,15 @@ impl Workspace {
 
     /// Pixels of the shown frame the pending selection selects, and of those the ones whose
     /// class a commit would change (the others already have the class): the second is what
-    /// Try edit counts for this frame.
+    /// Try edit counts for this frame. The classification compared is the shown frame's, from
+    /// whichever pipeline ran (an overhead frame's is not the robot pipeline's).
     #[must_use]
     pub fn selection_pixel_counts(&self) -> (usize, usize) {
-        let code = self.settings.class.code();
-        let codes = self.pipeline.result().classified.codes();
-        if codes.len() != self.preview_mask.len() {
-            return (0, 0);
-        }
-        self.preview_mask
-            .iter()
-            .zip(codes)
-            .filter(|(m, _)| **m)
-            .fold((0, 0), |(sel, chg), (_, &c)| {
-                (sel + 1, chg + usize::from(c != code))
-            })
+        self.preview_pixels().fold((0, 0), |(sel, chg), p| match p {
+            super::compose::PreviewPixel::Outside => (sel, chg),
+            super::compose::PreviewPixel::Unchanged => (sel + 1, chg),
+            super::compose::PreviewPixel::Changes => (sel + 1, chg + 1),
+        })
     }
 
     pub(super) fn sample_cell(&mut self, cell: [usize; 3]) -> anyhow::Result<()> {
@@ -400,6 +432,7 @@ impl Workspace {
                 sensitivity: self.settings.sensitivity,
             },
             pixel: None,
+            class: SelectionClass::Current,
         });
         self.refresh_preview();
         Ok(())

@@ -48,6 +48,11 @@ pub struct Timings {
     /// While playing: eframe's CPU time per frame (our UI, tessellation, the renderer's
     /// submission; not the wait for the display), milliseconds.
     pub playing_cpu_ms: Vec<f64>,
+    /// UI frame intervals that followed a frame with input (pointer, wheel, keys): how long
+    /// the window took to answer the user while zooming, panning or typing, milliseconds.
+    pub input_frames_ms: Vec<f64>,
+    /// From the app's start to its first frame on screen, milliseconds (`None` before).
+    pub first_frame_ms: Option<f64>,
     /// Frames shown by playback since the app started.
     pub played_frames: u64,
     /// Frames playback skipped because the next one was already due (not ready in time).

@@ -1,7 +1,8 @@
 //! The app watching a robot: Camera ▸ Connect… ▸ network to an `eotn serve` stand-in robot,
 //! driven headlessly with egui_kittest; its frames arrive in the app state with their sensors.
 //! Camera ▸ Connect to robot…: two robots at once in the robots window, clicking one shows it,
-//! the Live switch holds the view while frames keep arriving, Record all writes one file each.
+//! the Live switch holds the view while frames keep arriving, Record all writes one file each
+//! and moves no button (Stop where Record was), Disconnect asks for a second click.
 //! A robot that sends garbage gets one orange line in the robots window.
 
 use std::time::Duration;
@@ -129,6 +130,10 @@ fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows
     let folder = dir.path().join("rec");
     h.state_mut().robots.folder = folder.display().to_string();
     h.run_steps(4);
+    let rect_of = |h: &egui_kittest::Harness<'_, EotnApp>, label: &str| {
+        h.get_all_by_label(label).next().unwrap().rect()
+    };
+    let (record, disconnect) = (rect_of(&h, "Record"), rect_of(&h, "Disconnect"));
     h.get_by_label("Record all").click();
     h.run_steps(4);
     run_steps_until(&mut h, WITHIN, |a| {
@@ -137,14 +142,26 @@ fn two_robots_connected_from_the_robots_window_are_listed_and_clicking_one_shows
             .iter()
             .all(|r| r.stats.recorded.is_some_and(|n| n >= 2))
     });
+    // Nothing moved under the cursor: Stop is where Record was, Disconnect where it was.
+    assert_eq!(rect_of(&h, "Stop recording"), record);
+    assert_eq!(rect_of(&h, "Disconnect"), disconnect);
+    // One click on Disconnect only asks; Cancel keeps the robot.
+    h.get_all_by_label("Disconnect").next().unwrap().click();
+    h.run_steps(4);
+    assert_eq!(h.state().state.robots().len(), 2);
+    h.get_by_label("Cancel").click();
+    h.run_steps(4);
+    assert!(h.query_by_label("Confirm disconnect").is_none());
     for _ in 0..2 {
-        // The list is wider than its dock tab: bring the button into view, as a user scrolls.
+        // The list may be taller than its dock tab: bring the button into view, as a user scrolls.
         h.get_all_by_label("Disconnect")
             .next()
             .unwrap()
             .scroll_to_me();
         h.run_steps(4);
         h.get_all_by_label("Disconnect").next().unwrap().click();
+        h.run_steps(4);
+        h.get_by_label("Confirm disconnect").click();
         h.run_steps(4);
     }
     assert!(h.state().state.robots().is_empty());
@@ -186,6 +203,8 @@ fn a_robot_that_sends_garbage_gets_one_line_in_the_robots_window_and_disconnects
     assert!(!problem.contains('\n'), "{problem}");
     assert_eq!(h.query_all_by_label(&problem).count(), 1, "{problem}");
     h.get_by_label("Disconnect").click();
+    h.run_steps(2);
+    h.get_by_label("Confirm disconnect").click();
     h.run_steps(2);
     assert!(h.state().state.robots().is_empty());
 }

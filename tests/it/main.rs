@@ -9,13 +9,19 @@ mod app_camera;
 #[cfg(feature = "gui")]
 mod app_cameras;
 #[cfg(feature = "gui")]
+mod app_classify;
+#[cfg(feature = "gui")]
 mod app_daily;
 #[cfg(feature = "gui")]
 mod app_hints;
 #[cfg(feature = "gui")]
+mod app_layout;
+#[cfg(feature = "gui")]
 mod app_live;
 #[cfg(feature = "gui")]
 mod app_overhead;
+#[cfg(feature = "gui")]
+mod app_overhead_tools;
 #[cfg(feature = "gui")]
 mod app_papercuts;
 mod beacons;
@@ -43,6 +49,7 @@ mod motion;
 mod outputs;
 mod overhead;
 mod overhead_lens;
+mod params_doc;
 mod patterns;
 mod peer;
 mod properties;
