@@ -382,8 +382,12 @@ pub(super) mod tests {
             .unwrap();
         ws.apply(Command::Open(vec![overhead_b])).unwrap();
         assert_eq!(ws.camera_kind(), crate::sources::CameraKind::Overhead);
-        assert_eq!(name(&ws), None, "not the robot stream's x.lut");
-        assert_eq!(ws.lut().class_counts()[1..].iter().sum::<usize>(), 0);
+        // The overhead stream's sidecar names its own table: that one, never the robot's x.lut.
+        assert_eq!(
+            name(&ws).as_deref(),
+            Some("sim-overhead.lut"),
+            "not the robot stream's x.lut"
+        );
         ws.apply(Command::Open(vec![robot_c.clone(), y])).unwrap();
         ws.apply(Command::Open(vec![robot_a])).unwrap();
         assert_eq!(name(&ws).as_deref(), Some("x.lut"), "its own, not C's");
