@@ -135,6 +135,8 @@ impl Clicks {
             ws.apply(TableCommand::SetSensitivity(Sensitivity { y, u, v }).into())?;
             if !g.cells.is_empty() {
                 ws.apply(HintsCommand::SelectCells(g.cells.clone()).into())?;
+                // A hint's colours are committed as the class chosen for them (Commit as…).
+                ws.apply(TableCommand::SetClass(class).into())?;
                 ws.apply(TableCommand::Commit.into())
                     .with_context(|| format!("{} hint of {} cells", g.class, g.cells.len()))?;
             }

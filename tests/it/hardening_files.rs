@@ -562,10 +562,11 @@ fn whole_table_edits_drop_the_oldest_undo_steps_with_a_note() {
     let all: Vec<usize> = (0..s.lut().cells().len()).collect();
     let class = |i: usize| [ColourClass::Orange, ColourClass::Green][i % 2];
     // 3.25 MiB a step (the cell list, 8 bytes a cell; old codes, 5): 100 steps would hold 325 MiB.
+    // Cells selected as a coverage hint's are committed as the class chosen for them.
     for i in 0..100 {
-        s.apply(Command::from(TableCommand::SetClass(class(i))))
-            .unwrap();
         s.apply(Command::from(HintsCommand::SelectCells(all.clone())))
+            .unwrap();
+        s.apply(Command::from(TableCommand::SetClass(class(i))))
             .unwrap();
         s.apply(Command::from(TableCommand::Commit)).unwrap();
     }
