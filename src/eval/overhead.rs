@@ -83,7 +83,6 @@ pub fn evaluate_overhead_frame(
         frame,
         ..OverheadFrameEval::default()
     };
-    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     match (&truth.ball, &detections.ball) {
         (Some(t), Some(d)) => {
             e.ball_eligible = t.visible_pixels >= params.ball_min_pixels;
@@ -103,14 +102,8 @@ pub fn evaluate_overhead_frame(
         let Some(marker) = t.marker else { continue };
         let eligible = marker.fully_visible();
         e.robots_eligible += usize::from(eligible);
-        let nearest = detections
-            .robots
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| !used[*k])
-            .map(|(k, d)| (k, dist(d.field_cm, t.field_cm)))
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        let Some((k, err)) = nearest.filter(|(_, err)| *err <= params.match_cm) else {
+        let positions = detections.robots.iter().map(|d| d.field_cm);
+        let Some((k, err)) = nearest_unused(positions, &used, t.field_cm, params.match_cm) else {
             continue;
         };
         used[k] = true;
@@ -170,7 +163,6 @@ pub fn evaluate_world_model(
             .is_some_and(|m| m.team == model.robot.team && m.identity == model.robot.identity)
     })?;
     let own = [model.own.x_cm, model.own.y_cm];
-    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     let overhead = t.marker.and_then(|m| {
         detections?
             .robots
@@ -319,6 +311,27 @@ impl OverheadEvalReport {
             world_models,
         }
     }
+}
+
+/// Distance between two field positions (centimetres).
+pub(super) fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// The detection nearest `target` among `positions` not yet `used`, if within `max_cm`: its
+/// index and distance (centimetres). Truth and detections are paired one to one this way.
+pub(super) fn nearest_unused(
+    positions: impl Iterator<Item = [f64; 2]>,
+    used: &[bool],
+    target: [f64; 2],
+    max_cm: f64,
+) -> Option<(usize, f64)> {
+    positions
+        .enumerate()
+        .filter(|(k, _)| !used.get(*k).copied().unwrap_or(true))
+        .map(|(k, p)| (k, dist(p, target)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|(_, err)| *err <= max_cm)
 }
 
 #[cfg(test)]

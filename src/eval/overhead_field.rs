@@ -13,7 +13,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::overhead::{
-    OverheadEvalParams, OverheadEvalReport, OverheadFrameEval, angle_diff, label,
+    OverheadEvalParams, OverheadEvalReport, OverheadFrameEval, angle_diff, dist, label,
+    nearest_unused,
 };
 use crate::model::truth::{OverheadRobot as TruthRobot, OverheadTruth};
 use crate::overhead::merge::{FieldPicture, FieldRobot, SslCameraId};
@@ -57,10 +58,6 @@ pub struct CameraTruth<'a> {
     pub truth: &'a OverheadTruth,
     /// Whether its own detections had a ball near the true one.
     pub found_ball: bool,
-}
-
-fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
 /// Share of the ball's whole image disc that showed in `truth`'s frame (its true camera gives
@@ -119,14 +116,8 @@ pub fn evaluate_field_frame(
                 .is_some_and(|m| m.fully_visible())
         });
         m.robots_eligible += usize::from(eligible);
-        let nearest = picture
-            .robots
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| !used[*k])
-            .map(|(k, d)| (k, dist(d.field_cm, t.field_cm)))
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        let Some((k, _)) = nearest.filter(|(_, err)| *err <= params.match_cm) else {
+        let positions = picture.robots.iter().map(|d| d.field_cm);
+        let Some((k, _)) = nearest_unused(positions, &used, t.field_cm, params.match_cm) else {
             continue;
         };
         used[k] = true;
