@@ -195,15 +195,27 @@ pub fn field_description(f: &SslGeometryFieldSize) -> FieldDescription {
         .iter()
         .filter(|a| finite(&[a.center.x, a.center.y, a.radius, a.a1, a.a2]))
         .map(|a| {
-            let (from, mut to) = (f64::from(a.a1), f64::from(a.a2));
-            while to <= from {
-                to += std::f64::consts::TAU;
-            }
+            // The arc runs counter-clockwise from a1 to a2; an a2 at or before a1 means it
+            // wraps. Taken modulo a turn, not by adding turns one at a time: a packet's angle
+            // of 1e30 rad would never move (a fuzzed packet hung the decoder that way).
+            let tau = std::f64::consts::TAU;
+            let from = f64::from(a.a1);
+            let from = if from.abs() > 16.0 * tau {
+                from.rem_euclid(tau)
+            } else {
+                from
+            };
+            let span = (f64::from(a.a2) - f64::from(a.a1)).rem_euclid(tau);
+            let span = if span <= 0.0 || span >= tau {
+                tau
+            } else {
+                span
+            };
             Arc {
                 centre_cm: [cm(a.center.x), cm(a.center.y)],
                 radius_cm: cm(a.radius),
                 from_rad: from,
-                to_rad: to.min(from + std::f64::consts::TAU),
+                to_rad: from + span,
             }
         })
         .collect();
@@ -523,5 +535,39 @@ mod tests {
         assert_eq!(distorted_radius(0.5, 0.0), 0.5);
         let r = distorted_radius(0.9, 0.3);
         assert!((r * (1.0 + 0.3 * r * r) - 0.9).abs() < 1e-12);
+    }
+
+    /// Arc angles from the wire: a wrap, a full circle and absurd angles all give one
+    /// counter-clockwise span of at most a turn, without looping (a fuzzed packet with an
+    /// angle of 1e30 rad once hung `field_description`).
+    #[test]
+    fn arc_angles_from_the_wire_give_one_span_of_at_most_a_turn() {
+        let field = FieldDescription::resolve("ssl-div-b").expect("shipped");
+        let mut f = field_size(&field);
+        let template = f.field_arcs[0].clone();
+        let arc = |a1: f32, a2: f32| SslFieldCircularArc {
+            a1,
+            a2,
+            ..template.clone()
+        };
+        f.field_arcs = vec![
+            arc(3.0, 1.0),
+            arc(0.5, 0.5),
+            arc(1e30, -1e30),
+            arc(-3e38, 3e38),
+            arc(0.25, 1.25),
+        ];
+        let d = field_description(&f);
+        let spans: Vec<f64> = d.arcs.iter().map(|a| a.to_rad - a.from_rad).collect();
+        let tau = std::f64::consts::TAU;
+        assert!((spans[0] - (tau - 2.0)).abs() < 1e-6, "{spans:?}");
+        assert!((spans[1] - tau).abs() < 1e-9, "{spans:?}");
+        assert!((spans[4] - 1.0).abs() < 1e-6, "{spans:?}");
+        assert_eq!(d.arcs[4].from_rad, 0.25);
+        for a in &d.arcs {
+            let span = a.to_rad - a.from_rad;
+            assert!(span > 0.0 && span <= tau + 1e-9, "{a:?}");
+            assert!(a.from_rad.abs() <= 16.0 * tau, "{a:?}");
+        }
     }
 }

@@ -162,19 +162,23 @@ pub fn recognise_beacons(
     let mut out: Vec<Beacon> = Vec::new();
     let mut paired: Vec<u32> = Vec::new();
     for pink in bands(blobs, ColourClass::Pink, p) {
-        let mut best: Option<(Beacon, u32)> = None;
+        let mut best: Option<(PairCandidate, u32)> = None;
         for other_colour in [ColourClass::SkyBlue, ColourClass::Yellow] {
             for other in bands(blobs, other_colour, p) {
-                let beacon = pair_candidate(img, ctx, p, pink, other);
+                let candidate = pair_candidate(ctx, p, pink, other);
                 if best
                     .as_ref()
-                    .is_none_or(|(b, _)| beacon.confidence.total > b.confidence.total)
+                    .is_none_or(|(b, _)| candidate.confidence.total > b.confidence.total)
                 {
-                    best = Some((beacon, other.number));
+                    best = Some((candidate, other.number));
                 }
             }
         }
-        if let Some((mut b, other)) = best {
+        // Only the best pairing is measured: the distance plays no part in the confidence,
+        // and scanning the band edges of every pink-and-other pair was half the recognition
+        // time of a frame with a goal in view.
+        if let Some((candidate, other)) = best {
+            let mut b = candidate.measured(img, ctx, p);
             b.accepted =
                 b.confidence.accepted() && !out.iter().any(|o| o.accepted && o.kind == b.kind);
             if b.accepted {
@@ -197,14 +201,44 @@ pub fn recognise_beacons(
     out
 }
 
+/// A pink band and a band of another colour above or below it, judged by the shape tests
+/// alone, before its distance is measured.
+struct PairCandidate<'a> {
+    top: &'a Blob,
+    bottom: &'a Blob,
+    kind: BeaconKind,
+    all: Blob,
+    cut_off: bool,
+    /// The pinhole distance of the two bands' box height, centimetres.
+    guess_cm: f64,
+    confidence: Confidence,
+}
+
+impl PairCandidate<'_> {
+    /// The beacon, its distance measured from the band edges.
+    fn measured(self, img: &ClassifiedImage, ctx: &ViewContext, p: &BeaconParams) -> Beacon {
+        let measured = distance::measure(img, ctx, p, self.top, self.bottom, self.guess_cm);
+        Beacon {
+            kind: self.kind,
+            bounds: self.all.bounds(),
+            cut_off: self.cut_off,
+            camera: ctx.camera_relative(measured.at, measured.distance_cm),
+            body: ctx.body_relative(measured.at, measured.distance_cm),
+            distance_from: measured.source,
+            edges: measured.edges,
+            confidence: self.confidence,
+            accepted: false,
+        }
+    }
+}
+
 /// The candidate made of `pink` and a band of another colour above or below it.
-fn pair_candidate(
-    img: &ClassifiedImage,
+fn pair_candidate<'a>(
     ctx: &ViewContext,
     p: &BeaconParams,
-    pink: &Blob,
-    other: &Blob,
-) -> Beacon {
+    pink: &'a Blob,
+    other: &'a Blob,
+) -> PairCandidate<'a> {
     let height = ctx.camera.height_px as u32;
     let centre = ctx.camera.centre;
     let angle = ctx.horizon_angle();
@@ -269,18 +303,14 @@ fn pair_candidate(
     };
     // A first guess for the skew removal and the axis direction: the pinhole distance of the
     // two bands' box height.
-    let guess = ctx.camera.focal_px * 2.0 * p.band_height_cm / bh;
-    let measured = distance::measure(img, ctx, p, top, bottom, guess);
-    Beacon {
+    PairCandidate {
+        top,
+        bottom,
         kind,
-        bounds: all.bounds(),
+        all,
         cut_off,
-        camera: ctx.camera_relative(measured.at, measured.distance_cm),
-        body: ctx.body_relative(measured.at, measured.distance_cm),
-        distance_from: measured.source,
-        edges: measured.edges,
+        guess_cm: ctx.camera.focal_px * 2.0 * p.band_height_cm / bh,
         confidence,
-        accepted: false,
     }
 }
 
