@@ -63,8 +63,9 @@ pub fn scan_rotated_rect(
     } else {
         1.0
     };
+    let rotation = angle.sin_cos();
     let corner = |x: f64, y: f64| {
-        ImagePoint::new(centre.x_px + x, centre.y_px + y).rotated_about(centre, angle)
+        ImagePoint::new(centre.x_px + x, centre.y_px + y).rotated_by(centre, rotation)
     };
     let area = ScanArea {
         corners: [

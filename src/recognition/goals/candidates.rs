@@ -29,8 +29,9 @@ fn rotated_extent(
         f64::NEG_INFINITY,
         f64::NEG_INFINITY,
     ];
+    let rotation = angle.sin_cos();
     for p in points {
-        let q = p.rotated_about(centre, angle);
+        let q = p.rotated_by(centre, rotation);
         e[0] = e[0].min(q.x_px);
         e[1] = e[1].min(q.y_px);
         e[2] = e[2].max(q.x_px);

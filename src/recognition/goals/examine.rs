@@ -382,6 +382,7 @@ pub(super) fn side_height(
     let columns = band.ceil() as usize;
     let rows = (e[3] - e[1]).ceil() as usize + 2;
     let mut best: Option<(f64, f64, f64)> = None;
+    let back = (-angle).sin_cos();
     for k in 0..columns {
         let x = if left {
             e[0] + 0.5 + k as f64
@@ -391,7 +392,7 @@ pub(super) fn side_height(
         let (mut top, mut bottom) = (None, None);
         for i in 0..rows {
             let y = e[1] - 1.0 + i as f64;
-            let q = ImagePoint::new(x, y + 0.5).rotated_about(centre, -angle);
+            let q = ImagePoint::new(x, y + 0.5).rotated_by(centre, back);
             if img.get_at(q.x_px, q.y_px).is_some_and(is_goal) {
                 top.get_or_insert(y);
                 bottom = Some(y + 1.0);

@@ -23,8 +23,9 @@ pub(super) fn scan_level_row(
 ) -> Option<f64> {
     let dir = if to >= from { 1.0 } else { -1.0 };
     let steps = (to - from).abs().ceil() as usize;
+    let back = (-angle).sin_cos();
     let goal_at = |x: f64| {
-        let q = ImagePoint::new(x, y).rotated_about(centre, -angle);
+        let q = ImagePoint::new(x, y).rotated_by(centre, back);
         img.get_at(q.x_px, q.y_px).is_some_and(is_goal)
     };
     for k in 0..=steps {
