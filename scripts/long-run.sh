@@ -6,6 +6,7 @@
 # start, after the first tenth and at its peak for each; fails when either grows by more than
 # 16 MiB after the first tenth (the frame cache and the pipeline's buffers are bounded). Then
 # `eotn serve` with 40 viewers that never read beside a good one for SERVE_SECONDS (default 20).
+# Last, every fuzz target for FUZZ_SECONDS each (default 600).
 #   scripts/long-run.sh [MINUTES]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -64,3 +65,7 @@ if rustup target list --installed 2>/dev/null | grep -qx aarch64-unknown-linux-g
 else
   echo "long-run: aarch64 check skipped (needs the aarch64-unknown-linux-gnu target and aarch64-linux-gnu-gcc)"
 fi
+
+# Deep fuzzing: every fuzz target for FUZZ_SECONDS (default 600, ten minutes a target; CI's
+# fuzz-smoke gives each 5 s). A crash or hang stops the run with its input in fuzz/artifacts/.
+scripts/fuzz.sh "${FUZZ_SECONDS:-600}"
