@@ -4,7 +4,9 @@
 //! that overhead truth with the error of each, and a plot of the errors over the frames seen.
 //! Clicking a robot selects it in every view. SSL-Vision's detections (a league log or a live
 //! address opened beside, or alone) are drawn over it, each camera's in its own colour. It draws
-//! the workspace's field model only.
+//! the workspace's field model only. Each overhead camera's coverage, the camera legend and which
+//! cameras saw each robot and the ball (a session's merged picture) are drawn by
+//! `field_cameras.rs`.
 
 use egui::{Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, vec2};
 use egui_plot::{Line, Plot, VLine};
@@ -97,6 +99,7 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
     if let Some(feed) = ssl {
         ssl_feed_ui(ui, state, feed, commands);
     }
+    super::field_cameras::legend_ui(ui, state, commands);
     let field = match ssl.and_then(crate::workspace::SslFeed::field) {
         Some(f) if !overhead.active() => f,
         _ => overhead.field(),
@@ -112,6 +115,9 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 2.0, Color32::from_rgb(20, 90, 40));
     let xf = FieldTransform::fit(rect, field);
+    if overhead.active() && state.settings.overhead.coverage {
+        super::field_cameras::paint_coverage(&painter, &xf, &overhead.field_cameras().cameras());
+    }
     paint_field(&painter, &xf, field, overhead.landmark());
     let show_truth_id = egui::Id::unique("eotn-field-view-truth");
     let mut show_truth: bool = ui.data(|d| d.get_temp(show_truth_id)).unwrap_or(true);
@@ -119,7 +125,10 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
         paint_truth(&painter, &xf, t);
     }
     let robots = paint_objects(&painter, &xf, state);
+    super::field_cameras::paint_seen_by(&painter, &xf, overhead.field_cameras(), ROBOT_RADIUS_CM);
     paint_ssl(&painter, &xf, overhead.field_model.ssl());
+    let hover_radius = CLICK_RADIUS_PT.max(ROBOT_RADIUS_CM * xf.scale());
+    super::field_cameras::seen_by_tooltip(&response, state, &xf, hover_radius);
     if response.clicked()
         && let Some(pos) = response.interact_pointer_pos()
     {
@@ -256,7 +265,7 @@ fn paint_objects(
     }
     let mut out = Vec::new();
     let radius = (ROBOT_RADIUS_CM * xf.scale()).max(4.0);
-    if let Some(d) = overhead.detections() {
+    if let Some(d) = overhead.field_cameras().picture() {
         for r in &d.robots {
             let key = RobotKey {
                 team: r.team,
@@ -283,7 +292,7 @@ fn paint_objects(
         }
         if let Some(b) = &d.ball {
             painter.circle_filled(
-                xf.to_screen(b.field_cm),
+                xf.to_screen(b.ball.field_cm),
                 (4.25 * xf.scale()).max(3.0),
                 BALL_COLOUR,
             );

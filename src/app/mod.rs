@@ -30,6 +30,7 @@
 //! | `overhead_menu.rs` | the Overhead menu: calibration files, view options, windows |
 //! | `calibration_window.rs` | pick landmarks by name, solve, each point's reprojection error |
 //! | `field_view.rs` | the top-down field: ball, robots, trails, world models and their errors |
+//! | `field_cameras.rs` | the field view's cameras: coverage, legend (current or stale), who saw what |
 //! | `renderer.rs` | wgpu on a GPU, OpenGL on a software rasteriser: the choice before the window opens |
 //!
 //! Only this folder names egui/eframe (`scripts/check.sh` checks it).
@@ -40,6 +41,7 @@ pub mod camera_menu;
 pub mod classify_panel;
 pub mod coverage_panel;
 pub mod dock;
+pub mod field_cameras;
 pub mod field_view;
 pub mod file_dialog;
 pub mod inspector;

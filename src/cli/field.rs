@@ -101,21 +101,7 @@ fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<Fi
 
 /// The overhead recogniser's settings from a JSON file; unknown keys refused.
 pub(super) fn load_params(path: &Path) -> anyhow::Result<OverheadParams> {
-    let text = crate::input_file::read_text_bounded(
-        path,
-        crate::input_file::MAX_SMALL_FILE_BYTES,
-        "overhead parameters",
-    )
-    .with_context(|| format!("{}", path.display()))?;
-    let given: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    let params: OverheadParams = serde_json::from_value(given.clone())
-        .with_context(|| format!("{}: not overhead parameters", path.display()))?;
-    let known = serde_json::to_value(params)?;
-    if let Some(key) = crate::input_file::unknown_keys(&given, &known).first() {
-        bail!("{}: unknown key '{key}'", path.display());
-    }
-    Ok(params)
+    crate::session::load_camera_params(path)
 }
 
 impl FieldCamera {

@@ -14,6 +14,8 @@ pub struct Args {
     /// frames; several frames open as one sequence to step through. SSL-Vision's detections
     /// show in the field view: a league log (`GAME.log`, `GAME.log.gz`) or packets received
     /// live (`udp://224.5.23.2:10006`, the league's group; `udp://HOST:PORT` for a unicast port).
+    /// A session file (`SESSION.json`) shows its overhead cameras on one field: the first as the
+    /// stream, the field view with every camera's coverage and which cameras saw what.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// The renderer: `auto` (wgpu on a GPU, OpenGL on a software rasteriser), `wgpu` or `gl`.

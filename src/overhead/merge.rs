@@ -78,6 +78,32 @@ pub fn merge_detections(views: &[(SslCameraId, &OverheadDetections)]) -> FieldPi
     }
 }
 
+/// One camera's detections as a field picture, unmerged: every robot it found (a misread
+/// identity found twice stays twice, as the camera saw it) and its ball, each seen by `camera`
+/// alone. What the field view draws for a single overhead camera.
+#[must_use]
+pub fn one_camera(camera: SslCameraId, d: &OverheadDetections) -> FieldPicture {
+    FieldPicture {
+        ball: d.ball.map(|ball| FieldBall {
+            ball,
+            camera,
+            camera_ids: vec![camera],
+        }),
+        robots: d
+            .robots
+            .iter()
+            .map(|r| FieldRobot {
+                team: r.team,
+                identity: r.identity,
+                field_cm: r.field_cm,
+                heading_rad: r.heading_rad,
+                confidence: r.confidence,
+                camera_ids: vec![camera],
+            })
+            .collect(),
+    }
+}
+
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }

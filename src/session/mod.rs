@@ -392,3 +392,23 @@ impl Resolver<'_> {
         }
     }
 }
+
+/// A session camera's overhead recogniser settings (its `params` file); unknown keys refused.
+///
+/// # Errors
+/// An unreadable or oversized file, not JSON, not these settings, or an unknown key: each
+/// naming the file.
+pub fn load_camera_params(path: &Path) -> anyhow::Result<crate::overhead::OverheadParams> {
+    use anyhow::Context as _;
+    let text = read_text_bounded(path, MAX_SMALL_FILE_BYTES, "overhead parameters")
+        .with_context(|| format!("{}", path.display()))?;
+    let given: Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let params: crate::overhead::OverheadParams = serde_json::from_value(given.clone())
+        .with_context(|| format!("{}: not overhead parameters", path.display()))?;
+    let known = serde_json::to_value(params)?;
+    if let Some(key) = crate::input_file::unknown_keys(&given, &known).first() {
+        anyhow::bail!("{}: unknown key '{key}'", path.display());
+    }
+    Ok(params)
+}

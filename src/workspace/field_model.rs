@@ -12,7 +12,7 @@ use std::collections::{BTreeMap, VecDeque};
 
 use super::overhead::RobotKey;
 use crate::model::world_model::{self, is_world_model_topic};
-use crate::overhead::OverheadDetections;
+use crate::overhead::merge::FieldPicture;
 use crate::wmd::{Matched, OverheadRobotPose, OverheadView, Targets};
 
 /// Positions a trail keeps (frames).
@@ -66,13 +66,14 @@ pub struct FieldModel {
 }
 
 impl FieldModel {
-    /// Takes in the shown frame: `index` in the source, its time, what the overhead camera
-    /// found and its extra channels (the world models).
+    /// Takes in the shown frame: `index` in the source, its time, what the overhead cameras
+    /// found (one camera's detections, or several cameras' merged) and its extra channels (the
+    /// world models).
     pub fn observe(
         &mut self,
         index: usize,
         time_ns: u64,
-        detections: Option<&OverheadDetections>,
+        detections: Option<&FieldPicture>,
         extra: &[(String, serde_json::Value)],
     ) {
         // Trails follow playback: a jump (seek, step back) starts them again; the same frame
@@ -92,7 +93,7 @@ impl FieldModel {
                 push_trail(self.trails.entry(key).or_default(), index, r.field_cm);
             }
             if let Some(b) = &d.ball {
-                push_trail(&mut self.ball_trail, index, b.field_cm);
+                push_trail(&mut self.ball_trail, index, b.ball.field_cm);
             }
         }
         let models: Vec<world_model::WorldModelMessage> = extra
@@ -186,10 +187,10 @@ fn push_trail(trail: &mut VecDeque<(usize, [f64; 2])>, index: usize, p: [f64; 2]
     }
 }
 
-/// What the overhead camera saw, as the comparison takes it.
-fn overhead_view(detections: Option<&OverheadDetections>) -> OverheadView {
+/// What the overhead cameras saw, as the comparison takes it.
+fn overhead_view(detections: Option<&FieldPicture>) -> OverheadView {
     detections.map_or_else(OverheadView::default, |d| OverheadView {
-        ball: d.ball.as_ref().map(|b| b.field_cm),
+        ball: d.ball.as_ref().map(|b| b.ball.field_cm),
         robots: d
             .robots
             .iter()
@@ -209,11 +210,12 @@ fn overhead_view(detections: Option<&OverheadDetections>) -> OverheadView {
 mod tests {
     use super::*;
     use crate::geometry::{ImagePoint, MarkerIdentity, MarkerTeam};
-    use crate::overhead::recognise::{OverheadBall, OverheadRobot};
+    use crate::overhead::merge::{SslCameraId, one_camera};
+    use crate::overhead::recognise::{OverheadBall, OverheadDetections, OverheadRobot};
 
-    fn detections(robot_at: [f64; 2], ball_at: [f64; 2]) -> OverheadDetections {
+    fn detections(robot_at: [f64; 2], ball_at: [f64; 2]) -> FieldPicture {
         let p = ImagePoint::new(0.0, 0.0);
-        OverheadDetections {
+        let d = OverheadDetections {
             ball: Some(OverheadBall {
                 field_cm: ball_at,
                 image: p,
@@ -230,7 +232,8 @@ mod tests {
                 confidence: 1.0,
             }],
             rejected: Vec::new(),
-        }
+        };
+        one_camera(SslCameraId(0), &d)
     }
 
     fn world_model(id: u32, x: f64, heading: f64, ball_x: f64) -> (String, serde_json::Value) {

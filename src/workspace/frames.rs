@@ -23,6 +23,8 @@ struct OpenPaths {
     jsons: Vec<PathBuf>,
     /// SSL-Vision sources: a league log file or a `udp://` multicast group.
     ssl: Vec<PathBuf>,
+    /// Session files (`SESSION.json`): several overhead cameras of one field.
+    sessions: Vec<PathBuf>,
 }
 
 impl OpenPaths {
@@ -33,6 +35,7 @@ impl OpenPaths {
             tables: Vec::new(),
             jsons: Vec::new(),
             ssl: Vec::new(),
+            sessions: Vec::new(),
         };
         for p in paths {
             let ext = p
@@ -43,6 +46,8 @@ impl OpenPaths {
                 &mut sorted.ssl
             } else if crate::streams::is_recording(&p) {
                 &mut sorted.streams
+            } else if ext == "json" && super::overhead::field_cameras::is_session_file(&p) {
+                &mut sorted.sessions
             } else if ext == "json" {
                 &mut sorted.jsons
             } else if crate::sources::is_frame_file(&p) || p.is_dir() {
@@ -64,16 +69,32 @@ impl Workspace {
         anyhow::ensure!(!paths.is_empty(), "nothing to open");
         let OpenPaths {
             mut streams,
-            frames,
+            mut frames,
             mut tables,
             jsons,
             ssl,
+            sessions,
         } = OpenPaths::sort(paths);
         let mut shown_camera = None;
         let mut offer = None;
         let mut failures = Vec::new();
         for p in ssl {
             if let Err(e) = self.open_ssl(&p) {
+                failures.push(format!("{e:#}"));
+            }
+        }
+        // A session shows its cameras instead of streams or frames given beside it.
+        if let Some(s) = sessions.last() {
+            for skipped in sessions.iter().rev().skip(1).chain(&streams).chain(&frames) {
+                failures.push(format!(
+                    "{}: not opened (one source at a time; session {} is shown)",
+                    skipped.display(),
+                    s.display()
+                ));
+            }
+            streams.clear();
+            frames.clear();
+            if let Err(e) = self.open_session(s) {
                 failures.push(format!("{e:#}"));
             }
         }

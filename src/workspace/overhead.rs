@@ -33,7 +33,10 @@ pub const MIN_CALIBRATION_POINTS: usize = crate::overhead::review::MIN_POINTS;
 /// robot selection of the workspace (field view, image overlays) is one of these.
 pub use crate::model::world_model::RobotKey;
 
+pub mod field_cameras;
 mod picking;
+
+pub use field_cameras::{CameraShown, FieldCameras, FrameState};
 
 /// The undistorted view's pixel map and the camera and frame size it was made for.
 #[derive(Debug, Clone)]
@@ -93,6 +96,8 @@ pub struct Overhead {
     empty_recognition: Recognition,
     /// The field view's model: trails, world models, errors over time.
     pub field_model: FieldModel,
+    /// The field's cameras: coverage, a session's other cameras, the merged picture.
+    cameras: FieldCameras,
     /// The calibration's and the frame's size last warned about (the warning is said once a
     /// pair, not once a frame).
     size_warned: Option<((usize, usize), (usize, usize))>,
@@ -130,6 +135,7 @@ impl Default for Overhead {
             field_generation: 0,
             empty_recognition: Recognition::default(),
             field_model: FieldModel::default(),
+            cameras: FieldCameras::default(),
             size_warned: None,
         }
     }
@@ -253,6 +259,12 @@ impl Overhead {
     #[must_use]
     pub fn picks_to_undo(&self) -> usize {
         self.picks.len()
+    }
+
+    /// The field's cameras: each one's coverage and frame, the merged field picture.
+    #[must_use]
+    pub const fn field_cameras(&self) -> &FieldCameras {
+        &self.cameras
     }
 
     /// The selected robot (field view, overlays).
@@ -385,10 +397,12 @@ impl Workspace {
         self.selected_object = None;
         self.frame_counts = self.overhead.pipeline.classified().histogram();
         let index = self.index_of_frame(loaded);
+        let size = (loaded.frame.width(), loaded.frame.height());
+        self.sync_field_cameras(index, loaded.time_ns, size);
         self.overhead.field_model.observe(
             index,
             loaded.time_ns,
-            self.overhead.detections.as_ref(),
+            self.overhead.cameras.picture(),
             &loaded.extra,
         );
         let t = self.overhead.pipeline.timings();
@@ -681,6 +695,7 @@ impl Workspace {
         self.overhead.stream_camera = None;
         self.overhead.truth = None;
         self.overhead.field_model = FieldModel::default();
+        self.overhead.cameras = FieldCameras::default();
     }
 
     /// Where an image point (pixels of the camera's image) is drawn in the views: itself, or

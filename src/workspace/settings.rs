@@ -168,6 +168,9 @@ pub struct OverheadView {
     pub undistorted: bool,
     /// Each picked calibration point with its reprojection error.
     pub points: bool,
+    /// Each overhead camera's view of the carpet on the field view (outline and light fill in
+    /// the camera's colour).
+    pub coverage: bool,
 }
 
 impl Default for OverheadView {
@@ -176,6 +179,7 @@ impl Default for OverheadView {
             field_lines: true,
             undistorted: false,
             points: true,
+            coverage: true,
         }
     }
 }

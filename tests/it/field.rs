@@ -377,3 +377,175 @@ fn a_whole_field_is_scored_merged_against_the_truth() {
     ]);
     assert!(!out.status.success(), "--session with --lut is refused");
 }
+
+/// Field points on a 10 cm grid over the field and round it, centimetres.
+fn field_grid() -> Vec<[f64; 2]> {
+    (-40..=40)
+        .flat_map(|i| (-30..=30).map(move |j| [f64::from(i) * 10.0, f64::from(j) * 10.0]))
+        .collect()
+}
+
+/// Camera `k`'s true camera and frame size, from its recording's truth.
+fn true_camera(session: &Session, k: usize) -> (eotn::geometry::OverheadCamera, usize, usize) {
+    let SessionSource::Recording(p) = &session.overhead[k].source else {
+        panic!("a recording expected");
+    };
+    let record = eotn::streams::StreamReader::open(p)
+        .unwrap()
+        .read(0)
+        .unwrap();
+    let GroundTruth::Overhead(t) =
+        serde_json::from_value::<GroundTruth>(record.ground_truth.unwrap()).unwrap()
+    else {
+        panic!("overhead truth expected");
+    };
+    (t.camera, record.frame.width(), record.frame.height())
+}
+
+#[test]
+fn a_session_opened_in_the_workspace_draws_each_cameras_coverage_and_who_saw_what() {
+    use eotn::workspace::overhead::FrameState;
+    use eotn::workspace::{Command, PlaybackCommand, Workspace};
+    let dir = tempfile::tempdir().unwrap();
+    let path = sim_field(dir.path(), 3, "320x200", 6, 6);
+    // Camera 2 stops delivering after two frames: the same rig's camera 2, recorded shorter.
+    let short = tempfile::tempdir().unwrap();
+    sim_field(short.path(), 3, "320x200", 2, 6);
+    let mut file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    for (key, name) in [
+        ("source", "cam2.mcap"),
+        ("lut", "cam2.lut"),
+        ("calibration", "cam2.cal.json"),
+    ] {
+        file["overhead"][2][key] = short.path().join(name).to_string_lossy().into();
+    }
+    std::fs::write(&path, file.to_string()).unwrap();
+    let session = Session::load(&path).unwrap();
+
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![path.clone()])).unwrap();
+    let cameras = w.overhead().field_cameras();
+    assert_eq!(cameras.session(), Some(path.as_path()));
+    let shown = cameras.cameras();
+    let ids: Vec<u8> = shown.iter().map(|c| c.id.0).collect();
+    assert_eq!(ids, [0, 1, 2], "one entry per camera, the reference first");
+    // Each camera's coverage holds the carpet points its true camera sees well inside its
+    // frame, and none it sees well outside (the coverage is of its solved calibration).
+    for (k, c) in shown.iter().enumerate() {
+        let coverage = c.coverage.expect("every camera has its coverage");
+        assert_eq!(coverage.camera, c.id);
+        let (truth, width, height) = true_camera(&session, k);
+        let margin = 0.1 * width as f64;
+        let (mut inside, mut outside) = (0, 0);
+        for p in field_grid() {
+            let Some(q) = truth.image_from_field(&eotn::geometry::Point::new(p[0], p[1], 0.0))
+            else {
+                continue;
+            };
+            let within = |m: f64| {
+                q.x_px > m && q.x_px < width as f64 - m && q.y_px > m && q.y_px < height as f64 - m
+            };
+            if within(margin) {
+                inside += 1;
+                assert!(coverage.contains(p), "camera {k} sees {p:?} at {q:?}");
+            } else if !within(-margin) {
+                outside += 1;
+                assert!(
+                    !coverage.contains(p),
+                    "camera {k} does not see {p:?} ({q:?})"
+                );
+            }
+        }
+        assert!(
+            inside > 50 && outside > 50,
+            "camera {k}: {inside} in, {outside} out"
+        );
+        assert!(
+            matches!(c.frame, FrameState::Current { .. }),
+            "camera {k} at the first frame: {:?}",
+            c.frame
+        );
+    }
+    // Who saw what: every merged robot names the cameras that saw it, all of them current.
+    let picture = cameras.picture().expect("a merged picture");
+    assert!(picture.robots.len() >= 4, "{picture:?}");
+    let mut seen_by: Vec<u8> = picture
+        .robots
+        .iter()
+        .flat_map(|r| r.camera_ids.iter().map(|id| id.0))
+        .collect();
+    seen_by.sort_unstable();
+    seen_by.dedup();
+    assert!(
+        seen_by.len() >= 2,
+        "robots seen by several cameras: {seen_by:?}"
+    );
+    assert!(picture.robots.iter().all(|r| !r.camera_ids.is_empty()));
+
+    // Past camera 2's last frame it is stale; the others go on.
+    w.apply(PlaybackCommand::Seek(5).into()).unwrap();
+    let shown = w.overhead().field_cameras().cameras();
+    assert!(matches!(
+        shown[0].frame,
+        FrameState::Current { index: 5, .. }
+    ));
+    assert!(matches!(shown[1].frame, FrameState::Current { .. }));
+    let FrameState::Stale { last_time_ns } = shown[2].frame else {
+        panic!("camera 2 stopped delivering: {:?}", shown[2].frame);
+    };
+    let SessionSource::Recording(cam2) = &session.overhead[2].source else {
+        panic!("a recording expected");
+    };
+    let cam2 = eotn::streams::StreamReader::open(cam2).unwrap();
+    assert_eq!(last_time_ns, cam2.time_ns(1), "its last frame");
+    let picture = w
+        .overhead()
+        .field_cameras()
+        .picture()
+        .expect("the others' picture");
+    assert!(
+        picture
+            .robots
+            .iter()
+            .all(|r| r.camera_ids.iter().all(|id| id.0 != 2)),
+        "a stale camera saw nothing of this field frame"
+    );
+}
+
+#[test]
+fn a_single_overhead_stream_has_one_cameras_coverage() {
+    use eotn::workspace::overhead::FrameState;
+    use eotn::workspace::{Command, Workspace};
+    let stream = Path::new(env!("CARGO_MANIFEST_DIR")).join("streams/sim-overhead-game.mcap");
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![stream])).unwrap();
+    let cameras = w.overhead().field_cameras();
+    assert_eq!(cameras.session(), None);
+    let shown = cameras.cameras();
+    assert_eq!(shown.len(), 1);
+    assert!(matches!(
+        shown[0].frame,
+        FrameState::Current { index: 0, .. }
+    ));
+    let coverage = shown[0]
+        .coverage
+        .expect("the stream's own camera's coverage");
+    let truth = w.overhead().truth().expect("the stream's truth");
+    for r in truth.robots.iter().filter(|r| r.visible_pixels > 200) {
+        assert!(
+            coverage.contains(r.field_cm),
+            "robot {} at {:?}",
+            r.id,
+            r.field_cm
+        );
+    }
+    let picture = cameras.picture().expect("the camera's picture");
+    assert!(!picture.robots.is_empty());
+    assert!(
+        picture
+            .robots
+            .iter()
+            .all(|r| r.camera_ids == [SslCameraId(0)])
+    );
+}

@@ -13,6 +13,8 @@ mod app_classify;
 #[cfg(feature = "gui")]
 mod app_daily;
 #[cfg(feature = "gui")]
+mod app_field_cameras;
+#[cfg(feature = "gui")]
 mod app_hints;
 #[cfg(feature = "gui")]
 mod app_layout;

@@ -603,7 +603,8 @@ fn a_recorded_session_replays_to_the_same_lines_and_shows_in_foxglove_and_the_ap
     );
     let detections = pipeline.process(&rec.frame).clone();
     let mut model = eotn::workspace::field_model::FieldModel::default();
-    model.observe(20, rec.time_ns, Some(&detections), &rec.extra);
+    let picture = eotn::overhead::merge::one_camera(eotn::session::SslCameraId(0), &detections);
+    model.observe(20, rec.time_ns, Some(&picture), &rec.extra);
     assert!(
         model
             .world_models()
