@@ -96,6 +96,8 @@ pub struct Overhead {
     /// The calibration's and the frame's size last warned about (the warning is said once a
     /// pair, not once a frame).
     size_warned: Option<((usize, usize), (usize, usize))>,
+    /// The SSL-Vision output, while sending (`workspace/ssl_out.rs`).
+    pub(super) ssl_out: Option<super::ssl_out::SslOutState>,
 }
 
 impl Default for Overhead {
@@ -131,6 +133,7 @@ impl Default for Overhead {
             empty_recognition: Recognition::default(),
             field_model: FieldModel::default(),
             size_warned: None,
+            ssl_out: None,
         }
     }
 }
@@ -391,6 +394,7 @@ impl Workspace {
             self.overhead.detections.as_ref(),
             &loaded.extra,
         );
+        self.send_ssl_out(loaded.time_ns);
         let t = self.overhead.pipeline.timings();
         crate::pipeline::StageTimings {
             classify: t.classify,
@@ -474,6 +478,7 @@ impl Workspace {
                     self.status = format!("selected robot {k}");
                 }
             }
+            OverheadCommand::SendSslVision(address) => self.set_ssl_out(address)?,
             OverheadCommand::SetView(v) => {
                 self.settings.overhead = v;
                 self.refresh_view_map(self.image_size());

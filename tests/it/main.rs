@@ -72,3 +72,4 @@ mod window;
 mod without_readings;
 mod wmd;
 mod wmd_live;
+mod wmd_ssl;
