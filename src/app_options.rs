@@ -101,6 +101,8 @@ pub struct RunOptions {
     pub camera: Option<String>,
     /// `--labels`: a label set (YOLO or VOC folder, COCO JSON) opened over the frames.
     pub labels: Option<PathBuf>,
+    /// `--ssl-vision HOST:PORT`: the overhead detections sent as SSL-Vision packets there.
+    pub ssl_vision: Option<String>,
 }
 
 #[cfg(test)]

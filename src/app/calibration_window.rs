@@ -23,6 +23,8 @@ pub struct OverheadPaths {
     pub field: String,
     /// The lens's intrinsics (a ROS `camera_info` YAML file).
     pub intrinsics: String,
+    /// Where SSL-Vision packets go (`HOST:PORT`; empty: the league's group).
+    pub ssl_vision: String,
 }
 
 /// A file dialog a window asks for: what for, and the file name a save suggests.
@@ -45,6 +47,57 @@ pub fn calibration_ui(
     picking_ui(ui, state, commands);
     ui.separator();
     points_table_ui(ui, state);
+    ui.separator();
+    ssl_vision_ui(ui, state, &mut paths.ssl_vision, commands);
+}
+
+/// Sending the detections as SSL-Vision packets: the address, the switch, what was sent and
+/// the last error (the workspace sends: `workspace/ssl_out.rs`).
+fn ssl_vision_ui(
+    ui: &mut Ui,
+    state: &Workspace,
+    address: &mut String,
+    commands: &mut Vec<Command>,
+) {
+    let status = state.ssl_out_status();
+    ui.horizontal_wrapped(|ui| {
+        let mut sending = status.is_some();
+        let name = ui.label("SSL-Vision to");
+        ui.add_enabled(
+            !sending,
+            egui::TextEdit::singleline(address)
+                .hint_text(crate::ssl_vision::LEAGUE_ADDRESS)
+                .desired_width(160.0),
+        )
+        .labelled_by(name.id);
+        let toggle = ui.checkbox(&mut sending, "Send SSL-Vision").on_hover_text(
+            "send each overhead frame's ball and robots as SSL-Vision packets over UDP \
+                 (camera 0), and the field and calibration every few seconds, for any Small \
+                 Size League team's software",
+        );
+        if toggle.changed() {
+            let typed = address.trim();
+            let target = if typed.is_empty() {
+                crate::ssl_vision::LEAGUE_ADDRESS
+            } else {
+                typed
+            };
+            commands
+                .push(OverheadCommand::SendSslVision(sending.then(|| target.to_owned())).into());
+        }
+    });
+    if let Some(s) = status {
+        ui.label(format!(
+            "sending to {}: {} detection and {} geometry packets",
+            s.address, s.detection_packets, s.geometry_packets
+        ));
+        if let Some(e) = &s.last_error {
+            ui.colored_label(
+                ui.visuals().warn_fg_color,
+                format!("{} sends failed; the last: {e}", s.failures),
+            );
+        }
+    }
 }
 
 /// One button of a [`path_row`]: its text, whether it can be used, and the file dialog it

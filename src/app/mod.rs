@@ -168,6 +168,11 @@ fn start_window(
             if let Some(labels) = &opts.labels {
                 app.state.run(Command::OpenLabels(labels.clone()));
             }
+            if let Some(address) = &opts.ssl_vision {
+                app.state.run(
+                    crate::workspace::OverheadCommand::SendSslVision(Some(address.clone())).into(),
+                );
+            }
             if opts.all_overlays {
                 app.state.settings.overlays = crate::workspace::Overlays::all_on();
             }

@@ -61,7 +61,7 @@ pub fn run(path: &Path, json: bool, ssl_vision: Option<&str>) -> anyhow::Result<
     let session = Session::load(path)?;
     let (field, mut cameras) = open_cameras(&session)?;
     let mut ssl = ssl_vision
-        .map(|addr| super::ssl_vision_out::SslOut::open(addr, &field, &ssl_cameras(&cameras)))
+        .map(|addr| super::ssl_vision_out::open(addr, &field, &ssl_cameras(&cameras)))
         .transpose()?;
     let times = frame_times(&cameras);
     let reference = times.first().cloned().unwrap_or_default();
@@ -92,7 +92,7 @@ pub fn run(path: &Path, json: bool, ssl_vision: Option<&str>) -> anyhow::Result<
     }
     out.flush().context("writing output")?;
     if let Some(ssl) = &ssl {
-        ssl.finish();
+        super::ssl_vision_out::finish(ssl);
     }
     Ok(())
 }

@@ -84,8 +84,11 @@ fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<Fi
             e.source
         );
     };
-    let lut = load_lut_arg(&e.lut)?;
-    let cal = load_usable_calibration(&e.calibration)?;
+    let (Some(lut), Some(cal)) = (&e.lut, &e.calibration) else {
+        bail!("overhead camera {}: no table or calibration", e.id);
+    };
+    let lut = load_lut_arg(lut)?;
+    let cal = load_usable_calibration(cal)?;
     let params = match &e.params {
         Some(p) => load_params(p)?,
         None => params_for(field),

@@ -52,6 +52,7 @@ mod wmd_feeds;
 mod wmd_inputs;
 mod wmd_live;
 mod wmd_record;
+mod wmd_ssl;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -44,6 +44,12 @@ pub struct Args {
     /// the missed and false frames listed as events (Windows ▸ Events and bookmarks).
     #[arg(long, value_name = "LABELS")]
     pub labels: Option<PathBuf>,
+    /// Send each overhead frame's detections as SSL-Vision packets over UDP to HOST:PORT (a
+    /// unicast address, or the league's group 224.5.23.2:10006), camera 0, with the field and
+    /// the calibration in use every few seconds, as `eotn overhead detect --ssl-vision` sends
+    /// them (also in the app: Windows ▸ Overhead calibration, "Send SSL-Vision").
+    #[arg(long, value_name = "HOST:PORT", value_parser = ssl_address)]
+    pub ssl_vision: Option<String>,
 }
 
 impl Args {
@@ -62,8 +68,29 @@ impl Args {
                 .map(|s| Duration::from_secs_f64(s.min(1e9))),
             all_overlays: self.all_overlays,
             labels: self.labels.clone(),
+            ssl_vision: self.ssl_vision.clone(),
         }
     }
+}
+
+/// `--ssl-vision`'s address, checked before the window opens: `HOST:PORT` that resolves, port
+/// not 0.
+fn ssl_address(text: &str) -> Result<String, String> {
+    use std::net::ToSocketAddrs as _;
+    let first = text
+        .to_socket_addrs()
+        .map_err(|e| {
+            format!(
+                "not HOST:PORT (e.g. {}): {e}",
+                crate::ssl_vision::LEAGUE_ADDRESS
+            )
+        })?
+        .next()
+        .ok_or("the host has no address")?;
+    if first.port() == 0 {
+        return Err("port 0 is not a port to send to".to_owned());
+    }
+    Ok(text.to_owned())
 }
 
 /// Runs `eotn open` in a build without the app: there is nothing to open it with.
@@ -126,6 +153,18 @@ mod tests {
             let refused = Open::try_parse_from(["open", "a.mcap", bad]).err();
             let said = refused.map(|e| e.to_string()).unwrap_or_default();
             assert!(said.contains("must be a number from 0"), "{bad}: {said}");
+        }
+    }
+
+    #[test]
+    fn ssl_vision_takes_an_address_that_resolves() {
+        let o = options(&["a.mcap", "--ssl-vision", "127.0.0.1:10006"]);
+        assert_eq!(o.ssl_vision.as_deref(), Some("127.0.0.1:10006"));
+        assert_eq!(options(&["a.mcap"]).ssl_vision, None);
+        for bad in ["nowhere", "127.0.0.1:0", "127.0.0.1:99999"] {
+            let refused = Open::try_parse_from(["open", "a.mcap", "--ssl-vision", bad]).err();
+            let said = refused.map(|e| e.to_string()).unwrap_or_default();
+            assert!(said.contains("--ssl-vision"), "{bad}: {said}");
         }
     }
 }

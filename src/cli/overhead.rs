@@ -443,7 +443,7 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
                 camera_id,
                 camera: cal.camera,
             };
-            super::ssl_vision_out::SslOut::open(addr, &field, &[entry])
+            super::ssl_vision_out::open(addr, &field, &[entry])
         })
         .transpose()?;
     let mut sizes = SizeCheck::default();
@@ -487,7 +487,7 @@ fn run_detect(a: &DetectArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     out.flush().context("writing output")?;
     if let Some(ssl) = &ssl {
-        ssl.finish();
+        super::ssl_vision_out::finish(ssl);
     }
     Ok(())
 }

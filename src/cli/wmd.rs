@@ -15,14 +15,12 @@ use anyhow::{Context, bail};
 use serde_json::{Value, json};
 
 use super::field::{FieldCamera, open_cameras};
-use super::overhead::{load_field, load_usable_calibration, overhead_json, params_for};
-use super::ssl_vision_out::SslOut;
+use super::overhead::{load_field, overhead_json};
 use super::wmd_inputs::{FieldFrame, RobotModels, field_frames, read_world_models, recorded};
 use super::wmd_record::{CameraFrame, SessionRecorder};
 use crate::model::world_model::RobotKey;
-use crate::overhead::OverheadPipeline;
 use crate::overhead::merge::{SslCameraId, frame_near};
-use crate::session::{Session, SessionSource};
+use crate::session::{Session, SessionSource, SslSource};
 use crate::wmd::clock::{ClockOffset, estimate_offset, frame_period_ns, shifted};
 use crate::wmd::summary::{RobotSummary, Spread, Summaries};
 use crate::wmd::{Comparison, Targets, WorldModelMessage, compare};
@@ -31,7 +29,9 @@ use crate::wmd::{Comparison, Targets, WorldModelMessage, compare};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The overhead camera: a recording, a `ws://HOST:PORT` server or a camera device
-    /// (`/dev/videoN`, as `eotn sources` lists them).
+    /// (`/dev/videoN`, as `eotn sources` lists them); or SSL-Vision's detections in its place,
+    /// live on `udp://GROUP:PORT` (the league's is udp://224.5.23.2:10006) or a league log
+    /// (`.log`, `.log.gz`) read through, which need no --lut or --calibration.
     #[arg(
         long,
         value_name = "SOURCE",
@@ -48,11 +48,12 @@ pub struct Args {
         conflicts_with = "session"
     )]
     pub robot: Vec<PathBuf>,
-    /// The overhead camera's lookup table.
-    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    /// The overhead camera's lookup table (required, except for an SSL-Vision source).
+    #[arg(long, conflicts_with = "session")]
     pub lut: Option<PathBuf>,
-    /// The overhead camera's calibration (`eotn overhead calibrate`).
-    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    /// The overhead camera's calibration (`eotn overhead calibrate`; required, except for an
+    /// SSL-Vision source).
+    #[arg(long, conflicts_with = "session")]
     pub calibration: Option<PathBuf>,
     /// Field description (a file or a shipped field's name): ball radius, plate height, and
     /// where the goals and landmarks a robot measures stand; four-legged-2005 by default.
@@ -108,13 +109,21 @@ pub struct Outcome {
 /// # Errors
 /// An unreadable input (named), no world models at all (recordings), no overhead frame.
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    if a.ssl_vision.is_some() && has_ssl_source(a)? {
+        bail!(
+            "--ssl-vision: the overhead source is SSL-Vision already; its packets go to its own \
+             clients"
+        );
+    }
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let outcome = if is_live(a)? {
         let (inputs, recorder) = super::wmd_inputs::open_live(a)?;
         let ssl = a
             .ssl_vision
             .as_deref()
-            .map(|addr| SslOut::open(addr, &inputs.field, &live_ssl_cameras(&inputs)))
+            .map(|addr| {
+                super::ssl_vision_out::open(addr, &inputs.field, &live_ssl_cameras(&inputs))
+            })
             .transpose()?;
         super::wmd_live::run(inputs, a.json, a.seconds, (recorder, ssl), &mut out)?
     } else {
@@ -136,11 +145,36 @@ fn live_ssl_cameras(inputs: &super::wmd_live::LiveInputs) -> Vec<crate::ssl_visi
     inputs
         .cameras
         .iter()
-        .map(|c| crate::ssl_vision::CameraEntry {
-            camera_id: super::ssl_vision_out::session_camera_id(c.id),
-            camera: *c.pipeline.camera(),
+        .filter_map(|c| {
+            Some(crate::ssl_vision::CameraEntry {
+                camera_id: super::ssl_vision_out::session_camera_id(c.id),
+                camera: *c.pipeline.as_ref()?.camera(),
+            })
         })
         .collect()
+}
+
+/// The overhead sources named (the session's or `--overhead`).
+fn overhead_sources(a: &Args) -> anyhow::Result<Vec<SessionSource>> {
+    Ok(match &a.session {
+        Some(path) => Session::load(path)?
+            .overhead
+            .into_iter()
+            .map(|e| e.source)
+            .collect(),
+        None => a
+            .overhead
+            .iter()
+            .map(|p| SessionSource::parse_arg(p))
+            .collect(),
+    })
+}
+
+/// True when the overhead source is SSL-Vision.
+fn has_ssl_source(a: &Args) -> anyhow::Result<bool> {
+    Ok(overhead_sources(a)?
+        .iter()
+        .any(|s| matches!(s, SessionSource::Ssl(_))))
 }
 
 /// True when any source is live or a device.
@@ -157,8 +191,12 @@ fn is_live(a: &Args) -> anyhow::Result<bool> {
         .any(|s| is_live_source(&s)))
 }
 
+/// Live: a server, a device, udp://; a recording and an SSL-Vision log are read through.
 fn is_live_source(s: &SessionSource) -> bool {
-    !matches!(s, SessionSource::Recording(_))
+    !matches!(
+        s,
+        SessionSource::Recording(_) | SessionSource::Ssl(SslSource::Log(_))
+    )
 }
 
 /// The closing report: robots that stopped early warned about; the table (or, with `--json`,
@@ -188,6 +226,7 @@ fn report(json: bool, o: &Outcome, out: &mut impl Write) -> anyhow::Result<()> {
 /// robot's clock offset searched, every frame compared (and recorded with `-o`).
 fn recorded_session(a: &Args, out: &mut impl Write) -> anyhow::Result<Outcome> {
     let (field, mut cameras, robots, single) = open(a)?;
+    let ssl_log = ssl_log_source(a)?;
     let mut models = RobotModels::new();
     let mut paired_before = std::collections::BTreeSet::new();
     for (path, only) in &robots {
@@ -206,11 +245,16 @@ fn recorded_session(a: &Args, out: &mut impl Write) -> anyhow::Result<Outcome> {
     let mut ssl = a
         .ssl_vision
         .as_deref()
-        .map(|addr| SslOut::open(addr, &field, &super::detect_field::ssl_cameras(&cameras)))
+        .map(|addr| {
+            super::ssl_vision_out::open(addr, &field, &super::detect_field::ssl_cameras(&cameras))
+        })
         .transpose()?;
-    let frames = field_frames(&mut cameras, single, ssl.as_mut())?;
+    let frames = match &ssl_log {
+        Some(log) => super::wmd_ssl::log_field_frames(log)?,
+        None => field_frames(&mut cameras, single, ssl.as_mut())?,
+    };
     if let Some(ssl) = &ssl {
-        ssl.finish();
+        super::ssl_vision_out::finish(ssl);
     }
     if frames.is_empty() {
         bail!("the overhead recording has no frames");
@@ -275,6 +319,23 @@ fn recorded_session(a: &Args, out: &mut impl Write) -> anyhow::Result<Outcome> {
     })
 }
 
+/// The SSL-Vision log that is the overhead source, if one is (refused with `-o`: it holds no
+/// frames to record).
+fn ssl_log_source(a: &Args) -> anyhow::Result<Option<PathBuf>> {
+    let ssl_log = overhead_sources(a)?.into_iter().find_map(|s| match s {
+        SessionSource::Ssl(SslSource::Log(p)) => Some(p),
+        _ => None,
+    });
+    if let (Some(log), Some(_)) = (&ssl_log, &a.output) {
+        bail!(
+            "-o: {} is SSL-Vision, which holds no frames to record; record without -o, or keep \
+             the league's log",
+            log.display()
+        );
+    }
+    Ok(ssl_log)
+}
+
 /// The overhead cameras as the recording names them, with their files.
 fn recorded_cameras(
     a: &Args,
@@ -285,9 +346,9 @@ fn recorded_cameras(
             .overhead
             .iter()
             .map(|e| crate::camera::CameraFiles {
-                lut: Some(e.lut.clone()),
+                lut: e.lut.clone(),
                 params: None,
-                calibration: Some(e.calibration.clone()),
+                calibration: e.calibration.clone(),
             })
             .collect(),
         None => vec![crate::camera::CameraFiles {
@@ -398,7 +459,11 @@ fn open(a: &Args) -> anyhow::Result<Opened> {
         if session.robots.is_empty() {
             bail!("{}: no robots to debug", path.display());
         }
-        for e in &session.overhead {
+        let ssl = session
+            .overhead
+            .iter()
+            .any(|e| matches!(e.source, SessionSource::Ssl(_)));
+        for e in session.overhead.iter().filter(|_| !ssl) {
             recorded(&e.source, &format!("overhead camera {}", e.id))?;
         }
         super::wmd_inputs::say_unused_session_keys(&session, a.output.is_some(), false);
@@ -413,26 +478,33 @@ fn open(a: &Args) -> anyhow::Result<Opened> {
                 Ok((recorded(&r.source, &format!("robot {key}"))?, Some(key)))
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
+        if ssl {
+            let field = session.field.load()?;
+            return Ok((field, Vec::new(), robots, false));
+        }
         let (field, cameras) = open_cameras(&session)?;
         return Ok((field, cameras, robots, false));
     }
-    let (Some(overhead), Some(lut), Some(cal)) = (&a.overhead, &a.lut, &a.calibration) else {
-        bail!("--overhead, --lut and --calibration name the overhead camera (or give --session)");
+    let Some(overhead) = &a.overhead else {
+        bail!("--overhead names the overhead camera (or give --session)");
     };
     let source = |p: &PathBuf, what: &str| recorded(&SessionSource::parse_arg(p), what);
-    let overhead = source(overhead, "overhead")?;
     let robots = a
         .robot
         .iter()
         .map(|p| Ok((source(p, "robot")?, None)))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let field = load_field(a.field.as_deref())?;
-    let cal = load_usable_calibration(cal)?;
-    let lut = super::inputs::load_lut_arg(lut)?;
+    let overhead_source = SessionSource::parse_arg(overhead);
+    let Some(pipeline) = super::wmd_inputs::overhead_pipeline(a, &overhead_source, &field)? else {
+        // SSL-Vision: its log's frames are read by the caller.
+        return Ok((field, Vec::new(), robots, true));
+    };
+    let overhead = recorded(&overhead_source, "overhead")?;
     let reader = crate::streams::StreamReader::open_camera(&overhead, a.camera.get())?;
     let camera = FieldCamera {
         id: SslCameraId(0),
-        pipeline: OverheadPipeline::new(lut, cal.camera, params_for(&field)),
+        pipeline,
         reader,
         name: crate::frame::display_name(&overhead),
     };

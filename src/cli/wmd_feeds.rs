@@ -50,6 +50,9 @@ pub enum OverheadFeed {
     Device(Streamer),
     /// A recording, replayed on its own clock.
     Replay(Box<Replay>),
+    /// SSL-Vision's detection frames (udp:// or a log replayed): detections, not frames
+    /// ([`super::wmd_ssl`]).
+    Ssl(Box<super::wmd_ssl::SslOverheadFeed>),
 }
 
 impl std::fmt::Debug for OverheadFeed {
@@ -58,6 +61,7 @@ impl std::fmt::Debug for OverheadFeed {
             Self::Live { robot, .. } => write!(f, "Live({})", robot.url()),
             Self::Device(s) => write!(f, "Device({s:?})"),
             Self::Replay(r) => write!(f, "Replay({})", r.reader.path().display()),
+            Self::Ssl(s) => write!(f, "Ssl({s:?})"),
         }
     }
 }
@@ -102,15 +106,21 @@ impl OverheadFeed {
     /// True for a recording played to its end (a live source never ends by itself).
     #[must_use]
     pub fn ended(&self) -> bool {
-        matches!(self, Self::Replay(r) if r.next >= r.reader.len())
+        match self {
+            Self::Replay(r) => r.next >= r.reader.len(),
+            Self::Ssl(s) => s.ended(),
+            Self::Live { .. } | Self::Device(_) => false,
+        }
     }
 
     /// The frames that arrived since the last call, with their times (see the module
     /// documentation); `start` and `start_unix_ns` are the session's start. Problems (a frame
-    /// that cannot be read, a device error) are warned about under `name`.
+    /// that cannot be read, a device error) are warned about under `name`. An SSL-Vision feed
+    /// gives no frames: its detections come from [`super::wmd_ssl::SslOverheadFeed::poll`].
     pub fn poll(&mut self, start: Instant, start_unix_ns: u64, name: &str) -> Vec<(u64, Frame)> {
         let mut out = Vec::new();
         match self {
+            Self::Ssl(_) => {}
             Self::Live { robot, next } => {
                 while *next < robot.len() {
                     if let Some(f) = robot.frame(*next) {
@@ -154,7 +164,7 @@ impl OverheadFeed {
     pub fn connection(&self) -> Option<String> {
         match self {
             Self::Live { robot, .. } => Some(robot.connection().to_string()),
-            Self::Device(_) | Self::Replay(_) => None,
+            Self::Device(_) | Self::Replay(_) | Self::Ssl(_) => None,
         }
     }
 }

@@ -118,6 +118,10 @@ pub fn recorded(source: &SessionSource, what: &str) -> anyhow::Result<std::path:
                 p.display()
             )
         }
+        SessionSource::Ssl(s) => bail!(
+            "{what} {s}: SSL-Vision's detections are an overhead source, not a recording of \
+             world models"
+        ),
     }
 }
 
@@ -266,15 +270,23 @@ fn open_live_session(path: &Path, record: bool) -> anyhow::Result<LiveOpened> {
     let mut cameras = Vec::new();
     let mut files = Vec::new();
     for e in &session.overhead {
-        let lut = super::inputs::load_lut_arg(&e.lut)?;
-        let cal = super::overhead::load_usable_calibration(&e.calibration)?;
-        let params = match &e.params {
-            Some(p) => super::field::load_params(p)?,
-            None => super::overhead::params_for(&field),
+        let pipeline = match (&e.source, &e.lut, &e.calibration) {
+            (SessionSource::Ssl(_), ..) => None,
+            (_, Some(lut), Some(cal)) => {
+                let lut = super::inputs::load_lut_arg(lut)?;
+                let cal = super::overhead::load_usable_calibration(cal)?;
+                let params = match &e.params {
+                    Some(p) => super::field::load_params(p)?,
+                    None => super::overhead::params_for(&field),
+                };
+                Some(crate::overhead::OverheadPipeline::new(
+                    lut, cal.camera, params,
+                ))
+            }
+            _ => bail!("overhead camera {}: no table or calibration", e.id),
         };
-        let pipeline = crate::overhead::OverheadPipeline::new(lut, cal.camera, params);
         cameras.push(live_camera(e.id, &e.source, e.camera.as_deref(), pipeline)?);
-        files.push(camera_files(&e.lut, &e.calibration));
+        files.push(camera_files(e.lut.as_deref(), e.calibration.as_deref()));
     }
     let mut robots = Vec::new();
     for r in &session.robots {
@@ -300,16 +312,12 @@ fn open_live_session(path: &Path, record: bool) -> anyhow::Result<LiveOpened> {
 }
 
 fn open_live_args(a: &super::wmd::Args, record: bool) -> anyhow::Result<LiveOpened> {
-    let (Some(overhead), Some(lut), Some(cal)) = (&a.overhead, &a.lut, &a.calibration) else {
-        bail!("--overhead, --lut and --calibration name the overhead camera (or give --session)");
+    let Some(overhead) = &a.overhead else {
+        bail!("--overhead names the overhead camera (or give --session)");
     };
     let field = super::overhead::load_field(a.field.as_deref())?;
-    let pipeline = crate::overhead::OverheadPipeline::new(
-        super::inputs::load_lut_arg(lut)?,
-        super::overhead::load_usable_calibration(cal)?.camera,
-        super::overhead::params_for(&field),
-    );
     let source = SessionSource::parse_arg(overhead);
+    let pipeline = overhead_pipeline(a, &source, &field)?;
     let cameras = vec![live_camera(
         SslCameraId(0),
         &source,
@@ -331,8 +339,42 @@ fn open_live_args(a: &super::wmd::Args, record: bool) -> anyhow::Result<LiveOpen
         field,
         cameras,
         robots,
-        files: vec![camera_files(lut, cal)],
+        files: vec![camera_files(a.lut.as_deref(), a.calibration.as_deref())],
     })
+}
+
+/// The pipeline of `--overhead`'s camera from `--lut` and `--calibration`; none for an
+/// SSL-Vision source (whose packets hold detections: a table or calibration given is said to be
+/// unused).
+///
+/// # Errors
+/// An eotn camera without `--lut` or `--calibration`; an unreadable table or calibration.
+pub fn overhead_pipeline(
+    a: &super::wmd::Args,
+    source: &SessionSource,
+    field: &crate::overhead::FieldDescription,
+) -> anyhow::Result<Option<crate::overhead::OverheadPipeline>> {
+    if let SessionSource::Ssl(s) = source {
+        if a.lut.is_some() || a.calibration.is_some() {
+            log::warn!(
+                "--lut, --calibration: not used: {s} is SSL-Vision, whose packets hold the \
+                 detections"
+            );
+        }
+        return Ok(None);
+    }
+    let (Some(lut), Some(cal)) = (&a.lut, &a.calibration) else {
+        bail!(
+            "--overhead {}: an eotn camera needs --lut and --calibration (only an SSL-Vision \
+             source, udp://GROUP:PORT or a league .log, goes without)",
+            source_name(source)
+        );
+    };
+    Ok(Some(crate::overhead::OverheadPipeline::new(
+        super::inputs::load_lut_arg(lut)?,
+        super::overhead::load_usable_calibration(cal)?.camera,
+        super::overhead::params_for(field),
+    )))
 }
 
 /// Every source of a live session opened as a feed, and the recording started with `-o`.
@@ -356,6 +398,15 @@ pub fn open_live(
         Some(path) => open_live_session(path, record)?,
         None => open_live_args(a, record)?,
     };
+    if a.output.is_some()
+        && let Some(c) = cameras.iter().find(|c| c.pipeline.is_none())
+    {
+        bail!(
+            "-o: {} is SSL-Vision, which sends no frames to record; record without -o, or keep \
+             the league's log",
+            c.name
+        );
+    }
     let recorder = match &a.output {
         Some(p) => {
             let described: Vec<super::wmd_record::RecordedCamera> = cameras
@@ -395,14 +446,15 @@ fn source_name(source: &SessionSource) -> String {
         SessionSource::Live(url) => url.clone(),
         SessionSource::Device(p) => p.display().to_string(),
         SessionSource::Recording(p) => crate::frame::display_name(p),
+        SessionSource::Ssl(s) => s.to_string(),
     }
 }
 
-fn camera_files(lut: &Path, calibration: &Path) -> crate::camera::CameraFiles {
+fn camera_files(lut: Option<&Path>, calibration: Option<&Path>) -> crate::camera::CameraFiles {
     crate::camera::CameraFiles {
-        lut: Some(lut.to_owned()),
+        lut: lut.map(Path::to_owned),
         params: None,
-        calibration: Some(calibration.to_owned()),
+        calibration: calibration.map(Path::to_owned),
     }
 }
 
@@ -427,7 +479,7 @@ fn live_camera(
     id: SslCameraId,
     source: &SessionSource,
     topic: Option<&str>,
-    pipeline: crate::overhead::OverheadPipeline,
+    pipeline: Option<crate::overhead::OverheadPipeline>,
 ) -> anyhow::Result<super::wmd_live::LiveCamera> {
     use super::wmd_feeds::OverheadFeed;
     let name = source_name(source);
@@ -435,6 +487,9 @@ fn live_camera(
         SessionSource::Live(url) => OverheadFeed::live(url)?,
         SessionSource::Device(p) => OverheadFeed::device(p)?,
         SessionSource::Recording(p) => OverheadFeed::replay(p, topic)?,
+        SessionSource::Ssl(s) => {
+            OverheadFeed::Ssl(Box::new(super::wmd_ssl::SslOverheadFeed::open(s)?))
+        }
     };
     if topic.is_some() && !matches!(source, SessionSource::Recording(_)) {
         log::warn!(
@@ -462,6 +517,10 @@ fn robot_feed(
         SessionSource::Device(p) => bail!(
             "robot {what}: {} is a camera device; a robot's source sends its world models (a recording or a ws:// robot)",
             p.display()
+        ),
+        SessionSource::Ssl(s) => bail!(
+            "robot {what}: {s} is SSL-Vision; a robot's source sends its world models (a \
+             recording or a ws:// robot)"
         ),
         SessionSource::Recording(p) => {
             let mut models = RobotModels::new();

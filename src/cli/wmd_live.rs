@@ -44,8 +44,8 @@ pub struct LiveCamera {
     pub id: SslCameraId,
     /// Its name in messages (the source).
     pub name: String,
-    /// Its pipeline.
-    pub pipeline: OverheadPipeline,
+    /// Its pipeline (none for SSL-Vision, whose packets hold detections).
+    pub pipeline: Option<OverheadPipeline>,
     /// Its frames.
     pub feed: OverheadFeed,
     /// Its connection as last said (live servers).
@@ -206,17 +206,33 @@ impl Session<'_> {
                 }
                 cam.connection = connection;
             }
+            let mut arrived: Vec<Seen> = Vec::new();
+            if let OverheadFeed::Ssl(feed) = &mut cam.feed {
+                for (time_ns, detections) in feed.poll(self.start, self.start_unix_ns, &cam.name) {
+                    arrived.push(Seen {
+                        time_ns,
+                        detections,
+                        frame: None,
+                    });
+                }
+            }
             for (time_ns, frame) in cam.feed.poll(self.start, self.start_unix_ns, &cam.name) {
-                let camera = *cam.pipeline.camera();
+                let Some(pipeline) = cam.pipeline.as_mut() else {
+                    continue;
+                };
+                let camera = *pipeline.camera();
                 if let Some(size) = self.sizes.get_mut(k) {
                     size.check(&camera, &cam.name, frame.width(), frame.height())?;
                 }
-                let detections = cam.pipeline.process(&frame).clone();
-                let seen = Seen {
+                let detections = pipeline.process(&frame).clone();
+                arrived.push(Seen {
                     time_ns,
                     detections,
                     frame: keep.then_some(frame),
-                };
+                });
+            }
+            for seen in arrived {
+                let time_ns = seen.time_ns;
                 if k == 0 {
                     self.times.push_back(time_ns);
                     if self.times.len() > PERIOD_WINDOW {
@@ -427,6 +443,11 @@ impl Session<'_> {
                 );
             }
         }
+        for c in &self.inputs.cameras {
+            if let OverheadFeed::Ssl(feed) = &c.feed {
+                feed.finish(&c.name);
+            }
+        }
         for r in std::mem::take(&mut self.inputs.robots) {
             if r.received == 0 {
                 log::warn!("{}: no world model arrived from it", r.name);
@@ -439,7 +460,7 @@ impl Session<'_> {
             .map(SessionRecorder::finish)
             .transpose();
         if let Some(ssl) = &self.ssl {
-            ssl.finish();
+            super::ssl_vision_out::finish(ssl);
         }
         made?;
         recorded?;

@@ -34,16 +34,49 @@ pub enum SessionSource {
     Live(String),
     /// A camera device as `eotn sources` names it (`/dev/videoN`).
     Device(PathBuf),
+    /// SSL-Vision's detection frames in place of an eotn overhead camera (no table or
+    /// calibration: ssl-vision has found the ball and robots already).
+    Ssl(SslSource),
+}
+
+/// Where SSL-Vision detection frames come from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SslSource {
+    /// Packets received live on `udp://GROUP:PORT` (a multicast group or a unicast address).
+    Udp(String),
+    /// A league log file (`SSL_LOG_FILE`, plain or gzip), resolved against the session file's
+    /// folder.
+    Log(PathBuf),
+}
+
+impl std::fmt::Display for SslSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Udp(url) => f.write_str(url),
+            Self::Log(p) => write!(f, "{}", p.display()),
+        }
+    }
+}
+
+/// Whether a path names a league log by its extension (`.log`, `.log.gz`): it is read as one,
+/// and a B-Human log so named gets the line pointing to `eotn import --bhuman`.
+fn is_log_name(p: &Path) -> bool {
+    let name = p.to_string_lossy().to_ascii_lowercase();
+    name.ends_with(".log") || name.ends_with(".log.gz")
 }
 
 impl SessionSource {
-    /// What a command-line SOURCE names: a `ws://`/`wss://` server, a `/dev/…` device, else a
-    /// recording.
+    /// What a command-line SOURCE names: a `ws://`/`wss://` server, a `/dev/…` device, a
+    /// `udp://` SSL-Vision address or a league log (`.log`, `.log.gz`), else a recording.
     #[must_use]
     pub fn parse_arg(arg: &Path) -> Self {
         let s = arg.to_string_lossy();
         if s.starts_with("ws://") || s.starts_with("wss://") {
             Self::Live(s.into_owned())
+        } else if crate::ssl_vision::listener::is_udp_url(&s) {
+            Self::Ssl(SslSource::Udp(s.into_owned()))
+        } else if is_log_name(arg) {
+            Self::Ssl(SslSource::Log(arg.to_owned()))
         } else if s.starts_with("/dev/") {
             Self::Device(arg.to_owned())
         } else {
@@ -84,10 +117,10 @@ pub struct OverheadEntry {
     pub source: SessionSource,
     /// The topic of its frames when the source has several.
     pub camera: Option<String>,
-    /// Its lookup table.
-    pub lut: PathBuf,
-    /// Its calibration (`eotn overhead calibrate`).
-    pub calibration: PathBuf,
+    /// Its lookup table (required, except for an SSL-Vision source, which has none).
+    pub lut: Option<PathBuf>,
+    /// Its calibration (`eotn overhead calibrate`; required, except for an SSL-Vision source).
+    pub calibration: Option<PathBuf>,
     /// Its lens intrinsics (ROS `camera_info` YAML), carried for the calibration.
     pub intrinsics: Option<PathBuf>,
     /// Its overhead recogniser parameters.
@@ -107,6 +140,7 @@ impl OverheadEntry {
                 .into_owned(),
             SessionSource::Live(url) => url.clone(),
             SessionSource::Device(p) => p.to_string_lossy().into_owned(),
+            SessionSource::Ssl(s) => s.to_string(),
         };
         let topic = self.camera.as_deref().unwrap_or(crate::camera::IMAGE_TOPIC);
         crate::camera::CameraId::overhead(&source, topic)
@@ -183,8 +217,8 @@ struct RawOverhead {
     id: u8,
     source: String,
     camera: Option<String>,
-    lut: PathBuf,
-    calibration: PathBuf,
+    lut: Option<PathBuf>,
+    calibration: Option<PathBuf>,
     intrinsics: Option<PathBuf>,
     params: Option<PathBuf>,
 }
@@ -253,6 +287,18 @@ impl Session {
             }
             overhead.push(e);
         }
+        if overhead.len() > 1
+            && let Some(i) = overhead
+                .iter()
+                .position(|o| matches!(o.source, SessionSource::Ssl(_)))
+        {
+            return Err(err(
+                entry_name("overhead", i, &raw.overhead[i], "id"),
+                "an SSL-Vision source brings its own cameras (merged by capture time): it is the \
+                 session's only overhead entry"
+                    .into(),
+            ));
+        }
         let mut robots: Vec<RobotEntry> = Vec::new();
         for (i, value) in raw.robots.iter().enumerate() {
             let name = entry_name("robots", i, value, "robot_id");
@@ -318,12 +364,28 @@ impl Resolver<'_> {
 
     fn overhead(&self, value: &Value) -> Result<OverheadEntry, String> {
         let raw: RawOverhead = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
+        let source = self.source(&raw.source)?;
+        let ssl = matches!(source, SessionSource::Ssl(_));
+        for (key, given) in [("lut", &raw.lut), ("calibration", &raw.calibration)] {
+            if given.is_none() && !ssl {
+                return Err(format!(
+                    "missing field `{key}`: an eotn camera needs its table and calibration (only \
+                     an SSL-Vision source, udp:// or a league .log, goes without)"
+                ));
+            }
+        }
         Ok(OverheadEntry {
             id: SslCameraId(raw.id),
-            source: self.source(&raw.source)?,
+            source,
             camera: raw.camera,
-            lut: self.file("lut", "lookup table", &raw.lut)?,
-            calibration: self.file("calibration", "calibration", &raw.calibration)?,
+            lut: raw
+                .lut
+                .map(|p| self.file("lut", "lookup table", &p))
+                .transpose()?,
+            calibration: raw
+                .calibration
+                .map(|p| self.file("calibration", "calibration", &p))
+                .transpose()?,
             intrinsics: raw
                 .intrinsics
                 .map(|p| self.file("intrinsics", "intrinsics file", &p))
@@ -368,12 +430,18 @@ impl Resolver<'_> {
         if s.starts_with("/dev/") {
             return Ok(SessionSource::Device(PathBuf::from(s)));
         }
+        if crate::ssl_vision::listener::is_udp_url(s) {
+            return Ok(SessionSource::Ssl(SslSource::Udp(s.to_owned())));
+        }
         let p = self.base.join(s);
+        if p.is_file() && is_log_name(&p) {
+            return Ok(SessionSource::Ssl(SslSource::Log(p)));
+        }
         if p.exists() {
             Ok(SessionSource::Recording(p))
         } else {
             Err(format!(
-                "source {}: no such recording (a source is a recording, a ws:// server or a /dev/video device)",
+                "source {}: no such recording (a source is a recording, a ws:// server, a /dev/video device, udp://GROUP:PORT or an SSL-Vision .log)",
                 p.display()
             ))
         }

@@ -46,7 +46,7 @@ fn two_cameras_and_two_robots_load_with_paths_beside_the_file() {
     assert_eq!(s.field, FieldRef::Shipped("four-legged-2005".to_owned()));
     assert_eq!(s.overhead.len(), 2);
     assert_eq!(s.overhead[1].id, SslCameraId(7));
-    assert_eq!(s.overhead[1].lut, dir.path().join("b.lut"));
+    assert_eq!(s.overhead[1].lut, Some(dir.path().join("b.lut")));
     assert_eq!(s.overhead[1].camera.as_deref(), Some("/cam7"));
     assert_eq!(
         s.overhead[1].intrinsics.as_deref(),
@@ -162,7 +162,10 @@ fn a_session_file_is_read_from_disk_with_paths_beside_it() {
     let path = dir.path().join("SESSION.json");
     std::fs::write(&path, TWO_CAMERAS).expect("write");
     let s = Session::load(&path).expect("loads");
-    assert_eq!(s.overhead[0].calibration, dir.path().join("a.cal.json"));
+    assert_eq!(
+        s.overhead[0].calibration,
+        Some(dir.path().join("a.cal.json"))
+    );
     let gone = Session::load(&dir.path().join("none.json")).expect_err("missing");
     assert!(gone.to_string().contains("none.json"));
 }
@@ -179,4 +182,54 @@ fn every_shipped_field_is_a_session_field_as_it_is_a_field_argument() {
         let by_argument = crate::overhead::FieldDescription::resolve(name).expect("shipped");
         assert_eq!(loaded, by_argument, "{name}");
     }
+}
+
+#[test]
+fn an_ssl_vision_source_needs_no_table_and_stands_alone() {
+    let dir = folder();
+    std::fs::write(dir.path().join("game.log"), b"SSL_LOG_FILE").expect("write");
+    let one = |source: &str| {
+        format!(
+            r#"{{"field": "ssl-div-a", "overhead": [{{"id": 0, "source": "{source}"}}],
+                "robots": [{{"team": "blue", "robot_id": 3, "source": "rob.mcap"}}]}}"#
+        )
+    };
+    let s = load(dir.path(), &one("udp://224.5.23.2:10006")).expect("loads");
+    assert_eq!(
+        s.overhead[0].source,
+        SessionSource::Ssl(SslSource::Udp("udp://224.5.23.2:10006".into()))
+    );
+    assert_eq!(
+        (
+            s.overhead[0].lut.as_ref(),
+            s.overhead[0].calibration.as_ref()
+        ),
+        (None, None)
+    );
+    let s = load(dir.path(), &one("game.log")).expect("loads");
+    assert_eq!(
+        s.overhead[0].source,
+        SessionSource::Ssl(SslSource::Log(dir.path().join("game.log")))
+    );
+    // An eotn camera still needs its table and calibration.
+    let m = message(load(dir.path(), &one("cam.mcap")));
+    assert!(m.contains("overhead[0]") && m.contains("`lut`"), "{m}");
+    // Beside another camera: refused, naming it.
+    let two = TWO_CAMERAS.replace(
+        r#"{"id": 0, "source": "cam.mcap", "camera": "/cam0", "lut": "a.lut", "calibration": "a.cal.json"}"#,
+        r#"{"id": 0, "source": "udp://127.0.0.1:10006"}"#,
+    );
+    let m = message(load(dir.path(), &two));
+    assert!(
+        m.contains("overhead[0] (id 0)") && m.contains("only overhead entry"),
+        "{m}"
+    );
+    assert_eq!(
+        SessionSource::parse_arg(Path::new("udp://127.0.0.1:5")),
+        SessionSource::Ssl(SslSource::Udp("udp://127.0.0.1:5".into()))
+    );
+    assert_eq!(
+        SessionSource::parse_arg(Path::new("x/Game.LOG")),
+        SessionSource::Ssl(SslSource::Log("x/Game.LOG".into()))
+    );
 }

@@ -9,6 +9,7 @@
 //! | `mod.rs` | [`decode_packet`] (bounded, typed errors), [`CameraFrame`] (one camera's detections as plain eotn data: centimetres, [`MarkerTeam`]), [`detection_frame`] (eotn's detections → a detection message) |
 //! | `geometry.rs` | the field (size, lines, arcs) from a field description; each camera's calibration in ssl-vision's model, its one distortion coefficient fitted to eotn's lens |
 //! | `sender.rs` | [`sender::SslSender`]: packets to `HOST:PORT` (unicast or multicast), geometry every few seconds |
+//! | `out.rs` | [`out::SslOut`]: eotn's detections as numbered detection frames with the geometry, what the CLI's `--ssl-vision` and the app send |
 //! | `listener.rs` | [`listener::Listener`]: a thread receiving `udp://GROUP:PORT` (multicast joined) or a unicast port, bounded |
 //! | `log.rs` | the league's log files (`SSL_LOG_FILE`, version 1; gzip too): read message by message, vision kept, the rest counted |
 //! | `truth.rs` | detection frames as the truth of an overhead stream: paired by capture time, merged over cameras, as an [`crate::model::truth::OverheadTruth`] |
@@ -21,6 +22,7 @@ pub mod geometry;
 pub mod listener;
 pub mod log;
 pub mod messages;
+pub mod out;
 pub mod sender;
 pub mod truth;
 

@@ -54,6 +54,8 @@ pub struct SslSender {
     pub geometry_sent: u64,
     /// Sends that failed.
     pub failures: u64,
+    /// The last send's error, if the last send failed.
+    pub last_error: Option<String>,
     warned: Vec<std::io::ErrorKind>,
 }
 
@@ -97,6 +99,7 @@ impl SslSender {
             frames_sent: 0,
             geometry_sent: 0,
             failures: 0,
+            last_error: None,
             warned: Vec::new(),
         })
     }
@@ -140,9 +143,13 @@ impl SslSender {
 
     fn send(&mut self, bytes: &[u8]) -> bool {
         match self.socket.send_to(bytes, self.target) {
-            Ok(_) => true,
+            Ok(_) => {
+                self.last_error = None;
+                true
+            }
             Err(e) => {
                 self.failures += 1;
+                self.last_error = Some(e.to_string());
                 if !self.warned.contains(&e.kind()) {
                     self.warned.push(e.kind());
                     log::warn!(

@@ -7,9 +7,11 @@
 use std::collections::BTreeMap;
 
 use super::{CameraFrame, SslBall, SslRobot};
-use crate::geometry::{MarkerIdentity, MarkerTeam, OverheadCamera};
+use crate::geometry::{ImagePoint, MarkerIdentity, MarkerTeam, OverheadCamera};
 use crate::model::scene::Team;
 use crate::model::truth::{OverheadMarkerTruth, OverheadObject, OverheadRobot, OverheadTruth};
+use crate::overhead::OverheadDetections;
+use crate::overhead::recognise::{OverheadBall, OverheadRobot as DetectedRobot};
 
 /// Every camera's detection frames, each camera's in capture-time order.
 #[derive(Debug, Clone, Default)]
@@ -103,6 +105,15 @@ impl FrameIndex {
             .collect()
     }
 
+    /// One camera's capture times, ascending (the reference camera's are a log's field frames).
+    #[must_use]
+    pub fn times_of(&self, camera_id: u32) -> Vec<u64> {
+        self.cameras
+            .get(&camera_id)
+            .map(|l| l.iter().map(|f| f.0).collect())
+            .unwrap_or_default()
+    }
+
     /// Each camera's latest frame, by camera id.
     #[must_use]
     pub fn latest(&self) -> Vec<&CameraFrame> {
@@ -147,6 +158,54 @@ pub fn merged(frames: &[&CameraFrame]) -> (Option<SslBall>, Vec<SslRobot>) {
     let mut robots: Vec<SslRobot> = by_key.into_values().collect();
     robots.extend(unnamed);
     (ball, robots)
+}
+
+/// Several cameras' detection frames of one instant as one overhead picture in eotn's own
+/// detections (what `eotn wmd` compares world models with when its overhead source is
+/// SSL-Vision): [`merged`] over the cameras, each robot with an id of 0–15 and a heading as the
+/// marker of its team colour (blue → blue, yellow → yellow) and that identity, at its field and
+/// image position (the identity dots all at the centre: the packet has none), the ball's image
+/// radius 0 (the packet has no size). Returns the detections and the robots left out (no id,
+/// an id beyond eotn's sixteen markers, or no heading).
+#[must_use]
+pub fn detections(frames: &[&CameraFrame]) -> (OverheadDetections, usize) {
+    let (ball, robots) = merged(frames);
+    let mut left_out = 0;
+    let robots = robots
+        .iter()
+        .filter_map(|r| {
+            let identity = r
+                .robot_id
+                .and_then(|id| u8::try_from(id).ok())
+                .and_then(MarkerIdentity::new);
+            let (Some(identity), Some(heading_rad)) = (identity, r.heading_rad) else {
+                left_out += 1;
+                return None;
+            };
+            let image = ImagePoint::new(r.image_px[0], r.image_px[1]);
+            Some(DetectedRobot {
+                team: r.team,
+                identity,
+                field_cm: r.field_cm,
+                heading_rad,
+                image,
+                dots: [image; 4],
+                confidence: r.confidence,
+            })
+        })
+        .collect();
+    let ball = ball.map(|b| OverheadBall {
+        field_cm: b.field_cm,
+        image: ImagePoint::new(b.image_px[0], b.image_px[1]),
+        radius_px: 0.0,
+        confidence: b.confidence,
+    });
+    let d = OverheadDetections {
+        ball,
+        robots,
+        rejected: Vec::new(),
+    };
+    (d, left_out)
 }
 
 /// The truth of one instant from SSL detection frames, as `eotn eval` scores an overhead
@@ -264,5 +323,16 @@ mod tests {
             "id 40 has no marker"
         );
         assert!(truth.robots[0].marker.is_some_and(|m| m.fully_visible()));
+        let (d, left_out) = detections(&near);
+        assert_eq!(left_out, 1, "id 40 has no marker");
+        assert_eq!(d.robots.len(), 1);
+        assert_eq!(
+            (d.robots[0].identity.value(), d.robots[0].field_cm),
+            (2, [12.0, 0.0])
+        );
+        assert_eq!(d.robots[0].team, MarkerTeam::Blue);
+        assert!(d.ball.is_none());
+        assert_eq!(index.times_of(0), [1_000_000_000, 1_020_000_000]);
+        assert!(index.times_of(7).is_empty());
     }
 }

@@ -374,6 +374,9 @@ pub enum OverheadCommand {
     SelectRobot(Option<RobotKey>),
     /// Overhead view options.
     SetView(OverheadView),
+    /// Send each processed overhead frame's detections as SSL-Vision packets to `HOST:PORT`
+    /// (and the geometry every few seconds), or stop (`None`): `workspace/ssl_out.rs`.
+    SendSslVision(Option<String>),
 }
 
 /// The app's extra windows.

@@ -24,13 +24,12 @@
 //! | `coverage.rs`, `cell_origin.rs`, `bookmarks.rs`, `hints.rs` | what is unclassified, who set a cell, events and bookmarks |
 //! | `labels.rs` | [`OpenLabels`]: a boxed label set over the open frames, scored; its missed and false frames as events |
 //! | `params.rs` | recognition parameters: open, tune, reset, save, the set a stream names, [`params::TryParams`] |
-//! | `compose.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`] |
-//! | `timings.rs` | step and frame-time measurements |
+//! | `compose.rs`, `timings.rs` | the enlarged view as RGB (Export view), [`PrimitiveFilter`]; step and frame-time measurements |
 //! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
 //! | `cameras.rs` | the camera shown of a recording with several (`Command::OpenCamera`) and each camera's own table |
 //! | `side_by_side.rs` | several cameras side by side, stepped together by time, each with its own table, pipeline and results; the focused one gets the clicks |
 //! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time, SSL-Vision's detections by camera |
-//! | `ssl_feed.rs` | [`SslFeed`]: SSL-Vision's detections opened beside the frames (a league log, paired by capture time, or a live address) |
+//! | `ssl_feed.rs`, `ssl_out.rs` | [`SslFeed`]: SSL-Vision's detections opened beside the frames (a league log, paired by capture time, or a live address); sending the processed overhead frames' detections as SSL-Vision packets (`OverheadCommand::SendSslVision`, [`ssl_out::SslOutStatus`] for the UI) |
 
 pub mod bookmarks;
 mod cameras;
@@ -53,6 +52,7 @@ mod settings;
 mod side_by_side;
 pub mod source;
 mod ssl_feed;
+pub mod ssl_out;
 mod stream_scan;
 mod table;
 mod timings;

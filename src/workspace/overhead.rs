@@ -101,6 +101,8 @@ pub struct Overhead {
     /// The calibration's and the frame's size last warned about (the warning is said once a
     /// pair, not once a frame).
     size_warned: Option<((usize, usize), (usize, usize))>,
+    /// The SSL-Vision output, while sending (`workspace/ssl_out.rs`).
+    pub(super) ssl_out: Option<super::ssl_out::SslOutState>,
 }
 
 impl Default for Overhead {
@@ -137,6 +139,7 @@ impl Default for Overhead {
             field_model: FieldModel::default(),
             cameras: FieldCameras::default(),
             size_warned: None,
+            ssl_out: None,
         }
     }
 }
@@ -405,6 +408,7 @@ impl Workspace {
             self.overhead.cameras.picture(),
             &loaded.extra,
         );
+        self.send_ssl_out(loaded.time_ns);
         let t = self.overhead.pipeline.timings();
         crate::pipeline::StageTimings {
             classify: t.classify,
@@ -488,6 +492,7 @@ impl Workspace {
                     self.status = format!("selected robot {k}");
                 }
             }
+            OverheadCommand::SendSslVision(address) => self.set_ssl_out(address)?,
             OverheadCommand::SetView(v) => {
                 self.settings.overhead = v;
                 self.refresh_view_map(self.image_size());

@@ -426,3 +426,37 @@ fn the_field_view_shows_the_truth_and_the_wheel_scrolls_the_window_not_the_plot(
     assert_eq!(*plot(&h).bounds(), bounds, "the plot did not zoom or move");
     assert!(plot(&h).auto_bounds.x && plot(&h).auto_bounds.y);
 }
+
+/// The calibration window's "Send SSL-Vision" switch sends to the address typed (through the
+/// workspace's command), says what went out, and stops when switched off.
+#[test]
+fn the_calibration_window_switches_ssl_vision_sending_on_and_off() {
+    let receiver = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    receiver
+        .set_read_timeout(Some(std::time::Duration::from_secs(5)))
+        .unwrap();
+    let address = receiver.local_addr().unwrap().to_string();
+    let mut h = harness_with(opened());
+    show_window(&mut h, Window::Calibration);
+    let field = h.get_by_label("SSL-Vision to");
+    field.focus();
+    field.type_text(&address);
+    h.run();
+    assert_eq!(h.state().overhead.ssl_vision, address);
+    click_label(&mut h, "Send SSL-Vision");
+    let status = h.state().state.ssl_out_status().expect("sending");
+    assert_eq!(status.address, address);
+    let mut buf = [0u8; 65_536];
+    let n = receiver.recv(&mut buf).expect("a packet arrives");
+    assert!(eotn::ssl_vision::decode_packet(&buf[..n]).is_ok());
+    h.run();
+    let said = format!("sending to {address}:");
+    assert!(
+        h.query_by_label_contains(&said).is_some(),
+        "{:#?}",
+        h.root()
+    );
+    click_label(&mut h, "Send SSL-Vision");
+    assert!(h.state().state.ssl_out_status().is_none());
+    assert!(h.query_by_label_contains(&said).is_none());
+}

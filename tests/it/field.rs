@@ -50,11 +50,11 @@ fn the_simulated_field_is_a_session_of_cameras_with_their_own_tables_calibration
             panic!("overhead truth expected");
         };
         assert!(t.robots.len() >= 4);
-        let cal = eotn::overhead::Calibration::load(&cam.calibration).unwrap();
+        let cal = eotn::overhead::Calibration::load(cam.calibration.as_deref().unwrap()).unwrap();
         // The solved camera is close to the true one.
         let d = t.camera.pose.position_cm[0] - cal.camera.pose.position_cm[0];
         assert!(d.abs() < 10.0, "camera {k}: {d} cm off in x");
-        assert!(eotn::lut::LookupTable::load(&cam.lut).is_ok());
+        assert!(eotn::lut::LookupTable::load(cam.lut.as_deref().unwrap()).is_ok());
         cameras.push(t.camera);
     }
     assert_ne!(cameras[0], cameras[1]);

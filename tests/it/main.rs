@@ -74,3 +74,4 @@ mod window;
 mod without_readings;
 mod wmd;
 mod wmd_live;
+mod wmd_ssl;

@@ -176,7 +176,7 @@ fn packets_of_overhead_detect_carry_the_json_positions_and_their_log_opens_in_eo
 
 /// The truth of each frame of `stream` as SSL-Vision packets (camera 0, every robot with a
 /// marker, the ball).
-fn truth_packets(stream: &Path) -> Vec<(i64, Vec<u8>)> {
+pub fn truth_packets(stream: &Path) -> Vec<(i64, Vec<u8>)> {
     let mut reader = eotn::streams::StreamReader::open(stream).unwrap();
     (0..reader.len())
         .map(|i| {
@@ -429,4 +429,101 @@ fn the_field_view_marks_each_cameras_detections_of_a_log_opened_alone() {
     }
     assert!(h.query_all_by_label_contains("ssl-vision step").count() > 0);
     assert_eq!(h.state().state.ssl_vision().unwrap().steps(), (6, 0));
+}
+
+/// Every SSL-Vision packet that arrives at `receiver` within `wait` of the last.
+fn received(receiver: &std::net::UdpSocket, wait: std::time::Duration) -> Vec<SslWrapperPacket> {
+    receiver.set_read_timeout(Some(wait)).unwrap();
+    let mut buf = vec![0u8; 65_536];
+    let mut out = Vec::new();
+    while let Ok(n) = receiver.recv(&mut buf) {
+        out.push(eotn::ssl_vision::decode_packet(&buf[..n]).unwrap());
+    }
+    out
+}
+
+/// The app's workspace sends what it shows: with the bundled overhead stream open and an SSL
+/// output to a loopback receiver, each frame shown goes out as a detection frame of camera 0
+/// (after the geometry with the camera's calibration) carrying the ball and robots the
+/// workspace shows, within 1 mm, at the frame's time; stopping stops it; a bad address is
+/// refused and nothing is sent.
+#[test]
+fn the_workspace_sends_the_overhead_detections_it_shows() {
+    use eotn::workspace::{Command, OverheadCommand, PlaybackCommand, Workspace};
+    let receiver = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let address = receiver.local_addr().unwrap().to_string();
+    let mut w = Workspace::default();
+    let stream = repo_file("streams/sim-overhead-game.mcap");
+    w.apply(Command::Open(vec![stream.clone()])).unwrap();
+    let refused = w.apply(OverheadCommand::SendSslVision(Some("nowhere".into())).into());
+    assert!(refused.is_err_and(|e| e.to_string().contains("HOST:PORT")));
+    assert!(w.ssl_out_status().is_none());
+    w.apply(OverheadCommand::SendSslVision(Some(address.clone())).into())
+        .unwrap();
+    let mut reader = eotn::streams::StreamReader::open(&stream).unwrap();
+    let wait = std::time::Duration::from_millis(300);
+    let mut robots_compared = 0;
+    let frames = reader.len();
+    assert!(frames >= 4, "{frames} frames");
+    for k in 0..frames {
+        if k > 0 {
+            w.apply(PlaybackCommand::Seek(k).into()).unwrap();
+        }
+        let packets = received(&receiver, wait);
+        if k == 0 {
+            let g = packets[0].geometry.as_ref().expect("the geometry first");
+            assert_eq!(g.calib.len(), 1, "the calibration in use");
+            assert_eq!(g.calib[0].camera_id, 0);
+        }
+        let frame = packets
+            .iter()
+            .rev()
+            .find_map(|p| p.detection.as_ref())
+            .unwrap_or_else(|| panic!("frame {k}: no detection frame"));
+        let sent = eotn::ssl_vision::CameraFrame::from_message(frame);
+        assert_eq!(sent.camera_id, 0);
+        let time_ns = reader.read(k).unwrap().time_ns;
+        assert!((sent.t_capture_s - time_ns as f64 * 1e-9).abs() < 1e-6);
+        let shown = w
+            .overhead_detections()
+            .expect("a calibration in use")
+            .clone();
+        match (shown.ball, sent.balls.first()) {
+            (None, None) => {}
+            (Some(b), Some(s)) => {
+                assert!((b.field_cm[0] - s.field_cm[0]).abs() <= 0.1);
+                assert!((b.field_cm[1] - s.field_cm[1]).abs() <= 0.1);
+            }
+            other => panic!("frame {k}: ball {other:?}"),
+        }
+        assert_eq!(shown.robots.len(), sent.robots.len(), "frame {k}");
+        for r in &shown.robots {
+            let s = sent
+                .robots
+                .iter()
+                .find(|s| s.team == r.team && s.robot_id == Some(u32::from(r.identity.value())))
+                .unwrap_or_else(|| panic!("frame {k}: robot {r:?} not sent"));
+            assert!((r.field_cm[0] - s.field_cm[0]).abs() <= 0.1);
+            assert!((r.field_cm[1] - s.field_cm[1]).abs() <= 0.1);
+            assert!((r.heading_rad - s.heading_rad.unwrap()).abs() < 1e-4);
+            robots_compared += 1;
+        }
+    }
+    assert!(
+        robots_compared >= 2 * frames,
+        "{robots_compared} robots compared"
+    );
+    let status = w.ssl_out_status().unwrap();
+    assert_eq!(status.address, address);
+    assert!(status.detection_packets >= frames as u64, "{status:?}");
+    assert_eq!(status.failures, 0);
+    assert!(
+        status.fits[0].contains("camera 0: distortion κ"),
+        "{status:?}"
+    );
+    w.apply(OverheadCommand::SendSslVision(None).into())
+        .unwrap();
+    assert!(w.ssl_out_status().is_none());
+    w.apply(PlaybackCommand::Seek(1).into()).unwrap();
+    assert!(received(&receiver, wait).is_empty(), "stopped");
 }

@@ -111,7 +111,7 @@ fn frames() -> Vec<SimFrame> {
 }
 
 /// The marker robot `n` of the truth wears, as `(team, id)`.
-fn marker_of(n: u32) -> (String, u64) {
+pub fn marker_of(n: u32) -> (String, u64) {
     let (_, t, _) = &frames()[0];
     let m = t.robots.iter().find(|r| r.id == n).unwrap().marker.unwrap();
     (m.team.name().to_owned(), u64::from(m.identity.value()))
@@ -177,7 +177,7 @@ fn wmd(robots: &[&Path], extra: &[&str]) -> (Vec<Value>, String) {
 }
 
 /// The world model of `(team, id)` in a line, and whether the overhead camera read that marker.
-fn entry<'a>(line: &'a Value, who: &(String, u64)) -> (Option<&'a Value>, bool) {
+pub fn entry<'a>(line: &'a Value, who: &(String, u64)) -> (Option<&'a Value>, bool) {
     let is = |v: &&Value| v["team"] == who.0.as_str() && v["id"] == who.1;
     let model = line["world_models"].as_array().unwrap().iter().find(is);
     let seen = line["robots"].as_array().unwrap().iter().any(|r| is(&r));
