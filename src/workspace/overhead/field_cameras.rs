@@ -223,9 +223,12 @@ impl OtherCamera {
                 e.source
             );
         };
-        let lut = crate::lut::LookupTable::load(&e.lut)
-            .with_context(|| format!("table {}", e.lut.display()))?;
-        let camera = usable_calibration(&e.calibration)?;
+        let (Some(lut_path), Some(calibration)) = (&e.lut, &e.calibration) else {
+            anyhow::bail!("overhead camera {}: no table or calibration", e.id);
+        };
+        let lut = crate::lut::LookupTable::load(lut_path)
+            .with_context(|| format!("table {}", lut_path.display()))?;
+        let camera = usable_calibration(calibration)?;
         let params = match &e.params {
             Some(p) => crate::session::load_camera_params(p)?,
             None => crate::overhead::OverheadParams {
@@ -371,6 +374,9 @@ impl Workspace {
                 reference.source
             );
         };
+        let (Some(lut), Some(calibration)) = (&reference.lut, &reference.calibration) else {
+            anyhow::bail!("{}: no table or calibration", at(reference));
+        };
         let others = rest
             .iter()
             .map(|e| OtherCamera::open(e, &field).with_context(|| at(e)))
@@ -384,9 +390,8 @@ impl Workspace {
             FieldRef::Shipped(name) => PathBuf::from(name),
         };
         self.apply_overhead(OverheadCommand::OpenField(field_name))?;
-        self.open_table(&reference.lut)
-            .with_context(|| at(reference))?;
-        self.open_calibration(reference.calibration.clone())
+        self.open_table(lut).with_context(|| at(reference))?;
+        self.open_calibration(calibration.clone())
             .with_context(|| at(reference))?;
         if let Some(p) = &reference.params {
             self.warn(format!(
