@@ -80,7 +80,7 @@ pub(super) fn say_unused_intrinsics(session: &Session) {
 fn open_camera(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<FieldCamera> {
     let SessionSource::Recording(path) = &e.source else {
         bail!(
-            "source {:?}: this command reads recorded cameras; live servers and devices are read by the app",
+            "{}: this command reads recorded eotn cameras; live servers and devices are read by `eotn wmd` and the app, SSL-Vision sources by `eotn wmd`, `eotn open` and `eval --truth-ssl`",
             e.source
         );
     };

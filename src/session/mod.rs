@@ -49,6 +49,19 @@ pub enum SslSource {
     Log(PathBuf),
 }
 
+/// The source as the user wrote it, with what it is: "recording streams/x.mcap", "SSL-Vision
+/// udp://224.5.23.2:10006" — for messages that refuse a kind of source.
+impl std::fmt::Display for SessionSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Recording(p) => write!(f, "recording {}", p.display()),
+            Self::Live(url) => write!(f, "live server {url}"),
+            Self::Device(p) => write!(f, "camera device {}", p.display()),
+            Self::Ssl(s) => write!(f, "SSL-Vision {s}"),
+        }
+    }
+}
+
 impl std::fmt::Display for SslSource {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

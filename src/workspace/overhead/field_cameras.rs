@@ -219,7 +219,7 @@ impl OtherCamera {
     fn open(e: &OverheadEntry, field: &FieldDescription) -> anyhow::Result<Self> {
         let SessionSource::Recording(path) = &e.source else {
             anyhow::bail!(
-                "source {:?}: the app opens a session's recorded cameras (`eotn wmd --session` reads live servers and devices)",
+                "{}: the app opens a session's recorded cameras (`eotn wmd --session` reads live servers, devices and SSL-Vision)",
                 e.source
             );
         };
@@ -369,7 +369,7 @@ impl Workspace {
             .with_context(|| format!("{}: no overhead camera", path.display()))?;
         let SessionSource::Recording(recording) = &reference.source else {
             anyhow::bail!(
-                "{}: source {:?}: the app opens a session's recorded cameras (`eotn wmd --session` reads live servers and devices)",
+                "{}: {}: the app opens a session's recorded cameras (`eotn wmd --session` reads live servers, devices and SSL-Vision)",
                 at(reference),
                 reference.source
             );
