@@ -174,11 +174,7 @@ pub fn detections(frames: &[&CameraFrame]) -> (OverheadDetections, usize) {
     let robots = robots
         .iter()
         .filter_map(|r| {
-            let identity = r
-                .robot_id
-                .and_then(|id| u8::try_from(id).ok())
-                .and_then(MarkerIdentity::new);
-            let (Some(identity), Some(heading_rad)) = (identity, r.heading_rad) else {
+            let Some((identity, heading_rad)) = as_marker(r) else {
                 left_out += 1;
                 return None;
             };
@@ -208,6 +204,16 @@ pub fn detections(frames: &[&CameraFrame]) -> (OverheadDetections, usize) {
     (d, left_out)
 }
 
+/// A robot as eotn's marker of its identity and its heading, radians; `None` without an id,
+/// with an id beyond eotn's sixteen markers, or without a heading.
+fn as_marker(r: &SslRobot) -> Option<(MarkerIdentity, f64)> {
+    let identity = r
+        .robot_id
+        .and_then(|id| u8::try_from(id).ok())
+        .and_then(MarkerIdentity::new)?;
+    Some((identity, r.heading_rad?))
+}
+
 /// The truth of one instant from SSL detection frames, as `eotn eval` scores an overhead
 /// frame against it: every robot with an id of 0–15 and a heading wears a fully visible marker
 /// of its team (`plate_height_cm` high), the ball is visible enough to be found. `camera` is
@@ -226,11 +232,7 @@ pub fn overhead_truth(
     let robots = robots
         .iter()
         .filter_map(|r| {
-            let identity = r
-                .robot_id
-                .and_then(|id| u8::try_from(id).ok())
-                .and_then(MarkerIdentity::new);
-            let (Some(identity), Some(heading_rad)) = (identity, r.heading_rad) else {
+            let Some((identity, heading_rad)) = as_marker(r) else {
                 left_out += 1;
                 return None;
             };
