@@ -6,7 +6,9 @@
 //!     cargo run --release --example egui_floor --features gui
 //!
 //! With `EOTN_FLOOR_IMAGE=1` it also draws one 640×480 texture scaled to fill the window, as the
-//! app's enlarged view does; `EOTN_FLOOR_DITHER=0` turns egui's dithering off;
+//! app's enlarged view does (`EOTN_FLOOR_IMAGE=2`: that texture twice, the second blended at half
+//! opacity, as the app's classified layer over the frame); `EOTN_FLOOR_DITHER=0` turns egui's
+//! dithering off; `EOTN_FLOOR_RENDERER=gl` draws with OpenGL (glow) instead of wgpu;
 //! `EOTN_FLOOR_PRESENT=immediate|mailbox|fifo` picks the present mode (default: eframe's).
 
 use std::time::{Duration, Instant};
@@ -19,7 +21,8 @@ struct Floor {
     cpu_ms: Vec<f64>,
     run_for: Duration,
     texture: Option<egui::TextureHandle>,
-    with_image: bool,
+    /// How many times the texture is drawn over the window (0: none).
+    image_layers: u8,
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -41,7 +44,7 @@ impl eframe::App for Floor {
         }
         self.last = Some(now);
         let ctx = ui.ctx().clone();
-        if self.with_image && self.texture.is_none() {
+        if self.image_layers > 0 && self.texture.is_none() {
             let img = egui::ColorImage::new(
                 [640, 480],
                 (0..640 * 480)
@@ -53,12 +56,15 @@ impl eframe::App for Floor {
         egui::CentralPanel::default().show(ui, |ui| {
             if let Some(t) = &self.texture {
                 let rect = ui.max_rect();
-                ui.painter().image(
-                    t.id(),
-                    rect,
-                    egui::Rect::from_min_max(egui::Pos2::ZERO, egui::pos2(1.0, 1.0)),
-                    egui::Color32::WHITE,
-                );
+                let uv = egui::Rect::from_min_max(egui::Pos2::ZERO, egui::pos2(1.0, 1.0));
+                for layer in 0..self.image_layers {
+                    let tint = if layer == 0 {
+                        egui::Color32::WHITE
+                    } else {
+                        egui::Color32::from_white_alpha(128)
+                    };
+                    ui.painter().image(t.id(), rect, uv, tint);
+                }
             }
             ui.label(format!("frame {}", self.intervals_ms.len()));
         });
@@ -70,10 +76,9 @@ impl eframe::App for Floor {
                 self.intervals_ms.len(),
                 median(&mut self.intervals_ms),
                 median(&mut self.cpu_ms),
-                if self.with_image {
-                    " (with a full-window 640×480 texture)"
-                } else {
-                    ""
+                match self.image_layers {
+                    0 => String::new(),
+                    n => format!(" (with a full-window 640×480 texture drawn {n} times)"),
                 }
             );
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
@@ -93,6 +98,9 @@ fn main() -> eframe::Result {
     };
     if std::env::var("EOTN_FLOOR_DITHER").is_ok_and(|v| v == "0") {
         options.dithering = false;
+    }
+    if std::env::var("EOTN_FLOOR_RENDERER").is_ok_and(|v| v == "gl") {
+        options.renderer = eframe::Renderer::Glow;
     }
     match std::env::var("EOTN_FLOOR_PRESENT").as_deref() {
         Ok("immediate") => {
@@ -116,7 +124,11 @@ fn main() -> eframe::Result {
                 cpu_ms: Vec::new(),
                 run_for: Duration::from_secs_f64(secs),
                 texture: None,
-                with_image: std::env::var_os("EOTN_FLOOR_IMAGE").is_some(),
+                image_layers: match std::env::var("EOTN_FLOOR_IMAGE").as_deref() {
+                    Err(_) | Ok("0") => 0,
+                    Ok("2") => 2,
+                    Ok(_) => 1,
+                },
             }))
         }),
     )

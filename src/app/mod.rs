@@ -71,8 +71,9 @@ pub use crate::workspace::{Command, PlaybackCommand, Settings, TableCommand, Vie
 
 use crate::app_options::{RendererSetting, RunOptions};
 pub use textures::{
-    ViewImages, palette, preview_image, preview_image_every, texture_step, view_images,
-    view_images_every, visible_preview_colour,
+    ViewImages, blend_classes, blend_texel, classes_alpha, palette, preview_image,
+    preview_image_every, texture_step, thumbnail_step, view_images, view_images_every,
+    visible_preview_colour,
 };
 
 use crate::workspace::{PixelInfo, median};
@@ -526,6 +527,15 @@ impl EotnApp {
                 t.dropped_frames,
                 t.late_frames,
                 self.renderer.as_ref().map_or("none", |r| r.kind.name()),
+            );
+            let parts: Vec<String> = t
+                .step_part_medians()
+                .iter()
+                .map(|(name, ms)| format!("{name} {ms:.2}"))
+                .collect();
+            eprintln!(
+                "eotn stats: step parts, medians in ms: {}",
+                parts.join(", ")
             );
         }
     }

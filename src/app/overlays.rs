@@ -109,12 +109,58 @@ impl ImageTransform {
 /// The textures of the shown frame.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameTextures {
-    /// The colour image.
-    pub raw: TextureId,
-    /// Class colours, transparent where unclassified.
-    pub classified: TextureId,
+    /// The colour image (`None` while it is not uploaded: nothing draws it).
+    pub raw: Option<TextureId>,
+    /// Class colours, transparent where unclassified (`None` as `raw`).
+    pub classified: Option<TextureId>,
     /// The preview highlight, transparent elsewhere.
     pub preview: TextureId,
+    /// The class colours already blended over the colour image at the overlay's opacity: drawn
+    /// instead of the two layers when there is one.
+    pub blended: Option<TextureId>,
+}
+
+/// The view's image layers: the frame, its class colours over it (blended, or two layers), or
+/// the class colours alone on black.
+fn paint_layers(
+    painter: &Painter,
+    img: Rect,
+    kind: ViewKind,
+    o: crate::workspace::Overlays,
+    tex: &FrameTextures,
+    with_overlays: bool,
+) {
+    let uv = Rect::from_min_max(Pos2::ZERO, pos2(1.0, 1.0));
+    match kind {
+        ViewKind::Raw | ViewKind::Objects => {
+            let with_classes = o.classified && with_overlays;
+            match tex.blended.filter(|_| with_classes) {
+                Some(blended) => {
+                    painter.image(blended, img, uv, Color32::WHITE);
+                }
+                None => {
+                    if let Some(raw) = tex.raw {
+                        painter.image(raw, img, uv, Color32::WHITE);
+                    }
+                    if let Some(classes) = tex.classified.filter(|_| with_classes) {
+                        let a = super::textures::classes_alpha(o.opacity);
+                        painter.image(classes, img, uv, Color32::from_white_alpha(a));
+                    }
+                }
+            }
+        }
+        ViewKind::Classified | ViewKind::Blobs => {
+            painter.rect_filled(img, 0.0, Color32::BLACK);
+            let tint = if kind == ViewKind::Blobs {
+                Color32::from_gray(110)
+            } else {
+                Color32::WHITE
+            };
+            if let Some(classes) = tex.classified {
+                painter.image(classes, img, uv, tint);
+            }
+        }
+    }
 }
 
 /// Paints one view of the shown frame, clipped to the transform's view; returns how many of
@@ -131,23 +177,7 @@ pub fn paint_view(
     let img = xf.image_rect();
     let uv = Rect::from_min_max(Pos2::ZERO, pos2(1.0, 1.0));
     let o = state.settings.overlays;
-    match kind {
-        ViewKind::Raw | ViewKind::Objects => {
-            painter.image(tex.raw, img, uv, Color32::WHITE);
-            if o.classified && with_overlays {
-                let a = (o.opacity.clamp(0.0, 1.0) * 255.0) as u8;
-                painter.image(tex.classified, img, uv, Color32::from_white_alpha(a));
-            }
-        }
-        ViewKind::Classified => {
-            painter.rect_filled(img, 0.0, Color32::BLACK);
-            painter.image(tex.classified, img, uv, Color32::WHITE);
-        }
-        ViewKind::Blobs => {
-            painter.rect_filled(img, 0.0, Color32::BLACK);
-            painter.image(tex.classified, img, uv, Color32::from_gray(110));
-        }
-    }
+    paint_layers(&painter, img, kind, o, tex, with_overlays);
     if with_overlays && o.preview && state.selection().is_some() {
         painter.image(tex.preview, img, uv, Color32::WHITE);
     }

@@ -12,6 +12,7 @@ impl EotnApp {
     pub(super) fn panels_ui(&mut self, ui: &mut egui::Ui, commands: &mut Vec<Command>) -> bool {
         let mut quit = false;
         let tex = self.textures.as_ref().map(Textures::ids);
+        let thumb_tex = self.textures.as_ref().map(Textures::thumb_ids);
         egui::Panel::top("menu").show(ui, |ui| {
             let out = menus::menu_bar_ui(ui, &self.state, &mut self.menu_input, commands);
             quit |= out.quit;
@@ -26,7 +27,7 @@ impl EotnApp {
             .default_size(120.0)
             .size_range(60.0..=300.0)
             .show(ui, |ui| {
-                views::thumbnails_ui(ui, &self.state, tex.as_ref(), commands)
+                views::thumbnails_ui(ui, &self.state, thumb_tex.as_ref(), commands)
             });
         egui::Panel::left("classify")
             .resizable(true)

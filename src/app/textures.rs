@@ -1,22 +1,33 @@
 //! The shown frame's textures: the colour and class-colour images built on the CPU, the
 //! pending selection's highlight, and their upload when the frame or the preview changes.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
 use super::EotnApp;
 use super::overlays::{FrameTextures, ImageTransform};
-use crate::workspace::{PreviewPixel, Workspace, hatch_rgb};
+use crate::workspace::{PreviewPixel, ViewKind, Workspace, hatch_rgb};
 
 /// How much the pixels outside a pending selection are darkened (alpha of black over them).
 const PREVIEW_DIM_ALPHA: u8 = 110;
 
-/// The textures of the shown frame and what they were built from.
+/// The textures of the shown frame and what they were built from. Each layer is uploaded only
+/// while something draws it: without a GPU every upload of a 1920×1200 frame's layer is a copy
+/// the software rasteriser makes on the UI thread (docs/speed.md).
 pub(super) struct Textures {
-    raw: TextureHandle,
-    classified: TextureHandle,
+    /// The main view's layers at `step`.
+    raw: Layer,
+    classified: Layer,
+    /// The classified layer blended over the frame, while the main view shows that.
+    blended: Layer,
     preview: TextureHandle,
+    /// The images behind `raw` and `classified` at `step` (shared with the upload, not copied),
+    /// kept to blend again when the opacity changes and to upload a layer when it is wanted.
+    images: (Arc<ColorImage>, Arc<ColorImage>),
+    /// The thumbnails' own smaller layers, when they show the frame coarser than the main view.
+    thumbs: Option<(Layer, Layer)>,
     frame_generation: u64,
     preview_generation: u64,
     /// The preview texture holds no highlight (nothing to re-upload while none is pending).
@@ -25,14 +36,172 @@ pub(super) struct Textures {
     step: usize,
 }
 
+/// One uploaded layer and what it holds: the frame generation, the step and (blended) the
+/// opacity it was made for.
+#[derive(Default)]
+struct Layer {
+    texture: Option<TextureHandle>,
+    holds: Option<(u64, usize, u8)>,
+}
+
+impl Layer {
+    /// The texture, when it holds `key`.
+    fn id_if(&self, key: (u64, usize, u8)) -> Option<egui::TextureId> {
+        self.texture
+            .as_ref()
+            .filter(|_| self.holds == Some(key))
+            .map(TextureHandle::id)
+    }
+
+    /// Uploads `image` (made for `key`) unless the layer already holds `key`.
+    fn upload(
+        &mut self,
+        ctx: &egui::Context,
+        name: &str,
+        key: (u64, usize, u8),
+        image: impl FnOnce() -> egui::ImageData,
+    ) {
+        if self.holds == Some(key) && self.texture.is_some() {
+            return;
+        }
+        match &mut self.texture {
+            Some(t) => t.set(image(), TextureOptions::NEAREST),
+            None => self.texture = Some(ctx.load_texture(name, image(), TextureOptions::NEAREST)),
+        }
+        self.holds = Some(key);
+    }
+}
+
+/// Which layers the views draw this frame.
+#[derive(Debug, Clone, Copy)]
+struct Wanted {
+    /// The opacity the main view blends the classes over the frame at, when it does.
+    blend: Option<u8>,
+    /// The main view draws the frame's colours alone, or its class colours alone.
+    raw: bool,
+    classified: bool,
+    /// Image pixels per texel of the thumbnails' own layers (none when it is the main step).
+    thumb_step: Option<usize>,
+}
+
 impl Textures {
+    fn key(&self, alpha: u8) -> (u64, usize, u8) {
+        (self.frame_generation, self.step, alpha)
+    }
+
+    /// The main view's textures: those holding the shown frame at the current step.
     pub(super) fn ids(&self) -> FrameTextures {
+        // The blended layer at any opacity: after the opacity changes it is blended again at
+        // the next frame's start, and one frame at the old opacity is not worth two layers.
+        let blended = (self.blended.holds)
+            .filter(|h| (h.0, h.1) == (self.frame_generation, self.step))
+            .and_then(|h| self.blended.id_if(h));
         FrameTextures {
-            raw: self.raw.id(),
-            classified: self.classified.id(),
+            raw: self.raw.id_if(self.key(0)),
+            classified: self.classified.id_if(self.key(0)),
             preview: self.preview.id(),
+            blended,
         }
     }
+
+    /// The thumbnails' textures: their own smaller layers, else the main view's.
+    pub(super) fn thumb_ids(&self) -> FrameTextures {
+        match &self.thumbs {
+            Some((raw, classified)) => {
+                let holding = |l: &Layer| l.holds.filter(|h| h.0 == self.frame_generation);
+                FrameTextures {
+                    raw: holding(raw).and_then(|h| raw.id_if(h)),
+                    classified: holding(classified).and_then(|h| classified.id_if(h)),
+                    preview: self.preview.id(),
+                    blended: None,
+                }
+            }
+            None => FrameTextures {
+                blended: None,
+                ..self.ids()
+            },
+        }
+    }
+
+    /// Uploads the thumbnails' own layers (`images` at a step of their own), or drops them when
+    /// the thumbnails share the main view's.
+    fn upload_thumbs(&mut self, ctx: &egui::Context, images: Option<(usize, ViewImages)>) {
+        let Some((step, ViewImages { raw, classified })) = images else {
+            self.thumbs = None;
+            return;
+        };
+        let key = (self.frame_generation, step, 0);
+        let (r, c) = self.thumbs.get_or_insert_with(Default::default);
+        r.upload(ctx, "thumbnail raw", key, || raw.into());
+        c.upload(ctx, "thumbnail classified", key, || classified.into());
+    }
+
+    /// Uploads the main view's wanted layers from `images` (blending at the wanted opacity),
+    /// and the layers the thumbnails share with it.
+    fn upload_wanted(&mut self, ctx: &egui::Context, wanted: Wanted) {
+        let shared = wanted.thumb_step.is_none();
+        let key = self.key(0);
+        if wanted.raw || shared {
+            let image = Arc::clone(&self.images.0);
+            self.raw.upload(ctx, "raw", key, || image.into());
+        }
+        if wanted.classified || shared {
+            let image = Arc::clone(&self.images.1);
+            self.classified
+                .upload(ctx, "classified", key, || image.into());
+        }
+        if let Some(alpha) = wanted.blend {
+            let (raw, classified) = (&self.images.0, &self.images.1);
+            let key = self.key(alpha);
+            self.blended.upload(ctx, "blended", key, || {
+                blend_classes(raw, classified, alpha).into()
+            });
+        }
+    }
+}
+
+/// The opacity (0–255) the classified layer is drawn at over the frame: the overlay's setting.
+#[must_use]
+pub fn classes_alpha(opacity: f32) -> u8 {
+    (opacity.clamp(0.0, 1.0) * 255.0) as u8
+}
+
+/// `classified` drawn over `raw` at `alpha` (0–255) where it has a class colour, as the
+/// renderer blends the layer ([`blend_texel`]); the two images must be of one size (else `raw`
+/// is returned as it is).
+#[must_use]
+pub fn blend_classes(raw: &ColorImage, classified: &ColorImage, alpha: u8) -> ColorImage {
+    if raw.size != classified.size {
+        return raw.clone();
+    }
+    let pixels = raw
+        .pixels
+        .iter()
+        .zip(&classified.pixels)
+        .map(|(&r, &c)| blend_texel(r, c, alpha))
+        .collect();
+    ColorImage::new(raw.size, pixels)
+}
+
+/// The class colour `class` over the frame's colour `raw` at `alpha` (0–255), as the renderer
+/// blends a layer drawn at that opacity (`c·a + r·(1 − a)` in the images' own sRGB values,
+/// rounded to nearest); `raw` where the class colour is transparent (unclassified).
+#[must_use]
+#[inline]
+pub fn blend_texel(raw: Color32, class: Color32, alpha: u8) -> Color32 {
+    // Without branches or division, so a whole image's loop vectorises in 16-bit lanes: an
+    // unclassified texel blends at opacity 0, which gives `raw` exactly, and
+    // `(t + 128 + ((t + 128) >> 8)) >> 8` is t/255 rounded for every t up to 255·255.
+    let a = if class.a() == 0 { 0 } else { u16::from(alpha) };
+    let mix = |c: u8, r: u8| {
+        let t = u16::from(c) * a + u16::from(r) * (255 - a) + 128;
+        ((t + (t >> 8)) >> 8) as u8
+    };
+    Color32::from_rgb(
+        mix(class.r(), raw.r()),
+        mix(class.g(), raw.g()),
+        mix(class.b(), raw.b()),
+    )
 }
 
 /// Display colours of every class code, transparent for unclassified.
@@ -87,39 +256,40 @@ pub fn view_images_every(
     let step = step.max(1);
     let (w, h) = (frame.width(), frame.height());
     let size = [w.div_ceil(step), h.div_ceil(step)];
-    let codes = state.view_codes();
-    let classified = ColorImage::new(
-        size,
-        sampled(size, step, |x, y| {
-            palette[usize::from(codes.get(y * w + x).copied().unwrap_or(0))]
-        }),
-    );
-    // The undistorted view of an overhead frame, when chosen, else the frame as it is.
-    let raw = if step == 1 {
-        ColorImage::from_rgb(size, &state.view_rgb())
-    } else if state.undistorted_view() {
+    let n = size[0] * size[1];
+    // The colours straight from the frame's YUV (only the pixels kept are converted), or from
+    // the undistorted view's RGB when that is shown.
+    let raw: Vec<Color32> = if state.undistorted_view() {
         let rgb = state.view_rgb();
-        ColorImage::new(
-            size,
-            sampled(size, step, |x, y| {
-                let i = (y * w + x) * 3;
-                rgb.get(i..i + 3)
-                    .map_or(Color32::BLACK, |p| Color32::from_rgb(p[0], p[1], p[2]))
-            }),
-        )
+        let mut raw = Vec::with_capacity(n);
+        for y in (0..h).step_by(step) {
+            raw.extend((0..w).step_by(step).map(|x| {
+                let p = rgb.get((y * w + x) * 3..(y * w + x) * 3 + 3);
+                p.map_or(Color32::BLACK, |p| Color32::from_rgb(p[0], p[1], p[2]))
+            }));
+        }
+        raw
     } else {
-        // Straight from the frame's YUV: only the pixels kept are converted.
-        ColorImage::new(
-            size,
-            sampled(size, step, |x, y| {
-                frame.pixel(x, y).map_or(Color32::BLACK, |p| {
-                    let [r, g, b] = crate::frame::yuv_to_rgb(p);
-                    Color32::from_rgb(r, g, b)
-                })
-            }),
-        )
+        frame
+            .rgba_every(step)
+            .into_iter()
+            .map(|[r, g, b, a]| Color32::from_rgba_premultiplied(r, g, b, a))
+            .collect()
     };
-    Some(ViewImages { raw, classified })
+    let codes = state.view_codes();
+    let mut classified = Vec::with_capacity(n);
+    for y in (0..h).step_by(step) {
+        match codes.get(y * w..(y + 1) * w) {
+            Some(row) => {
+                classified.extend(row.iter().step_by(step).map(|&c| palette[usize::from(c)]))
+            }
+            None => classified.resize(classified.len() + size[0], Color32::TRANSPARENT),
+        }
+    }
+    Some(ViewImages {
+        raw: ColorImage::new(size, raw),
+        classified: ColorImage::new(size, classified),
+    })
 }
 
 /// The texels of an image of `size` texels, each the value at image pixel (x·step, y·step).
@@ -184,15 +354,23 @@ pub fn visible_preview_colour(class_colour: Color32) -> Color32 {
     Color32::from_rgb(r, g, b)
 }
 
+/// Image pixels per texel of the thumbnails' layers: at least 320 texels across, plenty for a
+/// thumbnail of a few hundred screen pixels drawn with nearest filtering.
+#[must_use]
+pub fn thumbnail_step(width: usize) -> usize {
+    (width / 320).max(1)
+}
+
 impl EotnApp {
     pub(super) fn update_textures(&mut self, ctx: &egui::Context) {
         let Some(frame) = self.state.frame() else {
             return;
         };
         let size = [frame.width(), frame.height()];
-        let opts = TextureOptions::NEAREST;
-        let fg = self.state.frame_generation();
-        let pg = self.state.preview_generation();
+        let (fg, pg) = (
+            self.state.frame_generation(),
+            self.state.preview_generation(),
+        );
         // How much of the image the main view shows: its last zoom, else the zoom that fits
         // the image into the window.
         let zoom = self.last_view.map_or_else(
@@ -203,59 +381,96 @@ impl EotnApp {
             |v| v.zoom,
         ) * ctx.pixels_per_point();
         let step = texture_step(zoom);
-        if self.textures.as_ref().is_some_and(|t| {
-            t.frame_generation == fg && t.preview_generation == pg && t.step == step
-        }) {
-            return;
-        }
+        let wanted = self.wanted_layers(step, size[0]);
         let t0 = Instant::now();
         let frame_changed = self
             .textures
             .as_ref()
             .is_none_or(|t| t.frame_generation != fg || t.step != step);
-        let empty = self.state.selection().is_none();
-        if frame_changed
-            && let Some(ViewImages { raw, classified }) =
-                view_images_every(&self.state, &self.palette, step)
-        {
-            match &mut self.textures {
-                Some(t) => {
-                    t.raw.set(raw, opts);
-                    t.classified.set(classified, opts);
-                    if t.step != step {
-                        // The preview's texels must match the others'.
-                        t.preview_generation = pg.wrapping_sub(1);
-                        t.preview_empty = false;
-                    }
-                    t.step = step;
-                }
-                None => {
-                    let preview = preview_image_every(&self.state, size, step);
-                    self.textures = Some(Textures {
-                        raw: ctx.load_texture("raw", raw, opts),
-                        classified: ctx.load_texture("classified", classified, opts),
-                        preview: ctx.load_texture("preview", preview, opts),
-                        frame_generation: fg,
-                        preview_generation: pg,
-                        preview_empty: empty,
-                        step,
-                    });
-                }
-            }
+        if frame_changed {
+            self.make_images(ctx, step, wanted.thumb_step);
         }
+        let empty = self.state.selection().is_none();
         if let Some(t) = &mut self.textures {
             // With nothing selected the preview is not drawn: an empty one is uploaded once,
             // not on every step of playback.
             if t.preview_generation != pg && !(empty && t.preview_empty) {
-                t.preview
-                    .set(preview_image_every(&self.state, size, t.step), opts);
+                let preview = preview_image_every(&self.state, size, t.step);
+                t.preview.set(preview, TextureOptions::NEAREST);
                 t.preview_empty = empty;
             }
-            t.frame_generation = fg;
             t.preview_generation = pg;
+            t.upload_wanted(ctx, wanted);
         }
         if frame_changed {
             self.state.record_upload(t0.elapsed());
+        }
+    }
+
+    /// The layers the views draw: the main view's by its kind and overlays, the thumbnails' at
+    /// [`thumbnail_step`] of their own when that is coarser than the main view's `step`.
+    fn wanted_layers(&self, step: usize, width: usize) -> Wanted {
+        let o = self.state.settings.overlays;
+        let frame_view = matches!(
+            self.state.settings.main_view,
+            ViewKind::Raw | ViewKind::Objects
+        );
+        let blend = (frame_view && o.classified).then(|| classes_alpha(o.opacity));
+        let thumb_step = thumbnail_step(width);
+        Wanted {
+            blend,
+            raw: frame_view && blend.is_none(),
+            classified: !frame_view,
+            thumb_step: (thumb_step > step).then_some(thumb_step),
+        }
+    }
+
+    /// Makes the shown frame's colour and class-colour images at `step` (uploaded later, as
+    /// wanted), and the thumbnails' own layers at `thumb_step`.
+    fn make_images(&mut self, ctx: &egui::Context, step: usize, thumb_step: Option<usize>) {
+        let Some(ViewImages { raw, classified }) =
+            view_images_every(&self.state, &self.palette, step)
+        else {
+            return;
+        };
+        let fg = self.state.frame_generation();
+        let images = (Arc::new(raw), Arc::new(classified));
+        let thumbs = thumb_step
+            .and_then(|ts| Some((ts, view_images_every(&self.state, &self.palette, ts)?)));
+        match &mut self.textures {
+            Some(t) => {
+                if t.step != step {
+                    // The preview's texels must match the others'.
+                    t.preview_generation = self.state.preview_generation().wrapping_sub(1);
+                    t.preview_empty = false;
+                }
+                t.step = step;
+                t.images = images;
+                t.frame_generation = fg;
+                t.upload_thumbs(ctx, thumbs);
+            }
+            None => {
+                let frame_size = self
+                    .state
+                    .frame()
+                    .map_or([0, 0], |f| [f.width(), f.height()]);
+                let preview = preview_image_every(&self.state, frame_size, step);
+                self.textures = Some(Textures {
+                    raw: Layer::default(),
+                    classified: Layer::default(),
+                    blended: Layer::default(),
+                    preview: ctx.load_texture("preview", preview, TextureOptions::NEAREST),
+                    images,
+                    thumbs: None,
+                    frame_generation: fg,
+                    preview_generation: self.state.preview_generation(),
+                    preview_empty: self.state.selection().is_none(),
+                    step,
+                });
+                if let Some(t) = &mut self.textures {
+                    t.upload_thumbs(ctx, thumbs);
+                }
+            }
         }
     }
 }

@@ -94,7 +94,7 @@ impl Workspace {
         let o = self.settings.overlays;
         let mut out = match kind {
             ViewKind::Raw | ViewKind::Objects => {
-                let mut rgb = self.rgb.clone();
+                let mut rgb = self.rgb().to_vec();
                 if o.classified {
                     let a = o.opacity;
                     for (px, &c) in rgb.chunks_exact_mut(3).zip(codes) {

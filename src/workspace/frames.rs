@@ -343,7 +343,7 @@ impl Workspace {
         let t1 = Instant::now();
         let t = self.run_pipeline(&loaded);
         let t2 = Instant::now();
-        loaded.frame.to_rgb_into(&mut self.rgb);
+        self.rgb.reset();
         for w in resized.iter().chain(&loaded.warnings) {
             if !self.warnings.contains(w) {
                 self.warn(w.clone());

@@ -293,7 +293,7 @@ impl Workspace {
 
     fn show_live_frame(&mut self, frame: SourceFrame) {
         let t = self.run_pipeline(&frame);
-        frame.frame.to_rgb_into(&mut self.rgb);
+        self.rgb.reset();
         for w in &frame.warnings {
             if !self.warnings.contains(w) {
                 self.warn(w.clone());

@@ -49,6 +49,7 @@ mod playback;
 pub mod player;
 mod robots;
 mod settings;
+mod shown_rgb;
 mod side_by_side;
 pub mod source;
 mod ssl_feed;
@@ -173,7 +174,7 @@ pub struct Workspace {
     open_topic: Option<String>,
     index: usize,
     current: Option<SourceFrame>,
-    rgb: Vec<u8>,
+    rgb: shown_rgb::ShownRgb,
     selection: Option<PendingSelection>,
     preview_mask: Vec<bool>,
     warnings: Vec<String>,
@@ -257,7 +258,7 @@ impl Workspace {
             open_topic: None,
             index: 0,
             current: None,
-            rgb: Vec::new(),
+            rgb: shown_rgb::ShownRgb::default(),
             selection: None,
             preview_mask: Vec::new(),
             warnings: Vec::new(),
@@ -467,12 +468,6 @@ impl Workspace {
     #[must_use]
     pub fn frame(&self) -> Option<&Frame> {
         self.current.as_ref().map(|c| c.frame.as_ref())
-    }
-
-    /// The shown frame as packed RGB.
-    #[must_use]
-    pub fn rgb(&self) -> &[u8] {
-        &self.rgb
     }
 
     /// The classified shown frame.

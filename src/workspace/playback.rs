@@ -127,5 +127,9 @@ impl Workspace {
         self.timings.last_step.upload = d;
         let total = self.timings.last_step.total().as_secs_f64() * 1e3;
         push_capped(&mut self.timings.steps_ms, total);
+        if self.timings.step_parts.len() >= self.timings.steps_ms.len() {
+            self.timings.step_parts.remove(0);
+        }
+        self.timings.step_parts.push(self.timings.last_step);
     }
 }

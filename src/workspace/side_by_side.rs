@@ -112,7 +112,7 @@ impl Workspace {
                     topic,
                     focused: true,
                     frame: self.frame(),
-                    rgb: &self.rgb,
+                    rgb: self.rgb(),
                     codes: self.pipeline.result().classified.codes(),
                     primitives: &self.primitives,
                     lut: self.pipeline.lut(),

@@ -38,6 +38,8 @@ pub struct Timings {
     pub last_step: StepTiming,
     /// Recent step totals, milliseconds.
     pub steps_ms: Vec<f64>,
+    /// The parts of the recent steps (as many as `steps_ms`), for where a step's time goes.
+    pub step_parts: Vec<StepTiming>,
     /// Recent UI frame intervals, milliseconds.
     pub frames_ms: Vec<f64>,
     /// Recent UI frame intervals while playing, milliseconds.
@@ -60,6 +62,30 @@ pub struct Timings {
     /// Frames playback showed late instead of skipping them (a later frame was already due,
     /// but the player was less than [`super::player::MAX_LAG`] behind).
     pub late_frames: u64,
+}
+
+impl Timings {
+    /// The median of each part of the recent steps, milliseconds, named as the exit report
+    /// names them: read, classify, blobs, recognition, prepare, upload.
+    #[must_use]
+    pub fn step_part_medians(&self) -> [(&'static str, f64); 6] {
+        let ms = |f: fn(&StepTiming) -> Duration| {
+            let v: Vec<f64> = self
+                .step_parts
+                .iter()
+                .map(|s| f(s).as_secs_f64() * 1e3)
+                .collect();
+            median(&v)
+        };
+        [
+            ("read", ms(|s| s.read)),
+            ("classify", ms(|s| s.classify)),
+            ("blobs", ms(|s| s.blobs)),
+            ("recognition", ms(|s| s.recognition)),
+            ("prepare", ms(|s| s.prepare)),
+            ("upload", ms(|s| s.upload)),
+        ]
+    }
 }
 
 pub(crate) fn push_capped(v: &mut Vec<f64>, x: f64) {

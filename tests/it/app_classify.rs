@@ -119,6 +119,50 @@ fn pixels_already_in_the_class_are_neither_counted_nor_hatched() {
     assert!(img.pixels[50 * 208 + 65].a() < 255);
 }
 
+/// The main view draws the class colours blended over the frame on the CPU (one textured layer
+/// for a software rasteriser to fill, not two: issue 33 item 9): each texel is what blending the
+/// class layer over the frame at the overlay's opacity gives, `c·a + r·(1 − a)` rounded to
+/// nearest, and the frame itself where no class colour is.
+#[test]
+fn class_colours_blend_over_the_frame_as_the_renderer_would() {
+    use egui::{Color32, ColorImage};
+    use eotn::app::{blend_classes, blend_texel, classes_alpha};
+    assert_eq!(classes_alpha(0.5), 127);
+    assert_eq!(classes_alpha(2.0), 255);
+    assert_eq!(classes_alpha(f32::NAN), 0);
+    for alpha in [0_u8, 1, 64, 127, 128, 200, 254, 255] {
+        let a = u32::from(alpha);
+        for c in 0..=255_u8 {
+            for r in 0..=255_u8 {
+                let exact = (u32::from(c) * a + u32::from(r) * (255 - a) + 127) / 255;
+                let got = blend_texel(Color32::from_gray(r), Color32::from_gray(c), alpha);
+                assert_eq!(u32::from(got.r()), exact, "c {c} r {r} alpha {alpha}");
+                assert_eq!((got.g(), got.b(), got.a()), (got.r(), got.r(), 255));
+            }
+        }
+    }
+    let raw = Color32::from_rgb(10, 200, 30);
+    assert_eq!(blend_texel(raw, Color32::TRANSPARENT, 255), raw);
+    let frame = ColorImage::new([2, 1], vec![raw, raw]);
+    let classes = ColorImage::new([2, 1], vec![Color32::TRANSPARENT, Color32::WHITE]);
+    let blended = blend_classes(&frame, &classes, 255);
+    assert_eq!(blended.pixels, vec![raw, Color32::WHITE]);
+    // Images of different sizes are not blended.
+    let other = ColorImage::new([1, 1], vec![Color32::WHITE]);
+    assert_eq!(blend_classes(&frame, &other, 255).pixels, frame.pixels);
+}
+
+/// Thumbnails keep at least 320 texels across, their own layers when that is coarser than
+/// the main view's.
+#[test]
+fn thumbnails_keep_at_least_320_texels_across() {
+    use eotn::app::thumbnail_step;
+    assert_eq!(thumbnail_step(208), 1);
+    assert_eq!(thumbnail_step(640), 2);
+    assert_eq!(thumbnail_step(1920), 6);
+    assert_eq!(thumbnail_step(0), 1);
+}
+
 /// A view smaller than the image keeps one pixel in `step` each way (what nearest filtering
 /// shows at that scale): each texel is the image's pixel at (x·step, y·step), raw, classified
 /// and preview alike (issue 33 item 9: a 1920×1200 frame fitted into the window was converted
