@@ -174,13 +174,29 @@ pub fn blend_classes(raw: &ColorImage, classified: &ColorImage, alpha: u8) -> Co
     if raw.size != classified.size {
         return raw.clone();
     }
-    let pixels = raw
-        .pixels
-        .iter()
-        .zip(&classified.pixels)
-        .map(|(&r, &c)| blend_texel(r, c, alpha))
-        .collect();
-    ColorImage::new(raw.size, pixels)
+    let blend = |raw: &[Color32], classes: &[Color32]| -> Vec<Color32> {
+        raw.iter()
+            .zip(classes)
+            .map(|(&r, &c)| blend_texel(r, c, alpha))
+            .collect()
+    };
+    let n = raw.pixels.len();
+    if n < PARALLEL_TEXELS {
+        return ColorImage::new(raw.size, blend(&raw.pixels, &classified.pixels));
+    }
+    // Two halves on two threads (see `PARALLEL_TEXELS`).
+    let (top, bottom) = (
+        raw.pixels.split_at(n / 2),
+        classified.pixels.split_at(n / 2),
+    );
+    let mut pixels = std::thread::scope(|s| {
+        let first = s.spawn(|| blend(top.0, bottom.0));
+        let second = blend(top.1, bottom.1);
+        (first.join(), second)
+    });
+    let mut all = pixels.0.unwrap_or_else(|_| top.0.to_vec());
+    all.append(&mut pixels.1);
+    ColorImage::new(raw.size, all)
 }
 
 /// The class colour `class` over the frame's colour `raw` at `alpha` (0–255), as the renderer
@@ -256,40 +272,78 @@ pub fn view_images_every(
     let step = step.max(1);
     let (w, h) = (frame.width(), frame.height());
     let size = [w.div_ceil(step), h.div_ceil(step)];
-    let n = size[0] * size[1];
-    // The colours straight from the frame's YUV (only the pixels kept are converted), or from
-    // the undistorted view's RGB when that is shown.
-    let raw: Vec<Color32> = if state.undistorted_view() {
-        let rgb = state.view_rgb();
-        let mut raw = Vec::with_capacity(n);
-        for y in (0..h).step_by(step) {
-            raw.extend((0..w).step_by(step).map(|x| {
-                let p = rgb.get((y * w + x) * 3..(y * w + x) * 3 + 3);
-                p.map_or(Color32::BLACK, |p| Color32::from_rgb(p[0], p[1], p[2]))
-            }));
-        }
-        raw
-    } else {
-        frame
-            .rgba_every(step)
-            .into_iter()
-            .map(|[r, g, b, a]| Color32::from_rgba_premultiplied(r, g, b, a))
-            .collect()
-    };
+    let undistorted = state.undistorted_view().then(|| state.view_rgb());
     let codes = state.view_codes();
-    let mut classified = Vec::with_capacity(n);
-    for y in (0..h).step_by(step) {
-        match codes.get(y * w..(y + 1) * w) {
-            Some(row) => {
-                classified.extend(row.iter().step_by(step).map(|&c| palette[usize::from(c)]))
-            }
-            None => classified.resize(classified.len() + size[0], Color32::TRANSPARENT),
-        }
-    }
+    let classes = || class_texels(&codes, palette, [w, h], step);
+    // Large images on two threads, a pass over the frame each: at full resolution (the view
+    // zoomed in past 1:1) one after the other took most of a 50 ms frame.
+    let (raw, classified) = if size[0] * size[1] >= PARALLEL_TEXELS {
+        std::thread::scope(|s| {
+            let raw = s.spawn(|| colour_texels(frame, undistorted.as_deref(), step));
+            let classified = classes();
+            (raw.join(), classified)
+        })
+    } else {
+        (
+            Ok(colour_texels(frame, undistorted.as_deref(), step)),
+            classes(),
+        )
+    };
+    // The thread only converts pixels; were it to panic, the view shows black, not a crash.
+    let raw = raw.unwrap_or_else(|_| vec![Color32::BLACK; size[0] * size[1]]);
     Some(ViewImages {
         raw: ColorImage::new(size, raw),
         classified: ColorImage::new(size, classified),
     })
+}
+
+/// From this many texels on, the view's images are made on two threads.
+const PARALLEL_TEXELS: usize = 1 << 18;
+
+/// The frame's colours at `step`: straight from its YUV (only the pixels kept are converted),
+/// or from the undistorted view's RGB (`undistorted`) when that is shown.
+fn colour_texels(
+    frame: &crate::frame::Frame,
+    undistorted: Option<&[u8]>,
+    step: usize,
+) -> Vec<Color32> {
+    let (w, h) = (frame.width(), frame.height());
+    let Some(rgb) = undistorted else {
+        return frame
+            .rgba_every(step)
+            .into_iter()
+            .map(|[r, g, b, a]| Color32::from_rgba_premultiplied(r, g, b, a))
+            .collect();
+    };
+    let mut raw = Vec::with_capacity(w.div_ceil(step) * h.div_ceil(step));
+    for y in (0..h).step_by(step) {
+        raw.extend((0..w).step_by(step).map(|x| {
+            let p = rgb.get((y * w + x) * 3..(y * w + x) * 3 + 3);
+            p.map_or(Color32::BLACK, |p| Color32::from_rgb(p[0], p[1], p[2]))
+        }));
+    }
+    raw
+}
+
+/// The class colours of `codes` (one a pixel of an image of `size`) at `step`.
+fn class_texels(
+    codes: &[u8],
+    palette: &[Color32; 256],
+    size: [usize; 2],
+    step: usize,
+) -> Vec<Color32> {
+    let [w, h] = size;
+    let tw = w.div_ceil(step);
+    let mut classified = Vec::with_capacity(tw * h.div_ceil(step));
+    for y in (0..h).step_by(step) {
+        match codes.get(y * w..(y + 1) * w) {
+            Some(row) => {
+                classified.extend(row.iter().step_by(step).map(|&c| palette[usize::from(c)]));
+            }
+            None => classified.resize(classified.len() + tw, Color32::TRANSPARENT),
+        }
+    }
+    classified
 }
 
 /// The texels of an image of `size` texels, each the value at image pixel (x·step, y·step).

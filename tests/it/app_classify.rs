@@ -152,6 +152,52 @@ fn class_colours_blend_over_the_frame_as_the_renderer_would() {
     assert_eq!(blend_classes(&frame, &other, 255).pixels, frame.pixels);
 }
 
+/// A frame large enough for the view's images to be made on two threads (640×480 at full
+/// resolution) gives the same texels as a pixel at a time: each the frame's pixel in colour,
+/// its class colour, and their blend over each other.
+#[test]
+fn large_views_made_on_two_threads_hold_every_pixel_in_its_place() {
+    use eotn::app::{blend_classes, blend_texel, classes_alpha, palette, view_images_every};
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("big.png");
+    image::RgbImage::from_fn(640, 480, |x, y| {
+        image::Rgb([
+            (x % 256) as u8,
+            (y % 256) as u8,
+            ((x * 7 + y * 3) % 256) as u8,
+        ])
+    })
+    .save(&png)
+    .unwrap();
+    let (_, table) = one_frame(dir.path());
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![png, table])).unwrap();
+    let p = palette();
+    let images = view_images_every(&w, &p, 1).unwrap();
+    let frame = w.frame().unwrap();
+    let codes = w.classified().codes();
+    assert_eq!(images.raw.size, [640, 480]);
+    assert!(codes.iter().any(|&c| c != 0), "some pixels are classified");
+    let alpha = classes_alpha(0.5);
+    let blended = blend_classes(&images.raw, &images.classified, alpha);
+    for (i, (&raw, &class)) in images
+        .raw
+        .pixels
+        .iter()
+        .zip(&images.classified.pixels)
+        .enumerate()
+    {
+        let [r, g, b] = eotn::frame::yuv_to_rgb(frame.pixel(i % 640, i / 640).unwrap());
+        assert_eq!(raw, egui::Color32::from_rgb(r, g, b), "texel {i}");
+        assert_eq!(class, p[usize::from(codes[i])], "texel {i}");
+        assert_eq!(
+            blended.pixels[i],
+            blend_texel(raw, class, alpha),
+            "texel {i}"
+        );
+    }
+}
+
 /// Thumbnails keep at least 320 texels across, their own layers when that is coarser than
 /// the main view's.
 #[test]
