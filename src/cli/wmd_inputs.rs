@@ -298,7 +298,7 @@ fn open_live_session(path: &Path, record: bool) -> anyhow::Result<LiveOpened> {
             only: Some(key),
             frames: record.then(|| r.camera.clone()),
         };
-        let topic = format!("/robot/{}-{}", key.team.name(), key.identity.value());
+        let topic = key.camera_topic();
         let name = format!("{key} ({})", source_name(&r.source));
         let feed = robot_feed(&r.source, wants, &key.to_string())?;
         robots.push((feed, topic, Some(r.clone()), name));
@@ -332,7 +332,7 @@ fn open_live_args(a: &super::wmd::Args, record: bool) -> anyhow::Result<LiveOpen
         };
         let source = SessionSource::parse_arg(p);
         let feed = robot_feed(&source, wants, &p.display().to_string())?;
-        let topic = format!("/robot/{}", i + 1);
+        let topic = format!("{}{}", crate::camera::SESSION_ROBOT_TOPIC_PREFIX, i + 1);
         robots.push((feed, topic, None, source_name(&source)));
     }
     Ok(LiveOpened {
@@ -418,6 +418,14 @@ pub fn open_live(
             for (_, topic, entry, _) in &robots {
                 if let Some(e) = entry.as_ref().filter(|e| e.lut.is_some()) {
                     rec.recognise(topic, robot_pipeline(e)?);
+                    rec.name_robot_camera(
+                        topic,
+                        &crate::camera::CameraFiles {
+                            lut: e.lut.clone(),
+                            params: e.params.as_ref().map(|p| p.display().to_string()),
+                            calibration: None,
+                        },
+                    )?;
                 }
             }
             Some(rec)

@@ -414,7 +414,8 @@ impl Workspace {
             ..FieldCameras::default()
         };
         self.remember_recent(path);
-        self.settings.show_field_view = true;
+        self.set_session_robots(&session.robots);
+        self.request_wmd_layout();
         self.reprocess();
         self.status = format!(
             "opened session {}: {} overhead cameras, camera {} shown",
