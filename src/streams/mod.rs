@@ -30,6 +30,7 @@ mod reader;
 pub mod rosbag2;
 pub mod schema;
 pub mod sensor_table;
+pub mod world_models;
 mod writer;
 
 use std::path::PathBuf;

@@ -406,11 +406,12 @@ impl Workspace {
         let size = (loaded.frame.width(), loaded.frame.height());
         self.sync_field_cameras(index, loaded.time_ns, size);
         self.overhead.field_model.set_field(&self.overhead.field);
+        let extra = self.with_session_world_models(loaded);
         self.overhead.field_model.observe(
             index,
             loaded.time_ns,
             self.overhead.cameras.picture(),
-            &loaded.extra,
+            &extra,
         );
         self.send_ssl_out(loaded.time_ns);
         let t = self.overhead.pipeline.timings();
@@ -707,7 +708,7 @@ impl Workspace {
         self.overhead.truth = None;
         self.overhead.field_model = FieldModel::default();
         self.overhead.cameras = FieldCameras::default();
-        self.overhead.wmd.robots.clear();
+        self.overhead.wmd.forget_session();
     }
 
     /// Where an image point (pixels of the camera's image) is drawn in the views: itself, or

@@ -1,6 +1,7 @@
 //! The World Model Debugger in the workspace (issue 30): which robots' cameras the app can show
-//! beside the overhead camera, and showing the selected robot's; its world model placed on the
-//! overhead image; the WMD layout request the app's dock follows.
+//! beside the overhead camera, and showing the selected robot's; a session file's robots' own
+//! world models, read from their recordings and paired with the shown frame; the world models
+//! placed on the overhead image; the robots list; the WMD layout request the app's dock follows.
 //!
 //! A robot's camera is, in this order: the camera of its session-file entry whose `source` is a
 //! recording (its own table and parameters from the entry), or the camera `/robot/TEAM-ID` of
@@ -10,11 +11,16 @@
 //! (`side_by_side.rs`): the overhead camera stays focused, the robot's camera is recognised
 //! with its own table.
 
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+
 use super::Workspace;
 use crate::camera::{CameraFiles, CameraId};
 use crate::geometry::{ImagePoint, Point};
 use crate::model::world_model::RobotKey;
 use crate::session::{RobotEntry, SessionSource};
+use crate::sources::SourceFrame;
+use crate::streams::world_models::{RobotModels, read_world_models};
 
 /// A session-file robot whose camera the app can show.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -27,13 +33,32 @@ pub struct RobotCamera {
     pub files: CameraFiles,
 }
 
-/// The WMD state of the workspace: the session file's robot cameras, the layout requests.
+/// The WMD state of the workspace: the session file's robot cameras and world models, the
+/// layout requests.
 #[derive(Debug, Default)]
 pub struct WmdState {
     /// The session file's robots whose source is a recording with camera frames.
     pub(super) robots: Vec<RobotCamera>,
+    /// The world models of the session file's robots read from their recordings, each robot's
+    /// in time order on its clock.
+    models: RobotModels,
+    /// Each of those robots' clock offset: overhead time − robot time, nanoseconds.
+    offsets: BTreeMap<RobotKey, i64>,
+    /// The overhead frames' period, nanoseconds: a world model within half of it of a frame is
+    /// shown with it.
+    period_ns: u64,
     /// Counts the requests for the WMD layout (the dock arranges itself when it changes).
     pub(super) layout_requests: u64,
+}
+
+impl WmdState {
+    /// Forgets the session's robots (another source is opened); the layout requests stay.
+    pub(super) fn forget_session(&mut self) {
+        *self = Self {
+            layout_requests: self.layout_requests,
+            ..Self::default()
+        };
+    }
 }
 
 impl RobotCamera {
@@ -114,8 +139,7 @@ impl Workspace {
         let src = self.source.as_ref()?;
         let topic = robot.camera_topic();
         src.cameras()
-            .iter()
-            .any(|t| *t == topic)
+            .contains(&topic)
             .then(|| src.camera_id_of(&topic))
             .flatten()
             .map(|c| (c, None))
@@ -157,9 +181,96 @@ impl Workspace {
             .map(|r| &r.files)
     }
 
-    /// The session file's robots with a camera the app can show (set when a session opens).
-    pub(super) fn set_session_robots(&mut self, entries: &[RobotEntry]) {
-        self.overhead.wmd.robots = entries.iter().filter_map(RobotCamera::of_entry).collect();
+    /// The session file's robots (set when a session opens): those with a camera the app can
+    /// show, and the world models of those whose source is a recording that holds them, each
+    /// robot's clock taken as the overhead frames' (`frames_ns`, period `period_ns`) when their
+    /// times overlap, else lined up by the first message and frame (`wmd::clock`'s start; the
+    /// offset search `eotn wmd` does runs the overhead recogniser over the whole recording).
+    /// A recording without world models is said as a warning.
+    pub(super) fn set_session_robots(
+        &mut self,
+        entries: &[RobotEntry],
+        frames_ns: &[u64],
+        period_ns: u64,
+    ) {
+        let mut wmd = super::wmd::WmdState {
+            robots: entries.iter().filter_map(RobotCamera::of_entry).collect(),
+            period_ns,
+            layout_requests: self.overhead.wmd.layout_requests,
+            ..super::wmd::WmdState::default()
+        };
+        for e in entries {
+            let SessionSource::Recording(path) = &e.source else {
+                continue;
+            };
+            let key = RobotKey {
+                team: e.team,
+                identity: e.robot_id,
+            };
+            if let Err(err) = read_world_models(path, Some(key), &mut wmd.models) {
+                self.warn(format!("robot {key}: {err:#}"));
+            }
+        }
+        for (key, models) in &wmd.models {
+            let own: Vec<(u64, [f64; 2])> = models
+                .iter()
+                .map(|(t, m)| (*t, [m.own.x_cm, m.own.y_cm]))
+                .collect();
+            let offset =
+                crate::wmd::clock::estimate_offset(frames_ns, period_ns, |_| None, &own, 0);
+            wmd.offsets.insert(*key, offset.offset_ns);
+        }
+        self.overhead.wmd = wmd;
+    }
+
+    /// A frame's channels with the session robots' world models paired with it (each robot's
+    /// message nearest the frame's time within half a frame period, as
+    /// `/world_model/TEAM-ID`) in place of any the frame carries for those robots; the frame's
+    /// own channels when the session has none.
+    pub(super) fn with_session_world_models<'a>(
+        &self,
+        loaded: &'a SourceFrame,
+    ) -> Cow<'a, [(String, serde_json::Value)]> {
+        let wmd = &self.overhead.wmd;
+        if wmd.models.is_empty() {
+            return Cow::Borrowed(&loaded.extra);
+        }
+        let half = i128::from(wmd.period_ns / 2);
+        let mut out: Vec<(String, serde_json::Value)> = loaded
+            .extra
+            .iter()
+            .filter(|(topic, v)| {
+                !crate::model::world_model::is_world_model_topic(topic)
+                    || crate::model::world_model::from_value(v)
+                        .map_or(true, |m| !wmd.models.contains_key(&m.robot))
+            })
+            .cloned()
+            .collect();
+        for (key, models) in &wmd.models {
+            let offset = i128::from(wmd.offsets.get(key).copied().unwrap_or(0));
+            let at = |i: usize| {
+                models.get(i).map(|(t, m)| {
+                    (
+                        (i128::from(*t) + offset - i128::from(loaded.time_ns)).abs(),
+                        m,
+                    )
+                })
+            };
+            let target = i128::from(loaded.time_ns) - offset;
+            let i = models.partition_point(|(t, _)| i128::from(*t) < target);
+            let nearest = [i.checked_sub(1).and_then(at), at(i)]
+                .into_iter()
+                .flatten()
+                .filter(|(d, _)| *d <= half)
+                .min_by_key(|(d, _)| *d);
+            if let Some((_, m)) = nearest {
+                out.push((
+                    format!("/world_model/{}-{}", key.team.name(), key.identity.value()),
+                    m.to_json(),
+                ));
+            }
+        }
+        Cow::Owned(out)
     }
 
     /// After robot `robot` was selected: its camera beside the overhead camera, when it has one

@@ -348,6 +348,14 @@ fn a_session_files_robot_recording_is_shown_beside_the_overhead_camera_with_its_
     let mut w = Workspace::default();
     w.apply(Command::Open(vec![session])).unwrap();
     assert_eq!(w.wmd_layout_requests(), 1);
+    // Its recording holds camera frames but no world models: said, not refused.
+    assert!(
+        w.warnings()
+            .iter()
+            .any(|l| l.contains(&format!("robot {key}")) && l.contains("no world-model channel")),
+        "{:?}",
+        w.warnings()
+    );
     let (camera, _) = w
         .robot_camera(key)
         .expect("the robot's recording has frames");
@@ -368,4 +376,86 @@ fn a_session_files_robot_recording_is_shown_beside_the_overhead_camera_with_its_
     w.apply(OverheadCommand::SelectRobot(Some(other)).into())
         .unwrap();
     assert!(w.camera_panes().is_empty());
+}
+
+/// Robot 1's own recording: its world models (the game's, moved 80 cm along x) on
+/// `/world_model`, logged and stamped at the overhead frames' times (one clock).
+fn own_recording(dir: &Path) -> PathBuf {
+    let path = dir.join("robot1-own.mcap");
+    let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    let mut w = mcap::Writer::new(file).unwrap();
+    let channel = w
+        .add_channel(
+            0,
+            "/world_model",
+            "json",
+            &std::collections::BTreeMap::new(),
+        )
+        .unwrap();
+    let mut game = StreamReader::open(&fixture().stream).unwrap();
+    for i in 0..game.len() {
+        let r = game.read(i).unwrap();
+        let (_, v) = r
+            .extra
+            .iter()
+            .find(|(t, _)| t == "/world_model/robot1")
+            .unwrap();
+        let mut v = v.clone();
+        v["self"]["x_cm"] = (v["self"]["x_cm"].as_f64().unwrap() + 80.0).into();
+        v["time_ns"] = r.time_ns.into();
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: u32::try_from(i).unwrap(),
+            log_time: r.time_ns,
+            publish_time: r.time_ns,
+        };
+        w.write_to_known_channel(&header, &serde_json::to_vec(&v).unwrap())
+            .unwrap();
+    }
+    w.finish().unwrap();
+    path
+}
+
+#[test]
+fn a_session_files_robot_brings_its_own_world_models_in_place_of_the_streams() {
+    let f = fixture();
+    let key = recorded().robots[0];
+    let dir = tempfile::tempdir().unwrap();
+    let own = own_recording(dir.path());
+    let session = dir.path().join("SESSION.json");
+    std::fs::write(
+        &session,
+        serde_json::json!({
+            "field": "four-legged-2005",
+            "overhead": [{"id": 0, "source": f.stream, "lut": f.table, "calibration": f.cal}],
+            "robots": [{"team": key.team.name(), "robot_id": key.identity.value(), "source": own}],
+        })
+        .to_string(),
+    )
+    .unwrap();
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![session])).unwrap();
+    w.apply(Command::Playback(eotn::workspace::PlaybackCommand::Seek(
+        10,
+    )))
+    .unwrap();
+    let record = StreamReader::open(&f.stream).unwrap().read(10).unwrap();
+    let streamed = model_of(&record.extra, 1);
+    let models = w.overhead().field_model.world_models();
+    let mine: Vec<_> = models.iter().filter(|m| m.robot == key).collect();
+    assert_eq!(mine.len(), 1, "one world model of robot 1: {models:?}");
+    assert!(
+        (mine[0].own[0] - (streamed.own.x_cm + 80.0)).abs() < 1e-6,
+        "its own recording's: {:?} vs {:?}",
+        mine[0].own,
+        streamed.own
+    );
+    assert_eq!(mine[0].matched, eotn::wmd::Matched::Marker);
+    // The other robots' world models still come from the stream.
+    assert!(models.len() > 1, "{models:?}");
+    // A recording of world models only has no camera to show.
+    assert!(
+        w.robot_camera(key).is_none(),
+        "no frames in a world-model recording"
+    );
 }
