@@ -284,7 +284,14 @@ impl Workspace {
             return;
         };
         let wanted = robot.and_then(|k| self.robot_camera(k)).map(|(c, _)| c);
-        let beside_robot = self.camera_panes().iter().any(|p| !p.focused);
+        // Only a robot's camera beside is closed again (other cameras shown side by side stay).
+        let beside_robot = self.camera_panes().iter().any(|p| {
+            !p.focused
+                && (p
+                    .topic
+                    .starts_with(crate::camera::SESSION_ROBOT_TOPIC_PREFIX)
+                    || self.session_robot_files(p.camera).is_some())
+        });
         let cameras = match &wanted {
             Some(c) => vec![shown, c.clone()],
             None if beside_robot => vec![shown],
