@@ -27,6 +27,11 @@ pub const IMAGE_TOPIC: &str = "/camera/image";
 /// them).
 pub const COMPRESSED_IMAGE_TOPIC: &str = "/camera/image/compressed";
 
+/// The start of a robot camera's image topic in a World Model Debugger session recording
+/// (`eotn wmd -o`): `/robot/TEAM-ID` (a session's robot, by its marker) or `/robot/N` (the N-th
+/// `--robot`). Such a camera of an overhead recording is a robot's camera, not the overhead one.
+pub const SESSION_ROBOT_TOPIC_PREFIX: &str = "/robot/";
+
 /// The MCAP metadata record naming one camera's default files (keys `topic`, `lut`, `params`,
 /// `calibration`; one record per camera).
 pub const CAMERA_METADATA_NAME: &str = "eotn.camera";

@@ -36,6 +36,8 @@ pub enum Pane {
 /// The layout of the image and the docked windows (kept while the app runs).
 pub struct Dock {
     tree: Tree<Pane>,
+    /// The workspace's WMD layout requests followed so far.
+    wmd_layouts: u64,
 }
 
 impl Default for Dock {
@@ -45,6 +47,7 @@ impl Default for Dock {
         let root = tiles.insert_horizontal_tile(vec![image]);
         Self {
             tree: Tree::new(egui::Id::unique("eotn-dock"), root, tiles),
+            wmd_layouts: 0,
         }
     }
 }
@@ -90,8 +93,14 @@ impl Dock {
         out
     }
 
-    /// Gives every open window a tab and removes the tabs of closed ones.
+    /// Gives every open window a tab and removes the tabs of closed ones; arranges the WMD
+    /// layout when the workspace asked for it again.
     pub fn sync(&mut self, state: &Workspace) {
+        if state.wmd_layout_requests() != self.wmd_layouts {
+            self.wmd_layouts = state.wmd_layout_requests();
+            self.arrange_wmd(state);
+            return;
+        }
         for w in Window::ALL {
             let tile = self.tree.tiles.find_pane(&Pane::Window(w));
             match (state.window_open(w), tile) {
@@ -142,6 +151,63 @@ impl Dock {
         let tabs = self.tree.tiles.insert_tab_tile(vec![pane]);
         let column = self.tree.tiles.insert_vertical_tile(vec![tabs]);
         self.add_beside_image(column);
+    }
+
+    /// The World Model Debugger layout: the overhead view (the image) on the left; right of it the
+    /// field view above the robots list, every other open window a tab beside the robots list.
+    fn arrange_wmd(&mut self, state: &Workspace) {
+        let mut tiles = Tiles::default();
+        let image = tiles.insert_pane(Pane::Image);
+        let field = tiles.insert_pane(Pane::Window(Window::FieldView));
+        let field_tabs = tiles.insert_tab_tile(vec![field]);
+        let mut rest = vec![tiles.insert_pane(Pane::Window(Window::Robots))];
+        for w in Window::ALL {
+            if state.window_open(w) && !matches!(w, Window::FieldView | Window::Robots) {
+                rest.push(tiles.insert_pane(Pane::Window(w)));
+            }
+        }
+        let robots = rest[0];
+        let rest_tabs = tiles.insert_tab_tile(rest);
+        if let Some(Tile::Container(Container::Tabs(t))) = tiles.get_mut(rest_tabs) {
+            t.set_active(robots);
+        }
+        let mut column =
+            egui_tiles::Linear::new(egui_tiles::LinearDir::Vertical, vec![field_tabs, rest_tabs]);
+        column.shares.set_share(field_tabs, 2.0);
+        column.shares.set_share(rest_tabs, 1.0);
+        let column = tiles.insert_container(column);
+        let mut row =
+            egui_tiles::Linear::new(egui_tiles::LinearDir::Horizontal, vec![image, column]);
+        row.shares.set_share(image, IMAGE_SHARE);
+        row.shares.set_share(column, 1.0);
+        let root = tiles.insert_container(row);
+        self.tree = Tree::new(egui::Id::unique("eotn-dock"), root, tiles);
+    }
+
+    /// The windows of the column right of the image, top to bottom, each group's tabs in order
+    /// (the WMD layout's test reads it).
+    #[must_use]
+    pub fn column_groups(&self) -> Vec<Vec<Window>> {
+        let tiles = &self.tree.tiles;
+        let Some(column) = self.window_column() else {
+            return Vec::new();
+        };
+        let Some(Tile::Container(Container::Linear(l))) = tiles.get(column) else {
+            return Vec::new();
+        };
+        l.children
+            .iter()
+            .map(|g| match tiles.get(*g) {
+                Some(Tile::Container(c)) => c
+                    .children()
+                    .filter_map(|k| match tiles.get_pane(k) {
+                        Some(Pane::Window(w)) => Some(*w),
+                        _ => None,
+                    })
+                    .collect(),
+                _ => Vec::new(),
+            })
+            .collect()
     }
 
     /// Whether tile `id` is a tab group holding a docked window.

@@ -1,7 +1,8 @@
 //! The field view: a top-down drawing of the field description's lines with the ball and each
 //! robot where the overhead camera puts them (position, heading, team colour, identity) and
 //! short trails; each robot's own world-model estimate of itself and of the ball drawn beside
-//! that overhead truth with the error of each, and a plot of the errors over the frames seen.
+//! that overhead truth with the error of each, and the errors over the frames seen
+//! (`wmd_errors.rs`).
 //! Clicking a robot selects it in every view. SSL-Vision's detections (a league log or a live
 //! address opened beside, or alone) are drawn over it, each camera's in its own colour. It draws
 //! the workspace's field model only. Each overhead camera's coverage, the camera legend and which
@@ -9,9 +10,9 @@
 //! `field_cameras.rs`.
 
 use egui::{Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, vec2};
-use egui_plot::{Line, Plot, VLine};
 
 use super::overhead_overlays::team_colour;
+pub use super::wmd_errors::errors_plot_id;
 use crate::overhead::FieldDescription;
 use crate::workspace::{Command, OverheadCommand, RobotKey, Workspace};
 
@@ -150,7 +151,7 @@ pub fn field_view_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Command>
         ui.data_mut(|d| d.insert_temp(show_truth_id, show_truth));
     }
     if !models.is_empty() {
-        errors_ui(ui, state);
+        super::wmd_errors::errors_ui(ui, state);
     }
 }
 
@@ -437,103 +438,6 @@ fn paint_ssl(
             painter.add(egui::Shape::closed_line(diamond, stroke));
         }
     }
-}
-
-/// Each world model's errors on this frame, and over the frames seen so far.
-fn errors_ui(ui: &mut Ui, state: &Workspace) {
-    let model = &state.overhead().field_model;
-    let cm = |e: Option<f64>| e.map_or_else(|| "–".to_owned(), |e| format!("{e:.1}"));
-    egui::Grid::new("world-model-errors")
-        .striped(true)
-        .show(ui, |ui| {
-            for h in [
-                "world model",
-                "robot",
-                "self (cm)",
-                "heading (°)",
-                "ball (cm)",
-            ] {
-                ui.strong(h);
-            }
-            ui.end_row();
-            for m in model.world_models() {
-                ui.label(format!("from {}", m.robot));
-                ui.label(match (m.matched, m.key) {
-                    (crate::wmd::Matched::Marker, Some(k)) => format!("marker {k}"),
-                    (crate::wmd::Matched::Position, Some(k)) => format!("by position: {k}"),
-                    _ => "not seen".to_owned(),
-                });
-                ui.monospace(cm(m.self_error_cm));
-                ui.monospace(cm(m.heading_error_deg));
-                ui.monospace(cm(m.ball_error_cm));
-                ui.end_row();
-            }
-        });
-    let now_s = state.current().map_or(0.0, |c| c.time_ns as f64 / 1e9);
-    let ids: Vec<crate::workspace::overhead::RobotKey> =
-        model.world_models().iter().map(|m| m.robot).collect();
-    // Each series' colour; the legend is a row above the plot (drawn over it, egui_plot's
-    // legend hid a third of the curves).
-    let series: Vec<(String, Color32, crate::workspace::overhead::RobotKey, usize)> = ids
-        .iter()
-        .flat_map(|id| [(*id, 0usize), (*id, 1)])
-        .enumerate()
-        .map(|(k, (id, pick))| {
-            let what = if pick == 0 { "self" } else { "ball" };
-            (format!("{id} {what}"), series_colour(k), id, pick)
-        })
-        .collect();
-    ui.horizontal_wrapped(|ui| {
-        for (name, colour, _, _) in &series {
-            let (r, _) = ui.allocate_exact_size(vec2(14.0, 3.0), Sense::hover());
-            ui.painter().rect_filled(r, 0.0, *colour);
-            ui.label(egui::RichText::new(name).small());
-        }
-    });
-    // The wheel scrolls the window, not the plot (zooming under the wheel trapped the scroll).
-    Plot::new("world-model-error-plot")
-        .id(errors_plot_id())
-        .height(140.0)
-        .allow_zoom(false)
-        .allow_scroll(false)
-        .allow_drag(false)
-        .allow_boxed_zoom(false)
-        .y_axis_label("error (cm)")
-        .show(ui, |p| {
-            for (name, colour, id, pick) in &series {
-                let points: Vec<[f64; 2]> = model
-                    .error_samples()
-                    .filter_map(|s| {
-                        let (_, own, ball) = s.errors.iter().find(|e| e.0 == *id)?;
-                        let e = if *pick == 0 { *own } else { *ball };
-                        e.map(|e| [s.time_s, e])
-                    })
-                    .collect();
-                p.line(Line::new(name.clone(), points).color(*colour));
-            }
-            p.vline(VLine::new("current frame", now_s).color(Color32::WHITE));
-        });
-}
-
-/// The error plot's id (tests read its memory: the wheel leaves its bounds alone).
-#[must_use]
-pub fn errors_plot_id() -> egui::Id {
-    egui::Id::unique("eotn-world-model-error-plot")
-}
-
-/// The `k`th plotted series' colour: distinct hues round the wheel.
-fn series_colour(k: usize) -> Color32 {
-    const PALETTE: [Color32; 8] = [
-        Color32::from_rgb(255, 99, 71),
-        Color32::from_rgb(60, 170, 255),
-        Color32::from_rgb(250, 220, 40),
-        Color32::from_rgb(120, 220, 120),
-        Color32::from_rgb(230, 120, 230),
-        Color32::from_rgb(255, 160, 60),
-        Color32::from_rgb(80, 220, 220),
-        Color32::from_rgb(200, 200, 200),
-    ];
-    PALETTE[k % PALETTE.len()]
 }
 
 #[cfg(test)]

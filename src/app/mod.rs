@@ -30,6 +30,7 @@
 //! | `overhead_menu.rs` | the Overhead menu: calibration files, view options, windows |
 //! | `calibration_window.rs` | pick landmarks by name, solve, each point's reprojection error |
 //! | `field_view.rs` | the top-down field: ball, robots, trails, world models and their errors |
+//! | `wmd_errors.rs`, `wmd_overlay.rs`, `wmd_robots.rs` | the World Model Debugger: errors, spreads, jumps and plots; world models over the overhead image; the session's robots list |
 //! | `field_cameras.rs` | the field view's cameras: coverage, legend (current or stale), who saw what |
 //! | `renderer.rs` | wgpu on a GPU, OpenGL on a software rasteriser: the choice before the window opens |
 //!
@@ -61,6 +62,9 @@ mod textures;
 mod timeline;
 pub mod uv_plane;
 pub mod views;
+pub mod wmd_errors;
+mod wmd_overlay;
+mod wmd_robots;
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

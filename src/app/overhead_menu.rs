@@ -35,6 +35,14 @@ pub fn overhead_menu_ui(ui: &mut Ui, state: &Workspace, commands: &mut Vec<Comma
             commands.push(Command::ShowWindow(w, open));
         }
     }
+    if ui
+        .button("World Model Debugger layout")
+        .on_hover_text("the overhead view, the field view and the robots list side by side")
+        .clicked()
+    {
+        commands.push(OverheadCommand::WmdLayout.into());
+        ui.close();
+    }
     ui.separator();
     let mut v = state.settings.overhead;
     let before = v;

@@ -3,7 +3,7 @@
 //! a glance), the ball (circle and field position), each robot (marker outline, heading arrow,
 //! team colour, identity; the selected one thicker, the rest dimmed), and the picked
 //! calibration points with each one's reprojection error drawn as a line to where the
-//! calibration puts it. In the undistorted view every point goes through the lens model first.
+//! calibration puts it; each robot's world model (`wmd_overlay.rs`). In the undistorted view every point goes through the lens model first.
 
 use egui::{Color32, FontId, Painter, Pos2, Rect, Stroke, pos2, vec2};
 
@@ -69,6 +69,7 @@ pub fn paint_overhead(
     }
     if kind == ViewKind::Objects || with_overlays {
         paint_detections(painter, xf, state, with_overlays, &to_screen);
+        super::wmd_overlay::paint_world_models(painter, state, &to_screen);
     }
     if with_overlays && view.points {
         paint_points(painter, state, &to_screen);

@@ -48,6 +48,7 @@ pub fn robots_ui(
     panel: &mut RobotsPanel,
     commands: &mut Vec<Command>,
 ) {
+    super::wmd_robots::wmd_robots_ui(ui, state, commands);
     ui.horizontal_wrapped(|ui| {
         let label = ui.label("address");
         ui.add(

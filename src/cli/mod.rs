@@ -51,7 +51,7 @@ mod wmd;
 mod wmd_feeds;
 mod wmd_inputs;
 mod wmd_live;
-mod wmd_record;
+pub mod wmd_record;
 mod wmd_ssl;
 
 use std::path::PathBuf;

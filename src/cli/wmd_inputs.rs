@@ -3,17 +3,15 @@
 //! robots' world models from their recordings; for a live session ([`open_live`]) every source
 //! opened as a feed ([`super::wmd_feeds`]).
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, bail};
 
 use super::field::FieldCamera;
-use crate::model::world_model::{self, RobotKey, WorldModelMessage};
+use crate::model::world_model::{RobotKey, WorldModelMessage};
 use crate::overhead::merge::{FieldPicture, SslCameraId, merge_detections};
 use crate::overhead::recognise::OverheadDetections;
 use crate::session::SessionSource;
-use crate::streams::StreamReader;
 use crate::wmd::{OverheadRobotPose, OverheadView};
 
 /// One field frame: the reference camera's frame time and what the cameras saw then.
@@ -99,10 +97,6 @@ pub fn field_frames(
     Ok(out)
 }
 
-/// The world models of every robot, each in time order: (time on the robot's clock —
-/// the message's `time_ns`, else the recording's log time —, message).
-pub type RobotModels = BTreeMap<RobotKey, Vec<(u64, WorldModelMessage)>>;
-
 /// The recording a source names, for a session of recordings only (a live session reads every
 /// kind: [`open_live`]).
 ///
@@ -159,88 +153,7 @@ pub fn say_unused_session_keys(session: &crate::session::Session, output: bool, 
     }
 }
 
-/// What one robot recording gave.
-#[derive(Debug, Default)]
-pub struct ReadModels {
-    /// World models read.
-    pub read: usize,
-    /// The robots whose world models a session recording (`eotn wmd -o`) holds: logged at the
-    /// overhead frame each was paired with, so they are taken at their log times with no clock
-    /// offset (a replay pairs them as the session did).
-    pub paired_when_recorded: Vec<RobotKey>,
-}
-
-/// Reads the world models of one robot recording into `into`: every JSON message on
-/// `/world_model` or `/world_model/<anything>`; with `only`, the messages naming that robot
-/// (others counted and warned about). A message refused is warned about (the first few by
-/// reason) and skipped. A message's time is its `time_ns` (the robot's clock), else its log
-/// time; in a session recording always its log time ([`ReadModels`]).
-///
-/// # Errors
-/// An unreadable recording, naming it; a recording with no world-model channel.
-pub fn read_world_models(
-    path: &Path,
-    only: Option<RobotKey>,
-    into: &mut RobotModels,
-) -> anyhow::Result<ReadModels> {
-    let name = crate::frame::display_name(path);
-    let mut reader = StreamReader::open(path).with_context(|| name.clone())?;
-    let session = reader.info().source == super::wmd_record::SESSION_SOURCE;
-    let mut keys = std::collections::BTreeSet::new();
-    let channels: Vec<u16> = reader
-        .channels()
-        .iter()
-        .filter(|c| world_model::is_world_model_topic(&c.topic) && c.message_encoding == "json")
-        .map(|c| c.id)
-        .collect();
-    if channels.is_empty() {
-        bail!("{name}: no world-model channel (JSON on /world_model or /world_model/<name>)");
-    }
-    let (mut read, mut refused, mut others) = (0, 0_usize, 0_usize);
-    reader
-        .for_each_message(|m| {
-            if !channels.contains(&m.channel) {
-                return;
-            }
-            match world_model::parse(m.data) {
-                Ok(w) if only.is_some_and(|k| k != w.robot) => others += 1,
-                Ok(w) => {
-                    let t = if session {
-                        m.log_time_ns
-                    } else {
-                        w.time_ns.unwrap_or(m.log_time_ns)
-                    };
-                    keys.insert(w.robot);
-                    into.entry(w.robot).or_default().push((t, w));
-                    read += 1;
-                }
-                Err(e) => {
-                    refused += 1;
-                    if refused <= 5 {
-                        log::warn!("{name}: world model at {} ns skipped: {e}", m.log_time_ns);
-                    }
-                }
-            }
-        })
-        .with_context(|| name.clone())?;
-    if refused > 5 {
-        log::warn!("{name}: {refused} world models skipped in all");
-    }
-    if let Some(k) = only.filter(|_| others > 0) {
-        log::warn!("{name}: {others} world models of other robots than {k} left out");
-    }
-    for models in into.values_mut() {
-        models.sort_by_key(|m| m.0);
-    }
-    Ok(ReadModels {
-        read,
-        paired_when_recorded: if session {
-            keys.into_iter().collect()
-        } else {
-            Vec::new()
-        },
-    })
-}
+pub use crate::streams::world_models::{RobotModels, read_world_models};
 
 /// A live session's sources opened: the field, the overhead cameras, each robot's feed with
 /// the topic of its camera frames, its session entry and its name, each camera's files.
@@ -298,7 +211,7 @@ fn open_live_session(path: &Path, record: bool) -> anyhow::Result<LiveOpened> {
             only: Some(key),
             frames: record.then(|| r.camera.clone()),
         };
-        let topic = format!("/robot/{}-{}", key.team.name(), key.identity.value());
+        let topic = key.camera_topic();
         let name = format!("{key} ({})", source_name(&r.source));
         let feed = robot_feed(&r.source, wants, &key.to_string())?;
         robots.push((feed, topic, Some(r.clone()), name));
@@ -332,7 +245,7 @@ fn open_live_args(a: &super::wmd::Args, record: bool) -> anyhow::Result<LiveOpen
         };
         let source = SessionSource::parse_arg(p);
         let feed = robot_feed(&source, wants, &p.display().to_string())?;
-        let topic = format!("/robot/{}", i + 1);
+        let topic = format!("{}{}", crate::camera::SESSION_ROBOT_TOPIC_PREFIX, i + 1);
         robots.push((feed, topic, None, source_name(&source)));
     }
     Ok(LiveOpened {
@@ -418,6 +331,14 @@ pub fn open_live(
             for (_, topic, entry, _) in &robots {
                 if let Some(e) = entry.as_ref().filter(|e| e.lut.is_some()) {
                     rec.recognise(topic, robot_pipeline(e)?);
+                    rec.name_robot_camera(
+                        topic,
+                        &crate::camera::CameraFiles {
+                            lut: e.lut.clone(),
+                            params: e.params.as_ref().map(|p| p.display().to_string()),
+                            calibration: None,
+                        },
+                    )?;
                 }
             }
             Some(rec)

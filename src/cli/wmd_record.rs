@@ -28,7 +28,7 @@ use crate::streams::{FrameRecord, IMAGE_TOPIC, RawChannelSpec, StreamInfo, Strea
 
 /// The stream source of a session recording (it names "overhead": the app opens it as the
 /// overhead camera's stream).
-pub const SESSION_SOURCE: &str = "overhead:wmd-session";
+pub const SESSION_SOURCE: &str = crate::streams::WMD_SESSION_SOURCE;
 /// The topic of each field frame's `eotn wmd --json` line.
 pub const LINE_TOPIC: &str = "/wmd/frame";
 /// The topic of each field frame's `foxglove.SceneUpdate`.
@@ -148,6 +148,18 @@ impl SessionRecorder {
     /// `TOPIC/annotations`).
     pub fn recognise(&mut self, topic: &str, pipeline: Pipeline) {
         self.recognisers.insert(topic.to_owned(), pipeline);
+    }
+
+    /// Names the table and parameters of the robot camera `topic` in the recording (the
+    /// session entry's), so the app reopens that camera with them.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn name_robot_camera(&mut self, topic: &str, files: &CameraFiles) -> anyhow::Result<()> {
+        if !files.is_empty() {
+            self.writer.name_camera_files(topic, files)?;
+        }
+        Ok(())
     }
 
     /// Queues a robot's camera frame (`topic`: its place in the recording); it is written in

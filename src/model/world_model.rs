@@ -45,6 +45,20 @@ impl std::fmt::Display for RobotKey {
     }
 }
 
+impl RobotKey {
+    /// The image topic of this robot's camera in a session recording (`eotn wmd -o`):
+    /// `/robot/TEAM-ID`.
+    #[must_use]
+    pub fn camera_topic(self) -> String {
+        format!(
+            "{}{}-{}",
+            crate::camera::SESSION_ROBOT_TOPIC_PREFIX,
+            self.team.name(),
+            self.identity.value()
+        )
+    }
+}
+
 /// A robot's estimate of itself.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SelfEstimate {

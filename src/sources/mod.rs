@@ -159,6 +159,23 @@ impl CameraKind {
         }
     }
 
+    /// The camera kind of image topic `topic` of a stream whose source is `source`: the
+    /// stream's kind ([`Self::of_stream_source`]), except that a robot camera of a World Model
+    /// Debugger session recording (an overhead stream, topics
+    /// [`crate::camera::SESSION_ROBOT_TOPIC_PREFIX`]…) is a robot's.
+    #[must_use]
+    pub fn of_stream_camera(source: &str, topic: Option<&str>) -> Self {
+        match Self::of_stream_source(source) {
+            Self::Overhead
+                if topic
+                    .is_some_and(|t| t.starts_with(crate::camera::SESSION_ROBOT_TOPIC_PREFIX)) =>
+            {
+                Self::Robot
+            }
+            kind => kind,
+        }
+    }
+
     /// The stream source kind a recording of a live camera of this kind gets (`"robot camera"`,
     /// `"overhead camera"`), which [`Self::of_stream_source`] reads back as this kind.
     #[must_use]
@@ -606,6 +623,20 @@ mod tests {
             CameraKind::Overhead
         );
         assert_eq!(CameraKind::of_stream_source("robot"), CameraKind::Robot);
+        // A session recording's robot cameras are robots'; its overhead camera is not.
+        let session = crate::streams::WMD_SESSION_SOURCE;
+        assert_eq!(
+            CameraKind::of_stream_camera(session, Some("/robot/blue-3")),
+            CameraKind::Robot
+        );
+        assert_eq!(
+            CameraKind::of_stream_camera(session, Some("/camera/image")),
+            CameraKind::Overhead
+        );
+        assert_eq!(
+            CameraKind::of_stream_camera("robot", Some("/camera/image")),
+            CameraKind::Robot
+        );
         assert_eq!(
             CameraKind::of_stream_source("bhuman2009"),
             CameraKind::Robot

@@ -107,7 +107,7 @@ impl FrameSource for StreamSource {
         SourceInfo {
             kind: SourceKind::Stream,
             label: self.label(),
-            camera: CameraKind::of_stream_source(&source),
+            camera: CameraKind::of_stream_camera(&source, self.reader.camera()),
             paths: vec![self.path.clone()],
             stream_source: source,
         }

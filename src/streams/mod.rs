@@ -30,6 +30,7 @@ mod reader;
 pub mod rosbag2;
 pub mod schema;
 pub mod sensor_table;
+pub mod world_models;
 mod writer;
 
 use std::path::PathBuf;
@@ -70,6 +71,10 @@ pub fn param_set_of_source(source: &str) -> Option<&'static str> {
 
 /// Version of the stream layout written by this crate (metadata key `format_version`).
 pub const FORMAT_VERSION: &str = "1";
+/// The stream source (`StreamInfo::source`) of a World Model Debugger session recording
+/// (`eotn wmd -o`). It names "overhead": the stream is the overhead camera's; its robot cameras
+/// (`/robot/…`) are robots' ([`crate::camera::SESSION_ROBOT_TOPIC_PREFIX`]).
+pub const WMD_SESSION_SOURCE: &str = "overhead:wmd-session";
 
 /// What a stream is: where its frames came from and a free description.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]

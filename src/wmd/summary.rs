@@ -82,7 +82,7 @@ pub struct RobotSummary {
     pub last_ns: u64,
 }
 
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 struct Gathered {
     counts: [usize; 3],
     position: Vec<f64>,
@@ -97,7 +97,7 @@ struct Gathered {
 }
 
 /// The summaries being gathered, frame by frame in time order.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub struct Summaries {
     robots: BTreeMap<RobotKey, Gathered>,
 }

@@ -370,8 +370,12 @@ pub enum OverheadCommand {
     /// Frame files (JPEG, PNG, …) come from an overhead camera (`true`) or a robot's: the
     /// overhead recogniser and the overhead table are used for them. Streams say it themselves.
     SetOverheadCamera(bool),
-    /// Select a robot in every view (`None` clears).
+    /// Select a robot in every view (`None` clears); its camera, when the session has it, is
+    /// shown beside the overhead camera (`workspace/wmd.rs`).
     SelectRobot(Option<RobotKey>),
+    /// Arrange the World Model Debugger layout: the overhead view, the field view and the
+    /// robots list (applied by itself when a session file or a recorded session opens).
+    WmdLayout,
     /// Overhead view options.
     SetView(OverheadView),
     /// Send each processed overhead frame's detections as SSL-Vision packets to `HOST:PORT`

@@ -1,7 +1,10 @@
 //! The field view's model, headless: where the overhead camera puts the ball and each robot
 //! (with short trails), each robot's own world-model estimate of itself and of the ball beside
 //! that overhead truth, the error of each, and the errors over the frames seen so far (for the
-//! plot). The app's field view (`app/field_view.rs`) only draws this.
+//! plot: position, heading, ball and tape-measure errors), each robot's medians, 95th percentiles
+//! and error jumps over them (`crate::wmd::summary`, the rule `eotn wmd` marks jumps by). The
+//! app's field view (`app/field_view.rs`, `app/wmd_errors.rs`) only draws this. The tape
+//! measure finds goals and landmarks in the field description in use ([`FieldModel::set_field`]).
 //!
 //! A world model (`/world_model`, `/world_model/<anything>`; docs/formats.md) names its robot by
 //! the marker it wears; it is compared with the overhead robot reading that marker, else by
@@ -13,7 +16,8 @@ use std::collections::{BTreeMap, VecDeque};
 use super::overhead::RobotKey;
 use crate::model::world_model::{self, is_world_model_topic};
 use crate::overhead::merge::FieldPicture;
-use crate::wmd::{Matched, OverheadRobotPose, OverheadView, Targets};
+use crate::wmd::summary::{RobotSummary, Summaries};
+use crate::wmd::{Comparison, Matched, OverheadRobotPose, OverheadView, Targets};
 
 /// Positions a trail keeps (frames).
 pub const TRAIL_FRAMES: usize = 30;
@@ -48,8 +52,13 @@ pub struct WorldModelView {
 pub struct ErrorSample {
     /// Frame time, seconds since the first frame.
     pub time_s: f64,
+    /// Frame time, nanoseconds since the first frame (the summaries' jumps are at these).
+    pub time_ns: u64,
     /// Per robot: self error and ball error, cm.
     pub errors: Vec<(RobotKey, Option<f64>, Option<f64>)>,
+    /// Every world model of the frame compared: heading errors (signed, degrees) and the tape
+    /// measure of each `seen` measurement among them.
+    pub comparisons: Vec<Comparison>,
 }
 
 /// See the module documentation.
@@ -63,6 +72,14 @@ pub struct FieldModel {
     warned: bool,
     /// SSL-Vision's detections shown beside eotn's: each camera's frame (`workspace/ssl_feed.rs`).
     ssl: Vec<crate::ssl_vision::CameraFrame>,
+    /// Where the goals and landmarks a robot measures stand (the field in use).
+    targets: Targets,
+    /// The summaries gathered over the frames in `errors` up to `gathered_to` (frame index),
+    /// in order: playback adds each new frame; a frame out of order gathers them again.
+    gathered: Summaries,
+    gathered_to: Option<usize>,
+    /// Each robot's summary over the frames seen so far.
+    summaries: Vec<RobotSummary>,
 }
 
 impl FieldModel {
@@ -111,8 +128,9 @@ impl FieldModel {
             .collect();
         let refs: Vec<&world_model::WorldModelMessage> = models.iter().collect();
         let view = overhead_view(detections);
-        self.world_models = crate::wmd::compare(&view, &refs, &Targets::default())
-            .into_iter()
+        let comparisons = crate::wmd::compare(&view, &refs, &self.targets);
+        self.world_models = comparisons
+            .iter()
             .zip(&models)
             .map(|(c, m)| WorldModelView {
                 robot: m.robot,
@@ -131,14 +149,46 @@ impl FieldModel {
                 index,
                 ErrorSample {
                     time_s: time_ns as f64 / 1e9,
+                    time_ns,
                     errors: self
                         .world_models
                         .iter()
                         .map(|m| (m.robot, m.self_error_cm, m.ball_error_cm))
                         .collect(),
+                    comparisons,
                 },
             );
+            self.gather(index);
         }
+    }
+
+    /// Brings the summaries up to frame `index` (just inserted): added on when it follows the
+    /// frames gathered, else all gathered again in frame order.
+    fn gather(&mut self, index: usize) {
+        if self.gathered_to.is_some_and(|g| index <= g) {
+            self.gathered = Summaries::default();
+            self.gathered_to = None;
+        }
+        let from = self.gathered_to.map_or(0, |g| g + 1);
+        for (i, s) in self.errors.range(from..) {
+            for c in &s.comparisons {
+                self.gathered.add(s.time_ns, c);
+            }
+            self.gathered_to = Some(*i);
+        }
+        self.summaries = self.gathered.clone().finish();
+    }
+
+    /// Each robot's medians, 95th percentiles and error jumps over the frames seen so far,
+    /// blue team first, then by identity.
+    #[must_use]
+    pub fn summaries(&self) -> &[RobotSummary] {
+        &self.summaries
+    }
+
+    /// Uses `field`'s goals and landmarks for the tape measure (frames already seen keep theirs).
+    pub fn set_field(&mut self, field: &crate::overhead::FieldDescription) {
+        self.targets = Targets::from_field(field);
     }
 
     /// Each robot's trail, oldest first: (frame index, field position in cm).
@@ -266,6 +316,38 @@ mod tests {
         let w = &m.world_models()[0];
         assert_eq!((w.key, w.self_error_cm), (None, None));
         assert_eq!(m.error_samples().count(), 2);
+    }
+
+    #[test]
+    fn the_tape_measure_uses_the_fields_goals_and_a_jump_is_marked_once() {
+        let field = crate::overhead::FieldDescription::four_legged_2005();
+        let goal = crate::wmd::Targets::from_field(&field)
+            .place(
+                &crate::wmd::SeenObject::YellowGoal,
+                &OverheadView::default(),
+            )
+            .expect("the 2005 field has a yellow goal");
+        let mut m = FieldModel::default();
+        m.set_field(&field);
+        let d = detections([100.0, 0.0], [0.0, 0.0]);
+        let true_cm = (goal[0] - 100.0).hypot(goal[1]);
+        for i in 0..12 {
+            let x = if i == 8 { 400.0 } else { 110.0 };
+            let (topic, mut v) = world_model(5, x, 0.0, 0.0);
+            v["seen"] = serde_json::json!([{"object": "yellow_goal",
+                "distance_cm": true_cm + 20.0, "bearing_rad": 0.0}]);
+            m.observe(i, i as u64 * 1_000_000, Some(&d), &[(topic, v)]);
+        }
+        let s = &m.summaries()[0];
+        let tape = s.distance_cm.expect("measured against the field's goal");
+        assert!((tape.median - 20.0).abs() < 1e-6, "{tape:?}");
+        assert_eq!(s.jumps_ns, [8_000_000]);
+        assert_eq!(s.ball_cm.map(|b| b.n), Some(12));
+        // A frame seen again (a new table): gathered again, the same summary.
+        let before = m.summaries().to_vec();
+        m.observe(3, 3_000_000, Some(&d), &[world_model(5, 110.0, 0.0, 0.0)]);
+        assert_eq!(m.summaries()[0].jumps_ns, before[0].jumps_ns);
+        assert_eq!(m.summaries()[0].world_models, 12);
     }
 
     #[test]

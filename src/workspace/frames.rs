@@ -111,6 +111,9 @@ impl Workspace {
                 Ok(camera) => {
                     offer = Some(s);
                     shown_camera = camera;
+                    if self.source_is_recorded_session() {
+                        self.request_wmd_layout();
+                    }
                 }
                 Err(e) => failures.push(format!("{e:#}")),
             }

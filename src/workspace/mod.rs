@@ -19,8 +19,7 @@
 //! | `robots.rs` | robots over the network, several at once: the list, the shown one, following live, recording each |
 //! | `table.rs` | the table: its commands (open, save, class, sensitivity, selection, commit, undo/redo, journal, try on the stream), places file; one table per camera kind |
 //! | `journal.rs` | the edit journal beside a table: append, replay |
-//! | `try_edit.rs` | [`TryEdit`]: the frames a pending edit would change |
-//! | `stream_scan.rs` | [`StreamScan`]: the whole-stream checks' one loop, a few frames per UI frame |
+//! | `try_edit.rs`, `stream_scan.rs` | [`TryEdit`]: the frames a pending edit would change; [`StreamScan`]: the whole-stream checks' one loop, a few frames per UI frame |
 //! | `coverage.rs`, `cell_origin.rs`, `bookmarks.rs`, `hints.rs` | what is unclassified, who set a cell, events and bookmarks |
 //! | `labels.rs` | [`OpenLabels`]: a boxed label set over the open frames, scored; its missed and false frames as events |
 //! | `params.rs` | recognition parameters: open, tune, reset, save, the set a stream names, [`params::TryParams`] |
@@ -28,7 +27,7 @@
 //! | `overhead.rs` | [`Overhead`]: an overhead source's frames through the overhead pipeline, calibration, picked points, robot selection |
 //! | `cameras.rs` | the camera shown of a recording with several (`Command::OpenCamera`) and each camera's own table |
 //! | `side_by_side.rs` | several cameras side by side, stepped together by time, each with its own table, pipeline and results; the focused one gets the clicks |
-//! | `field_model.rs` | the field view's model: trails, world models beside the overhead truth, errors over time, SSL-Vision's detections by camera |
+//! | `field_model.rs`, `wmd.rs` | the field view's model: trails, world models beside the overhead truth, errors over time and their spreads and jumps, SSL-Vision's detections by camera; the World Model Debugger's robot cameras shown beside the overhead camera, world models on the overhead image, the WMD layout |
 //! | `ssl_feed.rs`, `ssl_out.rs` | [`SslFeed`]: SSL-Vision's detections opened beside the frames (a league log, paired by capture time, or a live address); sending the processed overhead frames' detections as SSL-Vision packets (`OverheadCommand::SendSslVision`, [`ssl_out::SslOutStatus`] for the UI) |
 
 pub mod bookmarks;
@@ -59,6 +58,7 @@ mod table;
 mod timings;
 mod try_edit;
 mod view;
+pub mod wmd;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

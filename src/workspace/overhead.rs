@@ -103,6 +103,8 @@ pub struct Overhead {
     size_warned: Option<((usize, usize), (usize, usize))>,
     /// The SSL-Vision output, while sending (`workspace/ssl_out.rs`).
     pub(super) ssl_out: Option<super::ssl_out::SslOutState>,
+    /// The session's robot cameras and the WMD layout requests (`workspace/wmd.rs`).
+    pub(super) wmd: super::wmd::WmdState,
 }
 
 impl Default for Overhead {
@@ -140,6 +142,7 @@ impl Default for Overhead {
             cameras: FieldCameras::default(),
             size_warned: None,
             ssl_out: None,
+            wmd: super::wmd::WmdState::default(),
         }
     }
 }
@@ -402,11 +405,13 @@ impl Workspace {
         let index = self.index_of_frame(loaded);
         let size = (loaded.frame.width(), loaded.frame.height());
         self.sync_field_cameras(index, loaded.time_ns, size);
+        self.overhead.field_model.set_field(&self.overhead.field);
+        let extra = self.with_session_world_models(loaded);
         self.overhead.field_model.observe(
             index,
             loaded.time_ns,
             self.overhead.cameras.picture(),
-            &loaded.extra,
+            &extra,
         );
         self.send_ssl_out(loaded.time_ns);
         let t = self.overhead.pipeline.timings();
@@ -491,7 +496,9 @@ impl Workspace {
                 if let Some(k) = key {
                     self.status = format!("selected robot {k}");
                 }
+                self.show_selected_robot_camera(key);
             }
+            OverheadCommand::WmdLayout => self.request_wmd_layout(),
             OverheadCommand::SendSslVision(address) => self.set_ssl_out(address)?,
             OverheadCommand::SetView(v) => {
                 self.settings.overhead = v;
@@ -701,6 +708,7 @@ impl Workspace {
         self.overhead.truth = None;
         self.overhead.field_model = FieldModel::default();
         self.overhead.cameras = FieldCameras::default();
+        self.overhead.wmd.forget_session();
     }
 
     /// Where an image point (pixels of the camera's image) is drawn in the views: itself, or

@@ -185,7 +185,11 @@ impl Workspace {
             !all.is_empty(),
             "the source is not a recording or robot: it has no cameras to show side by side"
         );
-        if let Some(c) = wanted.iter().find(|c| !all.contains(c)) {
+        // A session robot's camera may come from its own recording (`wmd.rs`).
+        if let Some(c) = wanted
+            .iter()
+            .find(|c| !all.contains(c) && self.session_robot_files(c).is_none())
+        {
             anyhow::bail!(
                 "camera {} is not in {}: its cameras are {}",
                 c.topic(),
@@ -235,9 +239,16 @@ impl Workspace {
             .as_ref()
             .context("no recording or robot is shown")?;
         let topic = camera.topic();
-        let source = match src.robot_frames() {
-            Some(robot) => Source::robot(robot.camera_view(topic)),
-            None => {
+        let own_recording = match camera {
+            CameraId::Recording { recording, .. } if !src.camera_ids().contains(camera) => {
+                Some(recording.clone())
+            }
+            _ => None,
+        };
+        let source = match (own_recording, src.robot_frames()) {
+            (Some(path), _) => Source::stream_camera(&path, Some(topic))?,
+            (None, Some(robot)) => Source::robot(robot.camera_view(topic)),
+            (None, None) => {
                 let path = src
                     .paths()
                     .into_iter()
@@ -247,7 +258,10 @@ impl Workspace {
             }
         };
         let bits = self.pipeline.lut().bits();
-        let files = self.camera_files(camera);
+        let mut files = self.camera_files(camera);
+        if let Some(session) = self.session_robot_files(camera) {
+            files = files.overridden_by(session);
+        }
         let own = files
             .lut
             .clone()

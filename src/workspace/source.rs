@@ -172,7 +172,15 @@ impl Source {
             return Some(CameraId::live(&r.url().to_string(), topic));
         }
         let path = self.canonical.as_deref()?;
-        Some(match self.info.camera {
+        // The stream's kind, not the shown camera's: a session recording's robot cameras keep
+        // the ids they had while its overhead camera was shown.
+        let kind = match self.info.kind {
+            crate::sources::SourceKind::Stream => {
+                crate::sources::CameraKind::of_stream_source(&self.info.stream_source)
+            }
+            _ => self.info.camera,
+        };
+        Some(match kind {
             crate::sources::CameraKind::Robot => CameraId::recording(path, topic),
             crate::sources::CameraKind::Overhead => {
                 CameraId::overhead(&path.to_string_lossy(), topic)

@@ -26,6 +26,8 @@ mod app_overhead;
 mod app_overhead_tools;
 #[cfg(feature = "gui")]
 mod app_papercuts;
+#[cfg(feature = "gui")]
+mod app_wmd;
 mod beacons;
 mod camera;
 mod cameras;

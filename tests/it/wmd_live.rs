@@ -225,6 +225,12 @@ fn live_robots_are_matched_by_marker_with_their_known_errors_and_their_clocks_sh
     assert!(frames >= 20, "{camera}: {frames} frames; {topics:?}");
     assert_eq!(topics.get(&format!("{camera}/recognition")), Some(&frames));
     assert_eq!(topics.get(&format!("/robot/{}-{}", two.0, two.1)), None);
+    // Its table is named for that camera, so the app reopens it with it.
+    let named = eotn::streams::StreamReader::open_camera(&session, Some(&camera))
+        .unwrap()
+        .camera_files()
+        .unwrap();
+    assert_eq!(named.lut.as_deref(), Some(robot_table.as_path()));
     // The recording replays to the same lines.
     let again = eotn_ok(&[
         OsStr::new("wmd"),

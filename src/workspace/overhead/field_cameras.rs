@@ -405,16 +405,22 @@ impl Workspace {
                 .map(|i| s.time_ns(i))
                 .collect()
         });
+        let period_ns = crate::wmd::clock::frame_period_ns(&times);
         self.overhead.cameras = FieldCameras {
             session: Some(path.to_owned()),
             reference: reference.id,
             reference_name: crate::frame::display_name(recording),
-            period_ns: crate::wmd::clock::frame_period_ns(&times),
+            period_ns,
             others,
             ..FieldCameras::default()
         };
         self.remember_recent(path);
-        self.settings.show_field_view = true;
+        let frames_ns: Vec<u64> = self
+            .source
+            .as_ref()
+            .map_or_else(Vec::new, |s| (0..s.len()).map(|i| s.time_ns(i)).collect());
+        self.set_session_robots(&session.robots, &frames_ns, period_ns);
+        self.request_wmd_layout();
         self.reprocess();
         self.status = format!(
             "opened session {}: {} overhead cameras, camera {} shown",
