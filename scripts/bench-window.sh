@@ -5,7 +5,7 @@
 # (median UI frame time). Then a 1920×1200 overhead stream on OpenGL: played frame by frame, and
 # zoomed, panned and typed into by xdotool (the slowest frame that answered input, and the time
 # from launch to the first frame). Prints the app's own EOTN_STATS lines and tables.
-# ONLY_BIG=1 runs only the 1920×1200 ones; BIG_FRAMES=N sets that stream's length (default 150,
+# ONLY_BIG=1 runs only the 1920×1200 ones, SKIP_BIG=1 all but those; BIG_FRAMES=N sets that stream's length (default 150,
 # 2 s at 75 fps).
 #   scripts/bench-window.sh [SECONDS]      (default 18 s a run: 15 s of stream, start-up)
 # EOTN_PROFILE=dev measures the debug build instead of the release build.
@@ -42,7 +42,7 @@ for renderer in gl wgpu; do
       # shellcheck disable=SC2086
       out=$(DISPLAY=":$n" HOME="$WORK/home" EOTN_STATS=1 "$EOTN" open ${STREAM[$size]} \
               --renderer "$renderer" --play --speed "$speed" --all-overlays \
-              --quit-after "$SECONDS_PER_RUN" 2>&1 >/dev/null | grep 'eotn stats' | tail -1 || true)
+              --quit-after "$SECONDS_PER_RUN" 2>&1 >/dev/null | grep 'eotn stats: steps' | tail -1 || true)
       echo "$out" >> "$WORK/stats.txt"
       median=$(echo "$out" | sed -n 's/.*playing frames [0-9]* median \([0-9.]*\) ms.*/\1/p')
       played=$(echo "$out" | sed -n 's/.*played \([0-9]*\) dropped.*/\1/p')
@@ -54,6 +54,7 @@ for renderer in gl wgpu; do
 done
 fi
 
+[ -n "${SKIP_BIG:-}" ] && { cat "$WORK/stats.txt"; exit 0; }
 # The big overhead stream and the window's answers to the user (issue 33): a 1920×1200 overhead
 # camera (one camera of `eotn overhead sim-field`, 150 frames at 75 fps, its own table) played
 # frame by frame with every overlay; then, not playing, zooming (the wheel over the image),
