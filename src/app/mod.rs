@@ -77,7 +77,7 @@ use crate::app_options::{RendererSetting, RunOptions};
 pub use textures::{
     ViewImages, blend_classes, blend_texel, classes_alpha, palette, preview_image,
     preview_image_every, texture_step, thumbnail_step, view_images, view_images_every,
-    visible_preview_colour,
+    view_images_in, visible_preview_colour, visible_region,
 };
 
 use crate::workspace::{PixelInfo, median};

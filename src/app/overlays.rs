@@ -118,19 +118,27 @@ pub struct FrameTextures {
     /// The class colours already blended over the colour image at the overlay's opacity: drawn
     /// instead of the two layers when there is one.
     pub blended: Option<TextureId>,
+    /// The part of the image (pixels) `raw`, `classified` and `blended` hold, when not all of
+    /// it (a large image zoomed in past 1:1).
+    pub region: Option<Rect>,
 }
 
 /// The view's image layers: the frame, its class colours over it (blended, or two layers), or
 /// the class colours alone on black.
 fn paint_layers(
     painter: &Painter,
-    img: Rect,
+    xf: &ImageTransform,
     kind: ViewKind,
     o: crate::workspace::Overlays,
     tex: &FrameTextures,
     with_overlays: bool,
 ) {
     let uv = Rect::from_min_max(Pos2::ZERO, pos2(1.0, 1.0));
+    // The whole image, or the part of it the layers hold.
+    let whole = xf.image_rect();
+    let img = tex.region.map_or(whole, |r| {
+        Rect::from_min_max(xf.to_screen(r.min), xf.to_screen(r.max))
+    });
     match kind {
         ViewKind::Raw | ViewKind::Objects => {
             let with_classes = o.classified && with_overlays;
@@ -150,7 +158,7 @@ fn paint_layers(
             }
         }
         ViewKind::Classified | ViewKind::Blobs => {
-            painter.rect_filled(img, 0.0, Color32::BLACK);
+            painter.rect_filled(whole, 0.0, Color32::BLACK);
             let tint = if kind == ViewKind::Blobs {
                 Color32::from_gray(110)
             } else {
@@ -177,7 +185,7 @@ pub fn paint_view(
     let img = xf.image_rect();
     let uv = Rect::from_min_max(Pos2::ZERO, pos2(1.0, 1.0));
     let o = state.settings.overlays;
-    paint_layers(&painter, img, kind, o, tex, with_overlays);
+    paint_layers(&painter, xf, kind, o, tex, with_overlays);
     if with_overlays && o.preview && state.selection().is_some() {
         painter.image(tex.preview, img, uv, Color32::WHITE);
     }

@@ -34,6 +34,11 @@ pub(super) struct Textures {
     preview_empty: bool,
     /// Image pixels per texel along each axis ([`texture_step`]).
     step: usize,
+    /// The part of the image the main view's layers hold (columns x0..x1, rows y0..y1), when
+    /// the view is zoomed in past 1:1 on a large image ([`visible_region`]); else all of it.
+    region: Option<[usize; 4]>,
+    /// Counts the images made: what the main view's layers are stamped with.
+    build: u64,
 }
 
 /// One uploaded layer and what it holds: the frame generation, the step and (blended) the
@@ -86,7 +91,7 @@ struct Wanted {
 
 impl Textures {
     fn key(&self, alpha: u8) -> (u64, usize, u8) {
-        (self.frame_generation, self.step, alpha)
+        (self.build, self.step, alpha)
     }
 
     /// The main view's textures: those holding the shown frame at the current step.
@@ -94,13 +99,19 @@ impl Textures {
         // The blended layer at any opacity: after the opacity changes it is blended again at
         // the next frame's start, and one frame at the old opacity is not worth two layers.
         let blended = (self.blended.holds)
-            .filter(|h| (h.0, h.1) == (self.frame_generation, self.step))
+            .filter(|h| (h.0, h.1) == (self.build, self.step))
             .and_then(|h| self.blended.id_if(h));
         FrameTextures {
             raw: self.raw.id_if(self.key(0)),
             classified: self.classified.id_if(self.key(0)),
             preview: self.preview.id(),
             blended,
+            region: self.region.map(|[x0, y0, x1, y1]| {
+                egui::Rect::from_min_max(
+                    egui::pos2(x0 as f32, y0 as f32),
+                    egui::pos2(x1 as f32, y1 as f32),
+                )
+            }),
         }
     }
 
@@ -114,10 +125,12 @@ impl Textures {
                     classified: holding(classified).and_then(|h| classified.id_if(h)),
                     preview: self.preview.id(),
                     blended: None,
+                    region: None,
                 }
             }
             None => FrameTextures {
                 blended: None,
+                region: None,
                 ..self.ids()
             },
         }
@@ -297,6 +310,75 @@ pub fn view_images_every(
     })
 }
 
+/// The colour and class-colour images of `region` (columns x0..x1, rows y0..y1) of the shown
+/// frame at full resolution: what a view zoomed in past 1:1 shows of a large frame.
+#[must_use]
+pub fn view_images_in(
+    state: &Workspace,
+    palette: &[Color32; 256],
+    region: [usize; 4],
+) -> Option<ViewImages> {
+    let frame = state.frame()?;
+    let [x0, y0, x1, y1] = region;
+    let (w, h) = (frame.width(), frame.height());
+    let (x1, y1) = (x1.min(w), y1.min(h));
+    let size = [x1.saturating_sub(x0), y1.saturating_sub(y0)];
+    let raw = frame
+        .rgba_in(x0..x1, y0..y1)
+        .into_iter()
+        .map(|[r, g, b, a]| Color32::from_rgba_premultiplied(r, g, b, a))
+        .collect();
+    let codes = state.view_codes();
+    let mut classified = Vec::with_capacity(size[0] * size[1]);
+    for y in y0..y1 {
+        match codes.get(y * w + x0..y * w + x1) {
+            Some(row) => classified.extend(row.iter().map(|&c| palette[usize::from(c)])),
+            None => classified.resize(classified.len() + size[0], Color32::TRANSPARENT),
+        }
+    }
+    Some(ViewImages {
+        raw: ColorImage::new(size, raw),
+        classified: ColorImage::new(size, classified),
+    })
+}
+
+/// The part of an image of `size` pixels the layers of `view` (zoomed in past 1:1) should
+/// hold: the visible part grown by half its size each way, so that panning rebuilds them only
+/// now and then; `kept`, the part held now, while it still covers what is visible. `None` when
+/// most of the image is visible anyway. Columns start and end even (UYVY pairs).
+#[must_use]
+pub fn visible_region(
+    view: &ImageTransform,
+    size: [usize; 2],
+    kept: Option<[usize; 4]>,
+) -> Option<[usize; 4]> {
+    let (w, h) = (size[0] as f32, size[1] as f32);
+    let a = view.to_image(view.view.min);
+    let b = view.to_image(view.view.max);
+    let (vx0, vy0) = (a.x.clamp(0.0, w), a.y.clamp(0.0, h));
+    let (vx1, vy1) = (b.x.clamp(0.0, w), b.y.clamp(0.0, h));
+    let (vw, vh) = (vx1 - vx0, vy1 - vy0);
+    if !(vw.is_finite() && vh.is_finite()) || vw * vh > 0.4 * w * h {
+        return None;
+    }
+    if let Some([x0, y0, x1, y1]) = kept {
+        let inside = vx0 >= x0 as f32 && vy0 >= y0 as f32 && vx1 <= x1 as f32 && vy1 <= y1 as f32;
+        if inside {
+            return kept;
+        }
+    }
+    let grow = |lo: f32, hi: f32, by: f32, max: f32| {
+        (
+            (lo - by).clamp(0.0, max) as usize,
+            (hi + by).ceil().clamp(0.0, max) as usize,
+        )
+    };
+    let (x0, x1) = grow(vx0, vx1, vw / 2.0, w);
+    let (y0, y1) = grow(vy0, vy1, vh / 2.0, h);
+    let (x0, x1) = (x0 & !1, (x1 + 1).min(size[0]) & !1);
+    Some([x0, y0, x1.max(x0), y1])
+}
+
 /// From this many texels on, the view's images are made on two threads.
 const PARALLEL_TEXELS: usize = 1 << 18;
 
@@ -436,13 +518,20 @@ impl EotnApp {
         ) * ctx.pixels_per_point();
         let step = texture_step(zoom);
         let wanted = self.wanted_layers(step, size[0]);
+        let region = match (&self.last_view, wanted.thumb_step) {
+            // Only where the thumbnails have layers of their own: they show the whole image.
+            (Some(view), Some(_)) if step == 1 && !self.state.undistorted_view() => {
+                visible_region(view, size, self.textures.as_ref().and_then(|t| t.region))
+            }
+            _ => None,
+        };
         let t0 = Instant::now();
         let frame_changed = self
             .textures
             .as_ref()
-            .is_none_or(|t| t.frame_generation != fg || t.step != step);
+            .is_none_or(|t| t.frame_generation != fg || t.step != step || t.region != region);
         if frame_changed {
-            self.make_images(ctx, step, wanted.thumb_step);
+            self.make_images(ctx, step, wanted.thumb_step, region);
         }
         let empty = self.state.selection().is_none();
         if let Some(t) = &mut self.textures {
@@ -479,12 +568,20 @@ impl EotnApp {
         }
     }
 
-    /// Makes the shown frame's colour and class-colour images at `step` (uploaded later, as
-    /// wanted), and the thumbnails' own layers at `thumb_step`.
-    fn make_images(&mut self, ctx: &egui::Context, step: usize, thumb_step: Option<usize>) {
-        let Some(ViewImages { raw, classified }) =
-            view_images_every(&self.state, &self.palette, step)
-        else {
+    /// Makes the shown frame's colour and class-colour images at `step`, or of `region` only
+    /// (uploaded later, as wanted), and the thumbnails' own layers at `thumb_step`.
+    fn make_images(
+        &mut self,
+        ctx: &egui::Context,
+        step: usize,
+        thumb_step: Option<usize>,
+        region: Option<[usize; 4]>,
+    ) {
+        let images = match region {
+            Some(r) => view_images_in(&self.state, &self.palette, r),
+            None => view_images_every(&self.state, &self.palette, step),
+        };
+        let Some(ViewImages { raw, classified }) = images else {
             return;
         };
         let fg = self.state.frame_generation();
@@ -501,6 +598,8 @@ impl EotnApp {
                 t.step = step;
                 t.images = images;
                 t.frame_generation = fg;
+                t.region = region;
+                t.build += 1;
                 t.upload_thumbs(ctx, thumbs);
             }
             None => {
@@ -520,6 +619,8 @@ impl EotnApp {
                     preview_generation: self.state.preview_generation(),
                     preview_empty: self.state.selection().is_none(),
                     step,
+                    region,
+                    build: 0,
                 });
                 if let Some(t) = &mut self.textures {
                     t.upload_thumbs(ctx, thumbs);

@@ -407,6 +407,53 @@ impl Frame {
         out
     }
 
+    /// The RGB ([`yuv_to_rgb`]) of the pixels in columns `cols` and rows `rows` (each clamped to
+    /// the frame), with an opaque alpha, in raster order: what a view zoomed in past 1:1 shows
+    /// of a large frame, converted without the rest. Give UYVY frames an even start and width
+    /// (a pixel pair shares its chroma); an odd last column is left black.
+    #[must_use]
+    pub fn rgba_in(
+        &self,
+        cols: std::ops::Range<usize>,
+        rows: std::ops::Range<usize>,
+    ) -> Vec<[u8; 4]> {
+        let (w, n) = (self.width, self.pixel_count());
+        let (x0, x1) = (cols.start.min(w), cols.end.min(w));
+        let (y0, y1) = (rows.start.min(self.height), rows.end.min(self.height));
+        let tw = x1.saturating_sub(x0);
+        let mut out = vec![[0, 0, 0, 255]; tw * y1.saturating_sub(y0)];
+        if tw == 0 {
+            return out;
+        }
+        let rgba = |p: Yuv| {
+            let [r, g, b] = yuv_to_rgb(p);
+            [r, g, b, 255]
+        };
+        for (o, y) in out.chunks_exact_mut(tw).zip(y0..y1) {
+            match self.layout {
+                PixelLayout::Uyvy => {
+                    let row = &self.data[(y * w + x0) * 2..(y * w + x1) * 2];
+                    uyvy_row_every(row, 1, o);
+                }
+                PixelLayout::Yuv444Packed => {
+                    let row = &self.data[(y * w + x0) * 3..(y * w + x1) * 3];
+                    for (o, p) in o.iter_mut().zip(row.chunks_exact(3)) {
+                        *o = rgba(Yuv::new(p[0], p[1], p[2]));
+                    }
+                }
+                PixelLayout::Yuv444Planar => {
+                    let at =
+                        |plane: usize| &self.data[plane * n + y * w + x0..plane * n + y * w + x1];
+                    let (ys, us, vs) = (at(0), at(1), at(2));
+                    for (((o, &l), &u), &v) in o.iter_mut().zip(ys).zip(us).zip(vs) {
+                        *o = rgba(Yuv::new(l, u, v));
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// The frame as packed 8-bit RGB; see [`Frame::to_rgb_into`].
     #[must_use]
     pub fn to_rgb(&self) -> Vec<u8> {
@@ -583,6 +630,42 @@ mod tests {
                     })
                     .collect();
                 assert_eq!(got, want, "{:?} step {step}", f.layout());
+            }
+        }
+    }
+
+    #[test]
+    fn rgba_in_is_the_frames_part_in_every_layout() {
+        let yuv = |x: usize, y: usize| {
+            Yuv::new(
+                u8::try_from(16 + (x * 11 + y * 5) % 220).unwrap_or(0),
+                u8::try_from((x * 37 + y * 3) % 256).unwrap_or(0),
+                u8::try_from((x * 3 + y * 41) % 256).unwrap_or(0),
+            )
+        };
+        let (w, h) = (12, 6);
+        let packed = Frame::yuv444_from_fn(w, h, yuv).unwrap();
+        let mut planar = vec![0; w * h * 3];
+        packed.for_each_pixel(|x, y, p| {
+            let i = y * w + x;
+            (planar[i], planar[w * h + i], planar[2 * w * h + i]) = (p.y, p.u, p.v);
+        });
+        let frames = [
+            Frame::uyvy_from_fn(w, h, yuv).unwrap(),
+            packed,
+            Frame::new(w, h, PixelLayout::Yuv444Planar, planar).unwrap(),
+        ];
+        for f in frames {
+            for (cols, rows) in [(2..8, 1..4), (0..12, 0..6), (4..40, 5..9), (6..6, 0..6)] {
+                let got = f.rgba_in(cols.clone(), rows.clone());
+                let want: Vec<[u8; 4]> = (rows.start..rows.end.min(h))
+                    .flat_map(|y| (cols.start..cols.end.min(w)).map(move |x| (x, y)))
+                    .map(|(x, y)| {
+                        let [r, g, b] = yuv_to_rgb(f.pixel(x, y).unwrap());
+                        [r, g, b, 255]
+                    })
+                    .collect();
+                assert_eq!(got, want, "{:?} {cols:?} {rows:?}", f.layout());
             }
         }
     }

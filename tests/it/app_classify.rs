@@ -198,6 +198,61 @@ fn large_views_made_on_two_threads_hold_every_pixel_in_its_place() {
     }
 }
 
+/// Zoomed in past 1:1 on a large image, the layers hold the visible part grown by half its size
+/// each way (even columns), keep it while panning stays inside, and hold the whole image again
+/// once most of it is visible; the part's images are the frame's pixels there.
+#[test]
+fn zoomed_in_layers_hold_the_visible_part_and_keep_it_while_it_covers_the_view() {
+    use eotn::app::overlays::ImageTransform;
+    use eotn::app::{palette, view_images_in, visible_region};
+    let view = egui::Rect::from_min_size(egui::pos2(0.0, 0.0), egui::vec2(400.0, 300.0));
+    let at = |zoom: f32, cx: f32, cy: f32| ImageTransform {
+        view,
+        zoom,
+        centre: egui::pos2(cx, cy),
+        size: [1920.0, 1200.0],
+    };
+    // 200×150 image pixels visible around (960, 600), grown by 100×75 each way.
+    let r = visible_region(&at(2.0, 960.0, 600.0), [1920, 1200], None).unwrap();
+    assert_eq!(r, [760, 450, 1160, 750]);
+    // A small pan stays inside: kept. A large one leaves it: a new part around the view.
+    assert_eq!(
+        visible_region(&at(2.0, 1000.0, 620.0), [1920, 1200], Some(r)),
+        Some(r)
+    );
+    let moved = visible_region(&at(2.0, 1500.0, 600.0), [1920, 1200], Some(r)).unwrap();
+    assert_eq!(moved, [1300, 450, 1700, 750]);
+    // Near the edge the part is cut at the image; most of the image visible: the whole image.
+    let edge = visible_region(&at(2.0, 50.0, 50.0), [1920, 1200], None).unwrap();
+    assert_eq!(edge[..2], [0, 0]);
+    assert_eq!(
+        visible_region(&at(0.3, 960.0, 600.0), [1920, 1200], None),
+        None
+    );
+    // The part's images: the frame's pixels and class colours there.
+    let dir = tempfile::tempdir().unwrap();
+    let (frame, table) = one_frame(dir.path());
+    let mut w = Workspace::default();
+    w.apply(Command::Open(vec![frame, table])).unwrap();
+    let p = palette();
+    let part = view_images_in(&w, &p, [40, 30, 120, 90]).unwrap();
+    assert_eq!(part.raw.size, [80, 60]);
+    let f = w.frame().unwrap();
+    let codes = w.classified().codes();
+    for (i, (&raw, &class)) in part
+        .raw
+        .pixels
+        .iter()
+        .zip(&part.classified.pixels)
+        .enumerate()
+    {
+        let (x, y) = (40 + i % 80, 30 + i / 80);
+        let [r, g, b] = eotn::frame::yuv_to_rgb(f.pixel(x, y).unwrap());
+        assert_eq!(raw, egui::Color32::from_rgb(r, g, b), "({x}, {y})");
+        assert_eq!(class, p[usize::from(codes[y * 208 + x])], "({x}, {y})");
+    }
+}
+
 /// Thumbnails keep at least 320 texels across, their own layers when that is coarser than
 /// the main view's.
 #[test]
