@@ -31,6 +31,7 @@ pub use io::{
 pub use pixel_box::{CutOff, PixelBox};
 
 use serde::{Deserialize, Serialize};
+use std::ops::Range;
 use thiserror::Error;
 
 /// Width × height of the AIBO ERS-7 head camera, pixels.
@@ -374,37 +375,7 @@ impl Frame {
     /// 1920×1200 frame at a step of 2 took 5 ms as a call per pixel (docs/speed.md).
     #[must_use]
     pub fn rgba_every(&self, step: usize) -> Vec<[u8; 4]> {
-        let step = step.max(1);
-        let (w, h) = (self.width, self.height);
-        let tw = w.div_ceil(step);
-        let mut out = vec![[0, 0, 0, 255]; tw * h.div_ceil(step)];
-        let rgba = |p: Yuv| {
-            let [r, g, b] = yuv_to_rgb(p);
-            [r, g, b, 255]
-        };
-        let n = self.pixel_count();
-        for (o, y) in out.chunks_exact_mut(tw).zip((0..h).step_by(step)) {
-            match self.layout {
-                PixelLayout::Uyvy => {
-                    let row = &self.data[y * w * 2..(y + 1) * w * 2];
-                    uyvy_row_every(row, step, o);
-                }
-                PixelLayout::Yuv444Packed => {
-                    let row = &self.data[y * w * 3..(y + 1) * w * 3];
-                    for (o, p) in o.iter_mut().zip(row.chunks_exact(3).step_by(step)) {
-                        *o = rgba(Yuv::new(p[0], p[1], p[2]));
-                    }
-                }
-                PixelLayout::Yuv444Planar => {
-                    let at = |plane: usize| &self.data[plane * n + y * w..plane * n + (y + 1) * w];
-                    let (ys, us, vs) = (at(0), at(1), at(2));
-                    for (o, x) in o.iter_mut().zip((0..w).step_by(step)) {
-                        *o = rgba(Yuv::new(ys[x], us[x], vs[x]));
-                    }
-                }
-            }
-        }
-        out
+        self.rgba_part(step, 0..self.width, 0..self.height)
     }
 
     /// The RGB ([`yuv_to_rgb`]) of the pixels in columns `cols` and rows `rows` (each clamped to
@@ -412,16 +383,18 @@ impl Frame {
     /// of a large frame, converted without the rest. Give UYVY frames an even start and width
     /// (a pixel pair shares its chroma); an odd last column is left black.
     #[must_use]
-    pub fn rgba_in(
-        &self,
-        cols: std::ops::Range<usize>,
-        rows: std::ops::Range<usize>,
-    ) -> Vec<[u8; 4]> {
-        let (w, n) = (self.width, self.pixel_count());
+    pub fn rgba_in(&self, cols: Range<usize>, rows: Range<usize>) -> Vec<[u8; 4]> {
+        self.rgba_part(1, cols, rows)
+    }
+
+    /// The pixels of `cols` × `rows` (clamped to the frame) at `step` (0 counts as 1): what
+    /// [`Frame::rgba_every`] and [`Frame::rgba_in`] hand out.
+    fn rgba_part(&self, step: usize, cols: Range<usize>, rows: Range<usize>) -> Vec<[u8; 4]> {
+        let (step, w, n) = (step.max(1), self.width, self.pixel_count());
         let (x0, x1) = (cols.start.min(w), cols.end.min(w));
         let (y0, y1) = (rows.start.min(self.height), rows.end.min(self.height));
-        let tw = x1.saturating_sub(x0);
-        let mut out = vec![[0, 0, 0, 255]; tw * y1.saturating_sub(y0)];
+        let tw = x1.saturating_sub(x0).div_ceil(step);
+        let mut out = vec![[0, 0, 0, 255]; tw * y1.saturating_sub(y0).div_ceil(step)];
         if tw == 0 {
             return out;
         }
@@ -429,24 +402,21 @@ impl Frame {
             let [r, g, b] = yuv_to_rgb(p);
             [r, g, b, 255]
         };
-        for (o, y) in out.chunks_exact_mut(tw).zip(y0..y1) {
+        for (o, y) in out.chunks_exact_mut(tw).zip((y0..y1).step_by(step)) {
+            let (start, end) = (y * w + x0, y * w + x1);
             match self.layout {
-                PixelLayout::Uyvy => {
-                    let row = &self.data[(y * w + x0) * 2..(y * w + x1) * 2];
-                    uyvy_row_every(row, 1, o);
-                }
+                PixelLayout::Uyvy => uyvy_row_every(&self.data[start * 2..end * 2], step, o),
                 PixelLayout::Yuv444Packed => {
-                    let row = &self.data[(y * w + x0) * 3..(y * w + x1) * 3];
-                    for (o, p) in o.iter_mut().zip(row.chunks_exact(3)) {
+                    let row = &self.data[start * 3..end * 3];
+                    for (o, p) in o.iter_mut().zip(row.chunks_exact(3).step_by(step)) {
                         *o = rgba(Yuv::new(p[0], p[1], p[2]));
                     }
                 }
                 PixelLayout::Yuv444Planar => {
-                    let at =
-                        |plane: usize| &self.data[plane * n + y * w + x0..plane * n + y * w + x1];
+                    let at = |plane: usize| &self.data[plane * n + start..plane * n + end];
                     let (ys, us, vs) = (at(0), at(1), at(2));
-                    for (((o, &l), &u), &v) in o.iter_mut().zip(ys).zip(us).zip(vs) {
-                        *o = rgba(Yuv::new(l, u, v));
+                    for (o, i) in o.iter_mut().zip((0..end - start).step_by(step)) {
+                        *o = rgba(Yuv::new(ys[i], us[i], vs[i]));
                     }
                 }
             }
@@ -596,8 +566,8 @@ mod tests {
         }
     }
 
-    #[test]
-    fn rgba_every_step_is_the_top_left_pixel_of_each_block_in_every_layout() {
+    /// A `w`×`h` frame of a varied pattern in each of the three layouts.
+    fn in_every_layout(w: usize, h: usize) -> [Frame; 3] {
         let yuv = |x: usize, y: usize| {
             Yuv::new(
                 u8::try_from(16 + (x * 13 + y * 7) % 220).unwrap_or(0),
@@ -605,66 +575,51 @@ mod tests {
                 u8::try_from((x * 5 + y * 29) % 256).unwrap_or(0),
             )
         };
-        let (w, h) = (10, 7);
         let packed = Frame::yuv444_from_fn(w, h, yuv).unwrap();
         let mut planar = vec![0; w * h * 3];
         packed.for_each_pixel(|x, y, p| {
             let i = y * w + x;
             (planar[i], planar[w * h + i], planar[2 * w * h + i]) = (p.y, p.u, p.v);
         });
-        let frames = [
+        [
             Frame::uyvy_from_fn(w, h, yuv).unwrap(),
             packed,
             Frame::new(w, h, PixelLayout::Yuv444Planar, planar).unwrap(),
-        ];
-        for f in frames {
+        ]
+    }
+
+    /// The opaque RGB of pixel (x, y), one pixel at a time.
+    fn rgba_at(f: &Frame, x: usize, y: usize) -> [u8; 4] {
+        let [r, g, b] = yuv_to_rgb(f.pixel(x, y).unwrap());
+        [r, g, b, 255]
+    }
+
+    #[test]
+    fn rgba_every_step_is_the_top_left_pixel_of_each_block_in_every_layout() {
+        let (w, h) = (10, 7);
+        for f in in_every_layout(w, h) {
             for step in 0..=5 {
-                let got = f.rgba_every(step);
                 let s = step.max(1);
                 let want: Vec<[u8; 4]> = (0..h)
                     .step_by(s)
                     .flat_map(|y| (0..w).step_by(s).map(move |x| (x, y)))
-                    .map(|(x, y)| {
-                        let [r, g, b] = yuv_to_rgb(f.pixel(x, y).unwrap());
-                        [r, g, b, 255]
-                    })
+                    .map(|(x, y)| rgba_at(&f, x, y))
                     .collect();
-                assert_eq!(got, want, "{:?} step {step}", f.layout());
+                assert_eq!(f.rgba_every(step), want, "{:?} step {step}", f.layout());
             }
         }
     }
 
     #[test]
     fn rgba_in_is_the_frames_part_in_every_layout() {
-        let yuv = |x: usize, y: usize| {
-            Yuv::new(
-                u8::try_from(16 + (x * 11 + y * 5) % 220).unwrap_or(0),
-                u8::try_from((x * 37 + y * 3) % 256).unwrap_or(0),
-                u8::try_from((x * 3 + y * 41) % 256).unwrap_or(0),
-            )
-        };
         let (w, h) = (12, 6);
-        let packed = Frame::yuv444_from_fn(w, h, yuv).unwrap();
-        let mut planar = vec![0; w * h * 3];
-        packed.for_each_pixel(|x, y, p| {
-            let i = y * w + x;
-            (planar[i], planar[w * h + i], planar[2 * w * h + i]) = (p.y, p.u, p.v);
-        });
-        let frames = [
-            Frame::uyvy_from_fn(w, h, yuv).unwrap(),
-            packed,
-            Frame::new(w, h, PixelLayout::Yuv444Planar, planar).unwrap(),
-        ];
-        for f in frames {
+        for f in in_every_layout(w, h) {
             for (cols, rows) in [(2..8, 1..4), (0..12, 0..6), (4..40, 5..9), (6..6, 0..6)] {
-                let got = f.rgba_in(cols.clone(), rows.clone());
                 let want: Vec<[u8; 4]> = (rows.start..rows.end.min(h))
                     .flat_map(|y| (cols.start..cols.end.min(w)).map(move |x| (x, y)))
-                    .map(|(x, y)| {
-                        let [r, g, b] = yuv_to_rgb(f.pixel(x, y).unwrap());
-                        [r, g, b, 255]
-                    })
+                    .map(|(x, y)| rgba_at(&f, x, y))
                     .collect();
+                let got = f.rgba_in(cols.clone(), rows.clone());
                 assert_eq!(got, want, "{:?} {cols:?} {rows:?}", f.layout());
             }
         }
